@@ -1,0 +1,33 @@
+#pragma once
+// Errors raised at the boundary: configuration and parameters that are refused
+// before they can reach a model or the actuator. Inside the per-sample loop
+// nothing throws; a status value leads to a safe state instead.
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace hystloop {
+
+// A parameter or configuration value that was refused. `field()` names it
+// (e.g. "c3", "mem.c3", "bridge.u_max_V") so the user can find it in the file.
+class ParameterError : public std::invalid_argument {
+ public:
+  ParameterError(std::string field, const std::string& reason)
+      : std::invalid_argument(field + ": " + reason), field_(std::move(field)) {}
+  const std::string& field() const noexcept { return field_; }
+
+ private:
+  std::string field_;
+};
+
+// Throws ParameterError unless `value` is finite.
+void require_finite(std::string_view field, double value);
+// Throws ParameterError unless `value` is finite and > 0.
+void require_positive(std::string_view field, double value);
+// Throws ParameterError unless `value` is finite and >= 0.
+void require_non_negative(std::string_view field, double value);
+// Throws ParameterError unless lo <= value <= hi (and finite).
+void require_in_range(std::string_view field, double value, double lo, double hi);
+
+}  // namespace hystloop
