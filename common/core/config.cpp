@@ -1,0 +1,312 @@
+#include "core/config.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+
+#include "core/config_impl.hpp"
+
+namespace hystloop {
+namespace {
+
+const std::string kOverrideSource = "--set";
+
+std::string compose(const std::string& source, const std::string& field, const std::string& reason) {
+  return field.empty() ? source + ": " + reason : source + ": " + field + ": " + reason;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// How a node that was not what we wanted looks, for "expected X, got Y".
+std::string describe(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar: return "'" + node.Scalar() + "'";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a map";
+    default: return "no value";
+  }
+}
+
+// Walks `parts` from `node`; nullopt when a key is absent (or its parent is an
+// empty section). Recursion, because assigning a YAML::Node would rewrite the tree.
+std::optional<YAML::Node> find_node(const Config& cfg, const YAML::Node& node,
+                                    const std::vector<std::string>& parts, std::size_t i,
+                                    std::string& walked) {
+  if (i == parts.size()) return node;
+  if (node.IsNull()) return std::nullopt;
+  if (!node.IsMap()) cfg.fail(walked, "expected a map, got " + describe(node));
+  const YAML::Node child = node[parts[i]];
+  if (!child.IsDefined()) return std::nullopt;
+  walked += walked.empty() ? parts[i] : "." + parts[i];
+  return find_node(cfg, child, parts, i + 1, walked);
+}
+
+void set_node(YAML::Node node, const std::vector<std::string>& parts,
+              std::size_t i, const YAML::Node& value, std::string& walked) {
+  if (!node.IsMap()) {
+    if (!node.IsDefined() || node.IsNull()) {
+      node = YAML::Node(YAML::NodeType::Map);  // assigns into the tree: creates the section
+    } else {
+      throw ConfigError(kOverrideSource, walked,
+                        "cannot set a key inside it: it is " + describe(node) + ", not a map");
+    }
+  }
+  walked += walked.empty() ? parts[i] : "." + parts[i];
+  YAML::Node child = node[parts[i]];
+  if (i + 1 == parts.size()) {
+    child = value;
+  } else {
+    set_node(child, parts, i + 1, value, walked);
+  }
+}
+
+void require_valid_path(const Config& cfg, std::string_view path, const std::vector<std::string>& parts) {
+  for (const auto& p : parts) {
+    if (p.empty()) cfg.fail(path, "malformed key (empty part between dots)");
+  }
+}
+
+template <class T>
+T convert_scalar(const Config& cfg, const YAML::Node& node, const std::string& field) {
+  if constexpr (std::is_same_v<T, std::string>) {
+    if (!node.IsScalar()) cfg.fail(field, "expected a string, got " + describe(node));
+    return node.Scalar();
+  } else {
+    const char* expected = std::is_same_v<T, bool>     ? "expected true or false"
+                           : std::is_same_v<T, double> ? "expected a number"
+                                                       : "expected an integer";
+    T value{};
+    if (!node.IsScalar() || !YAML::convert<T>::decode(node, value)) {
+      cfg.fail(field, std::string(expected) + ", got " + describe(node));
+    }
+    if constexpr (std::is_same_v<T, double>) {
+      if (!std::isfinite(value)) cfg.fail(field, "must be a finite number (got " + node.Scalar() + ")");
+    }
+    return value;
+  }
+}
+
+template <class T>
+T convert_value(const Config& cfg, const YAML::Node& node, const std::string& field) {
+  if constexpr (std::is_same_v<T, std::vector<double>> || std::is_same_v<T, std::vector<std::string>>) {
+    if (!node.IsSequence()) cfg.fail(field, "expected a list, got " + describe(node));
+    T out;
+    out.reserve(node.size());
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      out.push_back(convert_scalar<typename T::value_type>(cfg, node[i],
+                                                            field + "[" + std::to_string(i) + "]"));
+    }
+    return out;
+  } else {
+    return convert_scalar<T>(cfg, node, field);
+  }
+}
+
+// ParameterError's what() is "field: reason"; ConfigError wants the reason alone.
+std::string reason_of(const ParameterError& e) {
+  const std::string what = e.what();
+  const std::string prefix = e.field() + ": ";
+  return what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what;
+}
+
+}  // namespace
+
+ConfigError::ConfigError(std::string source, std::string field, const std::string& reason)
+    : ParameterError(std::move(field), reason),
+      source_(std::move(source)),
+      reason_(reason),
+      message_(compose(source_, this->field(), reason_)) {}
+
+const std::string& Config::Impl::source_for(std::string_view path) const {
+  for (const auto& key : overridden) {
+    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key &&
+                        path[key.size()] == '.')) {
+      return kOverrideSource;
+    }
+  }
+  return source;
+}
+
+std::vector<std::string> split_config_path(std::string_view path) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', start);
+    parts.emplace_back(path.substr(start, dot == std::string_view::npos ? dot : dot - start));
+    if (dot == std::string_view::npos) return parts;
+    start = dot + 1;
+  }
+}
+
+Config::Config() : impl_(std::make_unique<Impl>()) {}
+Config::Config(const Config& other) : impl_(std::make_unique<Impl>(*other.impl_)) {
+  impl_->root.reset(YAML::Clone(other.impl_->root));  // reset(): `=` would write into `other`
+}
+Config& Config::operator=(const Config& other) {
+  if (this != &other) *this = Config(other);
+  return *this;
+}
+Config::Config(Config&&) noexcept = default;
+Config& Config::operator=(Config&&) noexcept = default;
+Config::~Config() = default;
+
+Config Config::from_string(std::string_view yaml_text, std::string source_name) {
+  Config cfg;
+  cfg.impl_->source = std::move(source_name);
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(cfg.impl_->source, "",
+                      "line " + std::to_string(e.mark.line + 1) + ", column " +
+                          std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (root.IsNull() || !root.IsDefined()) return cfg;  // empty file: empty map
+  if (!root.IsMap()) {
+    throw ConfigError(cfg.impl_->source, "", "the top level must be a map of keys, got " + describe(root));
+  }
+  cfg.impl_->root.reset(root);
+  return cfg;
+}
+
+Config Config::load_file(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::FILE* f = std::fopen(name.c_str(), "rb");
+  if (f == nullptr) throw ConfigError(name, "", "cannot open file");
+  std::string text;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw ConfigError(name, "", "cannot read file");
+  return from_string(text, name);
+}
+
+const std::string& Config::source() const noexcept { return impl_->source; }
+
+void Config::fail(std::string_view path, const std::string& reason) const {
+  throw ConfigError(impl_->source_for(path), std::string(path), reason);
+}
+
+bool Config::has(std::string_view path) const {
+  const auto parts = split_config_path(path);
+  require_valid_path(*this, path, parts);
+  std::string walked;
+  return find_node(*this, impl_->root, parts, 0, walked).has_value();
+}
+
+template <ConfigValue T>
+T Config::get(std::string_view path, const T& default_value) const {
+  const auto parts = split_config_path(path);
+  require_valid_path(*this, path, parts);
+  std::string walked;
+  const auto node = find_node(*this, impl_->root, parts, 0, walked);
+  if (!node) return default_value;
+  const std::string field(path);
+  if constexpr (std::is_same_v<T, int>) {
+    const auto wide = convert_value<std::int64_t>(*this, *node, field);
+    if (wide < std::numeric_limits<int>::min() || wide > std::numeric_limits<int>::max()) {
+      fail(path, "out of range for an int (got " + std::to_string(wide) + ")");
+    }
+    return static_cast<int>(wide);
+  } else {
+    return convert_value<T>(*this, *node, field);
+  }
+}
+
+template <ConfigValue T>
+T Config::get(std::string_view path) const {
+  if (!has(path)) fail(path, "required but missing");
+  return get<T>(path, T{});
+}
+
+double Config::get_in_range(std::string_view path, double default_value, double lo, double hi) const {
+  const double v = get<double>(path, default_value);
+  if (!(v >= lo && v <= hi)) {
+    fail(path, "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")");
+  }
+  return v;
+}
+
+double Config::get_positive(std::string_view path, double default_value) const {
+  const double v = get<double>(path, default_value);
+  try {
+    require_positive(path, v);
+  } catch (const ParameterError& e) {
+    fail(path, reason_of(e));
+  }
+  return v;
+}
+
+double Config::get_non_negative(std::string_view path, double default_value) const {
+  const double v = get<double>(path, default_value);
+  try {
+    require_non_negative(path, v);
+  } catch (const ParameterError& e) {
+    fail(path, reason_of(e));
+  }
+  return v;
+}
+
+std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t default_value,
+                                      std::int64_t lo, std::int64_t hi) const {
+  const auto v = get<std::int64_t>(path, default_value);
+  if (v < lo || v > hi) {
+    fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " +
+                   std::to_string(v) + ")");
+  }
+  return v;
+}
+
+void Config::apply_override(std::string_view assignment) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string_view::npos || eq == 0) {
+    throw ConfigError(kOverrideSource, "",
+                      "expected key=value, got '" + std::string(assignment) + "'");
+  }
+  const std::string key(assignment.substr(0, eq));
+  const std::string text(assignment.substr(eq + 1));
+  const auto parts = split_config_path(key);
+  for (const auto& p : parts) {
+    if (p.empty()) throw ConfigError(kOverrideSource, key, "malformed key (empty part between dots)");
+  }
+  YAML::Node value;
+  try {
+    value = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(kOverrideSource, key, "cannot parse value '" + text + "': " + e.msg);
+  }
+  std::string walked;
+  set_node(impl_->root, parts, 0, value, walked);
+  impl_->overridden.push_back(key);
+}
+
+void Config::apply_overrides(const std::vector<std::string>& assignments) {
+  for (const auto& a : assignments) apply_override(a);
+}
+
+std::string Config::dump() const {
+  YAML::Emitter out;
+  out << impl_->root;
+  return out.c_str();
+}
+
+#define HYSTLOOP_CONFIG_INSTANTIATE(T)                                \
+  template T Config::get<T>(std::string_view, const T&) const; \
+  template T Config::get<T>(std::string_view) const;
+HYSTLOOP_CONFIG_INSTANTIATE(bool)
+HYSTLOOP_CONFIG_INSTANTIATE(int)
+HYSTLOOP_CONFIG_INSTANTIATE(std::int64_t)
+HYSTLOOP_CONFIG_INSTANTIATE(double)
+HYSTLOOP_CONFIG_INSTANTIATE(std::string)
+HYSTLOOP_CONFIG_INSTANTIATE(std::vector<double>)
+HYSTLOOP_CONFIG_INSTANTIATE(std::vector<std::string>)
+#undef HYSTLOOP_CONFIG_INSTANTIATE
+
+}  // namespace hystloop
