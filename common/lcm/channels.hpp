@@ -1,0 +1,61 @@
+#pragma once
+// Channel names of one rig. Every channel starts with the rig's prefix (default "HX_"),
+// so two rigs on one network never mix. LCM treats a subscribed channel as a regular
+// expression, so the prefix is restricted to [A-Z0-9_]: a name is then matched literally.
+
+#include <array>
+#include <string>
+#include <string_view>
+
+namespace hystloop {
+
+inline constexpr std::string_view kDefaultRigPrefix = "HX_";
+
+// Throws ParameterError("rig.prefix", ...) unless `prefix` is 1..32 characters of
+// [A-Z0-9_], starts with a letter and ends with '_'.
+void validate_rig_prefix(std::string_view prefix);
+
+// The six channels of DESIGN.md, by suffix.
+inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_sample_t, 10 kHz
+inline constexpr std::string_view kCommandSuffix = "COMMAND";        // actuator_command_t, 10 kHz
+inline constexpr std::string_view kTrajectorySuffix = "TRAJECTORY";  // trajectory_t, on change
+inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_params_t, on refit
+inline constexpr std::string_view kStatusSuffix = "STATUS";          // service_status_t, 1 Hz per process
+inline constexpr std::string_view kControlSuffix = "CONTROL";        // control_t, on demand
+
+// Suffix and LCM type name ("hystloop.sensor_sample_t") of every channel, e.g. for a
+// logger that records them all or a tool that lists them.
+struct ChannelSpec {
+  std::string_view suffix;
+  std::string_view type_name;
+};
+inline constexpr std::array<ChannelSpec, 6> kChannelSpecs{{
+    {kSensorSuffix, "hystloop.sensor_sample_t"},
+    {kCommandSuffix, "hystloop.actuator_command_t"},
+    {kTrajectorySuffix, "hystloop.trajectory_t"},
+    {kParamsSuffix, "hystloop.mem_params_t"},
+    {kStatusSuffix, "hystloop.service_status_t"},
+    {kControlSuffix, "hystloop.control_t"},
+}};
+
+// The full names for one prefix, built once (publishing then never builds a string).
+struct ChannelNames {
+  std::string prefix;
+  std::string sensor;
+  std::string command;
+  std::string trajectory;
+  std::string params;
+  std::string status;
+  std::string control;
+
+  // Validates the prefix (throws ParameterError naming "rig.prefix").
+  explicit ChannelNames(std::string_view rig_prefix = kDefaultRigPrefix);
+
+  // Regular expression matching every channel of this rig (and no other rig's): "HX_.*".
+  std::string all_channels_regex() const { return prefix + ".*"; }
+};
+
+// One channel's full name: prefix + suffix, the prefix validated.
+std::string channel_name(std::string_view rig_prefix, std::string_view suffix);
+
+}  // namespace hystloop

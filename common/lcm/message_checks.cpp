@@ -1,0 +1,142 @@
+#include "lcm/message_checks.hpp"
+
+#include <cmath>
+#include <cstddef>
+
+namespace hystloop {
+namespace {
+
+// Collects the findings of one message: any non-finite value outranks a range failure.
+class Findings {
+ public:
+  void require(bool ok) noexcept { out_of_range_ |= !ok; }
+  void finite(double v) noexcept { non_finite_ |= !std::isfinite(v); }
+  // NaN is a documented sentinel ("none"); an infinity never is.
+  void finite_or_nan(double v) noexcept { non_finite_ |= std::isinf(v); }
+  void within(double v, double lo, double hi) noexcept {
+    finite(v);
+    require(!std::isfinite(v) || (v >= lo && v <= hi));
+  }
+  void nan_or_within(double v, double lo, double hi) noexcept {
+    finite_or_nan(v);
+    require(!std::isfinite(v) || (v >= lo && v <= hi));
+  }
+  Verdict verdict() const noexcept {
+    if (non_finite_) return Verdict::kNonFinite;
+    return out_of_range_ ? Verdict::kOutOfRange : Verdict::kOk;
+  }
+
+ private:
+  bool non_finite_ = false;
+  bool out_of_range_ = false;
+};
+
+constexpr double kHuge = 1.0e300;  // "any finite value"
+
+bool is_command_mode(std::int8_t mode) noexcept {
+  return mode >= actuator_command_t::MODE_HOLD && mode <= actuator_command_t::MODE_EXPERIMENT;
+}
+
+}  // namespace
+
+Verdict check_message(const sensor_sample_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.seq >= 0);
+  f.within(msg.u_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.within(msg.y_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  f.require(msg.flags >= 0 && (msg.flags & ~kKnownSampleFlags) == 0);
+  return f.verdict();
+}
+
+Verdict check_message(const actuator_command_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.seq >= 0 && msg.sample_seq >= -1);
+  f.within(msg.u_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.within(msg.u_ff_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.within(msg.u_fb_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.nan_or_within(msg.y_ref_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  f.require(msg.params_version >= 0);
+  f.require(is_command_mode(msg.mode));
+  return f.verdict();
+}
+
+Verdict check_message(const trajectory_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.version >= 1);
+  f.require(msg.shape >= trajectory_t::HOLD && msg.shape <= trajectory_t::POINTS);
+  f.within(msg.amplitude_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  f.within(msg.offset_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  f.within(msg.phase_rad, -kHuge, kHuge);
+  f.within(msg.blend_s, 0.0, kMaxDuration_s);
+  const bool periodic = msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE ||
+                        msg.shape == trajectory_t::TRIANGLE;
+  f.within(msg.frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
+  f.require(!periodic || msg.frequency_Hz > 0.0);
+
+  const bool count_ok = msg.n_points >= 0 && msg.n_points <= trajectory_t::MAX_POINTS &&
+                        msg.points_t_s.size() == static_cast<std::size_t>(msg.n_points) &&
+                        msg.points_y_m.size() == static_cast<std::size_t>(msg.n_points);
+  f.require(count_ok);
+  f.require(msg.shape != trajectory_t::POINTS || msg.n_points >= 1);
+  if (count_ok) {
+    for (std::size_t i = 0; i < msg.points_t_s.size(); ++i) {
+      f.within(msg.points_t_s[i], 0.0, kMaxDuration_s);
+      f.within(msg.points_y_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
+      f.require(i == 0 || msg.points_t_s[i] > msg.points_t_s[i - 1]);
+    }
+  }
+  return f.verdict();
+}
+
+Verdict check_message(const mem_params_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
+  f.finite(msg.c1);
+  f.require(!(msg.c1 <= 0.0) && !(msg.c1 > 1.0));  // [m/V]
+  f.within(msg.c2, 0.0, kHuge);
+  f.finite(msg.c3);
+  f.require(!(msg.c3 <= 0.0) && !(msg.c3 > 50.0));  // beyond ~50, p^c3 overflows for p of 100s of volts
+  f.within(msg.residual_m, 0.0, kMaxAbsPosition_m);
+  f.within(msg.window_s, 0.0, kMaxDuration_s);
+  return f.verdict();
+}
+
+Verdict check_message(const service_status_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.pid > 0 && !msg.process.empty());
+  f.require(msg.state >= service_status_t::STARTING && msg.state <= service_status_t::STOPPING);
+  const bool count_ok = msg.n_counters >= 0 && msg.n_counters <= service_status_t::MAX_COUNTERS &&
+                        msg.counter_names.size() == static_cast<std::size_t>(msg.n_counters) &&
+                        msg.counter_values.size() == static_cast<std::size_t>(msg.n_counters);
+  f.require(count_ok);
+  if (count_ok) {
+    for (const std::int64_t value : msg.counter_values) f.require(value >= 0);
+  }
+  for (const double t : {msg.loop_p50_us, msg.loop_p99_us, msg.loop_max_us, msg.latency_p50_us,
+                         msg.latency_p99_us, msg.latency_max_us}) {
+    f.nan_or_within(t, 0.0, kHuge);
+  }
+  f.require(msg.late >= 0 && msg.rejected >= 0);
+  return f.verdict();
+}
+
+Verdict check_message(const control_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.request_id > 0);
+  f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::SHUTDOWN);
+  f.require(is_command_mode(msg.mode));
+  f.within(msg.kp, 0.0, kHuge);
+  f.within(msg.ki, 0.0, kHuge);
+  f.within(msg.kd, 0.0, kHuge);
+  f.within(msg.experiment_amplitude_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.within(msg.experiment_offset_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+  f.within(msg.experiment_frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
+  f.within(msg.experiment_duration_s, 0.0, kMaxDuration_s);
+  if (msg.command == control_t::START_EXPERIMENT) {
+    f.require(!msg.experiment.empty() && msg.experiment_amplitude_V > 0.0 && msg.experiment_frequency_Hz > 0.0 &&
+              msg.experiment_duration_s > 0.0);
+  }
+  return f.verdict();
+}
+
+}  // namespace hystloop

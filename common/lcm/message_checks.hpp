@@ -1,0 +1,54 @@
+#pragma once
+// The value contract of every message type: what a receiver accepts and a publisher may
+// send. Non-finite values are told apart from out-of-range ones so that the counts say
+// which kind of sender bug it is. The bounds are sanity bounds (unit mistakes, corrupted
+// senders), not the actuator's limits: the bridge clamps to those itself.
+// All checks are allocation- and throw-free (they run at 10 kHz).
+
+#include <cstdint>
+
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "hystloop/trajectory_t.hpp"
+#include "lcm/reject_reason.hpp"
+
+namespace hystloop {
+
+inline constexpr double kMaxAbsVoltage_V = 1.0e4;   // no piezo amplifier goes near 10 kV
+inline constexpr double kMaxAbsPosition_m = 1.0;    // a nanopositioner moves micrometres
+inline constexpr double kMaxAbsFrequency_Hz = 1.0e5;
+inline constexpr double kMaxDuration_s = 86400.0;
+inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FAULT
+
+// sensor_sample_t: finite u and y within the sanity bounds, seq and utime >= 0, known flags.
+Verdict check_message(const sensor_sample_t& msg) noexcept;
+// actuator_command_t: finite u, u_ff, u_fb; y_ref finite or NaN (no reference); seq >= 0,
+// sample_seq >= -1, params_version >= 0, a known mode.
+Verdict check_message(const actuator_command_t& msg) noexcept;
+// trajectory_t: known shape, finite numbers, frequency > 0 for periodic shapes, version >= 1,
+// 0..MAX_POINTS points (>= 1 for POINTS) with strictly increasing times >= 0, array sizes
+// equal to n_points (so that encoding never reads past a vector).
+Verdict check_message(const trajectory_t& msg) noexcept;
+// mem_params_t: finite, c1 > 0, c2 >= 0, 0 < c3 <= 50, residual, samples and window >= 0,
+// version >= 1. Validity (`valid`) is the consumer's decision, not a wire error.
+Verdict check_message(const mem_params_t& msg) noexcept;
+// service_status_t: non-empty process, pid > 0, known state, 0..MAX_COUNTERS counters >= 0
+// with matching array sizes, timings NaN (not measured) or finite >= 0.
+Verdict check_message(const service_status_t& msg) noexcept;
+// control_t: known command and mode, request_id > 0, gains finite >= 0; START_EXPERIMENT
+// needs a name and amplitude, frequency and duration > 0.
+Verdict check_message(const control_t& msg) noexcept;
+
+// The check a Subscription/Publisher uses; the default is check_message for T.
+template <class T>
+using MessageCheck = Verdict (*)(const T&) noexcept;
+
+template <class T>
+constexpr MessageCheck<T> default_message_check() noexcept {
+  return static_cast<MessageCheck<T>>(&check_message);
+}
+
+}  // namespace hystloop

@@ -1,0 +1,35 @@
+#include "lcm/message_storage.hpp"
+
+namespace hystloop {
+
+void reserve_storage(trajectory_t& msg) {
+  msg.points_t_s.reserve(trajectory_t::MAX_POINTS);
+  msg.points_y_m.reserve(trajectory_t::MAX_POINTS);
+}
+
+void reserve_storage(mem_params_t& msg) { msg.source.reserve(kReservedStringChars); }
+
+void reserve_storage(service_status_t& msg) {
+  msg.process.reserve(kReservedStringChars);
+  msg.host.reserve(kReservedStringChars);
+  msg.detail.reserve(kReservedStringChars);
+  msg.counter_names.reserve(service_status_t::MAX_COUNTERS);
+  msg.counter_values.reserve(service_status_t::MAX_COUNTERS);
+}
+
+void reserve_storage(control_t& msg) {
+  msg.target.reserve(kReservedStringChars);
+  msg.experiment.reserve(kReservedStringChars);
+}
+
+bool arrays_consistent(const trajectory_t& msg) noexcept {
+  return msg.n_points >= 0 && msg.points_t_s.size() == static_cast<std::size_t>(msg.n_points) &&
+         msg.points_y_m.size() == static_cast<std::size_t>(msg.n_points);
+}
+
+bool arrays_consistent(const service_status_t& msg) noexcept {
+  return msg.n_counters >= 0 && msg.counter_names.size() == static_cast<std::size_t>(msg.n_counters) &&
+         msg.counter_values.size() == static_cast<std::size_t>(msg.n_counters);
+}
+
+}  // namespace hystloop

@@ -1,0 +1,39 @@
+#pragma once
+// Storage of the variable-size types.
+//
+// reserve_storage: capacity reserved up front in a message that is decoded into again and again, so that
+// decoding the largest message the contract allows does not allocate after construction.
+// Fixed-size types need nothing. Strings longer than `kReservedStringChars` still allocate
+// (status and control are 1 Hz / on-demand channels).
+
+#include <cstddef>
+
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "hystloop/trajectory_t.hpp"
+
+namespace hystloop {
+
+inline constexpr std::size_t kReservedStringChars = 64;
+
+inline void reserve_storage(sensor_sample_t&) {}
+inline void reserve_storage(actuator_command_t&) {}
+void reserve_storage(trajectory_t& msg);
+void reserve_storage(mem_params_t& msg);
+void reserve_storage(service_status_t& msg);
+void reserve_storage(control_t& msg);
+
+// arrays_consistent: every variable array holds exactly its count (lcm-gen's encode reads
+// `count` elements whatever the vector's size). Publisher refuses an inconsistent
+// message even when its value check is switched off.
+inline bool arrays_consistent(const sensor_sample_t&) noexcept { return true; }
+inline bool arrays_consistent(const actuator_command_t&) noexcept { return true; }
+inline bool arrays_consistent(const mem_params_t&) noexcept { return true; }
+inline bool arrays_consistent(const control_t&) noexcept { return true; }
+bool arrays_consistent(const trajectory_t& msg) noexcept;
+bool arrays_consistent(const service_status_t& msg) noexcept;
+
+}  // namespace hystloop

@@ -1,0 +1,58 @@
+#include "lcm/status_counters.hpp"
+
+#include <cstddef>
+#include <limits>
+#include <string>
+
+namespace hystloop {
+namespace {
+
+std::int64_t saturate(std::uint64_t value) {
+  constexpr auto kMax = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+  return static_cast<std::int64_t>(value > kMax ? kMax : value);
+}
+
+std::string joined(std::string_view endpoint, std::string_view name) {
+  std::string out(endpoint);
+  out += '.';
+  out += name;
+  return out;
+}
+
+}  // namespace
+
+void clear_counters(service_status_t& status) {
+  status.counter_names.clear();
+  status.counter_values.clear();
+  status.n_counters = 0;
+}
+
+bool add_counter(service_status_t& status, std::string_view name, std::uint64_t value) {
+  if (status.n_counters >= service_status_t::MAX_COUNTERS) return false;
+  status.counter_names.emplace_back(name);
+  status.counter_values.push_back(saturate(value));
+  status.n_counters = static_cast<std::int32_t>(status.counter_names.size());
+  return true;
+}
+
+bool add_endpoint_counters(service_status_t& status, std::string_view endpoint, const EndpointCounters& counters) {
+  bool ok = add_counter(status, joined(endpoint, "received"), counters.received);
+  ok = add_counter(status, joined(endpoint, "accepted"), counters.accepted) && ok;
+  for (std::size_t i = 0; i < kRejectReasonCount; ++i) {
+    const auto reason = static_cast<RejectReason>(i);
+    ok = add_counter(status, joined(endpoint, "rejected_" + std::string(to_string(reason))),
+                     counters.rejected(reason)) && ok;
+  }
+  status.rejected = saturate(static_cast<std::uint64_t>(status.rejected) + counters.rejected_total());
+  return ok;
+}
+
+bool add_publisher_counters(service_status_t& status, std::string_view endpoint, const PublisherCounters& counters) {
+  bool ok = add_counter(status, joined(endpoint, "published"), counters.published);
+  ok = add_counter(status, joined(endpoint, "invalid"), counters.invalid) && ok;
+  ok = add_counter(status, joined(endpoint, "encode_failed"), counters.encode_failed) && ok;
+  ok = add_counter(status, joined(endpoint, "transport_failed"), counters.transport_failed) && ok;
+  return ok;
+}
+
+}  // namespace hystloop

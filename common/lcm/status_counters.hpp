@@ -1,0 +1,27 @@
+#pragma once
+// Filling service_status_t's named counters from the endpoint counts (1 Hz, off the
+// per-sample path: these build strings).
+
+#include <cstdint>
+#include <string_view>
+
+#include "hystloop/service_status_t.hpp"
+#include "lcm/reject_reason.hpp"
+
+namespace hystloop {
+
+// Empties the counter arrays (keeping their capacity).
+void clear_counters(service_status_t& status);
+
+// Appends one counter, keeping n_counters in step. Returns false (and adds nothing) when
+// MAX_COUNTERS are already there. Values above INT64_MAX saturate.
+bool add_counter(service_status_t& status, std::string_view name, std::uint64_t value);
+
+// "<endpoint>.received", "<endpoint>.accepted", "<endpoint>.rejected_<reason>" for each reason.
+// Adds `counters.rejected_total()` to status.rejected. Returns false if some did not fit.
+bool add_endpoint_counters(service_status_t& status, std::string_view endpoint, const EndpointCounters& counters);
+
+// "<endpoint>.published", ".invalid", ".encode_failed", ".transport_failed".
+bool add_publisher_counters(service_status_t& status, std::string_view endpoint, const PublisherCounters& counters);
+
+}  // namespace hystloop

@@ -1,0 +1,97 @@
+#include "lcm/wire_layout.hpp"
+
+#include <array>
+
+namespace hystloop {
+namespace {
+
+using F = WireField;
+
+// LCM encodes integers big-endian.
+std::int64_t read_be(const unsigned char* p, int bytes) noexcept {
+  std::uint64_t v = 0;
+  for (int i = 0; i < bytes; ++i) v = (v << 8) | p[i];
+  if (bytes == 4) return static_cast<std::int32_t>(static_cast<std::uint32_t>(v));
+  return static_cast<std::int64_t>(v);
+}
+
+// The fingerprints below are T::getHash() of the .lcm files as committed; the layout test
+// checks them, so a changed type fails loudly rather than being walked with a stale layout.
+constexpr std::array kSensor{F::kInt64, F::kInt64, F::kDouble, F::kDouble, F::kInt32};
+constexpr std::array kCommand{F::kInt64,  F::kInt64,  F::kInt64, F::kDouble, F::kDouble,
+                              F::kDouble, F::kDouble, F::kInt32, F::kInt8};
+constexpr std::array kTrajectory{F::kInt64,  F::kInt64,  F::kInt8,  F::kDouble,      F::kDouble,      F::kDouble,
+                                 F::kDouble, F::kInt64,  F::kDouble, F::kCount, F::kDoubleArray, F::kDoubleArray};
+constexpr std::array kParams{F::kInt64, F::kInt32, F::kDouble, F::kDouble, F::kDouble,
+                             F::kDouble, F::kInt64, F::kDouble, F::kInt8,   F::kString};
+constexpr std::array kStatus{F::kInt64,  F::kString, F::kString, F::kInt32,  F::kInt8,   F::kString,
+                             F::kInt64,  F::kCount,  F::kStringArray, F::kInt64Array, F::kDouble, F::kDouble,
+                             F::kDouble, F::kDouble, F::kDouble, F::kDouble, F::kInt64,  F::kInt64};
+constexpr std::array kControl{F::kInt64,  F::kInt64,  F::kInt8,   F::kString, F::kInt8,   F::kDouble, F::kDouble,
+                              F::kDouble, F::kString, F::kDouble, F::kDouble, F::kDouble, F::kDouble};
+
+}  // namespace
+
+WireLayout wire_layout(const sensor_sample_t*) noexcept { return {7786445219695628610, kSensor, 0}; }
+WireLayout wire_layout(const actuator_command_t*) noexcept { return {-6278125682187443296, kCommand, 0}; }
+WireLayout wire_layout(const trajectory_t*) noexcept {
+  return {-2105350467762901674, kTrajectory, trajectory_t::MAX_POINTS};
+}
+WireLayout wire_layout(const mem_params_t*) noexcept { return {2426068061725658864, kParams, 0}; }
+WireLayout wire_layout(const service_status_t*) noexcept {
+  return {-2051245413666674676, kStatus, service_status_t::MAX_COUNTERS};
+}
+WireLayout wire_layout(const control_t*) noexcept { return {8443511174066765041, kControl, 0}; }
+
+std::int64_t wire_fingerprint(const void* data, std::size_t size) noexcept {
+  if (data == nullptr || size < 8) return 0;
+  return read_be(static_cast<const unsigned char*>(data), 8);
+}
+
+std::int64_t walk_wire_layout(const WireLayout& layout, const void* data, std::size_t size) noexcept {
+  if (data == nullptr || size < 8) return -1;
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  std::size_t pos = 8;  // past the fingerprint
+  std::int64_t count = -1;
+
+  const auto take = [&](std::size_t n) noexcept {
+    if (n > size - pos) return false;
+    pos += n;
+    return true;
+  };
+  const auto take_string = [&]() noexcept {
+    if (4 > size - pos) return false;
+    const std::int64_t length = read_be(bytes + pos, 4);
+    pos += 4;
+    return length >= 1 && take(static_cast<std::size_t>(length));
+  };
+
+  for (const WireField field : layout.fields) {
+    bool ok = true;
+    switch (field) {
+      case F::kInt8: ok = take(1); break;
+      case F::kInt32: ok = take(4); break;
+      case F::kInt64:
+      case F::kDouble: ok = take(8); break;
+      case F::kString: ok = take_string(); break;
+      case F::kCount:
+        ok = 4 <= size - pos;
+        if (ok) {
+          count = read_be(bytes + pos, 4);
+          pos += 4;
+          ok = count >= 0 && count <= layout.max_count;
+        }
+        break;
+      case F::kDoubleArray:
+      case F::kInt64Array: ok = count >= 0 && take(static_cast<std::size_t>(count) * 8); break;
+      case F::kStringArray:
+        ok = count >= 0;
+        for (std::int64_t i = 0; ok && i < count; ++i) ok = take_string();
+        break;
+    }
+    if (!ok) return -1;
+  }
+  return static_cast<std::int64_t>(pos);
+}
+
+}  // namespace hystloop

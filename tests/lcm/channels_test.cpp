@@ -1,0 +1,45 @@
+#include "lcm/channels.hpp"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+namespace {
+
+TEST(Channels, DefaultPrefixGivesTheDesignNames) {
+  const ChannelNames names;
+  EXPECT_EQ(names.prefix, "HX_");
+  EXPECT_EQ(names.sensor, "HX_SENSOR");
+  EXPECT_EQ(names.command, "HX_COMMAND");
+  EXPECT_EQ(names.trajectory, "HX_TRAJECTORY");
+  EXPECT_EQ(names.params, "HX_PARAMS");
+  EXPECT_EQ(names.status, "HX_STATUS");
+  EXPECT_EQ(names.control, "HX_CONTROL");
+  EXPECT_EQ(names.all_channels_regex(), "HX_.*");
+}
+
+TEST(Channels, AnotherRigGetsItsOwnNames) {
+  const ChannelNames names("RIG2_");
+  EXPECT_EQ(names.sensor, "RIG2_SENSOR");
+  EXPECT_EQ(channel_name("RIG2_", kControlSuffix), "RIG2_CONTROL");
+}
+
+TEST(Channels, RefusesPrefixesThatAreNotLiteralRegexes) {
+  for (const char* bad : {"", "hx_", "HX", "HX.*_", "H X_", "1HX_", "HX-A_", "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456_"}) {
+    try {
+      ChannelNames names(bad);
+      ADD_FAILURE() << "accepted \"" << bad << "\"";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.field(), "rig.prefix") << bad;
+    }
+  }
+}
+
+TEST(Channels, SpecsListEveryChannelOnce) {
+  EXPECT_EQ(kChannelSpecs.size(), 6u);
+  EXPECT_EQ(kChannelSpecs[0].type_name, "hystloop.sensor_sample_t");
+}
+
+}  // namespace
+}  // namespace hystloop

@@ -1,0 +1,164 @@
+// Every message type survives encode -> decode with every field intact, and the
+// generated constants are the ones the rest of the code relies on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "lcm/message_fixtures.hpp"
+
+namespace hystloop {
+namespace {
+
+template <class T>
+T round_trip(const T& in) {
+  const auto bytes = fixtures::encode(in);
+  T out{};
+  EXPECT_EQ(out.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  EXPECT_EQ(fixtures::encode(out), bytes);  // byte-identical re-encoding: no field lost
+  return out;
+}
+
+TEST(LcmTypes, SensorSampleRoundTripsEveryField) {
+  const auto in = fixtures::sample(7);
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.seq, 7);
+  EXPECT_EQ(out.u_V, in.u_V);
+  EXPECT_EQ(out.y_m, in.y_m);
+  EXPECT_EQ(out.flags, in.flags);
+}
+
+TEST(LcmTypes, ActuatorCommandRoundTripsEveryField) {
+  const auto in = fixtures::command(11);
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.seq, 13);
+  EXPECT_EQ(out.sample_seq, 11);
+  EXPECT_EQ(out.u_V, in.u_V);
+  EXPECT_EQ(out.u_ff_V, in.u_ff_V);
+  EXPECT_EQ(out.u_fb_V, in.u_fb_V);
+  EXPECT_EQ(out.y_ref_m, in.y_ref_m);
+  EXPECT_EQ(out.params_version, in.params_version);
+  EXPECT_EQ(out.mode, actuator_command_t::MODE_MODEL_FF_FEEDBACK);
+}
+
+TEST(LcmTypes, TrajectoryRoundTripsEveryFieldAndPoint) {
+  const auto in = fixtures::trajectory(5);  // 6 points
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.version, in.version);
+  EXPECT_EQ(out.shape, trajectory_t::POINTS);
+  EXPECT_EQ(out.amplitude_m, in.amplitude_m);
+  EXPECT_EQ(out.offset_m, in.offset_m);
+  EXPECT_EQ(out.frequency_Hz, in.frequency_Hz);
+  EXPECT_EQ(out.phase_rad, in.phase_rad);
+  EXPECT_EQ(out.start_utime, in.start_utime);
+  EXPECT_EQ(out.blend_s, in.blend_s);
+  ASSERT_EQ(out.n_points, 6);
+  EXPECT_EQ(out.points_t_s, in.points_t_s);
+  EXPECT_EQ(out.points_y_m, in.points_y_m);
+}
+
+TEST(LcmTypes, TrajectoryWithNoPointsRoundTrips) {
+  auto in = fixtures::trajectory(0);
+  in.shape = trajectory_t::COSINE;
+  in.n_points = 0;
+  in.points_t_s.clear();
+  in.points_y_m.clear();
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.n_points, 0);
+  EXPECT_TRUE(out.points_t_s.empty());
+}
+
+TEST(LcmTypes, MemParamsRoundTripsEveryField) {
+  const auto in = fixtures::params(4);
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.version, 5);
+  EXPECT_EQ(out.c1, in.c1);
+  EXPECT_EQ(out.c2, in.c2);
+  EXPECT_EQ(out.c3, in.c3);
+  EXPECT_EQ(out.residual_m, in.residual_m);
+  EXPECT_EQ(out.samples_used, in.samples_used);
+  EXPECT_EQ(out.window_s, in.window_s);
+  EXPECT_EQ(out.valid, in.valid);
+  EXPECT_EQ(out.source, "reident@lab-host-4");
+}
+
+TEST(LcmTypes, ServiceStatusRoundTripsEveryFieldAndCounter) {
+  const auto in = fixtures::status(4);  // 4 counters
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.process, "compensator");
+  EXPECT_EQ(out.host, in.host);
+  EXPECT_EQ(out.pid, in.pid);
+  EXPECT_EQ(out.state, service_status_t::DEGRADED);
+  EXPECT_EQ(out.detail, in.detail);
+  EXPECT_EQ(out.start_utime, in.start_utime);
+  ASSERT_EQ(out.n_counters, 4);
+  EXPECT_EQ(out.counter_names, in.counter_names);
+  EXPECT_EQ(out.counter_values, in.counter_values);
+  EXPECT_EQ(out.loop_p50_us, in.loop_p50_us);
+  EXPECT_EQ(out.loop_p99_us, in.loop_p99_us);
+  EXPECT_EQ(out.loop_max_us, in.loop_max_us);
+  EXPECT_EQ(out.latency_p50_us, in.latency_p50_us);
+  EXPECT_EQ(out.latency_p99_us, in.latency_p99_us);
+  EXPECT_EQ(out.latency_max_us, in.latency_max_us);
+  EXPECT_EQ(out.late, in.late);
+  EXPECT_EQ(out.rejected, in.rejected);
+}
+
+TEST(LcmTypes, ControlRoundTripsEveryField) {
+  const auto in = fixtures::control(3);
+  const auto out = round_trip(in);
+  EXPECT_EQ(out.utime, in.utime);
+  EXPECT_EQ(out.request_id, 103);
+  EXPECT_EQ(out.command, control_t::START_EXPERIMENT);
+  EXPECT_EQ(out.target, "compensator");
+  EXPECT_EQ(out.mode, actuator_command_t::MODE_EXPERIMENT);
+  EXPECT_EQ(out.kp, in.kp);
+  EXPECT_EQ(out.ki, in.ki);
+  EXPECT_EQ(out.kd, in.kd);
+  EXPECT_EQ(out.experiment, "sine");
+  EXPECT_EQ(out.experiment_amplitude_V, in.experiment_amplitude_V);
+  EXPECT_EQ(out.experiment_offset_V, in.experiment_offset_V);
+  EXPECT_EQ(out.experiment_frequency_Hz, in.experiment_frequency_Hz);
+  EXPECT_EQ(out.experiment_duration_s, in.experiment_duration_s);
+}
+
+TEST(LcmTypes, NaNSentinelSurvivesTheWire) {
+  auto in = fixtures::command(1);
+  in.y_ref_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(round_trip(in).y_ref_m));
+}
+
+// Values other code depends on: common/loop/bridge_core.hpp's sample_flags and
+// common/loop/trajectory.hpp's TrajectoryShape repeat them.
+TEST(LcmTypes, ConstantsAreTheContractedValues) {
+  EXPECT_EQ(sensor_sample_t::SATURATED, 1);
+  EXPECT_EQ(sensor_sample_t::SAFE_STATE, 2);
+  EXPECT_EQ(sensor_sample_t::SIMULATED, 4);
+  EXPECT_EQ(sensor_sample_t::SLEW_LIMITED, 8);
+  EXPECT_EQ(sensor_sample_t::LATE_COMMAND, 16);
+  EXPECT_EQ(sensor_sample_t::SENSOR_FAULT, 32);
+  EXPECT_EQ(trajectory_t::HOLD, 0);
+  EXPECT_EQ(trajectory_t::SINE, 1);
+  EXPECT_EQ(trajectory_t::COSINE, 2);
+  EXPECT_EQ(trajectory_t::TRIANGLE, 3);
+  EXPECT_EQ(trajectory_t::POINTS, 4);
+  EXPECT_EQ(trajectory_t::MAX_POINTS, 256);
+  EXPECT_EQ(service_status_t::STARTING, 0);
+  EXPECT_EQ(service_status_t::STOPPING, 4);
+  EXPECT_EQ(control_t::SET_MODE, 1);
+  EXPECT_EQ(control_t::SHUTDOWN, 8);
+}
+
+TEST(LcmTypes, FixedSizeTypesHaveTheirWireSize) {
+  // 8-byte fingerprint + fields; these two go out at 10 kHz.
+  EXPECT_EQ(fixtures::sample(0).getEncodedSize(), 8 + 8 + 8 + 8 + 8 + 4);
+  EXPECT_EQ(fixtures::command(0).getEncodedSize(), 8 + 3 * 8 + 4 * 8 + 4 + 1);
+}
+
+}  // namespace
+}  // namespace hystloop

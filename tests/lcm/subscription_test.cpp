@@ -1,0 +1,246 @@
+// Subscription<T> over the in-process memq:// provider: what arrives intact is delivered,
+// everything else is rejected, counted by reason, and never crashes (this also runs under
+// ASan+UBSan).
+#include "lcm/subscription.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "lcm/connection.hpp"
+#include "lcm/message_fixtures.hpp"
+#include "lcm/publisher.hpp"
+#include "support/allocation_counter.hpp"
+
+namespace hystloop {
+namespace {
+
+using namespace std::chrono_literals;
+
+class SubscriptionTest : public ::testing::Test {
+ protected:
+  lcm::LCM lcm_{"memq://"};
+
+  void publish_raw(const std::string& channel, const std::vector<std::uint8_t>& bytes) {
+    ASSERT_EQ(lcm_.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())), 0);
+  }
+  int drain() { return handle_pending(lcm_, 0us); }
+};
+
+TEST_F(SubscriptionTest, DeliversEachTypeIntactThroughLcm) {
+  std::vector<std::int64_t> seqs;
+  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_sample_t& m, std::int64_t) {
+    seqs.push_back(m.seq);
+  });
+  Subscription<trajectory_t> traj(lcm_, "HX_TRAJECTORY");
+  Subscription<service_status_t> status(lcm_, "HX_STATUS");
+  Publisher<sensor_sample_t> pub_sensor(lcm_, "HX_SENSOR");
+  Publisher<trajectory_t> pub_traj(lcm_, "HX_TRAJECTORY");
+  Publisher<service_status_t> pub_status(lcm_, "HX_STATUS");
+
+  for (std::int64_t k = 0; k < 5; ++k) ASSERT_TRUE(pub_sensor.publish(fixtures::sample(k)));
+  ASSERT_TRUE(pub_traj.publish(fixtures::trajectory(4)));
+  ASSERT_TRUE(pub_status.publish(fixtures::status(3)));
+  EXPECT_EQ(drain(), 7);
+
+  EXPECT_EQ(seqs, (std::vector<std::int64_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(sensor.counters().accepted, 5u);
+  EXPECT_EQ(sensor.counters().rejected_total(), 0u);
+  EXPECT_EQ(fixtures::encode(sensor.latest()), fixtures::encode(fixtures::sample(4)));
+  EXPECT_EQ(fixtures::encode(traj.latest()), fixtures::encode(fixtures::trajectory(4)));
+  EXPECT_EQ(fixtures::encode(status.latest()), fixtures::encode(fixtures::status(3)));
+}
+
+TEST_F(SubscriptionTest, EveryTruncationIsRejectedAndCounted) {
+  Subscription<service_status_t> status(lcm_, "HX_STATUS");
+  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND");
+  const auto status_bytes = fixtures::encode(fixtures::status(4));
+  const auto command_bytes = fixtures::encode(fixtures::command(4));
+  for (std::size_t n = 0; n < status_bytes.size(); ++n) {
+    status.receive(status_bytes.data(), n, 0);
+  }
+  for (std::size_t n = 0; n < command_bytes.size(); ++n) {
+    publish_raw("HX_COMMAND", {command_bytes.begin(), command_bytes.begin() + static_cast<long>(n)});
+  }
+  drain();
+  EXPECT_EQ(status.counters().rejected(RejectReason::kDecodeFailed), status_bytes.size());
+  EXPECT_EQ(command.counters().rejected(RejectReason::kDecodeFailed), command_bytes.size());
+  EXPECT_EQ(status.counters().accepted + command.counters().accepted, 0u);
+  EXPECT_EQ(status.valid_count(), 0u);
+}
+
+TEST_F(SubscriptionTest, TrailingBytesAreASizeMismatch) {
+  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR");
+  auto bytes = fixtures::encode(fixtures::sample(1));
+  bytes.push_back(0);
+  publish_raw("HX_SENSOR", bytes);
+  drain();
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kSizeMismatch), 1u);
+  EXPECT_EQ(sensor.counters().accepted, 0u);
+}
+
+TEST_F(SubscriptionTest, AnotherTypeOnTheChannelIsAWrongType) {
+  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR");
+  publish_raw("HX_SENSOR", fixtures::encode(fixtures::command(1)));  // 61 bytes: a plausible size
+  drain();
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kWrongType), 1u);
+}
+
+TEST_F(SubscriptionTest, InvalidValuesAreRejectedPerReasonAndKeepTheLastGoodMessage) {
+  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND");
+  Publisher<actuator_command_t> unchecked(lcm_, "HX_COMMAND", nullptr);
+  ASSERT_TRUE(unchecked.publish(fixtures::command(1)));
+  auto bad = fixtures::command(2);
+  bad.u_V = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(unchecked.publish(bad));
+  bad.u_V = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(unchecked.publish(bad));
+  bad = fixtures::command(3);
+  bad.mode = 42;
+  ASSERT_TRUE(unchecked.publish(bad));
+  drain();
+  const auto& c = command.counters();
+  EXPECT_EQ(c.received, 4u);
+  EXPECT_EQ(c.accepted, 1u);
+  EXPECT_EQ(c.rejected(RejectReason::kNonFinite), 2u);
+  EXPECT_EQ(c.rejected(RejectReason::kOutOfRange), 1u);
+  EXPECT_EQ(command.latest().seq, fixtures::command(1).seq);
+}
+
+TEST_F(SubscriptionTest, ACustomCheckReplacesTheDefault) {
+  Subscription<sensor_sample_t>::Options options;
+  options.check = [](const sensor_sample_t& m) noexcept {
+    return m.seq % 2 == 0 ? Verdict::kOk : Verdict::kOutOfRange;
+  };
+  Subscription<sensor_sample_t> even(lcm_, "HX_SENSOR", {}, options);
+  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
+  for (std::int64_t k = 0; k < 6; ++k) pub.publish(fixtures::sample(k));
+  drain();
+  EXPECT_EQ(even.counters().accepted, 3u);
+  EXPECT_EQ(even.counters().rejected(RejectReason::kOutOfRange), 3u);
+}
+
+TEST_F(SubscriptionTest, AThrowingHandlerIsCountedAndLcmCarriesOn) {
+  std::vector<RejectReason> reported;
+  Subscription<sensor_sample_t>::Options options;
+  options.on_reject = [&](RejectReason r) { reported.push_back(r); };
+  int calls = 0;
+  Subscription<sensor_sample_t> sensor(
+      lcm_, "HX_SENSOR",
+      [&](const sensor_sample_t& m, std::int64_t) {
+        ++calls;
+        if (m.seq == 1) throw std::runtime_error("handler bug");
+      },
+      options);
+  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
+  for (std::int64_t k = 0; k < 3; ++k) pub.publish(fixtures::sample(k));
+  EXPECT_EQ(drain(), 3);
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(sensor.counters().accepted, 2u);
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kHandlerFailed), 1u);
+  EXPECT_EQ(sensor.valid_count(), 3u);
+  EXPECT_EQ(reported, std::vector<RejectReason>{RejectReason::kHandlerFailed});
+}
+
+// Seeded random corruption of every type: flipped bits, overwritten bytes, cut or grown
+// buffers. Every message is either accepted (and then valid) or counted as rejected.
+template <class T>
+void fuzz(const std::vector<T>& originals, std::uint64_t seed, int rounds) {
+  lcm::LCM lcm("memq://");
+  Subscription<T> sub(lcm, "FUZZ");
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < rounds; ++i) {
+    auto bytes = fixtures::encode(originals[static_cast<std::size_t>(i) % originals.size()]);
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = 8 + rng() % (bytes.size() - 8);  // keep the fingerprint most of the time
+      switch (rng() % 4) {
+        case 0: bytes[at] ^= static_cast<std::uint8_t>(1u << (rng() % 8)); break;
+        case 1: bytes[at] = static_cast<std::uint8_t>(rng()); break;
+        case 2: bytes[at] = 0xff; break;
+        default: bytes.resize(8 + rng() % (bytes.size() - 7)); break;
+      }
+      if (bytes.size() <= 8) break;
+    }
+    if (rng() % 16 == 0) bytes[rng() % 8] ^= 1;  // and sometimes the fingerprint
+    sub.receive(bytes.data(), bytes.size(), 0);
+    if (sub.valid_count() > 0) {
+      ASSERT_EQ(check_message(sub.latest()), Verdict::kOk);
+    }
+  }
+  const auto& c = sub.counters();
+  EXPECT_EQ(c.received, static_cast<std::uint64_t>(rounds));
+  EXPECT_EQ(c.accepted + c.rejected_total(), c.received);
+  EXPECT_GT(c.rejected_total(), 0u);
+}
+
+#ifdef __SANITIZE_ADDRESS__
+constexpr int kFuzzRounds = 3000;
+#else
+constexpr int kFuzzRounds = 20000;
+#endif
+
+template <class T>
+std::vector<T> originals(T (*make)(std::int64_t)) {
+  std::vector<T> out;
+  for (std::int64_t k = 0; k < 8; ++k) out.push_back(make(k));
+  return out;
+}
+
+TEST(SubscriptionFuzz, CorruptedBuffersNeverCrashAndAreAllCounted) {
+  fuzz(originals(&fixtures::sample), 1, kFuzzRounds);
+  fuzz(originals(&fixtures::command), 2, kFuzzRounds);
+  fuzz(originals(&fixtures::trajectory), 3, kFuzzRounds);
+  fuzz(originals(&fixtures::params), 4, kFuzzRounds);
+  fuzz(originals(&fixtures::status), 5, kFuzzRounds);
+  fuzz(originals(&fixtures::control), 6, kFuzzRounds);
+}
+
+TEST_F(SubscriptionTest, ReceivingAFixedSizeTypeAllocatesNothing) {
+  std::int64_t last = -1;
+  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND",
+                                           [&](const actuator_command_t& m, std::int64_t) { last = m.seq; });
+  const auto good = fixtures::encode(fixtures::command(9));
+  auto bad = good;
+  bad.resize(20);
+  command.receive(good.data(), good.size(), 0);  // warm-up
+  testing::AllocationCounter counter;
+  for (int i = 0; i < 1000; ++i) {
+    command.receive(good.data(), good.size(), 0);
+    command.receive(bad.data(), bad.size(), 0);
+  }
+  EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_EQ(last, 11);
+  EXPECT_EQ(command.counters().rejected(RejectReason::kDecodeFailed), 1000u);
+}
+
+TEST_F(SubscriptionTest, ReceivingTheLargestTrajectoryAllocatesNothingAfterConstruction) {
+  Subscription<trajectory_t> traj(lcm_, "HX_TRAJECTORY");
+  auto big = fixtures::trajectory(0);
+  big.n_points = trajectory_t::MAX_POINTS;
+  big.points_t_s.resize(trajectory_t::MAX_POINTS);
+  big.points_y_m.assign(trajectory_t::MAX_POINTS, 1e-7);
+  for (int i = 0; i < trajectory_t::MAX_POINTS; ++i) big.points_t_s[static_cast<std::size_t>(i)] = 0.01 * i;
+  const auto bytes = fixtures::encode(big);
+  testing::AllocationCounter counter;
+  for (int i = 0; i < 10; ++i) traj.receive(bytes.data(), bytes.size(), 0);
+  EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_EQ(traj.counters().accepted, 10u);
+}
+
+TEST_F(SubscriptionTest, UnsubscribesWhenDestroyed) {
+  int calls = 0;
+  {
+    Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_sample_t&, std::int64_t) { ++calls; });
+  }
+  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
+  pub.publish(fixtures::sample(0));
+  drain();
+  EXPECT_EQ(calls, 0);
+}
+
+}  // namespace
+}  // namespace hystloop

@@ -1,0 +1,70 @@
+#include "lcm/url.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+namespace {
+
+void expect_refused(std::string_view url, bool allow_network = false) {
+  try {
+    checked_lcm_url(url, allow_network);
+    ADD_FAILURE() << "accepted " << url;
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "lcm.url");
+  }
+}
+
+TEST(LcmUrl, DefaultStaysOnThisHost) {
+  EXPECT_EQ(kDefaultLcmUrl, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(checked_lcm_url(kDefaultLcmUrl), kDefaultLcmUrl);
+  EXPECT_EQ(lcm_url_option(parse_lcm_url(kDefaultLcmUrl), "ttl"), "0");
+}
+
+TEST(LcmUrl, ParsesProviderNetworkAndOptions) {
+  const auto url = parse_lcm_url("udpm://239.1.2.3:7000?recv_buf_size=2097152&ttl=1");
+  EXPECT_EQ(url.provider, "udpm");
+  EXPECT_EQ(url.network, "239.1.2.3:7000");
+  EXPECT_EQ(lcm_url_option(url, "recv_buf_size"), "2097152");
+  EXPECT_EQ(lcm_url_option(url, "ttl"), "1");
+  EXPECT_EQ(lcm_url_option(url, "missing"), "");
+}
+
+TEST(LcmUrl, TtlAboveZeroNeedsTheAllowFlag) {
+  expect_refused("udpm://239.255.76.67:7667?ttl=1");
+  expect_refused("udpm://239.255.76.67:7667?ttl=0&ttl=1");  // LCM takes the last one
+  EXPECT_NO_THROW(checked_lcm_url("udpm://239.255.76.67:7667?ttl=1", true));
+  EXPECT_NO_THROW(checked_lcm_url("udpm://239.255.76.67:7667"));  // LCM's default ttl is 0
+}
+
+TEST(LcmUrl, RefusesMalformedUrls) {
+  for (const char* bad : {"", "239.255.76.67:7667", "://x", "udpm://239.255.76.67:7667?ttl=abc",
+                          "udpm://239.255.76.67:7667?ttl=-1", "udpm://239.255.76.67:7667?ttl=256",
+                          "udpm://10.0.0.1:7667?ttl=0", "carrier-pigeon://x"}) {
+    expect_refused(bad, true);
+  }
+}
+
+TEST(LcmUrl, LocalProvidersAreAlwaysFine_TcpqNeedsTheFlag) {
+  EXPECT_NO_THROW(checked_lcm_url("memq://"));
+  EXPECT_NO_THROW(checked_lcm_url("file:///tmp/x.lcmlog?mode=r"));
+  expect_refused("tcpq://lab-hub:7700");
+  EXPECT_NO_THROW(checked_lcm_url("tcpq://lab-hub:7700", true));
+}
+
+TEST(LcmUrl, ResolvesRequestedThenEnvironmentThenDefault) {
+  ::unsetenv("LCM_DEFAULT_URL");
+  EXPECT_EQ(resolve_lcm_url(""), kDefaultLcmUrl);
+  ::setenv("LCM_DEFAULT_URL", "memq://", 1);
+  EXPECT_EQ(resolve_lcm_url(""), "memq://");
+  EXPECT_EQ(resolve_lcm_url("udpm://239.1.1.1:7001?ttl=0"), "udpm://239.1.1.1:7001?ttl=0");
+  ::setenv("LCM_DEFAULT_URL", "udpm://239.255.76.67:7667?ttl=3", 1);
+  EXPECT_THROW(resolve_lcm_url(""), ParameterError);  // the environment is checked too
+  ::unsetenv("LCM_DEFAULT_URL");
+}
+
+}  // namespace
+}  // namespace hystloop

@@ -1,0 +1,100 @@
+// The length-field walk that runs before lcm-gen's decode: it must agree with the real
+// encoding of every type, and refuse every length that decode would trust blindly.
+#include "lcm/wire_layout.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "lcm/message_fixtures.hpp"
+
+namespace hystloop {
+namespace {
+
+template <class T>
+void expect_walk_matches_encoding(const T& msg) {
+  const auto bytes = fixtures::encode(msg);
+  EXPECT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
+            static_cast<std::int64_t>(bytes.size()))
+      << T::getTypeName();
+}
+
+void put_be32(std::vector<std::uint8_t>& bytes, std::size_t at, std::int32_t value) {
+  const auto u = static_cast<std::uint32_t>(value);
+  for (int i = 0; i < 4; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(u >> (24 - 8 * i));
+}
+
+// If this fails, a .lcm file changed: update kXxx and the fingerprint in wire_layout.cpp.
+TEST(WireLayout, EveryLayoutIsPinnedToItsTypesFingerprint) {
+  EXPECT_TRUE(layout_matches<sensor_sample_t>());
+  EXPECT_TRUE(layout_matches<actuator_command_t>());
+  EXPECT_TRUE(layout_matches<trajectory_t>());
+  EXPECT_TRUE(layout_matches<mem_params_t>());
+  EXPECT_TRUE(layout_matches<service_status_t>());
+  EXPECT_TRUE(layout_matches<control_t>());
+}
+
+TEST(WireLayout, WalkCoversExactlyTheEncodedBytesOfEveryType) {
+  for (std::int64_t k = 0; k < 12; ++k) {  // varying array counts and string lengths
+    expect_walk_matches_encoding(fixtures::sample(k));
+    expect_walk_matches_encoding(fixtures::command(k));
+    expect_walk_matches_encoding(fixtures::trajectory(k));
+    expect_walk_matches_encoding(fixtures::params(k));
+    expect_walk_matches_encoding(fixtures::status(k));
+    expect_walk_matches_encoding(fixtures::control(k));
+  }
+}
+
+TEST(WireLayout, WalkAcceptsTheLargestArraysTheContractAllows) {
+  auto traj = fixtures::trajectory(0);
+  traj.n_points = trajectory_t::MAX_POINTS;
+  traj.points_t_s.assign(trajectory_t::MAX_POINTS, 0.5);
+  traj.points_y_m.assign(trajectory_t::MAX_POINTS, 1e-7);
+  expect_walk_matches_encoding(traj);
+
+  auto status = fixtures::status(0);
+  status.n_counters = service_status_t::MAX_COUNTERS;
+  status.counter_names.assign(service_status_t::MAX_COUNTERS, "x");
+  status.counter_values.assign(service_status_t::MAX_COUNTERS, 1);
+  expect_walk_matches_encoding(status);
+}
+
+TEST(WireLayout, EveryTruncationIsRefused) {
+  const auto bytes = fixtures::encode(fixtures::status(3));
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    EXPECT_LT(walk_wire_layout(wire_layout_of<service_status_t>(), bytes.data(), n), 0) << n;
+  }
+}
+
+// trajectory_t's n_points sits after the fingerprint and 9 fixed fields.
+constexpr std::size_t kTrajectoryCountOffset = 8 + 8 + 8 + 1 + 4 * 8 + 8 + 8;
+
+TEST(WireLayout, CountsDecodeWouldAllocateForAreRefused) {
+  auto bytes = fixtures::encode(fixtures::trajectory(2));
+  ASSERT_EQ(bytes[kTrajectoryCountOffset + 3], 3u);  // the offset is right: n_points = 3
+  for (const std::int32_t bad : {-1, -2147483647 - 1, 257, 1 << 28, 2147483647}) {
+    put_be32(bytes, kTrajectoryCountOffset, bad);
+    EXPECT_LT(walk_wire_layout(wire_layout_of<trajectory_t>(), bytes.data(), bytes.size()), 0) << bad;
+  }
+  put_be32(bytes, kTrajectoryCountOffset, 4);  // within bounds but more than the bytes hold
+  EXPECT_LT(walk_wire_layout(wire_layout_of<trajectory_t>(), bytes.data(), bytes.size()), 0);
+}
+
+TEST(WireLayout, StringLengthsDecodeWouldMisreadAreRefused) {
+  auto bytes = fixtures::encode(fixtures::params(1));
+  const std::size_t string_at = bytes.size() - (4 + fixtures::params(1).source.size() + 1);
+  for (const std::int32_t bad : {0, -1, -2147483647 - 1, 2147483647, 1 << 20}) {
+    put_be32(bytes, string_at, bad);
+    EXPECT_LT(walk_wire_layout(wire_layout_of<mem_params_t>(), bytes.data(), bytes.size()), 0) << bad;
+  }
+}
+
+TEST(WireLayout, FingerprintIsReadBigEndian) {
+  const auto bytes = fixtures::encode(fixtures::sample(0));
+  EXPECT_EQ(wire_fingerprint(bytes.data(), bytes.size()), sensor_sample_t::getHash());
+  EXPECT_EQ(wire_fingerprint(bytes.data(), 7), 0);
+  EXPECT_EQ(wire_fingerprint(nullptr, 100), 0);
+}
+
+}  // namespace
+}  // namespace hystloop
