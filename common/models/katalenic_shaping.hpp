@@ -24,7 +24,8 @@ enum class ShapingKind { linear, polynomial, tanh };
 
 struct ShapingFunction {
   static constexpr std::size_t kMaxCoefficients = 8;  // polynomial degree <= 7
-  // atanh(1 - 2^-40) ~= 14.2: the tanh inverse never returns more than this many scales.
+  // The tanh inverse clamps (y - offset) / amplitude to +-(1 - 1e-12): atanh of that is 14.16,
+  // so it never returns more than this many scales.
   static constexpr double kTanhInverseLimit = 14.2;
 
   ShapingKind kind = ShapingKind::linear;
