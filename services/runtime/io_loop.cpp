@@ -1,0 +1,30 @@
+#include "runtime/io_loop.hpp"
+
+#include "core/process.hpp"
+#include "lcm/connection.hpp"
+#include "runtime/status_reporter.hpp"
+
+namespace hystloop {
+
+int run_io_loop(lcm::LCM& lcm, const IoLoopOptions& options, const std::function<void(std::int64_t)>& on_period,
+                const std::function<void()>& after_dispatch) {
+  using clock = std::chrono::steady_clock;
+  int errors = 0;
+  auto next = clock::now() + options.period;
+  while (!stop_requested()) {
+    const auto now = clock::now();
+    auto budget = std::chrono::duration_cast<std::chrono::microseconds>(next - now);
+    if (budget > options.poll_timeout) budget = options.poll_timeout;
+    if (budget.count() < 0) budget = std::chrono::microseconds(0);
+    const int n = handle_pending(lcm, budget);
+    if (n < 0) ++errors;
+    if (n > 0 && after_dispatch) after_dispatch();
+    if (clock::now() >= next) {
+      next += options.period;
+      if (on_period) on_period(wall_utime());
+    }
+  }
+  return errors;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,23 @@
+#include "runtime/service_options.hpp"
+
+namespace hystloop {
+
+void add_service_options(CLI::App& app, ServiceOptions& options) {
+  app.add_option("--config", options.config_file, "YAML configuration file")->check(CLI::ExistingFile);
+  app.add_option("--set", options.overrides, "Override a configuration value, KEY=VALUE (repeatable)");
+  app.add_option("--lcm-url", options.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
+  app.add_flag("--allow-network", options.allow_network,
+               "Accept an LCM URL whose packets can leave this host (ttl > 0, tcpq): for a multi-host lab");
+  app.add_option("--rig", options.rig_prefix, "Channel prefix of the rig")->capture_default_str();
+  app.add_option("--log-level", options.log_level, "trace, debug, info, warn or error")->capture_default_str();
+  app.add_option("--log-file", options.log_file, "Also write the log to this file");
+}
+
+Config load_service_config(const ServiceOptions& options) {
+  Config config = options.config_file.empty() ? Config() : Config::load_file(options.config_file);
+  config.apply_overrides(options.overrides);
+  return config;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,44 @@
+#pragma once
+// Builds and publishes a process's service_status_t once per report period (1 Hz by
+// default). Off the per-sample path: it builds strings. A service fills the counters
+// and timings it has, then calls publish().
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/latency_stats.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/reject_reason.hpp"
+
+namespace hystloop {
+
+class StatusReporter {
+ public:
+  StatusReporter(lcm::LCM& lcm, const std::string& channel, std::string process);
+
+  // Starts a new report: clears counters and timings, keeps process/host/pid/start.
+  void begin(std::int8_t state, std::string detail = {});
+  void counter(std::string_view name, std::uint64_t value);
+  void endpoint(std::string_view name, const EndpointCounters& counters);   // adds to rejected
+  void publisher(std::string_view name, const PublisherCounters& counters);
+  void loop_timing(const LatencyStats& stats);  // per-iteration work
+  void latency(const LatencyStats& stats);      // sample-to-command
+  void late(std::int64_t count) { status_.late = count; }
+  void add_rejected(std::int64_t count) { status_.rejected += count; }
+  bool publish(std::int64_t utime);
+
+  const service_status_t& status() const noexcept { return status_; }
+
+ private:
+  service_status_t status_{};
+  Publisher<service_status_t> publisher_;
+};
+
+// Microseconds since the UNIX epoch (for utime fields).
+std::int64_t wall_utime() noexcept;
+
+}  // namespace hystloop
