@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <type_traits>
 
 #include "core/config_impl.hpp"
 
