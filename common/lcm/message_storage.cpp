@@ -22,6 +22,16 @@ void reserve_storage(control_t& msg) {
   msg.experiment.reserve(kReservedStringChars);
 }
 
+void clear_arrays(trajectory_t& msg) noexcept {
+  msg.points_t_s.clear();
+  msg.points_y_m.clear();
+}
+
+void clear_arrays(service_status_t& msg) noexcept {
+  msg.counter_names.clear();  // destroys the strings; their heap buffers, if any, go with them
+  msg.counter_values.clear();
+}
+
 bool arrays_consistent(const trajectory_t& msg) noexcept {
   return msg.n_points >= 0 && msg.points_t_s.size() == static_cast<std::size_t>(msg.n_points) &&
          msg.points_y_m.size() == static_cast<std::size_t>(msg.n_points);

@@ -26,6 +26,16 @@ void reserve_storage(mem_params_t& msg);
 void reserve_storage(service_status_t& msg);
 void reserve_storage(control_t& msg);
 
+// clear_arrays: empties every variable array, keeping its capacity. Needed before decoding
+// into a reused message: lcm-gen's decode skips a primitive array whose count is 0, so it
+// would keep the previous message's elements.
+inline void clear_arrays(sensor_sample_t&) noexcept {}
+inline void clear_arrays(actuator_command_t&) noexcept {}
+inline void clear_arrays(mem_params_t&) noexcept {}
+inline void clear_arrays(control_t&) noexcept {}
+void clear_arrays(trajectory_t& msg) noexcept;
+void clear_arrays(service_status_t& msg) noexcept;
+
 // arrays_consistent: every variable array holds exactly its count (lcm-gen's encode reads
 // `count` elements whatever the vector's size). Publisher refuses an inconsistent
 // message even when its value check is switched off.

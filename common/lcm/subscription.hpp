@@ -74,6 +74,7 @@ class Subscription {
     if (walk_wire_layout(wire_layout_of<T>(), data, size) < 0) return reject(RejectReason::kDecodeFailed);
 
     int decoded = -1;
+    clear_arrays(scratch_);
     try {
       decoded = scratch_.decode(data, 0, static_cast<int>(size));
     } catch (...) {  // a string longer than any reserve could throw bad_alloc

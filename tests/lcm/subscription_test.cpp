@@ -72,6 +72,30 @@ TEST_F(SubscriptionTest, EveryTruncationIsRejectedAndCounted) {
   EXPECT_EQ(status.valid_count(), 0u);
 }
 
+// lcm-gen's decode leaves a primitive array untouched when its count is 0: decoding into a
+// reused message must not keep the previous message's elements.
+TEST_F(SubscriptionTest, AnEmptyArrayAfterAFullOneDecodesEmpty) {
+  Subscription<service_status_t> status(lcm_, "HX_STATUS");
+  Subscription<trajectory_t> traj(lcm_, "HX_TRAJECTORY");
+  for (std::int64_t k : {4, 5, 4, 5, 5}) {  // status(5) has no counters
+    const auto bytes = fixtures::encode(fixtures::status(k));
+    status.receive(bytes.data(), bytes.size(), 0);
+    EXPECT_EQ(fixtures::encode(status.latest()), bytes) << k;
+  }
+  EXPECT_EQ(status.counters().accepted, 5u);
+  auto empty = fixtures::trajectory(1);
+  empty.shape = trajectory_t::SINE;
+  empty.n_points = 0;
+  empty.points_t_s.clear();
+  empty.points_y_m.clear();
+  for (const auto& m : {fixtures::trajectory(5), empty, fixtures::trajectory(5), empty}) {
+    const auto bytes = fixtures::encode(m);
+    traj.receive(bytes.data(), bytes.size(), 0);
+    EXPECT_EQ(fixtures::encode(traj.latest()), bytes);
+  }
+  EXPECT_EQ(traj.counters().accepted, 4u);
+}
+
 TEST_F(SubscriptionTest, TrailingBytesAreASizeMismatch) {
   Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR");
   auto bytes = fixtures::encode(fixtures::sample(1));

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# lcm-logger records what the project publishes; the log is read back by the project's
+# endpoints, then lcm-logplayer plays it into a project subscriber: every message must
+# arrive intact, once. Run inside tools/netns-run.
+#   lcm_log_replay.sh <lcm_probe> [rounds]
+set -euo pipefail
+probe="$1"; rounds="${2:-300}"
+url="udpm://239.255.76.67:7667?ttl=0"
+[ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
+dir="$(mktemp -d)"; logger=""
+cleanup() { [ -n "$logger" ] && kill "$logger" 2>/dev/null; rm -rf "$dir"; }
+trap cleanup EXIT
+
+echo "== record with lcm-logger"
+lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*' "$dir/run.lcmlog" &
+logger=$!
+sleep 0.5  # lcm-logger gives no ready signal; it subscribes at start-up
+"$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 2000
+sleep 0.3
+kill -INT "$logger"; wait "$logger" || true; logger=""
+
+echo "== read the log back"
+"$probe" check-log --file "$dir/run.lcmlog" --prefix HX_ --rounds "$rounds"
+
+echo "== play it with lcm-logplayer into a subscriber"
+"$probe" subscribe --url "$url" --prefix HX_ --rounds "$rounds" --timeout-s 8 --ready-file "$dir/ready" &
+sub=$!
+for _ in $(seq 100); do [ -e "$dir/ready" ] && break; sleep 0.05; done
+[ -e "$dir/ready" ] || { echo "subscriber never became ready" >&2; kill "$sub"; exit 1; }
+lcm-logplayer --lcm-url="$url" --speed=1.0 "$dir/run.lcmlog"
+wait "$sub"

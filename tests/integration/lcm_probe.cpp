@@ -1,0 +1,285 @@
+// A test program for the LCM plumbing across processes (tests/integration):
+//
+//   lcm_probe publish   --url U --prefix P --rounds N [--rate-hz R]
+//   lcm_probe subscribe --url U --prefix P --rounds N [--timeout-s T] [--ready-file F]
+//   lcm_probe write-log --file F --prefix P --rounds N      (an LCM event log, no network)
+//   lcm_probe check-log --file F --prefix P --rounds N      (read one back, e.g. lcm-logger's)
+//
+// Round k sends fixtures::sample(k) and command(k); every 10th round (j = k / 10) also
+// trajectory(j), params(j), status(j) and control(j). A receiver recovers k or j from the
+// message, and requires every expected message exactly once, byte-identical to the fixture,
+// with nothing rejected. Exit status 0 = all intact, 1 = something missing or altered.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/message_fixtures.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+
+namespace hystloop {
+namespace {
+
+struct Options {
+  std::string mode;
+  std::string url;
+  std::string prefix{kDefaultRigPrefix};
+  std::string file;
+  std::string ready_file;
+  std::int64_t rounds = 100;
+  double rate_hz = 2000.0;
+  double timeout_s = 5.0;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  if (argc < 2) throw std::invalid_argument("usage: lcm_probe publish|subscribe|write-log|check-log [options]");
+  o.mode = argv[1];
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string key = argv[i];
+    const std::string value = argv[i + 1];
+    if (key == "--url") o.url = value;
+    else if (key == "--prefix") o.prefix = value;
+    else if (key == "--file") o.file = value;
+    else if (key == "--ready-file") o.ready_file = value;
+    else if (key == "--rounds") o.rounds = std::stoll(value);
+    else if (key == "--rate-hz") o.rate_hz = std::stod(value);
+    else if (key == "--timeout-s") o.timeout_s = std::stod(value);
+    else throw std::invalid_argument("unknown option " + key);
+  }
+  return o;
+}
+
+std::int64_t rare_rounds(std::int64_t rounds) { return (rounds + 9) / 10; }
+
+// Calls emit(channel, message) for every message of round k, in order.
+template <class Emit>
+void emit_round(const ChannelNames& ch, std::int64_t k, Emit&& emit) {
+  emit(ch.sensor, fixtures::sample(k));
+  emit(ch.command, fixtures::command(k));
+  if (k % 10 == 0) {
+    const std::int64_t j = k / 10;
+    emit(ch.trajectory, fixtures::trajectory(j));
+    emit(ch.params, fixtures::params(j));
+    emit(ch.status, fixtures::status(j));
+    emit(ch.control, fixtures::control(j));
+  }
+}
+
+// The fixture index a message carries.
+std::int64_t index_of(const sensor_sample_t& m) { return m.seq; }
+std::int64_t index_of(const actuator_command_t& m) { return m.sample_seq; }
+std::int64_t index_of(const trajectory_t& m) { return m.version - 1; }
+std::int64_t index_of(const mem_params_t& m) { return m.version - 1; }
+std::int64_t index_of(const service_status_t& m) { return m.pid - 4242; }
+std::int64_t index_of(const control_t& m) { return m.request_id - 100; }
+sensor_sample_t fixture_for(const sensor_sample_t*, std::int64_t i) { return fixtures::sample(i); }
+actuator_command_t fixture_for(const actuator_command_t*, std::int64_t i) { return fixtures::command(i); }
+trajectory_t fixture_for(const trajectory_t*, std::int64_t i) { return fixtures::trajectory(i); }
+mem_params_t fixture_for(const mem_params_t*, std::int64_t i) { return fixtures::params(i); }
+service_status_t fixture_for(const service_status_t*, std::int64_t i) { return fixtures::status(i); }
+control_t fixture_for(const control_t*, std::int64_t i) { return fixtures::control(i); }
+
+// Checks what arrives on one channel against the fixtures.
+template <class T>
+class Expectation {
+ public:
+  Expectation(std::string channel, std::int64_t expected) : channel_(std::move(channel)), expected_(expected) {}
+
+  void see(const T& msg) {
+    const std::int64_t i = index_of(msg);
+    if (i < 0 || i >= expected_) {
+      ++altered_;
+    } else if (!seen_.insert(i).second) {
+      ++duplicates_;
+    } else if (fixtures::encode(msg) != fixtures::encode(fixture_for(static_cast<const T*>(nullptr), i))) {
+      ++altered_;
+    }
+  }
+  bool complete() const { return static_cast<std::int64_t>(seen_.size()) == expected_; }
+  bool report(std::uint64_t rejected) const {
+    const bool ok = complete() && altered_ == 0 && duplicates_ == 0 && rejected == 0;
+    std::printf("%-16s expected %6lld  intact %6zu  altered %4lld  duplicate %4lld  rejected %4llu  %s\n",
+                channel_.c_str(), static_cast<long long>(expected_), seen_.size(), static_cast<long long>(altered_),
+                static_cast<long long>(duplicates_), static_cast<unsigned long long>(rejected), ok ? "ok" : "FAIL");
+    return ok;
+  }
+
+ private:
+  std::string channel_;
+  std::int64_t expected_;
+  std::set<std::int64_t> seen_;
+  std::int64_t altered_ = 0;
+  std::int64_t duplicates_ = 0;
+};
+
+// All six expectations, fed either by Subscriptions or by a log file.
+struct Expectations {
+  Expectations(const ChannelNames& ch, std::int64_t rounds)
+      : sensor(ch.sensor, rounds),
+        command(ch.command, rounds),
+        trajectory(ch.trajectory, rare_rounds(rounds)),
+        params(ch.params, rare_rounds(rounds)),
+        status(ch.status, rare_rounds(rounds)),
+        control(ch.control, rare_rounds(rounds)) {}
+  bool complete() const {
+    return sensor.complete() && command.complete() && trajectory.complete() && params.complete() &&
+           status.complete() && control.complete();
+  }
+  Expectation<sensor_sample_t> sensor;
+  Expectation<actuator_command_t> command;
+  Expectation<trajectory_t> trajectory;
+  Expectation<mem_params_t> params;
+  Expectation<service_status_t> status;
+  Expectation<control_t> control;
+};
+
+int publish(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  Publisher<sensor_sample_t> sensor(*lcm, ch.sensor);
+  Publisher<actuator_command_t> command(*lcm, ch.command);
+  Publisher<trajectory_t> trajectory(*lcm, ch.trajectory);
+  Publisher<mem_params_t> params(*lcm, ch.params);
+  Publisher<service_status_t> status(*lcm, ch.status);
+  Publisher<control_t> control(*lcm, ch.control);
+  std::uint64_t failed = 0;
+  const auto emit = [&](const std::string& channel, const auto& msg) {
+    using T = std::decay_t<decltype(msg)>;
+    bool ok = false;
+    if constexpr (std::is_same_v<T, sensor_sample_t>) ok = sensor.publish(msg);
+    else if constexpr (std::is_same_v<T, actuator_command_t>) ok = command.publish(msg);
+    else if constexpr (std::is_same_v<T, trajectory_t>) ok = trajectory.publish(msg);
+    else if constexpr (std::is_same_v<T, mem_params_t>) ok = params.publish(msg);
+    else if constexpr (std::is_same_v<T, service_status_t>) ok = status.publish(msg);
+    else ok = control.publish(msg);
+    (void)channel;
+    failed += ok ? 0 : 1;
+  };
+  const auto period = std::chrono::duration<double>(1.0 / o.rate_hz);
+  const auto start = std::chrono::steady_clock::now();
+  for (std::int64_t k = 0; k < o.rounds; ++k) {
+    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                              period * static_cast<double>(k)));
+    emit_round(ch, k, emit);
+  }
+  std::printf("published %lld rounds, %llu failures\n", static_cast<long long>(o.rounds),
+              static_cast<unsigned long long>(failed));
+  return failed == 0 ? 0 : 1;
+}
+
+int subscribe(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  Expectations expect(ch, o.rounds);
+  const int queue = static_cast<int>(2 * o.rounds + 64);  // a slow start must not drop
+  Subscription<sensor_sample_t>::Options so;
+  so.queue_capacity = queue;
+  Subscription<actuator_command_t>::Options co;
+  co.queue_capacity = queue;
+  Subscription<sensor_sample_t> sensor(*lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
+  Subscription<actuator_command_t> command(*lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
+  Subscription<trajectory_t> trajectory(*lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
+  Subscription<mem_params_t> params(*lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
+  Subscription<service_status_t> status(*lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
+  Subscription<control_t> control(*lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
+  if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
+
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
+  while (!expect.complete() && std::chrono::steady_clock::now() < deadline) {
+    if (handle_pending(*lcm, std::chrono::milliseconds(10)) < 0) {
+      std::fprintf(stderr, "lcm_probe: LCM reported an error\n");
+      return 1;
+    }
+  }
+  handle_pending(*lcm, std::chrono::milliseconds(50));  // late duplicates would show here
+  bool ok = expect.sensor.report(sensor.counters().rejected_total());
+  ok = expect.command.report(command.counters().rejected_total()) && ok;
+  ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
+  ok = expect.params.report(params.counters().rejected_total()) && ok;
+  ok = expect.status.report(status.counters().rejected_total()) && ok;
+  ok = expect.control.report(control.counters().rejected_total()) && ok;
+  return ok ? 0 : 1;
+}
+
+int write_log(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  lcm::LogFile log(o.file, "w");
+  if (!log.good()) throw std::runtime_error("cannot write " + o.file);
+  std::int64_t number = 0;
+  for (std::int64_t k = 0; k < o.rounds; ++k) {
+    emit_round(ch, k, [&](const std::string& channel, const auto& msg) {
+      auto bytes = fixtures::encode(msg);
+      lcm::LogEvent event{};
+      event.eventnum = number++;
+      event.timestamp = fixtures::kBaseUtime + 100 * k;
+      event.channel = channel;
+      event.datalen = static_cast<int32_t>(bytes.size());
+      event.data = bytes.data();
+      if (log.writeEvent(&event) != 0) throw std::runtime_error("write failed: " + o.file);
+    });
+  }
+  std::printf("wrote %lld events to %s\n", static_cast<long long>(number), o.file.c_str());
+  return 0;
+}
+
+int check_log(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  lcm::LogFile log(o.file, "r");
+  if (!log.good()) throw std::runtime_error("cannot read " + o.file);
+  // A memq LCM only to host the Subscriptions: events are fed to receive() directly.
+  lcm::LCM lcm("memq://");
+  Expectations expect(ch, o.rounds);
+  Subscription<sensor_sample_t> sensor(lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); });
+  Subscription<actuator_command_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
+  Subscription<trajectory_t> trajectory(lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
+  Subscription<mem_params_t> params(lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
+  Subscription<service_status_t> status(lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
+  Subscription<control_t> control(lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
+  std::int64_t other = 0;
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    const auto size = static_cast<std::size_t>(event->datalen);
+    if (event->channel == ch.sensor) sensor.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.command) command.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.trajectory) trajectory.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.params) params.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.status) status.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.control) control.receive(event->data, size, event->timestamp);
+    else ++other;
+  }
+  bool ok = expect.sensor.report(sensor.counters().rejected_total());
+  ok = expect.command.report(command.counters().rejected_total()) && ok;
+  ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
+  ok = expect.params.report(params.counters().rejected_total()) && ok;
+  ok = expect.status.report(status.counters().rejected_total()) && ok;
+  ok = expect.control.report(control.counters().rejected_total()) && ok;
+  if (other != 0) std::printf("%lld events on other channels\n", static_cast<long long>(other));
+  return ok && other == 0 ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace hystloop
+
+int main(int argc, char** argv) {
+  try {
+    const auto o = hystloop::parse(argc, argv);
+    if (o.mode == "publish") return hystloop::publish(o);
+    if (o.mode == "subscribe") return hystloop::subscribe(o);
+    if (o.mode == "write-log") return hystloop::write_log(o);
+    if (o.mode == "check-log") return hystloop::check_log(o);
+    std::fprintf(stderr, "lcm_probe: unknown mode %s\n", o.mode.c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lcm_probe: %s\n", e.what());
+    return 2;
+  }
+}
