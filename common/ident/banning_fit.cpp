@@ -1,0 +1,381 @@
+#include "ident/banning_fit.hpp"
+
+#include <ceres/ceres.h>
+
+#include <boost/math/tools/minima.hpp>
+
+#include <Eigen/Dense>
+#include <unsupported/Eigen/MatrixFunctions>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <numbers>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+
+void BanningFitOptions::validate() const {
+  require_positive("frequency_threshold_Hz", frequency_threshold_Hz);
+  require_positive("small_amplitude_max_V", small_amplitude_max_V);
+  require_non_negative("min_offset_span_V", min_offset_span_V);
+  loop.validate();
+  require_positive("max_solver_time_s", max_solver_time_s);
+}
+
+namespace {
+
+struct SineFit {
+  double offset = 0.0, amplitude = 0.0, rss = 0.0;
+};
+
+// Least squares x = c0 + cs sin(w k) + cc cos(w k) at a given frequency.
+SineFit sine_fit(std::span<const double> x, double f, double fs) {
+  Eigen::Matrix3d g = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  double xx = 0.0;
+  const double w = 2.0 * std::numbers::pi * f / fs;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const Eigen::Vector3d phi(1.0, std::sin(w * static_cast<double>(k)), std::cos(w * static_cast<double>(k)));
+    g += phi * phi.transpose();
+    r += phi * x[k];
+    xx += x[k] * x[k];
+  }
+  const Eigen::Vector3d c = g.ldlt().solve(r);
+  return {c[0], std::hypot(c[1], c[2]), xx - c.dot(r)};
+}
+
+}  // namespace
+
+SineEstimate estimate_sine(std::span<const double> u, double fs, bool refine_frequency) {
+  SineEstimate e;
+  if (u.size() < 8 || !(fs > 0.0)) return e;
+  const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
+  const double mid = 0.5 * (*lo + *hi);
+  if (!(*hi > *lo)) return e;
+  // Crossings of the mid level, interpolated: half a period apart.
+  double first = -1.0, last = -1.0;
+  std::size_t count = 0;
+  for (std::size_t k = 1; k < u.size(); ++k) {
+    const double a = u[k - 1] - mid, b = u[k] - mid;
+    if ((a < 0.0 && b >= 0.0) || (a > 0.0 && b <= 0.0)) {
+      const double t = (static_cast<double>(k - 1) + a / (a - b)) / fs;
+      if (count == 0) first = t;
+      last = t;
+      ++count;
+    }
+  }
+  if (count < 3 || !(last > first)) return e;
+  // Linear interpolation of the crossings is biased at a few samples per period: refine the
+  // frequency by minimising the least-squares residual of the sine fit around it.
+  const double f0 = static_cast<double>(count - 1) / (2.0 * (last - first));
+  if (!refine_frequency) {
+    const SineFit fit = sine_fit(u, f0, fs);
+    e.frequency_Hz = f0, e.offset = fit.offset, e.amplitude = fit.amplitude;
+    e.ok = std::isfinite(e.amplitude) && e.amplitude > 0.0;
+    return e;
+  }
+  std::uintmax_t iterations = 60;
+  const auto best = boost::math::tools::brent_find_minima(
+      [&](double f) { return sine_fit(u, f, fs).rss; }, f0 * (1.0 - 2e-3), f0 * (1.0 + 2e-3), 40, iterations);
+  const SineFit fit = sine_fit(u, best.first, fs);
+  e.frequency_Hz = best.first;
+  e.offset = fit.offset;
+  e.amplitude = fit.amplitude;
+  e.ok = std::isfinite(e.amplitude) && e.amplitude > 0.0;
+  return e;
+}
+
+double first_harmonic_amplitude(std::span<const double> y, double f, double fs) {
+  return sine_fit(y, f, fs).amplitude;
+}
+
+double stage_magnitude_model(double k, double c, double omega, double T) noexcept {
+  if (!(T > 0.0)) return k / std::hypot(k - omega * omega, c * omega);
+  // Exact ZOH: exp of the augmented [A B; 0 0] T gives Phi and Gamma at once.
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  m(0, 1) = 1.0;
+  m(1, 0) = -k;
+  m(1, 1) = -c;
+  m(1, 2) = k;
+  const Eigen::Matrix3d e = (m * T).exp();
+  using C = std::complex<double>;
+  const C z = std::polar(1.0, omega * T);
+  // (z I - Phi)^{-1} Gamma, first row (y = x_0).
+  const C a00 = z - e(0, 0), a01 = -e(0, 1), a10 = -e(1, 0), a11 = z - e(1, 1);
+  const C det = a00 * a11 - a01 * a10;
+  const C x0 = (a11 * e(0, 2) - a01 * e(1, 2)) / det;
+  return std::abs(x0);
+}
+
+namespace {
+
+// (21) and (24) of Theorem 3 with b in nm/V (x[0]) and alpha in 1/V (x[1]); a fixed.
+struct SlopeResidual {
+  double a_nm, amplitude, slope_nm;
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    using std::tanh;
+    const T& b = x[0];
+    const T& al = x[1];
+    const T zeta = T(a_nm) + (b - T(a_nm)) / al * tanh(al * T(amplitude)) / T(amplitude);
+    r[0] = (zeta - T(slope_nm)) / T(slope_nm);
+    return true;
+  }
+};
+
+struct AreaResidual {
+  double a_nm, amplitude, area_nmV;
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    using std::tanh;
+    const T& b = x[0];
+    const T& al = x[1];
+    const T eps = T(4.0) * (T(a_nm) - b) / al * (T(amplitude) - tanh(al * T(amplitude)) / al);
+    r[0] = (eps - T(area_nmV)) / T(area_nmV);
+    return true;
+  }
+};
+
+struct MagnitudeResidual {
+  double omega, magnitude, sample_time;
+  bool operator()(const double* x, double* r) const {
+    r[0] = (stage_magnitude_model(std::exp(x[0]), std::exp(x[1]), omega, sample_time) - magnitude) / magnitude;
+    return true;
+  }
+};
+
+ceres::Solver::Options solver_options(double time_s) {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.max_num_iterations = 200;
+  o.max_solver_time_in_seconds = time_s;
+  o.logging_type = ceres::SILENT;
+  o.function_tolerance = 1e-14;
+  o.parameter_tolerance = 1e-12;
+  o.gradient_tolerance = 1e-16;
+  return o;
+}
+
+double ch_slope_closed(double a, double b, double alpha, double amp) {
+  return a + (b - a) / alpha * std::tanh(alpha * amp) / amp;
+}
+
+BanningFitResult refuse(BanningFitResult r, FitStatus s, std::string why) {
+  r.status = s;
+  r.reason = std::move(why);
+  return r;
+}
+
+// Inverts (25) for h (paper order): ptp = 2 a h A + 2 (b - a)/alpha tanh(alpha A h), increasing in h.
+double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp) {
+  auto f = [&](double h) { return 2.0 * p.a * h * amp + 2.0 * (p.b - p.a) / p.alpha * std::tanh(p.alpha * amp * h) - ptp; };
+  double lo = 0.0, hi = 1.0;
+  while (f(hi) < 0.0 && hi < 1e6) hi *= 2.0;
+  for (int i = 0; i < 100; ++i) {
+    const double m = 0.5 * (lo + hi);
+    (f(m) < 0.0 ? lo : hi) = m;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments, const BanningFitOptions& o) {
+  o.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto stamp = [&](BanningFitResult r) {
+    r.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  };
+  BanningFitResult res;
+  // 1. Features of every experiment.
+  for (std::size_t i = 0; i < experiments.size(); ++i) {
+    const auto& ex = experiments[i];
+    BanningPoint pt;
+    if (ex.u.size() != ex.y.size() || ex.u.empty()) {
+      std::ostringstream s;
+      s << "experiment " << i << ": u has " << ex.u.size() << " samples, y " << ex.y.size();
+      return stamp(refuse(res, FitStatus::size_mismatch, s.str()));
+    }
+    for (std::size_t k = 0; k < ex.u.size(); ++k) {
+      if (!std::isfinite(ex.u[k]) || !std::isfinite(ex.y[k])) {
+        std::ostringstream s;
+        s << "experiment " << i << ", sample " << k << " is not finite";
+        return stamp(refuse(res, FitStatus::non_finite_data, s.str()));
+      }
+    }
+    SineEstimate se = estimate_sine(ex.u, ex.sample_rate_Hz, false);
+    if (se.ok && se.frequency_Hz >= o.frequency_threshold_Hz) se = estimate_sine(ex.u, ex.sample_rate_Hz, true);
+    if (!se.ok) {
+      pt.note = "input is not a sine of at least one period";
+      res.points.push_back(pt);
+      continue;
+    }
+    pt.offset_V = se.offset, pt.amplitude_V = se.amplitude, pt.frequency_Hz = se.frequency_Hz;
+    pt.magnitude_experiment = se.frequency_Hz >= o.frequency_threshold_Hz;
+    if (pt.magnitude_experiment) {
+      pt.magnitude = first_harmonic_amplitude(ex.y, se.frequency_Hz, ex.sample_rate_Hz);  // ptp/2 for now
+      pt.used = true;
+    } else {
+      const LoopFeatureResult lf = extract_loop_features(ex.u, ex.y, o.loop);
+      if (!lf.ok()) {
+        pt.note = std::string("loop features: ") + std::string(describe(lf.status));
+      } else {
+        pt.features = lf.features;
+        pt.used = true;
+      }
+    }
+    res.points.push_back(pt);
+  }
+  // 2. a from the centres.
+  std::vector<const BanningPoint*> loops, mags;
+  for (const auto& p : res.points) {
+    if (p.used) (p.magnitude_experiment ? mags : loops).push_back(&p);
+  }
+  double umin = 1e300, umax = -1e300;
+  for (const auto* p : loops) umin = std::min(umin, p->features.u_centre), umax = std::max(umax, p->features.u_centre);
+  if (loops.size() < 2 || umax - umin < o.min_offset_span_V) {
+    std::ostringstream s;
+    s << loops.size() << " usable loop experiments whose centres span " << (loops.empty() ? 0.0 : umax - umin)
+      << " V; need two or more offsets spanning >= " << o.min_offset_span_V << " V to identify a";
+    return stamp(refuse(res, FitStatus::too_few_samples, s.str()));
+  }
+  {
+    Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d r = Eigen::Vector2d::Zero();
+    for (const auto* p : loops) {
+      const Eigen::Vector2d phi(p->features.u_centre, 1.0);
+      g += phi * phi.transpose();
+      r += phi * p->features.y_centre;
+    }
+    const Eigen::Vector2d c = g.ldlt().solve(r);
+    res.hysteresis.a = c[0];
+    double ss = 0.0;
+    for (const auto* p : loops) ss += std::pow(p->features.y_centre - c[0] * p->features.u_centre - c[1], 2);
+    res.centre_rms_m = std::sqrt(ss / static_cast<double>(loops.size()));
+  }
+  const double a = res.hysteresis.a;
+  // 3. b and alpha seeds.
+  double b0 = 0.0;
+  {
+    std::size_t n = 0;
+    for (const auto* p : loops) if (p->amplitude_V <= o.small_amplitude_max_V) b0 += p->features.slope, ++n;
+    if (n == 0) {  // no small loop: the smallest one
+      const auto* smallest = *std::min_element(loops.begin(), loops.end(),
+                                               [](auto* x, auto* y) { return x->amplitude_V < y->amplitude_V; });
+      b0 = smallest->features.slope, n = 1;
+    }
+    b0 /= static_cast<double>(n);
+  }
+  if (!(a > 0.0) || !(b0 > 0.0) || !(b0 < a)) {
+    std::ostringstream s;
+    s << "a = " << a << " m/V, small-loop slope b = " << b0 << " m/V: need 0 < b < a (a loop with area)";
+    return stamp(refuse(res, FitStatus::out_of_range, s.str()));
+  }
+  std::vector<double> alphas;
+  for (const auto* p : loops) {
+    if (p->amplitude_V > o.small_amplitude_max_V && p->features.area > 0.0) {
+      alphas.push_back(3.0 * p->features.area / (4.0 * (a - b0) * std::pow(p->amplitude_V, 3)));
+    }
+  }
+  if (alphas.empty()) {
+    return stamp(refuse(res, FitStatus::too_few_samples,
+                        "no loop above small_amplitude_max_V with a positive area: alpha cannot be identified"));
+  }
+  std::nth_element(alphas.begin(), alphas.begin() + static_cast<std::ptrdiff_t>(alphas.size() / 2), alphas.end());
+  double x[2] = {b0 * 1e9, alphas[alphas.size() / 2]};
+  // 4. (b, alpha) jointly on the exact (21) and (24).
+  {
+    ceres::Problem problem;
+    for (const auto* p : loops) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SlopeResidual, 1, 2>(
+                                   new SlopeResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9}),
+                               nullptr, x);
+      if (p->amplitude_V > o.small_amplitude_max_V) {
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AreaResidual, 1, 2>(
+                                     new AreaResidual{a * 1e9, p->amplitude_V, p->features.area * 1e9}),
+                                 nullptr, x);
+      }
+    }
+    problem.SetParameterLowerBound(x, 0, 1e-6);
+    problem.SetParameterLowerBound(x, 1, 1e-9);
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options(o.max_solver_time_s), &problem, &summary);
+    if (!summary.IsSolutionUsable()) return stamp(refuse(res, FitStatus::solver_failure, "Ceres (b, alpha): " + summary.message));
+  }
+  res.hysteresis.b = x[0] * 1e-9;
+  res.hysteresis.alpha = x[1];
+  try {
+    res.hysteresis.validate();
+  } catch (const ParameterError& e) {
+    return stamp(refuse(res, FitStatus::out_of_range, std::string("hysteresis: ") + e.what()));
+  }
+  {
+    double ss = 0.0, sa = 0.0;
+    std::size_t na = 0;
+    for (const auto* p : loops) {
+      const double z = ch_slope_closed(a, res.hysteresis.b, res.hysteresis.alpha, p->amplitude_V);
+      ss += std::pow((z - p->features.slope) / p->features.slope, 2);
+      if (p->amplitude_V > o.small_amplitude_max_V) {
+        const double al = res.hysteresis.alpha, A = p->amplitude_V;
+        const double eps = 4.0 * (a - res.hysteresis.b) / al * (A - std::tanh(al * A) / al);
+        sa += std::pow((eps - p->features.area) / p->features.area, 2), ++na;
+      }
+    }
+    res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
+    res.area_rel_rms = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
+  }
+  // 5. k, c from the magnitudes.
+  if (mags.size() < 3) {
+    res.status = FitStatus::ok;
+    res.reason = mags.empty() ? "no magnitude experiments: stage (k, c) not identified"
+                              : "fewer than 3 magnitude experiments: stage (k, c) not identified";
+    return stamp(res);
+  }
+  double fs = experiments.front().sample_rate_Hz;
+  for (auto& p : res.points) {
+    if (!p.used || !p.magnitude_experiment) continue;
+    const double ptp = 2.0 * p.magnitude;
+    if (o.order == BanningOrder::kStageThenHysteresis) {
+      p.magnitude = invert_peak_to_peak(res.hysteresis, ptp, p.amplitude_V);
+    } else {  // hysteresis first: the stage sees a loop of slope (21) at the drive amplitude
+      p.magnitude = ptp / (2.0 * ch_slope_closed(a, res.hysteresis.b, res.hysteresis.alpha, p.amplitude_V) * p.amplitude_V);
+    }
+  }
+  double peak_h = 0.0, peak_f = 0.0;
+  for (const auto& p : res.points) {
+    if (p.used && p.magnitude_experiment && p.magnitude > peak_h) peak_h = p.magnitude, peak_f = p.frequency_Hz;
+  }
+  // Seed: resonance at the peak, damping from its height (h_peak ~ 1 / (2 zeta)).
+  const double wp = 2.0 * std::numbers::pi * peak_f;
+  double k0 = wp * wp, c0 = peak_h > 1.2 ? wp / peak_h : wp;
+  double kc[2] = {std::log(k0), std::log(c0)};
+  ceres::Problem problem;
+  for (const auto& p : res.points) {
+    if (!p.used || !p.magnitude_experiment) continue;
+    problem.AddResidualBlock(new ceres::NumericDiffCostFunction<MagnitudeResidual, ceres::CENTRAL, 1, 2>(
+                                 new MagnitudeResidual{2.0 * std::numbers::pi * p.frequency_Hz, p.magnitude,
+                                                       o.zoh_magnitude ? 1.0 / fs : 0.0}),
+                             nullptr, kc);
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options(o.max_solver_time_s), &problem, &summary);
+  if (!summary.IsSolutionUsable()) return stamp(refuse(res, FitStatus::solver_failure, "Ceres (k, c): " + summary.message));
+  res.stage.k = std::exp(kc[0]);
+  res.stage.c = std::exp(kc[1]);
+  try {
+    res.stage.validate();
+  } catch (const ParameterError& e) {
+    return stamp(refuse(res, FitStatus::out_of_range, std::string("stage: ") + e.what()));
+  }
+  res.magnitude_rel_rms = std::sqrt(2.0 * summary.final_cost / static_cast<double>(mags.size()));
+  res.stage_identified = true;
+  res.status = FitStatus::ok;
+  return stamp(res);
+}
+
+}  // namespace hystloop

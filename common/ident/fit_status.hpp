@@ -1,0 +1,25 @@
+#pragma once
+// Why a fit was refused. Every fitter in common/ident returns one of these with a sentence in
+// `reason`; only `ok` means the parameters may be used.
+
+#include <string_view>
+
+namespace hystloop {
+
+enum class FitStatus {
+  ok,
+  invalid_options,   // the options themselves failed validate()
+  size_mismatch,     // u and y (or t) spans of different length, or empty
+  non_finite_data,   // NaN / Inf in the samples
+  constant_input,    // u spans less than the minimum input range
+  too_few_branches,  // fewer complete branches (after the first reversal) than required
+  too_few_samples,   // too few usable samples (e.g. all below the SNR threshold)
+  out_of_range,      // the optimum lies outside the physical range (c1 <= 0, c2 < 0, ...)
+  solver_failure,    // the nonlinear solver did not return a usable solution
+  no_improvement,    // (online) valid, but does not predict held-out data better than the set in use
+  poisoned_window,   // (online) the window holds dropped / stuck / non-finite samples
+};
+
+std::string_view to_string(FitStatus status) noexcept;
+
+}  // namespace hystloop
