@@ -54,6 +54,24 @@ std::string lcm_url_option(const LcmUrl& url, std::string_view key) {
   return found;  // the last occurrence wins, as in LCM's own parser
 }
 
+std::string lcm_url_with_default_option(std::string_view url, std::string_view key, std::string_view value) {
+  const LcmUrl parsed = parse_lcm_url(url);
+  std::string_view options = parsed.options;
+  while (!options.empty()) {  // present, even with an empty value: leave it to the caller
+    const auto amp = options.find('&');
+    const std::string_view pair = options.substr(0, amp);
+    if (pair.substr(0, pair.find('=')) == key) return std::string(url);
+    if (amp == std::string_view::npos) break;
+    options.remove_prefix(amp + 1);
+  }
+  std::string out(url);
+  out += parsed.options.empty() ? (url.find('?') == std::string_view::npos ? "?" : "") : "&";
+  out += key;
+  out += '=';
+  out += value;
+  return out;
+}
+
 std::string checked_lcm_url(std::string_view url, bool allow_network) {
   const LcmUrl parsed = parse_lcm_url(url);
   if (parsed.provider == "memq" || parsed.provider == "file") return std::string(url);

@@ -5,7 +5,7 @@
 #   lcm_log_replay.sh <lcm_probe> [rounds]
 set -euo pipefail
 probe="$1"; rounds="${2:-300}"
-url="udpm://239.255.76.67:7667?ttl=0"
+url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"  # 10 kHz survives a busy CPU (see url.hpp)
 [ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
 dir="$(mktemp -d)"; logger=""
 cleanup() { [ -n "$logger" ] && kill "$logger" 2>/dev/null; rm -rf "$dir"; }

@@ -4,12 +4,16 @@
 //   lcm_probe subscribe --url U --prefix P --rounds N [--timeout-s T] [--ready-file F]
 //   lcm_probe write-log --file F --prefix P --rounds N      (an LCM event log, no network)
 //   lcm_probe check-log --file F --prefix P --rounds N      (read one back, e.g. lcm-logger's)
+//   lcm_probe echo      --url U --prefix P --rounds N [--ready-file F]   answers N samples
+//   lcm_probe ping      --url U --prefix P --rounds N [--rate-hz R]      round-trip percentiles
 //
 // Round k sends fixtures::sample(k) and command(k); every 10th round (j = k / 10) also
 // trajectory(j), params(j), status(j) and control(j). A receiver recovers k or j from the
 // message, and requires every expected message exactly once, byte-identical to the fixture,
 // with nothing rejected. Exit status 0 = all intact, 1 = something missing or altered.
+#include <algorithm>
 #include <chrono>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -266,6 +270,64 @@ int check_log(const Options& o) {
   return ok && other == 0 ? 0 : 1;
 }
 
+// Answers each sample k with the command for tick k + 1, as a compensator would.
+int echo(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  Publisher<actuator_command_t> command(*lcm, ch.command);
+  std::int64_t answered = 0;
+  Subscription<sensor_sample_t>::Options so;
+  so.queue_capacity = 1000;
+  Subscription<sensor_sample_t> sensor(*lcm, ch.sensor, [&](const sensor_sample_t& m, std::int64_t) {
+    auto c = fixtures::command(m.seq);
+    answered += command.publish(c) ? 1 : 0;
+  }, so);
+  if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
+  while (answered < o.rounds && std::chrono::steady_clock::now() < deadline) {
+    if (handle_pending(*lcm, std::chrono::milliseconds(10)) < 0) return 1;
+  }
+  return answered == o.rounds ? 0 : 1;
+}
+
+// Sends samples at rate R and times sample -> command round trips through an echo process.
+int ping(const Options& o) {
+  using Clock = std::chrono::steady_clock;
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  Publisher<sensor_sample_t> sensor(*lcm, ch.sensor);
+  std::vector<Clock::time_point> sent(static_cast<std::size_t>(o.rounds));
+  std::vector<double> rtt_us;
+  rtt_us.reserve(sent.size());
+  Subscription<actuator_command_t>::Options co;
+  co.queue_capacity = 1000;
+  Subscription<actuator_command_t> command(*lcm, ch.command, [&](const actuator_command_t& m, std::int64_t) {
+    if (m.sample_seq >= 0 && m.sample_seq < o.rounds) {
+      rtt_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent[static_cast<std::size_t>(m.sample_seq)]).count());
+    }
+  }, co);
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / o.rate_hz));
+  const auto start = Clock::now();
+  for (std::int64_t k = 0; k < o.rounds; ++k) {
+    const auto due = start + period * k;
+    while (Clock::now() < due) {  // serve replies while waiting for the next tick
+      handle_pending(*lcm, std::chrono::duration_cast<std::chrono::microseconds>(due - Clock::now()));
+    }
+    sent[static_cast<std::size_t>(k)] = Clock::now();
+    sensor.publish(fixtures::sample(k));
+  }
+  const auto deadline = Clock::now() + std::chrono::seconds(2);
+  while (static_cast<std::int64_t>(rtt_us.size()) < o.rounds && Clock::now() < deadline) {
+    handle_pending(*lcm, std::chrono::milliseconds(10));
+  }
+  if (rtt_us.empty()) return 1;
+  std::sort(rtt_us.begin(), rtt_us.end());
+  const auto pct = [&](double p) { return rtt_us[static_cast<std::size_t>(p * static_cast<double>(rtt_us.size() - 1))]; };
+  std::printf("round trips %zu/%lld at %.0f Hz: p50 %.1f us  p99 %.1f us  max %.1f us\n", rtt_us.size(),
+              static_cast<long long>(o.rounds), o.rate_hz, pct(0.5), pct(0.99), rtt_us.back());
+  return static_cast<std::int64_t>(rtt_us.size()) == o.rounds ? 0 : 1;
+}
+
 }  // namespace
 }  // namespace hystloop
 
@@ -276,6 +338,8 @@ int main(int argc, char** argv) {
     if (o.mode == "subscribe") return hystloop::subscribe(o);
     if (o.mode == "write-log") return hystloop::write_log(o);
     if (o.mode == "check-log") return hystloop::check_log(o);
+    if (o.mode == "echo") return hystloop::echo(o);
+    if (o.mode == "ping") return hystloop::ping(o);
     std::fprintf(stderr, "lcm_probe: unknown mode %s\n", o.mode.c_str());
     return 2;
   } catch (const std::exception& e) {

@@ -4,7 +4,7 @@
 #   lcm_udpm_exchange.sh <lcm_probe> [rounds]
 set -euo pipefail
 probe="$1"; rounds="${2:-400}"
-url="udpm://239.255.76.67:7667?ttl=0"
+url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"  # 10 kHz survives a busy CPU (see url.hpp)
 [ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
 dir="$(mktemp -d)"; trap 'rm -rf "$dir"' EXIT
 

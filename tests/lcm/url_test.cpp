@@ -55,6 +55,17 @@ TEST(LcmUrl, LocalProvidersAreAlwaysFine_TcpqNeedsTheFlag) {
   EXPECT_NO_THROW(checked_lcm_url("tcpq://lab-hub:7700", true));
 }
 
+TEST(LcmUrl, AddsAnOptionOnlyWhenAbsent) {
+  EXPECT_EQ(lcm_url_with_default_option(kDefaultLcmUrl, "recv_buf_size", kRecommendedRecvBufBytes),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(lcm_url_with_default_option("udpm://239.1.1.1:7667", "ttl", "0"), "udpm://239.1.1.1:7667?ttl=0");
+  EXPECT_EQ(lcm_url_with_default_option("udpm://239.1.1.1:7667?", "ttl", "0"), "udpm://239.1.1.1:7667?ttl=0");
+  EXPECT_EQ(lcm_url_with_default_option("udpm://239.1.1.1:7667?recv_buf_size=1", "recv_buf_size", "9"),
+            "udpm://239.1.1.1:7667?recv_buf_size=1");
+  const auto url = lcm_url_with_default_option(kDefaultLcmUrl, "recv_buf_size", "65536");
+  EXPECT_EQ(checked_lcm_url(url), url);
+}
+
 TEST(LcmUrl, ResolvesRequestedThenEnvironmentThenDefault) {
   ::unsetenv("LCM_DEFAULT_URL");
   EXPECT_EQ(resolve_lcm_url(""), kDefaultLcmUrl);
