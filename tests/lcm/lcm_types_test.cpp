@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "lcm/message_fixtures.hpp"
+#include "loop/bridge_core.hpp"  // constants only: nothing from hystloop::loop is linked
+#include "loop/trajectory.hpp"
 
 namespace hystloop {
 namespace {
@@ -153,6 +155,19 @@ TEST(LcmTypes, ConstantsAreTheContractedValues) {
   EXPECT_EQ(control_t::SET_MODE, 1);
   EXPECT_EQ(control_t::SHUTDOWN, 8);
 }
+
+// The loop core keeps its own copies of these values (it has no LCM); they must agree.
+static_assert(sample_flags::kSaturated == sensor_sample_t::SATURATED);
+static_assert(sample_flags::kSafeState == sensor_sample_t::SAFE_STATE);
+static_assert(sample_flags::kSimulated == sensor_sample_t::SIMULATED);
+static_assert(sample_flags::kSlewLimited == sensor_sample_t::SLEW_LIMITED);
+static_assert(sample_flags::kLateCommand == sensor_sample_t::LATE_COMMAND);
+static_assert(static_cast<int>(TrajectoryShape::kHold) == trajectory_t::HOLD);
+static_assert(static_cast<int>(TrajectoryShape::kSine) == trajectory_t::SINE);
+static_assert(static_cast<int>(TrajectoryShape::kCosine) == trajectory_t::COSINE);
+static_assert(static_cast<int>(TrajectoryShape::kTriangle) == trajectory_t::TRIANGLE);
+static_assert(static_cast<int>(TrajectoryShape::kPoints) == trajectory_t::POINTS);
+static_assert(TrajectorySpec::kMaxPoints == static_cast<std::size_t>(trajectory_t::MAX_POINTS));
 
 TEST(LcmTypes, FixedSizeTypesHaveTheirWireSize) {
   // 8-byte fingerprint + fields; these two go out at 10 kHz.
