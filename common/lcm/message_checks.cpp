@@ -34,7 +34,7 @@ class Findings {
 constexpr double kHuge = 1.0e300;  // "any finite value"
 
 bool is_command_mode(std::int8_t mode) noexcept {
-  return mode >= actuator_command_t::MODE_HOLD && mode <= actuator_command_t::MODE_EXPERIMENT;
+  return mode >= actuator_command_t::MODE_OFF && mode <= actuator_command_t::MODE_EXPERIMENT;
 }
 
 }  // namespace

@@ -42,7 +42,7 @@ TEST(LcmTypes, ActuatorCommandRoundTripsEveryField) {
   EXPECT_EQ(out.u_fb_V, in.u_fb_V);
   EXPECT_EQ(out.y_ref_m, in.y_ref_m);
   EXPECT_EQ(out.params_version, in.params_version);
-  EXPECT_EQ(out.mode, actuator_command_t::MODE_MODEL_FF_FEEDBACK);
+  EXPECT_EQ(out.mode, actuator_command_t::MODE_KATALENIC);
 }
 
 TEST(LcmTypes, TrajectoryRoundTripsEveryFieldAndPoint) {

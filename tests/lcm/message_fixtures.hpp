@@ -41,7 +41,7 @@ inline actuator_command_t command(std::int64_t k) {
   m.u_V = m.u_ff_V + m.u_fb_V;
   m.y_ref_m = 1.25e-6 - 2.0e-10 * dk(k);
   m.params_version = static_cast<std::int32_t>(3 + k % 5);
-  m.mode = actuator_command_t::MODE_MODEL_FF_FEEDBACK;
+  m.mode = actuator_command_t::MODE_KATALENIC;
   return m;
 }
 
