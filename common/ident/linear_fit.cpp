@@ -1,0 +1,47 @@
+#include "ident/linear_fit.hpp"
+
+#include <cmath>
+
+namespace hystloop {
+
+LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y, double min_range) {
+  LinearFitResult r;
+  if (u.size() != y.size() || u.size() < 2) {
+    r.status = FitStatus::size_mismatch;
+    r.reason = "u and y differ in length or have fewer than 2 samples";
+    return r;
+  }
+  double su = 0.0, sy = 0.0, umin = u[0], umax = u[0];
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) {
+      r.status = FitStatus::non_finite_data;
+      r.reason = "sample " + std::to_string(k) + " is not finite";
+      return r;
+    }
+    su += u[k], sy += y[k];
+    umin = std::min(umin, u[k]), umax = std::max(umax, u[k]);
+  }
+  if (!(umax - umin >= min_range) || umax == umin) {
+    r.status = FitStatus::constant_input;
+    r.reason = "u does not move";
+    return r;
+  }
+  const double n = static_cast<double>(u.size()), mu = su / n, my = sy / n;
+  double suu = 0.0, suy = 0.0;
+  for (std::size_t k = 0; k < u.size(); ++k) suu += (u[k] - mu) * (u[k] - mu), suy += (u[k] - mu) * (y[k] - my);
+  r.gain_m_per_V = suy / suu;
+  r.offset_m = my - r.gain_m_per_V * mu;
+  double ss = 0.0;
+  for (std::size_t k = 0; k < u.size(); ++k) ss += std::pow(y[k] - r.gain_m_per_V * u[k] - r.offset_m, 2);
+  r.residual_rms_m = std::sqrt(ss / n);
+  r.samples_used = u.size();
+  if (!(r.gain_m_per_V > 0.0)) {
+    r.status = FitStatus::out_of_range;
+    r.reason = "gain " + std::to_string(r.gain_m_per_V) + " m/V: must be > 0";
+    return r;
+  }
+  r.status = FitStatus::ok;
+  return r;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,90 @@
+#include "ident/pi_fit.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "ident/branches.hpp"
+#include "ident/nnls.hpp"
+
+namespace hystloop {
+
+void PiFitOptions::validate() const {
+  if (operators < 1 || operators > 200) throw ParameterError("operators", "must be in [1, 200]");
+  require_non_negative("min_input_range_V", min_input_range_V);
+  if (min_samples < 8) throw ParameterError("min_samples", "must be >= 8");
+}
+
+void play_operator(std::span<const double> u, double r, double initial, std::span<double> out) {
+  double prev = initial;
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    prev = std::max(u[k] - r, std::min(u[k] + r, prev));
+    out[k] = prev;
+  }
+}
+
+std::vector<double> predict_pi(const PiFitResult& fit, std::span<const double> u) {
+  std::vector<double> y(u.size(), fit.offset_m), play(u.size());
+  if (u.empty()) return y;
+  for (std::size_t i = 0; i < fit.weights.size(); ++i) {
+    play_operator(u, fit.thresholds_V[i], u[0], play);
+    for (std::size_t k = 0; k < u.size(); ++k) y[k] += fit.weights[i] * play[k];
+  }
+  return y;
+}
+
+PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const PiFitOptions& o) {
+  o.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  PiFitResult res;
+  auto done = [&](FitStatus s, std::string why) {
+    res.status = s;
+    res.reason = std::move(why);
+    res.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return res;
+  };
+  if (u.size() != y.size() || u.empty()) return done(FitStatus::size_mismatch, "u and y differ in length or are empty");
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) return done(FitStatus::non_finite_data, "sample " + std::to_string(k) + " is not finite");
+  }
+  const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
+  const double half = 0.5 * (*hi - *lo);
+  if (!(2.0 * half >= o.min_input_range_V) || half == 0.0) return done(FitStatus::constant_input, "u does not move");
+  const std::vector<std::size_t> rev = find_reversals(u);
+  if (rev.size() < 2) return done(FitStatus::too_few_branches, std::to_string(rev.size()) + " reversals: need 2 to wipe out the plays' initial state");
+  const std::size_t begin = rev[1];
+  const auto m = static_cast<Eigen::Index>(u.size() - begin);
+  res.samples_used = u.size() - begin;
+  if (res.samples_used < o.min_samples) return done(FitStatus::too_few_samples, "too few samples after the second reversal");
+  const auto n = static_cast<Eigen::Index>(o.operators);
+  // Centred columns: the free offset is eliminated, the weights stay non-negative.
+  Eigen::MatrixXd a(m, n);
+  std::vector<double> play(u.size());
+  res.thresholds_V.resize(o.operators);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    res.thresholds_V[static_cast<std::size_t>(i)] = half * static_cast<double>(i) / static_cast<double>(n);
+    play_operator(u, res.thresholds_V[static_cast<std::size_t>(i)], u[0], play);
+    for (Eigen::Index k = 0; k < m; ++k) a(k, i) = play[begin + static_cast<std::size_t>(k)];
+  }
+  Eigen::VectorXd b(m);
+  for (Eigen::Index k = 0; k < m; ++k) b[k] = y[begin + static_cast<std::size_t>(k)];
+  const Eigen::RowVectorXd amean = a.colwise().mean();
+  const double bmean = b.mean();
+  Eigen::MatrixXd ac = a.rowwise() - amean;
+  const Eigen::VectorXd bc = b.array() - bmean;
+  // Scale to O(1) (volts and metres differ by 1e9) for the active-set tolerances.
+  const double ys = std::max(bc.cwiseAbs().maxCoeff(), 1e-300), us = std::max(half, 1e-300);
+  const NnlsResult nn = nnls(ac / us, bc / ys);
+  if (!nn.converged) return done(FitStatus::solver_failure, "NNLS did not converge in " + std::to_string(nn.iterations) + " iterations");
+  const Eigen::VectorXd w = nn.x * (ys / us);
+  res.weights.assign(w.data(), w.data() + n);
+  res.offset_m = bmean - amean.dot(w);
+  res.residual_rms_m = std::sqrt((bc - ac * w).squaredNorm() / static_cast<double>(m));
+  if (!(w.sum() > 0.0)) return done(FitStatus::out_of_range, "all weights are zero: y does not follow u");
+  return done(FitStatus::ok, "");
+}
+
+}  // namespace hystloop
