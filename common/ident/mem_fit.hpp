@@ -1,0 +1,79 @@
+#pragma once
+// Identification of the MEM hysteresis model (Strijbosch, Tiels & Oomen, Section III) by
+// separable (variable-projection) least squares: for a given c3 the parameters that enter
+// linearly are solved in closed form (Theorem 5, eqs. (12)-(17)), the projected residual is
+// minimised over the single nonlinear c3 by a grid + Brent search, and (c1, c2, c3) are finally
+// refined jointly by Ceres with a robust loss.
+//
+// Two forms of the data:
+//   derivative  (paper):  z_k = dy/du over the sample interval against p, kept only where the
+//               signal-to-noise ratio |du| * slope / (sqrt(2) sigma_y) reaches min_snr; the model
+//               of z_k is the exact mean of M(p) = c1 + c2 p^c3 over [p_{k-lag}, p_k], so
+//               noise-free data are fitted without a discretisation bias.
+//   integrated: y_k - y_b = s_b (c1 p + c2 p^(c3+1) / (c3+1)) on branch b with direction s_b;
+//               the branch start y_b is a free (linear) offset per branch, so the noise on the
+//               one sample at the reversal does not bias the fit. Much less noise-sensitive.
+// Units: u [V], y [m], c1 [m/V], c2 [m/V^(1+c3)], c3 [-].
+
+#include <cstddef>
+#include <span>
+#include <string>
+
+#include "ident/branches.hpp"
+#include "ident/fit_status.hpp"
+#include "models/mem.hpp"
+
+namespace hystloop {
+
+enum class MemFitForm { integrated, derivative };
+enum class RobustLoss { none, huber, cauchy };
+
+struct MemFitOptions {
+  MemFitForm form = MemFitForm::integrated;
+  double c3_min = 0.05;              // search interval of the nonlinear parameter
+  double c3_max = 5.0;               // also the physical upper limit: an optimum at it is refused
+  int c3_grid_points = 12;           // coarse log grid that brackets the global minimum
+  int brent_bits = 30;               // Brent precision in bits on the bracket
+  double min_snr = 3.0;              // derivative form: keep points with SNR >= this
+  int derivative_lag = 1;            // derivative form: difference over this many samples
+  double noise_rms_m = 0.0;          // sensor noise; 0 = estimate from the data (third difference)
+  double reversal_dead_band_V = 0.0;
+  std::size_t min_branches = 2;      // complete branches after the first reversal
+  std::size_t min_samples = 50;      // usable samples (points, in the derivative form)
+  double min_input_range_V = 1e-3;   // below this u is "constant"
+  RobustLoss robust_loss = RobustLoss::huber;
+  double robust_scale_sigmas = 1.345;  // loss scale in robust sigmas of the projected residual
+  bool refine_with_ceres = true;
+  double max_solver_time_s = 0.05;   // Ceres max_solver_time_in_seconds
+  int max_solver_iterations = 50;
+
+  // Throws ParameterError naming the field.
+  void validate() const;
+};
+
+struct MemFitResult {
+  MemParams params{};
+  double residual_rms_m = 0.0;   // integrated-branch residual (per-branch offsets fitted), both forms
+  std::size_t samples_used = 0;  // samples (integrated) or difference points (derivative)
+  std::size_t branches_used = 0;
+  FitStatus status = FitStatus::solver_failure;
+  std::string reason;
+  double solve_time_s = 0.0;     // wall time of the whole fit (instrumentation only)
+  double noise_rms_m = 0.0;      // noise level used (given or estimated)
+  double projected_c3 = 0.0;     // c3 from the variable-projection search, before Ceres
+  bool ok() const noexcept { return status == FitStatus::ok; }
+};
+
+// Fits (c1, c2, c3) to the samples. Never throws for bad data: the status says why it refused;
+// throws ParameterError only for invalid options.
+MemFitResult fit_mem(std::span<const double> u_V, std::span<const double> y_m, const MemFitOptions& options = {});
+
+// c1 p + c2 p^(c3+1)/(c3+1): the MEM branch increment at distance p [V] from the reversal.
+double mem_branch_increment(const MemParams& params, double p_V) noexcept;
+
+// RMS [m] of y - (y_b + s_b * increment) over the given branches, with y_b the least-squares
+// offset of each branch: how well the parameters explain the branch shapes.
+double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m,
+                      std::span<const BranchSegment> branches, const MemParams& params);
+
+}  // namespace hystloop
