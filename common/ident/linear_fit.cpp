@@ -4,6 +4,14 @@
 
 namespace hystloop {
 
+LinearParams to_linear_params(const LinearFitResult& fit) {
+  LinearParams p;
+  p.gain = fit.gain_m_per_V;
+  p.offset = fit.offset_m;
+  p.validate();
+  return p;
+}
+
 LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y, double min_range) {
   LinearFitResult r;
   if (u.size() != y.size() || u.size() < 2) {

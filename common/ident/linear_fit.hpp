@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ident/fit_status.hpp"
+#include "models/linear.hpp"
 
 namespace hystloop {
 
@@ -18,6 +19,8 @@ struct LinearFitResult {
   std::string reason;
   bool ok() const noexcept { return status == FitStatus::ok; }
 };
+
+LinearParams to_linear_params(const LinearFitResult& fit);  // validates
 
 LinearFitResult fit_linear(std::span<const double> u_V, std::span<const double> y_m, double min_input_range_V = 1e-3);
 

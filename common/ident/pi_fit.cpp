@@ -13,7 +13,9 @@
 namespace hystloop {
 
 void PiFitOptions::validate() const {
-  if (operators < 1 || operators > 200) throw ParameterError("operators", "must be in [1, 200]");
+  if (operators < 1 || operators > kPiMaxOperators) {
+    throw ParameterError("operators", "must be in [1, " + std::to_string(kPiMaxOperators) + "]");
+  }
   require_non_negative("min_input_range_V", min_input_range_V);
   if (min_samples < 8) throw ParameterError("min_samples", "must be >= 8");
 }
@@ -24,6 +26,17 @@ void play_operator(std::span<const double> u, double r, double initial, std::spa
     prev = std::max(u[k] - r, std::min(u[k] + r, prev));
     out[k] = prev;
   }
+}
+
+PiParams to_pi_params(const PiFitResult& fit) {
+  if (fit.weights.size() > kPiMaxOperators || fit.weights.size() != fit.thresholds_V.size()) {
+    throw ParameterError("count", "must be in [1, " + std::to_string(kPiMaxOperators) + "]");
+  }
+  PiParams p;
+  p.count = fit.weights.size();
+  for (std::size_t i = 0; i < p.count; ++i) p.thresholds[i] = fit.thresholds_V[i], p.weights[i] = fit.weights[i];
+  p.validate();
+  return p;
 }
 
 std::vector<double> predict_pi(const PiFitResult& fit, std::span<const double> u) {

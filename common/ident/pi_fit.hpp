@@ -11,11 +11,12 @@
 #include <vector>
 
 #include "ident/fit_status.hpp"
+#include "models/prandtl_ishlinskii.hpp"
 
 namespace hystloop {
 
 struct PiFitOptions {
-  std::size_t operators = 15;  // the paper's comparison used 15 play operators
+  std::size_t operators = 15;  // the paper's comparison used 15 play operators; <= kPiMaxOperators
   double min_input_range_V = 1e-3;
   std::size_t min_samples = 50;
   void validate() const;  // throws ParameterError naming the field
@@ -38,6 +39,11 @@ PiFitResult fit_pi(std::span<const double> u_V, std::span<const double> y_m, con
 // Play (backlash) operator of threshold r: out_k = max(u_k - r, min(u_k + r, out_{k-1})), with
 // out_{-1} = initial. Writes u.size() values.
 void play_operator(std::span<const double> u_V, double r_V, double initial, std::span<double> out);
+
+// The project's parameter set (models/prandtl_ishlinskii.hpp); the offset has no place there
+// (PiModel starts demagnetised at 0) and stays in the fit result. Throws ParameterError if the
+// weights do not make a valid PiParams (e.g. w_0 = 0).
+PiParams to_pi_params(const PiFitResult& fit);
 
 // y predicted by fitted PI weights, every play started at initial = u[0] (centred state).
 std::vector<double> predict_pi(const PiFitResult& fit, std::span<const double> u_V);

@@ -1,0 +1,40 @@
+#pragma once
+// Reading recorded samples from CSV: a header row naming the columns (t, u, y required, SI:
+// seconds, volts, metres; an optional `experiment` column groups rows into experiments), then one
+// sample per row. Blank lines and lines starting with '#' are skipped; other columns are ignored.
+// A malformed file is refused with a message naming the file, line and column.
+
+#include <istream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hystloop {
+
+class CsvError : public std::runtime_error {
+ public:
+  CsvError(std::string file, std::size_t line, const std::string& message)
+      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), file_(std::move(file)), line_(line) {}
+  std::size_t line() const noexcept { return line_; }
+  const std::string& file() const noexcept { return file_; }
+
+ private:
+  std::string file_;
+  std::size_t line_;
+};
+
+struct SampleTable {
+  std::vector<double> t, u, y;           // [s], [V], [m]
+  std::vector<std::string> experiment;   // empty unless the column exists
+};
+
+SampleTable parse_sample_csv(std::istream& in, const std::string& name);
+SampleTable read_sample_csv(const std::string& path);  // throws CsvError (also if unreadable)
+
+// Rows grouped by the experiment column, in order of first appearance (one group without it).
+std::vector<SampleTable> split_experiments(const SampleTable& table);
+
+// 1 / median sample interval [Hz]; 0 if fewer than two samples or t does not increase.
+double sample_rate_Hz(const std::vector<double>& t);
+
+}  // namespace hystloop

@@ -1,0 +1,156 @@
+// hystloop-identify end to end: CSVs generated here, the tool run as a process, its printed and
+// written parameters checked; a malformed file and an unfit record give their reasons.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "ident/banning_experiments.hpp"
+#include "ident/mem_test_data.hpp"
+
+namespace hystloop {
+namespace {
+
+const std::string kTool = std::string(HYSTLOOP_BINARY_DIR) + "/tools/identify/hystloop-identify";
+
+struct ToolRun {
+  int exit_code = -1;
+  std::string output;
+};
+
+ToolRun run_tool(const std::string& args) {
+  ToolRun r;
+  FILE* pipe = ::popen((kTool + " " + args + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.output += buf;
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class IdentifyTool : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(kTool)) GTEST_SKIP() << "not built: " << kTool;
+    dir_ = std::filesystem::temp_directory_path() /
+           ("hystloop_identify_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::filesystem::path dir_;
+};
+
+void write_csv(const std::string& file, const std::vector<double>& u, const std::vector<double>& y, double fs) {
+  std::FILE* f = std::fopen(file.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fprintf(f, "t,u,y\n");
+  for (std::size_t k = 0; k < u.size(); ++k) std::fprintf(f, "%.9g,%.17g,%.17g\n", static_cast<double>(k) / fs, u[k], y[k]);
+  std::fclose(f);
+}
+
+TEST_F(IdentifyTool, FitsMemAndWritesTheYamlSnippet) {
+  const MemParams truth = MemParams::paper_like();
+  MemModel model(truth);
+  model.reset(0.0);
+  const auto u = testdata::paper_identification_input();
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  testdata::add_noise(y, 1e-9, 5);
+  write_csv(path("mem.csv"), u, y, 1e4);
+  const ToolRun r = run_tool(path("mem.csv") + " --model mem --out " + path("params.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("c1 = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("residual"), std::string::npos) << r.output;
+  const YAML::Node doc = YAML::LoadFile(path("params.yaml"));
+  EXPECT_NEAR(doc["mem"]["c1"].as<double>(), truth.c1, 0.01 * truth.c1);
+  EXPECT_NEAR(doc["mem"]["c2"].as<double>(), truth.c2, 0.02 * truth.c2);
+  EXPECT_NEAR(doc["mem"]["c3"].as<double>(), truth.c3, 0.01 * truth.c3);
+
+  // The paper's derivative form through the CLI too.
+  const ToolRun d = run_tool(path("mem.csv") + " --model mem --form derivative");
+  EXPECT_EQ(d.exit_code, 0) << d.output;
+  EXPECT_NE(d.output.find("derivative form"), std::string::npos) << d.output;
+
+  // auto ranks every model; MEM wins on MEM data.
+  const ToolRun a = run_tool(path("mem.csv") + " --model auto --out " + path("auto.yaml"));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_NE(a.output.find("best: mem"), std::string::npos) << a.output;
+  EXPECT_TRUE(YAML::LoadFile(path("auto.yaml"))["mem"]);
+}
+
+TEST_F(IdentifyTool, MalformedFileNamesLineAndColumn) {
+  {
+    std::ofstream f(path("bad.csv"));
+    f << "t,u,y\n0,0,0\n0.0001,1.5,abc\n";
+  }
+  const ToolRun r = run_tool(path("bad.csv") + " --model mem");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.csv:3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("column 'y'"), std::string::npos) << r.output;
+  {
+    std::ofstream f(path("nohdr.csv"));
+    f << "time,volts\n0,0\n";
+  }
+  const ToolRun h = run_tool(path("nohdr.csv") + " --model mem");
+  EXPECT_EQ(h.exit_code, 2) << h.output;
+  EXPECT_NE(h.output.find("lacks column"), std::string::npos) << h.output;
+}
+
+TEST_F(IdentifyTool, UnfitRecordExitsNonZeroWithTheReason) {
+  const std::vector<double> u(2000, 5.0), y(2000, 1e-9);
+  write_csv(path("flat.csv"), u, y, 1e4);
+  const ToolRun r = run_tool(path("flat.csv") + " --model mem");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("constant_input"), std::string::npos) << r.output;
+}
+
+TEST_F(IdentifyTool, BanningFromOneFileWithAnExperimentColumn) {
+  BanningPlanOptions plan_options;
+  plan_options.offsets_V = {-80.0, 0.0, 80.0};
+  plan_options.small_amplitudes_V = {1.0, 3.0};
+  plan_options.amplitudes_V = {50.0, 100.0, 200.0};
+  plan_options.hysteresis_frequency_Hz = 2.0;
+  plan_options.frequencies_Hz = {100.0, 800.0, 1400.0, 1650.0, 1720.0, 1800.0, 2100.0, 2800.0};
+  const BanningStageParams truth{};
+  const auto plan = plan_banning_experiments(plan_options);
+  {
+    std::FILE* f = std::fopen(path("banning.csv").c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, "experiment,t,u,y\n");
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      const auto y = run_on_stage(truth, plan[i], 1e-9, 100 + i);
+      for (std::size_t k = plan[i].measure_begin; k < plan[i].u.size(); ++k) {
+        std::fprintf(f, "e%zu,%.9g,%.17g,%.17g\n", i, static_cast<double>(k) * 1e-4, plan[i].u[k], y[k]);
+      }
+    }
+    std::fclose(f);
+  }
+  const ToolRun r = run_tool(path("banning.csv") + " --model banning --out " + path("banning.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("alpha = "), std::string::npos) << r.output;
+  const YAML::Node doc = YAML::LoadFile(path("banning.yaml"));
+  EXPECT_NEAR(doc["banning"]["hysteresis"]["a"].as<double>(), truth.hysteresis.a, 0.005 * truth.hysteresis.a);
+  EXPECT_NEAR(doc["banning"]["hysteresis"]["b"].as<double>(), truth.hysteresis.b, 0.01 * truth.hysteresis.b);
+  EXPECT_NEAR(doc["banning"]["hysteresis"]["alpha"].as<double>(), truth.hysteresis.alpha, 0.03 * truth.hysteresis.alpha);
+  EXPECT_NEAR(doc["banning"]["stage"]["k"].as<double>(), truth.stage.k, 0.01 * truth.stage.k);
+  EXPECT_NEAR(doc["banning"]["stage"]["c"].as<double>(), truth.stage.c, 0.05 * truth.stage.c);
+}
+
+TEST_F(IdentifyTool, HelpDescribesTheModels) {
+  const ToolRun r = run_tool("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--model"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("banning"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace hystloop
