@@ -76,14 +76,13 @@ double evaluate_shape(const TrajectorySpec& spec, double tau_s) noexcept {
 
 double evaluate(const TrajectorySpec& spec, double t_s) noexcept {
   const double tau = t_s - spec.start_s;
-  if (tau <= 0.0 && spec.blend_s <= 0.0) return evaluate_shape(spec, 0.0);
-  if (spec.blend_s <= 0.0) return evaluate_shape(spec, tau);
-  // Fade in: the shape runs from start_s on, weighted from 0 to 1 over blend_s.
-  const double target = evaluate_shape(spec, std::max(tau, 0.0));
-  if (tau <= 0.0) return spec.hold_m;
-  if (tau >= spec.blend_s) return target;
-  const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * tau / spec.blend_s);
-  return spec.hold_m + w * (target - spec.hold_m);
+  if (tau >= 0.0) return evaluate_shape(spec, tau);
+  if (spec.blend_s <= 0.0) return evaluate_shape(spec, 0.0);
+  // Approach: hold, then a raised cosine from hold_m to the shape's first value.
+  const double into = tau + spec.blend_s;  // time since the approach began
+  if (into <= 0.0) return spec.hold_m;
+  const double w = 0.5 - 0.5 * std::cos(std::numbers::pi * into / spec.blend_s);
+  return spec.hold_m + w * (evaluate_shape(spec, 0.0) - spec.hold_m);
 }
 
 TrajectorySpec mem_paper_reference(double start_s, double blend_s, double hold_m) {
