@@ -27,6 +27,7 @@ void MemFitOptions::validate() const {
   if (min_branches < 1) throw ParameterError("min_branches", "must be >= 1");
   if (min_samples < 4) throw ParameterError("min_samples", "must be >= 4");
   require_non_negative("min_input_range_V", min_input_range_V);
+  require_in_range("min_c1_fraction", min_c1_fraction, 0.0, 1.0);
   require_positive("robust_scale_sigmas", robust_scale_sigmas);
   require_positive("max_solver_time_s", max_solver_time_s);
   if (max_solver_iterations < 1) throw ParameterError("max_solver_iterations", "must be >= 1");
@@ -65,6 +66,7 @@ using detail::ScaledMem;
 struct Scales {
   double u = 1.0;  // U [V]: largest p
   double y = 1.0;  // Y [m]: half the output range
+  double y_span = 0.0;  // [m] output range on the branches
 };
 
 MemFitResult refuse(MemFitResult r, FitStatus status, std::string reason) {
@@ -197,15 +199,30 @@ std::string range_problem(const MemParams& p, const MemFitOptions& o) {
 template <class Data>
 MemFitResult solve(const Data& coarse, const Data& data, const Scales& sc, const MemFitOptions& o,
                    MemFitResult result) {
+  // A stage that does not respond: y spans no more than its own noise. (The constrained fit
+  // would otherwise return a tiny but "valid" slope.)
+  if (sc.y_span < 20.0 * result.noise_rms_m) {
+    std::ostringstream s;
+    s << "y spans " << sc.y_span << " m, within its noise (" << result.noise_rms_m
+      << " m RMS): the stage does not move with u";
+    return refuse(std::move(result), FitStatus::out_of_range, s.str());
+  }
   const double c3 = search_c3(coarse, data, o);
   const LinearPart lin = data.project(c3);
   ScaledMem m{lin.c1, lin.c2, c3};
   result.projected_c3 = c3;
   result.params = unscale(m, sc);
+  result.constrained = lin.constrained;
+  if (lin.constrained && lin.c2 == 0.0) {
+    return refuse(std::move(result), FitStatus::out_of_range,
+                  "separable least squares: c2 would be < 0: the loop bends the wrong way for MEM (its slope falls "
+                  "with the distance from a reversal)");
+  }
   if (std::string why = range_problem(result.params, o); !why.empty()) {
     return refuse(std::move(result), FitStatus::out_of_range, "separable least squares: " + why);
   }
-  if (o.refine_with_ceres) {
+  // On the domain's edge the unconstrained joint refinement would only walk back out of it.
+  if (o.refine_with_ceres && !lin.constrained) {
     const double sigma = robust_sigma(residuals(data, m));
     const double scale = std::max(o.robust_scale_sigmas * sigma, 1e-12);
     detail::RefineOutcome refined;
@@ -275,23 +292,28 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
   }
   if (!(sc.u > 0.0)) return stamp(refuse(result, FitStatus::constant_input, "u does not move after the first reversal"));
   sc.y = ymax > ymin ? 0.5 * (ymax - ymin) : 1.0;
+  sc.y_span = ymax - ymin;
   result.noise_rms_m = o.noise_rms_m > 0.0 ? o.noise_rms_m : estimate_noise_rms(y);
 
   if (o.form == MemFitForm::integrated) {
-    const IntegratedData data = build_integrated(u, y, branches, sc);
+    IntegratedData data = build_integrated(u, y, branches, sc);
+    data.c1_floor_fraction = o.min_c1_fraction;
     result.samples_used = data.y.size();
     if (result.samples_used < o.min_samples) {
       std::ostringstream s;
       s << result.samples_used << " samples on branches (need " << o.min_samples << ")";
       return stamp(refuse(result, FitStatus::too_few_samples, s.str()));
     }
-    result = solve(build_integrated(u, y, branches, sc, kGridStride), data, sc, o, std::move(result));
+    IntegratedData coarse = build_integrated(u, y, branches, sc, kGridStride);
+    coarse.c1_floor_fraction = o.min_c1_fraction;
+    result = solve(coarse, data, sc, o, std::move(result));
   } else {
     // SNR of z = dy/du: |du| * slope / (sqrt(2) sigma_y); the slope is the loop's mean slope.
     const double slope = (ymax - ymin) / (*umax - *umin);
     const double min_du = slope > 0.0 ? o.min_snr * std::sqrt(2.0) * result.noise_rms_m / slope : 0.0;
-    const DerivativeData data =
+    DerivativeData data =
         build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag));
+    data.c1_floor_fraction = o.min_c1_fraction;
     result.samples_used = data.z.size();
     if (result.samples_used < o.min_samples) {
       std::ostringstream s;
@@ -299,8 +321,9 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
         << "; |du| must be >= " << min_du << " V per " << o.derivative_lag << " samples)";
       return stamp(refuse(result, FitStatus::too_few_samples, s.str()));
     }
-    const DerivativeData coarse = build_derivative(u, y, branches, sc, min_du,
-                                                   static_cast<std::size_t>(o.derivative_lag), kGridStride);
+    DerivativeData coarse = build_derivative(u, y, branches, sc, min_du,
+                                             static_cast<std::size_t>(o.derivative_lag), kGridStride);
+    coarse.c1_floor_fraction = o.min_c1_fraction;
     result = solve(coarse, data, sc, o, std::move(result));
   }
   if (result.status == FitStatus::ok || result.status == FitStatus::out_of_range) {

@@ -41,6 +41,10 @@ struct MemFitOptions {
   std::size_t min_branches = 2;      // complete branches after the first reversal
   std::size_t min_samples = 50;      // usable samples (points, in the derivative form)
   double min_input_range_V = 1e-3;   // below this u is "constant"
+  // c1 (the slope right after a reversal) >= this x the data's mean slope. A MEM element
+  // fitted to a stage whose slope saturates (Coleman-Hodgdon) otherwise drifts to c1 -> 0,
+  // c3 -> 0, and its inverse would jump the voltage at every reversal. 0 = only c1 >= 0.
+  double min_c1_fraction = 0.25;
   RobustLoss robust_loss = RobustLoss::huber;
   double robust_scale_sigmas = 1.345;  // loss scale in robust sigmas of the projected residual
   bool refine_with_ceres = true;
@@ -59,6 +63,9 @@ struct MemFitResult {
   FitStatus status = FitStatus::solver_failure;
   std::string reason;
   double solve_time_s = 0.0;     // wall time of the whole fit (instrumentation only)
+  // The best MEM element lies on the domain's edge (c1 at its floor, or c2 = 0): the data are
+  // not exactly MEM-shaped. The parameters are usable; expect a larger model error.
+  bool constrained = false;
   double noise_rms_m = 0.0;      // noise level used (given or estimated)
   double projected_c3 = 0.0;     // c3 from the variable-projection search, before Ceres
   bool ok() const noexcept { return status == FitStatus::ok; }

@@ -1,8 +1,28 @@
 #include "ident/mem_projection.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace hystloop::detail {
+
+LinearPart constrained_pair(double saa, double sab, double sbb, double say, double sby, double syy,
+                            double c1_floor) noexcept {
+  auto rss = [&](double c1, double c2) {
+    return syy - 2.0 * (c1 * say + c2 * sby) + c1 * c1 * saa + 2.0 * c1 * c2 * sab + c2 * c2 * sbb;
+  };
+  const double det = saa * sbb - sab * sab;
+  if (det > 1e-13 * saa * sbb) {
+    const double c1 = (sbb * say - sab * sby) / det;
+    const double c2 = (saa * sby - sab * say) / det;
+    if (c1 >= c1_floor && c2 >= 0.0) return {c1, c2, rss(c1, c2), false};
+  }
+  // Edge c2 = 0: best c1 >= floor. Edge c1 = floor: best c2 >= 0.
+  const double e1_c1 = saa > 0.0 ? std::max(say / saa, c1_floor) : c1_floor;
+  const double e2_c2 = sbb > 0.0 ? std::max((sby - c1_floor * sab) / sbb, 0.0) : 0.0;
+  const double r1 = rss(e1_c1, 0.0), r2 = rss(c1_floor, e2_c2);
+  return r1 <= r2 ? LinearPart{e1_c1, 0.0, r1, true} : LinearPart{c1_floor, e2_c2, r2, true};
+}
 
 double pow_from_log(double log_x, double e) noexcept { return log_x == kLogZero ? 0.0 : std::exp(e * log_x); }
 
@@ -49,17 +69,8 @@ LinearPart IntegratedData::project(double c3) const noexcept {
     sab -= sum_a[b] * sb / n;
     sby -= sum_y[b] * sb / n;
   }
-  LinearPart out;
-  const double det = saa * sbb - sab * sab;
-  if (!(det > 1e-13 * saa * sbb)) {  // B is (numerically) a multiple of A: c2 not identifiable
-    out.c1 = saa > 0.0 ? say / saa : 0.0;
-    out.c2 = 0.0;
-    out.residual_ss = syy - out.c1 * say;
-  } else {
-    out.c1 = (sbb * say - sab * sby) / det;
-    out.c2 = (saa * sby - sab * say) / det;
-    out.residual_ss = syy - out.c1 * say - out.c2 * sby;
-  }
+  const double floor = saa > 0.0 ? c1_floor_fraction * std::max(say / saa, 0.0) : 0.0;
+  LinearPart out = constrained_pair(saa, sab, sbb, say, sby, syy, floor);
   if (out.residual_ss < 0.0) out.residual_ss = 0.0;
   return out;
 }
@@ -107,13 +118,9 @@ LinearPart DerivativeData::project(double c3) const noexcept {
     sgz += g * z[k];
   }
   const double n = static_cast<double>(z.size());
-  const double cgg = sgg - sg * sg / n;
-  const double cgz = sgz - sg * sum_z / n;
-  const double czz = sum_zz - sum_z * sum_z / n;
-  LinearPart out;
-  out.c2 = cgg > 0.0 ? cgz / cgg : 0.0;
-  out.c1 = (sum_z - out.c2 * sg) / n;
-  out.residual_ss = czz - out.c2 * cgz;
+  // z = c1 + c2 g in the uncentred sums (the constant regressor is the first one).
+  const double floor = c1_floor_fraction * std::max(sum_z / n, 0.0);
+  LinearPart out = constrained_pair(n, sg, sgg, sum_z, sgz, sum_zz, floor);
   if (out.residual_ss < 0.0) out.residual_ss = 0.0;
   return out;
 }

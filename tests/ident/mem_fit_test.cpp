@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "ident/mem_test_data.hpp"
+#include "models/banning_stage.hpp"
 
 namespace hystloop {
 namespace {
@@ -224,6 +225,33 @@ TEST(MemFit, RecoversTheProjectModelsParameters) {
   EXPECT_LT(testdata::rel_err(noisy.params.c1, truth.c1), 0.01);
   EXPECT_LT(testdata::rel_err(noisy.params.c2, truth.c2), 0.02);
   EXPECT_LT(testdata::rel_err(noisy.params.c3, truth.c3), 0.01);
+}
+
+}  // namespace
+}  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+// On a stage that is not MEM-shaped (Banning's Coleman-Hodgdon stage, whose slope saturates),
+// the unconstrained optimum leaves the MEM domain (c1 < 0, c3 -> 0). The fit returns the best
+// MEM element inside it instead, flagged as constrained, with c1 at its floor.
+TEST(MemFit, ColemanHodgdonStageGivesTheBestConstrainedMem) {
+  const auto u = testdata::paper_identification_input();
+  BanningStage stage;
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = stage.step(u[k], 1e-4);
+  testdata::add_noise(y, 1e-9, 11);
+  const MemFitResult r = fit_mem(u, y);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_TRUE(r.constrained);
+  const double mean_slope = 8.58e-9;  // Table 1's a: the loop's centre line
+  EXPECT_GT(r.params.c1, 0.15 * mean_slope);
+  EXPECT_LT(r.params.c1, 0.5 * mean_slope);
+  EXPECT_LT(r.residual_rms_m, 40e-9);  // the shape only approximately fits: tens of nm
+  MemFitOptions unconstrained;
+  unconstrained.min_c1_fraction = 0.0;
+  EXPECT_FALSE(fit_mem(u, y, unconstrained).ok());  // c1 -> 0: refused, not returned
 }
 
 }  // namespace
