@@ -17,6 +17,29 @@ namespace {
 
 double rel(double est, double truth) { return std::abs(est - truth) / std::abs(truth); }
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+// The default plan (357k samples), or under the sanitizer a lighter one (5 Hz loops: the stage's
+// lag then adds ~0.5 % to the smaller areas, hence the looser alpha bound there).
+BanningPlanOptions test_plan() {
+  BanningPlanOptions p;
+  if (kSanitized) {
+    p.offsets_V = {-100.0, 0.0, 100.0};
+    p.small_amplitudes_V = {1.0, 3.0};
+    p.amplitudes_V = {50.0, 100.0, 200.0};
+    p.hysteresis_frequency_Hz = 5.0;
+    p.settle_periods = 10;
+    p.frequencies_Hz = {100.0, 800.0, 1400.0, 1650.0, 1720.0, 1800.0, 2100.0, 2800.0};
+    p.frequency_measure_s = 0.05;
+  }
+  return p;
+}
+const double kAlphaTolerance = kSanitized ? 0.04 : 0.02;
+
 struct Recorded {
   std::vector<BanningExperiment> plan;
   std::vector<std::vector<double>> y;
@@ -67,7 +90,7 @@ TEST(BanningFit, ZohMagnitudeMatchesTheSimulatedLinearStage) {
 
 TEST(BanningFit, RecoversTables1And2FromNoisySimulatedExperiments) {
   const BanningStageParams truth{};
-  const Recorded rec = record(truth, {}, 1e-9, 1000);
+  const Recorded rec = record(truth, test_plan(), 1e-9, 1000);
   const BanningFitResult r = fit_banning(rec.data);
   ASSERT_TRUE(r.ok()) << r.reason;
   ASSERT_TRUE(r.stage_identified) << r.reason;
@@ -78,17 +101,17 @@ TEST(BanningFit, RecoversTables1And2FromNoisySimulatedExperiments) {
               rel(r.stage.c, truth.stage.c), r.solve_time_s * 1e3);
   EXPECT_LT(rel(r.hysteresis.a, h.a), 2e-3);
   EXPECT_LT(rel(r.hysteresis.b, h.b), 5e-3);
-  EXPECT_LT(rel(r.hysteresis.alpha, h.alpha), 0.02);
+  EXPECT_LT(rel(r.hysteresis.alpha, h.alpha), kAlphaTolerance);
   EXPECT_LT(rel(r.stage.k, truth.stage.k), 5e-3);
   EXPECT_LT(rel(r.stage.c, truth.stage.c), 0.03);
   EXPECT_LT(r.slope_rel_rms, 0.01);
-  EXPECT_LT(r.area_rel_rms, 0.02);
+  EXPECT_LT(r.area_rel_rms, kSanitized ? 0.04 : 0.02);
 }
 
 TEST(BanningFit, PaperOrderIsRecoveredToo) {
   BanningStageParams truth{};
   truth.order = BanningOrder::kStageThenHysteresis;
-  const Recorded rec = record(truth, {}, 1e-9, 2000);
+  const Recorded rec = record(truth, test_plan(), 1e-9, 2000);
   BanningFitOptions o;
   o.order = BanningOrder::kStageThenHysteresis;
   const BanningFitResult r = fit_banning(rec.data, o);
@@ -96,7 +119,7 @@ TEST(BanningFit, PaperOrderIsRecoveredToo) {
   EXPECT_LT(rel(r.hysteresis.a, truth.hysteresis.a), 2e-3);
   // The CH input is the stage output here, sampled at the step ends: a little looser.
   EXPECT_LT(rel(r.hysteresis.b, truth.hysteresis.b), 1e-2);
-  EXPECT_LT(rel(r.hysteresis.alpha, truth.hysteresis.alpha), 0.03);
+  EXPECT_LT(rel(r.hysteresis.alpha, truth.hysteresis.alpha), kAlphaTolerance + 0.01);
   EXPECT_LT(rel(r.stage.k, truth.stage.k), 5e-3);
   EXPECT_LT(rel(r.stage.c, truth.stage.c), 0.05);
   std::printf("paper order: a %.2e b %.2e alpha %.2e k %.2e c %.2e (rel. errors)\n", rel(r.hysteresis.a, truth.hysteresis.a),
@@ -122,7 +145,10 @@ TEST(BanningFit, RefusalsSayWhy) {
   EXPECT_EQ(fit_banning(mismatch).status, FitStatus::size_mismatch);
 
   // Hysteresis only (no frequency sweep): ok, but the stage is not identified and it says so.
-  BanningPlanOptions no_sweep;
+  BanningPlanOptions no_sweep = test_plan();
+  no_sweep.small_amplitudes_V = {2.0};
+  no_sweep.amplitudes_V = {100.0};
+  no_sweep.hysteresis_frequency_Hz = 5.0;
   no_sweep.frequencies_Hz = {};
   const Recorded rec2 = record(BanningStageParams{}, no_sweep, 0.0, 5);
   const BanningFitResult r2 = fit_banning(rec2.data);
