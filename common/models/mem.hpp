@@ -164,10 +164,9 @@ class MemInverse {
   double y_ref_ = 0.0;
   int direction_ = 0;    // of u (= of y along a branch): +1, -1, 0 = not yet known
   std::uint64_t reversals_ = 0;
-  // Warm start: the last point where F and M were evaluated. A tangent from any point of the
-  // convex F lands at or beyond the root, so it is always a safe upper bound to start Newton from.
+  // Warm start: the last point where F, M and p^c3 were evaluated (see solve_run).
   bool warm_ = false;
-  double warm_p_ = 0.0, warm_f_ = 0.0, warm_m_ = 0.0;
+  double warm_p_ = 0.0, warm_f_ = 0.0, warm_m_ = 0.0, warm_pc3_ = 0.0;
 };
 
 }  // namespace hystloop
