@@ -96,6 +96,7 @@ void Compensator::set_mode(FeedforwardMode mode) {
   if (mode != mode_) {
     mode_ = mode;
     inverse_fresh_ = true;
+    if (last_seq_ >= 0) anchor_ = Anchor{last_u_, last_ref_};
   }
 }
 
@@ -114,7 +115,15 @@ void Compensator::stop_experiment() noexcept {
 
 void Compensator::reset_inverse(double y0) noexcept {
   switch (mode_) {
-    case FeedforwardMode::kMem: mem_.reset(y0); break;
+    case FeedforwardMode::kMem:
+      // A virgin stage starts on the skeleton; one that has moved (after an experiment or a
+      // mode switch) is on a branch through where it is now, and the voltage must not jump.
+      if (anchor_) {
+        mem_.reset_to_branch(anchor_->y_m, anchor_->u_V);
+      } else {
+        mem_.reset(y0);
+      }
+      break;
     case FeedforwardMode::kPi: pi_.reset(y0); break;
     case FeedforwardMode::kKatalenic: katalenic_.reset(y0); break;
     case FeedforwardMode::kLinear: linear_.reset(y0); break;
@@ -174,6 +183,7 @@ std::optional<CompensatorOutput> Compensator::update(const CompensatorInput& sam
     trajectory_.start_s = t_cmd + trajectory_.blend_s;
     trajectory_.hold_m = sample.y_m;
     last_ref_ = sample.y_m;
+    anchor_ = Anchor{sample.u_V, sample.y_m};
     last_dir_ = 0.0;
     inverse_fresh_ = true;
   }
@@ -196,6 +206,7 @@ std::optional<CompensatorOutput> Compensator::update(const CompensatorInput& sam
   if (inverse_fresh_) {
     reset_inverse(y_ref);
     inverse_fresh_ = false;
+    anchor_.reset();
   }
 
   out.y_ref_m = y_ref;

@@ -153,6 +153,11 @@ class Compensator {
   double last_u_ = 0.0;         // last voltage commanded
   double last_dir_ = 0.0;       // sign of the last non-zero reference change
   bool inverse_fresh_ = true;   // next reference initialises the inverse
+  struct Anchor {
+    double u_V;
+    double y_m;
+  };
+  std::optional<Anchor> anchor_;  // where the stage is, when it is not virgin
   CompensatorCounters counters_;
 };
 
