@@ -1,0 +1,79 @@
+// CSV reading: columns by name, experiments, errors naming line and column; YAML snippets.
+#include "ident/sample_csv.hpp"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <sstream>
+
+#include "ident/params_yaml.hpp"
+
+namespace hystloop {
+namespace {
+
+SampleTable parse(const std::string& text) {
+  std::istringstream in(text);
+  return parse_sample_csv(in, "x.csv");
+}
+
+TEST(SampleCsv, ReadsColumnsByNameInAnyOrder) {
+  const SampleTable t = parse("# comment\ny, U ,t,extra\n1e-9,2.5,0,a\n\n2e-9,3.5,0.0001,b\r\n");
+  ASSERT_EQ(t.t.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.u[1], 3.5);
+  EXPECT_DOUBLE_EQ(t.y[0], 1e-9);
+  EXPECT_DOUBLE_EQ(t.t[1], 1e-4);
+  EXPECT_TRUE(t.experiment.empty());
+  EXPECT_NEAR(sample_rate_Hz(t.t), 1e4, 1e-6);
+}
+
+TEST(SampleCsv, GroupsExperimentsInOrderOfAppearance) {
+  const SampleTable t = parse("experiment,t,u,y\nb,0,1,1\na,0,2,2\nb,1,3,3\n");
+  const auto groups = split_experiments(t);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].experiment.front(), "b");
+  EXPECT_EQ(groups[0].u, (std::vector<double>{1.0, 3.0}));
+  EXPECT_EQ(groups[1].u, (std::vector<double>{2.0}));
+}
+
+TEST(SampleCsv, ErrorsNameFileLineAndColumn) {
+  auto message = [](const std::string& text) {
+    try {
+      parse(text);
+    } catch (const CsvError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("t,u,y\n0,1,2\n0,1,x2\n"), "x.csv:3: column 'y' (3): cannot read 'x2' as a number");
+  EXPECT_EQ(message("t,u,y\n0,1\n"), "x.csv:2: 2 fields, the header has 3");
+  EXPECT_NE(message("t,v,y\n0,1,2\n").find("lacks column(s) u"), std::string::npos);
+  EXPECT_NE(message("t,u,y\n").find("no samples"), std::string::npos);
+  EXPECT_NE(message("").find("no header"), std::string::npos);
+  EXPECT_NE(message("t,u,y\n0,,1\n").find("column 'u' (2)"), std::string::npos);
+  EXPECT_THROW(read_sample_csv("/nonexistent/file.csv"), CsvError);
+}
+
+TEST(ParamsYaml, KeysAreTheParameterNamesAndValuesRoundTrip) {
+  MemParams m;
+  m.c1 = 4.123456789012345e-9;
+  const YAML::Node mem = YAML::Load(to_yaml(m));
+  EXPECT_DOUBLE_EQ(mem["mem"]["c1"].as<double>(), m.c1);
+  EXPECT_DOUBLE_EQ(mem["mem"]["c3"].as<double>(), m.c3);
+  const SecondOrderStageParams stage{};
+  const YAML::Node ban = YAML::Load(to_yaml(ColemanHodgdonParams{}, &stage));
+  EXPECT_DOUBLE_EQ(ban["banning"]["hysteresis"]["alpha"].as<double>(), ColemanHodgdonParams{}.alpha);
+  EXPECT_DOUBLE_EQ(ban["banning"]["stage"]["k"].as<double>(), stage.k);
+  const YAML::Node kat = YAML::Load(to_yaml(KatalenicParams{}));
+  EXPECT_DOUBLE_EQ(kat["katalenic"]["k1"].as<double>(), KatalenicParams{}.k1);
+  EXPECT_EQ(kat["katalenic"]["output_shaping"]["kind"].as<std::string>(), "linear");
+  PiParams pi = PiParams::with_even_thresholds(3, 100.0);
+  pi.weights = {1e-9, 2e-10, 1e-10};
+  const YAML::Node p = YAML::Load(to_yaml(pi));
+  EXPECT_EQ(p["pi"]["weights"].size(), 3u);
+  EXPECT_DOUBLE_EQ(p["pi"]["thresholds"][2].as<double>(), pi.thresholds[2]);
+  const YAML::Node l = YAML::Load(to_yaml(LinearParams{}));
+  EXPECT_DOUBLE_EQ(l["linear"]["gain"].as<double>(), LinearParams{}.gain);
+}
+
+}  // namespace
+}  // namespace hystloop
