@@ -1,0 +1,232 @@
+#include "csv_export.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+
+#include "decode.hpp"
+#include "log_reader.hpp"
+
+namespace hystloop::report {
+
+namespace {
+
+enum class Kind { kUndecided, kSensor, kCommand, kTrajectory, kParams, kStatus, kControl, kUnknown };
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+std::string csv_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + '"';
+}
+
+std::string joined(const std::vector<double>& values) {
+  std::string out;
+  for (const double v : values) {
+    if (!out.empty()) out += ' ';
+    out += num(v);
+  }
+  return csv_quoted(out);
+}
+
+Kind kind_of(const lcm::LogEvent& e) {
+  if (has_fingerprint_of<sensor_sample_t>(e)) return Kind::kSensor;
+  if (has_fingerprint_of<actuator_command_t>(e)) return Kind::kCommand;
+  if (has_fingerprint_of<trajectory_t>(e)) return Kind::kTrajectory;
+  if (has_fingerprint_of<mem_params_t>(e)) return Kind::kParams;
+  if (has_fingerprint_of<service_status_t>(e)) return Kind::kStatus;
+  if (has_fingerprint_of<control_t>(e)) return Kind::kControl;
+  return Kind::kUnknown;
+}
+
+const char* type_name(Kind kind) {
+  switch (kind) {
+    case Kind::kSensor: return "hystloop.sensor_sample_t";
+    case Kind::kCommand: return "hystloop.actuator_command_t";
+    case Kind::kTrajectory: return "hystloop.trajectory_t";
+    case Kind::kParams: return "hystloop.mem_params_t";
+    case Kind::kStatus: return "hystloop.service_status_t";
+    case Kind::kControl: return "hystloop.control_t";
+    default: return "unknown";
+  }
+}
+
+const char* header(Kind kind) {
+  switch (kind) {
+    case Kind::kSensor: return "utime_us,seq,u_V,y_m,flags";
+    case Kind::kCommand: return "utime_us,seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode";
+    case Kind::kTrajectory:
+      return "utime_us,version,shape,amplitude_m,offset_m,frequency_Hz,phase_rad,start_utime_us,blend_s,n_points,"
+             "points_t_s,points_y_m";
+    case Kind::kParams:
+      return "utime_us,version,c1_m_per_V,c2_m_per_V_pow_1_plus_c3,c3,residual_m,samples_used,window_s,valid,source";
+    case Kind::kStatus:
+      return "utime_us,process,host,pid,state,detail,start_utime_us,loop_p50_us,loop_p99_us,loop_max_us,"
+             "latency_p50_us,latency_p99_us,latency_max_us,late,rejected,counters";
+    case Kind::kControl:
+      return "utime_us,request_id,command,target,mode,kp,ki_per_s,kd_s,experiment,experiment_amplitude_V,"
+             "experiment_offset_V,experiment_frequency_Hz,experiment_duration_s";
+    default: return "size_bytes";
+  }
+}
+
+// Appends comma-separated fields to a row.
+class Fields {
+ public:
+  explicit Fields(std::string& out) : out_(out) { out_.clear(); }
+  Fields& i(long long v) { return raw(std::to_string(v)); }
+  Fields& d(double v) { return raw(num(v)); }
+  Fields& s(const std::string& text) { return raw(csv_quoted(text)); }
+  Fields& raw(const std::string& text) {
+    if (!first_) out_ += ',';
+    first_ = false;
+    out_ += text;
+    return *this;
+  }
+
+ private:
+  std::string& out_;
+  bool first_ = true;
+};
+
+// The decoded fields of one event after "t_s,recv_utime_us,", or false if it does not decode.
+class RowDecoder {
+ public:
+  bool row(Kind kind, const lcm::LogEvent& e, std::string& out) {
+    switch (kind) {
+      case Kind::kSensor: {
+        const auto& m = sample_;
+        if (!decode_checked(e, sample_)) return false;
+        Fields(out).i(m.utime).i(m.seq).d(m.u_V).d(m.y_m).i(m.flags);
+        return true;
+      }
+      case Kind::kCommand: {
+        const auto& m = command_;
+        if (!decode_checked(e, command_)) return false;
+        Fields(out).i(m.utime).i(m.seq).i(m.sample_seq).d(m.u_V).d(m.u_ff_V).d(m.u_fb_V).d(m.y_ref_m)
+            .i(m.params_version).i(m.mode);
+        return true;
+      }
+      case Kind::kTrajectory: {
+        const auto& m = trajectory_;
+        if (!decode_checked(e, trajectory_)) return false;
+        Fields(out).i(m.utime).i(m.version).i(m.shape).d(m.amplitude_m).d(m.offset_m).d(m.frequency_Hz)
+            .d(m.phase_rad).i(m.start_utime).d(m.blend_s).i(m.n_points).raw(joined(m.points_t_s))
+            .raw(joined(m.points_y_m));
+        return true;
+      }
+      case Kind::kParams: {
+        const auto& m = params_;
+        if (!decode_checked(e, params_)) return false;
+        Fields(out).i(m.utime).i(m.version).d(m.c1).d(m.c2).d(m.c3).d(m.residual_m).i(m.samples_used).d(m.window_s)
+            .i(m.valid ? 1 : 0).s(m.source);
+        return true;
+      }
+      case Kind::kStatus: {
+        const auto& m = status_;
+        if (!decode_checked(e, status_)) return false;
+        std::string counters;
+        for (std::size_t k = 0; k < m.counter_names.size(); ++k) {
+          if (k > 0) counters += ';';
+          counters += m.counter_names[k];
+          counters += '=';
+          counters += std::to_string(m.counter_values[k]);
+        }
+        Fields(out).i(m.utime).s(m.process).s(m.host).i(m.pid).i(m.state).s(m.detail).i(m.start_utime)
+            .d(m.loop_p50_us).d(m.loop_p99_us).d(m.loop_max_us).d(m.latency_p50_us).d(m.latency_p99_us)
+            .d(m.latency_max_us).i(m.late).i(m.rejected).s(counters);
+        return true;
+      }
+      case Kind::kControl: {
+        const auto& m = control_;
+        if (!decode_checked(e, control_)) return false;
+        Fields(out).i(m.utime).i(m.request_id).i(m.command).s(m.target).i(m.mode).d(m.kp).d(m.ki).d(m.kd)
+            .s(m.experiment).d(m.experiment_amplitude_V).d(m.experiment_offset_V).d(m.experiment_frequency_Hz)
+            .d(m.experiment_duration_s);
+        return true;
+      }
+      default:
+        Fields(out).i(e.datalen);
+        return true;
+    }
+  }
+
+ private:
+  sensor_sample_t sample_;
+  actuator_command_t command_;
+  trajectory_t trajectory_;
+  mem_params_t params_;
+  service_status_t status_;
+  control_t control_;
+};
+
+struct ChannelWriter {
+  CsvExport result;
+  Kind kind = Kind::kUndecided;
+  std::ofstream out;
+};
+
+}  // namespace
+
+std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel) {
+  std::string name = channel;
+  for (char& c : name) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+                    c == '.' || c == '-';
+    if (!ok) c = '_';
+  }
+  return dir / (name + ".csv");
+}
+
+std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs, const std::vector<std::string>& channels,
+                                  std::int64_t t0_utime, double lower_s, double upper_s,
+                                  const std::filesystem::path& dir) {
+  std::vector<std::unique_ptr<ChannelWriter>> writers;
+  for (const auto& channel : channels) {
+    auto writer = std::make_unique<ChannelWriter>();
+    writer->result.channel = channel;
+    writer->result.file = csv_path(dir, channel);
+    writer->out.open(writer->result.file);
+    if (!writer->out) throw std::runtime_error(writer->result.file.string() + ": cannot write");
+    writers.push_back(std::move(writer));
+  }
+  RowDecoder decoder;
+  std::string row;
+  for_each_event(logs, [&](const lcm::LogEvent& e) {
+    for (auto& w : writers) {
+      if (e.channel != w->result.channel) continue;
+      if (w->kind == Kind::kUndecided) {  // the first event decides the channel's type and header
+        w->kind = kind_of(e);
+        w->result.type_name = type_name(w->kind);
+        w->out << "t_s,recv_utime_us," << header(w->kind) << '\n';
+      }
+      const double t = static_cast<double>(e.timestamp - t0_utime) * 1e-6;
+      if (t < lower_s || t > upper_s) continue;
+      if (!decoder.row(w->kind, e, row)) {
+        ++w->result.skipped;
+        continue;
+      }
+      w->out << num(t) << ',' << e.timestamp << ',' << row << '\n';
+      ++w->result.rows;
+    }
+  });
+  std::vector<CsvExport> results;
+  for (auto& w : writers) {
+    if (w->kind == Kind::kUndecided) w->out << "t_s,recv_utime_us\n";  // no event at all
+    w->out.close();
+    if (!w->out) throw std::runtime_error(w->result.file.string() + ": write failed");
+    results.push_back(w->result);
+  }
+  return results;
+}
+
+}  // namespace hystloop::report

@@ -1,0 +1,40 @@
+#pragma once
+// Decoding one logged message the way a Subscription does: the fingerprint is T's, every
+// length field fits the buffer (checked before lcm-gen's decode trusts it), the whole
+// buffer is used, and the values pass the contract's check. A corrupt event in a log is
+// then a count, never a crash or a gigabyte allocation.
+
+#include <cstdint>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "lcm/message_checks.hpp"
+#include "lcm/message_storage.hpp"
+#include "lcm/wire_layout.hpp"
+
+namespace hystloop::report {
+
+// True if `data` starts with T's fingerprint (decides a channel's type from its bytes).
+template <class T>
+bool has_fingerprint_of(const lcm::LogEvent& event) noexcept {
+  if (event.datalen < 8) return false;
+  const auto size = static_cast<std::size_t>(event.datalen);
+  return wire_fingerprint(event.data, size) == T::getHash();
+}
+
+template <class T>
+bool decode_checked(const lcm::LogEvent& event, T& msg) noexcept {
+  if (!has_fingerprint_of<T>(event)) return false;
+  const auto size = static_cast<std::size_t>(event.datalen);
+  if (walk_wire_layout(wire_layout_of<T>(), event.data, size) < 0) return false;
+  clear_arrays(msg);
+  int used = -1;
+  try {
+    used = msg.decode(event.data, 0, event.datalen);
+  } catch (...) {
+    return false;
+  }
+  return used == event.datalen && check_message(msg) == Verdict::kOk;
+}
+
+}  // namespace hystloop::report

@@ -1,0 +1,152 @@
+// hystloop-report: the figures of a recorded run, from LCM event logs.
+//
+//   hystloop-report LOG... --out DIR [--csv CHANNEL]... [--from S] [--to S] [--skip-initial S]
+//                   [--rig PREFIX] [--quiet] [--no-plots] [--gnuplot PATH]
+//
+// Writes DIR/summary.json, DIR/<channel>.csv for each --csv, and the plots (PNG via
+// gnuplot, with their data files and plots.gp); prints a table of the main figures.
+// Exit status: 0 done (a missing gnuplot is a warning), 1 a log could not be read or an
+// output written, 2 bad arguments.
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "csv_export.hpp"
+#include "lcm/channels.hpp"
+#include "log_reader.hpp"
+#include "plots.hpp"
+#include "report_metrics.hpp"
+#include "report_table.hpp"
+#include "summary_json.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace hystloop;
+using namespace hystloop::report;
+
+struct Options {
+  std::vector<fs::path> logs;
+  fs::path out;
+  std::vector<std::string> csv;
+  std::optional<double> from_s, to_s;
+  double skip_initial_s = 0.0;
+  std::string rig = std::string(kDefaultRigPrefix);
+  bool quiet = false;
+  bool no_plots = false;
+  PlotOptions plots;
+  std::string bridge_process = "bridge";
+  std::string logger_process = "logger";
+};
+
+// A --csv argument names a channel as logged ("HX_SENSOR") or by its suffix ("SENSOR").
+std::string resolve_channel(const std::string& name, const RunData& run, const std::string& prefix) {
+  if (run.channel_counts.count(name) != 0) return name;
+  if (run.channel_counts.count(prefix + name) != 0) return prefix + name;
+  std::string known;
+  for (const auto& [channel, count] : run.channel_counts) known += (known.empty() ? "" : ", ") + channel;
+  throw ParameterError("--csv", "no channel '" + name + "' in the log (channels: " + (known.empty() ? "none" : known) + ")");
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+int run(const Options& o) {
+  const ChannelNames channels(o.rig);
+  ReportOptions ro;
+  ro.from_s = o.from_s;
+  ro.to_s = o.to_s;
+  ro.skip_initial_s = o.skip_initial_s;
+  ro.bridge_process = o.bridge_process;
+  ro.logger_process = o.logger_process;
+  ro.validate();
+  if (o.plots.max_points == 0) throw ParameterError("--plot-max-points", "must be > 0 (got 0)");
+
+  const RunData data = read_logs(o.logs, channels);
+  std::vector<std::string> csv_channels;
+  for (const auto& name : o.csv) csv_channels.push_back(resolve_channel(name, data, channels.prefix));
+
+  std::error_code ec;
+  fs::create_directories(o.out, ec);
+  if (ec || !fs::is_directory(o.out)) throw std::runtime_error(o.out.string() + ": cannot create the folder");
+
+  const ReportMetrics metrics = compute_metrics(data, ro);
+  if (data.samples.empty()) {
+    std::fprintf(stderr, "hystloop-report: warning: no %s samples in the log; most figures are null\n",
+                 channels.sensor.c_str());
+  }
+  write_text(o.out / "summary.json", summary_json(metrics, ro, o.logs));
+
+  std::vector<CsvExport> exports;
+  if (!csv_channels.empty()) {
+    exports = export_csv(o.logs, csv_channels, data.time_zero_utime(), ro.lower_s(), ro.upper_s(), o.out);
+  }
+  PlotResult plots;
+  if (!o.no_plots) {
+    plots = write_plots(matched_ticks(data, ro), metrics, o.out, o.plots);
+    if (!plots.warning.empty()) std::fprintf(stderr, "hystloop-report: warning: %s\n", plots.warning.c_str());
+  }
+
+  if (!o.quiet) {
+    std::printf("hystloop-report: %zu log file(s), rig %s\n%s", o.logs.size(), channels.prefix.c_str(),
+                format_table(metrics).c_str());
+    std::printf("  wrote                  %s", (o.out / "summary.json").c_str());
+    for (const auto& e : exports) std::printf(", %s (%zu rows)", e.file.filename().c_str(), e.rows);
+    for (const auto& image : plots.images) std::printf(", %s", image.filename().c_str());
+    std::printf("\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"hystloop-report: tracking error, latency, late commands, parameter history and plots of a recorded "
+               "run, from LCM event logs (times are the log's receive timestamps, relative to the first sensor sample)"};
+  app.add_option("logs", o.logs, "LCM event log file(s); rotated files in recording order")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--out", o.out, "Output folder (created if missing)")->required();
+  app.add_option("--csv", o.csv, "Export a channel to DIR/<channel>.csv, e.g. HX_SENSOR or SENSOR (repeatable)");
+  app.add_option("--from", o.from_s, "Start of the analysed range [s after the first sensor sample]");
+  app.add_option("--to", o.to_s, "End of the analysed range [s after the first sensor sample]");
+  app.add_option("--skip-initial", o.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
+      ->capture_default_str();
+  app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();
+  app.add_option("--bridge-process", o.bridge_process, "Process name of the bridge in HX_STATUS")->capture_default_str();
+  app.add_option("--logger-process", o.logger_process, "Process name of the logger in HX_STATUS")->capture_default_str();
+  app.add_flag("--quiet", o.quiet, "Print nothing but warnings and errors");
+  app.add_flag("--no-plots", o.no_plots, "Write no plots");
+  app.add_option("--gnuplot", o.plots.gnuplot, "gnuplot executable")->capture_default_str();
+  app.add_option("--plot-max-points", o.plots.max_points, "Decimate the plotted ticks to at most this many")
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+  try {
+    return run(o);
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
+    return 1;
+  }
+}

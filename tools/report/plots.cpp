@@ -1,0 +1,220 @@
+#include "plots.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace hystloop::report {
+
+namespace {
+
+std::ofstream open_for_writing(const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+  return out;
+}
+
+void close_checked(std::ofstream& out, const std::filesystem::path& path) {
+  out.close();
+  if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+// Runs `gnuplot args...` with `dir` as working directory, output silenced; returns its exit status.
+// gnuplot's own messages go to `log_name` in dir.
+int run_in(const std::filesystem::path& dir, const std::filesystem::path& exe, const std::vector<std::string>& args,
+           const char* log_name = "/dev/null") {
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    if (std::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(126);
+    if (std::freopen(log_name, "w", stderr) == nullptr) ::_exit(126);
+    std::vector<char*> argv;
+    std::string program = exe.string();
+    argv.push_back(program.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(program.c_str(), argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+struct Histogram {
+  double lo = 0.0, width = 1.0;
+  std::vector<std::size_t> counts;
+  std::size_t above = 0;  // values beyond the last bin (folded into it)
+  double cap = 0.0;
+};
+
+// 60 bins from the minimum to the maximum, or to 3 x p99 when the tail is longer.
+Histogram latency_histogram(const ReportMetrics& m) {
+  Histogram h;
+  const auto& v = m.latencies_us;
+  if (v.empty()) return h;
+  h.lo = v.front();
+  h.cap = std::min(v.back(), std::max(3.0 * m.latency_p99_us.value_or(v.back()), h.lo + 1.0));
+  h.counts.assign(60, 0);
+  h.width = std::max((h.cap - h.lo) / 60.0, 1e-3);
+  for (const double x : v) {
+    if (x > h.cap) ++h.above;
+    const auto bin = static_cast<std::size_t>(std::clamp((x - h.lo) / h.width, 0.0, 59.0));
+    ++h.counts[bin];
+  }
+  return h;
+}
+
+}  // namespace
+
+std::filesystem::path find_executable(const std::string& name) {
+  if (name.empty()) return {};
+  if (name.find('/') != std::string::npos) return ::access(name.c_str(), X_OK) == 0 ? std::filesystem::path(name) : "";
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path != nullptr ? path : "/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    const auto candidate = std::filesystem::path(dir.empty() ? "." : dir) / name;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+  }
+  return {};
+}
+
+PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics& m, const std::filesystem::path& dir,
+                       const PlotOptions& options) {
+  PlotResult result;
+  const bool have_ticks = !ticks.empty();
+  const bool have_tracking = m.tracking_samples > 0;
+  const bool have_latency = !m.latencies_us.empty();
+
+  {  // track.dat: every n-th tick.
+    const auto path = dir / "track.dat";
+    auto out = open_for_writing(path);
+    out << "# t_s u_V y_um y_ref_um e_nm   (NaN: no reference for the tick)\n";
+    const std::size_t step = std::max<std::size_t>(1, (ticks.size() + options.max_points - 1) / std::max<std::size_t>(options.max_points, 1));
+    for (std::size_t i = 0; i < ticks.size(); i += step) {
+      const auto& p = ticks[i];
+      out << num(p.t_s) << ' ' << num(p.u_V) << ' ' << num(p.y_m * 1e6) << ' ' << num(p.y_ref_m * 1e6) << ' '
+          << num((p.y_m - p.y_ref_m) * 1e9) << '\n';
+    }
+    close_checked(out, path);
+    result.data_files.push_back(path);
+  }
+  {
+    const auto path = dir / "per_second.dat";
+    auto out = open_for_writing(path);
+    out << "# t_s rms_error_nm params_version   (t_s = start of the second)\n";
+    for (const auto& bin : m.per_second) {
+      out << num(bin.t_s) << ' ' << num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")) << ' ' << bin.params_version
+          << '\n';
+    }
+    close_checked(out, path);
+    result.data_files.push_back(path);
+  }
+  const Histogram hist = latency_histogram(m);
+  {
+    const auto path = dir / "latency_hist.dat";
+    auto out = open_for_writing(path);
+    out << "# bin_low_us bin_high_us count   (the last bin also holds " << hist.above << " values above "
+        << num(hist.cap) << " us)\n";
+    for (std::size_t i = 0; i < hist.counts.size(); ++i) {
+      const double lo = hist.lo + hist.width * static_cast<double>(i);
+      out << num(lo) << ' ' << num(lo + hist.width) << ' ' << hist.counts[i] << '\n';
+    }
+    close_checked(out, path);
+    result.data_files.push_back(path);
+  }
+
+  std::vector<std::string> images;
+  std::ostringstream gp;
+  gp << "# Re-plot with: cd <this folder> && gnuplot plots.gp   (terminal: edit the first line)\n"
+     << "set terminal @TERMINAL@ size 1000,700 noenhanced\n"
+     << "set grid\nset key top left\n";
+  if (have_ticks) {
+    images.push_back("hysteresis_u_y.png");
+    gp << "\nset output 'hysteresis_u_y.png'\nset title 'Hysteresis loop: applied voltage u -> measured position y'\n"
+       << "set xlabel 'u [V]'\nset ylabel 'y [um]'\n"
+       << "plot 'track.dat' using 2:3 with lines lw 1 title 'y(u)'\n";
+  }
+  if (have_tracking) {
+    images.push_back("hysteresis_yref_y.png");
+    gp << "\nset output 'hysteresis_yref_y.png'\n"
+       << "set title 'Reference y_ref -> measured position y (cf. the MEM paper, Fig. 11)'\n"
+       << "set xlabel 'y_ref [um]'\nset ylabel 'y [um]'\nset size ratio -1\n"
+       << "plot 'track.dat' using 4:3 with lines lw 1 title 'y(y_ref)', x with lines dt 2 lc rgb 'gray' title 'y = y_ref'\n"
+       << "set size noratio\n";
+    images.push_back("tracking_error.png");
+    gp << "\nset output 'tracking_error.png'\nset title 'Tracking error e = y - y_ref'\n"
+       << "set xlabel 't [s]'\nset ylabel 'e [nm]'\n"
+       << "plot 'track.dat' using 1:5 with lines lw 1 title 'e', "
+       << "'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n";
+  }
+  if (have_latency) {
+    images.push_back("latency_histogram.png");
+    gp << "\nset output 'latency_histogram.png'\n"
+       << "set title 'Sample-to-command latency (log receive times), n = " << m.latencies_us.size()
+       << (hist.above > 0 ? ", " + std::to_string(hist.above) + " above " + num(hist.cap) + " us in the last bin" : "")
+       << "'\nset xlabel 'latency [us]'\nset ylabel 'commands'\nset style fill solid 0.6\nset boxwidth 0.9 relative\n"
+       << "plot 'latency_hist.dat' using (($1+$2)/2):3 with boxes title 'count'\n";
+  }
+  gp << "\nunset output\n";
+
+  result.script = dir / "plots.gp";
+  auto write_script = [&](const std::string& terminal) {
+    std::string text = gp.str();
+    text.replace(text.find("@TERMINAL@"), 10, terminal);
+    auto out = open_for_writing(result.script);
+    out << text;
+    close_checked(out, result.script);
+  };
+  write_script("pngcairo");
+
+  const auto exe = find_executable(options.gnuplot);
+  if (exe.empty()) {
+    result.warning = "gnuplot not found ('" + options.gnuplot + "'): plots skipped (data and plots.gp are in " +
+                     dir.string() + ")";
+    return result;
+  }
+  if (images.empty()) {
+    result.warning = "no data to plot";
+    return result;
+  }
+  for (const std::string terminal : {"pngcairo", "png"}) {
+    if (run_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // terminal not built in
+    write_script(terminal);
+    for (const auto& image : images) std::filesystem::remove(dir / image);
+    const int rc = run_in(dir, exe, {"plots.gp"}, "gnuplot.log");
+    result.terminal = terminal;
+    for (const auto& image : images) {
+      if (std::filesystem::exists(dir / image)) result.images.push_back(dir / image);
+    }
+    if (rc != 0 || result.images.size() != images.size()) {
+      result.warning = "gnuplot failed (exit " + std::to_string(rc) + "): " + std::to_string(result.images.size()) +
+                       " of " + std::to_string(images.size()) + " plots written; see " + (dir / "gnuplot.log").string();
+    }
+    return result;
+  }
+  result.warning = "gnuplot has neither the pngcairo nor the png terminal: plots skipped";
+  return result;
+}
+
+}  // namespace hystloop::report

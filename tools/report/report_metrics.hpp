@@ -1,0 +1,107 @@
+#pragma once
+// The figures of a recorded run, computed from RunData alone (no I/O), so that each can
+// be checked against an independent computation in a test.
+//
+// Time axis: t_s = (log receive time - receive time of the first HX_SENSOR event) [s].
+// Tracking error of tick k: e_k = y_k - y_ref_k, with y_k from the sample with seq k and
+// y_ref_k from the first logged command with seq k (the command meant for that tick);
+// only ticks with a finite y_ref count ("tracking"). Latency of a command that answers
+// sample k: its receive time minus the receive time of sample k, both as logged.
+// Percentiles are nearest-rank: the ceil(q*n)-th smallest value.
+
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "run_data.hpp"
+
+namespace hystloop::report {
+
+struct ReportOptions {
+  std::optional<double> from_s;   // keep t_s >= from_s (+ skip_initial_s)
+  std::optional<double> to_s;     // keep t_s <= to_s
+  double skip_initial_s = 0.0;    // warm-up excluded at the start of the range, >= 0
+  std::string bridge_process = "bridge";
+  std::string logger_process = "logger";
+
+  // Throws ParameterError naming the option ("--from", "--to", "--skip-initial").
+  void validate() const;
+  // The selected interval [lower, upper] of t_s (lower = -inf without --from/--skip-initial).
+  double lower_s() const noexcept;
+  double upper_s() const noexcept;
+};
+
+struct SecondBin {
+  double t_s = 0.0;                  // start of the one-second bin
+  std::size_t tracking_samples = 0;
+  std::optional<double> rms_error_m;
+  std::int32_t params_version = 0;   // of the last command applied in the bin (carried forward)
+};
+
+struct MemParams {
+  std::int32_t version = 0;
+  double c1 = 0.0, c2 = 0.0, c3 = 0.0;
+};
+
+struct ParamsPoint {
+  double t_s = 0.0;
+  std::int32_t version = 0;
+  double c1 = 0.0, c2 = 0.0, c3 = 0.0, residual_m = 0.0;
+  bool valid = false;
+};
+
+struct ReportMetrics {
+  std::size_t samples = 0;           // sensor samples in the range
+  double duration_s = 0.0;           // last minus first sample time in the range
+  std::optional<double> first_sample_t_s, last_sample_t_s;
+
+  std::size_t tracking_samples = 0;
+  std::optional<double> rms_error_m, max_abs_error_m;
+  std::optional<double> rms_error_first_5s_m, rms_error_last_5s_m;
+  std::vector<SecondBin> per_second;
+
+  std::size_t armed_samples = 0;     // samples without SAFE_STATE
+  std::size_t late_samples = 0;      // armed samples with LATE_COMMAND
+  std::optional<double> late_command_fraction;
+
+  std::vector<double> latencies_us;  // sorted ascending
+  std::optional<double> latency_p50_us, latency_p99_us, latency_max_us;
+
+  std::optional<std::int64_t> commands_rejected;
+  std::string commands_rejected_source;  // which counters of which status, or why none
+  std::vector<std::pair<std::string, std::int64_t>> commands_rejected_counters;
+
+  std::vector<ParamsPoint> params_history;  // in the range, one entry per (version, valid)
+  std::optional<MemParams> params_initial, params_final;
+  std::size_t params_updates = 0;
+
+  std::optional<std::int64_t> logger_gaps;
+  std::string logger_gaps_source;    // "logger status counter <name>" or "sensor seq"
+  std::int64_t seq_gaps = 0;         // jumps > 1 between consecutive samples in the range
+  std::int64_t missing_samples = 0;  // ticks missing in those jumps
+
+  std::map<std::string, std::uint64_t> channels;
+  std::uint64_t events = 0;
+  std::uint64_t undecodable = 0;
+};
+
+ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options);
+
+// Nearest-rank percentile of an ascending vector, q in [0, 1]; nullopt when empty.
+std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) noexcept;
+
+// One matched tick (for plots): time, applied voltage, measured and reference position.
+struct TrackPoint {
+  double t_s;
+  double u_V;
+  double y_m;
+  double y_ref_m;  // NaN when the tick had no reference
+};
+// Every sample of the range with its reference (if any), in log order.
+std::vector<TrackPoint> matched_ticks(const RunData& run, const ReportOptions& options);
+
+}  // namespace hystloop::report

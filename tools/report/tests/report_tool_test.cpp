@@ -1,0 +1,472 @@
+// hystloop-report end to end: a log with known content is written with lcm::LogFile,
+// the tool runs on it, and every figure of summary.json is checked against values
+// computed here from the generator's own truth (not through report_metrics).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "hystloop/trajectory_t.hpp"
+#include "mini_json.hpp"
+
+namespace fs = std::filesystem;
+using namespace hystloop;
+
+namespace {
+
+constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // receive time of the first sample [us]
+constexpr std::int64_t kTicks = 12'000;               // 12 s at 1 kHz (the tool does not assume 10 kHz)
+constexpr std::int64_t kTickUs = 1000;
+constexpr std::int64_t kGapFirst = 5000, kGapLen = 10;  // samples 5000..5009 never logged
+constexpr std::int64_t kFirstReference = 1000;          // ticks before this have y_ref = NaN
+constexpr std::int64_t kFirstArmed = 500;               // ticks before this carry SAFE_STATE
+constexpr std::int64_t kDuplicateSeq = 3000;            // a second command for this tick (ignored)
+
+bool logged(std::int64_t k) { return k < kGapFirst || k >= kGapFirst + kGapLen; }
+std::int64_t sample_recv(std::int64_t k) { return kT0 + k * kTickUs; }
+// The report's time axis, by its definition: (receive time - first sample's) * 1e-6.
+double tick_time(std::int64_t k) { return static_cast<double>(k * kTickUs) * 1e-6; }
+double reference(std::int64_t k) {
+  return k < kFirstReference ? std::nan("") : 1e-6 * std::sin(2.0 * M_PI * 0.5 * static_cast<double>(k) / 1000.0);
+}
+double error_of(std::int64_t k) {  // y - y_ref: larger in the first seconds, with a sign pattern
+  const double size = k < 4000 ? 40e-9 : 10e-9;
+  return size * static_cast<double>(1 + k % 5) * ((k % 2) != 0 ? 1.0 : -1.0);
+}
+bool late(std::int64_t k) { return k >= kFirstArmed && k % 250 == 3; }
+std::int64_t latency_us(std::int64_t k) { return k % 1000 == 7 ? 1900 : 50 + k % 100; }
+std::int32_t version_in_use(std::int64_t k) { return k < 3200 ? 1 : (k < 7200 ? 2 : 4); }
+
+struct Event {
+  std::int64_t t;
+  std::string channel;
+  std::vector<std::uint8_t> bytes;
+};
+
+template <class T>
+Event event(std::int64_t t, const std::string& channel, const T& msg) {
+  Event e{t, channel, std::vector<std::uint8_t>(static_cast<std::size_t>(msg.getEncodedSize()))};
+  msg.encode(e.bytes.data(), 0, msg.getEncodedSize());
+  return e;
+}
+
+mem_params_t params(std::int32_t version, double c1, bool valid) {
+  mem_params_t p{};
+  p.utime = kT0;
+  p.version = version;
+  p.c1 = c1;
+  p.c2 = 2e-9 * version;
+  p.c3 = 0.5 + 0.1 * version;
+  p.residual_m = 1e-9 * version;
+  p.valid = valid;
+  p.source = "test";
+  return p;
+}
+
+service_status_t status(const std::string& process, std::int64_t t, std::vector<std::pair<std::string, std::int64_t>> c) {
+  service_status_t s{};
+  s.utime = t;
+  s.process = process;
+  s.host = "h";
+  s.pid = 42;
+  s.state = service_status_t::HEALTHY;
+  s.start_utime = kT0;
+  for (auto& [name, value] : c) {
+    s.counter_names.push_back(name);
+    s.counter_values.push_back(value);
+  }
+  s.n_counters = static_cast<std::int32_t>(c.size());
+  s.loop_p50_us = s.loop_p99_us = s.loop_max_us = std::nan("");
+  s.latency_p50_us = s.latency_p99_us = s.latency_max_us = std::nan("");
+  s.rejected = 77;
+  return s;
+}
+
+// Writes the synthetic run; returns the number of events per channel.
+std::map<std::string, std::size_t> write_log(const fs::path& file, bool with_logger_status) {
+  std::vector<Event> events;
+  for (std::int64_t k = 0; k < kTicks; ++k) {
+    if (logged(k)) {
+      sensor_sample_t s{};
+      s.utime = sample_recv(k) - 30;
+      s.seq = k;
+      s.u_V = 10.0 * std::sin(static_cast<double>(k) / 300.0);
+      const double ref = reference(k);
+      s.y_m = (std::isfinite(ref) ? ref : 0.0) + error_of(k);
+      s.flags = sensor_sample_t::SIMULATED | (k < kFirstArmed ? sensor_sample_t::SAFE_STATE : 0) |
+                (late(k) ? sensor_sample_t::LATE_COMMAND : 0);
+      events.push_back(event(sample_recv(k), "HX_SENSOR", s));
+    }
+    actuator_command_t c{};
+    c.seq = k;
+    c.sample_seq = k >= 2 ? k - 2 : -1;  // answers the sample two ticks earlier
+    c.utime = sample_recv(k - 2) + latency_us(k) + 5;
+    c.u_V = c.u_ff_V = 1.0;
+    c.y_ref_m = reference(k);
+    c.params_version = version_in_use(k);
+    c.mode = actuator_command_t::MODE_MEM;
+    events.push_back(event(sample_recv(k - 2) + latency_us(k), "HX_COMMAND", c));
+    if (k == kDuplicateSeq) {
+      c.y_ref_m = 1.0e-3;  // would ruin the error if the tool used it
+      c.sample_seq = -1;
+      events.push_back(event(sample_recv(k) - 1, "HX_COMMAND", c));
+    }
+  }
+  events.push_back(event(kT0 - 500'000, "HX_PARAMS", params(1, 1e-7, true)));
+  events.push_back(event(kT0 + 3'000'000, "HX_PARAMS", params(2, 1.1e-7, true)));
+  events.push_back(event(kT0 + 3'001'000, "HX_PARAMS", params(2, 1.1e-7, true)));  // a repeat
+  events.push_back(event(kT0 + 5'000'000, "HX_PARAMS", params(3, 9e-7, false)));   // diagnostic only
+  events.push_back(event(kT0 + 7'000'000, "HX_PARAMS", params(4, 1.2e-7, true)));
+  for (std::int64_t s = 1; s <= 12; ++s) {
+    const std::int64_t t = kT0 + s * 1'000'000 - 100;
+    events.push_back(event(t, "HX_STATUS",
+                           status("bridge", t,
+                                  {{"ticks", s * 1000},
+                                   {"rejected_nonfinite", s},  // final 12
+                                   {"stale", 2},
+                                   {"command.rejected_out_of_range", 1},
+                                   {"control.rejected_decode_failed", 5}})));
+    if (with_logger_status) events.push_back(event(t + 10, "HX_STATUS", status("logger", t, {{"sensor.gaps", 1}})));
+  }
+  trajectory_t traj{};
+  traj.utime = kT0;
+  traj.version = 1;
+  traj.shape = trajectory_t::SINE;
+  traj.amplitude_m = 1e-6;
+  traj.frequency_Hz = 0.5;
+  events.push_back(event(kT0 + 900'000, "HX_TRAJECTORY", traj));
+
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+  lcm::LogFile log(file.string(), "w");
+  EXPECT_TRUE(log.good());
+  std::map<std::string, std::size_t> counts;
+  for (auto& e : events) {
+    lcm::LogEvent le{};
+    le.timestamp = e.t;
+    le.channel = e.channel;
+    le.datalen = static_cast<std::int32_t>(e.bytes.size());
+    le.data = e.bytes.data();
+    EXPECT_EQ(log.writeEvent(&le), 0);
+    ++counts[e.channel];
+  }
+  return counts;
+}
+
+struct ToolRun {
+  int exit_code;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+ToolRun run_tool(const std::string& args, const fs::path& scratch) {
+  const std::string cmd = std::string(HYSTLOOP_REPORT_EXE) + " " + args + " >" + (scratch / "stdout").string() + " 2>" +
+                          (scratch / "stderr").string();
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(scratch / "stdout"), slurp(scratch / "stderr")};
+}
+
+bool is_png(const fs::path& path) {
+  const std::string head = slurp(path).substr(0, 8);
+  return head == std::string("\x89PNG\r\n\x1a\n", 8);
+}
+
+// The expected figures for samples with lo <= t <= hi, computed from the generator's truth.
+struct Expected {
+  std::size_t samples = 0, tracking = 0, armed = 0, late = 0;
+  double rms = 0, max_abs = 0, rms_first = 0, rms_last = 0;
+  std::vector<double> latencies;
+  std::map<std::int64_t, std::pair<double, std::size_t>> bins;  // second -> (sum sq, n)
+};
+
+Expected expected(double lo, double hi) {
+  Expected x;
+  double sum = 0, first_sum = 0, last_sum = 0;
+  std::size_t first_n = 0, last_n = 0;
+  double t_first = -1, t_last = -1;
+  for (std::int64_t k = 0; k < kTicks; ++k) {
+    const double t = tick_time(k);
+    if (!logged(k) || t < lo || t > hi) continue;
+    ++x.samples;
+    if (k >= kFirstArmed) ++x.armed, x.late += late(k) ? 1 : 0;
+    if (k + 2 < kTicks) x.latencies.push_back(static_cast<double>(latency_us(k + 2)));
+    if (k < kFirstReference) continue;
+    if (t_first < 0) t_first = t;
+    t_last = t;
+  }
+  for (std::int64_t k = kFirstReference; k < kTicks; ++k) {
+    const double t = tick_time(k);
+    if (!logged(k) || t < lo || t > hi) continue;
+    const double e = error_of(k);
+    ++x.tracking;
+    sum += e * e;
+    x.max_abs = std::max(x.max_abs, std::abs(e));
+    if (t < t_first + 5.0) first_sum += e * e, ++first_n;
+    if (t > t_last - 5.0) last_sum += e * e, ++last_n;
+    auto& bin = x.bins[static_cast<std::int64_t>(std::floor(t))];
+    bin.first += e * e, ++bin.second;
+  }
+  x.rms = std::sqrt(sum / static_cast<double>(x.tracking));
+  x.rms_first = std::sqrt(first_sum / static_cast<double>(first_n));
+  x.rms_last = std::sqrt(last_sum / static_cast<double>(last_n));
+  std::sort(x.latencies.begin(), x.latencies.end());
+  return x;
+}
+
+double rank(const std::vector<double>& sorted, double q) {
+  const auto r = static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size())));
+  return sorted[std::max<std::size_t>(r, 1) - 1];
+}
+
+class ReportToolTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("hystloop_report_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    // Kept on failure, or with HYSTLOOP_KEEP_TEST_OUTPUT=1 (to look at the plots).
+    if (!HasFailure() && std::getenv("HYSTLOOP_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir_);
+  }
+  fs::path dir_;
+};
+
+constexpr double kRel = 1e-9;
+
+}  // namespace
+
+TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
+  const auto counts = write_log(dir_ / "run.lcmlog", true);
+  const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
+                             " --csv HX_SENSOR --csv COMMAND --csv HX_STATUS",
+                         dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
+  const Expected x = expected(-1e9, 1e9);
+
+  EXPECT_EQ(j["samples"].num(), static_cast<double>(x.samples));
+  EXPECT_EQ(j["samples"].num(), static_cast<double>(kTicks - kGapLen));
+  EXPECT_NEAR(j["duration_s"].num(), static_cast<double>(kTicks - 1) * 1e-3, 1e-9);
+  EXPECT_EQ(j["tracking_samples"].num(), static_cast<double>(x.tracking));
+  EXPECT_NEAR(j["rms_error_m"].num(), x.rms, kRel * x.rms);
+  EXPECT_NEAR(j["max_abs_error_m"].num(), 200e-9, 1e-18);
+  EXPECT_NEAR(j["max_abs_error_m"].num(), x.max_abs, 1e-18);
+  EXPECT_NEAR(j["rms_error_first_5s_m"].num(), x.rms_first, kRel * x.rms_first);
+  EXPECT_NEAR(j["rms_error_last_5s_m"].num(), x.rms_last, kRel * x.rms_last);
+  EXPECT_GT(x.rms_first, 2.0 * x.rms_last);  // the generator's pattern: the test can tell them apart
+
+  const auto& per_second = j["per_second"].array;
+  ASSERT_EQ(per_second.size(), 12u);
+  for (std::size_t s = 0; s < per_second.size(); ++s) {
+    const auto& bin = per_second[s];
+    EXPECT_EQ(bin["t_s"].num(), static_cast<double>(s));
+    const auto it = x.bins.find(static_cast<std::int64_t>(s));
+    if (it == x.bins.end()) {
+      EXPECT_TRUE(bin["rms_error_m"].is_null()) << s;
+    } else {
+      const double want = std::sqrt(it->second.first / static_cast<double>(it->second.second));
+      EXPECT_NEAR(bin["rms_error_m"].num(), want, kRel * want) << s;
+    }
+    EXPECT_EQ(bin["params_version"].num(), version_in_use(static_cast<std::int64_t>(s) * 1000 + 999)) << s;
+  }
+
+  EXPECT_EQ(j["armed_samples"].num(), static_cast<double>(x.armed));
+  EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
+  EXPECT_NEAR(j["late_command_fraction"].num(), static_cast<double>(x.late) / static_cast<double>(x.armed), 1e-15);
+
+  EXPECT_EQ(j["latency_samples"].num(), static_cast<double>(x.latencies.size()));
+  EXPECT_EQ(j["latency_p50_us"].num(), rank(x.latencies, 0.50));
+  EXPECT_EQ(j["latency_p99_us"].num(), rank(x.latencies, 0.99));
+  EXPECT_EQ(j["latency_max_us"].num(), 1900.0);
+
+  EXPECT_EQ(j["commands_rejected"].num(), 12 + 2 + 1);  // not the control endpoint's 5, not 'rejected' (77)
+  EXPECT_EQ(j["logger_gaps"].num(), 1.0);
+  EXPECT_NE(j["logger_gaps_source"].string.find("sensor.gaps"), std::string::npos);
+  EXPECT_EQ(j["seq_gaps"].num(), 1.0);
+  EXPECT_EQ(j["missing_samples"].num(), static_cast<double>(kGapLen));
+
+  const auto& history = j["params_history"].array;
+  ASSERT_EQ(history.size(), 4u);  // v1, v2 (its repeat folded), v3 (invalid), v4
+  const double want_t[] = {-0.5, 3.0, 5.0, 7.0};
+  const int want_v[] = {1, 2, 3, 4};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(history[i]["t_s"].num(), want_t[i], 1e-9);
+    EXPECT_EQ(history[i]["version"].num(), want_v[i]);
+    EXPECT_EQ(history[i]["valid"].boolean, want_v[i] != 3);
+    EXPECT_NEAR(history[i]["c2"].num(), 2e-9 * want_v[i], 1e-24);
+    EXPECT_NEAR(history[i]["residual_m"].num(), 1e-9 * want_v[i], 1e-24);
+  }
+  EXPECT_EQ(j["params_initial"]["version"].num(), 1);
+  EXPECT_EQ(j["params_initial"]["c1"].num(), 1e-7);
+  EXPECT_EQ(j["params_final"]["version"].num(), 4);
+  EXPECT_EQ(j["params_final"]["c1"].num(), 1.2e-7);
+  EXPECT_NEAR(j["params_final"]["c3"].num(), 0.9, 1e-15);
+  EXPECT_EQ(j["params_updates"].num(), 2);  // v2 and v4; the invalid v3 is no update
+
+  for (const auto& [channel, n] : counts) EXPECT_EQ(j["channels"][channel].num(), static_cast<double>(n)) << channel;
+  EXPECT_EQ(j["undecodable_events"].num(), 0);
+
+  // CSV: header of decoded fields with units, one row per event.
+  const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
+  EXPECT_EQ(sensor.substr(0, sensor.find('\n')), "t_s,recv_utime_us,utime_us,seq,u_V,y_m,flags");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), counts.at("HX_SENSOR") + 1);
+  const std::string command = slurp(dir_ / "out" / "HX_COMMAND.csv");
+  EXPECT_EQ(command.substr(0, command.find('\n')),
+            "t_s,recv_utime_us,utime_us,seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(command.begin(), command.end(), '\n')), counts.at("HX_COMMAND") + 1);
+  EXPECT_NE(slurp(dir_ / "out" / "HX_STATUS.csv").find("rejected_nonfinite=12"), std::string::npos);
+
+  // Plots, when gnuplot is there; their data and script always.
+  for (const char* data : {"track.dat", "per_second.dat", "latency_hist.dat", "plots.gp"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "out" / data)) << data;
+  }
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    for (const char* png : {"hysteresis_u_y.png", "hysteresis_yref_y.png", "tracking_error.png", "latency_histogram.png"}) {
+      EXPECT_TRUE(is_png(dir_ / "out" / png)) << png << "\n" << r.err;
+    }
+  }
+  // The table.
+  EXPECT_NE(r.out.find("tracking RMS error"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("latency p50/p99/max"), std::string::npos) << r.out;
+}
+
+TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
+  write_log(dir_ / "run.lcmlog", false);
+  const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
+                             " --from 2 --to 9 --skip-initial 1 --no-plots --quiet --csv SENSOR",
+                         dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
+  const Expected x = expected(3.0, 9.0);
+  EXPECT_EQ(j["samples"].num(), static_cast<double>(x.samples));
+  EXPECT_NEAR(j["rms_error_m"].num(), x.rms, kRel * x.rms);
+  EXPECT_NEAR(j["rms_error_first_5s_m"].num(), x.rms_first, kRel * x.rms_first);
+  EXPECT_NEAR(j["rms_error_last_5s_m"].num(), x.rms_last, kRel * x.rms_last);
+  EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
+  EXPECT_EQ(j["range"]["from_s"].num(), 3.0);
+  EXPECT_EQ(j["range"]["to_s"].num(), 9.0);
+  // Parameters in force at the start (v2), updated once (v4) inside the range.
+  EXPECT_EQ(j["params_initial"]["version"].num(), 2);
+  EXPECT_EQ(j["params_final"]["version"].num(), 4);
+  EXPECT_EQ(j["params_updates"].num(), 1);
+  // No logger status: gaps come from the sensor's seq.
+  EXPECT_EQ(j["logger_gaps"].num(), 1.0);
+  EXPECT_NE(j["logger_gaps_source"].string.find("sensor seq"), std::string::npos);
+  const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), x.samples + 1);
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "plots.gp"));
+}
+
+TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
+  write_log(dir_ / "run.lcmlog", true);
+  // Split the log into two files at an event boundary.
+  {
+    lcm::LogFile in((dir_ / "run.lcmlog").string(), "r");
+    lcm::LogFile a((dir_ / "run.00").string(), "w"), b((dir_ / "run.01").string(), "w");
+    std::size_t n = 0;
+    while (const lcm::LogEvent* e = in.readNextEvent()) {
+      lcm::LogEvent copy = *e;
+      (n++ < 9000 ? a : b).writeEvent(&copy);
+    }
+  }
+  const ToolRun whole = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "a").string() + " --no-plots", dir_);
+  const ToolRun split = run_tool((dir_ / "run.00").string() + " " + (dir_ / "run.01").string() + " --out " +
+                                 (dir_ / "b").string() + " --no-plots",
+                             dir_);
+  ASSERT_EQ(whole.exit_code, 0);
+  ASSERT_EQ(split.exit_code, 0) << split.err;
+  const auto ja = mini_json::parse(slurp(dir_ / "a" / "summary.json"));
+  const auto jb = mini_json::parse(slurp(dir_ / "b" / "summary.json"));
+  EXPECT_EQ(ja["samples"].num(), jb["samples"].num());
+  EXPECT_EQ(ja["rms_error_m"].num(), jb["rms_error_m"].num());
+  EXPECT_EQ(ja["latency_p99_us"].num(), jb["latency_p99_us"].num());
+}
+
+TEST_F(ReportToolTest, MissingGnuplotIsAWarningNotAFailure) {
+  write_log(dir_ / "run.lcmlog", true);
+  const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
+                             " --gnuplot /nonexistent/gnuplot --quiet",
+                         dir_);
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.err.find("gnuplot not found"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "plots.gp"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "track.dat"));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "tracking_error.png"));
+}
+
+TEST_F(ReportToolTest, BadArgumentsExitTwoNamingTheOption) {
+  write_log(dir_ / "run.lcmlog", true);
+  const std::string log = (dir_ / "run.lcmlog").string();
+  const std::string out = " --out " + (dir_ / "out").string();
+  ToolRun r = run_tool(log + out + " --skip-initial -1", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--skip-initial"), std::string::npos) << r.err;
+  r = run_tool(log + out + " --from 5 --to 4", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--to"), std::string::npos) << r.err;
+  r = run_tool(log + out + " --csv NO_SUCH_CHANNEL", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("NO_SUCH_CHANNEL"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("HX_SENSOR"), std::string::npos) << r.err;  // lists what is there
+  r = run_tool((dir_ / "missing.lcmlog").string() + out, dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_tool(log, dir_);  // no --out
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--out"), std::string::npos) << r.err;
+  r = run_tool("--help", dir_);
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--skip-initial"), std::string::npos);
+}
+
+TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
+  {
+    lcm::LogFile log((dir_ / "bad.lcmlog").string(), "w");
+    sensor_sample_t s{};
+    s.seq = 1;
+    s.y_m = 1e-6;
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(s.getEncodedSize()));
+    s.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    lcm::LogEvent e{};
+    e.channel = "HX_SENSOR";
+    e.timestamp = kT0;
+    e.datalen = static_cast<std::int32_t>(bytes.size());
+    e.data = bytes.data();
+    log.writeEvent(&e);
+    bytes[3] ^= 0x55;  // wrong fingerprint
+    e.timestamp += 100;
+    log.writeEvent(&e);
+    e.datalen = 5;  // truncated
+    log.writeEvent(&e);
+  }
+  const ToolRun r = run_tool((dir_ / "bad.lcmlog").string() + " --out " + (dir_ / "out").string() + " --no-plots", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(j["samples"].num(), 1);
+  EXPECT_EQ(j["undecodable_events"].num(), 2);
+  EXPECT_TRUE(j["rms_error_m"].is_null());
+  EXPECT_TRUE(j["latency_p50_us"].is_null());
+}
