@@ -1,0 +1,79 @@
+#pragma once
+// The channels the logger has seen, each with its counters: a fixed table filled by the
+// receiving thread as new channel names appear (no allocation: names live in fixed
+// arrays), read by the disk thread (the name, by index) and by the status/summary code.
+//
+// Threading: the receive-side fields belong to the receiving thread; a slot's name is
+// written before the first record that refers to it is pushed through the RecordRing,
+// whose release/acquire publishes it to the disk thread. The disk-side counters are
+// atomics (relaxed) because the receiving thread reads them for status.
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "logger/sequence_gap_detector.hpp"
+
+namespace hystloop {
+
+// Which channels carry a tick number the logger checks for gaps.
+enum class SequenceKind : std::uint8_t { kNone, kSensor, kCommand };
+
+struct ChannelSlot {
+  static constexpr std::size_t kMaxName = 63;  // LCM's own limit on a channel name
+
+  std::array<char, kMaxName + 1> name{};
+  std::size_t name_length = 0;
+  SequenceKind kind = SequenceKind::kNone;
+
+  // Receiving thread.
+  std::uint64_t received = 0;
+  std::uint64_t bytes_received = 0;
+  std::uint64_t dropped_queue_full = 0;  // the disk thread fell behind: the ring was full
+  std::uint64_t dropped_oversize = 0;    // larger than the ring's largest record
+  std::uint64_t undecodable = 0;         // kind != kNone but not that type: recorded, seq not checked
+  SequenceGapDetector sequence;
+
+  // Disk thread.
+  std::atomic<std::uint64_t> written{0};
+  std::atomic<std::uint64_t> bytes_written{0};  // payload bytes
+  std::atomic<std::uint64_t> write_failed{0};   // the file refused it (disk full, I/O error)
+
+  std::string_view name_view() const noexcept { return {name.data(), name_length}; }
+  std::uint64_t dropped() const noexcept {
+    return dropped_queue_full + dropped_oversize + write_failed.load(std::memory_order_relaxed);
+  }
+};
+
+class ChannelTable {
+ public:
+  static constexpr std::size_t kMaxChannels = 64;
+
+  // Names whose messages are checked for gaps (the rig's sensor and command channels).
+  ChannelTable(std::string_view sensor_channel, std::string_view command_channel,
+               std::int64_t restart_threshold = 10000);
+
+  // Receiving thread: the index of `name`, adding a slot for a new one; nullopt when the
+  // table is full or the name longer than ChannelSlot::kMaxName (the caller counts that).
+  std::optional<std::uint32_t> find_or_add(const char* name) noexcept;
+
+  std::size_t size() const noexcept { return size_.load(std::memory_order_acquire); }
+  ChannelSlot& operator[](std::size_t i) noexcept { return slots_[i]; }
+  const ChannelSlot& operator[](std::size_t i) const noexcept { return slots_[i]; }
+
+  // Messages refused because the table was full or the name too long.
+  std::uint64_t unrecorded_channels() const noexcept { return unrecorded_; }
+
+ private:
+  std::array<ChannelSlot, kMaxChannels> slots_;
+  std::atomic<std::size_t> size_{0};
+  std::array<char, ChannelSlot::kMaxName + 1> sensor_{};
+  std::array<char, ChannelSlot::kMaxName + 1> command_{};
+  std::uint32_t last_hit_ = 0;
+  std::uint64_t unrecorded_ = 0;
+};
+
+}  // namespace hystloop

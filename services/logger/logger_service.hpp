@@ -1,0 +1,94 @@
+#pragma once
+// hystloop-logger's wiring: one raw LCM subscription to the rig's channels (every message
+// recorded byte-exact, whatever its type) -> RecordRing -> LogWriter (disk thread) ->
+// LogFileSet. The receive path (LCM's handler, in the thread that calls run()) looks up
+// the channel in a fixed table, checks HX_SENSOR/HX_COMMAND seq for gaps by decoding into
+// preallocated messages, and copies the bytes into the ring: no allocation, no lock, no
+// log, no disk. A full ring drops the message and counts it per channel.
+//
+// HX_STATUS (process "logger") once a second: per channel received/written/dropped/gaps/
+// missing, files, bytes; DEGRADED with a detail when something was dropped or a gap seen
+// in the last period. On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive
+// what LCM already holds, stop receiving, write the queue out, close the file, write the
+// summary (logger_summary.hpp).
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/latency_stats.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/subscription.hpp"
+#include "logger/channel_table.hpp"
+#include "logger/log_file_set.hpp"
+#include "logger/log_writer.hpp"
+#include "logger/logger_options.hpp"
+#include "logger/logger_summary.hpp"
+#include "logger/record_ring.hpp"
+#include "runtime/control_filter.hpp"
+#include "runtime/status_reporter.hpp"
+
+namespace hystloop {
+
+class LoggerService {
+ public:
+  static constexpr const char* kProcessName = "logger";
+
+  // Opens the first log file and subscribes. Throws ParameterError / std::runtime_error.
+  LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options);
+  ~LoggerService();
+  LoggerService(const LoggerService&) = delete;
+  LoggerService& operator=(const LoggerService&) = delete;
+
+  // Records until a stop is requested, then closes and writes the summary.
+  // Returns 0, or 1 if the summary could not be written.
+  int run();
+
+  const ChannelTable& channels() const noexcept { return *channels_; }
+
+ private:
+  static void on_raw(const lcm_recv_buf_t* rbuf, const char* channel, void* self) noexcept;
+  void receive(const char* channel, const void* data, std::size_t size, std::int64_t recv_utime) noexcept;
+  void check_sequence(ChannelSlot& slot, const void* data, std::size_t size) noexcept;
+  void on_control(const control_t& msg);
+  void report(std::int64_t utime, std::int8_t state_override = -1);
+  void unsubscribe() noexcept;
+  RecordingSummary finish();
+
+  lcm::LCM& lcm_;
+  LoggerOptions options_;
+  std::string channels_regex_;
+  std::int64_t start_utime_;
+  double start_s_;
+
+  std::unique_ptr<ChannelTable> channels_;
+  std::unique_ptr<RecordRing> ring_;
+  std::unique_ptr<LogFileSet> files_;
+  std::unique_ptr<LogWriter> writer_;
+  lcm_subscription_t* raw_ = nullptr;
+  sensor_sample_t sample_{};
+  actuator_command_t command_{};
+
+  ControlFilter control_filter_{kProcessName};
+  std::unique_ptr<Subscription<control_t>> control_;
+  bool shutdown_requested_ = false;
+  StatusReporter reporter_;
+  LatencyStats handling_;  // time spent on one received message [ns]
+
+  // What the last report had seen, to tell whether anything went wrong in this period.
+  struct Seen {
+    std::uint64_t dropped = 0;
+    std::uint64_t gap_events = 0;
+    std::uint64_t missing = 0;
+  };
+  std::array<Seen, ChannelTable::kMaxChannels> seen_{};
+  std::uint64_t seen_unrecorded_ = 0;
+};
+
+}  // namespace hystloop

@@ -1,0 +1,147 @@
+#include "logger/logger_summary.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace hystloop {
+
+namespace {
+std::string json_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char escaped[8];
+          std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          out += escaped;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+struct Totals {
+  std::uint64_t received = 0, written = 0, dropped = 0, bytes_written = 0, gap_events = 0, missing = 0;
+  std::uint64_t queue_full = 0, oversize = 0, write_failed = 0;
+};
+
+Totals totals_of(const ChannelTable& channels) {
+  Totals t;
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    const ChannelSlot& c = channels[i];
+    t.received += c.received;
+    t.written += c.written.load();
+    t.dropped += c.dropped();
+    t.bytes_written += c.bytes_written.load();
+    t.gap_events += c.sequence.gap_events();
+    t.missing += c.sequence.missing();
+    t.queue_full += c.dropped_queue_full;
+    t.oversize += c.dropped_oversize;
+    t.write_failed += c.write_failed.load();
+  }
+  return t;
+}
+}  // namespace
+
+std::string summary_json(const RecordingSummary& s, const ChannelTable& channels) {
+  const Totals t = totals_of(channels);
+  std::ostringstream j;
+  j.precision(6);
+  j << std::fixed;
+  j << "{\n  \"recording\": " << json_string(s.recording) << ",\n  \"start_utime\": " << s.start_utime
+    << ",\n  \"stop_utime\": " << s.stop_utime << ",\n  \"duration_s\": " << s.duration_s
+    << ",\n  \"stop_reason\": " << json_string(s.stop_reason) << ",\n  \"files\": [";
+  for (std::size_t i = 0; i < s.files.size(); ++i) {
+    const LogFileInfo& f = s.files[i];
+    j << (i ? "," : "") << "\n    {\"path\": " << json_string(f.path.string()) << ", \"events\": " << f.events
+      << ", \"bytes\": " << f.bytes << "}";
+  }
+  j << "\n  ],\n  \"totals\": {\"received\": " << t.received << ", \"written\": " << t.written
+    << ", \"dropped\": " << t.dropped + s.unrecorded_channel << ", \"bytes_written\": " << t.bytes_written
+    << ", \"gap_events\": " << t.gap_events << ", \"missing\": " << t.missing << "},\n";
+  j << "  \"dropped\": {\"queue_full\": " << t.queue_full << ", \"oversize\": " << t.oversize
+    << ", \"write_failed\": " << t.write_failed << ", \"unrecorded_channel\": " << s.unrecorded_channel << "},\n";
+  j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes << ", \"high_water_bytes\": "
+    << s.queue_high_water_bytes << "},\n";
+  j << "  \"process\": {\"cpu_user_s\": " << s.cpu_user_s << ", \"cpu_system_s\": " << s.cpu_system_s
+    << ", \"peak_rss_bytes\": " << s.peak_rss_bytes << "},\n  \"channels\": {";
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    const ChannelSlot& c = channels[i];
+    j << (i ? "," : "") << "\n    " << json_string(c.name_view()) << ": {\"received\": " << c.received
+      << ", \"bytes_received\": " << c.bytes_received << ", \"written\": " << c.written.load()
+      << ", \"bytes_written\": " << c.bytes_written.load() << ", \"dropped\": " << c.dropped()
+      << ", \"dropped_queue_full\": " << c.dropped_queue_full << ", \"dropped_oversize\": " << c.dropped_oversize
+      << ", \"write_failed\": " << c.write_failed.load();
+    if (c.kind != SequenceKind::kNone) {
+      const SequenceGapDetector& q = c.sequence;
+      j << ",\n      \"sequence\": {\"first_seq\": " << q.first_seq() << ", \"last_seq\": " << q.last_seq()
+        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing()
+        << ", \"duplicates\": " << q.duplicates() << ", \"out_of_order\": " << q.out_of_order()
+        << ", \"restarts\": " << q.restarts() << ", \"undecodable\": " << c.undecodable << ", \"gaps\": [";
+      for (std::size_t g = 0; g < q.kept_gap_count(); ++g) {
+        j << (g ? ", " : "") << "[" << q.kept_gaps()[g].first_missing << ", " << q.kept_gaps()[g].last_missing << "]";
+      }
+      j << "]}";
+    }
+    j << "}";
+  }
+  j << "\n  }\n}\n";
+  return j.str();
+}
+
+std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelTable& channels) {
+  const Totals t = totals_of(channels);
+  std::vector<std::string> lines;
+  std::ostringstream head;
+  head.precision(1);
+  head << std::fixed << "recorded " << t.written << " of " << t.received << " messages (" << t.bytes_written
+       << " payload bytes) in " << s.files.size() << " file(s) over " << s.duration_s << " s, stopped by "
+       << s.stop_reason << "; dropped " << t.dropped + s.unrecorded_channel << " (queue full " << t.queue_full
+       << ", oversize " << t.oversize << ", write failed " << t.write_failed << ", no channel slot "
+       << s.unrecorded_channel << ")";
+  lines.push_back(head.str());
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    const ChannelSlot& c = channels[i];
+    std::ostringstream line;
+    line << "  " << c.name_view() << ": received " << c.received << ", written " << c.written.load() << ", dropped "
+         << c.dropped();
+    if (c.kind != SequenceKind::kNone) {
+      const SequenceGapDetector& q = c.sequence;
+      line << ", seq " << q.first_seq() << ".." << q.last_seq() << ", gaps " << q.gap_events() << " (missing "
+           << q.missing() << "), duplicates " << q.duplicates() << ", out of order " << q.out_of_order();
+      if (c.undecodable > 0) line << ", undecodable " << c.undecodable;
+    }
+    lines.push_back(line.str());
+  }
+  for (const LogFileInfo& f : s.files) {
+    lines.push_back("  file " + f.path.string() + ": " + std::to_string(f.events) + " events, " +
+                    std::to_string(f.bytes) + " bytes");
+  }
+  return lines;
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
+}
+
+}  // namespace hystloop

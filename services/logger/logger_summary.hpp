@@ -1,0 +1,54 @@
+#pragma once
+// What a recording did, written at close: a JSON file next to the logs for scripts, and
+// a few lines for the process log. Built once, after the disk thread has stopped.
+//
+// JSON layout (counts are integers; times in us since the epoch; durations in s):
+//   { "recording", "start_utime", "stop_utime", "duration_s", "stop_reason",
+//     "files": [ {"path", "events", "bytes"} ],
+//     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing" },
+//     "dropped": { "queue_full", "oversize", "write_failed", "unrecorded_channel" },
+//     "queue": { "capacity_bytes", "high_water_bytes" },
+//     "process": { "cpu_user_s", "cpu_system_s", "peak_rss_bytes" },
+//     "channels": { "<name>": { "received", "bytes_received", "written", "bytes_written",
+//                               "dropped", "dropped_queue_full", "dropped_oversize", "write_failed",
+//                               ["sequence": { "first_seq", "last_seq", "gap_events", "missing",
+//                                              "duplicates", "out_of_order", "restarts",
+//                                              "undecodable", "gaps": [[first_missing, last_missing], ...] }] } } }
+// "gaps" lists the first SequenceGapDetector::kKeptGaps gaps of a channel; "sequence" is
+// present for the channels checked for gaps (the rig's sensor and command channels).
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "logger/channel_table.hpp"
+#include "logger/log_file_set.hpp"
+
+namespace hystloop {
+
+struct RecordingSummary {
+  std::string recording;  // the recording's base path
+  std::int64_t start_utime = 0;
+  std::int64_t stop_utime = 0;
+  double duration_s = 0.0;
+  std::string stop_reason;
+  std::vector<LogFileInfo> files;
+  std::uint64_t unrecorded_channel = 0;  // messages of channels the table had no room for
+  std::uint64_t queue_capacity_bytes = 0;
+  std::uint64_t queue_high_water_bytes = 0;
+  double cpu_user_s = 0.0;  // the whole process, all threads
+  double cpu_system_s = 0.0;
+  std::int64_t peak_rss_bytes = 0;
+};
+
+std::string summary_json(const RecordingSummary& summary, const ChannelTable& channels);
+
+// A few lines: files, per-channel counts, gaps and drops.
+std::vector<std::string> summary_lines(const RecordingSummary& summary, const ChannelTable& channels);
+
+// Writes `text` to `path` (through a temporary file and a rename, so a reader never sees
+// half of it). Throws std::runtime_error naming the path.
+void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace hystloop

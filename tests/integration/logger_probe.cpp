@@ -1,0 +1,232 @@
+// Test program for hystloop-logger (tests/integration/logger_*.sh):
+//
+//   logger_probe publish   --url U --prefix P --samples N [--gap-at G --gap-len L] [--commands M]
+//                          [--rate-hz R] [--wait-logger-s T]
+//   logger_probe check-log --prefix P --samples N [--gap-at G --gap-len L] [--commands M] FILE...
+//   logger_probe shutdown  --url U --prefix P          (control_t SHUTDOWN addressed to "logger")
+//   logger_probe wait-logger --url U --prefix P [--wait-logger-s T]   (until the logger reports)
+//
+// The stream, round k = 0..N-1: sensor sample(k) unless G <= k < G+L (the deliberate gap),
+// command(k) if k < M, and every 100th round trajectory(k/100) and params(k/100) (types the
+// logger does not decode: recorded byte-exact all the same). `publish` first waits until
+// the logger's HX_STATUS is heard (it reports once at start), then sends the stream paced
+// at R rounds per second. `check-log` reads the files in the order given with lcm::LogFile
+// and requires exactly that stream on those channels, in order, byte-identical to the
+// fixtures, with event numbers and timestamps non-decreasing in each file. Other channels
+// (HX_STATUS) are ignored. Exit status 0 = as expected, 1 = not, 2 = usage.
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "hystloop/control_t.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/message_fixtures.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+
+namespace hystloop {
+namespace {
+
+struct Options {
+  std::string mode;
+  std::string url;
+  std::string prefix{kDefaultRigPrefix};
+  std::int64_t samples = 1000;
+  std::int64_t gap_at = -1;
+  std::int64_t gap_len = 0;
+  std::int64_t commands = 0;
+  double rate_hz = 2000.0;
+  double wait_logger_s = 5.0;
+  std::vector<std::string> files;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  if (argc < 2) throw std::invalid_argument("usage: logger_probe publish|check-log|shutdown [options]");
+  o.mode = argv[1];
+  for (int i = 2; i < argc; ++i) {
+    const std::string key = argv[i];
+    if (key.rfind("--", 0) != 0) {
+      o.files.push_back(key);
+      continue;
+    }
+    if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
+    const std::string value = argv[++i];
+    if (key == "--url") o.url = value;
+    else if (key == "--prefix") o.prefix = value;
+    else if (key == "--samples") o.samples = std::stoll(value);
+    else if (key == "--gap-at") o.gap_at = std::stoll(value);
+    else if (key == "--gap-len") o.gap_len = std::stoll(value);
+    else if (key == "--commands") o.commands = std::stoll(value);
+    else if (key == "--rate-hz") o.rate_hz = std::stod(value);
+    else if (key == "--wait-logger-s") o.wait_logger_s = std::stod(value);
+    else throw std::invalid_argument("unknown option " + key);
+  }
+  return o;
+}
+
+template <class T>
+std::vector<std::uint8_t> encoded(const T& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+struct Event {
+  const std::string* channel;
+  std::vector<std::uint8_t> bytes;
+};
+
+// The stream in publication order.
+std::vector<Event> expected_stream(const Options& o, const ChannelNames& ch) {
+  std::vector<Event> events;
+  for (std::int64_t k = 0; k < o.samples; ++k) {
+    if (!(k >= o.gap_at && k < o.gap_at + o.gap_len)) events.push_back({&ch.sensor, encoded(fixtures::sample(k))});
+    if (k < o.commands) events.push_back({&ch.command, encoded(fixtures::command(k))});
+    if (k % 100 == 0) {
+      events.push_back({&ch.trajectory, encoded(fixtures::trajectory(k / 100))});
+      events.push_back({&ch.params, encoded(fixtures::params(k / 100))});
+    }
+  }
+  return events;
+}
+
+bool wait_for_logger(lcm::LCM& lcm, const ChannelNames& ch, double timeout_s) {
+  bool heard = false;
+  Subscription<service_status_t> status(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
+    if (m.process == "logger") heard = true;
+  });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!heard && std::chrono::steady_clock::now() < until) handle_pending(lcm, std::chrono::milliseconds(50));
+  return heard;
+}
+
+int publish(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  if (!wait_for_logger(*lcm, ch, o.wait_logger_s)) {
+    std::fprintf(stderr, "logger_probe: no HX_STATUS from the logger within %.1f s\n", o.wait_logger_s);
+    return 1;
+  }
+  const std::vector<Event> events = expected_stream(o, ch);
+  // Pace by rounds: the events of round k go out at start + k / rate.
+  const auto start = std::chrono::steady_clock::now();
+  std::size_t next = 0;
+  std::int64_t round = 0;
+  int failures = 0;
+  for (std::int64_t k = 0; k < o.samples; ++k) {
+    const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(static_cast<double>(k) / o.rate_hz));
+    std::this_thread::sleep_until(due);
+    // The events of round k: as many as expected_stream made for it.
+    const std::size_t count = static_cast<std::size_t>(!(k >= o.gap_at && k < o.gap_at + o.gap_len)) +
+                              static_cast<std::size_t>(k < o.commands) + (k % 100 == 0 ? 2u : 0u);
+    for (std::size_t i = 0; i < count; ++i, ++next) {
+      const Event& e = events[next];
+      if (lcm->publish(*e.channel, e.bytes.data(), static_cast<unsigned>(e.bytes.size())) != 0) ++failures;
+    }
+    round = k + 1;
+  }
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("logger_probe: published %zu messages in %lld rounds over %.3f s (%.0f rounds/s), %d failed\n",
+              next, static_cast<long long>(round), elapsed, static_cast<double>(round) / elapsed, failures);
+  return failures == 0 ? 0 : 1;
+}
+
+int check_log(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  const std::vector<Event> expected = expected_stream(o, ch);
+  const std::string* names[] = {&ch.sensor, &ch.command, &ch.trajectory, &ch.params};
+  std::size_t next = 0;
+  int errors = 0;
+  auto fail = [&](const std::string& what) {
+    if (++errors <= 10) std::fprintf(stderr, "logger_probe check-log: %s\n", what.c_str());
+  };
+  for (const std::string& file : o.files) {
+    lcm::LogFile log(file, "r");
+    if (!log.good()) {
+      fail("cannot open " + file);
+      continue;
+    }
+    std::int64_t last_eventnum = -1;
+    std::int64_t last_timestamp = 0;
+    std::size_t events_in_file = 0;
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      ++events_in_file;
+      if (ev->eventnum <= last_eventnum) fail(file + ": event numbers not increasing at " + std::to_string(ev->eventnum));
+      if (ev->timestamp < last_timestamp) fail(file + ": timestamp goes back at event " + std::to_string(ev->eventnum));
+      last_eventnum = ev->eventnum;
+      last_timestamp = ev->timestamp;
+      bool ours = false;
+      for (const std::string* n : names) ours = ours || ev->channel == *n;
+      if (!ours) continue;
+      if (next >= expected.size()) {
+        fail(file + ": more messages than published (" + ev->channel + ")");
+        continue;
+      }
+      const Event& want = expected[next];
+      if (ev->channel != *want.channel) {
+        fail(file + ": message " + std::to_string(next) + " is on " + ev->channel + ", expected " + *want.channel);
+      } else if (static_cast<std::size_t>(ev->datalen) != want.bytes.size() ||
+                 std::memcmp(ev->data, want.bytes.data(), want.bytes.size()) != 0) {
+        fail(file + ": message " + std::to_string(next) + " on " + ev->channel + " differs from what was published");
+      }
+      ++next;
+    }
+    if (events_in_file == 0) fail(file + ": no events (rotation must not leave empty files)");
+  }
+  if (next != expected.size()) {
+    fail("found " + std::to_string(next) + " of " + std::to_string(expected.size()) + " published messages");
+  }
+  std::printf("logger_probe check-log: %zu files, %zu of %zu messages intact and in order, %d errors\n",
+              o.files.size(), next, expected.size(), errors);
+  return errors == 0 ? 0 : 1;
+}
+
+int wait_logger(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  if (wait_for_logger(*lcm, ch, o.wait_logger_s)) return 0;
+  std::fprintf(stderr, "logger_probe: no HX_STATUS from the logger within %.1f s\n", o.wait_logger_s);
+  return 1;
+}
+
+int shutdown(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  control_t msg{};
+  msg.utime = fixtures::kBaseUtime;
+  msg.request_id = 4242;
+  msg.command = control_t::SHUTDOWN;
+  msg.target = "logger";
+  Publisher<control_t> publisher(*lcm, ch.control);
+  // Repeated, as senders do over UDP: the logger acts once.
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) ok = publisher.publish(msg) && ok;
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace hystloop
+
+int main(int argc, char** argv) {
+  try {
+    const hystloop::Options o = hystloop::parse(argc, argv);
+    if (o.mode == "publish") return hystloop::publish(o);
+    if (o.mode == "check-log") return hystloop::check_log(o);
+    if (o.mode == "shutdown") return hystloop::shutdown(o);
+    if (o.mode == "wait-logger") return hystloop::wait_logger(o);
+    std::fprintf(stderr, "logger_probe: unknown mode %s\n", o.mode.c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "logger_probe: %s\n", e.what());
+    return 2;
+  }
+}

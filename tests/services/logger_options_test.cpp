@@ -1,0 +1,89 @@
+#include "logger/logger_options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/config.hpp"
+
+namespace hystloop {
+namespace {
+
+std::string error_of(const Config& config) {
+  try {
+    read_logger_options(config);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LoggerOptions, DefaultsWithAnEmptyConfiguration) {
+  const LoggerOptions o = read_logger_options(Config());
+  EXPECT_EQ(o.out_dir, "logs");
+  EXPECT_EQ(o.max_file_mb, 1024.0);
+  EXPECT_EQ(o.max_file_s, 0.0);
+  EXPECT_TRUE(o.summary_file.empty());
+  EXPECT_TRUE(o.channels.empty());
+  EXPECT_EQ(o.lcm_queue, 20000);
+}
+
+TEST(LoggerOptions, ReadsTheFileAndIgnoresOtherSections) {
+  const Config c = Config::from_string(
+      "logger:\n  out_dir: /data/rig1\n  max_file_mb: 0.5\n  max_file_s: 60\n  channels: 'HX_S.*'\n"
+      "bridge:\n  u_max_V: 120\n",
+      "rig.yaml");
+  const LoggerOptions o = read_logger_options(c);
+  EXPECT_EQ(o.out_dir, "/data/rig1");
+  EXPECT_EQ(o.max_file_mb, 0.5);
+  EXPECT_EQ(o.max_file_s, 60.0);
+  EXPECT_EQ(o.channels, "HX_S.*");
+}
+
+TEST(LoggerOptions, BadValuesNameTheField) {
+  EXPECT_EQ(error_of(Config::from_string("logger:\n  max_file_mb: -1\n", "rig.yaml")),
+            "rig.yaml: logger.max_file_mb: must be in [0, 1e+09] (got -1)");
+  EXPECT_NE(error_of(Config::from_string("logger:\n  queue_mb: 0\n", "rig.yaml")).find("logger.queue_mb"),
+            std::string::npos);
+  EXPECT_NE(error_of(Config::from_string("logger:\n  lcm_queue: 0\n", "rig.yaml")).find("logger.lcm_queue"),
+            std::string::npos);
+  EXPECT_NE(error_of(Config::from_string("logger:\n  file_prefix: a/b\n", "rig.yaml")).find("logger.file_prefix"),
+            std::string::npos);
+  EXPECT_NE(error_of(Config::from_string("logger:\n  flush_interval_s: 0\n")).find("logger.flush_interval_s"),
+            std::string::npos);
+}
+
+TEST(LoggerOptions, UnknownLoggerKeyGetsASuggestion) {
+  const std::string e = error_of(Config::from_string("logger:\n  max_file_sec: 5\n", "rig.yaml"));
+  EXPECT_NE(e.find("logger.max_file_sec"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'logger.max_file_s'"), std::string::npos) << e;
+}
+
+TEST(LoggerOptions, FlagsOverrideTheFileAndKeepTextAsText) {
+  Config c = Config::from_string("logger:\n  max_file_mb: 5\n  channels: 'HX_.*'\n");
+  LoggerFlags flags;
+  flags.values["max_file_mb"] = "7.5";
+  flags.values["channels"] = "[A-Z]+_SENSOR";  // YAML would read this as a list unless quoted
+  flags.values["file_prefix"] = "it's_";
+  apply_logger_flags(flags, c);
+  const LoggerOptions o = read_logger_options(c);
+  EXPECT_EQ(o.max_file_mb, 7.5);
+  EXPECT_EQ(o.channels, "[A-Z]+_SENSOR");
+  EXPECT_EQ(o.file_prefix, "it's_");
+}
+
+TEST(LoggerOptions, CommandLineFlagsParse) {
+  CLI::App app;
+  LoggerFlags flags;
+  add_logger_options(app, flags);
+  const char* argv[] = {"hystloop-logger", "--out-dir", "/tmp/x", "--max-file-s", "30"};
+  app.parse(5, const_cast<char**>(argv));
+  Config c;
+  apply_logger_flags(flags, c);
+  const LoggerOptions o = read_logger_options(c);
+  EXPECT_EQ(o.out_dir, "/tmp/x");
+  EXPECT_EQ(o.max_file_s, 30.0);
+}
+
+}  // namespace
+}  // namespace hystloop
