@@ -1,0 +1,39 @@
+#include "command_alteration.hpp"
+
+#include <bit>
+#include <stdexcept>
+#include <vector>
+
+#include "decode.hpp"
+#include "log_reader.hpp"
+
+namespace hystloop::replay {
+
+AlterationResult write_altered_log(const std::filesystem::path& log, const std::filesystem::path& out,
+                                   const ChannelNames& channels, const CommandAlteration& alteration) {
+  lcm::LogFile writer(out.string(), "w");
+  if (!writer.good()) throw std::runtime_error(out.string() + ": cannot open for writing");
+  std::optional<AlterationResult> done;
+  actuator_command_t msg;
+  std::vector<std::uint8_t> buffer;
+  report::for_each_event({log}, [&](const lcm::LogEvent& event) {
+    lcm::LogEvent copy = event;
+    if (!done && event.channel == channels.command && report::decode_checked(event, msg) && msg.seq == alteration.seq) {
+      const double old_u = msg.u_V;
+      msg.u_V = alteration.delta_V ? old_u + *alteration.delta_V
+                                   : std::bit_cast<double>(std::bit_cast<std::uint64_t>(old_u) ^ 1u);
+      buffer.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+      msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+      copy.data = buffer.data();
+      copy.datalen = static_cast<std::int32_t>(buffer.size());
+      done = AlterationResult{old_u, msg.u_V};
+    }
+    if (writer.writeEvent(&copy) != 0) throw std::runtime_error(out.string() + ": write failed");
+  });
+  if (!done) {
+    throw std::runtime_error(log.string() + ": no command for tick " + std::to_string(alteration.seq) + " on " + channels.command);
+  }
+  return *done;
+}
+
+}  // namespace hystloop::replay

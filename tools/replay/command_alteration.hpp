@@ -1,0 +1,28 @@
+#pragma once
+// A deliberately altered copy of a log, for the tests that prove a replay notices a change:
+// the command for one tick gets a different u_V, every other event is copied unchanged.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "lcm/channels.hpp"
+
+namespace hystloop::replay {
+
+struct CommandAlteration {
+  std::int64_t seq = 0;             // tick of the command to alter
+  std::optional<double> delta_V;    // add this to u_V; unset: flip u_V's least significant mantissa bit (1 ulp)
+};
+
+struct AlterationResult {
+  double old_u_V = 0.0;
+  double new_u_V = 0.0;
+};
+
+// Throws std::runtime_error naming the file if a log cannot be read or written, or if the
+// log holds no decodable command for `alteration.seq`.
+AlterationResult write_altered_log(const std::filesystem::path& log, const std::filesystem::path& out,
+                                   const ChannelNames& channels, const CommandAlteration& alteration);
+
+}  // namespace hystloop::replay

@@ -1,0 +1,62 @@
+// hystloop-replay-filter: prepares logs for tools/replay-check.
+//
+//   hystloop-replay-filter inputs LOG OUT [--rig HX_] [--only-answered] [--compensator-process NAME]
+//       OUT = the recorded compensator's inputs (SENSOR, TRAJECTORY, PARAMS, CONTROL) from the
+//       first sample it answered on, to play into a fresh compensator with lcm-logplayer.
+//   hystloop-replay-filter alter LOG OUT --seq N [--delta-V D]
+//       OUT = LOG with the command for tick N changed (u_V + D, default: 1 ulp flipped), to
+//       prove that a replay notices.
+// Exit 0 on success, 2 on bad arguments or unreadable logs.
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <string>
+
+#include "command_alteration.hpp"
+#include "replay_inputs.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Prepares LCM event logs for a replay regression (tools/replay-check)."};
+  app.require_subcommand(1);
+  std::string log, out, rig = std::string(hystloop::kDefaultRigPrefix);
+  app.add_option("--rig", rig, "Channel prefix of the rig")->capture_default_str();
+
+  hystloop::replay::ReplayInputOptions input_options;
+  CLI::App* inputs = app.add_subcommand("inputs", "Write the recorded compensator's inputs, from its first answered sample");
+  inputs->add_option("log", log, "Recorded LCM event log")->required();
+  inputs->add_option("out", out, "Inputs-only log to write")->required();
+  inputs->add_flag("--only-answered", input_options.only_answered,
+                   "Also leave out samples the recorded compensator did not answer (gaps it saw)");
+  inputs->add_option("--compensator-process", input_options.compensator_process,
+                     "Process name of the compensator in HX_STATUS (its start time bounds the warm-up)")
+      ->capture_default_str();
+
+  hystloop::replay::CommandAlteration alteration;
+  std::optional<double> delta_V;
+  CLI::App* alter = app.add_subcommand("alter", "Copy a log with one command's u_V changed");
+  alter->add_option("log", log, "Recorded LCM event log")->required();
+  alter->add_option("out", out, "Altered log to write")->required();
+  alter->add_option("--seq", alteration.seq, "Tick of the command to change")->required();
+  alter->add_option("--delta-V", delta_V, "Add this to u_V [V] (default: flip its least significant bit)");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const hystloop::ChannelNames channels(rig);
+    if (inputs->parsed()) {
+      const auto selection = hystloop::replay::write_replay_inputs(log, out, channels, input_options);
+      std::fputs(hystloop::replay::describe(selection).c_str(), stdout);
+      std::printf("first-sample %lld\n", static_cast<long long>(selection.first_answered_sample.value_or(-1)));
+    } else {
+      alteration.delta_V = delta_V;
+      const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
+      std::printf("tick %lld: u_V %.17g -> %.17g\n", static_cast<long long>(alteration.seq), r.old_u_V, r.new_u_V);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

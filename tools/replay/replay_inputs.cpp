@@ -1,0 +1,125 @@
+#include "replay_inputs.hpp"
+
+#include <cstdio>
+#include <set>
+#include <stdexcept>
+
+#include "decode.hpp"
+#include "log_reader.hpp"
+#include "recorded_commands.hpp"
+
+namespace hystloop::replay {
+namespace {
+
+// start_utime of the compensator's first status and the log's first receive time.
+struct LogStart {
+  std::optional<std::int64_t> compensator_start_utime;
+  std::optional<std::int64_t> first_event_utime;
+};
+
+LogStart read_log_start(const std::filesystem::path& log, const ChannelNames& channels, const std::string& process) {
+  LogStart s;
+  service_status_t status;
+  report::for_each_event({log}, [&](const lcm::LogEvent& event) {
+    if (!s.first_event_utime) s.first_event_utime = event.timestamp;
+    if (s.compensator_start_utime || event.channel != channels.status) return;
+    if (report::decode_checked(event, status) && status.process == process) s.compensator_start_utime = status.start_utime;
+  });
+  return s;
+}
+
+bool is_other_input(const std::string& channel, const ChannelNames& c) {
+  return channel == c.trajectory || channel == c.params || channel == c.control;
+}
+
+template <class T>
+bool decodes(const lcm::LogEvent& event) {
+  T msg;
+  return report::decode_checked(event, msg);
+}
+
+bool other_input_decodes(const lcm::LogEvent& event, const ChannelNames& c) {
+  if (event.channel == c.trajectory) return decodes<trajectory_t>(event);
+  if (event.channel == c.params) return decodes<mem_params_t>(event);
+  return decodes<control_t>(event);
+}
+
+}  // namespace
+
+ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const std::filesystem::path& out,
+                                         const ChannelNames& channels, const ReplayInputOptions& options) {
+  ReplayInputSelection sel;
+  std::set<std::int64_t> answered;
+  for (const auto& [seq, c] : read_commands(log, channels).by_seq) {
+    if (c.sample_seq >= 0) answered.insert(c.sample_seq);
+  }
+  if (answered.empty()) throw std::runtime_error(log.string() + ": no " + channels.command + " command answering a sample: nothing to replay against");
+  sel.first_answered_sample = *answered.begin();
+  const LogStart start = read_log_start(log, channels, options.compensator_process);
+  sel.compensator_start_utime = start.compensator_start_utime;
+  sel.log_starts_after_compensator = start.compensator_start_utime && start.first_event_utime &&
+                                     *start.first_event_utime > *start.compensator_start_utime;
+
+  lcm::LogFile writer(out.string(), "w");
+  if (!writer.good()) throw std::runtime_error(out.string() + ": cannot open for writing");
+  bool started = false;  // reached the first answered sample
+  sensor_sample_t sample;
+  report::for_each_event({log}, [&](const lcm::LogEvent& event) {
+    if (event.channel == channels.sensor) {
+      if (!report::decode_checked(event, sample)) return void(++sel.undecodable);
+      if (!sel.first_log_sample) sel.first_log_sample = sample.seq;
+      if (sample.seq < *sel.first_answered_sample) return void(++sel.samples_before_start);
+      started = true;
+      if (answered.count(sample.seq) == 0) {
+        ++sel.samples_unanswered;
+        if (options.only_answered) return void(++sel.samples_unanswered_dropped);
+      }
+      ++sel.samples_written;
+    } else if (is_other_input(event.channel, channels)) {
+      if (!other_input_decodes(event, channels)) return void(++sel.undecodable);
+      const bool running = started || (start.compensator_start_utime && event.timestamp >= *start.compensator_start_utime);
+      if (!running) return void(++sel.other_inputs_skipped);
+      ++sel.other_inputs_written;
+    } else {
+      return;
+    }
+    lcm::LogEvent copy = event;  // writeEvent takes a non-const pointer
+    if (writer.writeEvent(&copy) != 0) throw std::runtime_error(out.string() + ": write failed");
+  });
+  return sel;
+}
+
+std::string describe(const ReplayInputSelection& s) {
+  std::string out;
+  char line[256];
+  const auto ll = [](std::optional<std::int64_t> v) { return static_cast<long long>(v.value_or(-1)); };
+  const auto ull = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
+  std::snprintf(line, sizeof line, "log's first sample: %lld; first sample the recorded compensator answered: %lld\n",
+                ll(s.first_log_sample), ll(s.first_answered_sample));
+  out += line;
+  if (s.samples_before_start > 0) {
+    std::snprintf(line, sizeof line,
+                  "warm-up: the recorded compensator started after the log did; the replay starts at sample %lld (%llu earlier samples left out)\n",
+                  ll(s.first_answered_sample), ull(s.samples_before_start));
+    out += line;
+  }
+  if (s.log_starts_after_compensator) {
+    out += "warning: the log begins after the recorded compensator started: inputs it received before are not in the log, the replay may diverge\n";
+  }
+  std::snprintf(line, sizeof line,
+                "replay inputs: %llu samples, %llu trajectory/params/control messages (%llu logged before the compensator ran, left out)\n",
+                ull(s.samples_written), ull(s.other_inputs_written), ull(s.other_inputs_skipped));
+  out += line;
+  if (s.samples_unanswered > 0) {
+    std::snprintf(line, sizeof line, "the recorded compensator did not answer %llu samples after its first (%llu left out)\n",
+                  ull(s.samples_unanswered), ull(s.samples_unanswered_dropped));
+    out += line;
+  }
+  if (s.undecodable > 0) {
+    std::snprintf(line, sizeof line, "%llu input events did not decode and were left out\n", ull(s.undecodable));
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace hystloop::replay

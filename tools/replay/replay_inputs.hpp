@@ -1,0 +1,48 @@
+#pragma once
+// The inputs of a recorded compensator, as a log to play back into a fresh one: its input
+// channels (SENSOR, TRAJECTORY, PARAMS, CONTROL) and nothing else, from the point where the
+// recorded compensator was running.
+//
+// Warm-up: the original may have started after the log did. Sensor samples are kept from the
+// first one it answered (the lowest sample_seq among its commands). Other inputs logged before
+// that sample are kept only if they arrived after the compensator started (start_utime of its
+// first HX_STATUS, when the log holds one; compared with the log's receive timestamps).
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "lcm/channels.hpp"
+
+namespace hystloop::replay {
+
+struct ReplayInputOptions {
+  std::string compensator_process = "compensator";  // service_status_t.process of the recorded compensator
+  bool only_answered = false;  // also drop samples the original did not answer (a gap it saw)
+};
+
+struct ReplayInputSelection {
+  std::optional<std::int64_t> first_log_sample;       // seq of the log's first sensor sample
+  std::optional<std::int64_t> first_answered_sample;  // lowest sample_seq among the logged commands
+  std::optional<std::int64_t> compensator_start_utime;
+  bool log_starts_after_compensator = false;  // inputs before the log began are unknown
+  std::uint64_t samples_written = 0;
+  std::uint64_t samples_before_start = 0;  // sensor samples the original never saw (warm-up), left out
+  std::uint64_t samples_unanswered = 0;    // later samples without a command of the original
+  std::uint64_t samples_unanswered_dropped = 0;  // of those, left out (only_answered)
+  std::uint64_t other_inputs_written = 0;  // trajectory, params, control
+  std::uint64_t other_inputs_skipped = 0;  // logged before the compensator ran
+  std::uint64_t undecodable = 0;           // input events that failed to decode or check (left out)
+};
+
+// Writes the inputs of `log` to `out` (an LCM event log, original timestamps kept).
+// Throws std::runtime_error naming the file when one cannot be read or written, or when
+// the log holds no command (nothing to replay against).
+ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const std::filesystem::path& out,
+                                         const ChannelNames& channels, const ReplayInputOptions& options);
+
+// Human-readable summary of the selection, one fact per line.
+std::string describe(const ReplayInputSelection& selection);
+
+}  // namespace hystloop::replay
