@@ -1,0 +1,79 @@
+#include "ctl_health.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace hystloop::ctl {
+
+namespace {
+
+std::string timing(double p50, double p99, double max) {
+  if (!std::isfinite(p50) && !std::isfinite(p99) && !std::isfinite(max)) return "--";
+  auto one = [](double v) {
+    if (!std::isfinite(v)) return std::string("--");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, v < 100.0 ? "%.1f" : "%.0f", v);
+    return std::string(buf);
+  };
+  return one(p50) + "/" + one(p99) + "/" + one(max) + " us";
+}
+
+}  // namespace
+
+std::string state_name(std::int8_t state) {
+  switch (state) {
+    case service_status_t::STARTING: return "STARTING";
+    case service_status_t::HEALTHY: return "HEALTHY";
+    case service_status_t::DEGRADED: return "DEGRADED";
+    case service_status_t::SAFE: return "SAFE";
+    case service_status_t::STOPPING: return "STOPPING";
+    default: return "state " + std::to_string(state);
+  }
+}
+
+void StatusBoard::update(const service_status_t& status, std::int64_t recv_utime) {
+  ProcessReport& report = processes_[status.process];
+  report.status = status;
+  report.recv_utime = recv_utime;
+  ++report.reports;
+}
+
+HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
+                           const std::vector<std::string>& accept_safe) {
+  HealthVerdict verdict;
+  for (const auto& name : required) {
+    const auto it = board.processes().find(name);
+    if (it == board.processes().end()) {
+      verdict.problems.push_back(name + ": no status received");
+      continue;
+    }
+    const auto& s = it->second.status;
+    const bool safe_ok = std::find(accept_safe.begin(), accept_safe.end(), name) != accept_safe.end();
+    if (s.state == service_status_t::HEALTHY || (safe_ok && s.state == service_status_t::SAFE)) continue;
+    verdict.problems.push_back(name + ": " + state_name(s.state) + (s.detail.empty() ? "" : " (" + s.detail + ")"));
+  }
+  verdict.healthy = verdict.problems.empty();
+  return verdict;
+}
+
+std::string format_status(const ProcessReport& report, bool all_counters) {
+  const auto& s = report.status;
+  char head[256];
+  const double up_s = static_cast<double>(s.utime - s.start_utime) * 1e-6;
+  std::snprintf(head, sizeof head, "%-12s %-9s pid %d@%s  up %.0f s  late %lld  rejected %lld", s.process.c_str(),
+                state_name(s.state).c_str(), s.pid, s.host.c_str(), up_s, static_cast<long long>(s.late),
+                static_cast<long long>(s.rejected));
+  std::string line = head;
+  line += "  loop p50/p99/max " + timing(s.loop_p50_us, s.loop_p99_us, s.loop_max_us);
+  line += "  latency " + timing(s.latency_p50_us, s.latency_p99_us, s.latency_max_us);
+  if (!s.detail.empty()) line += "  [" + s.detail + "]";
+  if (all_counters) {
+    for (std::size_t i = 0; i < s.counter_names.size() && i < s.counter_values.size(); ++i) {
+      line += "\n    " + s.counter_names[i] + " = " + std::to_string(s.counter_values[i]);
+    }
+  }
+  return line;
+}
+
+}  // namespace hystloop::ctl

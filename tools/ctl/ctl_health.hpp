@@ -1,0 +1,46 @@
+#pragma once
+// `hystloop-ctl status`: the latest HX_STATUS report of each process, one line each, and
+// the --wait-healthy verdict. No I/O here: the caller feeds the reports in.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hystloop/service_status_t.hpp"
+
+namespace hystloop::ctl {
+
+// "STARTING", "HEALTHY", "DEGRADED", "SAFE", "STOPPING", or "state <n>".
+std::string state_name(std::int8_t state);
+
+struct ProcessReport {
+  service_status_t status;
+  std::int64_t recv_utime = 0;
+  std::uint64_t reports = 0;
+};
+
+class StatusBoard {
+ public:
+  void update(const service_status_t& status, std::int64_t recv_utime);
+  const std::map<std::string, ProcessReport>& processes() const noexcept { return processes_; }
+
+ private:
+  std::map<std::string, ProcessReport> processes_;
+};
+
+struct HealthVerdict {
+  bool healthy = false;
+  std::vector<std::string> problems;  // "bridge: no status", "compensator: DEGRADED (late commands)"
+};
+
+// Every process in `required` has reported HEALTHY in its latest report, or SAFE if it
+// is listed in `accept_safe`.
+HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
+                           const std::vector<std::string>& accept_safe);
+
+// One line: process, state, pid@host, uptime, late/rejected, loop and latency timing, detail.
+// With all_counters, the named counters follow, one per indented line.
+std::string format_status(const ProcessReport& report, bool all_counters);
+
+}  // namespace hystloop::ctl

@@ -1,0 +1,76 @@
+#pragma once
+// hystloop-ctl's side of LCM: the connection, repeated publishing of a request, and the
+// listening subcommands (status, watch, the params version look-up).
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "lcm/channels.hpp"
+#include "lcm/publisher.hpp"
+
+namespace hystloop::ctl {
+
+struct LinkOptions {
+  std::string lcm_url;         // empty: $LCM_DEFAULT_URL, else the ttl=0 default
+  bool allow_network = false;
+  std::string rig = "HX_";
+};
+
+class CtlLink {
+ public:
+  // Throws ParameterError for a refused URL or prefix, std::runtime_error if LCM cannot start.
+  explicit CtlLink(const LinkOptions& options);
+  lcm::LCM& lcm() noexcept { return *lcm_; }
+  const ChannelNames& channels() const noexcept { return channels_; }
+  const std::string& url() const noexcept { return url_; }
+
+ private:
+  ChannelNames channels_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+};
+
+// Publishes `msg` `repeats` times, `gap` apart (UDP may drop one; receivers dedupe by
+// request id / version). Returns false if the message was refused or never sent.
+template <class T>
+bool publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg, int repeats = 3,
+                      std::chrono::milliseconds gap = std::chrono::milliseconds(5)) {
+  Publisher<T> publisher(lcm, channel);
+  bool all = true;
+  for (int i = 0; i < repeats; ++i) {
+    if (i > 0) std::this_thread::sleep_for(gap);
+    all = publisher.publish(msg) && all;
+  }
+  return all;
+}
+
+struct StatusOptions {
+  double listen_s = 1.5;                   // without --wait-healthy: how long to collect reports
+  std::vector<std::string> wait_healthy;   // processes that must report HEALTHY
+  std::vector<std::string> accept_safe;    // ... or SAFE, for these
+  double timeout_s = 10.0;
+  bool all_counters = false;
+};
+
+// Prints one line per process; returns the exit status (0 ok, 1 nobody / not healthy in time).
+int run_status(CtlLink& link, const StatusOptions& options);
+
+struct WatchOptions {
+  double seconds = 0.0;                 // 0: until SIGINT/SIGTERM
+  std::string bridge_process = "bridge";
+};
+
+// Prints a line per second; returns 0 (1 if LCM failed).
+int run_watch(CtlLink& link, const WatchOptions& options);
+
+// The highest parameter version seen on HX_PARAMS or in HX_COMMAND within listen_s, plus one
+// (1 when nothing was seen), so that a set sent by hand supersedes the one in use.
+std::int32_t next_params_version(CtlLink& link, double listen_s);
+
+}  // namespace hystloop::ctl

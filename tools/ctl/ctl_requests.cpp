@@ -1,0 +1,217 @@
+#include "ctl_requests.hpp"
+
+#include <array>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include "core/errors.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "lcm/message_checks.hpp"
+
+namespace hystloop::ctl {
+
+namespace {
+
+constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kModes{{
+    {"off", actuator_command_t::MODE_OFF},
+    {"linear", actuator_command_t::MODE_LINEAR},
+    {"mem", actuator_command_t::MODE_MEM},
+    {"pi", actuator_command_t::MODE_PI},
+    {"katalenic", actuator_command_t::MODE_KATALENIC},
+}};
+
+constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kShapes{{
+    {"hold", trajectory_t::HOLD},
+    {"sine", trajectory_t::SINE},
+    {"cosine", trajectory_t::COSINE},
+    {"triangle", trajectory_t::TRIANGLE},
+    {"points", trajectory_t::POINTS},
+}};
+
+template <std::size_t N>
+std::int8_t lookup(const std::array<std::pair<std::string_view, std::int8_t>, N>& table, std::string_view field,
+                   std::string_view name) {
+  std::string names;
+  for (const auto& [key, value] : table) {
+    if (key == name) return value;
+    if (!names.empty()) names += '|';
+    names += key;
+  }
+  throw ParameterError(std::string(field), "must be one of " + names + " (got '" + std::string(name) + "')");
+}
+
+std::string str(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+}  // namespace
+
+std::int64_t new_request_id(std::int64_t utime, int pid) noexcept {
+  return (utime % 1'000'000'000'000'000) * 1000 + (pid % 1000) + 1;  // > 0, unique per us and pid
+}
+
+std::int8_t parse_mode(std::string_view name) { return lookup(kModes, "mode", name); }
+
+control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime) {
+  control_t msg{};
+  msg.utime = utime;
+  msg.request_id = request_id;
+  msg.command = command;
+  msg.target = std::move(target);
+  return msg;
+}
+
+void GainsRequest::validate() const {
+  require_non_negative("kp", kp);
+  require_non_negative("ki", ki);
+  require_non_negative("kd", kd);
+}
+
+void ExperimentRequest::validate() const {
+  if (kind.empty()) throw ParameterError("kind", "must not be empty");
+  require_positive("amplitude", amplitude_V);
+  require_in_range("amplitude", amplitude_V, 0.0, kMaxAbsVoltage_V);
+  require_positive("frequency", frequency_Hz);
+  require_in_range("frequency", frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
+  require_positive("duration", duration_s);
+  require_in_range("duration", duration_s, 0.0, kMaxDuration_s);
+  require_in_range("offset", offset_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+}
+
+void apply(const GainsRequest& gains, control_t& msg) {
+  gains.validate();
+  msg.kp = gains.kp;
+  msg.ki = gains.ki;
+  msg.kd = gains.kd;
+}
+
+void apply(const ExperimentRequest& experiment, control_t& msg) {
+  experiment.validate();
+  msg.experiment = experiment.kind;
+  msg.experiment_amplitude_V = experiment.amplitude_V;
+  msg.experiment_frequency_Hz = experiment.frequency_Hz;
+  msg.experiment_duration_s = experiment.duration_s;
+  msg.experiment_offset_V = experiment.offset_V;
+}
+
+void TrajectoryRequest::validate() const {
+  const std::int8_t s = lookup(kShapes, "shape", shape);
+  require_in_range("amplitude", amplitude_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  require_in_range("offset", offset_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  require_finite("phase", phase_rad);
+  require_non_negative("blend", blend_s);
+  if (s == trajectory_t::SINE || s == trajectory_t::COSINE || s == trajectory_t::TRIANGLE) {
+    require_positive("frequency", frequency_Hz);
+    require_in_range("frequency", frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
+  }
+  if (s == trajectory_t::POINTS) {
+    if (points_t_s.empty()) throw ParameterError("points-csv", "shape points needs at least one point (--points-csv)");
+    if (points_t_s.size() > static_cast<std::size_t>(trajectory_t::MAX_POINTS)) {
+      throw ParameterError("points-csv", "at most " + std::to_string(trajectory_t::MAX_POINTS) + " points (got " +
+                                             std::to_string(points_t_s.size()) + ")");
+    }
+    for (std::size_t i = 0; i < points_t_s.size(); ++i) {
+      require_non_negative("points-csv", points_t_s[i]);
+      require_in_range("points-csv", points_y_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
+      if (i > 0 && !(points_t_s[i] > points_t_s[i - 1])) {
+        throw ParameterError("points-csv", "times must increase strictly (point " + std::to_string(i + 1) + ": " +
+                                               str(points_t_s[i]) + " after " + str(points_t_s[i - 1]) + ")");
+      }
+    }
+  } else if (!points_t_s.empty()) {
+    throw ParameterError("points-csv", "only for --shape points");
+  }
+}
+
+TrajectoryRequest mem_paper_trajectory(double blend_s) {
+  TrajectoryRequest r;
+  r.shape = "cosine";
+  r.amplitude_m = -1.6e-6;
+  r.frequency_Hz = 1.0;
+  r.blend_s = blend_s;
+  return r;
+}
+
+void read_points_csv(const std::filesystem::path& file, TrajectoryRequest& request) {
+  std::ifstream in(file);
+  if (!in) throw ParameterError("points-csv", file.string() + ": cannot read");
+  std::string line;
+  int number = 0;
+  request.points_t_s.clear();
+  request.points_y_m.clear();
+  while (std::getline(in, line)) {
+    ++number;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    for (char& c : line) {
+      if (c == ',' || c == ';' || c == '\t') c = ' ';
+    }
+    std::istringstream fields(line);
+    double t = 0.0, y = 0.0;
+    std::string rest;
+    if (!(fields >> t >> y)) {
+      if (request.points_t_s.empty() && number == 1) continue;  // a header line
+      throw ParameterError("points-csv", file.string() + " line " + std::to_string(number) +
+                                             ": expected two numbers t_s,y_m");
+    }
+    if (fields >> rest) {
+      throw ParameterError("points-csv", file.string() + " line " + std::to_string(number) +
+                                             ": expected two columns t_s,y_m (got more)");
+    }
+    request.points_t_s.push_back(t);
+    request.points_y_m.push_back(y);
+  }
+}
+
+trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t version, std::int64_t utime) {
+  request.validate();
+  trajectory_t msg{};
+  msg.utime = utime;
+  msg.version = version;
+  msg.shape = lookup(kShapes, "shape", request.shape);
+  const bool periodic = msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE ||
+                        msg.shape == trajectory_t::TRIANGLE;
+  msg.amplitude_m = request.amplitude_m;
+  msg.offset_m = request.offset_m;
+  msg.frequency_Hz = periodic ? request.frequency_Hz : 0.0;
+  msg.phase_rad = request.phase_rad;
+  msg.start_utime = 0;  // as soon as received
+  msg.blend_s = request.blend_s;
+  msg.n_points = static_cast<std::int32_t>(request.points_t_s.size());
+  msg.points_t_s = request.points_t_s;
+  msg.points_y_m = request.points_y_m;
+  if (check_message(msg) != Verdict::kOk) throw ParameterError("trajectory", "refused by the message contract");
+  return msg;
+}
+
+void ParamsRequest::validate() const {
+  require_positive("c1", c1);
+  require_in_range("c1", c1, 0.0, 1.0);
+  require_non_negative("c2", c2);
+  require_positive("c3", c3);
+  require_in_range("c3", c3, 0.0, 50.0);
+  require_in_range("residual", residual_m, 0.0, kMaxAbsPosition_m);
+  if (version < 1) throw ParameterError("version", "must be >= 1 (got " + std::to_string(version) + ")");
+}
+
+mem_params_t make_params(const ParamsRequest& request, std::int64_t utime) {
+  request.validate();
+  mem_params_t msg{};
+  msg.utime = utime;
+  msg.version = request.version;
+  msg.c1 = request.c1;
+  msg.c2 = request.c2;
+  msg.c3 = request.c3;
+  msg.residual_m = request.residual_m;
+  msg.samples_used = 0;
+  msg.window_s = 0.0;
+  msg.valid = true;
+  msg.source = "hystloop-ctl";
+  if (check_message(msg) != Verdict::kOk) throw ParameterError("params", "refused by the message contract");
+  return msg;
+}
+
+}  // namespace hystloop::ctl

@@ -1,0 +1,80 @@
+#pragma once
+// What hystloop-ctl sends, built and validated without any I/O: each request type checks
+// its values where they enter (ParameterError naming the option, e.g. "c1: must be > 0
+// (got -1)") and converts to the LCM message, which must then also pass the contract's
+// check_message.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hystloop/control_t.hpp"
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/trajectory_t.hpp"
+
+namespace hystloop::ctl {
+
+// A request id unique per sender and request (> 0): wall time [us] and the pid.
+std::int64_t new_request_id(std::int64_t utime, int pid) noexcept;
+
+// "off"|"linear"|"mem"|"pi"|"katalenic" -> actuator_command_t::MODE_*; throws ParameterError("mode").
+std::int8_t parse_mode(std::string_view name);
+
+// A control_t with the common fields set and every other field neutral (0 / empty).
+control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime);
+
+struct GainsRequest {
+  double kp = 0.0;  // [-]
+  double ki = 0.0;  // [1/s]
+  double kd = 0.0;  // [s]
+  void validate() const;  // finite, >= 0
+};
+
+struct ExperimentRequest {
+  std::string kind = "sine";  // control_t.experiment
+  double amplitude_V = 0.0;   // > 0
+  double frequency_Hz = 0.0;  // > 0
+  double duration_s = 0.0;    // > 0
+  double offset_V = 0.0;      // finite
+  void validate() const;
+};
+
+void apply(const GainsRequest& gains, control_t& msg);
+void apply(const ExperimentRequest& experiment, control_t& msg);
+
+struct TrajectoryRequest {
+  std::string shape;          // cosine|sine|triangle|hold|points
+  double amplitude_m = 0.0;
+  double frequency_Hz = 1.0;  // > 0 for the periodic shapes
+  double offset_m = 0.0;
+  double phase_rad = 0.0;
+  double blend_s = 1.0;       // fade-in from the previous reference, >= 0
+  std::vector<double> points_t_s, points_y_m;  // points: >= 1, t >= 0 strictly increasing
+  void validate() const;
+};
+
+// The MEM paper's reference, eq. (24): y_d(t) = -1.6 um * cos(2 pi t).
+TrajectoryRequest mem_paper_trajectory(double blend_s);
+
+// Reads "t_s,y_m" rows (a header line and '#' comments are skipped) into the request.
+// Throws ParameterError("points-csv", "<file> line N: ...").
+void read_points_csv(const std::filesystem::path& file, TrajectoryRequest& request);
+
+// version: increases per new trajectory (ctl uses the wall time in us); start "as received".
+trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t version, std::int64_t utime);
+
+struct ParamsRequest {
+  double c1 = 0.0;          // [m/V], > 0 (and <= 1, the contract's sanity bound)
+  double c2 = 0.0;          // [m/V^(1+c3)], >= 0
+  double c3 = 0.0;          // [-], 0 < c3 <= 50
+  double residual_m = 0.0;  // >= 0
+  std::int32_t version = 0; // >= 1
+  void validate() const;
+};
+
+// valid = true, source "hystloop-ctl".
+mem_params_t make_params(const ParamsRequest& request, std::int64_t utime);
+
+}  // namespace hystloop::ctl

@@ -1,0 +1,237 @@
+// hystloop-ctl: operate a running rig over LCM.
+//
+//   hystloop-ctl [--lcm-url URL] [--allow-network] [--rig PREFIX] SUBCOMMAND [options]
+//
+//   status [--wait-healthy P... [--accept-safe P]... --timeout S] [--listen S] [--counters]
+//   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
+//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd
+//   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine]
+//   trajectory --shape cosine|sine|triangle|hold|points --amplitude M --frequency HZ --offset M
+//              --blend S [--points-csv FILE]   |   trajectory --mem-paper
+//   params --c1 --c2 --c3 [--residual M] [--version N]
+//   watch [--seconds S]
+//
+// Requests are sent 3 times a few ms apart with the same request id (UDP may drop one;
+// receivers act on an id once). Exit status: 0 done, 1 failed (not healthy in time, LCM
+// error), 2 bad arguments (the message names the option).
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "ctl_link.hpp"
+#include "ctl_requests.hpp"
+#include "runtime/status_reporter.hpp"
+
+namespace {
+
+using namespace hystloop;
+using namespace hystloop::ctl;
+
+struct Options {
+  LinkOptions link;
+  std::string target;
+  std::string process;  // positional of shutdown / reset-counters
+  std::string mode;
+  GainsRequest gains;
+  ExperimentRequest experiment;
+  TrajectoryRequest trajectory;
+  std::string points_csv;
+  bool mem_paper = false;
+  ParamsRequest params;
+  std::optional<std::int32_t> params_version;
+  double params_listen_s = 1.5;
+  StatusOptions status;
+  WatchOptions watch;
+};
+
+std::string to_whom(const std::string& target) { return target.empty() ? "every process" : "'" + target + "'"; }
+
+int send_control(const Options& o, std::int8_t command, const std::string& target, const char* what,
+                 const std::function<void(control_t&)>& fill = {}) {
+  const std::int64_t now = wall_utime();
+  control_t msg = make_control(command, target, new_request_id(now, static_cast<int>(::getpid())), now);
+  if (fill) fill(msg);
+  if (check_message(msg) != Verdict::kOk) throw ParameterError(what, "refused by the message contract");
+  CtlLink link(o.link);
+  if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().control.c_str());
+    return 1;
+  }
+  std::printf("hystloop-ctl: sent %s to %s on %s (request %lld)\n", what, to_whom(target).c_str(),
+              link.channels().control.c_str(), static_cast<long long>(msg.request_id));
+  return 0;
+}
+
+int send_trajectory(const Options& o) {
+  TrajectoryRequest request = o.mem_paper ? mem_paper_trajectory(o.trajectory.blend_s) : o.trajectory;
+  if (!o.mem_paper && request.shape.empty()) throw ParameterError("shape", "required (or --mem-paper)");
+  if (!o.points_csv.empty()) read_points_csv(o.points_csv, request);
+  const std::int64_t now = wall_utime();
+  const trajectory_t msg = make_trajectory(request, now, now);  // version: wall time, increases per request
+  CtlLink link(o.link);
+  if (!publish_repeated(link.lcm(), link.channels().trajectory, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().trajectory.c_str());
+    return 1;
+  }
+  std::printf("hystloop-ctl: sent trajectory %s amplitude %g m frequency %g Hz offset %g m blend %g s%s on %s "
+              "(version %lld)\n",
+              request.shape.c_str(), msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s,
+              msg.n_points > 0 ? (" with " + std::to_string(msg.n_points) + " points").c_str() : "",
+              link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
+  return 0;
+}
+
+int send_params(const Options& o) {
+  ParamsRequest request = o.params;
+  request.version = 1;
+  request.validate();  // refuse bad values before listening for the version
+  CtlLink link(o.link);
+  request.version = o.params_version ? *o.params_version : next_params_version(link, o.params_listen_s);
+  const mem_params_t msg = make_params(request, wall_utime());
+  if (!publish_repeated(link.lcm(), link.channels().params, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().params.c_str());
+    return 1;
+  }
+  std::printf("hystloop-ctl: sent MEM parameters v%d c1 %g m/V c2 %g c3 %g on %s\n", msg.version, msg.c1, msg.c2,
+              msg.c3, link.channels().params.c_str());
+  return 0;
+}
+
+CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, Options& o) {
+  CLI::App* sub = app.add_subcommand(name, help);
+  sub->add_option("--target", o.target, "Process the request is for (default: every process)");
+  return sub;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, gains, "
+               "experiments, trajectories, parameters, live tracking error)"};
+  app.require_subcommand(1);
+  app.fallthrough();
+  app.add_option("--lcm-url", o.link.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
+  app.add_flag("--allow-network", o.link.allow_network, "Accept an LCM URL whose packets can leave this host");
+  app.add_option("--rig", o.link.rig, "Channel prefix of the rig")->capture_default_str();
+
+  CLI::App* status = app.add_subcommand("status", "Print the latest HX_STATUS of each process, or wait until healthy");
+  status->add_option("--wait-healthy", o.status.wait_healthy,
+                     "Exit 0 as soon as each of these processes reports HEALTHY; 1 after --timeout");
+  status->add_option("--accept-safe", o.status.accept_safe, "Also accept SAFE from this process (e.g. an unarmed bridge)");
+  status->add_option("--timeout", o.status.timeout_s, "How long --wait-healthy waits [s]")->capture_default_str();
+  status->add_option("--listen", o.status.listen_s, "Without --wait-healthy: how long to collect reports [s]")
+      ->capture_default_str();
+  status->add_flag("--counters", o.status.all_counters, "Also print every named counter");
+
+  CLI::App* arm = control_subcommand(app, "arm", "Bridge: leave the safe state and apply commands", o);
+  CLI::App* disarm = control_subcommand(app, "disarm", "Bridge: enter the safe state now", o);
+  CLI::App* stop_exp = control_subcommand(app, "stop-experiment", "Compensator: stop the identification experiment", o);
+  CLI::App* shutdown = app.add_subcommand("shutdown", "Stop a process cleanly (default: every process)");
+  shutdown->add_option("process", o.process, "Process to stop (default: all)");
+  CLI::App* reset = app.add_subcommand("reset-counters", "Zero the status counters of a process (default: all)");
+  reset->add_option("process", o.process, "Process (default: all)");
+
+  CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
+  mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
+
+  CLI::App* gains = control_subcommand(app, "gains", "Compensator: feedback gains (normalised PID, all >= 0)", o);
+  gains->add_option("--kp", o.gains.kp, "Proportional gain [-]")->capture_default_str();
+  gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();
+  gains->add_option("--kd", o.gains.kd, "Derivative gain [s]")->capture_default_str();
+
+  CLI::App* experiment = control_subcommand(app, "experiment", "Compensator: run an identification experiment", o);
+  experiment->add_option("--amplitude", o.experiment.amplitude_V, "Excitation amplitude [V], > 0")->required();
+  experiment->add_option("--frequency", o.experiment.frequency_Hz, "Excitation frequency [Hz], > 0")->required();
+  experiment->add_option("--duration", o.experiment.duration_s, "Duration [s], > 0")->required();
+  experiment->add_option("--offset", o.experiment.offset_V, "Offset [V]")->capture_default_str();
+  experiment->add_option("--kind", o.experiment.kind, "Experiment: sine, triangle, chirp, ...")->capture_default_str();
+
+  CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
+  trajectory->add_option("--shape", o.trajectory.shape, "cosine, sine, triangle, hold or points");
+  trajectory->add_option("--amplitude", o.trajectory.amplitude_m, "Peak amplitude [m] (may be negative)")
+      ->capture_default_str();
+  trajectory->add_option("--frequency", o.trajectory.frequency_Hz, "Frequency [Hz] of the periodic shapes")
+      ->capture_default_str();
+  trajectory->add_option("--offset", o.trajectory.offset_m, "Offset [m]")->capture_default_str();
+  trajectory->add_option("--phase", o.trajectory.phase_rad, "Phase [rad]")->capture_default_str();
+  trajectory->add_option("--blend", o.trajectory.blend_s, "Fade-in from the current reference [s]")
+      ->capture_default_str();
+  trajectory->add_option("--points-csv", o.points_csv, "points: CSV of t_s,y_m rows (times from the start, increasing)");
+  trajectory->add_flag("--mem-paper", o.mem_paper, "The MEM paper's y_d = -1.6 um cos(2 pi t) (with --blend)")
+      ->excludes("--shape");
+
+  CLI::App* params = app.add_subcommand("params", "Send a MEM parameter set (HX_PARAMS, valid, source hystloop-ctl)");
+  params->add_option("--c1", o.params.c1, "Slope at a branch point [m/V], > 0")->required();
+  params->add_option("--c2", o.params.c2, "Growth of the slope [m/V^(1+c3)], >= 0")->required();
+  params->add_option("--c3", o.params.c3, "Exponent [-], in (0, 50]")->required();
+  params->add_option("--residual", o.params.residual_m, "Fit residual to report [m], >= 0")->capture_default_str();
+  params->add_option("--version", o.params_version,
+                     "Version (default: 1 + the highest seen on HX_PARAMS/HX_COMMAND within --listen)");
+  params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
+      ->capture_default_str();
+
+  CLI::App* watch = app.add_subcommand("watch", "Print the tracking error, params version, late commands and latency "
+                                                "once a second");
+  watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
+  watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
+      ->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+
+  try {
+    if (*status) {
+      if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
+      CtlLink link(o.link);
+      return run_status(link, o.status);
+    }
+    if (*arm) return send_control(o, control_t::ARM, o.target, "ARM");
+    if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM");
+    if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT");
+    if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN");
+    if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS");
+    if (*mode) {
+      const std::int8_t m = parse_mode(o.mode);
+      return send_control(o, control_t::SET_MODE, o.target, ("SET_MODE " + o.mode).c_str(),
+                          [m](control_t& msg) { msg.mode = m; });
+    }
+    if (*gains) {
+      o.gains.validate();
+      return send_control(o, control_t::SET_GAINS, o.target, "SET_GAINS", [&](control_t& msg) { apply(o.gains, msg); });
+    }
+    if (*experiment) {
+      o.experiment.validate();
+      return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT",
+                          [&](control_t& msg) { apply(o.experiment, msg); });
+    }
+    if (*trajectory) return send_trajectory(o);
+    if (*params) return send_params(o);
+    if (*watch) {
+      require_non_negative("seconds", o.watch.seconds);
+      CtlLink link(o.link);
+      return run_watch(link, o.watch);
+    }
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
+    return 1;
+  }
+  return 2;
+}

@@ -1,0 +1,277 @@
+// hystloop-ctl's plain parts: request validation and conversion, the health verdict, the
+// tick matcher and the watch line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "ctl_health.hpp"
+#include "ctl_requests.hpp"
+#include "ctl_watch.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "lcm/message_checks.hpp"
+
+using namespace hystloop;
+using namespace hystloop::ctl;
+
+namespace {
+
+template <class F>
+std::string field_of(F&& f) {
+  try {
+    f();
+  } catch (const ParameterError& e) {
+    return e.field();
+  }
+  return "<no error>";
+}
+
+}  // namespace
+
+TEST(CtlRequests, ModesByName) {
+  EXPECT_EQ(parse_mode("mem"), actuator_command_t::MODE_MEM);
+  EXPECT_EQ(parse_mode("katalenic"), actuator_command_t::MODE_KATALENIC);
+  EXPECT_EQ(parse_mode("off"), actuator_command_t::MODE_OFF);
+  try {
+    parse_mode("experiment");  // has its own subcommand
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "mode");
+    EXPECT_NE(std::string(e.what()).find("off|linear|mem|pi|katalenic"), std::string::npos);
+  }
+}
+
+TEST(CtlRequests, RequestIdsArePositiveAndDiffer) {
+  EXPECT_GT(new_request_id(1'700'000'000'000'000, 123), 0);
+  EXPECT_NE(new_request_id(1'700'000'000'000'000, 123), new_request_id(1'700'000'000'000'001, 123));
+  EXPECT_NE(new_request_id(1'700'000'000'000'000, 123), new_request_id(1'700'000'000'000'000, 124));
+}
+
+TEST(CtlRequests, GainsAndExperimentAreCheckedAndPassTheContract) {
+  EXPECT_EQ(field_of([] { GainsRequest{-1, 0, 0}.validate(); }), "kp");
+  EXPECT_EQ(field_of([] { GainsRequest{0, NAN, 0}.validate(); }), "ki");
+  ExperimentRequest x;
+  x.amplitude_V = 10;
+  x.frequency_Hz = 0;
+  x.duration_s = 1;
+  EXPECT_EQ(field_of([&] { x.validate(); }), "frequency");
+  x.frequency_Hz = 5;
+  control_t msg = make_control(control_t::START_EXPERIMENT, "", 9, 1);
+  apply(x, msg);
+  EXPECT_EQ(check_message(msg), Verdict::kOk);
+  EXPECT_EQ(msg.experiment, "sine");
+  x.duration_s = -2;
+  EXPECT_EQ(field_of([&] { x.validate(); }), "duration");
+}
+
+TEST(CtlRequests, MemPaperTrajectory) {
+  const trajectory_t t = make_trajectory(mem_paper_trajectory(0.5), 3, 4);
+  EXPECT_EQ(t.shape, trajectory_t::COSINE);
+  EXPECT_DOUBLE_EQ(t.amplitude_m, -1.6e-6);
+  EXPECT_DOUBLE_EQ(t.frequency_Hz, 1.0);
+  EXPECT_DOUBLE_EQ(t.offset_m, 0.0);
+  EXPECT_DOUBLE_EQ(t.blend_s, 0.5);
+  EXPECT_EQ(t.version, 3);
+  EXPECT_EQ(t.start_utime, 0);
+}
+
+TEST(CtlRequests, TrajectoryValidationNamesTheOption) {
+  TrajectoryRequest r;
+  r.shape = "square";
+  EXPECT_EQ(field_of([&] { r.validate(); }), "shape");
+  r.shape = "sine";
+  r.frequency_Hz = 0;
+  EXPECT_EQ(field_of([&] { r.validate(); }), "frequency");
+  r.frequency_Hz = 1;
+  r.blend_s = -1;
+  EXPECT_EQ(field_of([&] { r.validate(); }), "blend");
+  r.blend_s = 0;
+  r.amplitude_m = 2.0;  // 2 m: surely micrometres were meant
+  EXPECT_EQ(field_of([&] { r.validate(); }), "amplitude");
+  r.amplitude_m = 1e-6;
+  r.shape = "hold";
+  r.frequency_Hz = 0;  // ignored for hold
+  EXPECT_NO_THROW(r.validate());
+  r.shape = "points";
+  EXPECT_EQ(field_of([&] { r.validate(); }), "points-csv");
+}
+
+TEST(CtlRequests, PointsCsv) {
+  const auto file = std::filesystem::temp_directory_path() / ("ctl_points_" + std::to_string(::getpid()) + ".csv");
+  {
+    std::ofstream out(file);
+    out << "t_s,y_m\n# a comment\n0,0\n0.5, 1e-6\n1.0;2e-6\n";
+  }
+  TrajectoryRequest r;
+  r.shape = "points";
+  read_points_csv(file, r);
+  ASSERT_EQ(r.points_t_s.size(), 3u);
+  EXPECT_DOUBLE_EQ(r.points_y_m[2], 2e-6);
+  const trajectory_t t = make_trajectory(r, 1, 1);
+  EXPECT_EQ(t.n_points, 3);
+  EXPECT_EQ(t.shape, trajectory_t::POINTS);
+  {
+    std::ofstream out(file);
+    out << "0,0\n1,1e-6\n0.5,0\n";
+  }
+  read_points_csv(file, r);
+  EXPECT_EQ(field_of([&] { r.validate(); }), "points-csv");
+  {
+    std::ofstream out(file);
+    out << "0,0\n1,abc\n";
+  }
+  try {
+    read_points_csv(file, r);
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(file);
+}
+
+TEST(CtlRequests, ParamsValidation) {
+  ParamsRequest p{1e-7, 1e-9, 0.5, 0, 1};
+  const mem_params_t msg = make_params(p, 5);
+  EXPECT_TRUE(msg.valid);
+  EXPECT_EQ(msg.source, "hystloop-ctl");
+  EXPECT_EQ(check_message(msg), Verdict::kOk);
+  p.c1 = -1;
+  EXPECT_EQ(field_of([&] { p.validate(); }), "c1");
+  try {
+    p.validate();
+  } catch (const ParameterError& e) {
+    EXPECT_STREQ(e.what(), "c1: must be > 0 (got -1)");
+  }
+  p.c1 = 1e-7;
+  p.c2 = -1e-9;
+  EXPECT_EQ(field_of([&] { p.validate(); }), "c2");
+  p.c2 = 0;
+  p.c3 = 0;
+  EXPECT_EQ(field_of([&] { p.validate(); }), "c3");
+  p.c3 = 51;
+  EXPECT_EQ(field_of([&] { p.validate(); }), "c3");
+  p.c3 = 1;
+  p.version = 0;
+  EXPECT_EQ(field_of([&] { p.validate(); }), "version");
+}
+
+namespace {
+service_status_t report(const std::string& process, std::int8_t state, const std::string& detail = "") {
+  service_status_t s{};
+  s.process = process;
+  s.host = "h";
+  s.pid = 1;
+  s.state = state;
+  s.detail = detail;
+  s.loop_p50_us = 1.5;
+  s.loop_p99_us = 3.0;
+  s.loop_max_us = 250.0;
+  s.latency_p50_us = s.latency_p99_us = s.latency_max_us = NAN;
+  return s;
+}
+}  // namespace
+
+TEST(CtlHealth, VerdictNamesWhoIsMissingOrUnhealthy) {
+  StatusBoard board;
+  auto v = check_health(board, {"bridge", "compensator"}, {});
+  EXPECT_FALSE(v.healthy);
+  ASSERT_EQ(v.problems.size(), 2u);
+  EXPECT_EQ(v.problems[0], "bridge: no status received");
+  board.update(report("bridge", service_status_t::SAFE, "not armed"), 1);
+  board.update(report("compensator", service_status_t::HEALTHY), 1);
+  v = check_health(board, {"bridge", "compensator"}, {});
+  ASSERT_EQ(v.problems.size(), 1u);
+  EXPECT_EQ(v.problems[0], "bridge: SAFE (not armed)");
+  EXPECT_TRUE(check_health(board, {"bridge", "compensator"}, {"bridge"}).healthy);
+  board.update(report("compensator", service_status_t::DEGRADED, "late commands"), 2);  // the latest report counts
+  EXPECT_FALSE(check_health(board, {"bridge", "compensator"}, {"bridge"}).healthy);
+}
+
+TEST(CtlHealth, StatusLine) {
+  StatusBoard board;
+  auto s = report("bridge", service_status_t::DEGRADED, "late commands");
+  s.late = 12;
+  s.counter_names = {"ticks"};
+  s.counter_values = {100};
+  s.n_counters = 1;
+  board.update(s, 1);
+  const std::string line = format_status(board.processes().at("bridge"), true);
+  EXPECT_NE(line.find("DEGRADED"), std::string::npos) << line;
+  EXPECT_NE(line.find("late 12"), std::string::npos) << line;
+  EXPECT_NE(line.find("loop p50/p99/max 1.5/3.0/250 us"), std::string::npos) << line;
+  EXPECT_NE(line.find("latency --"), std::string::npos) << line;
+  EXPECT_NE(line.find("[late commands]"), std::string::npos) << line;
+  EXPECT_NE(line.find("ticks = 100"), std::string::npos) << line;
+}
+
+TEST(CtlWatch, MatcherPairsTicksInEitherOrder) {
+  TickMatcher m;
+  EXPECT_FALSE(m.on_command(10, 1e-6));
+  EXPECT_NEAR(*m.on_sample(10, 1.02e-6), 0.02e-6, 1e-18);
+  EXPECT_FALSE(m.on_sample(10, 5.0));  // already matched: no second pairing
+  EXPECT_FALSE(m.on_sample(11, 2e-6));
+  EXPECT_NEAR(*m.on_command(11, 1.5e-6), 0.5e-6, 1e-18);
+  EXPECT_FALSE(m.on_command(12, NAN));  // no reference
+  EXPECT_FALSE(m.on_sample(12, 1e-6));
+  // A stale half kSlots ticks back is overwritten, not matched.
+  EXPECT_FALSE(m.on_command(13, 1e-6));
+  EXPECT_FALSE(m.on_command(13 + static_cast<std::int64_t>(TickMatcher::kSlots), 2e-6));
+  EXPECT_FALSE(m.on_sample(13, 1e-6));
+}
+
+TEST(CtlWatch, RandomInterleavingGivesTheExactRms) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 25e-9);
+  std::uniform_real_distribution<double> lag(-3.5, 3.5);  // a command arrives a few ticks before/after its sample
+  constexpr std::int64_t kTicks = 10'000;
+  auto ref = [](std::int64_t k) { return 1e-6 * std::sin(0.01 * static_cast<double>(k)); };
+  std::vector<double> errors(kTicks);
+  struct Arrival {
+    double at;
+    std::int64_t seq;
+    bool command;
+  };
+  std::vector<Arrival> arrivals;
+  double sum = 0;
+  for (std::int64_t k = 0; k < kTicks; ++k) {
+    const double e = noise(rng);
+    errors[static_cast<std::size_t>(k)] = e;
+    sum += e * e;
+    arrivals.push_back({static_cast<double>(k) + lag(rng), k, true});
+    arrivals.push_back({static_cast<double>(k), k, false});
+  }
+  std::sort(arrivals.begin(), arrivals.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
+  TickMatcher m;
+  WatchSecond second;
+  for (const auto& a : arrivals) {
+    const auto e = a.command ? m.on_command(a.seq, ref(a.seq))
+                             : m.on_sample(a.seq, ref(a.seq) + errors[static_cast<std::size_t>(a.seq)]);
+    if (e) second.add_error(*e);
+  }
+  ASSERT_EQ(second.tracking, static_cast<std::uint64_t>(kTicks));
+  EXPECT_NEAR(*second.rms_m(), std::sqrt(sum / static_cast<double>(kTicks)), 1e-15);
+}
+
+TEST(CtlWatch, LineIsTidy) {
+  WatchLine l;
+  l.elapsed_s = 12;
+  l.second.samples = 10000;
+  l.second.add_error(27.9e-9);
+  l.second.add_error(-27.9e-9);
+  l.params_in_use = 3;
+  l.params_latest = 4;
+  l.late_total = 5;
+  l.late_delta = 1;
+  l.latency_p99_us = 120.4;
+  l.bridge_state = "HEALTHY";
+  EXPECT_EQ(format_watch_line(l),
+            "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
+            "lat p99 120 us  bridge HEALTHY");
+  EXPECT_EQ(format_watch_line(WatchLine{}),
+            "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  lat p99 --  bridge --");
+}

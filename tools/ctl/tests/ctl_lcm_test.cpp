@@ -1,0 +1,390 @@
+// hystloop-ctl against real udpm LCM (ttl=0) inside tools/netns-run: this test subscribes,
+// runs the tool as a child process, keeps dispatching (and, where needed, plays the rig by
+// publishing statuses, samples and commands) until the child exits, then checks what
+// arrived and what the tool printed. Argument errors and --help need no LCM and always run.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+using namespace hystloop;
+
+namespace {
+
+const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Runs hystloop-ctl with args; while it runs, calls tick() every ~2 ms (after dispatching
+// whatever LCM has for `lcm`, if given).
+Result run_ctl(const std::vector<std::string>& args, lcm::LCM* lcm = nullptr, const std::function<void()>& tick = {}) {
+  const fs::path dir = fs::temp_directory_path();
+  const fs::path out = dir / ("ctl_out_" + std::to_string(::getpid()));
+  const fs::path err = dir / ("ctl_err_" + std::to_string(::getpid()));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<std::string> all{HYSTLOOP_CTL_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  Result r;
+  if (posix_spawn(&pid, HYSTLOOP_CTL_EXE, &actions, nullptr, argv.data(), environ) != 0) return r;
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (true) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (std::chrono::steady_clock::now() > give_up) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      break;
+    }
+    if (lcm != nullptr) {
+      handle_pending(*lcm, std::chrono::microseconds(2000));
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (tick) tick();
+  }
+  if (lcm != nullptr) handle_pending(*lcm, std::chrono::microseconds(20'000));  // stragglers
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+bool in_netns() { return std::getenv("HYSTLOOP_NETNS") != nullptr; }
+
+class CtlLcmTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!in_netns()) GTEST_SKIP() << "needs udpm LCM: run inside tools/netns-run";
+    lcm_ = open_lcm(kUrl);
+  }
+  std::unique_ptr<lcm::LCM> lcm_;
+  ChannelNames ch_;
+};
+
+std::vector<std::string> with_url(std::vector<std::string> args) {
+  args.insert(args.begin(), {"--lcm-url", kUrl});
+  return args;
+}
+
+service_status_t status_of(const std::string& process, std::int8_t state, std::int64_t late = 0) {
+  service_status_t s{};
+  s.utime = now_us();
+  s.process = process;
+  s.host = "test";
+  s.pid = static_cast<std::int32_t>(::getpid());
+  s.state = state;
+  s.start_utime = s.utime - 1'000'000;
+  s.loop_p50_us = s.loop_p99_us = s.loop_max_us = std::nan("");
+  s.latency_p50_us = 40.0;
+  s.latency_p99_us = 95.0;
+  s.latency_max_us = 300.0;
+  s.late = late;
+  return s;
+}
+
+}  // namespace
+
+TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
+  std::vector<control_t> got;
+  Subscription<control_t> sub(*lcm_, ch_.control, [&](const control_t& c, std::int64_t) { got.push_back(c); });
+  struct Case {
+    std::vector<std::string> args;
+    std::int8_t command;
+    std::string target;
+    std::function<void(const control_t&)> check;
+  };
+  const std::vector<Case> cases{
+      {{"arm"}, control_t::ARM, "", {}},
+      {{"disarm", "--target", "bridge"}, control_t::DISARM, "bridge", {}},
+      {{"shutdown", "compensator"}, control_t::SHUTDOWN, "compensator", {}},
+      {{"shutdown"}, control_t::SHUTDOWN, "", {}},
+      {{"reset-counters", "bridge"}, control_t::RESET_COUNTERS, "bridge", {}},
+      {{"stop-experiment"}, control_t::STOP_EXPERIMENT, "", {}},
+      {{"mode", "mem"}, control_t::SET_MODE, "",
+       [](const control_t& c) { EXPECT_EQ(c.mode, actuator_command_t::MODE_MEM); }},
+      {{"mode", "pi", "--target", "compensator"}, control_t::SET_MODE, "compensator",
+       [](const control_t& c) { EXPECT_EQ(c.mode, actuator_command_t::MODE_PI); }},
+      {{"gains", "--kp", "0.5", "--ki", "20", "--kd", "1e-5"}, control_t::SET_GAINS, "",
+       [](const control_t& c) {
+         EXPECT_EQ(c.kp, 0.5);
+         EXPECT_EQ(c.ki, 20.0);
+         EXPECT_EQ(c.kd, 1e-5);
+       }},
+      {{"experiment", "--amplitude", "50", "--frequency", "2", "--duration", "10", "--offset", "-5", "--kind",
+        "triangle"},
+       control_t::START_EXPERIMENT, "",
+       [](const control_t& c) {
+         EXPECT_EQ(c.experiment, "triangle");
+         EXPECT_EQ(c.experiment_amplitude_V, 50.0);
+         EXPECT_EQ(c.experiment_frequency_Hz, 2.0);
+         EXPECT_EQ(c.experiment_duration_s, 10.0);
+         EXPECT_EQ(c.experiment_offset_V, -5.0);
+       }},
+  };
+  std::vector<std::int64_t> ids;
+  for (const auto& c : cases) {
+    got.clear();
+    const Result r = run_ctl(with_url(c.args), lcm_.get());
+    ASSERT_EQ(r.exit_code, 0) << c.args[0] << ": " << r.err;
+    ASSERT_EQ(got.size(), 3u) << c.args[0];
+    for (const auto& msg : got) {
+      EXPECT_EQ(msg.command, c.command) << c.args[0];
+      EXPECT_EQ(msg.target, c.target) << c.args[0];
+      EXPECT_EQ(msg.request_id, got[0].request_id) << c.args[0];
+      EXPECT_GT(msg.request_id, 0);
+      EXPECT_NEAR(static_cast<double>(msg.utime), static_cast<double>(now_us()), 10e6);
+      if (c.check) c.check(msg);
+    }
+    EXPECT_EQ(std::count(ids.begin(), ids.end(), got[0].request_id), 0) << "request ids must differ";
+    ids.push_back(got[0].request_id);
+  }
+}
+
+TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
+  std::vector<trajectory_t> got;
+  Subscription<trajectory_t> sub(*lcm_, ch_.trajectory, [&](const trajectory_t& t, std::int64_t) { got.push_back(t); });
+
+  Result r = run_ctl(with_url({"trajectory", "--mem-paper", "--blend", "0.5"}), lcm_.get());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[0].shape, trajectory_t::COSINE);
+  EXPECT_DOUBLE_EQ(got[0].amplitude_m, -1.6e-6);
+  EXPECT_DOUBLE_EQ(got[0].frequency_Hz, 1.0);
+  EXPECT_DOUBLE_EQ(got[0].blend_s, 0.5);
+  EXPECT_EQ(got[2].version, got[0].version);
+  const std::int64_t first_version = got[0].version;
+
+  got.clear();
+  r = run_ctl(with_url({"trajectory", "--shape", "triangle", "--amplitude", "2e-6", "--frequency", "5", "--offset",
+                        "1e-7", "--blend", "0"}),
+              lcm_.get());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[0].shape, trajectory_t::TRIANGLE);
+  EXPECT_DOUBLE_EQ(got[0].amplitude_m, 2e-6);
+  EXPECT_DOUBLE_EQ(got[0].frequency_Hz, 5.0);
+  EXPECT_DOUBLE_EQ(got[0].offset_m, 1e-7);
+  EXPECT_GT(got[0].version, first_version);  // a new trajectory supersedes the last
+
+  const fs::path csv = fs::temp_directory_path() / ("ctl_points_" + std::to_string(::getpid()) + ".csv");
+  std::ofstream(csv) << "t_s,y_m\n0,0\n0.25,1e-6\n0.5,-1e-6\n";
+  got.clear();
+  r = run_ctl(with_url({"trajectory", "--shape", "points", "--points-csv", csv.string()}), lcm_.get());
+  fs::remove(csv);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[0].shape, trajectory_t::POINTS);
+  ASSERT_EQ(got[0].n_points, 3);
+  EXPECT_DOUBLE_EQ(got[0].points_t_s[1], 0.25);
+  EXPECT_DOUBLE_EQ(got[0].points_y_m[2], -1e-6);
+}
+
+TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
+  std::vector<mem_params_t> got;
+  Subscription<mem_params_t> sub(*lcm_, ch_.params, [&](const mem_params_t& p, std::int64_t) { got.push_back(p); });
+  Result r = run_ctl(with_url({"params", "--c1", "1.2e-7", "--c2", "3e-9", "--c3", "0.8", "--version", "7"}), lcm_.get());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[0].version, 7);
+  EXPECT_EQ(got[0].c1, 1.2e-7);
+  EXPECT_EQ(got[0].c2, 3e-9);
+  EXPECT_EQ(got[0].c3, 0.8);
+  EXPECT_TRUE(got[0].valid);
+  EXPECT_EQ(got[0].source, "hystloop-ctl");
+
+  // Without --version: one above the version the rig uses (here: commands with v5).
+  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  actuator_command_t cmd{};
+  cmd.utime = now_us();
+  cmd.sample_seq = -1;
+  cmd.y_ref_m = 0.0;
+  cmd.params_version = 5;
+  got.clear();
+  r = run_ctl(with_url({"params", "--c1", "1e-7", "--c2", "0", "--c3", "1", "--listen", "0.5"}), lcm_.get(), [&] {
+    ++cmd.seq;
+    commands.publish(cmd);
+  });
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got.back().version, 6);
+}
+
+TEST_F(CtlLcmTest, WaitHealthyTimesOutNamingWhoIsMissing) {
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = run_ctl(with_url({"status", "--wait-healthy", "bridge", "compensator", "--timeout", "1"}));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("not healthy after 1 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bridge: no status received"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("compensator: no status received"), std::string::npos) << r.err;
+  EXPECT_GE(took, 0.9);
+  EXPECT_LT(took, 5.0);
+}
+
+TEST_F(CtlLcmTest, WaitHealthyReturnsAsSoonAsEveryoneIsHealthy) {
+  Publisher<service_status_t> status(*lcm_, ch_.status);
+  int ticks = 0;
+  auto play_rig = [&] {
+    if (++ticks % 20 != 0) return;  // every ~40 ms
+    status.publish(status_of("bridge", service_status_t::SAFE));
+    status.publish(status_of("compensator", service_status_t::HEALTHY));
+  };
+  const auto start = std::chrono::steady_clock::now();
+  Result r = run_ctl(with_url({"status", "--wait-healthy", "bridge", "compensator", "--accept-safe", "bridge",
+                               "--timeout", "10"}),
+                     lcm_.get(), play_rig);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(took, 5.0);
+  EXPECT_NE(r.out.find("bridge"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("SAFE"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("compensator"), std::string::npos) << r.out;
+
+  // SAFE is not healthy unless accepted.
+  r = run_ctl(with_url({"status", "--wait-healthy", "bridge", "--timeout", "0.5"}), lcm_.get(), play_rig);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bridge: SAFE"), std::string::npos) << r.err;
+
+  // Plain status lists what reported.
+  r = run_ctl(with_url({"status", "--listen", "0.5"}), lcm_.get(), play_rig);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("HEALTHY"), std::string::npos) << r.out;
+}
+
+TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfMatchedTicks) {
+  Publisher<sensor_sample_t> samples(*lcm_, ch_.sensor);
+  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  Publisher<service_status_t> status(*lcm_, ch_.status);
+  std::int64_t k = 0;
+  int ticks = 0;
+  auto play_rig = [&] {  // ~20 ticks every 2 ms: about 10 kHz; error exactly 20 nm
+    for (int i = 0; i < 20; ++i, ++k) {
+      const double ref = 1e-6 * std::sin(0.001 * static_cast<double>(k));
+      actuator_command_t c{};
+      c.utime = now_us();
+      c.seq = k;
+      c.sample_seq = k - 1;
+      c.y_ref_m = ref;
+      c.params_version = 3;
+      commands.publish(c);
+      sensor_sample_t s{};
+      s.utime = now_us();
+      s.seq = k;
+      s.y_m = ref + 20e-9;
+      samples.publish(s);
+    }
+    if (++ticks % 100 == 0) status.publish(status_of("bridge", service_status_t::HEALTHY, 7));
+  };
+  const Result r = run_ctl(with_url({"watch", "--seconds", "2.5"}), lcm_.get(), play_rig);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> lines;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 2u) << r.out;
+  const std::string& last = lines.back();
+  EXPECT_NE(last.find("rms    20.0 nm"), std::string::npos) << last;
+  EXPECT_NE(last.find("max    20.0 nm"), std::string::npos) << last;
+  EXPECT_NE(last.find("params v3"), std::string::npos) << last;
+  EXPECT_NE(last.find("late 7"), std::string::npos) << last;
+  EXPECT_NE(last.find("lat p99 95 us"), std::string::npos) << last;
+}
+
+// No LCM needed below: arguments are checked before the tool opens a connection.
+TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string must_say;
+  };
+  const std::vector<Case> cases{
+      {{"params", "--c1", "-1", "--c2", "0", "--c3", "1"}, "c1: must be > 0 (got -1)"},
+      {{"params", "--c1", "1e-7", "--c2", "-1e-9", "--c3", "1"}, "c2:"},
+      {{"params", "--c1", "1e-7", "--c2", "0", "--c3", "0"}, "c3:"},
+      {{"params", "--c1", "1e-7", "--c2", "0"}, "--c3"},
+      {{"params", "--c1", "abc", "--c2", "0", "--c3", "1"}, "--c1"},
+      {{"mode", "fast"}, "mode: must be one of off|linear|mem|pi|katalenic"},
+      {{"gains", "--kp", "-0.1"}, "kp:"},
+      {{"experiment", "--amplitude", "0", "--frequency", "1", "--duration", "1"}, "amplitude:"},
+      {{"experiment", "--amplitude", "1", "--frequency", "1"}, "--duration"},
+      {{"trajectory", "--shape", "square"}, "shape:"},
+      {{"trajectory", "--shape", "sine", "--frequency", "0"}, "frequency:"},
+      {{"trajectory", "--shape", "sine", "--blend", "-1"}, "blend:"},
+      {{"trajectory", "--shape", "points"}, "points-csv:"},
+      {{"trajectory"}, "shape:"},
+      {{"status", "--wait-healthy", "bridge", "--timeout", "0"}, "timeout:"},
+      {{"watch", "--seconds", "-1"}, "seconds:"},
+      {{"frobnicate"}, "subcommand"},
+      {{}, "subcommand"},
+      {{"--lcm-url", "udpm://239.255.76.67:7667?ttl=1", "arm"}, "lcm.url"},
+  };
+  for (const auto& c : cases) {
+    const Result r = run_ctl(c.args);
+    std::string joined;
+    for (const auto& a : c.args) joined += a + " ";
+    EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.must_say), std::string::npos) << joined << "\nstderr: " << r.err;
+  }
+}
+
+TEST(CtlArguments, HelpEverywhere) {
+  const std::vector<std::pair<std::string, std::string>> subcommands{
+      {"status", "--wait-healthy"}, {"arm", "--target"},         {"disarm", "--target"},
+      {"shutdown", "process"},      {"reset-counters", "process"}, {"mode", "katalenic"},
+      {"gains", "--kd"},            {"experiment", "--duration"}, {"stop-experiment", "--target"},
+      {"trajectory", "--mem-paper"}, {"params", "--c3"},          {"watch", "--seconds"}};
+  Result r = run_ctl({"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const auto& [name, option] : subcommands) {
+    EXPECT_NE(r.out.find(name), std::string::npos) << name;
+    const Result sub = run_ctl({name, "--help"});
+    EXPECT_EQ(sub.exit_code, 0) << name << ": " << sub.err;
+    EXPECT_NE(sub.out.find(option), std::string::npos) << name << ":\n" << sub.out;
+  }
+}
