@@ -1,0 +1,163 @@
+// LoggerService in one process over LCM's in-process memq provider: the receive path
+// allocates nothing, the log and the summary hold what was sent, a SHUTDOWN stops it.
+#include "logger/logger_service.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/process.hpp"
+#include "lcm/connection.hpp"
+#include "support/allocation_counter.hpp"
+
+namespace hystloop {
+namespace {
+
+namespace fs = std::filesystem;
+
+template <class T>
+void publish(lcm::LCM& lcm, const std::string& channel, const T& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class LoggerServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    clear_stop_request();
+    dir_ = fs::temp_directory_path() / ("logger_service_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    options_.out_dir = dir_;
+    options_.queue_mb = 1.0;
+    lcm_ = open_lcm("memq://");
+  }
+  void TearDown() override {
+    clear_stop_request();
+    fs::remove_all(dir_);
+  }
+  void dispatch_all() {
+    while (handle_pending(*lcm_, std::chrono::microseconds(0)) > 0) {
+    }
+  }
+
+  fs::path dir_;
+  LoggerOptions options_;
+  ChannelNames names_{"HX_"};
+  std::unique_ptr<lcm::LCM> lcm_;
+};
+
+TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocating) {
+  LoggerService service(*lcm_, names_, options_);
+  sensor_sample_t sample{};
+  actuator_command_t command{};
+  int sent_samples = 0;
+  std::size_t allocations = 0;
+  for (std::int64_t k = 0; k < 400; ++k) {
+    sample.seq = k;
+    sample.utime = 1000 + k;
+    command.seq = k + 2;
+    command.sample_seq = k;
+    if (k < 150 || k >= 153) {
+      publish(*lcm_, names_.sensor, sample);
+      ++sent_samples;
+    }
+    publish(*lcm_, names_.command, command);
+    if (k % 100 == 0) publish(*lcm_, names_.prefix + "OTHER_THING", command);  // any channel, any type
+    const hystloop::testing::AllocationCounter counter;
+    dispatch_all();
+    allocations += counter.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+
+  const ChannelTable& channels = service.channels();
+  ASSERT_EQ(channels.size(), 3u);
+  EXPECT_EQ(channels[0].received, static_cast<std::uint64_t>(sent_samples));
+  EXPECT_EQ(channels[0].sequence.missing(), 3u);
+  EXPECT_EQ(channels[1].sequence.missing(), 0u);
+  EXPECT_EQ(channels[2].kind, SequenceKind::kNone);
+
+  request_stop();
+  EXPECT_EQ(service.run(), 0);
+
+  std::vector<fs::path> logs, summaries;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".lcmlog")) logs.push_back(entry.path());
+    if (name.ends_with(".summary.json")) summaries.push_back(entry.path());
+  }
+  ASSERT_EQ(logs.size(), 1u);
+  ASSERT_EQ(summaries.size(), 1u);
+  lcm::LogFile log(logs[0].string(), "r");
+  int sensor_events = 0, command_events = 0, other_events = 0;
+  std::int64_t last_seq = -1;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    if (ev->channel == names_.sensor) {
+      ASSERT_EQ(sample.decode(ev->data, 0, ev->datalen), ev->datalen);
+      EXPECT_GT(sample.seq, last_seq);
+      last_seq = sample.seq;
+      ++sensor_events;
+    }
+    command_events += ev->channel == names_.command;
+    other_events += ev->channel == "HX_OTHER_THING";
+  }
+  EXPECT_EQ(sensor_events, sent_samples);
+  EXPECT_EQ(command_events, 400);
+  EXPECT_EQ(other_events, 4);
+
+  const std::string summary = read_text(summaries[0]);
+  EXPECT_NE(summary.find("\"gaps\": [[150, 152]]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"stop_reason\": \"stop request\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"dropped\": {\"queue_full\": 0"), std::string::npos) << summary;
+}
+
+TEST_F(LoggerServiceTest, AFullQueueDropsAndCountsEveryMessage) {
+  options_.queue_mb = 0.005;  // 5000 bytes: ~60 samples
+  options_.flush_interval_s = 1.0;
+  LoggerService service(*lcm_, names_, options_);
+  sensor_sample_t sample{};
+  // Faster than any disk thread wakes (it dozes 1 ms): most of a burst is refused.
+  for (std::int64_t k = 0; k < 2000; ++k) {
+    sample.seq = k;
+    publish(*lcm_, names_.sensor, sample);
+  }
+  dispatch_all();
+  const ChannelSlot& slot = service.channels()[0];
+  EXPECT_EQ(slot.received, 2000u);
+  EXPECT_GT(slot.dropped_queue_full, 0u);
+  request_stop();
+  EXPECT_EQ(service.run(), 0);
+  EXPECT_EQ(slot.written.load() + slot.dropped(), 2000u);
+  EXPECT_EQ(slot.sequence.missing(), 0u);  // the network lost nothing: drops are the logger's own
+}
+
+TEST_F(LoggerServiceTest, ShutdownForTheLoggerStopsIt) {
+  LoggerService service(*lcm_, names_, options_);
+  control_t msg{};
+  msg.request_id = 7;
+  msg.command = control_t::SHUTDOWN;
+  msg.target = "compensator";
+  publish(*lcm_, names_.control, msg);
+  dispatch_all();
+  EXPECT_FALSE(stop_requested());
+  msg.request_id = 8;
+  msg.target = "logger";
+  publish(*lcm_, names_.control, msg);
+  dispatch_all();
+  EXPECT_TRUE(stop_requested());
+  EXPECT_EQ(service.run(), 0);
+}
+
+}  // namespace
+}  // namespace hystloop
