@@ -1,0 +1,106 @@
+#include "bridge/bridge_settings.hpp"
+
+#include <cstdint>
+#include <climits>
+
+#include <spdlog/fmt/fmt.h>
+
+#include "runtime/config_validation.hpp"
+
+namespace hystloop {
+const std::vector<std::string>& bridge_config_keys() {
+  static const std::vector<std::string> keys = {
+      "bridge.backend", "bridge.rate_hz", "bridge.noise_rms_m", "bridge.seed", "bridge.drift_fraction",
+      "bridge.drift_start_s", "bridge.drift_duration_s", "bridge.auto_arm", "bridge.degraded_late_fraction",
+      "bridge.run_seconds", "bridge.command_queue_capacity",
+      "actuator.u_min_V", "actuator.u_max_V", "actuator.slew_V_per_s", "actuator.safe_u_V",
+      "actuator.safe_ramp_V_per_s", "actuator.watchdog_s",
+      "rt.priority", "rt.lock_memory", "rt.cpu",
+      "banning.hysteresis.a", "banning.hysteresis.b", "banning.hysteresis.alpha", "banning.hysteresis.s_max",
+      "banning.stage.k", "banning.stage.c", "banning.order",
+      "ro.c1", "ro.c2", "ro.c3"};
+  return keys;
+}
+
+BridgeSettings load_bridge_settings(const Config& config) {
+  config.check_no_unknown_keys(bridge_config_keys());
+  BridgeSettings s;
+  s.backend = config.get<std::string>("bridge.backend", s.backend);
+  if (s.backend != "sim" && s.backend != "ro") config.fail("bridge.backend", "must be sim or ro (got '" + s.backend + "')");
+  s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
+  s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
+  s.degraded_late_fraction = config.get_in_range("bridge.degraded_late_fraction", s.degraded_late_fraction, 0.0, 1.0);
+  s.run_seconds = config.get_non_negative("bridge.run_seconds", s.run_seconds);
+  s.command_queue_capacity =
+      static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 1000, 1000000));
+
+  SimulatedStageConfig& st = s.stage;
+  st.noise_rms_m = config.get_in_range("bridge.noise_rms_m", st.noise_rms_m, 0.0, 1e-6);
+  st.seed = static_cast<std::uint64_t>(config.get_int_in_range("bridge.seed", 1, 0, INT64_MAX));
+  st.drift_fraction = config.get_in_range("bridge.drift_fraction", st.drift_fraction, -0.5, 1.0);
+  st.drift_start_s = config.get_non_negative("bridge.drift_start_s", st.drift_start_s);
+  st.drift_duration_s = config.get_positive("bridge.drift_duration_s", st.drift_duration_s);
+  auto& h = st.banning.hysteresis;
+  h.a = config.get_positive("banning.hysteresis.a", h.a);
+  h.b = config.get_positive("banning.hysteresis.b", h.b);
+  h.alpha = config.get_positive("banning.hysteresis.alpha", h.alpha);
+  h.s_max = config.get_positive("banning.hysteresis.s_max", h.s_max);
+  st.banning.stage.k = config.get_positive("banning.stage.k", st.banning.stage.k);
+  st.banning.stage.c = config.get_positive("banning.stage.c", st.banning.stage.c);
+  const std::string order = config.get<std::string>("banning.order", "hysteresis_then_stage");
+  if (order == "hysteresis_then_stage") {
+    st.banning.order = BanningOrder::kHysteresisThenStage;
+  } else if (order == "stage_then_hysteresis") {
+    st.banning.order = BanningOrder::kStageThenHysteresis;
+  } else {
+    config.fail("banning.order", "must be hysteresis_then_stage or stage_then_hysteresis (got '" + order + "')");
+  }
+  st.ramberg_osgood.c1 = config.get_positive("ro.c1", st.ramberg_osgood.c1);
+  st.ramberg_osgood.c2 = config.get_non_negative("ro.c2", st.ramberg_osgood.c2);
+  st.ramberg_osgood.c3 = config.get_positive("ro.c3", st.ramberg_osgood.c3);
+  validate_config_section(config, "banning.", [&] { st.banning.validate(); });
+  validate_config_section(config, "ro.", [&] { st.ramberg_osgood.validate(); });
+  validate_config_section(config, "", [&] { st.validate(); });
+
+  ActuatorLimits& a = s.limits;
+  a.u_min_V = config.get_in_range("actuator.u_min_V", a.u_min_V, -1e4, 1e4);
+  a.u_max_V = config.get_in_range("actuator.u_max_V", a.u_max_V, -1e4, 1e4);
+  a.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", a.slew_V_per_s);
+  a.safe_u_V = config.get_in_range("actuator.safe_u_V", a.safe_u_V, -1e4, 1e4);
+  a.safe_ramp_V_per_s = config.get_positive("actuator.safe_ramp_V_per_s", a.safe_ramp_V_per_s);
+  a.watchdog_s = config.get_in_range("actuator.watchdog_s", a.watchdog_s, 1e-5, 10.0);
+  validate_config_section(config, "", [&] { a.validate(); });
+  if (a.watchdog_s < 2.0 * s.dt_s()) {
+    config.fail("actuator.watchdog_s", "must be at least two ticks (" + std::to_string(2.0 * s.dt_s()) + " s)");
+  }
+
+  s.rt.priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt.priority, 0, 99));
+  s.rt.lock_memory = config.get<bool>("rt.lock_memory", s.rt.lock_memory);
+  s.rt.cpu = static_cast<int>(config.get_int_in_range("rt.cpu", s.rt.cpu, -1, 1023));
+  return s;
+}
+
+std::vector<std::string> describe(const BridgeSettings& s) {
+  const auto& st = s.stage;
+  const auto& h = st.banning.hysteresis;
+  const auto& a = s.limits;
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format(
+      "bridge: backend {}, rate {} Hz, noise {:.3g} m RMS, seed {}, drift {:+.3g} over {} s from {} s, {}{}", s.backend,
+      s.rate_hz, st.noise_rms_m, st.seed, st.drift_fraction, st.drift_duration_s, st.drift_start_s,
+      s.auto_arm ? "auto-arm" : "arm via HX_CONTROL",
+      s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
+  lines.push_back(fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s",
+                              a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_V_per_s, a.watchdog_s));
+  if (s.backend == "sim") {
+    lines.push_back(fmt::format("banning: a {} m/V, b {} m/V, alpha {} 1/V, s_max {} V, k {} 1/s^2, c {} 1/s", h.a, h.b,
+                                h.alpha, h.s_max, st.banning.stage.k, st.banning.stage.c));
+  } else {
+    lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
+                                st.ramberg_osgood.c3));
+  }
+  lines.push_back(fmt::format("rt: priority {}, lock_memory {}, cpu {}", s.rt.priority, s.rt.lock_memory, s.rt.cpu));
+  return lines;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,45 @@
+#pragma once
+// Everything hystloop-bridge is configured with, read from the YAML tree (after --set
+// overrides) and validated there: a refused value throws ConfigError naming the file and
+// the field. Keys carry SI units in their names (see deploy/config/bridge.yaml).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/config.hpp"
+#include "loop/bridge_core.hpp"
+#include "loop/simulated_stage.hpp"
+
+namespace hystloop {
+
+struct RtSettings {
+  int priority = 0;          // SCHED_FIFO priority 1..99 of the real-time thread; 0 = normal scheduling
+  bool lock_memory = false;  // mlockall at start
+  int cpu = -1;              // pin the real-time thread to this CPU; -1 = no pinning
+};
+
+struct BridgeSettings {
+  std::string backend = "sim";     // sim (Banning stage) | ro (Ramberg-Osgood)
+  double rate_hz = 10000.0;        // the loop's clock
+  SimulatedStageConfig stage{};    // noise, seed, drift and the plants' parameters
+  ActuatorLimits limits{};
+  RtSettings rt{};
+  bool auto_arm = false;           // arm as soon as commands flow (first arm only)
+  double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
+  double run_seconds = 0.0;        // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
+  int command_queue_capacity = 4096;  // LCM's queue for HX_COMMAND (>= 1000: 100 ms at 10 kHz)
+
+  double dt_s() const noexcept { return 1.0 / rate_hz; }
+};
+
+// Every key the bridge reads (for check_no_unknown_keys and the docs).
+const std::vector<std::string>& bridge_config_keys();
+
+// Reads and validates; refuses unknown keys. Throws ConfigError naming the field.
+BridgeSettings load_bridge_settings(const Config& config);
+
+// One line per section, for the start-up log.
+std::vector<std::string> describe(const BridgeSettings& settings);
+
+}  // namespace hystloop

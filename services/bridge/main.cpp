@@ -1,0 +1,77 @@
+// hystloop-bridge: the 10 kHz clock, the stage (simulated: Banning or Ramberg-Osgood), the
+// actuator limits and the watchdog. See services/bridge/README.md.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include <spdlog/spdlog.h>
+
+#include "bridge/bridge_service.hpp"
+#include "core/logging.hpp"
+#include "core/process.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/url.hpp"
+#include "runtime/service_options.hpp"
+
+int main(int argc, char** argv) {
+  using namespace hystloop;
+  CLI::App app{"hystloop-bridge: owns the loop's clock; applies HX_COMMAND to the stage and publishes HX_SENSOR "
+               "every tick. Starts in the safe state: arm it with an ARM request on HX_CONTROL (or --auto-arm)."};
+  ServiceOptions options;
+  add_service_options(app, options);
+  std::string backend, noise, drift, seconds;
+  bool auto_arm = false;
+  app.add_option("--backend", backend, "Stage backend: sim (Banning stage) or ro (Ramberg-Osgood) [bridge.backend]");
+  app.add_option("--noise-rms-m", noise, "Sensor noise RMS [m] [bridge.noise_rms_m]");
+  app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
+  app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");
+  app.add_flag("--auto-arm", auto_arm, "Arm as soon as commands flow (first arm only) [bridge.auto_arm]");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  // Flags are overrides of their config keys, so every value is validated in one place.
+  if (!backend.empty()) options.overrides.push_back("bridge.backend=" + backend);
+  if (!noise.empty()) options.overrides.push_back("bridge.noise_rms_m=" + noise);
+  if (!drift.empty()) options.overrides.push_back("bridge.drift_fraction=" + drift);
+  if (!seconds.empty()) options.overrides.push_back("bridge.run_seconds=" + seconds);
+  if (auto_arm) options.overrides.push_back("bridge.auto_arm=true");
+
+  BridgeSettings settings;
+  std::string url;
+  try {
+    init_logging("bridge", options.log_level,
+                 options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
+    settings = load_bridge_settings(load_service_config(options));
+    url = resolve_lcm_url(options.lcm_url, options.allow_network);
+    if (parse_lcm_url(url).provider == "udpm") {
+      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
+    }
+  } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
+    std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
+    return 2;
+  }
+
+  try {
+    install_stop_handlers();
+    if (settings.rt.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
+    const ChannelNames channels(options.rig_prefix);
+    auto lcm = open_lcm(url, options.allow_network);
+    spdlog::info("lcm: {}", url);
+    BridgeService service(settings, *lcm, channels);
+    const int rc = service.run();
+    flush_logging();
+    return rc;
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    flush_logging();
+    return 1;
+  }
+}

@@ -1,0 +1,74 @@
+#pragma once
+// How the real-time thread hands its counters and timing histograms to the I/O thread
+// once per status period without locking or copying the histograms: two report buffers,
+// the RT thread fills one while the I/O thread reads the other.
+//
+//   I/O thread:  request();  ... later  if (const RtReport* r = take()) { use *r; release(); }
+//   RT thread:   current() every tick;  serve_request([&](RtReport& r) { fill counters });
+//
+// The RT thread flips buffers only when asked, and the I/O thread asks again only after
+// it released the buffer it took (it resets that buffer's windows), so the two never
+// touch the same buffer.
+
+#include <atomic>
+#include <cstdint>
+
+#include "core/latency_stats.hpp"
+#include "loop/bridge_core.hpp"
+
+namespace hystloop {
+
+struct RtReport {
+  // Cumulative since start (the I/O thread subtracts a baseline for RESET_COUNTERS).
+  BridgeCounters core{};
+  std::uint64_t ticks_skipped = 0;       // timer deadlines passed over (overruns)
+  std::uint64_t samples_dropped = 0;     // outgoing queue full: the I/O thread fell behind
+  std::uint64_t commands_processed = 0;  // commands taken from the incoming queue
+  std::uint64_t auto_arms = 0;
+  std::int64_t last_tick = -1;
+  std::int64_t last_trip_tick = -1;      // tick of the last watchdog trip
+  double u_applied_V = 0.0;
+  double gain_scale = 1.0;
+  bool armed = false;
+  // This report period's windows.
+  LatencyStats work;      // RT work per tick (wake to sample pushed) [ns]
+  LatencyStats lateness;  // timer wake-up lateness [ns]
+};
+
+class RtReportExchange {
+ public:
+  // I/O thread.
+  void request() noexcept {
+    if (!ready_.load(std::memory_order_acquire)) requested_.store(true, std::memory_order_release);
+  }
+  const RtReport* take() const noexcept {
+    if (!ready_.load(std::memory_order_acquire)) return nullptr;
+    return &buffers_[active_.load(std::memory_order_relaxed) ^ 1];
+  }
+  void release() noexcept {
+    RtReport& r = buffers_[active_.load(std::memory_order_relaxed) ^ 1];
+    r.work.reset();
+    r.lateness.reset();
+    ready_.store(false, std::memory_order_release);
+  }
+
+  // RT thread.
+  RtReport& current() noexcept { return buffers_[active_.load(std::memory_order_relaxed)]; }
+  template <class Fill>
+  void serve_request(Fill&& fill) noexcept {
+    if (!requested_.load(std::memory_order_acquire)) return;
+    const unsigned a = active_.load(std::memory_order_relaxed);
+    fill(buffers_[a]);
+    active_.store(a ^ 1, std::memory_order_relaxed);
+    requested_.store(false, std::memory_order_relaxed);
+    ready_.store(true, std::memory_order_release);
+  }
+
+ private:
+  RtReport buffers_[2];
+  std::atomic<unsigned> active_{0};
+  std::atomic<bool> requested_{false};
+  std::atomic<bool> ready_{false};
+};
+
+}  // namespace hystloop

@@ -1,0 +1,20 @@
+#include "bridge/stage_backend.hpp"
+
+#include "loop/bridge_core.hpp"
+
+namespace hystloop {
+
+SimulatedBackend::SimulatedBackend(std::string name, const SimulatedStageConfig& config)
+    : name_(std::move(name)), stage_(config) {}
+
+StageReading SimulatedBackend::step(double u_V, double t_s, double dt_s) noexcept {
+  return {stage_.step(u_V, t_s, dt_s), sample_flags::kSimulated};
+}
+
+std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config) {
+  config.plant = parse_plant_kind(name, "bridge.backend");  // throws for an unknown name
+  // A hardware backend is added here: `if (name == "mydaq") return std::make_unique<MyDaqBackend>(...);`
+  return std::make_unique<SimulatedBackend>(name, config);
+}
+
+}  // namespace hystloop

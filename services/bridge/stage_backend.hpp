@@ -1,0 +1,47 @@
+#pragma once
+// What the bridge drives: one small interface, so that hardware plugs in beside the
+// simulators (see services/bridge/README.md). The real-time thread calls step() once per
+// tick; it must not allocate, lock, log or block longer than a fraction of the period.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "loop/simulated_stage.hpp"
+
+namespace hystloop {
+
+struct StageReading {
+  double y_m = 0.0;         // measured position [m]
+  std::int32_t flags = 0;   // sample_flags bits the backend adds (kSimulated, a sensor fault, ...)
+};
+
+class StageBackend {
+ public:
+  virtual ~StageBackend() = default;
+  // Applies u [V] over [t, t + dt] and returns the position measured at its end.
+  virtual StageReading step(double u_V, double t_s, double dt_s) noexcept = 0;
+  // "sim", "ro", ... (logged and reported in HX_STATUS).
+  virtual const std::string& name() const noexcept = 0;
+  // Stage gain relative to its start (1 for hardware: unknown), for the status detail.
+  virtual double gain_scale() const noexcept { return 1.0; }
+};
+
+// The built-in simulator (Banning stage or Ramberg-Osgood plant) with noise and drift.
+class SimulatedBackend final : public StageBackend {
+ public:
+  SimulatedBackend(std::string name, const SimulatedStageConfig& config);
+  StageReading step(double u_V, double t_s, double dt_s) noexcept override;
+  const std::string& name() const noexcept override { return name_; }
+  double gain_scale() const noexcept override { return stage_.gain_scale(); }
+
+ private:
+  std::string name_;
+  SimulatedStage stage_;
+};
+
+// The backend `name` names: "sim" (Banning) or "ro" (Ramberg-Osgood); the plant kind in
+// `config` is set from the name. Throws ParameterError("bridge.backend") otherwise.
+std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config);
+
+}  // namespace hystloop

@@ -1,0 +1,192 @@
+#include "compensator/compensator_settings.hpp"
+
+#include <cstdio>
+
+#include <spdlog/fmt/fmt.h>
+
+#include "runtime/config_validation.hpp"
+
+namespace hystloop {
+namespace {
+
+TrajectoryShape parse_shape(const Config& config, const std::string& name) {
+  if (name == "hold") return TrajectoryShape::kHold;
+  if (name == "sine") return TrajectoryShape::kSine;
+  if (name == "cosine") return TrajectoryShape::kCosine;
+  if (name == "triangle") return TrajectoryShape::kTriangle;
+  if (name == "points") return TrajectoryShape::kPoints;
+  config.fail("trajectory.shape", "must be hold, sine, cosine, triangle or points (got '" + name + "')");
+}
+
+ShapingFunction read_shaping(const Config& config, const std::string& prefix, const ShapingFunction& fallback) {
+  if (!config.has(prefix + ".kind")) {
+    for (const char* key : {".gain", ".offset", ".coefficients", ".amplitude", ".scale"}) {
+      if (config.has(prefix + key)) config.fail(prefix + ".kind", "required when other " + prefix + " keys are given");
+    }
+    return fallback;
+  }
+  const std::string kind = config.get<std::string>(prefix + ".kind");
+  ShapingFunction s;
+  if (kind == "linear") {
+    s = ShapingFunction::make_linear(config.get<double>(prefix + ".gain"), config.get<double>(prefix + ".offset", 0.0));
+  } else if (kind == "polynomial") {
+    const auto c = config.get<std::vector<double>>(prefix + ".coefficients");
+    if (c.empty() || c.size() > ShapingFunction::kMaxCoefficients) {
+      config.fail(prefix + ".coefficients", fmt::format("needs 1..{} values", ShapingFunction::kMaxCoefficients));
+    }
+    s.kind = ShapingKind::polynomial;
+    for (std::size_t i = 0; i < c.size(); ++i) s.coefficients[i] = c[i];
+    s.domain_min = config.get<double>(prefix + ".domain_min");
+    s.domain_max = config.get<double>(prefix + ".domain_max");
+  } else if (kind == "tanh") {
+    s = ShapingFunction::make_tanh(config.get<double>(prefix + ".amplitude"), config.get<double>(prefix + ".scale"),
+                                   config.get<double>(prefix + ".offset", 0.0));
+  } else {
+    config.fail(prefix + ".kind", "must be linear, polynomial or tanh (got '" + kind + "')");
+  }
+  validate_config_section(config, "", [&] { s.validate(prefix); });
+  return s;
+}
+
+}  // namespace
+
+const std::vector<std::string>& compensator_config_keys() {
+  static const std::vector<std::string> keys = {
+      "compensator.mode", "compensator.lead_ticks", "compensator.dt_s", "compensator.run_seconds",
+      "compensator.sample_queue_capacity",
+      "mem.c1", "mem.c2", "mem.c3",
+      "pi.count", "pi.thresholds", "pi.weights", "pi.range_V",
+      "linear.gain", "linear.offset",
+      "katalenic.k1", "katalenic.k2", "katalenic.k2_slope", "katalenic.k2_domain_min", "katalenic.k2_domain_max",
+      "katalenic.initial_offset", "katalenic.input_shaping.*", "katalenic.output_shaping.*",
+      "feedback.kp", "feedback.ki", "feedback.kd", "feedback.nominal_gain_m_per_V", "feedback.u_limit_V",
+      "feedback.d_filter_hz",
+      "trajectory.shape", "trajectory.amplitude_m", "trajectory.offset_m", "trajectory.frequency_hz",
+      "trajectory.phase_rad", "trajectory.blend_s", "trajectory.points_t_s", "trajectory.points_y_m"};
+  return keys;
+}
+
+CompensatorSettings load_compensator_settings(const Config& config) {
+  config.check_no_unknown_keys(compensator_config_keys());
+  CompensatorSettings s;
+  CompensatorConfig& c = s.control;
+  const std::string mode = config.get<std::string>("compensator.mode", "mem");
+  validate_config_section(config, "", [&] { c.mode = parse_feedforward_mode(mode, "compensator.mode"); });
+  c.lead_ticks = config.get_int_in_range("compensator.lead_ticks", c.lead_ticks, 1, 32);
+  c.dt_s = config.get_in_range("compensator.dt_s", c.dt_s, 1e-6, 1.0);
+  s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
+  s.sample_queue_capacity =
+      static_cast<int>(config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 1000, 1000000));
+
+  c.mem.c1 = config.get_positive("mem.c1", c.mem.c1);
+  c.mem.c2 = config.get_non_negative("mem.c2", c.mem.c2);
+  c.mem.c3 = config.get_positive("mem.c3", c.mem.c3);
+  validate_config_section(config, "mem.", [&] { c.mem.validate(); });
+
+  // PI: explicit plays (as identified), or the MEM-matched baseline over +-pi.range_V.
+  if (config.has("pi.thresholds") || config.has("pi.weights")) {
+    const auto r = config.get<std::vector<double>>("pi.thresholds");
+    const auto w = config.get<std::vector<double>>("pi.weights");
+    if (r.empty() || r.size() > kPiMaxOperators) config.fail("pi.thresholds", fmt::format("needs 1..{} values", kPiMaxOperators));
+    if (w.size() != r.size()) config.fail("pi.weights", fmt::format("needs as many values as pi.thresholds ({})", r.size()));
+    const auto count = config.get_int_in_range("pi.count", static_cast<std::int64_t>(r.size()), 1,
+                                               static_cast<std::int64_t>(kPiMaxOperators));
+    if (static_cast<std::size_t>(count) != r.size()) config.fail("pi.count", "must equal the number of pi.thresholds");
+    c.pi = PiParams{};
+    c.pi.count = r.size();
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      c.pi.thresholds[i] = r[i];
+      c.pi.weights[i] = w[i];
+    }
+  } else {
+    const auto count = config.get_int_in_range("pi.count", 15, 1, static_cast<std::int64_t>(kPiMaxOperators));
+    const double range = config.get_positive("pi.range_V", 250.0);
+    validate_config_section(config, "pi.", [&] { c.pi = pi_params_from_mem(c.mem, static_cast<std::size_t>(count), range); });
+  }
+  validate_config_section(config, "pi.", [&] { c.pi.validate(); });
+
+  c.linear.gain = config.get<double>("linear.gain", c.linear.gain);
+  c.linear.offset = config.get<double>("linear.offset", c.linear.offset);
+  validate_config_section(config, "linear.", [&] { c.linear.validate(); });
+
+  KatalenicParams& k = c.katalenic;
+  k.k1 = config.get_positive("katalenic.k1", k.k1);
+  k.k2 = config.get_positive("katalenic.k2", k.k2);
+  k.k2_slope = config.get<double>("katalenic.k2_slope", k.k2_slope);
+  k.k2_domain_min = config.get<double>("katalenic.k2_domain_min", k.k2_domain_min);
+  k.k2_domain_max = config.get<double>("katalenic.k2_domain_max", k.k2_domain_max);
+  k.initial_offset = config.get<double>("katalenic.initial_offset", k.initial_offset);
+  k.input_shaping = read_shaping(config, "katalenic.input_shaping", k.input_shaping);
+  k.output_shaping = read_shaping(config, "katalenic.output_shaping", k.output_shaping);
+  validate_config_section(config, "katalenic.", [&] { k.validate(); });
+
+  FeedbackGains& g = c.feedback;
+  g.kp = config.get_non_negative("feedback.kp", g.kp);
+  g.ki = config.get_non_negative("feedback.ki", g.ki);
+  g.kd = config.get_non_negative("feedback.kd", g.kd);
+  g.nominal_gain_m_per_V = config.get_positive("feedback.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
+  g.u_limit_V = config.get_positive("feedback.u_limit_V", g.u_limit_V);
+  g.d_filter_hz = config.get_positive("feedback.d_filter_hz", g.d_filter_hz);
+  validate_config_section(config, "", [&] { g.validate(); });
+  validate_config_section(config, "", [&] { c.validate(); });
+
+  TrajectorySpec& t = s.trajectory;
+  t.shape = parse_shape(config, config.get<std::string>("trajectory.shape", "hold"));
+  t.amplitude_m = config.get_in_range("trajectory.amplitude_m", 0.0, -1e-3, 1e-3);
+  t.offset_m = config.get_in_range("trajectory.offset_m", 0.0, -1e-3, 1e-3);
+  t.frequency_hz = config.get_in_range("trajectory.frequency_hz", 1.0, 1e-6, 1e4);
+  t.phase_rad = config.get<double>("trajectory.phase_rad", 0.0);
+  t.blend_s = config.get_in_range("trajectory.blend_s", 0.5, 0.0, 3600.0);
+  const auto pt = config.get<std::vector<double>>("trajectory.points_t_s", {});
+  const auto py = config.get<std::vector<double>>("trajectory.points_y_m", {});
+  if (pt.size() != py.size()) config.fail("trajectory.points_y_m", "needs as many values as trajectory.points_t_s");
+  if (pt.size() > TrajectorySpec::kMaxPoints) config.fail("trajectory.points_t_s", "too many points");
+  t.n_points = pt.size();
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    t.points_t_s[i] = pt[i];
+    t.points_y_m[i] = py[i];
+  }
+  validate_config_section(config, "", [&] { t.validate(); });
+  return s;
+}
+
+void merge_params_file(Config& config, const std::filesystem::path& snippet) {
+  const Config params = Config::load_file(snippet);
+  for (const std::string& key : params.keys()) {
+    std::string value;
+    try {
+      value = params.get<std::string>(key);
+    } catch (const ConfigError&) {  // a list: thresholds, weights, coefficients
+      const auto list = params.get<std::vector<double>>(key);
+      value.assign(1, '[');
+      for (std::size_t i = 0; i < list.size(); ++i) value += fmt::format("{}{:.17g}", i ? ", " : "", list[i]);
+      value.push_back(']');
+    }
+    std::string assignment = key;  // (appended, not key + "=" + value: GCC 12 warns falsely on that)
+    assignment.append(1, '=').append(value);
+    config.apply_override(assignment);
+  }
+}
+
+std::vector<std::string> describe(const CompensatorSettings& s) {
+  const CompensatorConfig& c = s.control;
+  const TrajectorySpec& t = s.trajectory;
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format("compensator: mode {}, lead {} ticks, dt {} s{}", to_string(c.mode), c.lead_ticks, c.dt_s,
+                              s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
+  lines.push_back(fmt::format("mem: c1 {:.6g} m/V, c2 {:.6g} m/V^(1+c3), c3 {:.6g}", c.mem.c1, c.mem.c2, c.mem.c3));
+  lines.push_back(fmt::format("pi: {} plays up to {:.4g} V", c.pi.count, c.pi.count ? c.pi.thresholds[c.pi.count - 1] : 0.0));
+  lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
+  lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
+                              c.katalenic.k2_slope));
+  lines.push_back(fmt::format("feedback: kp {}, ki {} 1/s, kd {} s, nominal gain {:.4g} m/V, limit {} V{}", c.feedback.kp,
+                              c.feedback.ki, c.feedback.kd, c.feedback.nominal_gain_m_per_V, c.feedback.u_limit_V,
+                              c.feedback.enabled() ? "" : " (off)"));
+  static const char* shapes[] = {"hold", "sine", "cosine", "triangle", "points"};
+  lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
+                              shapes[static_cast<int>(t.shape)], t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s,
+                              t.n_points));
+  return lines;
+}
+
+}  // namespace hystloop

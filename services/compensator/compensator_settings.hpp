@@ -1,0 +1,37 @@
+#pragma once
+// Everything hystloop-compensator is configured with, read from the YAML tree (after --set
+// overrides and --params snippets) and validated there: a refused value throws ConfigError
+// naming the file and the field. Model sections use the parameter names, the same keys
+// `hystloop-identify --out` writes (mem: {c1, c2, c3}, pi: {count, thresholds, weights},
+// linear: {gain, offset}, katalenic: {k1, k2, ..., input_shaping: {...}}).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/config.hpp"
+#include "loop/compensator.hpp"
+#include "loop/trajectory.hpp"
+
+namespace hystloop {
+
+struct CompensatorSettings {
+  CompensatorConfig control{};   // mode, models, feedback gains, lead, dt
+  TrajectorySpec trajectory{};   // the initial reference (default: hold at 0), started with the first sample
+  double run_seconds = 0.0;      // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
+  int sample_queue_capacity = 4096;  // LCM's queue for HX_SENSOR (>= 1000)
+};
+
+const std::vector<std::string>& compensator_config_keys();
+
+// Reads and validates; refuses unknown keys. Throws ConfigError naming the field.
+CompensatorSettings load_compensator_settings(const Config& config);
+
+// Merges a parameter snippet (as hystloop-identify --out writes it) over `config`, key by key.
+// Throws ConfigError naming the snippet file when it cannot be read.
+void merge_params_file(Config& config, const std::filesystem::path& snippet);
+
+// One line per section, for the start-up log.
+std::vector<std::string> describe(const CompensatorSettings& settings);
+
+}  // namespace hystloop

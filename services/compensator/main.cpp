@@ -1,0 +1,74 @@
+// hystloop-compensator: answers every HX_SENSOR sample with the HX_COMMAND for a later tick,
+// feedforward through the selected model's inverse plus optional feedback.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include <spdlog/spdlog.h>
+
+#include "compensator/compensator_service.hpp"
+#include "core/logging.hpp"
+#include "core/process.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/url.hpp"
+#include "runtime/service_options.hpp"
+
+int main(int argc, char** argv) {
+  using namespace hystloop;
+  CLI::App app{"hystloop-compensator: turns the reference (HX_TRAJECTORY) into the voltage (HX_COMMAND) that makes "
+               "the stage follow it, through the inverse of the selected hysteresis model plus optional PID feedback; "
+               "swaps in new MEM parameters (HX_PARAMS) at reversals; mode and gains change through HX_CONTROL."};
+  ServiceOptions options;
+  add_service_options(app, options);
+  std::vector<std::filesystem::path> params_files;
+  std::string mode, seconds;
+  app.add_option("--params", params_files,
+                 "Model parameters as `hystloop-identify --out` writes them (merged over the config; repeatable)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--mode", mode, "Feedforward: mem, pi, katalenic, linear or off [compensator.mode]");
+  app.add_option("--seconds", seconds, "Stop after this many seconds [compensator.run_seconds]");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  if (!mode.empty()) options.overrides.push_back("compensator.mode=" + mode);
+  if (!seconds.empty()) options.overrides.push_back("compensator.run_seconds=" + seconds);
+
+  CompensatorSettings settings;
+  std::string url;
+  try {
+    init_logging("compensator", options.log_level,
+                 options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
+    Config config = load_service_config(options);
+    for (const auto& file : params_files) merge_params_file(config, file);
+    settings = load_compensator_settings(config);
+    url = resolve_lcm_url(options.lcm_url, options.allow_network);
+    if (parse_lcm_url(url).provider == "udpm") {
+      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
+    }
+  } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
+    std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
+    return 2;
+  }
+
+  try {
+    install_stop_handlers();
+    const ChannelNames channels(options.rig_prefix);
+    auto lcm = open_lcm(url, options.allow_network);
+    spdlog::info("lcm: {}", url);
+    CompensatorService service(settings, *lcm, channels);
+    const int rc = service.run();
+    flush_logging();
+    return rc;
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    flush_logging();
+    return 1;
+  }
+}

@@ -1,0 +1,41 @@
+#include "compensator/trajectory_message.hpp"
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+
+TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
+  TrajectorySpec spec;
+  switch (msg.shape) {
+    case trajectory_t::HOLD: spec.shape = TrajectoryShape::kHold; break;
+    case trajectory_t::SINE: spec.shape = TrajectoryShape::kSine; break;
+    case trajectory_t::COSINE: spec.shape = TrajectoryShape::kCosine; break;
+    case trajectory_t::TRIANGLE: spec.shape = TrajectoryShape::kTriangle; break;
+    case trajectory_t::POINTS: spec.shape = TrajectoryShape::kPoints; break;
+    default: throw ParameterError("trajectory.shape", "unknown shape " + std::to_string(msg.shape));
+  }
+  spec.amplitude_m = msg.amplitude_m;
+  spec.offset_m = msg.offset_m;
+  spec.frequency_hz = msg.frequency_Hz > 0.0 ? msg.frequency_Hz : 1.0;  // ignored for HOLD and POINTS
+  spec.phase_rad = msg.phase_rad;
+  spec.blend_s = msg.blend_s;
+  if (msg.n_points < 0 || static_cast<std::size_t>(msg.n_points) > TrajectorySpec::kMaxPoints ||
+      msg.points_t_s.size() != static_cast<std::size_t>(msg.n_points) ||
+      msg.points_y_m.size() != static_cast<std::size_t>(msg.n_points)) {
+    throw ParameterError("trajectory.n_points", "must be 0.." + std::to_string(TrajectorySpec::kMaxPoints) +
+                                                    " and match the point arrays");
+  }
+  spec.n_points = static_cast<std::size_t>(msg.n_points);
+  for (std::size_t i = 0; i < spec.n_points; ++i) {
+    spec.points_t_s[i] = msg.points_t_s[i];
+    spec.points_y_m[i] = msg.points_y_m[i];
+  }
+  spec.validate();
+  return spec;
+}
+
+double loop_time_of_utime(std::int64_t utime, std::int64_t sample_utime, std::int64_t sample_seq, double dt_s) noexcept {
+  return static_cast<double>(sample_seq) * dt_s + static_cast<double>(utime - sample_utime) * 1e-6;
+}
+
+}  // namespace hystloop
