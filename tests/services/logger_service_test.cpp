@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -100,7 +101,7 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
   ASSERT_EQ(logs.size(), 1u);
   ASSERT_EQ(summaries.size(), 1u);
   lcm::LogFile log(logs[0].string(), "r");
-  int sensor_events = 0, command_events = 0, other_events = 0;
+  int sensor_events = 0, command_events = 0, other_events = 0, status_events = 0;
   std::int64_t last_seq = -1;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (ev->channel == names_.sensor) {
@@ -109,12 +110,28 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
       last_seq = sample.seq;
       ++sensor_events;
     }
+    if (ev->channel == names_.status) {  // the logger's own first report, recorded too
+      service_status_t status;
+      ASSERT_EQ(status.decode(ev->data, 0, ev->datalen), ev->datalen);
+      EXPECT_EQ(status.process, "logger");
+      EXPECT_EQ(status.state, service_status_t::DEGRADED);
+      EXPECT_NE(status.detail.find("1 gap(s), 3 missing on HX_SENSOR"), std::string::npos) << status.detail;
+      std::map<std::string, std::int64_t> counters;
+      for (int i = 0; i < status.n_counters; ++i) counters[status.counter_names[i]] = status.counter_values[i];
+      EXPECT_EQ(counters["HX_SENSOR.received"], sent_samples);
+      EXPECT_EQ(counters["HX_SENSOR.missing"], 3);
+      EXPECT_EQ(counters["HX_SENSOR.gaps"], 1);
+      EXPECT_EQ(counters["HX_COMMAND.dropped"], 0);
+      EXPECT_EQ(counters["files"], 1);
+      ++status_events;
+    }
     command_events += ev->channel == names_.command;
     other_events += ev->channel == "HX_OTHER_THING";
   }
   EXPECT_EQ(sensor_events, sent_samples);
   EXPECT_EQ(command_events, 400);
   EXPECT_EQ(other_events, 4);
+  EXPECT_EQ(status_events, 1);
 
   const std::string summary = read_text(summaries[0]);
   EXPECT_NE(summary.find("\"gaps\": [[150, 152]]"), std::string::npos) << summary;
