@@ -1,0 +1,107 @@
+// hystloop-reidentifier: refits the MEM hysteresis parameters from <rig>SENSOR on a schedule,
+// off the receive thread, and publishes on <rig>PARAMS only candidates that pass every gate
+// (fit succeeded and in range, residual bound, better on held-out branches than the set in
+// use). See reident_service.hpp and reident_options.hpp; `--help` lists the options.
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <optional>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "core/config.hpp"
+#include "core/errors.hpp"
+#include "core/logging.hpp"
+#include "core/process.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/url.hpp"
+#include "reidentifier/reident_options.hpp"
+#include "reidentifier/reident_service.hpp"
+#include "runtime/service_options.hpp"
+
+namespace {
+constexpr int kExitBadConfiguration = 2;
+}
+
+int main(int argc, char** argv) {
+  using namespace hystloop;
+  CLI::App app{
+      "hystloop-reidentifier: feeds <rig>SENSOR to the online MEM estimator, refits every\n"
+      "reident.refit_period_s on a worker thread, and publishes on <rig>PARAMS only candidates that pass\n"
+      "validation (signs, ranges, residual, a held-out branch better than the set in use), with their\n"
+      "held-out residual. The initial set in use is mem.c1/c2/c3 (the compensator's keys, version 1);\n"
+      "a newer valid set published by anyone else on <rig>PARAMS replaces it. Status on <rig>STATUS\n"
+      "(process \"reident\") at 1 Hz. Configuration keys: mem.{c1,c2,c3}, reident.{rate_hz, refit_period_s,\n"
+      "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
+      "max_solver_time_s, publish_invalid, stale_after_s, degraded_after_poisoned, lcm_queue}\n"
+      "(see deploy/config/reidentifier.yaml). Exit codes: 0 clean stop, 1 runtime error, 2 bad configuration."};
+  ServiceOptions service;
+  bool publish_invalid = false;
+  add_service_options(app, service);
+  app.add_flag("--publish-invalid", publish_invalid,
+               "Also publish refused candidates, with valid = false, for diagnosis (= --set reident.publish_invalid=true)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hystloop-reidentifier: %s\n", e.what());
+    return kExitBadConfiguration;
+  }
+
+  ReidentOptions options;
+  std::string url;
+  std::unique_ptr<ChannelNames> names;
+  try {
+    init_logging(ReidentService::kProcessName, service.log_level,
+                 service.log_file.empty() ? std::nullopt : std::optional(service.log_file));
+    Config config = load_service_config(service);
+    if (publish_invalid) config.apply_override("reident.publish_invalid=true");
+    options = read_reident_options(config);
+    names = std::make_unique<ChannelNames>(service.rig_prefix);
+    url = resolve_lcm_url(service.lcm_url, service.allow_network);
+    if (parse_lcm_url(url).provider == "udpm") {
+      // The kernel's default socket buffer loses samples at 10 kHz when we are descheduled.
+      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
+    }
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "hystloop-reidentifier: %s\n", e.what());
+    return kExitBadConfiguration;
+  }
+
+  try {
+    install_stop_handlers();
+    const OnlineMemOptions& e = options.estimator;
+    spdlog::info("lcm: url {}, rig {}", url, names->prefix);
+    spdlog::info("mem: c1 {:.9g} m/V, c2 {:.9g} m/V^(1+c3), c3 {:.9g} (initial set in use, version 1)",
+                 options.initial.c1, options.initial.c2, options.initial.c3);
+    spdlog::info(
+        "reident: rate_hz {}, refit_period_s {}, window_s {} ({} samples), capacity_s {} ({} samples), "
+        "holdout_branches {}, min_relative_improvement {}, max_residual_rms_m {:.3g}, max_solver_time_s {}, "
+        "publish_invalid {}, stale_after_s {}, degraded_after_poisoned {}, lcm_queue {}",
+        options.rate_hz, options.refit_period_s, options.window_s, e.window_samples, options.capacity_s,
+        e.capacity_samples, e.holdout_branches, e.min_relative_improvement, e.max_residual_rms_m,
+        e.fit.max_solver_time_s, options.publish_invalid, options.stale_after_s, options.degraded_after_poisoned,
+        options.lcm_queue);
+    auto lcm = open_lcm(url, service.allow_network);
+    int rc = 0;
+    {
+      ReidentService reident(*lcm, *names, options);
+      rc = reident.run();
+    }  // joins the refit worker before the log is flushed
+    flush_logging();
+    return rc;
+  } catch (const ParameterError& e) {
+    spdlog::error("{}", e.what());
+    flush_logging();
+    return kExitBadConfiguration;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    flush_logging();
+    return 1;
+  }
+}

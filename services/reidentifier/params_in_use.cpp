@@ -1,0 +1,57 @@
+#include "reidentifier/params_in_use.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hystloop {
+
+std::string_view to_string(ParamsOffer offer) noexcept {
+  switch (offer) {
+    case ParamsOffer::adopted: return "adopted";
+    case ParamsOffer::echo: return "echo";
+    case ParamsOffer::stale: return "stale";
+    case ParamsOffer::invalid: return "invalid";
+  }
+  return "unknown";
+}
+
+ParamsInUse::ParamsInUse(const MemParams& initial, std::string own_source)
+    : params_(initial), own_source_(std::move(own_source)) {
+  params_.validate();
+}
+
+namespace {
+bool in_domain(const MemParams& p) noexcept {
+  return std::isfinite(p.c1) && std::isfinite(p.c2) && std::isfinite(p.c3) && p.c1 > 0.0 && p.c2 >= 0.0 && p.c3 > 0.0;
+}
+}  // namespace
+
+ParamsOffer ParamsInUse::offer(const MemParams& params, std::int32_t version, bool valid,
+                               std::string_view source) noexcept {
+  if (source == own_source_ && version <= own_published_) return ParamsOffer::echo;
+  highest_seen_ = std::max(highest_seen_, version);
+  if (!valid || !in_domain(params)) return ParamsOffer::invalid;
+  if (version <= version_) return ParamsOffer::stale;
+  params_ = params;
+  version_ = version;
+  source_.assign(source.begin(), source.end());  // off the per-sample path (HX_PARAMS is rare)
+  return ParamsOffer::adopted;
+}
+
+std::int32_t ParamsInUse::claim_version() noexcept {
+  const std::int32_t top = std::max(highest_seen_, version_);
+  const std::int32_t next = top < std::numeric_limits<std::int32_t>::max() ? top + 1 : top;
+  highest_seen_ = next;
+  own_published_ = next;
+  return next;
+}
+
+std::int32_t ParamsInUse::adopt_own(const MemParams& params) noexcept {
+  params_ = params;
+  version_ = claim_version();
+  source_ = own_source_;
+  return version_;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,144 @@
+#include "reidentifier/reident_core.hpp"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "hystloop/sensor_sample_t.hpp"
+
+namespace hystloop {
+
+ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread,
+                         RefitWorker::OnEvaluated on_evaluated)
+    : options_(options),
+      estimator_(options.estimator, options.initial),
+      in_use_(options.initial, std::move(own_source)),
+      worker_(options.estimator, estimator_.make_window(), start_thread, std::move(on_evaluated)),
+      period_us_(std::llround(options.refit_period_s * 1e6)),
+      stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
+
+void ReidentCore::on_sample(std::int64_t seq, double u_V, double y_m, std::int32_t flags,
+                            std::int64_t now_us) noexcept {
+  last_sample_us_ = now_us;
+  if (last_seq_ >= 0) {
+    // Samples refused on the wire since the last one were not lost: they are no gap.
+    const std::int64_t missing = seq - last_seq_ - 1 - refused_since_last_;
+    if (seq > last_seq_ + 1 && missing > 0) {
+      counters_.add(ReidentCounter::seq_gaps);
+      counters_.add(ReidentCounter::samples_missed, static_cast<std::uint64_t>(missing));
+    } else if (seq <= last_seq_) {
+      counters_.add(ReidentCounter::seq_restarts);
+    }
+  }
+  last_seq_ = seq;
+  refused_since_last_ = 0;
+  if ((flags & sensor_sample_t::SAFE_STATE) != 0) {
+    counters_.add(ReidentCounter::skipped_safe_state);
+    return;
+  }
+  if ((flags & sensor_sample_t::SENSOR_FAULT) != 0) {
+    counters_.add(ReidentCounter::skipped_sensor_fault);
+    return;
+  }
+  estimator_.feed(u_V, y_m);
+}
+
+void ReidentCore::on_refused_sample(std::int64_t now_us) noexcept {
+  // The wire check refused a NaN/Inf or absurd value: mark the window as holding one, so no
+  // refit straddles it (the estimator counts it as non-finite).
+  last_sample_us_ = now_us;
+  ++refused_since_last_;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  estimator_.feed(kNaN, kNaN);
+}
+
+ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, bool valid,
+                                   std::string_view source) noexcept {
+  const ParamsOffer offer = in_use_.offer(params, version, valid, source);
+  switch (offer) {
+    case ParamsOffer::adopted: counters_.add(ReidentCounter::params_adopted); break;
+    case ParamsOffer::echo: counters_.add(ReidentCounter::params_echo); break;
+    case ParamsOffer::stale: counters_.add(ReidentCounter::params_stale); break;
+    case ParamsOffer::invalid: counters_.add(ReidentCounter::params_invalid); break;
+  }
+  return offer;
+}
+
+RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
+  RefitDecision d;
+  if (worker_.done()) {
+    d = decide(worker_.result());
+    worker_.release();
+  }
+  const std::uint64_t fed = estimator_.samples_fed();
+  if (worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
+      fed != fed_at_last_snapshot_) {
+    estimator_.snapshot(worker_.job_window());  // no allocation: the worker's window is preallocated
+    worker_.submit(in_use_.params(), static_cast<std::uint64_t>(in_use_.version()));
+    counters_.add(ReidentCounter::refits_attempted);
+    fed_at_last_snapshot_ = fed;
+    next_refit_us_ = now_us + period_us_;
+  }
+  return d;
+}
+
+RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
+  const MemRefitOutcome& o = r.outcome;
+  RefitDecision d;
+  d.status = o.status;
+  d.fitted = o.fit.samples_used > 0;
+  d.candidate = o.candidate;
+  d.holdout_rms_candidate_m = o.holdout_rms_candidate_m;
+  d.holdout_rms_in_use_m = o.holdout_rms_in_use_m;
+  d.fit_residual_rms_m = o.fit.residual_rms_m;
+  d.samples_used = o.fit.samples_used;
+  d.window_samples = r.window_samples;
+  d.duration_s = r.duration_s;
+  last_refit_s_ = r.duration_s;
+  refit_time_.add(std::llround(r.duration_s * 1e9));
+  poisoned_streak_ = o.status == FitStatus::poisoned_window ? poisoned_streak_ + 1 : 0;
+
+  if (!o.accepted) {
+    // An "accepted" outcome always has status ok; anything else is a refusal with its reason.
+    counters_.add_rejected(o.status == FitStatus::ok ? FitStatus::solver_failure : o.status);
+    d.kind = RefitDecision::Kind::refused;
+    return d;
+  }
+  if (o.judged_against_version != static_cast<std::uint64_t>(in_use_.version())) {
+    counters_.add(ReidentCounter::refits_superseded);
+    d.kind = RefitDecision::Kind::superseded;
+    return d;
+  }
+  d.version = in_use_.adopt_own(o.candidate);
+  counters_.add(ReidentCounter::refits_accepted);
+  d.kind = RefitDecision::Kind::accepted;
+  return d;
+}
+
+bool ReidentCore::stale(std::int64_t now_us) const noexcept {
+  return last_sample_us_ < 0 || now_us - last_sample_us_ > stale_after_us_;
+}
+
+bool ReidentCore::poisoned() const noexcept {
+  return poisoned_streak_ >= options_.degraded_after_poisoned;
+}
+
+double ReidentCore::seconds_since_sample(std::int64_t now_us) const noexcept {
+  return last_sample_us_ < 0 ? std::numeric_limits<double>::infinity()
+                             : static_cast<double>(now_us - last_sample_us_) * 1e-6;
+}
+
+const ReidentCounters& ReidentCore::counters() noexcept {
+  counters_.set(ReidentCounter::samples_fed, estimator_.samples_fed());
+  counters_.set(ReidentCounter::non_finite, estimator_.non_finite_samples());
+  counters_.set(ReidentCounter::dropouts, estimator_.dropouts());
+  return counters_;
+}
+
+void ReidentCore::reset_counters() noexcept {
+  counters();
+  counters_.reset();
+  refit_time_.reset();
+}
+
+}  // namespace hystloop

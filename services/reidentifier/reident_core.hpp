@@ -1,0 +1,96 @@
+#pragma once
+// The re-identifier without LCM and without a clock: samples in, refit decisions out.
+// It owns the OnlineMemEstimator (fed on the calling thread, the "I/O thread"), the refit
+// worker, the set in use and the counters. Time is an argument (now_us, any monotonic
+// microsecond clock).
+//
+//   per sample:     on_sample(seq, u, y, flags, now_us)    noexcept, no allocation, no lock
+//   refused sample: on_refused_sample(now_us)              a NaN/out-of-range sample poisons the window
+//   HX_PARAMS:      on_params(...)                        a newer valid set becomes the set in use
+//   often (~10 ms): poll(now_us) -> RefitDecision          collects a finished refit, starts the next
+//
+// A refit starts every refit_period_s once a full window of new samples is there and the
+// worker is idle (one job in flight; a refit that overruns the period delays the next).
+// Its outcome is adopted only if it was accepted AND judged against the set still in use:
+// the same rule as OnlineMemEstimator::adopt(), kept here because the set in use may also
+// change from outside (HX_PARAMS), which the estimator's own version does not know about.
+
+#include <cstdint>
+#include <string>
+
+#include "core/latency_stats.hpp"
+#include "ident/online_mem_estimator.hpp"
+#include "reidentifier/params_in_use.hpp"
+#include "reidentifier/refit_worker.hpp"
+#include "reidentifier/reident_counters.hpp"
+#include "reidentifier/reident_options.hpp"
+
+namespace hystloop {
+
+struct RefitDecision {
+  enum class Kind : std::uint8_t { none, accepted, refused, superseded };
+  Kind kind = Kind::none;
+  FitStatus status = FitStatus::ok;
+  bool fitted = false;                   // a fit ran: `candidate` holds fitted parameters
+  MemParams candidate{};
+  std::int32_t version = 0;              // accepted: the version it is published with
+  double holdout_rms_candidate_m = 0.0;  // held-out branch RMS of the candidate
+  double holdout_rms_in_use_m = 0.0;
+  double fit_residual_rms_m = 0.0;
+  std::size_t samples_used = 0;
+  std::size_t window_samples = 0;
+  double duration_s = 0.0;
+};
+
+class ReidentCore {
+ public:
+  // own_source names our sets on HX_PARAMS ("reident@host"). start_thread = false: tests
+  // run the worker's job themselves (worker().run_pending()).
+  ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread = true,
+              RefitWorker::OnEvaluated on_evaluated = {});
+
+  void on_sample(std::int64_t seq, double u_V, double y_m, std::int32_t flags, std::int64_t now_us) noexcept;
+  void on_refused_sample(std::int64_t now_us) noexcept;
+  ParamsOffer on_params(const MemParams& params, std::int32_t version, bool valid, std::string_view source) noexcept;
+  RefitDecision poll(std::int64_t now_us) noexcept;
+
+  // A version for a refused candidate published as valid = false (--publish-invalid).
+  std::int32_t claim_diagnostic_version() noexcept { return in_use_.claim_version(); }
+
+  // Health, for HX_STATUS.
+  bool stale(std::int64_t now_us) const noexcept;  // no sample for longer than stale_after_s
+  bool poisoned() const noexcept;  // the last degraded_after_poisoned windows were all poisoned
+  std::int64_t poisoned_streak() const noexcept { return poisoned_streak_; }
+  bool seen_samples() const noexcept { return last_sample_us_ >= 0; }
+  double seconds_since_sample(std::int64_t now_us) const noexcept;
+
+  const ReidentCounters& counters() noexcept;  // refreshes the estimator's mirrored totals
+  void reset_counters() noexcept;
+  const LatencyStats& refit_time() const noexcept { return refit_time_; }  // ns, since start
+  double last_refit_s() const noexcept { return last_refit_s_; }
+  const ParamsInUse& in_use() const noexcept { return in_use_; }
+  const ReidentOptions& options() const noexcept { return options_; }
+  const OnlineMemEstimator& estimator() const noexcept { return estimator_; }
+  RefitWorker& worker() noexcept { return worker_; }
+
+ private:
+  RefitDecision decide(const RefitResult& result) noexcept;
+
+  ReidentOptions options_;
+  OnlineMemEstimator estimator_;
+  ParamsInUse in_use_;
+  RefitWorker worker_;
+  ReidentCounters counters_;
+  LatencyStats refit_time_;
+  std::int64_t period_us_;
+  std::int64_t stale_after_us_;
+  std::int64_t next_refit_us_ = INT64_MIN;
+  std::uint64_t fed_at_last_snapshot_ = 0;
+  std::int64_t last_seq_ = -1;
+  std::int64_t refused_since_last_ = 0;  // samples refused on the wire since last_seq_
+  std::int64_t last_sample_us_ = -1;
+  std::int64_t poisoned_streak_ = 0;
+  double last_refit_s_ = 0.0;
+};
+
+}  // namespace hystloop

@@ -1,0 +1,63 @@
+#pragma once
+// The re-identifier's counters, by name, as HX_STATUS reports them. Every sample that is not
+// fed and every refit that is not published is counted under its reason. Reset (control_t
+// RESET_COUNTERS) keeps a baseline, so the counts stay cheap increments.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "ident/fit_status.hpp"
+
+namespace hystloop {
+
+enum class ReidentCounter : std::uint8_t {
+  samples_fed,           // handed to the estimator (incl. poison markers for refused samples)
+  skipped_safe_state,    // flagged SAFE_STATE: the bridge is ramping/holding, not following commands
+  skipped_sensor_fault,  // flagged SENSOR_FAULT: y is the last good value
+  seq_gaps,              // a jump forward in seq not explained by samples refused on the wire
+  samples_missed,        // ticks missing in those gaps
+  seq_restarts,          // seq went backwards (a bridge restart)
+  non_finite,            // NaN/Inf samples (refused on the wire or fed): poison the window
+  dropouts,              // y stuck while u moves: poisons the window
+  refits_attempted,
+  refits_accepted,
+  refits_superseded,     // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
+  params_adopted,        // sets from HX_PARAMS that became the set in use
+  params_echo,           // our own sets coming back
+  params_stale,          // valid sets not newer than the set in use
+  params_invalid,        // valid = false sets
+  refits_rejected_first  // + static_cast<int>(FitStatus) for each refusal reason
+};
+
+inline constexpr std::size_t kFitStatusCount = static_cast<std::size_t>(FitStatus::poisoned_window) + 1;
+inline constexpr std::size_t kReidentCounterCount =
+    static_cast<std::size_t>(ReidentCounter::refits_rejected_first) + kFitStatusCount;
+
+// "samples_fed", ..., "refits_rejected_<fit status>" (index by counter).
+std::string_view counter_name(std::size_t index) noexcept;
+
+class ReidentCounters {
+ public:
+  void add(ReidentCounter c, std::uint64_t n = 1) noexcept { values_[index(c)] += n; }
+  void add_rejected(FitStatus s) noexcept { values_[rejected_index(s)] += 1; }
+  void set(ReidentCounter c, std::uint64_t total) noexcept { values_[index(c)] = total; }  // mirrored totals
+  // Since start or the last reset.
+  std::uint64_t get(ReidentCounter c) const noexcept { return at(index(c)); }
+  std::uint64_t rejected(FitStatus s) const noexcept { return at(rejected_index(s)); }
+  std::uint64_t rejected_total() const noexcept;
+  std::uint64_t at(std::size_t i) const noexcept { return values_[i] - baseline_[i]; }
+  void reset() noexcept { baseline_ = values_; }
+
+  static constexpr std::size_t index(ReidentCounter c) noexcept { return static_cast<std::size_t>(c); }
+  static constexpr std::size_t rejected_index(FitStatus s) noexcept {
+    return index(ReidentCounter::refits_rejected_first) + static_cast<std::size_t>(s);
+  }
+
+ private:
+  std::array<std::uint64_t, kReidentCounterCount> values_{};
+  std::array<std::uint64_t, kReidentCounterCount> baseline_{};
+};
+
+}  // namespace hystloop

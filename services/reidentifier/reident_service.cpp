@@ -1,0 +1,201 @@
+#include "reidentifier/reident_service.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "core/process.hpp"
+#include "runtime/counter_baseline.hpp"
+#include "runtime/io_loop.hpp"
+
+namespace hystloop {
+
+std::int64_t steady_ns() noexcept {
+  using namespace std::chrono;
+  return duration_cast<nanoseconds>(steady_clock::now().time_since_epoch()).count();
+}
+
+namespace {
+std::int64_t steady_us() noexcept { return steady_ns() / 1000; }
+}  // namespace
+
+namespace {
+// Runs on the worker thread, right after evaluate: the I/O thread never formats a refusal.
+void log_refusal(const RefitResult& r) {
+  if (r.outcome.accepted) return;
+  spdlog::info("refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms]", to_string(r.outcome.status),
+               r.outcome.reason, r.window_samples, r.window_first_seq, r.duration_s * 1e3);
+}
+}  // namespace
+
+ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options)
+    : lcm_(lcm),
+      options_(options),
+      own_source_(std::string(kProcessName) + "@" + host_name()),
+      core_(std::make_unique<ReidentCore>(options, own_source_, true, &log_refusal)),
+      params_out_(lcm, names.params),
+      status_(lcm, names.status, kProcessName),
+      control_filter_(kProcessName) {
+  out_.source = own_source_;
+  Subscription<sensor_sample_t>::Options sensor_options;
+  sensor_options.queue_capacity = static_cast<int>(options.lcm_queue);
+  sensor_options.on_reject = [this](RejectReason reason) {
+    if (reason == RejectReason::kNonFinite || reason == RejectReason::kOutOfRange) {
+      core_->on_refused_sample(steady_us());
+    }
+  };
+  sensor_ = std::make_unique<Subscription<sensor_sample_t>>(
+      lcm, names.sensor, [this](const sensor_sample_t& msg, std::int64_t) { on_sample(msg); }, sensor_options);
+  params_in_ = std::make_unique<Subscription<mem_params_t>>(
+      lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
+  control_ = std::make_unique<Subscription<control_t>>(
+      lcm, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); });
+}
+
+ReidentService::~ReidentService() = default;
+
+void ReidentService::on_sample(const sensor_sample_t& msg) noexcept {
+  const std::int64_t t0 = steady_ns();
+  core_->on_sample(msg.seq, msg.u_V, msg.y_m, msg.flags, t0 / 1000);
+  sample_cost_.add(steady_ns() - t0);
+}
+
+void ReidentService::on_params(const mem_params_t& msg) {
+  const MemParams p{msg.c1, msg.c2, msg.c3};
+  const ParamsOffer offer = core_->on_params(p, msg.version, msg.valid, msg.source);
+  if (offer == ParamsOffer::adopted) {
+    spdlog::info("params in use now version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", msg.version,
+                 msg.source, msg.c1, msg.c2, msg.c3);
+  } else if (offer == ParamsOffer::stale) {
+    spdlog::debug("params version {} from '{}' ignored: not newer than version {} in use", msg.version, msg.source,
+                  core_->in_use().version());
+  }
+}
+
+void ReidentService::on_control(const control_t& msg) {
+  if (!control_filter_.accept(msg)) return;
+  if (msg.command == control_t::SHUTDOWN) {
+    spdlog::info("shutdown requested (request {})", msg.request_id);
+    request_stop();
+  } else if (msg.command == control_t::RESET_COUNTERS) {
+    spdlog::info("counters reset (request {})", msg.request_id);
+    core_->reset_counters();
+    sensor_base_ = sensor_->counters();
+    params_in_base_ = params_in_->counters();
+    control_base_ = control_->counters();
+    params_out_base_ = params_out_.counters();
+  }
+}
+
+void ReidentService::publish_decision(const RefitDecision& d) {
+  using Kind = RefitDecision::Kind;
+  if (d.kind == Kind::none) return;
+  if (d.kind == Kind::superseded) {
+    spdlog::info("refit accepted but not adopted: the set in use changed to version {} meanwhile",
+                 core_->in_use().version());
+    return;
+  }
+  if (d.kind == Kind::refused && !(options_.publish_invalid && d.fitted)) return;
+  const bool valid = d.kind == Kind::accepted;
+  out_.utime = wall_utime();
+  out_.version = valid ? d.version : core_->claim_diagnostic_version();
+  out_.c1 = d.candidate.c1;
+  out_.c2 = d.candidate.c2;
+  out_.c3 = d.candidate.c3;
+  out_.residual_m = d.holdout_rms_candidate_m > 0.0 ? d.holdout_rms_candidate_m : d.fit_residual_rms_m;
+  out_.samples_used = static_cast<std::int64_t>(d.samples_used);
+  out_.window_s = static_cast<double>(d.window_samples) / options_.rate_hz;
+  out_.valid = valid;
+  const bool sent = params_out_.publish(out_);
+  if (valid) {
+    spdlog::info(
+        "published params version {}{}: c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}; held-out RMS {:.3g} m vs {:.3g} m in use; "
+        "refit {:.1f} ms",
+        out_.version, sent ? "" : " (PUBLISH FAILED)", out_.c1, out_.c2, out_.c3, d.holdout_rms_candidate_m,
+        d.holdout_rms_in_use_m, d.duration_s * 1e3);
+  }
+}
+
+void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
+  std::int8_t state = service_status_t::HEALTHY;
+  std::string why;
+  const double quiet_s = core_->seconds_since_sample(now_us);
+  if (stopping) {
+    state = service_status_t::STOPPING;
+  } else if (core_->stale(now_us)) {
+    state = service_status_t::DEGRADED;
+    why = core_->seen_samples() ? fmt::format("no sample for {:.1f} s; ", quiet_s) : "no sample received yet; ";
+  }
+  if (!stopping && core_->poisoned()) {
+    state = service_status_t::DEGRADED;
+    why += fmt::format("last {} windows poisoned (NaN or dropout); ", core_->poisoned_streak());
+  }
+  const ParamsInUse& in_use = core_->in_use();
+  const LatencyStats& refit = core_->refit_time();
+  why += fmt::format("params version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", in_use.version(),
+                     in_use.source(), in_use.params().c1, in_use.params().c2, in_use.params().c3);
+  if (refit.count() > 0) {
+    why += fmt::format("; refit last {:.1f} ms, p50 {:.1f} ms, max {:.1f} ms", core_->last_refit_s() * 1e3,
+                       refit.percentile(0.5) * 1e-6, static_cast<double>(refit.max_ns()) * 1e-6);
+  }
+  status_.begin(state, std::move(why));
+  const ReidentCounters& c = core_->counters();
+  const std::size_t ok_index = ReidentCounters::rejected_index(FitStatus::ok);
+  for (std::size_t i = 0; i < kReidentCounterCount; ++i) {
+    if (i != ok_index) status_.counter(counter_name(i), c.at(i));
+  }
+  status_.counter("refits_rejected", c.rejected_total());
+  status_.counter("params_version", static_cast<std::uint64_t>(in_use.version()));
+  if (refit.count() > 0) {
+    status_.counter("refit_last_us", static_cast<std::uint64_t>(std::llround(core_->last_refit_s() * 1e6)));
+    status_.counter("refit_p50_us", static_cast<std::uint64_t>(std::llround(refit.percentile(0.5) * 1e-3)));
+    status_.counter("refit_max_us", static_cast<std::uint64_t>(refit.max_ns() / 1000));
+  }
+  status_.endpoint("sensor", counters_since(sensor_->counters(), sensor_base_));
+  status_.endpoint("params_in", counters_since(params_in_->counters(), params_in_base_));
+  status_.endpoint("control", counters_since(control_->counters(), control_base_));
+  status_.publisher("params_out", counters_since(params_out_.counters(), params_out_base_));
+  status_.loop_timing(sample_cost_);  // per-sample handler cost
+  sample_cost_.reset();
+  status_.publish(wall_utime());
+}
+
+void ReidentService::on_tick(std::int64_t /*wall_us*/) {
+  const std::int64_t now = steady_us();
+  publish_decision(core_->poll(now));
+  if (now >= next_status_us_) {
+    publish_status(now, false);
+    next_status_us_ += 1'000'000;
+    if (next_status_us_ <= now) next_status_us_ = now + 1'000'000;
+  }
+}
+
+int ReidentService::run() {
+  publish_status(steady_us(), false);  // announce ourselves at once (tests wait for it)
+  next_status_us_ = steady_us() + 1'000'000;
+  IoLoopOptions loop;
+  loop.poll_timeout = std::chrono::microseconds(1000);
+  loop.period = std::chrono::milliseconds(10);  // refit scheduling; status every 100th tick
+  const int lcm_errors = run_io_loop(lcm_, loop, [this](std::int64_t wall_us) { on_tick(wall_us); });
+  const std::int64_t now = steady_us();
+  publish_status(now, true);
+  const ReidentCounters& c = core_->counters();
+  const LatencyStats& refit = core_->refit_time();
+  spdlog::info(
+      "stopping: {} samples fed, {} skipped (safe state {}, sensor fault {}), {} gaps, {} non-finite, {} dropouts; "
+      "refits {} attempted, {} accepted, {} rejected, {} superseded; refit p50 {:.1f} ms max {:.1f} ms; "
+      "params version {} c1 {:.6g} c2 {:.6g} c3 {:.6g}; {} LCM errors",
+      c.get(ReidentCounter::samples_fed),
+      c.get(ReidentCounter::skipped_safe_state) + c.get(ReidentCounter::skipped_sensor_fault),
+      c.get(ReidentCounter::skipped_safe_state), c.get(ReidentCounter::skipped_sensor_fault),
+      c.get(ReidentCounter::seq_gaps), c.get(ReidentCounter::non_finite), c.get(ReidentCounter::dropouts),
+      c.get(ReidentCounter::refits_attempted), c.get(ReidentCounter::refits_accepted), c.rejected_total(),
+      c.get(ReidentCounter::refits_superseded), refit.count() ? refit.percentile(0.5) * 1e-6 : 0.0,
+      static_cast<double>(refit.max_ns()) * 1e-6, core_->in_use().version(), core_->in_use().params().c1,
+      core_->in_use().params().c2, core_->in_use().params().c3, lcm_errors);
+  return 0;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,74 @@
+#pragma once
+// hystloop-reidentifier's LCM shell around ReidentCore. One I/O thread (the caller of run())
+// owns lcm::LCM and the estimator; the refit runs on the core's worker thread.
+//
+//   <rig>SENSOR  -> ReidentCore::on_sample (samples flagged SAFE_STATE / SENSOR_FAULT skipped and
+//                   counted; refused non-finite ones poison the window)
+//   <rig>PARAMS  -> a newer valid set from someone else becomes the set in use; our echo ignored
+//   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to "reident" (or to all)
+//   every 10 ms  -> poll the core: publish an accepted candidate on <rig>PARAMS (valid = true,
+//                   residual_m = its held-out RMS); a refused one is counted, logged by the
+//                   worker, and published only with publish_invalid, as valid = false
+//   1 Hz         -> <rig>STATUS, process "reident"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/latency_stats.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+#include "reidentifier/reident_core.hpp"
+#include "reidentifier/reident_options.hpp"
+#include "runtime/control_filter.hpp"
+#include "runtime/status_reporter.hpp"
+
+namespace hystloop {
+
+class ReidentService {
+ public:
+  static constexpr const char* kProcessName = "reident";
+
+  ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options);
+  ~ReidentService();
+
+  // Serves until SIGINT/SIGTERM or a SHUTDOWN request; returns the exit code (0).
+  int run();
+
+ private:
+  void on_sample(const sensor_sample_t& msg) noexcept;
+  void on_params(const mem_params_t& msg);
+  void on_control(const control_t& msg);
+  void on_tick(std::int64_t now_us);
+  void publish_decision(const RefitDecision& d);
+  void publish_status(std::int64_t now_us, bool stopping);
+
+  lcm::LCM& lcm_;
+  ReidentOptions options_;
+  std::string own_source_;
+  std::unique_ptr<ReidentCore> core_;
+  Publisher<mem_params_t> params_out_;
+  StatusReporter status_;
+  ControlFilter control_filter_;
+  LatencyStats sample_cost_;  // per-sample handler (feed) cost [ns], per status period
+  // RESET_COUNTERS: the endpoints' counts at the reset (they only count up).
+  EndpointCounters sensor_base_{}, params_in_base_{}, control_base_{};
+  PublisherCounters params_out_base_{};
+  mem_params_t out_{};
+  std::int64_t next_status_us_ = 0;
+  // Last: their handlers use everything above.
+  std::unique_ptr<Subscription<sensor_sample_t>> sensor_;
+  std::unique_ptr<Subscription<mem_params_t>> params_in_;
+  std::unique_ptr<Subscription<control_t>> control_;
+};
+
+// Steady (monotonic) clock in nanoseconds; / 1000 is the core's time base.
+std::int64_t steady_ns() noexcept;
+
+}  // namespace hystloop

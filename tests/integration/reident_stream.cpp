@@ -1,0 +1,316 @@
+// Test publisher for hystloop-reidentifier (tests/integration/reident_*.sh), run inside
+// tools/netns-run:
+//
+//   reident_stream good    --url U [--duration-s 6] [--frequency-hz 1] [--tolerance 0.03]
+//   reident_stream garbage --url U [--phase-s 2]
+//
+// Both wait for the re-identifier's first HX_STATUS, then stream sensor_sample_t at 10 kHz of
+// real time (bursts of 10 samples per millisecond), reading HX_PARAMS and HX_STATUS between
+// bursts, then wait --settle-s for the last reports.
+//  good:    first announces an external valid set (version 5, source "probe") equal to the
+//           re-identifier's initial params; then streams u = 250 sin(2 pi f t), y from the MEM
+//           model (common/models/mem.hpp) with gain 1.1 x the initial params + 1 nm noise.
+//           Passes if a valid HX_PARAMS from "reident@..." arrives with version >= 6 and c1, c2
+//           within --tolerance of the truth, and the status shows the external set adopted.
+//  garbage: three phases: y NaN on every 200th sample (sine u), constant u with noisy y,
+//           y stuck while u moves. Passes if no valid set is ever published and the status
+//           counts poisoned-window and constant-input refusals, non-finite samples and dropouts.
+// Prints the figures (refit time p50/max, per-sample feed cost) from the last status.
+// Exit status 0 = pass, 1 = fail, 2 = usage.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "hystloop/mem_params_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/service_status_t.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+#include "models/mem.hpp"
+
+namespace hystloop {
+namespace {
+
+using clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string mode;
+  std::string url;
+  std::string prefix{kDefaultRigPrefix};
+  double duration_s = 6.0;
+  double phase_s = 2.0;
+  double frequency_hz = 1.0;
+  double tolerance = 0.03;
+  double settle_s = 2.5;
+  double c1 = MemParams::paper_like().c1, c2 = MemParams::paper_like().c2, c3 = MemParams::paper_like().c3;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  if (argc < 2) throw std::invalid_argument("usage: reident_stream good|garbage --url U [options]");
+  o.mode = argv[1];
+  if (o.mode != "good" && o.mode != "garbage") throw std::invalid_argument("mode must be good or garbage");
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string key = argv[i];
+    const std::string value = argv[i + 1];
+    if (key == "--url") o.url = value;
+    else if (key == "--prefix") o.prefix = value;
+    else if (key == "--duration-s") o.duration_s = std::stod(value);
+    else if (key == "--phase-s") o.phase_s = std::stod(value);
+    else if (key == "--frequency-hz") o.frequency_hz = std::stod(value);
+    else if (key == "--tolerance") o.tolerance = std::stod(value);
+    else if (key == "--settle-s") o.settle_s = std::stod(value);
+    else throw std::invalid_argument("unknown option " + key);
+  }
+  return o;
+}
+
+struct Observed {
+  int valid_params = 0, invalid_params = 0;
+  mem_params_t best{};  // last valid set from the re-identifier
+  double first_valid_after_s = -1.0;
+  int statuses = 0;
+  service_status_t last_status{};
+  std::map<std::string, std::int64_t> counters;  // of the last status
+  // Per-sample feed cost over the reports that measured one (the last ones have no samples).
+  double feed_p50_us = std::nan(""), feed_p99_us = std::nan(""), feed_max_us = 0.0;
+};
+
+class Stream {
+ public:
+  explicit Stream(const Options& o)
+      : o_(o),
+        names_(o.prefix),
+        lcm_(open_lcm(o.url)),
+        sensor_(*lcm_, names_.sensor, nullptr),  // unchecked: the garbage mode sends NaN on purpose
+        params_pub_(*lcm_, names_.params),
+        params_(*lcm_, names_.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
+        status_(*lcm_, names_.status, [this](const service_status_t& m, std::int64_t) { on_status(m); }) {}
+
+  int run() {
+    if (!wait_for_status(10.0)) {
+      std::fprintf(stderr, "reident_stream: no HX_STATUS from reident within 10 s\n");
+      return 1;
+    }
+    return o_.mode == "good" ? run_good() : run_garbage();
+  }
+
+ private:
+  void on_params(const mem_params_t& m) {
+    if (m.source.rfind("reident@", 0) != 0) return;  // our own announcement
+    if (m.valid) {
+      ++seen_.valid_params;
+      seen_.best = m;
+      if (seen_.first_valid_after_s < 0) seen_.first_valid_after_s = seconds_since(stream_start_);
+      std::printf("reident_stream: HX_PARAMS version %d valid: c1 %.6g c2 %.6g c3 %.6g residual %.3g m, %lld samples\n",
+                  m.version, m.c1, m.c2, m.c3, m.residual_m, static_cast<long long>(m.samples_used));
+    } else {
+      ++seen_.invalid_params;
+    }
+  }
+  void on_status(const service_status_t& m) {
+    if (m.process != "reident") return;
+    ++seen_.statuses;
+    seen_.last_status = m;
+    if (std::isfinite(m.loop_p50_us)) {
+      seen_.feed_p50_us = m.loop_p50_us;
+      seen_.feed_p99_us = std::isfinite(seen_.feed_p99_us) ? std::max(seen_.feed_p99_us, m.loop_p99_us) : m.loop_p99_us;
+      seen_.feed_max_us = std::max(seen_.feed_max_us, m.loop_max_us);
+    }
+    seen_.counters.clear();
+    for (int i = 0; i < m.n_counters; ++i) seen_.counters[m.counter_names[static_cast<std::size_t>(i)]] =
+        m.counter_values[static_cast<std::size_t>(i)];
+  }
+  static double seconds_since(clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); }
+
+  bool wait_for_status(double timeout_s) {
+    const auto start = clock::now();
+    while (seen_.statuses == 0 && seconds_since(start) < timeout_s) handle_pending(*lcm_, std::chrono::milliseconds(10));
+    return seen_.statuses > 0;
+  }
+
+  // Streams n samples at 10 kHz of real time; sample(k, u, y, flags) fills one.
+  template <class Fill>
+  void stream(std::int64_t n, Fill fill) {
+    sensor_sample_t s{};
+    const auto start = clock::now();
+    for (std::int64_t k = 0; k < n; ++k) {
+      s.seq = seq_++;
+      s.flags = sensor_sample_t::SIMULATED;
+      fill(k, s.u_V, s.y_m);
+      s.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                    std::chrono::system_clock::now().time_since_epoch()).count();
+      sensor_.publish(s);
+      if ((k + 1) % 10 == 0) {  // a burst per millisecond
+        handle_pending(*lcm_, std::chrono::microseconds(0));
+        std::this_thread::sleep_until(start + std::chrono::microseconds((k + 1) * 100));
+      }
+    }
+  }
+
+  void settle() {
+    const auto start = clock::now();
+    const int statuses = seen_.statuses;
+    // At least two more reports after the stream, so the counters include the last refits.
+    while (seconds_since(start) < o_.settle_s || seen_.statuses < statuses + 2) {
+      if (seconds_since(start) > o_.settle_s + 3.0) break;
+      handle_pending(*lcm_, std::chrono::milliseconds(10));
+    }
+  }
+
+  std::int64_t counter(const std::string& name) const {
+    const auto it = seen_.counters.find(name);
+    return it == seen_.counters.end() ? -1 : it->second;
+  }
+
+  void print_figures() const {
+    const service_status_t& st = seen_.last_status;
+    std::printf(
+        "reident_stream: figures: refit p50 %.1f ms, max %.1f ms (%lld refits); per-sample feed p50 %.3f us, "
+        "worst p99 %.3f us, max %.3f us (over the stream's reports); samples fed %lld, sensor rejected %lld, gaps %lld\n",
+        static_cast<double>(counter("refit_p50_us")) * 1e-3, static_cast<double>(counter("refit_max_us")) * 1e-3,
+        static_cast<long long>(counter("refits_attempted")), seen_.feed_p50_us, seen_.feed_p99_us, seen_.feed_max_us,
+        static_cast<long long>(counter("samples_fed")), static_cast<long long>(counter("sensor.rejected_non_finite")),
+        static_cast<long long>(counter("seq_gaps")));
+    std::printf("reident_stream: status detail: %s\n", st.detail.c_str());
+  }
+
+  int run_good() {
+    const MemParams initial{o_.c1, o_.c2, o_.c3};
+    const MemParams truth{1.1 * o_.c1, 1.1 * o_.c2, o_.c3};
+    // Someone else's set, newer than the config's: it becomes the set in use.
+    mem_params_t external{};
+    external.utime = 1;
+    external.version = 5;
+    external.c1 = initial.c1;
+    external.c2 = initial.c2;
+    external.c3 = initial.c3;
+    external.valid = true;
+    external.source = "probe";
+    params_pub_.publish(external);
+
+    MemModel model(truth);
+    std::mt19937_64 rng(42);
+    std::normal_distribution<double> noise(0.0, 1e-9);
+    const double w = 2.0 * std::numbers::pi * o_.frequency_hz;
+    stream_start_ = clock::now();
+    stream(std::llround(o_.duration_s * 1e4), [&](std::int64_t k, double& u, double& y) {
+      u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
+      y = model.forward(u) + noise(rng);
+    });
+    settle();
+    print_figures();
+    int failures = 0;
+    auto check = [&](bool ok, const std::string& what) {
+      if (!ok) {
+        std::fprintf(stderr, "reident_stream: FAIL: %s\n", what.c_str());
+        ++failures;
+      }
+    };
+    check(seen_.valid_params >= 1, "no valid HX_PARAMS from the re-identifier");
+    if (seen_.valid_params >= 1) {
+      const mem_params_t& b = seen_.best;
+      const double e1 = std::abs(b.c1 / truth.c1 - 1.0), e2 = std::abs(b.c2 / truth.c2 - 1.0);
+      std::printf("reident_stream: c1 error %.3f %%, c2 error %.3f %%, c3 %.4f (truth %.4f), version %d, first after "
+                  "%.2f s of stream\n",
+                  100 * e1, 100 * e2, b.c3, truth.c3, b.version, seen_.first_valid_after_s);
+      check(e1 <= o_.tolerance, "c1 off by " + std::to_string(100 * e1) + " %");
+      check(e2 <= 3 * o_.tolerance, "c2 off by " + std::to_string(100 * e2) + " %");
+      check(b.version >= 6, "version " + std::to_string(b.version) + " is not above the external set's 5");
+      check(std::isfinite(b.residual_m) && b.residual_m > 0 && b.residual_m < 20e-9, "residual_m out of range");
+      check(b.samples_used > 0 && b.window_s > 0, "samples_used/window_s missing");
+    }
+    check(seen_.invalid_params == 0, "a valid = false set was published without --publish-invalid");
+    check(counter("params_adopted") == 1, "the external set was not adopted");
+    check(counter("refits_accepted") >= 1, "status does not count the accepted refit");
+    check(counter("seq_gaps") == 0, "samples were lost on the way");
+    return failures == 0 ? 0 : 1;
+  }
+
+  int run_garbage() {
+    const MemModel truth_model(MemParams{1.1 * o_.c1, 1.1 * o_.c2, o_.c3});
+    MemModel model = truth_model;
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> noise(0.0, 1e-9);
+    const double w = 2.0 * std::numbers::pi * 10.0;
+    const auto n = std::llround(o_.phase_s * 1e4);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    stream_start_ = clock::now();
+    stream(n, [&](std::int64_t k, double& u, double& y) {  // NaN y now and then
+      u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
+      y = k % 200 == 0 ? nan : model.forward(u) + noise(rng);
+    });
+    stream(n, [&](std::int64_t, double& u, double& y) {  // constant input
+      u = 12.0;
+      y = 3e-8 + noise(rng);
+    });
+    model = truth_model;
+    stream(n, [&](std::int64_t k, double& u, double& y) {  // y stuck while u moves
+      u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
+      y = 1e-7;
+    });
+    settle();
+    print_figures();
+    int failures = 0;
+    auto check = [&](bool ok, const std::string& what) {
+      if (!ok) {
+        std::fprintf(stderr, "reident_stream: FAIL: %s\n", what.c_str());
+        ++failures;
+      }
+    };
+    check(seen_.valid_params == 0, "garbage produced a valid HX_PARAMS");
+    check(seen_.invalid_params == 0, "a valid = false set was published without --publish-invalid");
+    check(counter("refits_accepted") == 0, "status counts an accepted refit");
+    check(counter("refits_rejected_poisoned_window") >= 2, "poisoned windows not counted (NaN, dropout)");
+    check(counter("refits_rejected_constant_input") >= 1, "constant input not refused");
+    check(counter("non_finite") > 0 && counter("sensor.rejected_non_finite") > 0, "NaN samples not counted");
+    check(counter("dropouts") >= 1, "stuck y not counted as a dropout");
+    check(counter("seq_gaps") == 0, "refused samples counted as a gap (or samples lost)");
+    check(counter("params_version") == 1, "the set in use changed");
+    for (const auto& [name, value] : seen_.counters) {
+      if (name.rfind("refits_", 0) == 0 && value > 0) std::printf("reident_stream: %s = %lld\n", name.c_str(),
+                                                                  static_cast<long long>(value));
+    }
+    return failures == 0 ? 0 : 1;
+  }
+
+  Options o_;
+  ChannelNames names_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  Publisher<sensor_sample_t> sensor_;
+  Publisher<mem_params_t> params_pub_;
+  Subscription<mem_params_t> params_;
+  Subscription<service_status_t> status_;
+  Observed seen_;
+  std::int64_t seq_ = 0;
+  clock::time_point stream_start_ = clock::now();
+};
+
+}  // namespace
+}  // namespace hystloop
+
+int main(int argc, char** argv) {
+  try {
+    const hystloop::Options o = hystloop::parse(argc, argv);
+    hystloop::Stream stream(o);
+    return stream.run();
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "reident_stream: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "reident_stream: %s\n", e.what());
+    return 1;
+  }
+}

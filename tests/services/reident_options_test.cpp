@@ -1,0 +1,83 @@
+// read_reident_options: defaults, the shared mem: snippet, and refusals that name the field.
+#include "reidentifier/reident_options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace hystloop {
+namespace {
+
+std::string refusal(const std::string& yaml) {
+  try {
+    read_reident_options(Config::from_string(yaml, "r.yaml"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(ReidentOptions, DefaultsAreTheEstimatorsAtTenKilohertz) {
+  const ReidentOptions o = read_reident_options(Config());
+  EXPECT_EQ(o.estimator.window_samples, 20000u);
+  EXPECT_EQ(o.estimator.capacity_samples, 100000u);
+  EXPECT_EQ(o.estimator.holdout_branches, 1u);
+  EXPECT_DOUBLE_EQ(o.refit_period_s, 1.0);
+  EXPECT_FALSE(o.publish_invalid);
+  EXPECT_GE(o.lcm_queue, 1000);
+  EXPECT_DOUBLE_EQ(o.initial.c1, MemParams::paper_like().c1);
+}
+
+TEST(ReidentOptions, ReadsTheSharedMemSnippetAndTheReidentSection) {
+  const ReidentOptions o = read_reident_options(Config::from_string(
+      "mem: {c1: 4.0e-9, c2: 2.0e-12, c3: 0.8}\n"
+      "compensator: {anything: 1}\n"
+      "reident: {rate_hz: 5000, window_s: 1.5, capacity_s: 3, refit_period_s: 0.5, holdout_branches: 2,\n"
+      "          min_relative_improvement: 0.05, max_residual_rms_m: 1.0e-8, max_solver_time_s: 0.02,\n"
+      "          publish_invalid: true, stale_after_s: 2, degraded_after_poisoned: 5, lcm_queue: 5000}\n"));
+  EXPECT_DOUBLE_EQ(o.initial.c1, 4.0e-9);
+  EXPECT_DOUBLE_EQ(o.initial.c2, 2.0e-12);
+  EXPECT_DOUBLE_EQ(o.initial.c3, 0.8);
+  EXPECT_EQ(o.estimator.window_samples, 7500u);
+  EXPECT_EQ(o.estimator.capacity_samples, 15000u);
+  EXPECT_EQ(o.estimator.holdout_branches, 2u);
+  EXPECT_DOUBLE_EQ(o.estimator.min_relative_improvement, 0.05);
+  EXPECT_DOUBLE_EQ(o.estimator.max_residual_rms_m, 1e-8);
+  EXPECT_DOUBLE_EQ(o.estimator.fit.max_solver_time_s, 0.02);
+  EXPECT_DOUBLE_EQ(o.refit_period_s, 0.5);
+  EXPECT_TRUE(o.publish_invalid);
+  EXPECT_EQ(o.degraded_after_poisoned, 5);
+  EXPECT_EQ(o.lcm_queue, 5000);
+}
+
+TEST(ReidentOptions, RefusalsNameTheField) {
+  EXPECT_NE(refusal("reident: {refit_period_s: -1}").find("r.yaml: reident.refit_period_s:"), std::string::npos);
+  EXPECT_NE(refusal("reident: {window_s: 0.001}").find("reident.window_s: must hold at least 16"), std::string::npos);
+  EXPECT_NE(refusal("reident: {window_s: 5, capacity_s: 2}").find("reident.capacity_s: must be >= reident.window_s"),
+            std::string::npos);
+  EXPECT_NE(refusal("reident: {holdout_branches: 0}").find("reident.holdout_branches"), std::string::npos);
+  EXPECT_NE(refusal("reident: {min_relative_improvement: 1.5}").find("reident.min_relative_improvement"),
+            std::string::npos);
+  EXPECT_NE(refusal("reident: {lcm_queue: 10}").find("reident.lcm_queue"), std::string::npos);
+  EXPECT_NE(refusal("reident: {publish_invalid: maybe}").find("reident.publish_invalid"), std::string::npos);
+  EXPECT_NE(refusal("mem: {c1: -1.0e-9}").find("mem.c1: must be > 0"), std::string::npos);
+  EXPECT_NE(refusal("mem: {c2: -1.0e-9}").find("mem.c2"), std::string::npos);
+  EXPECT_NE(refusal("mem: {c3: 0}").find("mem.c3"), std::string::npos);
+  const std::string typo = refusal("reident: {refit_period: 2}");
+  EXPECT_NE(typo.find("reident.refit_period: unknown key"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("reident.refit_period_s"), std::string::npos) << typo;
+}
+
+TEST(ReidentOptions, TheDeployedDefaultsLoad) {
+  const ReidentOptions o =
+      read_reident_options(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/reidentifier.yaml"));
+  const ReidentOptions d = read_reident_options(Config());
+  EXPECT_EQ(o.estimator.window_samples, d.estimator.window_samples);
+  EXPECT_EQ(o.estimator.capacity_samples, d.estimator.capacity_samples);
+  EXPECT_DOUBLE_EQ(o.initial.c1, d.initial.c1);
+  EXPECT_DOUBLE_EQ(o.refit_period_s, d.refit_period_s);
+  EXPECT_EQ(o.lcm_queue, d.lcm_queue);
+}
+
+}  // namespace
+}  // namespace hystloop
