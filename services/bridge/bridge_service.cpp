@@ -112,6 +112,7 @@ int BridgeService::run() {
   rt_.start();
   while (!rt_.started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   spdlog::info("real-time thread: {}; {}", rt_.priority_status().detail, rt_.affinity_status().detail);
+
   spdlog::info("started in the safe state ({}); {}", settings_.limits.safe_u_V,
                settings_.auto_arm ? "arms when commands flow" : "waiting for ARM on HX_CONTROL");
 

@@ -15,7 +15,7 @@ const std::vector<std::string>& bridge_config_keys() {
       "bridge.run_seconds", "bridge.command_queue_capacity",
       "actuator.u_min_V", "actuator.u_max_V", "actuator.slew_V_per_s", "actuator.safe_u_V",
       "actuator.safe_ramp_V_per_s", "actuator.watchdog_s",
-      "rt.priority", "rt.lock_memory", "rt.cpu",
+      "rt.priority", "rt.io_priority", "rt.lock_memory", "rt.cpu",
       "banning.hysteresis.a", "banning.hysteresis.b", "banning.hysteresis.alpha", "banning.hysteresis.s_max",
       "banning.stage.k", "banning.stage.c", "banning.order",
       "ro.c1", "ro.c2", "ro.c3"};
@@ -75,6 +75,10 @@ BridgeSettings load_bridge_settings(const Config& config) {
   }
 
   s.rt.priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt.priority, 0, 99));
+  s.rt.io_priority = static_cast<int>(config.get_int_in_range("rt.io_priority", s.rt.io_priority, 0, 99));
+  if (s.rt.io_priority > 0 && s.rt.io_priority >= s.rt.priority) {
+    config.fail("rt.io_priority", "must be below rt.priority, so the I/O thread never preempts the clock");
+  }
   s.rt.lock_memory = config.get<bool>("rt.lock_memory", s.rt.lock_memory);
   s.rt.cpu = static_cast<int>(config.get_int_in_range("rt.cpu", s.rt.cpu, -1, 1023));
   return s;
@@ -99,7 +103,8 @@ std::vector<std::string> describe(const BridgeSettings& s) {
     lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
                                 st.ramberg_osgood.c3));
   }
-  lines.push_back(fmt::format("rt: priority {}, lock_memory {}, cpu {}", s.rt.priority, s.rt.lock_memory, s.rt.cpu));
+  lines.push_back(fmt::format("rt: priority {}, I/O priority {}, lock_memory {}, cpu {}", s.rt.priority,
+                              s.rt.io_priority, s.rt.lock_memory, s.rt.cpu));
   return lines;
 }
 

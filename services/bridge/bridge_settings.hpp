@@ -15,6 +15,7 @@ namespace hystloop {
 
 struct RtSettings {
   int priority = 0;          // SCHED_FIFO priority 1..99 of the real-time thread; 0 = normal scheduling
+  int io_priority = 0;       // SCHED_FIFO priority of the I/O thread (below `priority`); 0 = normal scheduling
   bool lock_memory = false;  // mlockall at start
   int cpu = -1;              // pin the real-time thread to this CPU; -1 = no pinning
 };

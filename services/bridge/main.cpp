@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
   try {
     install_stop_handlers();
     if (settings.rt.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
+    if (settings.rt.io_priority > 0) {
+      // Before LCM starts: its receive thread inherits the I/O thread's scheduling.
+      spdlog::info("I/O thread: {}", set_realtime_priority(settings.rt.io_priority).detail);
+    }
     const ChannelNames channels(options.rig_prefix);
     auto lcm = open_lcm(url, options.allow_network);
     spdlog::info("lcm: {}", url);

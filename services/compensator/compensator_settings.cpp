@@ -53,7 +53,7 @@ ShapingFunction read_shaping(const Config& config, const std::string& prefix, co
 const std::vector<std::string>& compensator_config_keys() {
   static const std::vector<std::string> keys = {
       "compensator.mode", "compensator.lead_ticks", "compensator.dt_s", "compensator.run_seconds",
-      "compensator.sample_queue_capacity",
+      "compensator.sample_queue_capacity", "rt.priority", "rt.lock_memory",
       "mem.c1", "mem.c2", "mem.c3",
       "pi.count", "pi.thresholds", "pi.weights", "pi.range_V",
       "linear.gain", "linear.offset",
@@ -77,6 +77,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
   s.sample_queue_capacity =
       static_cast<int>(config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 1000, 1000000));
+  s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
+  s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
   c.mem.c1 = config.get_positive("mem.c1", c.mem.c1);
   c.mem.c2 = config.get_non_negative("mem.c2", c.mem.c2);
@@ -182,6 +184,7 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("feedback: kp {}, ki {} 1/s, kd {} s, nominal gain {:.4g} m/V, limit {} V{}", c.feedback.kp,
                               c.feedback.ki, c.feedback.kd, c.feedback.nominal_gain_m_per_V, c.feedback.u_limit_V,
                               c.feedback.enabled() ? "" : " (off)"));
+  lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
   static const char* shapes[] = {"hold", "sine", "cosine", "triangle", "points"};
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
                               shapes[static_cast<int>(t.shape)], t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s,

@@ -56,6 +56,9 @@ int main(int argc, char** argv) {
 
   try {
     install_stop_handlers();
+    if (settings.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
+    // Before LCM starts: its receive thread inherits this thread's scheduling.
+    if (settings.rt_priority > 0) spdlog::info("scheduling: {}", set_realtime_priority(settings.rt_priority).detail);
     const ChannelNames channels(options.rig_prefix);
     auto lcm = open_lcm(url, options.allow_network);
     spdlog::info("lcm: {}", url);

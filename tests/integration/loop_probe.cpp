@@ -1,0 +1,413 @@
+// The integration tests' hands and eyes on a running bridge + compensator (udpm inside
+// tools/netns-run):
+//
+//   loop_probe record  --dir D --seconds S       HX_SENSOR -> D/sensor.csv, HX_COMMAND -> D/command.csv,
+//                                                HX_STATUS -> D/status.log (one line per report)
+//   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
+//                                reset_counters|shutdown [--target P] [--mode N] [--kp --ki --kd]
+//   loop_probe inject  --target bridge|compensator [--count N]
+//                      malformed (truncated), wrong-type, non-finite and out-of-range messages on
+//                      every input channel of that service (N of each)
+//   loop_probe trajectory --version V --shape N --amplitude-m A --frequency-hz F --blend-s B
+//   loop_probe params  --version V --c1 --c2 --c3 [--valid 0|1]
+//   loop_probe analyze --dir D --u-min --u-max --slew --ramp --dt --watchdog
+//                      checks the recorded samples: never outside [u_min, u_max], never a step
+//                      above max(slew, ramp) * dt, every watchdog trip within watchdog_s + 5 ticks
+//                      of the last command applied; prints key=value figures. Exit 1 on a violation.
+//   loop_probe status-value --dir D --process P --key K   the last report's value of K
+//                      (a counter name, or state/late/rejected/latency_p50_us/... or detail)
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+
+namespace hystloop {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::int64_t now_utime() {
+  using namespace std::chrono;
+  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
+}
+
+void pause_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+
+int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds) {
+  std::FILE* sensor = std::fopen((dir + "/sensor.csv").c_str(), "w");
+  std::FILE* command = std::fopen((dir + "/command.csv").c_str(), "w");
+  std::FILE* status = std::fopen((dir + "/status.log").c_str(), "w");
+  if (!sensor || !command || !status) {
+    std::fprintf(stderr, "loop_probe: cannot write into %s\n", dir.c_str());
+    return 2;
+  }
+  std::fprintf(sensor, "seq,utime,u_V,y_m,flags\n");
+  std::fprintf(command, "seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode\n");
+  Subscription<sensor_sample_t>::Options so;
+  so.queue_capacity = 100000;
+  Subscription<sensor_sample_t> s(
+      lcm, ch.sensor,
+      [&](const sensor_sample_t& m, std::int64_t) {
+        std::fprintf(sensor, "%lld,%lld,%.17g,%.17g,%d\n", static_cast<long long>(m.seq),
+                     static_cast<long long>(m.utime), m.u_V, m.y_m, m.flags);
+      },
+      so);
+  Subscription<actuator_command_t>::Options co;
+  co.queue_capacity = 100000;
+  co.check = nullptr;  // record what the bridge is sent, including what it rejects
+  Subscription<actuator_command_t> c(
+      lcm, ch.command,
+      [&](const actuator_command_t& m, std::int64_t) {
+        std::fprintf(command, "%lld,%lld,%.17g,%.17g,%.17g,%.17g,%d,%d\n", static_cast<long long>(m.seq),
+                     static_cast<long long>(m.sample_seq), m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.params_version,
+                     m.mode);
+      },
+      co);
+  Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
+    std::fprintf(status,
+                 "process=%s state=%d late=%lld rejected=%lld loop_p50_us=%.3f loop_p99_us=%.3f loop_max_us=%.3f "
+                 "latency_p50_us=%.3f latency_p99_us=%.3f latency_max_us=%.3f",
+                 m.process.c_str(), m.state, static_cast<long long>(m.late), static_cast<long long>(m.rejected),
+                 m.loop_p50_us, m.loop_p99_us, m.loop_max_us, m.latency_p50_us, m.latency_p99_us, m.latency_max_us);
+    for (int i = 0; i < m.n_counters; ++i) {
+      std::fprintf(status, " %s=%lld", m.counter_names[static_cast<std::size_t>(i)].c_str(),
+                   static_cast<long long>(m.counter_values[static_cast<std::size_t>(i)]));
+    }
+    std::fprintf(status, " detail=%s\n", m.detail.c_str());
+    std::fflush(status);
+  });
+  std::fclose(std::fopen((dir + "/recording").c_str(), "w"));  // ready marker
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) handle_pending(lcm, std::chrono::milliseconds(10));
+  std::fclose(sensor);
+  std::fclose(command);
+  std::fclose(status);
+  std::printf("recorded %llu samples, %llu commands, %llu status reports\n",
+              static_cast<unsigned long long>(s.counters().accepted),
+              static_cast<unsigned long long>(c.counters().accepted),
+              static_cast<unsigned long long>(st.counters().accepted));
+  return 0;
+}
+
+struct ControlArgs {
+  std::string command;
+  std::string target;
+  int mode = 2;
+  double kp = 0, ki = 0, kd = 0;
+};
+
+int control(lcm::LCM& lcm, const ChannelNames& ch, const ControlArgs& a) {
+  static const std::map<std::string, std::int8_t> commands = {
+      {"set_mode", control_t::SET_MODE},         {"set_gains", control_t::SET_GAINS},
+      {"arm", control_t::ARM},                   {"disarm", control_t::DISARM},
+      {"start_experiment", control_t::START_EXPERIMENT}, {"stop_experiment", control_t::STOP_EXPERIMENT},
+      {"reset_counters", control_t::RESET_COUNTERS}, {"shutdown", control_t::SHUTDOWN}};
+  const auto it = commands.find(a.command);
+  if (it == commands.end()) {
+    std::fprintf(stderr, "loop_probe: unknown control command %s\n", a.command.c_str());
+    return 2;
+  }
+  control_t m{};
+  m.utime = now_utime();
+  m.request_id = m.utime;  // unique enough for a test
+  m.command = it->second;
+  m.target = a.target;
+  m.mode = static_cast<std::int8_t>(m.command == control_t::SET_MODE ? a.mode : 0);
+  m.kp = a.kp;
+  m.ki = a.ki;
+  m.kd = a.kd;
+  m.experiment = m.command == control_t::START_EXPERIMENT ? "sine" : "";
+  m.experiment_amplitude_V = m.command == control_t::START_EXPERIMENT ? 100.0 : 0.0;
+  m.experiment_frequency_Hz = m.command == control_t::START_EXPERIMENT ? 10.0 : 0.0;
+  m.experiment_duration_s = m.command == control_t::START_EXPERIMENT ? 1.0 : 0.0;
+  Publisher<control_t> pub(lcm, ch.control);
+  for (int i = 0; i < 3; ++i) {  // a receiver acts on a request_id once
+    if (!pub.publish(m)) return 1;
+    pause_ms(10);
+  }
+  return 0;
+}
+
+// Publishes `msg` encoded, cut to half its length.
+template <class T>
+void publish_truncated(lcm::LCM& lcm, const std::string& channel, const T& msg) {
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  lcm.publish(channel, buf.data(), static_cast<unsigned>(buf.size() / 2));
+}
+
+template <class T>
+void publish_unchecked(lcm::LCM& lcm, const std::string& channel, const T& msg) {
+  Publisher<T> pub(lcm, channel, nullptr);
+  pub.publish(msg);
+}
+
+control_t valid_control(std::int64_t id) {
+  control_t m{};
+  m.utime = now_utime();
+  m.request_id = id;
+  m.command = control_t::SET_GAINS;
+  m.target = "nobody";  // valid on the wire, addressed to no one
+  return m;
+}
+
+// N of each: truncated, wrong type, non-finite, out of range, on each input channel of `target`.
+int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int count) {
+  const std::int64_t base_id = now_utime();
+  for (int i = 0; i < count; ++i) {
+    // HX_CONTROL (both services).
+    control_t c = valid_control(base_id + i);
+    publish_truncated(lcm, ch.control, c);
+    publish_unchecked(lcm, ch.control, sensor_sample_t{});  // wrong type
+    c.kp = kNaN;
+    publish_unchecked(lcm, ch.control, c);
+    c.kp = 0.0;
+    c.command = 99;
+    publish_unchecked(lcm, ch.control, c);
+    if (target == "bridge") {
+      actuator_command_t m{};
+      m.utime = now_utime();
+      m.seq = 1;
+      m.sample_seq = -1;
+      publish_truncated(lcm, ch.command, m);
+      publish_unchecked(lcm, ch.command, control_t{});  // wrong type
+      m.u_V = kNaN;
+      publish_unchecked(lcm, ch.command, m);
+      m.u_V = 1e6;  // beyond any amplifier: a unit mistake
+      publish_unchecked(lcm, ch.command, m);
+    } else {
+      sensor_sample_t s{};
+      s.utime = now_utime();
+      s.seq = 1;
+      publish_truncated(lcm, ch.sensor, s);
+      publish_unchecked(lcm, ch.sensor, control_t{});
+      s.y_m = kNaN;
+      publish_unchecked(lcm, ch.sensor, s);
+      s.y_m = 0.0;
+      s.seq = -5;
+      publish_unchecked(lcm, ch.sensor, s);
+
+      trajectory_t t{};
+      t.utime = now_utime();
+      t.version = 1000 + i;
+      t.shape = trajectory_t::SINE;
+      t.frequency_Hz = 1.0;
+      publish_truncated(lcm, ch.trajectory, t);
+      publish_unchecked(lcm, ch.trajectory, control_t{});
+      t.amplitude_m = kNaN;
+      publish_unchecked(lcm, ch.trajectory, t);
+      t.amplitude_m = 0.0;
+      t.shape = 42;
+      publish_unchecked(lcm, ch.trajectory, t);
+
+      mem_params_t p{};
+      p.utime = now_utime();
+      p.version = 1000 + i;
+      p.c1 = 5e-9;
+      p.c2 = 1e-12;
+      p.c3 = 1.2;
+      p.valid = true;
+      publish_truncated(lcm, ch.params, p);
+      publish_unchecked(lcm, ch.params, control_t{});
+      p.c1 = kNaN;
+      publish_unchecked(lcm, ch.params, p);
+      p.c1 = -1e-9;
+      publish_unchecked(lcm, ch.params, p);
+    }
+    pause_ms(5);
+  }
+  return 0;
+}
+
+int analyze(const std::string& dir, double u_min, double u_max, double slew, double ramp, double dt, double watchdog) {
+  std::ifstream in(dir + "/sensor.csv");
+  std::string line;
+  std::getline(in, line);
+  const double max_step = std::max(slew, ramp) * dt * (1 + 1e-9) + 1e-9;
+  const auto watchdog_ticks = static_cast<std::int64_t>(std::llround(watchdog / dt));
+  std::int64_t n = 0, gaps = 0, out_of_range = 0, too_fast = 0, trips = 0, slow_trips = 0, applied = 0;
+  std::int64_t prev_seq = -1, last_applied = -1, worst_trip_ticks = 0;
+  double prev_u = kNaN, max_du = 0.0;
+  bool prev_safe = true;
+  while (std::getline(in, line)) {
+    long long seq = 0, utime = 0;
+    double u = 0, y = 0;
+    int flags = 0;
+    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%d", &seq, &utime, &u, &y, &flags) != 5) continue;
+    ++n;
+    const bool consecutive = prev_seq >= 0 && seq == prev_seq + 1;
+    if (prev_seq >= 0 && !consecutive) ++gaps;
+    if (!(u >= u_min && u <= u_max)) ++out_of_range;
+    if (consecutive && std::isfinite(prev_u)) {
+      const double du = std::abs(u - prev_u);
+      max_du = std::max(max_du, du);
+      if (du > max_step) ++too_fast;
+    }
+    const bool safe = (flags & sensor_sample_t::SAFE_STATE) != 0;
+    const bool fresh = !safe && (flags & sensor_sample_t::LATE_COMMAND) == 0;
+    if (fresh) {
+      last_applied = seq;
+      ++applied;
+    }
+    if (safe && !prev_safe && last_applied >= 0) {  // a trip (or a disarm) after commands were applied
+      ++trips;
+      const std::int64_t ticks = seq - last_applied;
+      worst_trip_ticks = std::max(worst_trip_ticks, ticks);
+      if (ticks > watchdog_ticks + 5) ++slow_trips;
+    }
+    prev_safe = safe;
+    prev_seq = seq;
+    prev_u = u;
+  }
+  std::printf("samples=%lld\nseq_gaps=%lld\napplied=%lld\nout_of_range=%lld\nmax_step_V=%.6g\nallowed_step_V=%.6g\n"
+              "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n",
+              static_cast<long long>(n), static_cast<long long>(gaps), static_cast<long long>(applied),
+              static_cast<long long>(out_of_range), max_du, max_step, static_cast<long long>(too_fast),
+              static_cast<long long>(trips), static_cast<long long>(worst_trip_ticks),
+              static_cast<long long>(watchdog_ticks), static_cast<long long>(slow_trips));
+  return (n > 0 && out_of_range == 0 && too_fast == 0 && slow_trips == 0) ? 0 : 1;
+}
+
+// The last status line of `process`, and one value from it.
+int status_value(const std::string& dir, const std::string& process, const std::string& key) {
+  std::ifstream in(dir + "/status.log");
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (line.rfind("process=" + process + " ", 0) == 0) last = line;
+  }
+  if (last.empty()) {
+    std::fprintf(stderr, "loop_probe: no status from %s\n", process.c_str());
+    return 1;
+  }
+  if (key == "detail") {
+    const auto at = last.find(" detail=");
+    std::printf("%s\n", last.substr(at + 8).c_str());
+    return 0;
+  }
+  std::istringstream words(last.substr(0, last.find(" detail=")));
+  std::string word;
+  while (words >> word) {
+    if (word.rfind(key + "=", 0) == 0) {
+      std::printf("%s\n", word.substr(key.size() + 1).c_str());
+      return 0;
+    }
+  }
+  std::fprintf(stderr, "loop_probe: %s reports no %s\n", process.c_str(), key.c_str());
+  return 1;
+}
+
+}  // namespace
+}  // namespace hystloop
+
+int main(int argc, char** argv) {
+  using namespace hystloop;
+  CLI::App app{"loop_probe: records, drives and checks a running bridge + compensator"};
+  app.require_subcommand(1);
+  std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+  std::string prefix = "HX_";
+  app.add_option("--url", url);
+  app.add_option("--prefix", prefix);
+
+  std::string dir;
+  double seconds = 5;
+  auto* rec = app.add_subcommand("record");
+  rec->add_option("--dir", dir)->required();
+  rec->add_option("--seconds", seconds);
+
+  ControlArgs ca;
+  auto* ctl = app.add_subcommand("control");
+  ctl->add_option("--command", ca.command)->required();
+  ctl->add_option("--target", ca.target);
+  ctl->add_option("--mode", ca.mode);
+  ctl->add_option("--kp", ca.kp);
+  ctl->add_option("--ki", ca.ki);
+  ctl->add_option("--kd", ca.kd);
+
+  std::string target;
+  int count = 5;
+  auto* inj = app.add_subcommand("inject");
+  inj->add_option("--target", target)->required();
+  inj->add_option("--count", count);
+
+  trajectory_t traj{};
+  int shape = trajectory_t::COSINE;
+  auto* tr = app.add_subcommand("trajectory");
+  tr->add_option("--version", traj.version)->required();
+  tr->add_option("--shape", shape);
+  tr->add_option("--amplitude-m", traj.amplitude_m);
+  tr->add_option("--offset-m", traj.offset_m);
+  tr->add_option("--frequency-hz", traj.frequency_Hz);
+  tr->add_option("--blend-s", traj.blend_s);
+
+  mem_params_t params{};
+  int valid = 1;
+  auto* pa = app.add_subcommand("params");
+  pa->add_option("--version", params.version)->required();
+  pa->add_option("--c1", params.c1)->required();
+  pa->add_option("--c2", params.c2)->required();
+  pa->add_option("--c3", params.c3)->required();
+  pa->add_option("--valid", valid);
+
+  double u_min = -250, u_max = 250, slew = 5e4, ramp = 1e3, dt = 1e-4, watchdog = 2e-3;
+  auto* an = app.add_subcommand("analyze");
+  an->add_option("--dir", dir)->required();
+  an->add_option("--u-min", u_min);
+  an->add_option("--u-max", u_max);
+  an->add_option("--slew", slew);
+  an->add_option("--ramp", ramp);
+  an->add_option("--dt", dt);
+  an->add_option("--watchdog", watchdog);
+
+  std::string process, key;
+  auto* sv = app.add_subcommand("status-value");
+  sv->add_option("--dir", dir)->required();
+  sv->add_option("--process", process)->required();
+  sv->add_option("--key", key)->required();
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*an) return analyze(dir, u_min, u_max, slew, ramp, dt, watchdog);
+    if (*sv) return status_value(dir, process, key);
+    const ChannelNames ch(prefix);
+    auto lcm = open_lcm(url);
+    if (*rec) return record(*lcm, ch, dir, seconds);
+    if (*ctl) return control(*lcm, ch, ca);
+    if (*inj) return inject(*lcm, ch, target, count);
+    if (*tr) {
+      traj.utime = now_utime();
+      traj.shape = static_cast<std::int8_t>(shape);
+      for (int i = 0; i < 3; ++i) {
+        publish_unchecked(*lcm, ch.trajectory, traj);  // repeats: the compensator applies a version once
+        pause_ms(10);
+      }
+      return 0;
+    }
+    if (*pa) {
+      params.utime = now_utime();
+      params.valid = valid != 0;
+      params.source = "loop_probe";
+      publish_unchecked(*lcm, ch.params, params);
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loop_probe: %s\n", e.what());
+    return 2;
+  }
+  return 2;
+}

@@ -1,0 +1,16 @@
+# hystloop-bridge + hystloop-compensator end to end (included by tests/integration/CMakeLists.txt):
+# real processes over udpm inside tools/netns-run (ttl=0). loop_probe records HX_SENSOR,
+# HX_COMMAND and HX_STATUS, sends HX_CONTROL/HX_TRAJECTORY/HX_PARAMS, injects bad messages,
+# and checks the recorded samples.
+add_executable(loop_probe ${CMAKE_CURRENT_LIST_DIR}/loop_probe.cpp)
+target_link_libraries(loop_probe PRIVATE hystloop::lcm CLI11::CLI11 hystloop::warnings)
+target_include_directories(loop_probe PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
+
+if(TARGET hystloop-bridge AND TARGET hystloop-compensator)
+  foreach(_script loop_run loop_watchdog loop_reject bridge_cli compensator_cli)
+    add_test(NAME ${_script}
+      COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/${_script}.sh
+              $<TARGET_FILE:hystloop-bridge> $<TARGET_FILE:hystloop-compensator> $<TARGET_FILE:loop_probe>)
+    set_tests_properties(${_script} PROPERTIES LABELS integration TIMEOUT 60)
+  endforeach()
+endif()
