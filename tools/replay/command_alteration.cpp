@@ -16,9 +16,12 @@ AlterationResult write_altered_log(const std::filesystem::path& log, const std::
   std::optional<AlterationResult> done;
   actuator_command_t msg;
   std::vector<std::uint8_t> buffer;
+  std::int64_t commands_seen = 0;
   report::for_each_event({log}, [&](const lcm::LogEvent& event) {
     lcm::LogEvent copy = event;
-    if (!done && event.channel == channels.command && report::decode_checked(event, msg) && msg.seq == alteration.seq) {
+    const bool is_command = !done && event.channel == channels.command && report::decode_checked(event, msg);
+    const bool chosen = is_command && (alteration.nth ? ++commands_seen == *alteration.nth : msg.seq == alteration.seq);
+    if (chosen) {
       const double old_u = msg.u_V;
       msg.u_V = alteration.delta_V ? old_u + *alteration.delta_V
                                    : std::bit_cast<double>(std::bit_cast<std::uint64_t>(old_u) ^ 1u);
@@ -26,12 +29,14 @@ AlterationResult write_altered_log(const std::filesystem::path& log, const std::
       msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
       copy.data = buffer.data();
       copy.datalen = static_cast<std::int32_t>(buffer.size());
-      done = AlterationResult{old_u, msg.u_V};
+      done = AlterationResult{msg.seq, old_u, msg.u_V};
     }
     if (writer.writeEvent(&copy) != 0) throw std::runtime_error(out.string() + ": write failed");
   });
   if (!done) {
-    throw std::runtime_error(log.string() + ": no command for tick " + std::to_string(alteration.seq) + " on " + channels.command);
+    const std::string which = alteration.nth ? "no command number " + std::to_string(*alteration.nth)
+                                             : "no command for tick " + std::to_string(alteration.seq);
+    throw std::runtime_error(log.string() + ": " + which + " on " + channels.command);
   }
   return *done;
 }

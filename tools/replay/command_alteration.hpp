@@ -11,17 +11,19 @@
 namespace hystloop::replay {
 
 struct CommandAlteration {
-  std::int64_t seq = 0;             // tick of the command to alter
+  std::int64_t seq = 0;             // tick of the command to alter (unless nth is set)
+  std::optional<std::int64_t> nth;  // else: the nth command in the log (1 = first), whatever its tick
   std::optional<double> delta_V;    // add this to u_V; unset: flip u_V's least significant mantissa bit (1 ulp)
 };
 
 struct AlterationResult {
+  std::int64_t seq = 0;  // tick of the altered command
   double old_u_V = 0.0;
   double new_u_V = 0.0;
 };
 
 // Throws std::runtime_error naming the file if a log cannot be read or written, or if the
-// log holds no decodable command for `alteration.seq`.
+// log holds no decodable command for `alteration.seq` (or fewer than `nth`).
 AlterationResult write_altered_log(const std::filesystem::path& log, const std::filesystem::path& out,
                                    const ChannelNames& channels, const CommandAlteration& alteration);
 

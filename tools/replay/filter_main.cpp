@@ -3,8 +3,8 @@
 //   hystloop-replay-filter inputs LOG OUT [--rig HX_] [--only-answered] [--compensator-process NAME]
 //       OUT = the recorded compensator's inputs (SENSOR, TRAJECTORY, PARAMS, CONTROL) from the
 //       first sample it answered on, to play into a fresh compensator with lcm-logplayer.
-//   hystloop-replay-filter alter LOG OUT --seq N [--delta-V D]
-//       OUT = LOG with the command for tick N changed (u_V + D, default: 1 ulp flipped), to
+//   hystloop-replay-filter alter LOG OUT (--seq N | --nth K) [--delta-V D]
+//       OUT = LOG with the command for tick N (or the K-th command) changed (u_V + D, default: 1 ulp flipped), to
 //       prove that a replay notices.
 // Exit 0 on success, 2 on bad arguments or unreadable logs.
 
@@ -39,7 +39,11 @@ int main(int argc, char** argv) {
   CLI::App* alter = app.add_subcommand("alter", "Copy a log with one command's u_V changed");
   alter->add_option("log", log, "Recorded LCM event log")->required();
   alter->add_option("out", out, "Altered log to write")->required();
-  alter->add_option("--seq", alteration.seq, "Tick of the command to change")->required();
+  std::optional<std::int64_t> seq;
+  CLI::Option* seq_opt = alter->add_option("--seq", seq, "Tick of the command to change");
+  alter->add_option("--nth", alteration.nth, "Change the nth command of the log instead (1 = first)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(seq_opt);
   alter->add_option("--delta-V", delta_V, "Add this to u_V [V] (default: flip its least significant bit)");
   CLI11_PARSE(app, argc, argv);
 
@@ -50,9 +54,11 @@ int main(int argc, char** argv) {
       std::fputs(hystloop::replay::describe(selection).c_str(), stdout);
       std::printf("first-sample %lld\n", static_cast<long long>(selection.first_answered_sample.value_or(-1)));
     } else {
+      if (!seq && !alteration.nth) throw std::runtime_error("alter: --seq or --nth is required");
+      alteration.seq = seq.value_or(0);
       alteration.delta_V = delta_V;
       const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
-      std::printf("tick %lld: u_V %.17g -> %.17g\n", static_cast<long long>(alteration.seq), r.old_u_V, r.new_u_V);
+      std::printf("altered tick %lld: u_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_V, r.new_u_V);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());

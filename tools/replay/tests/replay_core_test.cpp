@@ -345,7 +345,8 @@ TEST(CommandAlteration, ChangesExactlyOneCommandAndTheComparisonNamesIt) {
   const auto recorded = write_recorded_log(tmp.path);
   const auto altered = tmp.path / "altered.lcmlog";
   const ChannelNames c;
-  const auto r = write_altered_log(recorded, altered, c, {40, std::nullopt});
+  const auto r = write_altered_log(recorded, altered, c, {40, std::nullopt, std::nullopt});
+  EXPECT_EQ(r.seq, 40);
   EXPECT_EQ(std::bit_cast<std::uint64_t>(r.old_u_V) ^ std::bit_cast<std::uint64_t>(r.new_u_V), 1u);
   const CommandLog e = read_commands(recorded, c);
   const CommandLog a = read_commands(altered, c);
@@ -355,9 +356,12 @@ TEST(CommandAlteration, ChangesExactlyOneCommandAndTheComparisonNamesIt) {
   EXPECT_EQ(report.first_divergence->seq, 40);
   EXPECT_EQ(report.first_divergence->field, "u_V");
 
-  const auto r2 = write_altered_log(recorded, altered, c, {41, 0.5});
+  const auto r2 = write_altered_log(recorded, altered, c, {41, std::nullopt, 0.5});
   EXPECT_EQ(r2.new_u_V, r2.old_u_V + 0.5);
-  EXPECT_THROW(write_altered_log(recorded, altered, c, {5, std::nullopt}), std::runtime_error);  // no command for tick 5
+  EXPECT_THROW(write_altered_log(recorded, altered, c, {5, std::nullopt, std::nullopt}), std::runtime_error);  // no tick 5
+  // The 10th command answers sample 29: tick 31.
+  EXPECT_EQ(write_altered_log(recorded, altered, c, {0, 10, std::nullopt}).seq, 31);
+  EXPECT_THROW(write_altered_log(recorded, altered, c, {0, 1000, std::nullopt}), std::runtime_error);
 }
 
 }  // namespace

@@ -1,0 +1,12 @@
+# Replay regression (tools/replay-check, tools/replay/): the golden log (tests/data/, made by
+# tools/replay/make-golden) replays into a fresh compensator exactly; a deliberately altered
+# copy fails, naming the altered tick. Included by CMakeLists.txt in this folder.
+if(TARGET hystloop-compensator AND TARGET hystloop-logger AND TARGET hystloop-replay-compare)
+  set(_golden_dir ${PROJECT_SOURCE_DIR}/tests/data)
+  add_test(NAME replay_golden
+    COMMAND ${PROJECT_SOURCE_DIR}/tools/replay-check --build ${PROJECT_BINARY_DIR}
+            --config ${_golden_dir}/golden-loop.compensator.yaml ${_golden_dir}/golden-loop.lcmlog)
+  add_test(NAME replay_altered
+    COMMAND ${_netns_run} -- ${CMAKE_CURRENT_SOURCE_DIR}/replay_altered.sh ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR})
+  set_tests_properties(replay_golden replay_altered PROPERTIES LABELS integration TIMEOUT 90)
+endif()
