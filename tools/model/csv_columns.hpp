@@ -1,0 +1,52 @@
+#pragma once
+// The CSV files hystloop-model reads and writes: a header row naming the columns, then one sample
+// per row, comma separated, numbers in C notation (optional spaces around each field). Blank lines
+// and lines starting with '#' are skipped, as hystloop-identify's reader does. Columns other than
+// the requested ones are ignored (the caller is told which, to say so). Everything else is refused
+// with the file, the line and the column: "data.csv:7: column 'u': expected a number, got 'abc'".
+
+#include <cstddef>
+#include <istream>
+#include <ostream>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hystloop::model_tool {
+
+class CsvError : public std::runtime_error {
+ public:
+  CsvError(const std::string& file, std::size_t line, const std::string& message)
+      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), line_(line) {}
+  std::size_t line() const noexcept { return line_; }
+
+ private:
+  std::size_t line_;
+};
+
+struct CsvColumns {
+  std::vector<std::string> names;           // the requested columns, in the requested order
+  std::vector<std::vector<double>> values;  // values[c][row], finite
+  std::vector<std::size_t> lines;           // file line (1-based) of each row
+  std::vector<std::string> ignored;         // header names that were not requested
+  std::size_t header_line = 0;
+
+  std::size_t rows() const noexcept { return lines.size(); }
+};
+
+// `file` names the input in messages ("<stdin>" for standard input). Header names match exactly
+// after trimming spaces and surrounding double quotes. At least one data row is required.
+CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span<const std::string_view> required);
+
+// Throws CsvError naming the first row whose value in `column` does not strictly exceed the
+// previous row's (e.g. t for a model with dynamics).
+void require_increasing(const CsvColumns& table, std::size_t column, const std::string& file);
+
+// Header, then one row per sample, every value as the shortest text that reads back to the same
+// double (as exact as %.17g).
+void write_csv_columns(std::ostream& out, std::span<const std::string_view> names,
+                       std::span<const std::vector<double>* const> columns);
+
+}  // namespace hystloop::model_tool

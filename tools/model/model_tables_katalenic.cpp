@@ -1,0 +1,104 @@
+// Parameter table of katalenic: the operator's k1, k2 (and its input-dependent schedule), the
+// initial offset, and the two shaping functions field by field ("input_shaping.gain", ...), the
+// flattened form of the YAML hystloop-identify writes (input_shaping: {kind: linear, gain: ...}).
+#include <array>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "model_descriptors.hpp"
+#include "param_fields.hpp"
+
+namespace hystloop::model_tool {
+namespace {
+
+using P = KatalenicParams;
+
+struct ShapingNames {
+  std::string_view kind, gain, offset, coefficients, domain_min, domain_max, amplitude, scale;
+};
+
+constexpr ShapingNames kInputNames{"input_shaping.kind",         "input_shaping.gain",       "input_shaping.offset",
+                                   "input_shaping.coefficients", "input_shaping.domain_min", "input_shaping.domain_max",
+                                   "input_shaping.amplitude",    "input_shaping.scale"};
+constexpr ShapingNames kOutputNames{"output_shaping.kind",         "output_shaping.gain",
+                                    "output_shaping.offset",       "output_shaping.coefficients",
+                                    "output_shaping.domain_min",   "output_shaping.domain_max",
+                                    "output_shaping.amplitude",    "output_shaping.scale"};
+
+// Sel: captureless generic lambda returning the ShapingFunction inside P.
+template <class Sel>
+void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, std::string_view map) {
+  rows.push_back(custom<P>(
+      n.kind, "-", map == "in" ? "input map V -> operator units" : "output map operator units -> m",
+      ValueKind::choice,
+      [](P& p, const ParsedValue& v) {
+        Sel{}(p).kind = v.choice == "tanh" ? ShapingKind::tanh
+                        : v.choice == "polynomial" ? ShapingKind::polynomial
+                                                   : ShapingKind::linear;
+      },
+      [](const P& p) {
+        switch (Sel{}(p).kind) {
+          case ShapingKind::polynomial: return std::string("polynomial");
+          case ShapingKind::tanh: return std::string("tanh");
+          case ShapingKind::linear: break;
+        }
+        return std::string("linear");
+      },
+      "linear|polynomial|tanh"));
+  const std::string_view unit = map == "in" ? "x/V" : "m/x";
+  rows.push_back(number<P>(n.gain, unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
+  rows.push_back(number<P>(n.offset, map == "in" ? "x" : "m", "linear, tanh: value at 0",
+                           [](auto& p) -> auto& { return Sel{}(p).offset; }));
+  rows.push_back(custom<P>(
+      n.coefficients, "-", "polynomial: c0,c1,...,c7 (units of the map)", ValueKind::list,
+      [](P& p, const ParsedValue& v) {
+        auto& c = Sel{}(p).coefficients;
+        if (v.list.size() > c.size()) {
+          throw std::invalid_argument("at most " + std::to_string(c.size()) + " coefficients (degree 7), got " +
+                                      std::to_string(v.list.size()));
+        }
+        c.fill(0.0);
+        for (std::size_t i = 0; i < v.list.size(); ++i) c[i] = v.list[i];
+      },
+      [](const P& p) {
+        const auto& c = Sel{}(p).coefficients;
+        std::size_t k = c.size();
+        while (k > 1 && c[k - 1] == 0.0) --k;
+        return format_list(std::span<const double>(c.data(), k));
+      }));
+  rows.push_back(number<P>(n.domain_min, map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
+                           [](auto& p) -> auto& { return Sel{}(p).domain_min; }));
+  rows.push_back(number<P>(n.domain_max, map == "in" ? "V" : "x", "polynomial: upper end of that domain",
+                           [](auto& p) -> auto& { return Sel{}(p).domain_max; }));
+  rows.push_back(number<P>(n.amplitude, map == "in" ? "x" : "m", "tanh: half the output range",
+                           [](auto& p) -> auto& { return Sel{}(p).amplitude; }));
+  rows.push_back(number<P>(n.scale, map == "in" ? "V" : "x", "tanh: input scale",
+                           [](auto& p) -> auto& { return Sel{}(p).scale; }));
+}
+
+std::vector<ParamSpec<P>> make_rows() {
+  std::vector<ParamSpec<P>> rows = {
+      number<P>("k1", "x", "half-width of the backlash band |z - x| <= k1", [](auto& p) -> auto& { return p.k1; }),
+      number<P>("k2", "1/x", "rate of the transition to the asymptotes", [](auto& p) -> auto& { return p.k2; }),
+      number<P>("k2_slope", "1/x^2", "k2(x) = k2 + k2_slope*clamp(x, k2_domain_min, k2_domain_max)",
+                [](auto& p) -> auto& { return p.k2_slope; }),
+      number<P>("k2_domain_min", "x", "working interval of that schedule, lower end",
+                [](auto& p) -> auto& { return p.k2_domain_min; }),
+      number<P>("k2_domain_max", "x", "working interval, upper end", [](auto& p) -> auto& { return p.k2_domain_max; }),
+      number<P>("initial_offset", "x", "z - x at reset, |.| <= k1", [](auto& p) -> auto& { return p.initial_offset; }),
+  };
+  add_shaping_rows<decltype([](auto& p) -> auto& { return p.input_shaping; })>(rows, kInputNames, "in");
+  add_shaping_rows<decltype([](auto& p) -> auto& { return p.output_shaping; })>(rows, kOutputNames, "out");
+  return rows;
+}
+
+}  // namespace
+
+std::span<const ParamSpec<KatalenicParams>> KatalenicDescriptor::table() {
+  static const std::vector<ParamSpec<P>> rows = make_rows();
+  return rows;
+}
+
+}  // namespace hystloop::model_tool
