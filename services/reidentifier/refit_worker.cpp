@@ -1,5 +1,9 @@
 #include "reidentifier/refit_worker.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <exception>
 #include <string>
@@ -47,6 +51,9 @@ void RefitWorker::wait_until_not_submitted() const noexcept {
 }
 
 void RefitWorker::thread_main() {
+  // Best effort: a fit (tens of ms of CPU) yields to the I/O thread and the rig's loop
+  // processes sharing the cores. Linux applies nice per thread (tid).
+  (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), kWorkerNice);
   for (;;) {
     std::uint32_t s = state_.load(std::memory_order_acquire);
     while (s == kIdle || s == kDone) {

@@ -13,6 +13,7 @@
 // never touched by both threads at once. No call on the owner side blocks, allocates or
 // locks (submit's wake-up is one futex call); evaluate allocates, on the worker thread.
 //
+// The worker thread runs at nice 10: a refit never competes on equal terms with the I/O thread.
 // Without a thread (start_thread = false) nothing runs by itself: run_pending() evaluates on
 // the calling thread, so a test drives the same handoff step by step, deterministically.
 
@@ -66,6 +67,7 @@ class RefitWorker {
 
  private:
   static constexpr std::uint32_t kIdle = 0, kSubmitted = 1, kDone = 2, kStop = 3;
+  static constexpr int kWorkerNice = 10;  // the worker thread's nice value
   void thread_main();
   void evaluate_job();
 

@@ -22,11 +22,30 @@ std::int64_t steady_us() noexcept { return steady_ns() / 1000; }
 }  // namespace
 
 namespace {
-// Runs on the worker thread, right after evaluate: the I/O thread never formats a refusal.
-void log_refusal(const RefitResult& r) {
-  if (r.outcome.accepted) return;
-  spdlog::info("refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms]", to_string(r.outcome.status),
-               r.outcome.reason, r.window_samples, r.window_first_seq, r.duration_s * 1e3);
+// Logs refusals on the worker thread, right after evaluate: the I/O thread never formats one.
+// A steady plant is refused every period (no_improvement): a reason is logged at info when it
+// differs from the previous refusal's, or once a minute while it repeats; at debug otherwise.
+RefitWorker::OnEvaluated refusal_logger() {
+  return [last = FitStatus::ok, last_info_ns = std::int64_t{0}, repeats = std::uint64_t{0}](
+             const RefitResult& r) mutable {
+    if (r.outcome.accepted) {
+      last = FitStatus::ok;
+      return;
+    }
+    const std::int64_t now = steady_ns();
+    const bool news = r.outcome.status != last || now - last_info_ns >= 60'000'000'000;
+    const auto level = news ? spdlog::level::info : spdlog::level::debug;
+    spdlog::log(level, "refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms{}]", to_string(r.outcome.status),
+                r.outcome.reason, r.window_samples, r.window_first_seq, r.duration_s * 1e3,
+                news && repeats > 0 ? fmt::format("; {} repeats at debug level before this", repeats) : std::string());
+    if (news) {
+      last_info_ns = now;
+      repeats = 0;
+    } else {
+      ++repeats;
+    }
+    last = r.outcome.status;
+  };
 }
 }  // namespace
 
@@ -34,7 +53,7 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
     : lcm_(lcm),
       options_(options),
       own_source_(std::string(kProcessName) + "@" + host_name()),
-      core_(std::make_unique<ReidentCore>(options, own_source_, true, &log_refusal)),
+      core_(std::make_unique<ReidentCore>(options, own_source_, true, refusal_logger())),
       params_out_(lcm, names.params),
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # hystloop-reidentifier end to end. Run inside tools/netns-run (udpm, ttl=0).
 #   reident_run.sh cli     <hystloop-reidentifier> <reident_stream> <source dir>
-#       --help; bad configuration exits 2 naming the field; SIGTERM exits 0 within 1 s
+#       --help; bad configuration exits 2 naming the field; SIGTERM exits 0 within 1 s;
+#       control_t SHUTDOWN exits 0
 #   reident_run.sh good    <...same...>   refit of a plant whose gain moved 10 % is published
 #   reident_run.sh garbage <...same...>   NaN / constant u / stuck y never publish a set
+#   reident_run.sh invalid <...same...>   with --publish-invalid, refused refits go out as valid = false
 set -euo pipefail
 what="$1"; reident="$2"; stream="$3"; src="$4"
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
@@ -14,6 +16,8 @@ cleanup() { [ -n "$pid" ] && kill -KILL "$pid" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; [ -f "$dir/reident.log" ] && tail -n 30 "$dir/reident.log" >&2; exit 1; }
 
+# True while the process runs (an exited child stays a zombie until waited for).
+alive() { local st; st="$(ps -o stat= -p "$1" 2>/dev/null)" || return 1; [[ "$st" != Z* ]]; }
 # Starts the re-identifier in the background with extra arguments.
 start() {
   "$reident" --config "$config" --lcm-url "$url" --log-file "$dir/reident.log" "$@" >"$dir/stdout" 2>"$dir/stderr" &
@@ -60,12 +64,25 @@ case "$what" in
     kill -0 "$pid" || fail "exited early: $(cat "$dir/stderr")"
     stop_within_1s
     grep -q "reident: rate_hz 10000" "$dir/reident.log" || fail "configuration not logged at start"
+    # control_t SHUTDOWN addressed to "reident" stops it as SIGTERM does.
+    start
+    "$stream" shutdown --url "$url" || fail "could not send SHUTDOWN"
+    for _ in $(seq 20); do alive "$pid" || break; sleep 0.05; done
+    ! alive "$pid" || fail "still running 1 s after SHUTDOWN"
+    rc=0; wait "$pid" || rc=$?; pid=""
+    [ "$rc" = 0 ] || fail "exit status $rc after SHUTDOWN"
+    grep -q "shutdown requested" "$dir/reident.log" || fail "SHUTDOWN not logged"
     ;;
   good)
     start
     "$stream" good --url "$url" --duration-s 6 --frequency-hz 1 --tolerance 0.03 || fail "stream check"
     stop_within_1s
     grep -q "published params version" "$dir/reident.log" || fail "no 'published' log line"
+    ;;
+  invalid)
+    start --publish-invalid
+    "$stream" good --url "$url" --duration-s 6 --frequency-hz 1 --tolerance 0.03 --expect-invalid 1 || fail "stream check"
+    stop_within_1s
     ;;
   garbage)
     start --set reident.window_s=1 --set reident.refit_period_s=0.5
@@ -74,6 +91,6 @@ case "$what" in
     grep -q "refit refused (poisoned_window)" "$dir/reident.log" || fail "refusals not logged"
     ! grep -q "published params" "$dir/reident.log" || fail "a set was published"
     ;;
-  *) echo "usage: reident_run.sh cli|good|garbage <reidentifier> <stream> <source dir>" >&2; exit 2 ;;
+  *) echo "usage: reident_run.sh cli|good|invalid|garbage <reidentifier> <stream> <source dir>" >&2; exit 2 ;;
 esac
 echo "reident_run.sh $what: OK"

@@ -1,8 +1,9 @@
 // Test publisher for hystloop-reidentifier (tests/integration/reident_*.sh), run inside
 // tools/netns-run:
 //
-//   reident_stream good    --url U [--duration-s 6] [--frequency-hz 1] [--tolerance 0.03]
+//   reident_stream good    --url U [--duration-s 6] [--frequency-hz 1] [--tolerance 0.03] [--expect-invalid 1]
 //   reident_stream garbage --url U [--phase-s 2]
+//   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reident" (after its first status)
 //
 // Both wait for the re-identifier's first HX_STATUS, then stream sensor_sample_t at 10 kHz of
 // real time (bursts of 10 samples per millisecond), reading HX_PARAMS and HX_STATUS between
@@ -12,6 +13,8 @@
 //           model (common/models/mem.hpp) with gain 1.1 x the initial params + 1 nm noise.
 //           Passes if a valid HX_PARAMS from "reident@..." arrives with version >= 6 and c1, c2
 //           within --tolerance of the truth, and the status shows the external set adopted.
+//           With --expect-invalid 1 (re-identifier run with --publish-invalid), the later refused
+//           refits must arrive as valid = false, with their own versions, and not become the set in use.
 //  garbage: three phases: y NaN on every 200th sample (sine u), constant u with noisy y,
 //           y stuck while u moves. Passes if no valid set is ever published and the status
 //           counts poisoned-window and constant-input refusals, non-finite samples and dropouts.
@@ -25,12 +28,14 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/sensor_sample_t.hpp"
 #include "hystloop/service_status_t.hpp"
@@ -54,6 +59,7 @@ struct Options {
   double frequency_hz = 1.0;
   double tolerance = 0.03;
   double settle_s = 2.5;
+  bool expect_invalid = false;  // the re-identifier runs with --publish-invalid
   double c1 = MemParams::paper_like().c1, c2 = MemParams::paper_like().c2, c3 = MemParams::paper_like().c3;
 };
 
@@ -61,7 +67,9 @@ Options parse(int argc, char** argv) {
   Options o;
   if (argc < 2) throw std::invalid_argument("usage: reident_stream good|garbage --url U [options]");
   o.mode = argv[1];
-  if (o.mode != "good" && o.mode != "garbage") throw std::invalid_argument("mode must be good or garbage");
+  if (o.mode != "good" && o.mode != "garbage" && o.mode != "shutdown") {
+    throw std::invalid_argument("mode must be good, garbage or shutdown");
+  }
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const std::string value = argv[i + 1];
@@ -72,6 +80,7 @@ Options parse(int argc, char** argv) {
     else if (key == "--frequency-hz") o.frequency_hz = std::stod(value);
     else if (key == "--tolerance") o.tolerance = std::stod(value);
     else if (key == "--settle-s") o.settle_s = std::stod(value);
+    else if (key == "--expect-invalid") o.expect_invalid = value == "1";
     else throw std::invalid_argument("unknown option " + key);
   }
   return o;
@@ -80,6 +89,8 @@ Options parse(int argc, char** argv) {
 struct Observed {
   int valid_params = 0, invalid_params = 0;
   mem_params_t best{};  // last valid set from the re-identifier
+  std::set<std::int32_t> versions;  // of every set from the re-identifier
+  bool duplicate_version = false;
   double first_valid_after_s = -1.0;
   int statuses = 0;
   service_status_t last_status{};
@@ -104,12 +115,23 @@ class Stream {
       std::fprintf(stderr, "reident_stream: no HX_STATUS from reident within 10 s\n");
       return 1;
     }
+    if (o_.mode == "shutdown") {
+      control_t c{};
+      c.utime = 1;
+      c.request_id = 4242;
+      c.command = control_t::SHUTDOWN;
+      c.target = "reident";
+      Publisher<control_t> control(*lcm_, names_.control);
+      for (int i = 0; i < 3; ++i) control.publish(c);  // repeated, as over UDP: acted on once
+      return 0;
+    }
     return o_.mode == "good" ? run_good() : run_garbage();
   }
 
  private:
   void on_params(const mem_params_t& m) {
     if (m.source.rfind("reident@", 0) != 0) return;  // our own announcement
+    if (!seen_.versions.insert(m.version).second) seen_.duplicate_version = true;
     if (m.valid) {
       ++seen_.valid_params;
       seen_.best = m;
@@ -232,7 +254,15 @@ class Stream {
       check(std::isfinite(b.residual_m) && b.residual_m > 0 && b.residual_m < 20e-9, "residual_m out of range");
       check(b.samples_used > 0 && b.window_s > 0, "samples_used/window_s missing");
     }
-    check(seen_.invalid_params == 0, "a valid = false set was published without --publish-invalid");
+    if (o_.expect_invalid) {
+      // Refits after the accepted one are no better: published for diagnosis, never in use.
+      check(seen_.invalid_params >= 1, "--publish-invalid published no refused candidate");
+      check(counter("params_version") == seen_.best.version, "a valid = false set became the set in use");
+      std::printf("reident_stream: %d diagnostic (valid = false) sets\n", seen_.invalid_params);
+    } else {
+      check(seen_.invalid_params == 0, "a valid = false set was published without --publish-invalid");
+    }
+    check(!seen_.duplicate_version, "two sets with one version");
     check(counter("params_adopted") == 1, "the external set was not adopted");
     check(counter("refits_accepted") >= 1, "status does not count the accepted refit");
     check(counter("seq_gaps") == 0, "samples were lost on the way");

@@ -7,7 +7,7 @@ target_link_libraries(reident_stream PRIVATE hystloop::lcm hystloop::models hyst
 target_include_directories(reident_stream PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
 
 if(TARGET hystloop-reidentifier)
-  foreach(_case cli good garbage)
+  foreach(_case cli good invalid garbage)
     add_test(NAME reident_${_case}
       COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/reident_run.sh ${_case}
               $<TARGET_FILE:hystloop-reidentifier> $<TARGET_FILE:reident_stream> ${PROJECT_SOURCE_DIR})
