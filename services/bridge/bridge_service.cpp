@@ -75,6 +75,14 @@ void BridgeService::on_control(const control_t& msg) {
       return;
     case control_t::RESET_COUNTERS:
       ++control_acted_;
+      // The I/O thread's counters from now; the real-time thread's from its next report (asked
+      // for at once, so at most a tick of its events is not counted).
+      baseline_.queue_full = command_queue_full_;
+      baseline_.acted = control_acted_;
+      baseline_.refused = control_refused_;
+      baseline_.commands = commands_.counters();
+      baseline_.control = control_.counters();
+      baseline_.sensor = sensor_pub_.counters();
       reset_pending_ = true;
       spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
       return;
@@ -140,10 +148,10 @@ int BridgeService::run() {
       }
     }
     const auto now = clock::now();
-    if (now >= next_report && !awaiting_report) {
+    if ((now >= next_report || reset_pending_) && !awaiting_report) {
       rt_.reports().request();
       awaiting_report = true;
-      next_report += std::chrono::seconds(1);
+      if (now >= next_report) next_report += std::chrono::seconds(1);
     }
     if (awaiting_report) {
       if (const RtReport* r = rt_.reports().take()) {
@@ -178,8 +186,9 @@ int BridgeService::run() {
 
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
   if (reset_pending_) {
-    baseline_ = {rt.core, rt.ticks_skipped, rt.samples_dropped, command_queue_full_, control_acted_, control_refused_,
-                 commands_.counters(), control_.counters(), sensor_pub_.counters()};
+    baseline_.core = rt.core;
+    baseline_.skipped = rt.ticks_skipped;
+    baseline_.dropped = rt.samples_dropped;
     reset_pending_ = false;
   }
   // Late fraction of this report period, over the ticks that were armed.

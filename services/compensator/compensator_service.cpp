@@ -212,7 +212,10 @@ void CompensatorService::on_control(const control_t& msg) {
         spdlog::info("experiment stopped (request {})", msg.request_id);
         break;
       case control_t::RESET_COUNTERS:
-        reset_pending_ = true;
+        baseline_ = collect_counters();
+        endpoint_base_ = {samples_.counters(), trajectories_.counters(), params_.counters(), control_.counters(),
+                          command_pub_.counters()};
+        spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
         break;
       case control_t::SHUTDOWN:
         spdlog::info("SHUTDOWN (request {})", msg.request_id);
@@ -269,13 +272,7 @@ std::vector<std::pair<std::string, std::uint64_t>> CompensatorService::collect_c
 }
 
 void CompensatorService::report(std::int64_t utime, bool stopping) {
-  auto counters = collect_counters();
-  if (reset_pending_) {
-    baseline_ = counters;
-    endpoint_base_ = {samples_.counters(), trajectories_.counters(), params_.counters(), control_.counters(),
-                     command_pub_.counters()};
-    reset_pending_ = false;
-  }
+  const auto counters = collect_counters();
   const Compensator& c = *compensator_;
   if (c.counters().params_swapped != swaps_reported_) {
     swaps_reported_ = c.counters().params_swapped;

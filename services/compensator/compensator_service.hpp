@@ -102,7 +102,6 @@ class CompensatorService {
     EndpointCounters sensor, trajectory, params, control;
     PublisherCounters command;
   } endpoint_base_{};
-  bool reset_pending_ = false;
 };
 
 }  // namespace hystloop

@@ -14,7 +14,7 @@
 //                      checks the recorded samples: never outside [u_min, u_max], never a step
 //                      above max(slew, ramp) * dt, every watchdog trip within watchdog_s + 5 ticks
 //                      of the last command applied; prints key=value figures. Exit 1 on a violation.
-//   loop_probe status-value --dir D --process P --key K   the last report's value of K
+//   loop_probe status-value --dir D --process P --key K   the last (not STOPPING) report's value of K
 //                      (a counter name, or state/late/rejected/latency_p50_us/... or detail)
 #include <CLI/CLI.hpp>
 
@@ -235,7 +235,25 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
   return 0;
 }
 
+// Reference per tick from the recorded commands (the last one sent for each tick).
+std::map<std::int64_t, double> references(const std::string& dir) {
+  std::map<std::int64_t, double> ref;
+  std::ifstream in(dir + "/command.csv");
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    long long seq = 0, sample_seq = 0;
+    double u = 0, uff = 0, ufb = 0, y_ref = 0;
+    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%lf,%lf", &seq, &sample_seq, &u, &uff, &ufb, &y_ref) == 6) {
+      ref[seq] = y_ref;
+    }
+  }
+  return ref;
+}
+
 int analyze(const std::string& dir, double u_min, double u_max, double slew, double ramp, double dt, double watchdog) {
+  const std::map<std::int64_t, double> ref = references(dir);
+  std::vector<double> run_errors;  // y - y_ref over the current armed run
   std::ifstream in(dir + "/sensor.csv");
   std::string line;
   std::getline(in, line);
@@ -265,6 +283,11 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
       last_applied = seq;
       ++applied;
     }
+    if (safe) {
+      run_errors.clear();
+    } else if (const auto r = ref.find(seq); r != ref.end() && std::isfinite(r->second)) {
+      run_errors.push_back(y - r->second);
+    }
     if (safe && !prev_safe && last_applied >= 0) {  // a trip (or a disarm) after commands were applied
       ++trips;
       const std::int64_t ticks = seq - last_applied;
@@ -275,6 +298,13 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
     prev_seq = seq;
     prev_u = u;
   }
+  // Tracking over the second half of the last armed run.
+  double sum2 = 0.0;
+  const std::size_t half = run_errors.size() / 2;
+  for (std::size_t i = half; i < run_errors.size(); ++i) sum2 += run_errors[i] * run_errors[i];
+  const std::size_t n_track = run_errors.size() - half;
+  std::printf("last_run_ticks=%zu\ntracking_rms_m=%.6g\n", run_errors.size(),
+              n_track > 0 ? std::sqrt(sum2 / static_cast<double>(n_track)) : kNaN);
   std::printf("samples=%lld\nseq_gaps=%lld\napplied=%lld\nout_of_range=%lld\nmax_step_V=%.6g\nallowed_step_V=%.6g\n"
               "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n",
               static_cast<long long>(n), static_cast<long long>(gaps), static_cast<long long>(applied),
@@ -289,7 +319,8 @@ int status_value(const std::string& dir, const std::string& process, const std::
   std::ifstream in(dir + "/status.log");
   std::string line, last;
   while (std::getline(in, line)) {
-    if (line.rfind("process=" + process + " ", 0) == 0) last = line;
+    // The last report before STOPPING (which says only that).
+    if (line.rfind("process=" + process + " ", 0) == 0 && line.find(" state=4 ") == std::string::npos) last = line;
   }
   if (last.empty()) {
     std::fprintf(stderr, "loop_probe: no status from %s\n", process.c_str());

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# hystloop-bridge's command line: --help, and a bad configuration value exits 2 naming the field.
+#   bridge_cli.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
+source "$(dirname "$0")/loop_common.sh" "$@"
+"$bridge" --help >"$dir/help.txt" || fail "--help exited with $?"
+for opt in --config --set --lcm-url --rig --backend --noise-rms-m --drift --seconds --auto-arm; do
+  grep -q -- "$opt" "$dir/help.txt" || fail "--help does not mention $opt"
+done
+refused() {  # expected-text, args...
+  local want="$1"; shift
+  set +e; "$bridge" "$@" >"$dir/out.txt" 2>"$dir/err.txt"; local rc=$?; set -e
+  [ $rc -eq 2 ] || fail "'$*' exited with $rc, expected 2 ($(cat "$dir/err.txt"))"
+  grep -q -- "$want" "$dir/err.txt" || fail "'$*': stderr does not say '$want': $(cat "$dir/err.txt")"
+}
+refused "actuator.watchdog_s" --set actuator.watchdog_s=-1
+refused "actuator.u_max_V: must be greater than actuator.u_min_V" --set actuator.u_max_V=-300
+refused "actuator.safe_u_V" --set actuator.safe_u_V=400
+refused "bridge.backend" --backend hardware
+refused "bridge.noise_rms_m" --noise-rms-m 1
+refused "bridge.drift_fraction" --drift 5
+refused "banning.hysteresis.b" --set banning.hysteresis.b=1e-8
+refused "ro.c3" --set ro.c3=0
+refused "rt.io_priority" --set rt.priority=50 --set rt.io_priority=60
+refused "did you mean 'actuator.watchdog_s'" --set actuator.watchdog=0.1
+printf 'actuator:\n  slew_V_per_s: -5\n' >"$dir/bad.yaml"
+refused "bad.yaml: actuator.slew_V_per_s" --config "$dir/bad.yaml"
+refused "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
+# The default configuration is valid: a short run on the in-process provider.
+"$bridge" --config "$config/bridge.yaml" --lcm-url memq:// --seconds 0.2 --set rt.priority=0 --set rt.io_priority=0 \
+  >"$dir/run.log" 2>&1 || fail "a run with deploy/config/bridge.yaml failed"
+grep -q "summary:" "$dir/run.log" || fail "no summary at stop"
+echo "bridge_cli: ok"

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Malformed (truncated), wrong-type, non-finite and out-of-range messages on every input channel
+# of each service -- HX_COMMAND and HX_CONTROL for the bridge; HX_SENSOR, HX_TRAJECTORY, HX_PARAMS
+# and HX_CONTROL for the compensator -- are rejected and counted in HX_STATUS, and nothing unsafe
+# reaches the actuator. Inside tools/netns-run.
+#   loop_reject.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
+source "$(dirname "$0")/loop_common.sh" "$@"
+n=5
+start_recording 5.0
+"$compensator" "${compensator_args[@]}" >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
+"$bridge" "${bridge_args[@]}" --auto-arm >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
+sleep 1.0
+"$probe" control --command reset_counters    # counts from here on
+sleep 0.1
+"$probe" inject --target bridge --count $n
+"$probe" inject --target compensator --count $n
+"$probe" params --version 7 --c1 5e-9 --c2 1e-12 --c3 1.2 --valid 0   # a diagnostic set: never used
+"$probe" control --command set_mode --target compensator --mode 5     # experiment is not a mode
+sleep 2.3
+kill -TERM $bpid $cpid
+wait $bpid || fail "the bridge exited with $?"
+wait $cpid || fail "the compensator exited with $?"
+wait "${pids[0]}"
+"$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
+
+# Both injections send their bad HX_CONTROL messages to everyone: 2n of each there.
+for reason in decode_failed wrong_type non_finite out_of_range; do
+  expect_value bridge command.rejected_$reason $n
+  expect_value bridge control.rejected_$reason $((2 * n))
+  for endpoint in sensor trajectory params; do
+    expect_value compensator $endpoint.rejected_$reason $n
+  done
+  expect_value compensator control.rejected_$reason $((2 * n))
+done
+expect_value compensator params_invalid 1
+expect_value compensator params_swapped 0
+expect_value compensator control_refused 1
+expect_value bridge watchdog_trips 0
+[ "$(value bridge rejected)" -ge $((12 * n)) ] || fail "bridge rejected = $(value bridge rejected), expected >= $((8 * n))"
+[ "$(value compensator rejected)" -ge $((20 * n + 2)) ] || fail "compensator rejected = $(value compensator rejected)"
+echo "bridge rejected $(value bridge rejected), compensator rejected $(value compensator rejected)"
+echo "loop_reject: ok"
