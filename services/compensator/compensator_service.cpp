@@ -42,7 +42,6 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
       status_(lcm, channels.status, "compensator"),
-      trajectory_(settings.trajectory),
       gains_(settings.control.feedback) {
   pending_trajectory_ = settings.trajectory;  // the configured reference starts with the first sample
   baseline_ = collect_counters();
@@ -244,6 +243,7 @@ void CompensatorService::restart_control_law() {
   TrajectorySpec spec = trajectory_;
   spec.hold_m = 0.0;
   pending_trajectory_ = spec;
+  trajectory_ = TrajectorySpec{};
   pending_start_utime_ = 0;
   ++counters_.bridge_restarts;
 }

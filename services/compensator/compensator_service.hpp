@@ -85,7 +85,7 @@ class CompensatorService {
   std::int64_t last_sample_seq_ = -1;
   std::optional<TrajectorySpec> pending_trajectory_;  // arrived before the first sample
   std::int64_t pending_start_utime_ = 0;
-  TrajectorySpec trajectory_{};       // the reference in use (for where a new one starts from)
+  TrajectorySpec trajectory_{};       // the reference in use (for where a new one starts from); none: hold at 0
   std::int64_t trajectory_version_ = 0;
   std::int32_t offered_version_ = 0;  // highest mem_params_t.version offered
   FeedbackGains gains_{};             // as the operator set them
