@@ -40,7 +40,7 @@ void StatusBoard::update(const service_status_t& status, std::int64_t recv_utime
 }
 
 HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
-                           const std::vector<std::string>& accept_safe) {
+                           const std::vector<std::string>& accept_safe, bool accept_degraded) {
   HealthVerdict verdict;
   for (const auto& name : required) {
     const auto it = board.processes().find(name);
@@ -50,7 +50,10 @@ HealthVerdict check_health(const StatusBoard& board, const std::vector<std::stri
     }
     const auto& s = it->second.status;
     const bool safe_ok = std::find(accept_safe.begin(), accept_safe.end(), name) != accept_safe.end();
-    if (s.state == service_status_t::HEALTHY || (safe_ok && s.state == service_status_t::SAFE)) continue;
+    if (s.state == service_status_t::HEALTHY || (safe_ok && s.state == service_status_t::SAFE) ||
+        (accept_degraded && s.state == service_status_t::DEGRADED)) {
+      continue;
+    }
     verdict.problems.push_back(name + ": " + state_name(s.state) + (s.detail.empty() ? "" : " (" + s.detail + ")"));
   }
   verdict.healthy = verdict.problems.empty();

@@ -35,9 +35,10 @@ struct HealthVerdict {
 };
 
 // Every process in `required` has reported HEALTHY in its latest report, or SAFE if it
-// is listed in `accept_safe`.
+// is listed in `accept_safe`, or DEGRADED when accept_degraded (it is serving, with a
+// complaint: e.g. a logger that saw a gap while the rig started).
 HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
-                           const std::vector<std::string>& accept_safe);
+                           const std::vector<std::string>& accept_safe, bool accept_degraded = false);
 
 // One line: process, state, pid@host, uptime, late/rejected, loop and latency timing, detail.
 // With all_counters, the named counters follow, one per indented line.

@@ -53,14 +53,14 @@ int run_status(CtlLink& link, const StatusOptions& o) {
       return 1;
     }
     if (waiting) {
-      verdict = check_health(board, o.wait_healthy, o.accept_safe);
+      verdict = check_health(board, o.wait_healthy, o.accept_safe, o.accept_degraded);
       if (verdict.healthy) break;
     }
   }
   for (const auto& [name, report] : board.processes()) std::printf("%s\n", format_status(report, o.all_counters).c_str());
   std::fflush(stdout);
   if (waiting) {
-    verdict = check_health(board, o.wait_healthy, o.accept_safe);
+    verdict = check_health(board, o.wait_healthy, o.accept_safe, o.accept_degraded);
     if (verdict.healthy) return 0;
     std::string problems;
     for (const auto& p : verdict.problems) {

@@ -54,6 +54,7 @@ struct StatusOptions {
   double listen_s = 1.5;                   // without --wait-healthy: how long to collect reports
   std::vector<std::string> wait_healthy;   // processes that must report HEALTHY
   std::vector<std::string> accept_safe;    // ... or SAFE, for these
+  bool accept_degraded = false;            // ... or DEGRADED, for all
   double timeout_s = 10.0;
   bool all_counters = false;
 };

@@ -2,7 +2,7 @@
 //
 //   hystloop-ctl [--lcm-url URL] [--allow-network] [--rig PREFIX] SUBCOMMAND [options]
 //
-//   status [--wait-healthy P... [--accept-safe P]... --timeout S] [--listen S] [--counters]
+//   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
 //   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine]
@@ -127,6 +127,8 @@ int main(int argc, char** argv) {
   status->add_option("--wait-healthy", o.status.wait_healthy,
                      "Exit 0 as soon as each of these processes reports HEALTHY; 1 after --timeout");
   status->add_option("--accept-safe", o.status.accept_safe, "Also accept SAFE from this process (e.g. an unarmed bridge)");
+  status->add_flag("--accept-degraded", o.status.accept_degraded,
+                   "Also accept DEGRADED (serving, with a complaint the status detail names)");
   status->add_option("--timeout", o.status.timeout_s, "How long --wait-healthy waits [s]")->capture_default_str();
   status->add_option("--listen", o.status.listen_s, "Without --wait-healthy: how long to collect reports [s]")
       ->capture_default_str();
