@@ -270,26 +270,24 @@ struct Refusal {
   std::string message;  // expected on stderr
 };
 
+// One case per kind of refusal (the reader's and the tables' messages are checked in detail
+// in-process by model_tool_core_test); each is a process start, which is slow under the sanitizer.
 TEST_F(ModelTool, EveryRefusalExitsWithTwoAndNamesWhere) {
   const std::string ok = "t,u\n0,0\n0.001,10\n";
   const std::vector<Refusal> cases = {
       {"--model mem --forward {in}", "t,u\n0,0\n0.001,abc\n", "{in}:3: column 'u': expected a number, got 'abc'"},
-      {"--model mem --forward {in}", "t,u\n0,0\n0.001,1.5e\n", "{in}:3: column 'u': expected a number, got '1.5e'"},
       {"--model mem --forward {in}", "", "{in}:1: empty file: expected a header row 't,u'"},
       {"--model mem --forward {in}", "0,0\n0.001,10\n", "{in}:1: missing header row: expected column names 't,u'"},
       {"--model mem --forward {in}", "t,v\n0,0\n", "{in}:1: header 't,v' lacks column 'u'"},
       {"--model mem --inverse {in}", ok, "{in}:1: header 't,u' lacks column 'y_ref' (expected 't,y_ref'"},
       {"--model mem --forward {in}", "t,u\n0,0\n0.001,inf\n", "{in}:3: column 'u': expected a finite number, got 'inf'"},
-      {"--model mem --forward {in}", "t,u\n0,0\nnan,1\n", "{in}:3: column 't': expected a finite number, got 'nan'"},
       {"--model mem --forward {in}", "t,u\n0,0\n0.001,1,2\n", "{in}:3: 3 fields, the header has 2"},
       {"--model mem --forward {in}", "t,u\n", "{in}:1: no data rows after the header"},
       {"--model banning --forward {in}", "t,u\n0,0\n0.001,1\n0.001,2\n",
        "{in}:4: column 't': must increase, got 0.001 after 0.001 (line 3)"},
-      {"--model banning --forward {in}", "t,u\n0,0\n0.002,1\n0.001,2\n", "{in}:4: column 't': must increase"},
       {"--model banning --inverse {in}", "t,y_ref\n0,0\n", "--inverse: model banning has no inverse"},
       {"--model mem --forward --param c4=1 {in}", ok,
        "--param c4=1: unknown parameter 'c4' of model mem; did you mean 'c1'? (valid: c1, c2, c3)"},
-      {"--model katalenic --forward --param k_1=30 {in}", ok, "did you mean 'k1'?"},
       {"--model mem --forward --param c1=5e-9x {in}", ok, "--param c1=5e-9x: expected a number, got '5e-9x'"},
       {"--model mem --forward --param c1 {in}", ok, "--param c1: expected NAME=VALUE"},
       {"--model mem --forward --param c3=-1 {in}", ok, "model mem: c3: must be > 0 (got -1)"},
@@ -297,8 +295,6 @@ TEST_F(ModelTool, EveryRefusalExitsWithTwoAndNamesWhere) {
       {"--model pi --forward --param n=40 {in}", ok, "model pi: n: must be in [1, 32] (got 40)"},
       {"--model pi --forward --param thresholds=0,10 {in}", ok, "model pi: thresholds: given without weights"},
       {"--model pi --forward --param weights=-1e-9 {in}", ok, "model pi: weights[0]:"},
-      {"--model katalenic --forward --param initial_offset=100 {in}", ok, "model katalenic: initial_offset:"},
-      {"--model linear --forward --param gain=0 {in}", ok, "model linear: gain:"},
       {"--model memm --forward {in}", ok, "--model: unknown model 'memm'; did you mean 'mem'?"},
       {"--forward {in}", ok, "give --model"},
       {"--model mem {in}", ok, "choose --forward"},
@@ -338,6 +334,16 @@ TEST_F(ModelTool, ParamsFileRefusalsNameTheFileAndKey) {
   r = run("--params-file " + other + " --model mem --forward " + in);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(other + ": no 'mem' section (it has: pi)"), std::string::npos) << r.err;
+}
+
+// A finite input the model cannot map (MEM's p^c3 overflows) is a failure of the run, not of
+// the file: exit 1, naming the row.
+TEST_F(ModelTool, ANonFiniteResultExitsWithOneNamingTheRow) {
+  const std::string in = write_text("u.csv", "t,u\n0,0\n0.001,1e300\n");
+  const ToolRun r = run("--model mem --forward " + in + " --out " + path("y.csv"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(in + ":3: model mem gave a non-finite y for u = 1e+300"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("y.csv")));
 }
 
 TEST_F(ModelTool, NoOutputFileIsWrittenWhenTheInputIsRefused) {
