@@ -12,7 +12,7 @@ namespace {
 constexpr const char* kReidentKeys[] = {
     "reident.rate_hz",          "reident.refit_period_s",           "reident.window_s",
     "reident.capacity_s",       "reident.holdout_branches",         "reident.min_relative_improvement",
-    "reident.max_residual_rms_m", "reident.max_solver_time_s",      "reident.publish_invalid",
+    "reident.max_residual_rms_m", "reident.max_solver_time_s", "reident.reversal_dead_band_V",      "reident.publish_invalid",
     "reident.stale_after_s",    "reident.degraded_after_poisoned", "reident.lcm_queue",
 };
 
@@ -63,6 +63,9 @@ ReidentOptions read_reident_options(const Config& config) {
       config.get_in_range("reident.min_relative_improvement", e.min_relative_improvement, 0.0, 0.99);
   e.max_residual_rms_m = config.get_in_range("reident.max_residual_rms_m", e.max_residual_rms_m, 1e-15, 1.0);
   e.fit.max_solver_time_s = config.get_in_range("reident.max_solver_time_s", e.fit.max_solver_time_s, 1e-4, 60.0);
+  // With feedback on, u carries small jitter: reversals smaller than this are not branches.
+  e.fit.reversal_dead_band_V =
+      config.get_in_range("reident.reversal_dead_band_V", e.fit.reversal_dead_band_V, 0.0, 100.0);
   // The field names of OnlineMemOptions are not the file's: a refusal here would be a bug above.
   e.validate();
   return o;
