@@ -155,6 +155,28 @@ TEST_F(IdentifyTool, HelpDescribesTheModels) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--model"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("banning"), std::string::npos) << r.output;
+  // LCM logs and publishing (tested on logs in tools/identify/tests/).
+  EXPECT_NE(r.output.find(".lcmlog"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--from"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--publish"), std::string::npos) << r.output;
+}
+
+TEST_F(IdentifyTool, PublishIsOnlyForMemAndNeedsALocalUrl) {
+  const MemParams truth = MemParams::paper_like();
+  MemModel model(truth);
+  model.reset(0.0);
+  const auto u = testdata::paper_identification_input();
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  write_csv(path("mem.csv"), u, y, 1e4);
+  const ToolRun pi = run_tool(path("mem.csv") + " --model pi --publish");
+  EXPECT_EQ(pi.exit_code, 2) << pi.output;
+  EXPECT_NE(pi.output.find("only with --model mem"), std::string::npos) << pi.output;
+  const ToolRun net = run_tool(path("mem.csv") + " --model mem --publish --lcm-url 'udpm://239.255.76.67:7667?ttl=3'");
+  EXPECT_EQ(net.exit_code, 2) << net.output;
+  EXPECT_NE(net.output.find("lcm.url"), std::string::npos) << net.output;
+  // A time range is for logs.
+  EXPECT_EQ(run_tool(path("mem.csv") + " --model mem --to 1").exit_code, 2);
 }
 
 }  // namespace

@@ -1,11 +1,20 @@
-// hystloop-identify data.csv --model mem|banning|katalenic|pi|linear|auto [--form integrated|derivative]
-//                   [--out params.yaml]
-// Exit status: 0 fitted, 1 the data cannot support a fit (the reason is printed), 2 usage or file error.
+// hystloop-identify data.csv|run.NNN.lcmlog... --model mem|banning|katalenic|pi|linear|auto
+//                   [--form integrated|derivative] [--out params.yaml]
+//                   [--log] [--rig HX_] [--dt 1e-4 | --time-from utime] [--from S] [--to S]
+//                   [--publish [--version N] [--listen-s 0.5] [--lcm-url URL] [--allow-network]]
+// Input: CSV t,u,y (sample_csv.hpp), or LCM event logs (files ending in .lcmlog, or --log): the
+// rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp).
+// --publish (MEM only) sends the fitted set on HX_PARAMS (params_publish.hpp).
+// Exit status: 0 fitted (and published), 1 the data cannot support a fit (the reason is printed;
+// nothing is published), 2 usage, file or LCM setup error, 3 fitted but not published.
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +23,8 @@
 #include "ident/model_selection.hpp"
 #include "ident/params_yaml.hpp"
 #include "ident/sample_csv.hpp"
+#include "log_samples.hpp"
+#include "params_publish.hpp"
 
 namespace {
 
@@ -28,6 +39,18 @@ struct Args {
   double min_snr = 3.0;
   std::size_t operators = 15;
   int katalenic_degree = 1;
+  // LCM logs
+  bool log = false;
+  std::string rig = "HX_";
+  double dt_s = 1e-4;
+  std::string time_from = "seq";
+  std::optional<double> from_s, to_s;
+  // --publish
+  bool publish = false;
+  std::optional<std::int32_t> version;
+  double listen_s = 0.5;
+  std::string lcm_url;
+  bool allow_network = false;
 };
 
 int refuse(FitStatus status, const std::string& reason) {
@@ -49,20 +72,55 @@ int emit(const Args& args, const std::string& yaml) {
   return 0;
 }
 
-int fit_single(const Args& args, const SampleTable& s) {
-  if (args.model == "mem") {
-    MemFitOptions o;
-    o.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
-    o.noise_rms_m = args.noise_rms_m;
-    o.min_snr = args.min_snr;
-    const MemFitResult r = fit_mem(s.u, s.y, o);
-    if (!r.ok()) return refuse(r.status, r.reason);
-    std::printf("MEM (%s form): c1 = %.6g m/V, c2 = %.6g m/V^(1+c3), c3 = %.6g\n", args.form.c_str(), r.params.c1,
-                r.params.c2, r.params.c3);
-    std::printf("fit: residual %.4g nm RMS, noise %.4g nm, %zu samples, %zu branches, %.1f ms\n", r.residual_rms_m * 1e9,
-                r.noise_rms_m * 1e9, r.samples_used, r.branches_used, r.solve_time_s * 1e3);
-    return emit(args, to_yaml(r.params));
+int publish_fit(ParamsLink& link, const Args& args, const MemFitResult& r, double window_s) {
+  std::int32_t version = 0;
+  if (args.version) {
+    version = *args.version;
+  } else {
+    const std::int32_t heard = link.highest_version_heard();
+    version = next_params_version(heard);
+    if (heard > 0) {
+      std::printf("version in use on %s: %d\n", link.channels().prefix.c_str(), heard);
+    } else {
+      std::printf("no parameter version heard on %s/%s in %.2g s\n", link.channels().params.c_str(),
+                  link.channels().command.c_str(), args.listen_s);
+    }
   }
+  const auto utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                         std::chrono::system_clock::now().time_since_epoch()).count();
+  const mem_params_t msg = to_mem_params(r, window_s, version, utime, identify_source());
+  const int sent = link.publish(msg);
+  if (sent == 0) {
+    std::cerr << "hystloop-identify: the parameters were not published (refused by the mem_params_t contract check "
+                 "or by LCM)\n";
+    return 3;
+  }
+  std::printf("published MEM parameters v%d on %s (%d time(s)) via %s, source '%s'\n", version,
+              link.channels().params.c_str(), sent, link.url().c_str(), msg.source.c_str());
+  return 0;
+}
+
+int fit_mem_and_emit(const Args& args, const SampleTable& s, ParamsLink* link) {
+  MemFitOptions o;
+  o.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
+  o.noise_rms_m = args.noise_rms_m;
+  o.min_snr = args.min_snr;
+  const MemFitResult r = fit_mem(s.u, s.y, o);
+  if (!r.ok()) {
+    if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
+    return refuse(r.status, r.reason);
+  }
+  std::printf("MEM (%s form): c1 = %.6g m/V, c2 = %.6g m/V^(1+c3), c3 = %.6g\n", args.form.c_str(), r.params.c1,
+              r.params.c2, r.params.c3);
+  std::printf("fit: residual %.4g nm RMS, noise %.4g nm, %zu samples, %zu branches, %.1f ms\n", r.residual_rms_m * 1e9,
+              r.noise_rms_m * 1e9, r.samples_used, r.branches_used, r.solve_time_s * 1e3);
+  const int written = emit(args, to_yaml(r.params));
+  if (written != 0 || link == nullptr) return written;
+  const double window_s = s.t.size() < 2 ? 0.0 : s.t.back() - s.t.front();
+  return publish_fit(*link, args, r, window_s);
+}
+
+int fit_single(const Args& args, const SampleTable& s) {
   if (args.model == "pi") {
     PiFitOptions o;
     o.operators = args.operators;
@@ -163,12 +221,38 @@ int fit_banning_files(const Args& args, const std::vector<SampleTable>& tables) 
   return emit(args, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
 }
 
+// Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError / SampleLogError.
+std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
+  std::vector<SampleTable> tables;
+  if (!logs) {
+    for (const auto& f : args.files) tables.push_back(read_sample_csv(f));
+    return tables;
+  }
+  LogReadOptions o;
+  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.time_base = args.time_from == "utime" ? LogTimeBase::utime : LogTimeBase::seq;
+  o.dt_s = args.dt_s;
+  o.from_s = args.from_s;
+  o.to_s = args.to_s;
+  LogSamples samples = read_sample_logs(args.files, o);
+  std::cout << describe(samples, o);
+  tables.push_back(std::move(samples.table));
+  return tables;
+}
+
+int usage_error(const std::string& message) {
+  std::cerr << "hystloop-identify: " << message << "\n";
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Fit a hysteresis model to recorded samples (CSV with a header row t,u,y in s, V, m)."};
+  CLI::App app{"Fit a hysteresis model to recorded samples: a CSV with a header row t,u,y (s, V, m), or LCM event logs "
+               "(*.lcmlog or --log: the rig's HX_SENSOR samples; rotated files in recording order)."};
   Args args;
-  app.add_option("files", args.files, "CSV file(s); for banning one per experiment, or one with an 'experiment' column")
+  app.add_option("files", args.files,
+                 "CSV file(s) (for banning one per experiment, or one with an 'experiment' column), or LCM log file(s)")
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--model", args.model, "mem, banning, katalenic, pi, linear, or auto (fit all, rank on held-out data)")
@@ -188,21 +272,62 @@ int main(int argc, char** argv) {
   app.add_option("--katalenic-degree", args.katalenic_degree, "Katalenic: output shaping polynomial degree (1 = linear)")
       ->check(CLI::Range(1, 7))
       ->capture_default_str();
+  auto* logs = app.add_option_group("LCM logs", "reading HX_SENSOR from LCM event logs");
+  logs->add_flag("--log", args.log, "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
+  logs->add_option("--rig", args.rig, "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>PARAMS")
+      ->capture_default_str();
+  logs->add_option("--dt", args.dt_s, "tick period [s]: t = (seq - first seq) * dt")->capture_default_str();
+  logs->add_option("--time-from", args.time_from, "time base: seq (* --dt) or utime (the samples' timestamps)")
+      ->check(CLI::IsMember({"seq", "utime"}))
+      ->capture_default_str();
+  logs->add_option("--from", args.from_s, "fit only samples at t >= this [s after the record's first sample]");
+  logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
+  auto* pub = app.add_option_group("publishing", "sending the fitted MEM set to a running compensator");
+  pub->add_flag("--publish", args.publish,
+                "after a successful MEM fit, publish mem_params_t on <rig>PARAMS (3 times, 10 ms apart)");
+  pub->add_option("--version", args.version,
+                  "parameter set version (default: 1 + the highest heard on <rig>PARAMS / <rig>COMMAND, at least 2)");
+  pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
+  pub->add_option("--lcm-url", args.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
+  pub->add_flag("--allow-network", args.allow_network, "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
   CLI11_PARSE(app, argc, argv);
+
+  std::size_t log_names = 0;
+  for (const auto& f : args.files) log_names += looks_like_lcm_log(f) ? 1 : 0;
+  const bool from_logs = args.log || log_names == args.files.size();
+  if (!from_logs && log_names > 0) return usage_error("mixed inputs: give either CSV files or LCM logs (*.lcmlog)");
+  if (!from_logs && (args.from_s || args.to_s)) return usage_error("--from/--to select a range of an LCM log");
+  if (args.publish && args.model != "mem") {
+    return usage_error("--publish sends MEM parameters (mem_params_t on HX_PARAMS): only with --model mem (got --model " +
+                       args.model + ")");
+  }
   try {
-    std::vector<SampleTable> tables;
-    for (const auto& f : args.files) tables.push_back(read_sample_csv(f));
+    std::unique_ptr<ParamsLink> link;
+    if (args.publish) {
+      PublishOptions p;
+      p.lcm_url = args.lcm_url;
+      p.allow_network = args.allow_network;
+      p.rig = args.rig;
+      p.version = args.version;
+      p.listen_s = args.listen_s;
+      link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
+    } else {
+      validate_rig_prefix(args.rig);
+    }
+    const std::vector<SampleTable> tables = read_inputs(args, from_logs);
     if (args.model == "banning") return fit_banning_files(args, tables);
     if (tables.size() != 1) {
-      std::cerr << "hystloop-identify: --model " << args.model << " takes one file (got " << tables.size() << ")\n";
-      return 2;
+      return usage_error("--model " + args.model + " takes one file (got " + std::to_string(tables.size()) + ")");
     }
+    if (args.model == "mem") return fit_mem_and_emit(args, tables.front(), link.get());
     return fit_single(args, tables.front());
   } catch (const CsvError& e) {
-    std::cerr << "hystloop-identify: " << e.what() << "\n";
-    return 2;
+    return usage_error(e.what());
+  } catch (const SampleLogError& e) {
+    return usage_error(e.what());
   } catch (const ParameterError& e) {
-    std::cerr << "hystloop-identify: " << e.what() << "\n";
-    return 2;
+    return usage_error(e.what());
+  } catch (const std::runtime_error& e) {  // LCM could not start
+    return usage_error(e.what());
   }
 }

@@ -1,0 +1,172 @@
+#include "log_samples.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/errors.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "lcm/message_checks.hpp"
+#include "lcm/wire_layout.hpp"
+
+namespace hystloop {
+namespace {
+
+constexpr std::size_t kGapsListed = 5;
+
+// Decodes one event as a sensor_sample_t exactly as a Subscription would (fingerprint,
+// length fields, whole buffer used), but without the value check: the caller tells a
+// non-finite value (refused) from an out-of-contract one (counted).
+bool decode_sample(const lcm::LogEvent& event, sensor_sample_t& msg) noexcept {
+  if (event.datalen < 8) return false;
+  const auto size = static_cast<std::size_t>(event.datalen);
+  if (wire_fingerprint(event.data, size) != sensor_sample_t::getHash()) return false;
+  if (walk_wire_layout(wire_layout_of<sensor_sample_t>(), event.data, size) < 0) return false;
+  try {
+    return msg.decode(event.data, 0, event.datalen) == event.datalen;
+  } catch (...) {
+    return false;
+  }
+}
+
+std::string where(const std::string& file, std::int64_t eventnum) {
+  return file + ": event " + std::to_string(eventnum);
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// Folds the samples of a record into LogSamples, one at a time, in log order.
+class RecordBuilder {
+ public:
+  explicit RecordBuilder(const LogReadOptions& options) : options_(options) {}
+
+  void add(const std::string& file, std::int64_t eventnum, const sensor_sample_t& s) {
+    if (!std::isfinite(s.u_V) || !std::isfinite(s.y_m)) {
+      throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) + "): " +
+                           (std::isfinite(s.u_V) ? "y_m" : "u_V") + " is not finite (u_V = " + number(s.u_V) +
+                           ", y_m = " + number(s.y_m) + ")");
+    }
+    if (check_message(s) != Verdict::kOk) return void(++out_.undecodable);
+    if (previous_seq_) {
+      if (s.seq == *previous_seq_) return void(++out_.duplicates);
+      if (s.seq < *previous_seq_) {
+        throw SampleLogError(where(file, eventnum) + ": seq goes back from " + std::to_string(*previous_seq_) + " to " +
+                             std::to_string(s.seq) +
+                             " (files out of order, or the bridge restarted): give the files in recording order");
+      }
+    } else {
+      first_seq_ = s.seq;
+      first_utime_ = s.utime;
+    }
+    const double t = options_.time_base == LogTimeBase::seq
+                         ? static_cast<double>(s.seq - first_seq_) * options_.dt_s
+                         : static_cast<double>(s.utime - first_utime_) * 1e-6;
+    const std::int64_t before = previous_seq_.value_or(s.seq - 1);
+    previous_seq_ = s.seq;
+    if ((options_.from_s && t < *options_.from_s) || (options_.to_s && t >= *options_.to_s)) {
+      ++out_.outside_range;
+      in_range_before_ = false;
+      return;
+    }
+    // A jump counts only between two samples of the range (entering it is not a gap).
+    if (in_range_before_ && s.seq > before + 1) {
+      const auto missing = static_cast<std::size_t>(s.seq - before - 1);
+      ++out_.gaps;
+      out_.missing += missing;
+      if (out_.first_gaps.size() < kGapsListed) out_.first_gaps.push_back({before + 1, missing});
+    }
+    in_range_before_ = true;
+    if ((s.flags & sensor_sample_t::SAFE_STATE) != 0) return void(++out_.safe_state);
+    if ((s.flags & sensor_sample_t::SENSOR_FAULT) != 0) return void(++out_.sensor_fault);
+    out_.table.t.push_back(t);
+    out_.table.u.push_back(s.u_V);
+    out_.table.y.push_back(s.y_m);
+    if (!out_.first_seq) out_.first_seq = s.seq;
+    out_.last_seq = s.seq;
+  }
+
+  LogSamples& result() noexcept { return out_; }
+
+ private:
+  const LogReadOptions& options_;
+  LogSamples out_;
+  std::optional<std::int64_t> previous_seq_;
+  std::int64_t first_seq_ = 0;
+  std::int64_t first_utime_ = 0;
+  bool in_range_before_ = false;
+};
+
+}  // namespace
+
+void LogReadOptions::validate() const {
+  if (sensor_channel.empty()) throw ParameterError("sensor_channel", "must not be empty");
+  require_positive("dt", dt_s);
+  if (from_s) require_non_negative("from", *from_s);
+  if (to_s) {
+    require_positive("to", *to_s);
+    if (from_s && !(*to_s > *from_s)) {
+      throw ParameterError("to", "must be > from (got from " + number(*from_s) + ", to " + number(*to_s) + ")");
+    }
+  }
+}
+
+bool looks_like_lcm_log(const std::string& path) {
+  return std::filesystem::path(path).extension() == ".lcmlog";
+}
+
+LogSamples read_sample_logs(const std::vector<std::string>& files, const LogReadOptions& options) {
+  options.validate();
+  if (files.empty()) throw SampleLogError("no log file given");
+  RecordBuilder record(options);
+  sensor_sample_t sample{};
+  for (const auto& file : files) {
+    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
+    lcm::LogFile log(file, "r");
+    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
+    ++record.result().files;
+    while (const lcm::LogEvent* event = log.readNextEvent()) {
+      ++record.result().events;
+      if (event->channel != options.sensor_channel) continue;
+      ++record.result().sensor_events;
+      if (!decode_sample(*event, sample)) {
+        ++record.result().undecodable;
+        continue;
+      }
+      record.add(file, event->eventnum, sample);
+    }
+  }
+  LogSamples& out = record.result();
+  if (out.table.t.empty()) {
+    std::ostringstream s;
+    s << (files.size() == 1 ? files.front() : files.front() + " ... " + files.back()) << ": no usable "
+      << options.sensor_channel << " sample (" << out.sensor_events << " on the channel, " << out.outside_range
+      << " outside the time range, " << out.skipped() << " skipped)";
+    throw SampleLogError(s.str());
+  }
+  return out;
+}
+
+std::string describe(const LogSamples& s, const LogReadOptions& options) {
+  std::ostringstream o;
+  o << "log: " << s.files << " file(s), " << s.events << " events, " << s.sensor_events << " on "
+    << options.sensor_channel << "\n";
+  o << "samples: " << s.table.t.size() << " kept (seq " << s.first_seq.value_or(0) << " .. " << s.last_seq.value_or(0)
+    << ", t " << number(s.table.t.front()) << " .. " << number(s.table.t.back()) << " s), " << s.outside_range
+    << " outside the time range\n";
+  o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
+    << " repeated seq, " << s.undecodable << " undecodable or out of contract\n";
+  o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";
+  for (const auto& g : s.first_gaps) o << "; seq " << g.first_missing << " +" << g.missing;
+  if (s.gaps > s.first_gaps.size()) o << "; ...";
+  o << "\n";
+  return o.str();
+}
+
+}  // namespace hystloop

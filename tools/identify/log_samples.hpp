@@ -1,0 +1,85 @@
+#pragma once
+// Identification samples from LCM event logs: the rig's HX_SENSOR sensor_sample_t messages,
+// read with lcm::LogFile from one or several files in the order given (a rotated recording is
+// one record), into the same SampleTable the CSV reader makes: u = u_V, y = y_m, and
+// t = (seq - seq of the first sample) * dt, or from utime.
+//
+// What a recording may hold and what becomes of it:
+//  - samples flagged SAFE_STATE (the bridge holding the safe voltage, not the experiment) or
+//    SENSOR_FAULT (y_m is a stale value): skipped and counted;
+//  - missing ticks (seq jumps): counted; they split nothing (MEM is rate independent, the
+//    record simply continues), but the report says how many samples were lost;
+//  - the same seq twice: the repeat is skipped and counted;
+//  - seq going back (files out of order, or the bridge restarted): refused, the message names
+//    the file and event;
+//  - a non-finite u or y: refused like a malformed CSV field, naming file, event and seq;
+//  - an event on the sensor channel that does not decode as sensor_sample_t, or whose values
+//    break the message contract (range, flag bits): skipped and counted;
+//  - other channels: ignored.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "ident/sample_csv.hpp"
+
+namespace hystloop {
+
+// A log that cannot be used; the message names the file (and event).
+class SampleLogError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class LogTimeBase { seq, utime };
+
+struct LogReadOptions {
+  std::string sensor_channel = "HX_SENSOR";  // rig prefix + "SENSOR"
+  LogTimeBase time_base = LogTimeBase::seq;
+  double dt_s = 1e-4;                        // tick period with LogTimeBase::seq [s]
+  // Time range [from, to) relative to the first sample of the record [s]; empty = open.
+  std::optional<double> from_s;
+  std::optional<double> to_s;
+
+  // Throws ParameterError naming the field ("dt", "from", "to").
+  void validate() const;
+};
+
+struct SeqGap {
+  std::int64_t first_missing = 0;  // seq of the first missing tick
+  std::size_t missing = 0;         // ticks missing from there
+};
+
+struct LogSamples {
+  SampleTable table;                 // the samples kept (t relative to the record's first sample)
+  std::size_t files = 0;
+  std::size_t events = 0;            // events of any channel read
+  std::size_t sensor_events = 0;     // events on the sensor channel
+  std::size_t outside_range = 0;     // valid samples outside [from, to)
+  std::size_t safe_state = 0;        // skipped: flagged SAFE_STATE
+  std::size_t sensor_fault = 0;      // skipped: flagged SENSOR_FAULT (and not SAFE_STATE)
+  std::size_t duplicates = 0;        // skipped: the same seq again
+  std::size_t undecodable = 0;       // skipped: not a sensor_sample_t, or out of contract
+  std::size_t gaps = 0;              // seq jumps among the samples in range
+  std::size_t missing = 0;           // ticks missing in those jumps
+  std::vector<SeqGap> first_gaps;    // the first few, for the report
+  std::optional<std::int64_t> first_seq, last_seq;  // of the samples kept
+
+  double window_s() const noexcept { return table.t.size() < 2 ? 0.0 : table.t.back() - table.t.front(); }
+  std::size_t skipped() const noexcept { return safe_state + sensor_fault + duplicates + undecodable; }
+};
+
+// True for a path that names an LCM event log by its ending (".lcmlog").
+bool looks_like_lcm_log(const std::string& path);
+
+// Reads the files in order as one record. Throws SampleLogError for a file that cannot be
+// opened, a non-finite value, seq going back, or no sample left; ParameterError for bad options.
+LogSamples read_sample_logs(const std::vector<std::string>& files, const LogReadOptions& options);
+
+// Lines for the tool's report: counts of what was kept, skipped and missing.
+std::string describe(const LogSamples& samples, const LogReadOptions& options);
+
+}  // namespace hystloop

@@ -1,0 +1,85 @@
+#include "params_publish.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <thread>
+
+#include "core/errors.hpp"
+#include "core/process.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+#include "lcm/url.hpp"
+
+namespace hystloop {
+
+void PublishOptions::validate() const {
+  if (version && *version < 1) throw ParameterError("version", "must be >= 1 (got " + std::to_string(*version) + ")");
+  require_in_range("listen_s", listen_s, 0.0, 60.0);
+  if (repeats < 1 || repeats > 10) {
+    throw ParameterError("repeats", "must be 1..10 (got " + std::to_string(repeats) + ")");
+  }
+  validate_rig_prefix(rig);
+}
+
+std::int32_t next_params_version(std::int32_t highest_heard) noexcept {
+  if (highest_heard >= std::numeric_limits<std::int32_t>::max()) return highest_heard;
+  return std::max(highest_heard + 1, 2);
+}
+
+mem_params_t to_mem_params(const MemFitResult& fit, double window_s, std::int32_t version, std::int64_t utime_us,
+                           const std::string& source) {
+  mem_params_t m{};
+  m.utime = utime_us;
+  m.version = version;
+  m.c1 = fit.params.c1;
+  m.c2 = fit.params.c2;
+  m.c3 = fit.params.c3;
+  m.residual_m = fit.residual_rms_m;
+  m.samples_used = static_cast<std::int64_t>(fit.samples_used);
+  m.window_s = window_s;
+  m.valid = fit.ok();
+  m.source = source;
+  return m;
+}
+
+std::string identify_source() { return "hystloop-identify@" + host_name(); }
+
+ParamsLink::ParamsLink(const PublishOptions& options)
+    : options_(options), channels_(options.rig), url_(resolve_lcm_url(options.lcm_url, options.allow_network)) {
+  options_.validate();
+  lcm_ = open_lcm(url_, options_.allow_network);
+}
+
+std::int32_t ParamsLink::highest_version_heard() {
+  std::int32_t highest = 0;
+  Subscription<mem_params_t> params(*lcm_, channels_.params,
+                                    [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
+  Subscription<actuator_command_t>::Options fast;
+  fast.queue_capacity = 20'000;  // 10 kHz for the whole listening time
+  Subscription<actuator_command_t> commands(
+      *lcm_, channels_.command,
+      [&](const actuator_command_t& c, std::int64_t) { highest = std::max(highest, c.params_version); }, fast);
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(options_.listen_s));
+  for (auto now = Clock::now(); now < deadline; now = Clock::now()) {
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now);
+    if (handle_pending(*lcm_, std::min(left, std::chrono::microseconds(50'000)), 1024) < 0) break;
+  }
+  return highest;
+}
+
+int ParamsLink::publish(const mem_params_t& msg) {
+  Publisher<mem_params_t> publisher(*lcm_, channels_.params);
+  int sent = 0;
+  for (int i = 0; i < options_.repeats; ++i) {
+    if (i > 0) std::this_thread::sleep_for(options_.gap);
+    if (publisher.publish(msg)) ++sent;
+    if (publisher.counters().invalid > 0) return 0;  // refused by the contract: never retried
+  }
+  return sent;
+}
+
+}  // namespace hystloop

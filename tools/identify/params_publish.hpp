@@ -1,0 +1,69 @@
+#pragma once
+// hystloop-identify --publish: a fitted MEM set sent on the rig's HX_PARAMS as mem_params_t,
+// so that a running compensator (which takes only a version above the one it was offered)
+// picks it up at its next reversal. The link is opened before the fit, so a refused URL or a
+// missing multicast route fails fast; the version is looked up after the fit, so it is fresh.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "hystloop/mem_params_t.hpp"
+#include "ident/mem_fit.hpp"
+#include "lcm/channels.hpp"
+
+namespace hystloop {
+
+struct PublishOptions {
+  std::string lcm_url;                     // empty: $LCM_DEFAULT_URL, else the ttl=0 default
+  bool allow_network = false;              // needed for a URL whose packets leave the host
+  std::string rig = std::string(kDefaultRigPrefix);
+  std::optional<std::int32_t> version;     // empty: next_params_version(highest heard)
+  double listen_s = 0.5;                   // how long to listen for the version in use [s]
+  int repeats = 3;                         // UDP may drop one; receivers dedupe by version
+  std::chrono::milliseconds gap{10};
+
+  // Throws ParameterError naming the field ("version", "listen_s", "repeats", "rig.prefix").
+  void validate() const;
+};
+
+// 1 + the highest version heard, and at least 2: version 1 is what a compensator starts with
+// from its configuration, so a first published set must supersede it.
+std::int32_t next_params_version(std::int32_t highest_heard) noexcept;
+
+// The message for a successful fit. residual_m is the fit's own residual (integrated
+// branches), samples_used the fit's, window_s the time span of the samples given to it.
+mem_params_t to_mem_params(const MemFitResult& fit, double window_s, std::int32_t version, std::int64_t utime_us,
+                           const std::string& source);
+
+// "hystloop-identify@<host>".
+std::string identify_source();
+
+class ParamsLink {
+ public:
+  // Throws ParameterError for a refused URL or rig prefix, std::runtime_error if LCM cannot start.
+  explicit ParamsLink(const PublishOptions& options);
+
+  // Listens options.listen_s on HX_PARAMS (and HX_COMMAND's params_version: a compensator
+  // does not repeat the set it uses) and returns the highest version heard, 0 if none.
+  std::int32_t highest_version_heard();
+
+  // Publishes msg options.repeats times, options.gap apart. Returns how many were handed to
+  // LCM (0 if the message fails the contract check).
+  int publish(const mem_params_t& msg);
+
+  const std::string& url() const noexcept { return url_; }
+  const ChannelNames& channels() const noexcept { return channels_; }
+
+ private:
+  PublishOptions options_;
+  ChannelNames channels_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+};
+
+}  // namespace hystloop

@@ -1,0 +1,210 @@
+// hystloop-identify --publish against real udpm LCM (ttl=0) inside tools/netns-run: the test
+// subscribes to HX_PARAMS, runs the tool on a recorded log as a child process, keeps
+// dispatching (and, where needed, plays a rig whose parameter set in use has a version) until
+// the child exits, then checks what arrived: the fitted values, valid = true, the version.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hystloop/actuator_command_t.hpp"
+#include "lcm/channels.hpp"
+#include "lcm/connection.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/subscription.hpp"
+#include "sensor_log_fixture.hpp"
+
+extern char** environ;
+
+namespace hystloop {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace testlog;
+
+const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Runs the tool; while it runs, dispatches `lcm` and calls tick() every ~2 ms.
+Result run_tool(const std::vector<std::string>& args, lcm::LCM& lcm, const std::function<void()>& tick = {}) {
+  const fs::path out = fs::temp_directory_path() / ("identify_publish_out_" + std::to_string(::getpid()));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  std::vector<std::string> all{HYSTLOOP_IDENTIFY_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  Result r;
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, HYSTLOOP_IDENTIFY_EXE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return r;
+  int status = 0;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (::waitpid(pid, &status, WNOHANG) != pid) {
+    if (std::chrono::steady_clock::now() > give_up) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      break;
+    }
+    handle_pending(lcm, std::chrono::microseconds(2000));
+    if (tick) tick();
+  }
+  handle_pending(lcm, std::chrono::microseconds(50'000));  // stragglers
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  fs::remove(out);
+  return r;
+}
+
+class IdentifyPublish : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::getenv("HYSTLOOP_NETNS") == nullptr) GTEST_SKIP() << "needs udpm LCM: run inside tools/netns-run";
+    dir_ = fs::temp_directory_path() / ("hystloop_identify_publish_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    lcm_ = open_lcm(kUrl);
+    params_ = std::make_unique<Subscription<mem_params_t>>(*lcm_, ch_.params, [this](const mem_params_t& m, std::int64_t) {
+      if (m.source.rfind("hystloop-identify@", 0) == 0) received_.push_back(m);
+    });
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::vector<std::string> args(const std::string& log, std::vector<std::string> more) const {
+    std::vector<std::string> a{log, "--model", "mem", "--publish", "--lcm-url", kUrl};
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  }
+
+  fs::path dir_;
+  ChannelNames ch_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<Subscription<mem_params_t>> params_;
+  std::vector<mem_params_t> received_;
+  const MemParams truth_ = MemParams::paper_like();
+};
+
+double printed(const std::string& out, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(out, m, std::regex(name + R"( = ([-+0-9.eE]+))"))) return -1.0;
+  return std::stod(m[1].str());
+}
+
+TEST_F(IdentifyPublish, FittedSetArrivesOnHxParamsWithTheNextVersion) {
+  write_log(path("run.lcmlog"), with_faults(mem_record(truth_, 0.5e-9)));
+  const Result r = run_tool(args(path("run.lcmlog"), {}), *lcm_);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("no parameter version heard"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("published MEM parameters v2 on HX_PARAMS (3 time(s))"), std::string::npos) << r.out;
+  ASSERT_GE(received_.size(), 1u) << r.out;  // sent 3 times; UDP inside one host should keep all
+  EXPECT_LE(received_.size(), 3u);
+  for (const auto& m : received_) {
+    EXPECT_EQ(m.version, 2);
+    EXPECT_TRUE(m.valid);
+    EXPECT_NEAR(m.c1, truth_.c1, 0.01 * truth_.c1);
+    EXPECT_NEAR(m.c2, truth_.c2, 0.01 * truth_.c2);
+    EXPECT_NEAR(m.c3, truth_.c3, 0.01 * truth_.c3);
+    // The values printed are the values sent (to the printed precision).
+    EXPECT_NEAR(m.c1, printed(r.out, "c1"), 1e-5 * m.c1);
+    EXPECT_NEAR(m.c3, printed(r.out, "c3"), 1e-5 * m.c3);
+    EXPECT_GT(m.samples_used, 15'000);
+    EXPECT_LE(m.samples_used, static_cast<std::int64_t>(kTicks));
+    EXPECT_NEAR(m.window_s, 1.9999, 1e-9);
+    EXPECT_GT(m.residual_m, 0.0);
+    EXPECT_LT(m.residual_m, 2e-9);
+    EXPECT_GT(m.utime, kFirstUtime);
+  }
+}
+
+TEST_F(IdentifyPublish, VersionSupersedesTheSetInUse) {
+  write_log(path("run.lcmlog"), mem_record(truth_));
+  // A rig whose compensator uses v6 (in its commands) and whose re-identifier sent v7.
+  Publisher<mem_params_t> params(*lcm_, ch_.params);
+  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  mem_params_t in_use{};
+  in_use.version = 7;
+  in_use.c1 = 4e-9;
+  in_use.c3 = 1.0;
+  in_use.valid = true;
+  in_use.source = "reident@test";
+  actuator_command_t cmd{};
+  cmd.params_version = 6;
+  cmd.sample_seq = -1;
+  int ticks = 0;
+  const Result r = run_tool(args(path("run.lcmlog"), {"--listen-s", "0.3"}), *lcm_, [&] {
+    commands.publish(cmd);
+    if (++ticks % 25 == 0) params.publish(in_use);
+  });
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("version in use on HX_: 7"), std::string::npos) << r.out;
+  ASSERT_GE(received_.size(), 1u) << r.out;
+  EXPECT_EQ(received_.front().version, 8);
+
+  // Only the commands: a compensator does not repeat HX_PARAMS, its commands carry the version.
+  received_.clear();
+  const Result c = run_tool(args(path("run.lcmlog"), {"--listen-s", "0.3"}), *lcm_, [&] { commands.publish(cmd); });
+  ASSERT_EQ(c.exit_code, 0) << c.out;
+  ASSERT_GE(received_.size(), 1u) << c.out;
+  EXPECT_EQ(received_.front().version, 7);
+
+  // --version wins, nothing is listened for; another rig's channels from --rig.
+  received_.clear();
+  write_log(path("rig3.lcmlog"), mem_record(truth_), 0, kTicks, false, "RIG3_SENSOR");
+  std::vector<mem_params_t> rig3;
+  Subscription<mem_params_t> rig3_params(*lcm_, "RIG3_PARAMS", [&](const mem_params_t& m, std::int64_t) { rig3.push_back(m); });
+  const Result v = run_tool(args(path("rig3.lcmlog"), {"--version", "42", "--rig", "RIG3_"}), *lcm_);
+  ASSERT_EQ(v.exit_code, 0) << v.out;
+  EXPECT_NE(v.out.find("published MEM parameters v42 on RIG3_PARAMS"), std::string::npos) << v.out;
+  EXPECT_TRUE(received_.empty()) << "published on HX_PARAMS although --rig RIG3_";
+  ASSERT_GE(rig3.size(), 1u);
+  EXPECT_EQ(rig3.front().version, 42);
+  EXPECT_NEAR(rig3.front().c2, truth_.c2, 0.01 * truth_.c2);
+}
+
+TEST_F(IdentifyPublish, RefusedFitPublishesNothing) {
+  auto record = mem_record(truth_);
+  for (auto& s : record) {
+    s.u_V = 5.0;
+    s.y_m = 1e-9;
+  }
+  write_log(path("flat.lcmlog"), record);
+  const Result r = run_tool(args(path("flat.lcmlog"), {"--listen-s", "0"}), *lcm_);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("constant_input"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("nothing published"), std::string::npos) << r.out;
+  EXPECT_TRUE(received_.empty());
+}
+
+}  // namespace
+}  // namespace hystloop
