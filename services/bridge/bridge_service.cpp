@@ -121,7 +121,7 @@ int BridgeService::run() {
   while (!rt_.started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   spdlog::info("real-time thread: {}; {}", rt_.priority_status().detail, rt_.affinity_status().detail);
 
-  spdlog::info("started in the safe state ({}); {}", settings_.limits.safe_u_V,
+  spdlog::info("started in the safe state ({} V); {}", settings_.limits.safe_u_V,
                settings_.auto_arm ? "arms when commands flow" : "waiting for ARM on HX_CONTROL");
 
   using clock = std::chrono::steady_clock;
@@ -244,6 +244,11 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   status_.counter("control_refused", control_refused_ - baseline_.refused);
   status_.counter("armed", rt.armed ? 1 : 0);
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
+  if (rt.lateness.count() > 0) {  // the timer's wake-up lateness this period
+    status_.counter("timer_lateness_p50_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.5)));
+    status_.counter("timer_lateness_p99_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.99)));
+    status_.counter("timer_lateness_max_ns", static_cast<std::uint64_t>(rt.lateness.max_ns()));
+  }
   const ResourceUsage usage = read_resource_usage();
   status_.counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
   status_.counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
