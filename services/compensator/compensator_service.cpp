@@ -91,7 +91,9 @@ void CompensatorService::on_sample(const sensor_sample_t& msg, std::int64_t recv
     command_.params_version = out->params_version;
     command_.mode = static_cast<std::int8_t>(out->mode);
     if (command_pub_.publish(command_)) ++counters_.commands_published;
-    latency_.add((wall_utime() - recv_utime) * 1000);
+    // recv_utime is LCM's receive time on this host's clock; a value outside [0, 10 s) is not a latency.
+    const std::int64_t latency_us = wall_utime() - recv_utime;
+    if (latency_us >= 0 && latency_us < 10'000'000) latency_.add(latency_us * 1000);
   }
   work_.add(monotonic_now_ns() - start_ns);
 }

@@ -19,14 +19,24 @@ fail() { echo "FAIL: $*" >&2; for f in "$dir"/*.log; do [ -f "$f" ] && { echo "=
 # loaded 2-CPU VM, e.g. loopback multicast waits for ksoftirqd); what is checked is that it
 # trips within watchdog_s + a few ticks when the commands stop, whatever watchdog_s is.
 watchdog_s=0.2
-bridge_args=(--config "$config/bridge.yaml" --set actuator.watchdog_s=$watchdog_s --set bridge.degraded_late_fraction=0.05)
+# Likewise DEGRADED is reported above 25 % late commands in a second, not 1 %: at a load of 18
+# on 2 CPUs, 5-10 % of the commands were late in every second (stalls of tens of ms).
+bridge_args=(--config "$config/bridge.yaml" --set actuator.watchdog_s=$watchdog_s --set bridge.degraded_late_fraction=0.25)
 compensator_args=(--config "$config/compensator.yaml" --set trajectory.shape=cosine --set trajectory.amplitude_m=-1.6e-6)
 
-start_recording() {  # seconds
-  "$probe" record --dir "$dir" --seconds "$1" >"$dir/probe.out" 2>&1 &
-  pids+=($!)
-  for _ in $(seq 100); do [ -e "$dir/recording" ] && return 0; sleep 0.02; done
+# The recorder runs until stop_recording (at most 60 s), at a low SCHED_FIFO priority when
+# allowed: starved for longer than its socket buffer it would lose samples.
+start_recording() {
+  "$probe" record --dir "$dir" --seconds 60 --rt-priority 10 >"$dir/probe.out" 2>&1 &
+  recorder=$!; pids+=($recorder)
+  for _ in $(seq 250); do [ -e "$dir/recording" ] && return 0; sleep 0.02; done
   fail "the recorder did not start"
+}
+stop_recording() { kill -TERM $recorder; wait $recorder || fail "the recorder failed"; }
+# Waits (up to 20 s: sanitizer builds start slowly) until a log file says something.
+wait_log() {  # file text
+  for _ in $(seq 400); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.05; done
+  fail "$1 never said '$2'"
 }
 value() { "$probe" status-value --dir "$dir" --process "$1" --key "$2"; }
 expect_value() {  # process key expected

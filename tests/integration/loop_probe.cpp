@@ -1,7 +1,7 @@
 // The integration tests' hands and eyes on a running bridge + compensator (udpm inside
 // tools/netns-run):
 //
-//   loop_probe record  --dir D --seconds S       HX_SENSOR -> D/sensor.csv, HX_COMMAND -> D/command.csv,
+//   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv, HX_COMMAND -> D/command.csv,
 //                                                HX_STATUS -> D/status.log (one line per report)
 //   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
 //                                reset_counters|shutdown [--target P] [--mode N] [--kp --ki --kd]
@@ -32,6 +32,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/process.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
@@ -49,7 +50,10 @@ std::int64_t now_utime() {
 
 void pause_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
 
-int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds) {
+int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds, int rt_priority) {
+  install_stop_handlers();  // SIGTERM ends the recording cleanly
+  // A recorder starved for longer than its socket buffer (~0.5 s of traffic) loses samples.
+  if (rt_priority > 0) set_realtime_priority(rt_priority);
   std::FILE* sensor = std::fopen((dir + "/sensor.csv").c_str(), "w");
   std::FILE* command = std::fopen((dir + "/command.csv").c_str(), "w");
   std::FILE* status = std::fopen((dir + "/status.log").c_str(), "w");
@@ -94,7 +98,9 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   });
   std::fclose(std::fopen((dir + "/recording").c_str(), "w"));  // ready marker
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) handle_pending(lcm, std::chrono::milliseconds(10));
+  while (!stop_requested() && std::chrono::steady_clock::now() < end) {
+    handle_pending(lcm, std::chrono::milliseconds(10));
+  }
   std::fclose(sensor);
   std::fclose(command);
   std::fclose(status);
@@ -357,9 +363,11 @@ int main(int argc, char** argv) {
 
   std::string dir;
   double seconds = 5;
+  int rt_priority = 0;
   auto* rec = app.add_subcommand("record");
   rec->add_option("--dir", dir)->required();
-  rec->add_option("--seconds", seconds);
+  rec->add_option("--seconds", seconds, "at most this long; SIGTERM stops it earlier");
+  rec->add_option("--rt-priority", rt_priority, "SCHED_FIFO priority (0 = normal)");
 
   ControlArgs ca;
   auto* ctl = app.add_subcommand("control");
@@ -417,7 +425,7 @@ int main(int argc, char** argv) {
     if (*sv) return status_value(dir, process, key);
     const ChannelNames ch(prefix);
     auto lcm = open_lcm(url);
-    if (*rec) return record(*lcm, ch, dir, seconds);
+    if (*rec) return record(*lcm, ch, dir, seconds, rt_priority);
     if (*ctl) return control(*lcm, ch, ca);
     if (*inj) return inject(*lcm, ch, target, count);
     if (*tr) {

@@ -6,9 +6,11 @@
 #   loop_reject.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
 n=5
-start_recording 5.0
+start_recording
 "$compensator" "${compensator_args[@]}" >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
 "$bridge" "${bridge_args[@]}" --auto-arm >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
+wait_log "$dir/compensator.log" "channels:"
+wait_log "$dir/bridge.log" "started in the safe state"
 sleep 1.0
 "$probe" control --command reset_counters    # counts from here on
 sleep 0.1
@@ -20,7 +22,7 @@ sleep 2.3
 kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
-wait "${pids[0]}"
+stop_recording
 "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
 
 # Both injections send their bad HX_CONTROL messages to everyone: 2n of each there.

@@ -5,23 +5,29 @@
 # a re-ARM resume tracking. Inside tools/netns-run.
 #   loop_watchdog.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
-start_recording 6.5
+start_recording
 "$compensator" "${compensator_args[@]}" >"$dir/compensator1.log" 2>&1 & c1=$!; pids+=($c1)
 "$bridge" "${bridge_args[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
-sleep 0.4
+wait_log "$dir/compensator1.log" "channels:"
+wait_log "$dir/bridge.log" "started in the safe state"
+sleep 0.2
 "$probe" control --command arm
+wait_log "$dir/bridge.log" "ARM (request"
 sleep 1.6
 kill -KILL $c1
 wait $c1 2>/dev/null || true
 sleep 1.0
+wait_log "$dir/bridge.log" "watchdog: no command"
 "$compensator" "${compensator_args[@]}" >"$dir/compensator2.log" 2>&1 & c2=$!; pids+=($c2)
+wait_log "$dir/compensator2.log" "channels:"
 sleep 0.6
 "$probe" control --command arm
+for _ in $(seq 100); do [ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ] && break; sleep 0.05; done
 sleep 2.2
 kill -TERM $bpid $c2
 wait $bpid || fail "the bridge exited with $? on SIGTERM"
 wait $c2 || fail "the compensator exited with $? on SIGTERM"
-wait "${pids[0]}"
+stop_recording
 "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples or a slow trip"; }
 cat "$dir/analysis.txt"
 get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }

@@ -54,7 +54,7 @@ struct Harness {
     std::vector<double> u;
     double applied = 0.0;
     for (std::int64_t k = from; k < from + ticks; ++k) {
-      service.on_sample(sample(k, applied, 6.3e-9 * applied, flags), sample(k, 0, 0).utime + 20);
+      service.on_sample(sample(k, applied, 6.3e-9 * applied, flags), wall_utime());
       u.push_back(service.last_command().u_V);
       applied = service.last_command().u_V;
     }
