@@ -75,10 +75,14 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t la
   ticks_skipped_ += skipped;
 
   switch (arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel)) {
-    case ArmRequest::kArm: core_.arm(t_s); break;
+    case ArmRequest::kArm:
+      core_.arm(t_s);
+      tripped_ = false;
+      break;
     case ArmRequest::kDisarm:
       core_.disarm();
       auto_arm_pending_ = false;  // an explicit disarm ends the convenience
+      tripped_ = false;           // ... and an operator's disarm is never undone automatically
       break;
     case ArmRequest::kNone: break;
   }
@@ -89,6 +93,15 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t la
       auto_arm_pending_ = false;
       ++auto_arms_;
     }
+    // Opt-in (actuator.rearm_after_trip_s > 0): after a watchdog trip, re-arm once commands
+    // flow again and the safe state has lasted that long. For demos and soak runs on shared
+    // machines; counted, and off by default.
+    if (tripped_ && !core_.armed() && settings_.rearm_after_trip_s > 0.0 &&
+        static_cast<double>(k - last_trip_tick_) * dt_s_ >= settings_.rearm_after_trip_s) {
+      core_.arm(t_s);
+      tripped_ = false;
+      ++auto_arms_;
+    }
     core_.submit(command->seq, command->u_V, command->params_version, t_s);
   }
   if (core_.armed()) auto_arm_pending_ = false;  // armed by HX_CONTROL: no auto-arm later
@@ -97,6 +110,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t la
   if (core_.counters().watchdog_trips != trips_seen_) {
     trips_seen_ = core_.counters().watchdog_trips;
     last_trip_tick_ = k;
+    tripped_ = true;
   }
   // After an overrun the stage has been holding the last voltage for the skipped ticks too.
   const double step_s = dt_s_ * static_cast<double>(1 + skipped);

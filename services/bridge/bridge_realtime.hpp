@@ -83,6 +83,7 @@ class BridgeRealtime {
 
   // RT-thread state.
   bool auto_arm_pending_ = false;
+  bool tripped_ = false;  // in the safe state because of the watchdog (not an operator)
   std::uint64_t ticks_skipped_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;

@@ -11,7 +11,7 @@ namespace hystloop {
 const std::vector<std::string>& bridge_config_keys() {
   static const std::vector<std::string> keys = {
       "bridge.backend", "bridge.rate_hz", "bridge.noise_rms_m", "bridge.seed", "bridge.drift_fraction",
-      "bridge.drift_start_s", "bridge.drift_duration_s", "bridge.auto_arm", "bridge.degraded_late_fraction",
+      "bridge.drift_start_s", "bridge.drift_duration_s", "bridge.auto_arm", "actuator.rearm_after_trip_s", "bridge.degraded_late_fraction",
       "bridge.run_seconds", "bridge.command_queue_capacity",
       "actuator.u_min_V", "actuator.u_max_V", "actuator.slew_V_per_s", "actuator.safe_u_V",
       "actuator.safe_ramp_V_per_s", "actuator.watchdog_s",
@@ -29,6 +29,7 @@ BridgeSettings load_bridge_settings(const Config& config) {
   if (s.backend != "sim" && s.backend != "ro") config.fail("bridge.backend", "must be sim or ro (got '" + s.backend + "')");
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
   s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
+  s.rearm_after_trip_s = config.get_in_range("actuator.rearm_after_trip_s", s.rearm_after_trip_s, 0.0, 3600.0);
   s.degraded_late_fraction = config.get_in_range("bridge.degraded_late_fraction", s.degraded_late_fraction, 0.0, 1.0);
   s.run_seconds = config.get_non_negative("bridge.run_seconds", s.run_seconds);
   s.command_queue_capacity =

@@ -27,6 +27,7 @@ struct BridgeSettings {
   ActuatorLimits limits{};
   RtSettings rt{};
   bool auto_arm = false;           // arm as soon as commands flow (first arm only)
+  double rearm_after_trip_s = 0.0; // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
   double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
   double run_seconds = 0.0;        // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
   int command_queue_capacity = 4096;  // LCM's queue for HX_COMMAND (>= 1000: 100 ms at 10 kHz)
