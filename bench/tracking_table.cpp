@@ -10,106 +10,17 @@
 //   tracking_table            prints the table (Markdown) and the identified MEM parameters
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <string>
-#include <vector>
 
-#include "ident/katalenic_fit.hpp"
-#include "ident/linear_fit.hpp"
-#include "ident/mem_fit.hpp"
-#include "ident/online_mem_estimator.hpp"
-#include "ident/pi_fit.hpp"
-#include "loop/loop_simulation.hpp"
-
-namespace hystloop {
-namespace {
-
-constexpr double kIdentSeconds = 2.0;
-constexpr double kTrackSeconds = 8.0;
-constexpr double kSettleSeconds = 4.0;
-
-LoopSimulationConfig base_config() {
-  LoopSimulationConfig c;
-  c.stage.noise_rms_m = 1e-9;
-  c.stage.seed = 7;
-  c.compensator.mode = FeedforwardMode::kOff;
-  return c;
-}
-
-struct Identified {
-  MemParams mem;
-  PiParams pi;
-  KatalenicParams katalenic;
-  LinearParams linear;
-  bool ok = true;
-};
-
-Identified identify() {
-  LoopSimulation sim(base_config());
-  ExperimentSpec e;
-  e.duration_s = kIdentSeconds;
-  sim.compensator().start_experiment(e);
-  sim.run(kIdentSeconds + 0.01);
-  std::vector<double> u, y;
-  for (const LoopTick& t : sim.history()) {
-    if (t.t_s < 0.01 || t.t_s > kIdentSeconds) continue;
-    u.push_back(t.u_V);
-    y.push_back(t.y_m);
-  }
-  Identified id;
-  const MemFitResult mem = fit_mem(u, y);
-  const PiFitResult pi = fit_pi(u, y);
-  const KatalenicFitResult kat = fit_katalenic(u, y);
-  const LinearFitResult lin = fit_linear(u, y);
-  id.ok = mem.status == FitStatus::ok && pi.ok() && kat.ok() && lin.ok();
-  id.mem = mem.params;
-  id.pi = to_pi_params(pi);
-  id.katalenic = kat.params;
-  id.linear = to_linear_params(lin);
-  std::printf("Identified MEM: c1 = %.4g m/V, c2 = %.4g, c3 = %.4g (fit residual %.2f nm)\n\n", id.mem.c1, id.mem.c2,
-              id.mem.c3, mem.residual_rms_m * 1e9);
-  return id;
-}
-
-TrackingStats track(const Identified& id, FeedforwardMode mode, bool feedback, bool reidentify, const MemParams& start) {
-  LoopSimulationConfig c = base_config();
-  c.compensator.mode = mode;
-  c.compensator.mem = start;
-  c.compensator.pi = id.pi;
-  c.compensator.katalenic = id.katalenic;
-  c.compensator.linear = id.linear;
-  if (feedback) {
-    c.compensator.feedback.ki = 600.0;
-    c.compensator.feedback.kp = 0.1;
-    c.compensator.feedback.nominal_gain_m_per_V = id.linear.gain;
-  }
-  LoopSimulation sim(c);
-  sim.compensator().set_trajectory(mem_paper_reference(0.5, 0.5, 0.0));
-  OnlineMemOptions opt;
-  opt.window_samples = 40000;
-  opt.fit.reversal_dead_band_V = 1.0;
-  OnlineMemEstimator estimator(opt, c.compensator.mem);
-  std::int32_t version = 1;
-  const auto refit_every = static_cast<std::int64_t>(1.0 / c.compensator.dt_s);
-  sim.run(kTrackSeconds, [&](const LoopTick& t) {
-    if (!reidentify) return;
-    estimator.feed(t.u_V, t.y_m);
-    if (t.k > 0 && t.k % refit_every == 0) {
-      const MemRefitOutcome out = estimator.refit();
-      if (out.accepted) sim.compensator().offer_mem_params(estimator.params(), ++version);
-    }
-  });
-  return sim.tracking(kSettleSeconds, kTrackSeconds);
-}
-
-}  // namespace
-}  // namespace hystloop
+#include "loop/tracking_experiment.hpp"
 
 int main() {
   using namespace hystloop;
   const auto t0 = std::chrono::steady_clock::now();
-  const Identified id = identify();
+  const TrackingExperiment experiment;
+  const IdentifiedModels id = identify_models_through_loop(experiment);
+  std::printf("Identified MEM: c1 = %.4g m/V, c2 = %.4g, c3 = %.4g (fit residual %.2f nm)\n\n", id.mem.c1, id.mem.c2,
+              id.mem.c3, id.mem_fit.residual_rms_m * 1e9);
   MemParams wrong = id.mem;
   wrong.c1 *= 0.6;
   wrong.c2 *= 1.8;
@@ -130,14 +41,14 @@ int main() {
               "| MEM paper, real actuator, feedforward only |\n| --- | --- | --- | --- |\n");
   for (const Row& r : rows) {
     const MemParams& start = r.wrong_start ? wrong : id.mem;
-    const TrackingStats ff = track(id, r.mode, false, r.reid, start);
-    const TrackingStats fb = track(id, r.mode, true, r.reid, start);
+    const TrackingStats ff = run_tracking(experiment, id, r.mode, false, r.reid, start).stats;
+    const TrackingStats fb = run_tracking(experiment, id, r.mode, true, r.reid, start).stats;
     std::printf("| %s | %.2f / %.2f nm | %.2f / %.2f nm | %s |\n", r.name, ff.rms_true_m * 1e9, ff.rms_measured_m * 1e9,
                 fb.rms_true_m * 1e9, fb.rms_measured_m * 1e9, r.paper);
     std::fflush(stdout);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("\n(%.0f s of simulated loop at 10 kHz in %.1f s of wall time)\n",
-              kIdentSeconds + 12 * kTrackSeconds, seconds);
+              experiment.identify_s + 12 * experiment.track_s, seconds);
   return id.ok ? 0 : 1;
 }

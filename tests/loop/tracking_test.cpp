@@ -7,115 +7,35 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
 
-#include "ident/katalenic_fit.hpp"
-#include "ident/linear_fit.hpp"
-#include "ident/mem_fit.hpp"
-#include "ident/online_mem_estimator.hpp"
-#include "ident/pi_fit.hpp"
-#include "loop/loop_simulation.hpp"
+#include "loop/tracking_experiment.hpp"
 
 namespace hystloop {
 namespace {
 
-constexpr double kIdentSeconds = 2.0;
-constexpr double kTrackSeconds = 8.0;
-constexpr double kSettleSeconds = 4.0;  // error measured over [settle, track): the last 4 periods
+using TrackRun = TrackingRun;
 
-LoopSimulationConfig base_config() {
-  LoopSimulationConfig c;
-  c.stage.noise_rms_m = 1e-9;
-  c.stage.seed = 7;
-  c.compensator.mode = FeedforwardMode::kOff;
-  return c;
-}
+const TrackingExperiment kExperiment{};
+constexpr double kSettleSeconds = TrackingExperiment{}.settle_s;
+constexpr double kTrackSeconds = TrackingExperiment{}.track_s;
 
-struct Identified {
-  MemParams mem;
-  PiParams pi;
-  KatalenicParams katalenic;
-  LinearParams linear;
-};
-
-// Runs the identification experiment through the loop and fits every model to it.
-const Identified& identified() {
-  static const Identified result = [] {
-    LoopSimulation sim(base_config());
-    ExperimentSpec e;  // 250 V, 10 Hz: the MEM paper's identification input
-    e.duration_s = kIdentSeconds;
-    sim.compensator().start_experiment(e);
-    sim.run(kIdentSeconds + 0.01);
-    std::vector<double> u, y;
-    for (const LoopTick& t : sim.history()) {
-      if (t.t_s < 0.01 || t.t_s > kIdentSeconds) continue;  // the lead ticks held 0 V
-      u.push_back(t.u_V);
-      y.push_back(t.y_m);
-    }
-    Identified id;
-    const MemFitResult mem = fit_mem(u, y);
-    EXPECT_EQ(mem.status, FitStatus::ok) << mem.reason;
-    id.mem = mem.params;
-    const PiFitResult pi = fit_pi(u, y);
-    EXPECT_TRUE(pi.ok()) << pi.reason;
-    id.pi = to_pi_params(pi);
-    const KatalenicFitResult kat = fit_katalenic(u, y);
-    EXPECT_TRUE(kat.ok()) << kat.reason;
-    id.katalenic = kat.params;
-    const LinearFitResult lin = fit_linear(u, y);
-    EXPECT_TRUE(lin.ok()) << lin.reason;
-    id.linear = to_linear_params(lin);
-    std::printf("identified MEM c1=%.4g m/V c2=%.4g c3=%.4g (residual %.2f nm)\n", id.mem.c1, id.mem.c2, id.mem.c3,
-                mem.residual_rms_m * 1e9);
-    return id;
+const IdentifiedModels& identified() {
+  static const IdentifiedModels models = [] {
+    IdentifiedModels m = identify_models_through_loop(kExperiment);
+    EXPECT_TRUE(m.ok) << "MEM: " << m.mem_fit.reason;
+    std::printf("identified MEM c1=%.4g m/V c2=%.4g c3=%.4g (residual %.2f nm)\n", m.mem.c1, m.mem.c2, m.mem.c3,
+                m.mem_fit.residual_rms_m * 1e9);
+    return m;
   }();
-  return result;
+  return models;
 }
-
-struct TrackRun {
-  TrackingStats stats;
-  int params_version = 0;
-  MemParams final_mem{};
-};
 
 TrackRun track(FeedforwardMode mode, bool feedback, bool reidentify, const MemParams* start_mem = nullptr) {
-  const Identified& id = identified();
-  LoopSimulationConfig c = base_config();
-  c.compensator.mode = mode;
-  c.compensator.mem = start_mem ? *start_mem : id.mem;
-  c.compensator.pi = id.pi;
-  c.compensator.katalenic = id.katalenic;
-  c.compensator.linear = id.linear;
-  if (feedback) {
-    c.compensator.feedback.ki = 600.0;
-    c.compensator.feedback.kp = 0.1;
-    c.compensator.feedback.nominal_gain_m_per_V = id.linear.gain;
-  }
-  LoopSimulation sim(c);
-  sim.compensator().set_trajectory(mem_paper_reference(0.5, 0.5, 0.0));  // approach over 0.5 s
-
-  OnlineMemOptions opt;
-  opt.window_samples = 40000;          // 4 s: four branches of the 1 Hz reference
-  opt.fit.reversal_dead_band_V = 1.0;  // feedback jitter on u is not a branch
-  OnlineMemEstimator estimator(opt, c.compensator.mem);
-  std::int32_t version = 1;
-  const auto refit_every = static_cast<std::int64_t>(1.0 / c.compensator.dt_s);
-  sim.run(kTrackSeconds, [&](const LoopTick& t) {
-    if (!reidentify) return;
-    estimator.feed(t.u_V, t.y_m);
-    if (t.k > 0 && t.k % refit_every == 0) {
-      const MemRefitOutcome out = estimator.refit();
-      if (std::getenv("HYSTLOOP_DEBUG")) std::printf("refit t=%.1f %s accepted=%d %s c1=%.3g c2=%.3g c3=%.3g holdout %.2f/%.2f nm\n", t.t_s, to_string(out.status).data(), out.accepted, out.reason.c_str(), out.candidate.c1, out.candidate.c2, out.candidate.c3, out.holdout_rms_candidate_m*1e9, out.holdout_rms_in_use_m*1e9);
-      if (out.accepted) sim.compensator().offer_mem_params(estimator.params(), ++version);
-    }
-  });
-  return {sim.tracking(kSettleSeconds, kTrackSeconds), sim.compensator().params_version(),
-          sim.compensator().mem_params()};
+  return run_tracking(kExperiment, identified(), mode, feedback, reidentify, start_mem ? *start_mem : identified().mem);
 }
 
 // Deliberately wrong MEM parameters for the re-identification runs: the demo's starting point.
