@@ -101,4 +101,12 @@ std::string resolve_lcm_url(std::string_view requested, bool allow_network) {
   return checked_lcm_url(kDefaultLcmUrl, allow_network);
 }
 
+std::string resolve_lcm_url_for_10khz(std::string_view requested, bool allow_network) {
+  std::string url = resolve_lcm_url(requested, allow_network);
+  if (parse_lcm_url(url).provider == "udpm") {
+    url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
+  }
+  return url;
+}
+
 }  // namespace hystloop

@@ -34,6 +34,11 @@ inline constexpr std::string_view kRecommendedRecvBufBytes = "4194304";
 // lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes) for udpm.
 std::string lcm_url_with_default_option(std::string_view url, std::string_view key, std::string_view value);
 
+// resolve_lcm_url for a process that receives a 10 kHz channel: a udpm URL gets the
+// recommended receive buffer unless it sets one (the kernel's default loses samples when the
+// process is descheduled for a moment).
+std::string resolve_lcm_url_for_10khz(std::string_view requested, bool allow_network = false);
+
 // Returns `url` if it is safe to use, else throws ParameterError("lcm.url", ...):
 //  - udpm: a ttl above 0 (packets leave the host) needs allow_network; ttl must be an
 //    integer 0..255 (absent = LCM's default, 0); the group must be an IPv4 multicast address.

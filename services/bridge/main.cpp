@@ -27,12 +27,7 @@ int main(int argc, char** argv) {
   app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");
   app.add_flag("--auto-arm", auto_arm, "Arm as soon as commands flow (first arm only) [bridge.auto_arm]");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   // Flags are overrides of their config keys, so every value is validated in one place.
   if (!backend.empty()) options.overrides.push_back("bridge.backend=" + backend);
@@ -47,10 +42,7 @@ int main(int argc, char** argv) {
     init_logging("bridge", options.log_level,
                  options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
     settings = load_bridge_settings(load_service_config(options));
-    url = resolve_lcm_url(options.lcm_url, options.allow_network);
-    if (parse_lcm_url(url).provider == "udpm") {
-      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
-    }
+    url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
   } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
     return 2;

@@ -28,12 +28,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--mode", mode, "Feedforward: mem, pi, katalenic, linear or off [compensator.mode]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [compensator.run_seconds]");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
   if (!mode.empty()) options.overrides.push_back("compensator.mode=" + mode);
   if (!seconds.empty()) options.overrides.push_back("compensator.run_seconds=" + seconds);
 
@@ -45,10 +40,7 @@ int main(int argc, char** argv) {
     Config config = load_service_config(options);
     for (const auto& file : params_files) merge_params_file(config, file);
     settings = load_compensator_settings(config);
-    url = resolve_lcm_url(options.lcm_url, options.allow_network);
-    if (parse_lcm_url(url).provider == "udpm") {
-      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
-    }
+    url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
   } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
     return 2;

@@ -36,16 +36,7 @@ int main(int argc, char** argv) {
   LoggerFlags flags;
   add_service_options(app, service);
   add_logger_options(app, flags);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
-    return kExitBadConfiguration;
-  }
+  if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   LoggerOptions options;
   std::string url;
@@ -57,11 +48,7 @@ int main(int argc, char** argv) {
     apply_logger_flags(flags, config);
     options = read_logger_options(config);
     names = std::make_unique<ChannelNames>(service.rig_prefix);
-    url = resolve_lcm_url(service.lcm_url, service.allow_network);
-    if (parse_lcm_url(url).provider == "udpm") {
-      // The kernel's default socket buffer loses samples at 10 kHz when we are descheduled.
-      url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
-    }
+    url = resolve_lcm_url_for_10khz(service.lcm_url, service.allow_network);
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
     return kExitBadConfiguration;

@@ -1,5 +1,7 @@
 #include "runtime/service_options.hpp"
 
+#include <cstdio>
+
 namespace hystloop {
 
 void add_service_options(CLI::App& app, ServiceOptions& options) {
@@ -12,6 +14,21 @@ void add_service_options(CLI::App& app, ServiceOptions& options) {
   app.add_option("--rig", options.rig_prefix, "Channel prefix of the rig")->capture_default_str();
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn or error")->capture_default_str();
   app.add_option("--log-file", options.log_file, "Also write the log to this file");
+}
+
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const std::string program = std::filesystem::path(app.get_name()).filename().string();
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), e.what());
+    return 2;
+  }
+  return std::nullopt;
 }
 
 Config load_service_config(const ServiceOptions& options) {

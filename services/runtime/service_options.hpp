@@ -9,6 +9,7 @@
 //   --log-file FILE     also log to this file
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct ServiceOptions {
 };
 
 void add_service_options(CLI::App& app, ServiceOptions& options);
+
+// Parses the command line. Returns the exit code when the program must stop now (0 after
+// --help, 2 with the reason on stderr for a bad option); nothing when it goes on.
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv);
 
 // The configuration file (or an empty tree) with --set overrides applied.
 // Throws ConfigError naming the file and the field.

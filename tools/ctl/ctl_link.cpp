@@ -27,11 +27,7 @@ Clock::time_point after(double seconds) {
 }
 
 std::string resolved_url(const LinkOptions& o) {
-  std::string url = resolve_lcm_url(o.lcm_url, o.allow_network);
-  // watch listens to the 10 kHz channels: ask for a socket buffer that survives a busy CPU.
-  if (parse_lcm_url(url).provider == "udpm") {
-    url = lcm_url_with_default_option(url, "recv_buf_size", kRecommendedRecvBufBytes);
-  }
+  std::string url = resolve_lcm_url_for_10khz(o.lcm_url, o.allow_network);
   return url;
 }
 
