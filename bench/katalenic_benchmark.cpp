@@ -41,13 +41,7 @@ void BM_KatalenicForward(benchmark::State& state) {
   hystloop::KatalenicModel model(params_for(shaping));
   const auto u = sine(240.0, 0.0);
   model.reset(u[0]);
-  hystloop::bench::SampleTimer timer;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    timer.time([&] { benchmark::DoNotOptimize(model.forward(u[i])); });
-    i = (i + 1 == u.size()) ? 0 : i + 1;
-  }
-  timer.report(state);
+  hystloop::bench::time_per_sample(state, u, [&](double s) { return model.forward(s); });
   state.SetLabel(shaping_name(shaping));
 }
 BENCHMARK(BM_KatalenicForward)->Arg(0)->Arg(1)->Arg(2);
@@ -62,13 +56,7 @@ void BM_KatalenicInverse(benchmark::State& state) {
   const auto y = sine(0.45 * (hi - lo), 0.5 * (hi + lo));
   hystloop::KatalenicInverse inverse(p);
   inverse.reset(y[0]);
-  hystloop::bench::SampleTimer timer;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    timer.time([&] { benchmark::DoNotOptimize(inverse.inverse(y[i])); });
-    i = (i + 1 == y.size()) ? 0 : i + 1;
-  }
-  timer.report(state);
+  hystloop::bench::time_per_sample(state, y, [&](double s) { return inverse.inverse(s); });
   state.SetLabel(shaping_name(shaping));
 }
 BENCHMARK(BM_KatalenicInverse)->Arg(0)->Arg(1)->Arg(2);

@@ -28,13 +28,7 @@ void BM_Pi15Forward(benchmark::State& state) {
   hystloop::PiModel model(pi15());
   const auto u = cosine(250.0, static_cast<double>(state.range(0)));
   model.reset(u[0]);
-  hystloop::bench::SampleTimer timer;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    timer.time([&] { benchmark::DoNotOptimize(model.forward(u[i])); });
-    i = (i + 1 == u.size()) ? 0 : i + 1;
-  }
-  timer.report(state);
+  hystloop::bench::time_per_sample(state, u, [&](double s) { return model.forward(s); });
 }
 BENCHMARK(BM_Pi15Forward)->Arg(1)->Arg(50);
 
@@ -42,13 +36,7 @@ void BM_Pi15Inverse(benchmark::State& state) {
   hystloop::PiInverse inv(pi15());
   const auto y = cosine(1.6e-6, static_cast<double>(state.range(0)));
   inv.reset(y[0]);
-  hystloop::bench::SampleTimer timer;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    timer.time([&] { benchmark::DoNotOptimize(inv.inverse(y[i])); });
-    i = (i + 1 == y.size()) ? 0 : i + 1;
-  }
-  timer.report(state);
+  hystloop::bench::time_per_sample(state, y, [&](double s) { return inv.inverse(s); });
 }
 BENCHMARK(BM_Pi15Inverse)->Arg(1)->Arg(50);
 

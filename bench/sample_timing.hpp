@@ -41,4 +41,17 @@ class SampleTimer {
   std::vector<double> ns_;
 };
 
+// Calls `call(sample)` once per benchmark iteration, cycling through `samples` (prepared
+// outside the timed loop), and reports the per-call percentiles.
+template <class F>
+void time_per_sample(benchmark::State& state, const std::vector<double>& samples, F&& call) {
+  SampleTimer timer;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    timer.time([&] { benchmark::DoNotOptimize(call(samples[i])); });
+    i = (i + 1 == samples.size()) ? 0 : i + 1;
+  }
+  timer.report(state);
+}
+
 }  // namespace hystloop::bench
