@@ -7,24 +7,15 @@
 #include <regex>
 #include <string>
 
+#include "support/tool_run.hpp"
+
 namespace {
 
 const std::string kTool = std::string(HYSTLOOP_BINARY_DIR) + "/tools/timer-check/hystloop-timer-check";
 
-struct ToolRun {
-  int status = -1;
-  std::string output;
-};
+using hystloop::testing::ToolRun;
 
-ToolRun run_tool(const std::string& args) {
-  ToolRun r;
-  FILE* pipe = ::popen((kTool + " " + args + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.output += buf;
-  r.status = ::pclose(pipe);
-  return r;
-}
+ToolRun run_tool(const std::string& args) { return hystloop::testing::run_tool(kTool + " " + args); }
 
 class TimerCheckTool : public ::testing::Test {
  protected:
@@ -35,7 +26,7 @@ class TimerCheckTool : public ::testing::Test {
 
 TEST_F(TimerCheckTool, Reports10kHzForOneSecond) {
   const ToolRun r = run_tool("--rate 10000 --seconds 1 --check");
-  ASSERT_EQ(r.status, 0) << r.output;
+  ASSERT_EQ(r.exit_code, 0) << r.output;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.output, m, std::regex(R"(deadlines (\d+): served (\d+), skipped (\d+))")))
       << r.output;
@@ -55,11 +46,11 @@ TEST_F(TimerCheckTool, Reports10kHzForOneSecond) {
 
 TEST_F(TimerCheckTool, HelpAndBadArguments) {
   const ToolRun help = run_tool("--help");
-  EXPECT_EQ(help.status, 0);
+  EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.output.find("--rate"), std::string::npos) << help.output;
   EXPECT_NE(help.output.find("--seconds"), std::string::npos) << help.output;
   const ToolRun bad = run_tool("--rate 0");
-  EXPECT_NE(bad.status, 0) << bad.output;
+  EXPECT_NE(bad.exit_code, 0) << bad.output;
   EXPECT_NE(bad.output.find("--rate"), std::string::npos) << bad.output;
 }
 

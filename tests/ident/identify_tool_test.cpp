@@ -10,43 +10,24 @@
 
 #include "ident/banning_experiments.hpp"
 #include "ident/mem_test_data.hpp"
+#include "support/tool_run.hpp"
 
 namespace hystloop {
 namespace {
 
 const std::string kTool = std::string(HYSTLOOP_BINARY_DIR) + "/tools/identify/hystloop-identify";
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string output;
-};
+using testing::ToolRun;
 
-ToolRun run_tool(const std::string& args) {
-  ToolRun r;
-  FILE* pipe = ::popen((kTool + " " + args + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.output += buf;
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+ToolRun run_tool(const std::string& args) { return testing::run_tool(kTool + " " + args); }
 
 class IdentifyTool : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!std::filesystem::exists(kTool)) GTEST_SKIP() << "not built: " << kTool;
-    dir_ = std::filesystem::temp_directory_path() /
-           ("hystloop_identify_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
   }
-  void TearDown() override {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::filesystem::path dir_;
+  std::string path(const std::string& name) const { return scratch_.path(name); }
+  testing::ScratchDir scratch_{"hystloop_identify"};
 };
 
 void write_csv(const std::string& file, const std::vector<double>& u, const std::vector<double>& y, double fs) {

@@ -18,42 +18,21 @@
 #include "log_samples.hpp"
 #include "params_publish.hpp"
 #include "sensor_log_fixture.hpp"
+#include "support/tool_run.hpp"
 
 namespace hystloop {
 namespace {
 
 using namespace testlog;
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string output;
-};
+using testing::ToolRun;
 
-ToolRun run_tool(const std::string& args) {
-  ToolRun r;
-  FILE* pipe = ::popen((std::string(HYSTLOOP_IDENTIFY_EXE) + " " + args + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr) r.output += buf;
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+ToolRun run_tool(const std::string& args) { return testing::run_tool(std::string(HYSTLOOP_IDENTIFY_EXE) + " " + args); }
 
 class IdentifyLog : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("hystloop_identify_log_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::filesystem::path dir_;
+  std::string path(const std::string& name) const { return scratch_.path(name); }
+  testing::ScratchDir scratch_{"hystloop_identify_log"};
   const MemParams truth_ = MemParams::paper_like();
 };
 
