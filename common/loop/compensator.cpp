@@ -1,5 +1,6 @@
 #include "loop/compensator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -55,6 +56,35 @@ void ExperimentSpec::validate() const {
   require_positive("experiment.duration_s", duration_s);
 }
 
+double experiment_end_s(double start_s, const ExperimentSpec& spec) noexcept {
+  const double periods = std::ceil(spec.duration_s * spec.frequency_hz - 1e-9);
+  return start_s + periods / spec.frequency_hz;
+}
+
+std::int64_t first_tick_at_or_after(double t_s, double dt_s) noexcept {
+  auto k = static_cast<std::int64_t>(std::ceil(t_s / dt_s));
+  // The compensator compares static_cast<double>(k) * dt with t: settle the rounding the same way.
+  while (k > 0 && static_cast<double>(k - 1) * dt_s >= t_s) --k;
+  while (static_cast<double>(k) * dt_s < t_s) ++k;
+  return k;
+}
+
+std::vector<ExperimentTicks> experiment_schedule(std::int64_t first_tick, std::span<const ExperimentSpec> specs,
+                                                 double dt_s) {
+  std::vector<ExperimentTicks> ticks;
+  ticks.reserve(specs.size());
+  double start_s = static_cast<double>(first_tick) * dt_s;  // Compensator::loop_time
+  std::int64_t begin = first_tick;
+  for (const ExperimentSpec& spec : specs) {
+    const double end_s = experiment_end_s(start_s, spec);
+    const std::int64_t end = std::max(begin, first_tick_at_or_after(end_s, dt_s));
+    ticks.push_back({begin, end});
+    begin = end;
+    start_s = end_s;
+  }
+  return ticks;
+}
+
 Compensator::Compensator(const CompensatorConfig& config)
     : config_((config.validate(), config)),
       mode_(config.mode),
@@ -104,13 +134,26 @@ void Compensator::set_gains(const FeedbackGains& gains) { feedback_.set_gains(ga
 
 void Compensator::start_experiment(const ExperimentSpec& spec) {
   spec.validate();
-  const double periods = std::ceil(spec.duration_s * spec.frequency_hz - 1e-9);
-  const double start = loop_time(last_seq_ + config_.lead_ticks + 1);
-  experiment_ = RunningExperiment{spec, start, start + periods / spec.frequency_hz};
+  if (!experiment_) {
+    experiment_ = RunningExperiment{spec};
+    return;
+  }
+  if (queued_ == kExperimentQueue) {
+    throw ParameterError("experiment", "queue full: " + std::to_string(kExperimentQueue) +
+                                           " experiments already wait behind the running one");
+  }
+  queue_[(queue_head_ + queued_) % kExperimentQueue] = spec;
+  ++queued_;
 }
 
 void Compensator::stop_experiment() noexcept {
-  if (experiment_) experiment_->end_s = loop_time(last_seq_ + config_.lead_ticks);
+  queued_ = 0;
+  if (!experiment_) return;
+  if (!experiment_->started) {
+    experiment_.reset();  // it never produced a command
+    return;
+  }
+  experiment_->end_s = loop_time(last_seq_ + config_.lead_ticks);
 }
 
 void Compensator::reset_inverse(double y0) noexcept {
@@ -164,6 +207,19 @@ std::optional<CompensatorOutput> Compensator::update(const CompensatorInput& sam
   ref_tick_[cmd_slot] = out.seq;
 
   if (experiment_) {
+    if (!experiment_->started) {
+      experiment_->started = true;
+      experiment_->start_s = t_cmd;
+      experiment_->end_s = experiment_end_s(t_cmd, experiment_->spec);
+    }
+    while (t_cmd >= experiment_->end_s && queued_ > 0) {
+      // Back to back: the next starts where this one ended, at a whole period (phase 0).
+      const double start = experiment_->end_s;
+      const ExperimentSpec& next = queue_[queue_head_];
+      queue_head_ = (queue_head_ + 1) % kExperimentQueue;
+      --queued_;
+      experiment_ = RunningExperiment{next, true, start, experiment_end_s(start, next)};
+    }
     if (t_cmd < experiment_->end_s) {
       const ExperimentSpec& e = experiment_->spec;
       out.u_V = e.offset_V + e.amplitude_V * std::sin(2.0 * std::numbers::pi * e.frequency_hz * (t_cmd - experiment_->start_s));

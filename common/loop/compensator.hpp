@@ -13,8 +13,10 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "loop/feedback.hpp"
 #include "loop/trajectory.hpp"
@@ -53,14 +55,36 @@ struct CompensatorConfig {
 };
 
 // An identification excitation u(t) = offset + amplitude * sin(2 pi f (t - start)),
-// run for a whole number of periods, then the compensator returns to its mode.
+// run for a whole number of periods. It starts at the first command produced after it was
+// given (start = that command's loop time); experiments given while one runs wait in a queue
+// and run back to back (the next starts at the loop time the previous ended, so a series of
+// whole-period sines is one continuous input); when none is left the compensator returns to
+// its mode. `settle` only labels the segment: the same sine, run to bring the hysteresis to
+// its stationary loop, whose samples identification skips (Banning's series).
 struct ExperimentSpec {
   double amplitude_V = 250.0;
   double offset_V = 0.0;
   double frequency_hz = 10.0;  // the MEM paper's identification input: 250 sin(20 pi t)
   double duration_s = 2.0;     // rounded up to whole periods
+  bool settle = false;
   void validate() const;
 };
+
+// Loop time [s] at which an experiment started at start_s ends: after its whole periods.
+double experiment_end_s(double start_s, const ExperimentSpec& spec) noexcept;
+// The first tick k whose loop time k * dt_s is at or after t_s: the first command past an
+// experiment that ends at t_s. With experiment_end_s this reproduces the compensator's
+// schedule from a log (tools/identify splits Banning's series with it).
+std::int64_t first_tick_at_or_after(double t_s, double dt_s) noexcept;
+
+// The command ticks [begin, end) of experiments run back to back, the first starting at
+// first_tick: what the compensator commands when all of them were given in time.
+struct ExperimentTicks {
+  std::int64_t begin = 0;
+  std::int64_t end = 0;
+};
+std::vector<ExperimentTicks> experiment_schedule(std::int64_t first_tick, std::span<const ExperimentSpec> specs,
+                                                 double dt_s);
 
 struct CompensatorInput {
   std::int64_t seq = 0;  // tick of the sample
@@ -109,14 +133,19 @@ class Compensator {
   void offer_mem_params(const MemParams& params, std::int32_t version);
   void set_mode(FeedforwardMode mode);   // re-initialises that inverse at the current reference
   void set_gains(const FeedbackGains& gains);
+  // Starts the experiment with the next command, or queues it behind the running one.
+  // Validated here (throws ParameterError; also when kExperimentQueue are already waiting).
   void start_experiment(const ExperimentSpec& spec);
+  // Ends the running experiment after the commands already produced and drops the queue.
   void stop_experiment() noexcept;
+  static constexpr std::size_t kExperimentQueue = 128;
 
   const CompensatorCounters& counters() const noexcept { return counters_; }
   FeedforwardMode mode() const noexcept { return mode_; }
   const MemParams& mem_params() const noexcept { return mem_.params(); }
   std::int32_t params_version() const noexcept { return params_version_; }
   bool experiment_running() const noexcept { return experiment_.has_value(); }
+  std::size_t experiments_queued() const noexcept { return queued_; }
   double loop_time(std::int64_t seq) const noexcept { return static_cast<double>(seq) * config_.dt_s; }
   std::int64_t last_seq() const noexcept { return last_seq_; }
   const CompensatorConfig& config() const noexcept { return config_; }
@@ -139,10 +168,14 @@ class Compensator {
 
   struct RunningExperiment {
     ExperimentSpec spec;
-    double start_s;
-    double end_s;
+    bool started = false;  // start_s/end_s are set by the first command it produces
+    double start_s = 0.0;
+    double end_s = 0.0;
   };
   std::optional<RunningExperiment> experiment_;
+  std::array<ExperimentSpec, kExperimentQueue> queue_{};  // ring: waiting experiments
+  std::size_t queue_head_ = 0;
+  std::size_t queued_ = 0;
 
   // References already commanded, by tick, for the error at the sample's tick.
   static constexpr std::size_t kRefRing = 256;

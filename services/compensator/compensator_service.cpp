@@ -197,20 +197,27 @@ void CompensatorService::on_control(const control_t& msg) {
         break;
       }
       case control_t::START_EXPERIMENT: {
-        if (msg.experiment != "sine") return refuse("experiment '" + msg.experiment + "' unknown (sine)");
+        if (msg.experiment != "sine" && msg.experiment != "settle") {
+          return refuse("experiment '" + msg.experiment + "' unknown (sine, or settle: a sine identification skips)");
+        }
         ExperimentSpec e;
         e.amplitude_V = msg.experiment_amplitude_V;
         e.offset_V = msg.experiment_offset_V;
         e.frequency_hz = msg.experiment_frequency_Hz;
         e.duration_s = msg.experiment_duration_s;
+        e.settle = msg.experiment == "settle";
+        const bool queued = compensator_->experiment_running();
         compensator_->start_experiment(e);
-        spdlog::info("experiment sine {} V + {} V at {} Hz for {} s (request {})", e.amplitude_V, e.offset_V,
-                     e.frequency_hz, e.duration_s, msg.request_id);
+        spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {})", msg.experiment, e.amplitude_V,
+                     e.offset_V, e.frequency_hz, e.duration_s,
+                     queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting" : "started",
+                     msg.request_id);
         break;
       }
       case control_t::STOP_EXPERIMENT:
+        spdlog::info("experiment stopped, {} queued dropped (request {})", compensator_->experiments_queued(),
+                     msg.request_id);
         compensator_->stop_experiment();
-        spdlog::info("experiment stopped (request {})", msg.request_id);
         break;
       case control_t::RESET_COUNTERS:
         baseline_ = collect_counters();

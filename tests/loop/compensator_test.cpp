@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -114,6 +115,86 @@ TEST(Compensator, TrackingAfterAnExperimentStartsFromWhereTheStageIs) {
   const TrackingStats s = sim.tracking(2.0, 5.0);
   ASSERT_GT(s.n, 20000u);
   EXPECT_LT(s.rms_true_m, 1e-11);  // rounding; a virgin-skeleton start would be off by nanometres
+}
+
+// Experiments given while one runs wait and run back to back, each from where the previous one
+// ended (whole periods, phase 0), on the schedule experiment_schedule() computes for a log.
+TEST(Compensator, QueuedExperimentsRunBackToBackOnTheSchedule) {
+  CompensatorConfig c;
+  c.mode = FeedforwardMode::kOff;
+  Compensator comp(c);
+  std::vector<ExperimentSpec> specs(3);
+  specs[0].amplitude_V = 10.0, specs[0].frequency_hz = 50.0, specs[0].duration_s = 0.04;            // 2 periods
+  specs[1].amplitude_V = 3.0, specs[1].offset_V = 5.0, specs[1].frequency_hz = 30.0;                // 1 period,
+  specs[1].duration_s = 0.01, specs[1].settle = true;                                               // rounded up
+  specs[2].amplitude_V = 2.0, specs[2].frequency_hz = 2900.0, specs[2].duration_s = 3.0 / 2900.0;  // not on a tick
+  std::int64_t seq = 0;
+  for (; seq < 10; ++seq) ASSERT_TRUE(comp.update({seq, 0.0, 0.0}));
+  for (const auto& s : specs) comp.start_experiment(s);
+  EXPECT_TRUE(comp.experiment_running());
+  EXPECT_EQ(comp.experiments_queued(), 2u);
+  std::vector<CompensatorOutput> out;
+  for (; seq < 2000; ++seq) out.push_back(*comp.update({seq, 0.0, 0.0}));
+  ASSERT_EQ(out.front().mode, FeedforwardMode::kExperiment);
+  const std::int64_t first = out.front().seq;
+  EXPECT_EQ(first, 10 + c.lead_ticks);  // the next command
+  const auto ticks = experiment_schedule(first, specs, c.dt_s);
+  ASSERT_EQ(ticks.size(), 3u);
+  EXPECT_EQ(ticks[0].end - ticks[0].begin, 400);   // 2 periods of 50 Hz
+  EXPECT_EQ(ticks[1].end - ticks[1].begin, 334);   // 1 period of 30 Hz: 333.3 ticks
+  double start_s = static_cast<double>(first) * c.dt_s;
+  std::size_t i = 0;
+  for (std::size_t e = 0; e < specs.size(); ++e) {
+    for (std::int64_t k = ticks[e].begin; k < ticks[e].end; ++k, ++i) {
+      ASSERT_EQ(out[i].seq, k);
+      ASSERT_EQ(out[i].mode, FeedforwardMode::kExperiment) << k;
+      const double t = static_cast<double>(k) * c.dt_s - start_s;
+      EXPECT_NEAR(out[i].u_V, specs[e].offset_V + specs[e].amplitude_V * std::sin(2.0 * std::numbers::pi *
+                                                                                  specs[e].frequency_hz * t), 1e-9);
+    }
+    start_s = experiment_end_s(start_s, specs[e]);
+  }
+  EXPECT_EQ(out[i].seq, ticks.back().end);
+  EXPECT_EQ(out[i].mode, FeedforwardMode::kOff);  // back to the mode, queue empty
+  EXPECT_FALSE(comp.experiment_running());
+  EXPECT_EQ(comp.experiments_queued(), 0u);
+}
+
+TEST(Compensator, StopExperimentDropsTheQueueAndAFullQueueIsRefused) {
+  Compensator comp(mem_config());
+  std::int64_t seq = 0;
+  for (; seq < 5; ++seq) comp.update({seq, 0.0, 0.0});
+  ExperimentSpec e;
+  for (std::size_t i = 0; i <= Compensator::kExperimentQueue; ++i) comp.start_experiment(e);
+  EXPECT_EQ(comp.experiments_queued(), Compensator::kExperimentQueue);
+  try {
+    comp.start_experiment(e);
+    FAIL() << "a full queue must be refused";
+  } catch (const ParameterError& err) {
+    EXPECT_EQ(err.field(), "experiment");
+  }
+  for (; seq < 100; ++seq) EXPECT_EQ(comp.update({seq, 0.0, 0.0})->mode, FeedforwardMode::kExperiment);
+  comp.stop_experiment();
+  EXPECT_EQ(comp.experiments_queued(), 0u);
+  EXPECT_NE(comp.update({seq++, 0.0, 0.0})->mode, FeedforwardMode::kExperiment);
+  EXPECT_FALSE(comp.experiment_running());
+  // Stopped before its first command: it never runs.
+  comp.start_experiment(e);
+  comp.stop_experiment();
+  EXPECT_FALSE(comp.experiment_running());
+  EXPECT_NE(comp.update({seq++, 0.0, 0.0})->mode, FeedforwardMode::kExperiment);
+}
+
+// The schedule's tick rounding is the compensator's test t_cmd < end: k * dt >= t exactly.
+TEST(Compensator, FirstTickAtOrAfterMatchesTheLoopTimeComparison) {
+  for (double dt : {1e-4, 1.0 / 3e4, 2.5e-4}) {
+    for (int i = 1; i < 20000; ++i) {
+      const double t = 0.000137 * i + (i % 7) * 1e-13;
+      const std::int64_t k = first_tick_at_or_after(t, dt);
+      EXPECT_GE(static_cast<double>(k) * dt, t);
+      EXPECT_LT(static_cast<double>(k - 1) * dt, t);
+    }
+  }
 }
 
 TEST(Compensator, ConfigValidationNamesTheField) {
