@@ -1,5 +1,6 @@
 #include "ident/banning_experiments.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -28,6 +29,7 @@ void BanningPlanOptions::validate() const {
   if (measure_periods < 1) throw ParameterError("measure_periods", "must be >= 1");
   require_positive("settle_frequency_Hz", settle_frequency_Hz);
   if (settle_periods < 0) throw ParameterError("settle_periods", "must be >= 0");
+  require_non_negative("settle_path_V", settle_path_V);
   for (double f : frequencies_Hz) require_in_range("frequencies_Hz", f, 1e-3, 0.45 * sample_rate_Hz);
   require_positive("frequency_amplitude_V", frequency_amplitude_V);
   require_non_negative("frequency_settle_s", frequency_settle_s);
@@ -56,6 +58,9 @@ BanningExperiment sine_experiment(BanningExperimentKind kind, double offset, dou
     e.u[n_settle + k] = offset + amplitude * std::sin(two_pi * f * static_cast<double>(k) / fs);
   }
   e.measure_begin = n_settle;
+  e.settle_frequency_Hz = settle_f;
+  e.settle_periods = settle_periods;
+  e.measure_periods = measure_periods;
   return e;
 }
 
@@ -65,21 +70,32 @@ std::vector<BanningExperiment> plan_banning_experiments(const BanningPlanOptions
   o.validate();
   std::vector<BanningExperiment> plan;
   const double fh = o.hysteresis_frequency_Hz, fs = o.sample_rate_Hz;
-  const double sp = o.settle_periods, mp = o.measure_periods;
+  const double mp = o.measure_periods;
+  // Settling cycles: settle_periods, and at least settle_path_V of input path (4 A per period):
+  // Coleman-Hodgdon forgets where it came from as exp(-alpha * path), so a small loop after a
+  // large one needs many more cycles than a large one (1 V: 100 periods for 400 V).
+  auto sp_for = [&](double amplitude) {
+    return std::max<double>(o.settle_periods, std::ceil(o.settle_path_V / (4.0 * amplitude) - 1e-9));
+  };
   for (double off : o.offsets_V) {
     plan.push_back(sine_experiment(BanningExperimentKind::offset, off, o.offset_amplitude_V, fh,
-                                   o.settle_frequency_Hz, sp, mp, fs));
+                                   o.settle_frequency_Hz, sp_for(o.offset_amplitude_V), mp, fs));
   }
   for (double a : o.small_amplitudes_V) {
-    plan.push_back(sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp, mp, fs));
+    plan.push_back(sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a),
+                                   mp, fs));
   }
   for (double a : o.amplitudes_V) {
-    plan.push_back(sine_experiment(BanningExperimentKind::amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp, mp, fs));
+    plan.push_back(
+        sine_experiment(BanningExperimentKind::amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a), mp, fs));
   }
   for (double f : o.frequencies_Hz) {
-    // Settle and measure at the drive frequency itself: here the transient is the stage's.
+    // Settle and measure at the drive frequency itself: the stage's transient needs
+    // frequency_settle_s, the hysteresis (on a live stage, coming from the previous experiment's
+    // loop) settle_periods.
     plan.push_back(sine_experiment(BanningExperimentKind::frequency, 0.0, o.frequency_amplitude_V, f, f,
-                                   std::ceil(o.frequency_settle_s * f), std::ceil(o.frequency_measure_s * f), fs));
+                                   std::max(std::ceil(o.frequency_settle_s * f), sp_for(o.frequency_amplitude_V)),
+                                   std::ceil(o.frequency_measure_s * f), fs));
   }
   return plan;
 }

@@ -7,7 +7,8 @@
 //   frequencies  a small amplitude at several frequencies: the magnitude (27) gives k, c
 // Each hysteresis experiment first cycles at settle_frequency_Hz (rate independence: the loop
 // converges per period, not per second) and then runs measure_periods slow periods, slow so the
-// stage's phase lag adds no area. Only the measured part is handed to the fit.
+// stage's phase lag adds no area. Only the measured part is handed to the fit. The frequency
+// experiments settle too (the stage's transient and the hysteresis'), at their own frequency.
 
 #include <cstddef>
 #include <cstdint>
@@ -32,6 +33,10 @@ struct BanningPlanOptions {
   int measure_periods = 2;
   double settle_frequency_Hz = 50.0;
   int settle_periods = 20;
+  // ... and at least this much input path (4 A per period) [V]: on a live stage each experiment
+  // starts from the previous one's state, which Coleman-Hodgdon forgets as exp(-alpha * path)
+  // (Table 1: alpha = 0.0123 1/V, so 400 V leave e^-5 of it).
+  double settle_path_V = 400.0;
   std::vector<double> frequencies_Hz{20.0,   100.0,  300.0,  600.0,  900.0,  1200.0, 1400.0, 1550.0,
                                      1650.0, 1700.0, 1750.0, 1800.0, 1900.0, 2100.0, 2400.0, 2800.0};
   double frequency_amplitude_V = 2.0;
@@ -49,6 +54,11 @@ struct BanningExperiment {
   double sample_rate_Hz = 1e4;
   std::vector<double> u;          // the whole input [V], settling included
   std::size_t measure_begin = 0;  // first sample of the stationary, measured part
+  // The same input as two whole-period sines, for a live rig (hystloop-ctl experiment
+  // --banning-series): settle_periods at settle_frequency_Hz, then measure_periods at frequency_Hz.
+  double settle_frequency_Hz = 0.0;
+  double settle_periods = 0.0;
+  double measure_periods = 0.0;
 };
 
 std::vector<BanningExperiment> plan_banning_experiments(const BanningPlanOptions& options = {});

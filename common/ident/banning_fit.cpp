@@ -208,8 +208,14 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
         return stamp(refuse(res, FitStatus::non_finite_data, s.str()));
       }
     }
-    SineEstimate se = estimate_sine(ex.u, ex.sample_rate_Hz, false);
-    if (se.ok && se.frequency_Hz >= o.frequency_threshold_Hz) se = estimate_sine(ex.u, ex.sample_rate_Hz, true);
+    SineEstimate se;
+    if (ex.frequency_Hz > 0.0) {
+      const SineFit fit = sine_fit(ex.u, ex.frequency_Hz, ex.sample_rate_Hz);
+      se = {fit.offset, fit.amplitude, ex.frequency_Hz, std::isfinite(fit.amplitude) && fit.amplitude > 0.0};
+    } else {
+      se = estimate_sine(ex.u, ex.sample_rate_Hz, false);
+      if (se.ok && se.frequency_Hz >= o.frequency_threshold_Hz) se = estimate_sine(ex.u, ex.sample_rate_Hz, true);
+    }
     if (!se.ok) {
       pt.note = "input is not a sine of at least one period";
       res.points.push_back(pt);

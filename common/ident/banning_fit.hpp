@@ -29,6 +29,9 @@ struct BanningExperimentData {
   std::span<const double> u;  // [V], stationary part only
   std::span<const double> y;  // [m]
   double sample_rate_Hz = 1e4;
+  // The excitation's frequency when it is known (e.g. from the logged request of a live
+  // experiment); 0 = estimate it from u. Offset and amplitude are always fitted to u.
+  double frequency_Hz = 0.0;
 };
 
 struct BanningFitOptions {
