@@ -10,27 +10,11 @@
 #include "core/errors.hpp"
 #include "hystloop/sensor_sample_t.hpp"
 #include "lcm/message_checks.hpp"
-#include "lcm/wire_layout.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr std::size_t kGapsListed = 5;
-
-// Decodes one event as a sensor_sample_t exactly as a Subscription would (fingerprint,
-// length fields, whole buffer used), but without the value check: the caller tells a
-// non-finite value (refused) from an out-of-contract one (counted).
-bool decode_sample(const lcm::LogEvent& event, sensor_sample_t& msg) noexcept {
-  if (event.datalen < 8) return false;
-  const auto size = static_cast<std::size_t>(event.datalen);
-  if (wire_fingerprint(event.data, size) != sensor_sample_t::getHash()) return false;
-  if (walk_wire_layout(wire_layout_of<sensor_sample_t>(), event.data, size) < 0) return false;
-  try {
-    return msg.decode(event.data, 0, event.datalen) == event.datalen;
-  } catch (...) {
-    return false;
-  }
-}
 
 std::string where(const std::string& file, std::int64_t eventnum) {
   return file + ": event " + std::to_string(eventnum);
@@ -135,7 +119,7 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
       ++record.result().events;
       if (event->channel != options.sensor_channel) continue;
       ++record.result().sensor_events;
-      if (!decode_sample(*event, sample)) {
+      if (!decode_logged(*event, sample)) {
         ++record.result().undecodable;
         continue;
       }

@@ -24,7 +24,10 @@
 #include <string>
 #include <vector>
 
+#include <lcm/lcm-cpp.hpp>
+
 #include "ident/sample_csv.hpp"
+#include "lcm/wire_layout.hpp"
 
 namespace hystloop {
 
@@ -71,6 +74,22 @@ struct LogSamples {
   double window_s() const noexcept { return table.t.size() < 2 ? 0.0 : table.t.back() - table.t.front(); }
   std::size_t skipped() const noexcept { return safe_state + sensor_fault + duplicates + undecodable; }
 };
+
+// Decodes one logged event as T exactly as a Subscription would (fingerprint, length fields,
+// whole buffer used), but without the contract's value check, which the caller makes (a
+// non-finite sample is refused, an out-of-contract one counted).
+template <class T>
+bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
+  if (event.datalen < 8) return false;
+  const auto size = static_cast<std::size_t>(event.datalen);
+  if (wire_fingerprint(event.data, size) != T::getHash()) return false;
+  if (walk_wire_layout(wire_layout_of<T>(), event.data, size) < 0) return false;
+  try {
+    return msg.decode(event.data, 0, event.datalen) == event.datalen;
+  } catch (...) {
+    return false;
+  }
+}
 
 // True for a path that names an LCM event log by its ending (".lcmlog").
 bool looks_like_lcm_log(const std::string& path);

@@ -1,9 +1,11 @@
 // hystloop-identify data.csv|run.NNN.lcmlog... --model mem|banning|katalenic|pi|linear|auto
 //                   [--form integrated|derivative] [--out params.yaml]
 //                   [--log] [--rig HX_] [--dt 1e-4 | --time-from utime] [--from S] [--to S]
+//                   [--compensator NAME --max-late F --max-missing F]   (banning on logs)
 //                   [--publish [--version N] [--listen-s 0.5] [--lcm-url URL] [--allow-network]]
 // Input: CSV t,u,y (sample_csv.hpp), or LCM event logs (files ending in .lcmlog, or --log): the
-// rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp).
+// rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp);
+// for --model banning, the experiments the loop ran, found by their requests (log_experiments.hpp).
 // --publish (MEM only) sends the fitted set on HX_PARAMS (params_publish.hpp).
 // Exit status: 0 fitted (and published), 1 the data cannot support a fit (the reason is printed;
 // nothing is published), 2 usage, file or LCM setup error, 3 fitted but not published.
@@ -23,6 +25,7 @@
 #include "ident/model_selection.hpp"
 #include "ident/params_yaml.hpp"
 #include "ident/sample_csv.hpp"
+#include "log_experiments.hpp"
 #include "log_samples.hpp"
 #include "params_publish.hpp"
 
@@ -45,6 +48,9 @@ struct Args {
   double dt_s = 1e-4;
   std::string time_from = "seq";
   std::optional<double> from_s, to_s;
+  std::string compensator = "compensator";
+  double max_late = 0.02;
+  double max_missing = 0.01;
   // --publish
   bool publish = false;
   std::optional<std::int32_t> version;
@@ -182,6 +188,8 @@ int fit_single(const Args& args, const SampleTable& s) {
   return 1;
 }
 
+int fit_banning_and_emit(const Args& args, const std::vector<BanningExperimentData>& data);
+
 int fit_banning_files(const Args& args, const std::vector<SampleTable>& tables) {
   std::vector<SampleTable> groups;
   for (const auto& t : tables) {
@@ -193,6 +201,10 @@ int fit_banning_files(const Args& args, const std::vector<SampleTable>& tables) 
     if (!(fs > 0.0)) return refuse(FitStatus::size_mismatch, "an experiment's t does not increase: no sample rate");
     data.push_back({g.u, g.y, fs});
   }
+  return fit_banning_and_emit(args, data);
+}
+
+int fit_banning_and_emit(const Args& args, const std::vector<BanningExperimentData>& data) {
   const BanningFitResult r = fit_banning(data);
   std::printf("experiment  offset [V]  amplitude [V]  frequency [Hz]  kind       feature\n");
   for (std::size_t i = 0; i < r.points.size(); ++i) {
@@ -240,6 +252,31 @@ std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
   return tables;
 }
 
+// --model banning on logs: the experiments the live loop ran (hystloop-ctl experiment
+// --banning-series), one table per measured experiment that can be used.
+int fit_banning_logs(const Args& args) {
+  ExperimentLogOptions o;
+  o.control_channel = channel_name(args.rig, kControlSuffix);
+  o.command_channel = channel_name(args.rig, kCommandSuffix);
+  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.compensator_process = args.compensator;
+  o.dt_s = args.dt_s;
+  o.max_not_as_commanded = args.max_late;
+  o.max_missing = args.max_missing;
+  o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
+  const LoggedExperiments logged = read_logged_experiments(args.files, o);
+  std::cout << describe(logged);
+  std::vector<BanningExperimentData> data;
+  for (const auto& e : logged.experiments) {
+    // The requested frequency is known: no need to estimate it from a u with held samples.
+    if (!e.spec.settle && e.usable()) data.push_back({e.samples.u, e.samples.y, 1.0 / args.dt_s, e.spec.frequency_hz});
+  }
+  if (data.empty()) {
+    return refuse(FitStatus::too_few_samples, "no usable measured experiment in the log (see the list above)");
+  }
+  return fit_banning_and_emit(args, data);
+}
+
 int usage_error(const std::string& message) {
   std::cerr << "hystloop-identify: " << message << "\n";
   return 2;
@@ -282,6 +319,19 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   logs->add_option("--from", args.from_s, "fit only samples at t >= this [s after the record's first sample]");
   logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
+  logs->add_option("--compensator", args.compensator,
+                   "banning: process name of the compensator whose HX_CONTROL experiment requests count")
+      ->capture_default_str();
+  logs->add_option("--max-late", args.max_late,
+                   "banning: skip a frequency-response experiment if more than this fraction of its samples were "
+                   "not applied as commanded (late, saturated, slew-limited); hysteresis loops keep them")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  logs->add_option("--max-missing", args.max_missing,
+                   "banning: skip a hysteresis-loop experiment if more than this fraction of its ticks has no sample "
+                   "(a frequency-response experiment may miss none)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   auto* pub = app.add_option_group("publishing", "sending the fitted MEM set to a running compensator");
   pub->add_flag("--publish", args.publish,
                 "after a successful MEM fit, publish mem_params_t on <rig>PARAMS (3 times, 10 ms apart)");
@@ -313,6 +363,13 @@ int main(int argc, char** argv) {
       link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
     } else {
       validate_rig_prefix(args.rig);
+    }
+    if (from_logs && args.model == "banning") {
+      if (args.from_s || args.to_s) {
+        return usage_error("--from/--to do not apply to --model banning on logs: the experiments are found by their "
+                           "requests (HX_CONTROL) and commands");
+      }
+      return fit_banning_logs(args);
     }
     const std::vector<SampleTable> tables = read_inputs(args, from_logs);
     if (args.model == "banning") return fit_banning_files(args, tables);

@@ -1,0 +1,332 @@
+#include "log_experiments.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/errors.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "lcm/message_checks.hpp"
+#include "log_samples.hpp"
+
+namespace hystloop {
+namespace {
+
+struct Request {
+  std::int64_t log_utime = 0;
+  std::int64_t id = 0;
+  ExperimentSpec spec;
+};
+
+struct Command {
+  std::int64_t seq = 0;
+  std::int64_t log_utime = 0;
+  double u_V = 0.0;
+  bool experiment = false;
+};
+
+struct Sample {
+  std::int64_t seq = 0;
+  double u_V = 0.0;
+  double y_m = 0.0;
+  std::int32_t flags = 0;
+};
+
+struct Record {
+  std::vector<Request> starts;        // log order, distinct ids, valid
+  std::vector<std::int64_t> stops;    // log times of STOP_EXPERIMENT requests
+  std::vector<Command> commands;      // by seq, distinct
+  std::vector<Sample> samples;        // by seq, distinct
+};
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string label(const LoggedExperiment& e) {
+  return std::string(e.spec.settle ? "settle" : "sine") + " " + number(e.spec.offset_V) + " V + " +
+         number(e.spec.amplitude_V) + " V at " + number(e.spec.frequency_hz) + " Hz (request " +
+         std::to_string(e.request_id) + ")";
+}
+
+Record read_record(const std::vector<std::string>& files, const ExperimentLogOptions& o, LoggedExperiments& out) {
+  Record r;
+  std::set<std::int64_t> ids;
+  control_t control{};
+  actuator_command_t command{};
+  sensor_sample_t sample{};
+  for (const auto& file : files) {
+    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
+    lcm::LogFile log(file, "r");
+    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
+    ++out.files;
+    while (const lcm::LogEvent* event = log.readNextEvent()) {
+      if (event->channel == o.sensor_channel) {
+        if (decode_logged(*event, sample) && check_message(sample) == Verdict::kOk) {
+          r.samples.push_back({sample.seq, sample.u_V, sample.y_m, sample.flags});
+        }
+      } else if (event->channel == o.command_channel) {
+        if (decode_logged(*event, command) && check_message(command) == Verdict::kOk) {
+          r.commands.push_back({command.seq, event->timestamp, command.u_V,
+                                command.mode == actuator_command_t::MODE_EXPERIMENT});
+        }
+      } else if (event->channel == o.control_channel) {
+        if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
+        if (!control.target.empty() && control.target != o.compensator_process) continue;
+        if (control.command == control_t::STOP_EXPERIMENT) {
+          r.stops.push_back(event->timestamp);
+          continue;
+        }
+        if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) continue;
+        Request q{event->timestamp, control.request_id, {}};
+        q.spec.amplitude_V = control.experiment_amplitude_V;
+        q.spec.offset_V = control.experiment_offset_V;
+        q.spec.frequency_hz = control.experiment_frequency_Hz;
+        q.spec.duration_s = control.experiment_duration_s;
+        q.spec.settle = control.experiment == "settle";
+        if (control.experiment != "sine" && control.experiment != "settle") {
+          out.notes.push_back("request " + std::to_string(q.id) + ": experiment '" + control.experiment +
+                              "' (the compensator refuses it)");
+          continue;
+        }
+        try {
+          q.spec.validate();
+        } catch (const ParameterError& e) {
+          out.notes.push_back("request " + std::to_string(q.id) + ": refused by the compensator's rules: " + e.what());
+          continue;
+        }
+        r.starts.push_back(q);
+      }
+    }
+  }
+  out.requests = r.starts.size();
+  auto by_seq = [](const auto& a, const auto& b) { return a.seq < b.seq; };
+  auto same_seq = [](const auto& a, const auto& b) { return a.seq == b.seq; };
+  std::stable_sort(r.commands.begin(), r.commands.end(), by_seq);
+  r.commands.erase(std::unique(r.commands.begin(), r.commands.end(), same_seq), r.commands.end());
+  std::stable_sort(r.samples.begin(), r.samples.end(), by_seq);
+  r.samples.erase(std::unique(r.samples.begin(), r.samples.end(), same_seq), r.samples.end());
+  return r;
+}
+
+// A run of EXPERIMENT commands: ticks first..last logged; the block certainly ended by end_max
+// (the next logged non-experiment command, or last + 1 when the log ends).
+struct Block {
+  std::int64_t first = 0, last = 0, end_max = 0;
+  std::int64_t first_log_utime = 0, last_log_utime = 0;
+  std::size_t first_index = 0;  // into Record::commands
+};
+
+std::vector<Block> find_blocks(const std::vector<Command>& commands) {
+  std::vector<Block> blocks;
+  for (std::size_t i = 0; i < commands.size();) {
+    if (!commands[i].experiment) {
+      ++i;
+      continue;
+    }
+    Block b{commands[i].seq, commands[i].seq, 0, commands[i].log_utime, commands[i].log_utime, i};
+    std::size_t j = i;
+    while (j < commands.size() && commands[j].experiment) {
+      b.last = commands[j].seq;
+      b.last_log_utime = std::max(b.last_log_utime, commands[j].log_utime);
+      ++j;
+    }
+    b.end_max = j < commands.size() ? commands[j].seq : b.last + 1;
+    blocks.push_back(b);
+    i = j;
+  }
+  return blocks;
+}
+
+// The first tick of [begin, end) whose logged command is not the requested sine, if any.
+std::optional<std::int64_t> first_mismatch(const std::vector<Command>& commands, std::size_t& index,
+                                           const ExperimentSpec& e, double start_s, std::int64_t begin,
+                                           std::int64_t end, double dt_s, double& expected, double& got) {
+  while (index < commands.size() && commands[index].seq < begin) ++index;
+  for (; index < commands.size() && commands[index].seq < end; ++index) {
+    const Command& c = commands[index];
+    const double t_cmd = static_cast<double>(c.seq) * dt_s;
+    // The compensator's own expression (Compensator::update).
+    expected = e.offset_V + e.amplitude_V * std::sin(2.0 * std::numbers::pi * e.frequency_hz * (t_cmd - start_s));
+    if (!c.experiment || !(std::abs(c.u_V - expected) <= 1e-9 * (1.0 + std::abs(expected)))) {
+      got = c.u_V;
+      return c.seq;
+    }
+  }
+  return std::nullopt;
+}
+
+void collect_samples(const std::vector<Sample>& samples, const ExperimentLogOptions& o, LoggedExperiment& e) {
+  const double dt_s = o.dt_s;
+  auto it = std::lower_bound(samples.begin(), samples.end(), e.begin_tick,
+                             [](const Sample& s, std::int64_t seq) { return s.seq < seq; });
+  constexpr std::int32_t kNotAsCommanded = std::int32_t{sensor_sample_t::LATE_COMMAND} |
+                                           std::int32_t{sensor_sample_t::SATURATED} |
+                                           std::int32_t{sensor_sample_t::SLEW_LIMITED};
+  std::int64_t expected_seq = e.begin_tick;
+  for (; it != samples.end() && it->seq < e.end_tick; ++it) {
+    e.missing += static_cast<std::size_t>(it->seq - expected_seq);
+    expected_seq = it->seq + 1;
+    if ((it->flags & sensor_sample_t::SAFE_STATE) != 0) {
+      ++e.safe_state;
+      continue;
+    }
+    if ((it->flags & sensor_sample_t::SENSOR_FAULT) != 0) {
+      ++e.sensor_fault;
+      continue;
+    }
+    if ((it->flags & kNotAsCommanded) != 0) ++e.not_as_commanded;
+    e.samples.t.push_back(static_cast<double>(it->seq - e.begin_tick) * dt_s);
+    e.samples.u.push_back(it->u_V);
+    e.samples.y.push_back(it->y_m);
+  }
+  e.missing += static_cast<std::size_t>(std::max<std::int64_t>(0, e.end_tick - expected_seq));
+  if (!e.problem.empty()) return;
+  const auto ticks = static_cast<double>(e.end_tick - e.begin_tick);
+  const bool loop = e.spec.frequency_hz < o.rate_independent_below_Hz;
+  if (e.missing > 0 && (!loop || static_cast<double>(e.missing) > o.max_missing * ticks)) {
+    e.problem = std::to_string(e.missing) + " tick(s) without a sample in the log" +
+                (loop ? ", more than " + number(o.max_missing * 100.0) + " %" : " (its time base matters)");
+  } else if (e.safe_state > 0) {
+    e.problem = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
+  } else if (e.sensor_fault > 0) {
+    e.problem = std::to_string(e.sensor_fault) + " sample(s) flagged SENSOR_FAULT";
+  } else if (!loop && static_cast<double>(e.not_as_commanded) > o.max_not_as_commanded * ticks) {
+    e.problem = std::to_string(e.not_as_commanded) + " sample(s) not applied as commanded (late, saturated or "
+                "slew-limited), more than " + number(o.max_not_as_commanded * 100.0) + " %";
+  }
+}
+
+}  // namespace
+
+void ExperimentLogOptions::validate() const {
+  if (control_channel.empty() || command_channel.empty() || sensor_channel.empty()) {
+    throw ParameterError("rig", "channel names must not be empty");
+  }
+  require_positive("dt", dt_s);
+  require_in_range("max_not_as_commanded", max_not_as_commanded, 0.0, 1.0);
+  require_in_range("max_missing", max_missing, 0.0, 1.0);
+  require_positive("rate_independent_below_Hz", rate_independent_below_Hz);
+}
+
+LoggedExperiments read_logged_experiments(const std::vector<std::string>& files, const ExperimentLogOptions& o) {
+  o.validate();
+  if (files.empty()) throw SampleLogError("no log file given");
+  LoggedExperiments out;
+  const Record r = read_record(files, o, out);
+  const std::vector<Block> blocks = find_blocks(r.commands);
+  out.blocks = blocks.size();
+  const std::string where = files.size() == 1 ? files.front() : files.front() + " ... " + files.back();
+  if (blocks.empty()) {
+    throw SampleLogError(where + ": no experiment ran (no " + o.command_channel + " command in mode EXPERIMENT; " +
+                         std::to_string(r.commands.size()) + " commands, " + std::to_string(out.requests) +
+                         " START_EXPERIMENT requests logged)");
+  }
+  std::size_t next = 0;  // first request not yet accounted for
+  for (std::size_t bi = 0; bi < blocks.size(); ++bi) {
+    const Block& b = blocks[bi];
+    std::size_t last = next;  // requests logged before the block's end: [next, last)
+    while (last < r.starts.size() && r.starts[last].log_utime <= b.last_log_utime) ++last;
+    if (last == next) {
+      out.notes.push_back("experiment commands at ticks " + std::to_string(b.first) + ".." + std::to_string(b.last) +
+                          " follow no START_EXPERIMENT request in the log (was it recorded from the start?)");
+      continue;
+    }
+    std::vector<ExperimentSpec> specs;
+    for (std::size_t i = next; i < last; ++i) specs.push_back(r.starts[i].spec);
+    const std::vector<ExperimentTicks> ticks = experiment_schedule(b.first, specs, o.dt_s);
+    double start_s = static_cast<double>(b.first) * o.dt_s;
+    std::size_t command_index = b.first_index;
+    std::string mismatch;  // once found, the rest of the block is unexplained
+    bool cut = false;
+    std::size_t i = next;
+    for (; i < last && ticks[i - next].begin < b.end_max; ++i) {
+      LoggedExperiment e;
+      e.request_id = r.starts[i].id;
+      e.spec = r.starts[i].spec;
+      e.begin_tick = ticks[i - next].begin;
+      e.end_tick = ticks[i - next].end;
+      e.complete = e.end_tick <= b.end_max;
+      if (!mismatch.empty()) {
+        e.problem = mismatch;
+      } else if (double expected = 0.0, got = 0.0;
+                 const auto tick = first_mismatch(r.commands, command_index, e.spec, start_s, e.begin_tick,
+                                                  std::min(e.end_tick, b.end_max), o.dt_s, expected, got)) {
+        mismatch = "the commands differ from the requested sines from tick " + std::to_string(*tick) + " (expected " +
+                   number(expected) + " V, commanded " + number(got) + " V): a request is missing from the log";
+        e.problem = mismatch;
+      } else if (!e.complete) {
+        e.problem = "cut short at tick " + std::to_string(b.last) + " (STOP_EXPERIMENT, or the compensator restarted)";
+        cut = true;
+      }
+      e.end_tick = std::min(e.end_tick, b.end_max);
+      start_s = experiment_end_s(start_s, e.spec);
+      collect_samples(r.samples, o, e);
+      out.experiments.push_back(std::move(e));
+      if (cut) {
+        ++i;
+        break;
+      }
+    }
+    const std::int64_t explained = out.experiments.empty() ? b.first : out.experiments.back().end_tick;
+    if (mismatch.empty() && !cut && explained < b.last + 1) {
+      out.notes.push_back("ticks " + std::to_string(explained) + ".." + std::to_string(b.last) +
+                          " ran an experiment no logged request explains (a request missing from the log?)");
+    }
+    // Requests logged before this block ended that did not run in it: dropped with the queue
+    // when it was cut short or stopped; otherwise they start the next block.
+    const std::int64_t next_block_utime = bi + 1 < blocks.size() ? blocks[bi + 1].first_log_utime : INT64_MAX;
+    const bool stopped = cut || std::any_of(r.stops.begin(), r.stops.end(), [&](std::int64_t t) {
+                           return t >= b.first_log_utime && t < next_block_utime;
+                         });
+    if (stopped) {
+      for (; i < last; ++i) {
+        out.notes.push_back("request " + std::to_string(r.starts[i].id) + " never ran (dropped by STOP_EXPERIMENT)");
+      }
+    }
+    next = i;
+  }
+  for (; next < r.starts.size(); ++next) {
+    out.notes.push_back("request " + std::to_string(r.starts[next].id) + " did not run before the log ends");
+  }
+  return out;
+}
+
+std::string describe(const LoggedExperiments& logged) {
+  std::ostringstream o;
+  std::size_t usable = 0, measured = 0;
+  for (const auto& e : logged.experiments) {
+    measured += e.spec.settle ? 0 : 1;
+    usable += (!e.spec.settle && e.usable()) ? 1 : 0;
+  }
+  o << "log: " << logged.files << " file(s), " << logged.requests << " experiment request(s), " << logged.blocks
+    << " run(s) of experiment commands, " << logged.experiments.size() << " experiment(s) ran (" << measured
+    << " measured, " << usable << " usable)\n";
+  for (std::size_t i = 0; i < logged.experiments.size(); ++i) {
+    const auto& e = logged.experiments[i];
+    o << "  " << i << ": " << label(e) << ", ticks " << e.begin_tick << ".." << e.end_tick << ": ";
+    if (e.usable()) {
+      o << (e.spec.settle ? "settling (not fitted)" : "used") << ", " << e.samples.t.size() << " samples";
+      if (e.missing > 0) o << ", " << e.missing << " missing";
+      if (e.not_as_commanded > 0) o << ", " << e.not_as_commanded << " not as commanded";
+    } else {
+      o << "skipped: " << e.problem;
+    }
+    o << "\n";
+  }
+  for (const auto& n : logged.notes) o << "  note: " << n << "\n";
+  return o.str();
+}
+
+}  // namespace hystloop

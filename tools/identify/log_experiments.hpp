@@ -1,0 +1,76 @@
+#pragma once
+// The identification experiments a live loop ran (hystloop-ctl experiment, e.g.
+// --banning-series), cut out of its LCM log: which samples belong to which experiment.
+//
+// The log holds the requests (<rig>CONTROL START_EXPERIMENT / STOP_EXPERIMENT), the commands
+// (<rig>COMMAND, mode EXPERIMENT while one runs) and the samples (<rig>SENSOR). The compensator
+// runs the requested sines back to back from the first experiment command on a schedule that
+// is a function of the requests alone (experiment_schedule, common/loop/compensator.hpp), so:
+//  - each block of consecutive EXPERIMENT commands is explained by the requests logged before
+//    its end, in order; a block that ends inside an experiment was stopped (or the compensator
+//    restarted): that experiment is cut short, and the requests still queued were dropped;
+//  - every experiment is checked against its commands: the commanded voltage must be the
+//    requested sine at every logged tick (so a request missing from the log, which would shift
+//    the schedule, is found, not silently mislabelled);
+//  - an experiment is usable when it ran to its end and no sample is SAFE_STATE / SENSOR_FAULT.
+//    A frequency-response experiment (at or above rate_independent_below_Hz) must also have a
+//    sample for every tick and at most max_not_as_commanded of them LATE_COMMAND, SATURATED or
+//    SLEW_LIMITED: its time base and its input's spectrum matter. A slower one is a hysteresis
+//    loop, a function of the voltage applied, which every sample records: held (late) or
+//    slew-limited commands do not spoil it, and it may lack up to max_missing of its ticks (the
+//    bridge skips a tick when it overruns; the stage moves on continuously).
+// "settle" experiments are kept and labelled: identification uses only the measured ones.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ident/sample_csv.hpp"
+#include "loop/compensator.hpp"
+
+namespace hystloop {
+
+struct ExperimentLogOptions {
+  std::string control_channel = "HX_CONTROL";
+  std::string command_channel = "HX_COMMAND";
+  std::string sensor_channel = "HX_SENSOR";
+  std::string compensator_process = "compensator";  // requests addressed to it (or to everyone) count
+  double dt_s = 1e-4;                                // the rig's tick [s]
+  double max_not_as_commanded = 0.02;                // fraction of a fast experiment's samples, in [0, 1]
+  double max_missing = 0.01;                         // fraction of a slow experiment's ticks, in [0, 1]
+  double rate_independent_below_Hz = 10.0;           // BanningFitOptions::frequency_threshold_Hz
+  void validate() const;                             // throws ParameterError naming the field
+};
+
+struct LoggedExperiment {
+  std::int64_t request_id = 0;
+  ExperimentSpec spec;          // as requested; spec.settle for "settle"
+  std::int64_t begin_tick = 0;  // [begin, end): the commands of this experiment
+  std::int64_t end_tick = 0;
+  bool complete = false;        // ran to its last period
+  std::size_t missing = 0;      // ticks without a sample in the log
+  std::size_t safe_state = 0;   // samples flagged SAFE_STATE
+  std::size_t sensor_fault = 0; // ... SENSOR_FAULT
+  std::size_t not_as_commanded = 0;  // ... LATE_COMMAND, SATURATED or SLEW_LIMITED
+  std::string problem;          // why it cannot be used; empty = usable
+  SampleTable samples;          // t = (seq - begin_tick) * dt [s], u = applied [V], y [m]
+  bool usable() const noexcept { return problem.empty(); }
+};
+
+struct LoggedExperiments {
+  std::vector<LoggedExperiment> experiments;  // in the order they ran
+  std::vector<std::string> notes;             // what else was found: dropped requests, unexplained ticks
+  std::size_t files = 0;
+  std::size_t requests = 0;                   // distinct START_EXPERIMENT requests for the compensator
+  std::size_t blocks = 0;                     // runs of EXPERIMENT commands
+};
+
+// Reads the files in order as one record. Throws SampleLogError (log_samples.hpp) for a file
+// that cannot be read or a log without any experiment command; ParameterError for bad options.
+LoggedExperiments read_logged_experiments(const std::vector<std::string>& files, const ExperimentLogOptions& options);
+
+// A table, one line per experiment, and the notes.
+std::string describe(const LoggedExperiments& logged);
+
+}  // namespace hystloop

@@ -1,0 +1,305 @@
+// Banning's series from a live loop's log: the requests hystloop-ctl sends (its banning_series),
+// run by the real Compensator against the simulated Banning stage tick by tick, recorded as the
+// logger would (HX_CONTROL, HX_COMMAND, HX_SENSOR) with lcm::LogFile. The splitter must find
+// every experiment at the ticks the compensator ran it, label settling, find a stopped series,
+// a request missing from the log and samples missing from it; the tool must fit the stage back.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "ctl_series.hpp"
+#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/sensor_sample_t.hpp"
+#include "log_experiments.hpp"
+#include "log_samples.hpp"
+#include "loop/compensator.hpp"
+#include "loop/simulated_stage.hpp"
+#include "sensor_log_fixture.hpp"
+#include "support/tool_run.hpp"
+
+namespace hystloop {
+namespace {
+
+using testlog::encoded;
+using testlog::write_event;
+
+constexpr std::int64_t kFirstSeq = 5000;
+constexpr std::int64_t kRequestTick = kFirstSeq + 300;  // the requests arrive 30 ms into the record
+constexpr std::int64_t kUtime0 = 1'700'000'000'000'000;
+
+// A short series: two offsets, a small and two large amplitudes at 5 Hz, four frequencies.
+BanningPlanOptions short_plan() {
+  BanningPlanOptions p;
+  p.offsets_V = {-60.0, 60.0};
+  p.small_amplitudes_V = {2.0};
+  p.amplitudes_V = {50.0, 120.0};
+  p.hysteresis_frequency_Hz = 5.0;
+  p.frequencies_Hz = {300.0, 1200.0, 1700.0, 2400.0};
+  return p;
+}
+
+struct Faults {
+  std::set<std::size_t> requests_not_logged;  // the compensator got them, the log did not
+  std::int64_t stop_at_tick = -1;             // STOP_EXPERIMENT at this tick
+  std::int64_t drop_samples_from = -1;        // ticks [from, from + count) not recorded
+  std::int64_t drop_samples_count = 0;
+  std::int64_t late_from = -1;                // ticks [from, from + count) flagged LATE_COMMAND
+  std::int64_t late_count = 0;
+};
+
+struct Recording {
+  std::vector<ExperimentSpec> specs;  // as sent
+  std::int64_t first_experiment_tick = -1;
+};
+
+ExperimentSpec spec_of(const ctl::ExperimentRequest& r) {
+  ExperimentSpec s;
+  s.amplitude_V = r.amplitude_V;
+  s.offset_V = r.offset_V;
+  s.frequency_hz = r.frequency_Hz;
+  s.duration_s = r.duration_s;
+  s.settle = r.kind == "settle";
+  return s;
+}
+
+// The loop: the command for tick k + 2 answers the sample of tick k and is applied on time.
+Recording record_series(const std::string& path, const std::vector<ctl::SeriesStep>& steps, const Faults& faults,
+                        double seconds) {
+  Recording rec;
+  lcm::LogFile log(path, "w");
+  EXPECT_TRUE(log.good());
+  std::int64_t eventnum = 0;
+  SimulatedStageConfig sc;
+  sc.noise_rms_m = 0.5e-9;
+  SimulatedStage stage(sc);
+  CompensatorConfig cc;
+  cc.mode = FeedforwardMode::kOff;
+  Compensator comp(cc);
+  std::array<double, 64> applied{};
+  const auto ticks = static_cast<std::int64_t>(seconds / cc.dt_s);
+  for (std::int64_t seq = kFirstSeq; seq < kFirstSeq + ticks; ++seq) {
+    const std::int64_t utime = kUtime0 + (seq - kFirstSeq) * 100;
+    const double t = static_cast<double>(seq) * cc.dt_s;
+    const double u = applied[static_cast<std::size_t>(seq) % applied.size()];
+    const double y = stage.step(u, t, cc.dt_s);
+    sensor_sample_t s{};
+    s.utime = utime;
+    s.seq = seq;
+    s.u_V = u;
+    s.y_m = y;
+    s.flags = sensor_sample_t::SIMULATED;
+    if (seq >= faults.late_from && seq < faults.late_from + faults.late_count) s.flags |= sensor_sample_t::LATE_COMMAND;
+    const bool dropped = seq >= faults.drop_samples_from && seq < faults.drop_samples_from + faults.drop_samples_count;
+    if (!dropped) write_event(log, eventnum, utime, "HX_SENSOR", encoded(s));
+    if (seq == kRequestTick) {
+      for (std::size_t i = 0; i < steps.size(); ++i) {
+        control_t c{};
+        c.utime = utime;
+        c.request_id = 7000 + static_cast<std::int64_t>(i);
+        c.command = control_t::START_EXPERIMENT;
+        c.experiment = steps[i].request.kind;
+        c.experiment_amplitude_V = steps[i].request.amplitude_V;
+        c.experiment_offset_V = steps[i].request.offset_V;
+        c.experiment_frequency_Hz = steps[i].request.frequency_Hz;
+        c.experiment_duration_s = steps[i].request.duration_s;
+        if (!faults.requests_not_logged.contains(i)) {
+          write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));
+          write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));  // ctl repeats a request
+        }
+        rec.specs.push_back(spec_of(steps[i].request));
+        comp.start_experiment(rec.specs.back());
+      }
+    }
+    if (seq == faults.stop_at_tick) {
+      control_t c{};
+      c.utime = utime;
+      c.request_id = 9999;
+      c.command = control_t::STOP_EXPERIMENT;
+      write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));
+      comp.stop_experiment();
+    }
+    const auto out = comp.update({seq, u, y});
+    if (!out) continue;
+    actuator_command_t cmd{};
+    cmd.utime = utime + 20;
+    cmd.seq = out->seq;
+    cmd.sample_seq = seq;
+    cmd.u_V = out->u_V;
+    cmd.u_ff_V = out->u_ff_V;
+    cmd.u_fb_V = out->u_fb_V;
+    cmd.y_ref_m = out->y_ref_m;
+    cmd.mode = static_cast<std::int8_t>(out->mode);
+    if (out->mode == FeedforwardMode::kExperiment && rec.first_experiment_tick < 0) rec.first_experiment_tick = out->seq;
+    write_event(log, eventnum, utime + 20, "HX_COMMAND", encoded(cmd));
+    applied[static_cast<std::size_t>(out->seq) % applied.size()] = out->u_V;
+  }
+  return rec;
+}
+
+class IdentifySeries : public ::testing::Test {
+ protected:
+  std::string path(const std::string& name) const { return scratch_.path(name); }
+  testing::ScratchDir scratch_{"hystloop_identify_series"};
+  const std::vector<ctl::SeriesStep> steps_ = ctl::banning_series(short_plan());
+  const double seconds_ = ctl::series_duration_s(steps_) + 0.2;
+};
+
+TEST_F(IdentifySeries, EveryExperimentIsFoundAtTheTicksTheCompensatorRanIt) {
+  const Recording rec = record_series(path("run.lcmlog"), steps_, {}, seconds_);
+  const LoggedExperiments logged = read_logged_experiments({path("run.lcmlog")}, {});
+  ASSERT_EQ(logged.experiments.size(), steps_.size()) << describe(logged);
+  EXPECT_EQ(logged.requests, steps_.size());
+  EXPECT_EQ(logged.blocks, 1u);
+  EXPECT_TRUE(logged.notes.empty()) << describe(logged);
+  const auto ticks = experiment_schedule(rec.first_experiment_tick, rec.specs, 1e-4);
+  double start_s = static_cast<double>(rec.first_experiment_tick) * 1e-4;
+  for (std::size_t i = 0; i < steps_.size(); ++i) {
+    const LoggedExperiment& e = logged.experiments[i];
+    EXPECT_EQ(e.request_id, 7000 + static_cast<std::int64_t>(i));
+    EXPECT_EQ(e.begin_tick, ticks[i].begin);
+    EXPECT_EQ(e.end_tick, ticks[i].end);
+    EXPECT_EQ(e.spec.settle, steps_[i].request.kind == "settle");
+    EXPECT_TRUE(e.usable()) << i << ": " << e.problem;
+    EXPECT_TRUE(e.complete);
+    ASSERT_EQ(e.samples.u.size(), static_cast<std::size_t>(e.end_tick - e.begin_tick));
+    // The requested sine, its phase continuing from where the previous experiment ended.
+    double worst = 0.0;
+    for (std::size_t k = 0; k < e.samples.u.size(); ++k) {
+      const double t = static_cast<double>(e.begin_tick + static_cast<std::int64_t>(k)) * 1e-4 - start_s;
+      const double expected = e.spec.offset_V + e.spec.amplitude_V * std::sin(2.0 * std::numbers::pi * e.spec.frequency_hz * t);
+      worst = std::max(worst, std::abs(e.samples.u[k] - expected));
+    }
+    EXPECT_LT(worst, 1e-9) << i;
+    start_s = experiment_end_s(start_s, e.spec);
+  }
+  // Back to back: no tick between two experiments.
+  for (std::size_t i = 1; i < logged.experiments.size(); ++i) {
+    EXPECT_EQ(logged.experiments[i].begin_tick, logged.experiments[i - 1].end_tick);
+  }
+}
+
+TEST_F(IdentifySeries, AStoppedSeriesCutsItsExperimentShortAndDropsTheQueue) {
+  Faults f;
+  f.stop_at_tick = kRequestTick + 10'500;  // 1.05 s in: inside the second offset experiment's settling
+  record_series(path("run.lcmlog"), steps_, f, seconds_);
+  const LoggedExperiments logged = read_logged_experiments({path("run.lcmlog")}, {});
+  ASSERT_FALSE(logged.experiments.empty());
+  const LoggedExperiment& last = logged.experiments.back();
+  EXPECT_FALSE(last.complete);
+  EXPECT_NE(last.problem.find("cut short"), std::string::npos) << last.problem;
+  for (std::size_t i = 0; i + 1 < logged.experiments.size(); ++i) EXPECT_TRUE(logged.experiments[i].usable());
+  const std::size_t dropped = steps_.size() - logged.experiments.size();
+  EXPECT_GT(dropped, 0u);
+  std::size_t never_ran = 0;
+  for (const auto& n : logged.notes) never_ran += n.find("never ran") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(never_ran, dropped) << describe(logged);
+}
+
+TEST_F(IdentifySeries, ARequestMissingFromTheLogIsFoundByTheCommandsNotMislabelled) {
+  Faults f;
+  f.requests_not_logged = {4};  // the third experiment's settling
+  record_series(path("run.lcmlog"), steps_, f, seconds_);
+  const LoggedExperiments logged = read_logged_experiments({path("run.lcmlog")}, {});
+  ASSERT_GE(logged.experiments.size(), 5u) << describe(logged);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(logged.experiments[i].usable()) << i;
+  for (std::size_t i = 4; i < logged.experiments.size(); ++i) {
+    EXPECT_NE(logged.experiments[i].problem.find("a request is missing from the log"), std::string::npos)
+        << i << ": " << logged.experiments[i].problem;
+  }
+}
+
+TEST_F(IdentifySeries, MissingSamplesSpoilAFrequencyExperimentButNotALoop) {
+  // Find the experiments' ticks from a clean recording first.
+  const Recording rec = record_series(path("clean.lcmlog"), steps_, {}, seconds_);
+  const auto schedule = experiment_schedule(rec.first_experiment_tick, rec.specs, 1e-4);
+  const std::size_t loop = 1;                 // offset -60 V, measured at 5 Hz: 4000 ticks
+  const std::size_t fast = steps_.size() - 1; // 2400 Hz, measured
+  Faults loop_gap;
+  loop_gap.drop_samples_from = schedule[loop].begin + 1000;
+  loop_gap.drop_samples_count = 5;
+  record_series(path("loop.lcmlog"), steps_, loop_gap, seconds_);
+  LoggedExperiments logged = read_logged_experiments({path("loop.lcmlog")}, {});
+  ASSERT_EQ(logged.experiments.size(), steps_.size());
+  EXPECT_TRUE(logged.experiments[loop].usable()) << logged.experiments[loop].problem;
+  EXPECT_EQ(logged.experiments[loop].missing, 5u);
+  ExperimentLogOptions strict;
+  strict.max_missing = 0.0;
+  logged = read_logged_experiments({path("loop.lcmlog")}, strict);
+  EXPECT_FALSE(logged.experiments[loop].usable());
+
+  Faults fast_gap;
+  fast_gap.drop_samples_from = schedule[fast].begin + 100;
+  fast_gap.drop_samples_count = 1;
+  record_series(path("fast.lcmlog"), steps_, fast_gap, seconds_);
+  logged = read_logged_experiments({path("fast.lcmlog")}, {});
+  EXPECT_FALSE(logged.experiments[fast].usable());
+  EXPECT_NE(logged.experiments[fast].problem.find("time base"), std::string::npos) << logged.experiments[fast].problem;
+}
+
+// A loop is a function of the voltage applied, which the samples record: late (held) commands
+// do not spoil it. A frequency-response experiment's input spectrum they do.
+TEST_F(IdentifySeries, LateCommandsSpoilAFrequencyExperimentButNotALoop) {
+  const Recording rec = record_series(path("clean.lcmlog"), steps_, {}, seconds_);
+  const auto schedule = experiment_schedule(rec.first_experiment_tick, rec.specs, 1e-4);
+  const std::size_t loop = 1, fast = steps_.size() - 1;
+  Faults f;
+  f.late_from = schedule[loop].begin + 100;
+  f.late_count = 400;  // 10 % of the loop
+  record_series(path("loop.lcmlog"), steps_, f, seconds_);
+  LoggedExperiments logged = read_logged_experiments({path("loop.lcmlog")}, {});
+  EXPECT_TRUE(logged.experiments[loop].usable()) << logged.experiments[loop].problem;
+  EXPECT_EQ(logged.experiments[loop].not_as_commanded, 400u);
+  f.late_from = schedule[fast].begin + 100;
+  f.late_count = 30;  // 3 % of the 1000 ticks
+  record_series(path("fast.lcmlog"), steps_, f, seconds_);
+  logged = read_logged_experiments({path("fast.lcmlog")}, {});
+  EXPECT_FALSE(logged.experiments[fast].usable());
+  EXPECT_NE(logged.experiments[fast].problem.find("not applied as commanded"), std::string::npos);
+  ExperimentLogOptions lenient;
+  lenient.max_not_as_commanded = 0.05;
+  logged = read_logged_experiments({path("fast.lcmlog")}, lenient);
+  EXPECT_TRUE(logged.experiments[fast].usable()) << logged.experiments[fast].problem;
+}
+
+TEST_F(IdentifySeries, NoExperimentInTheLogIsAClearError) {
+  record_series(path("run.lcmlog"), {}, {}, 0.1);
+  try {
+    read_logged_experiments({path("run.lcmlog")}, {});
+    FAIL();
+  } catch (const SampleLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("no experiment ran"), std::string::npos) << e.what();
+  }
+}
+
+// The tool, as a user runs it on the logger's file: Banning's a, b, alpha, k, c come back.
+TEST_F(IdentifySeries, ToolFitsTheStageFromTheLog) {
+  record_series(path("run.lcmlog"), steps_, {}, seconds_);
+  const auto r = testing::run_tool(std::string(HYSTLOOP_IDENTIFY_EXE) + " --model banning " + path("run.lcmlog") +
+                                   " --out " + path("b.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(std::to_string(steps_.size()) + " experiment(s) ran (" +
+                          std::to_string(steps_.size() / 2) + " measured, " + std::to_string(steps_.size() / 2) +
+                          " usable)"),
+            std::string::npos)
+      << r.output;
+  const YAML::Node b = YAML::LoadFile(path("b.yaml"))["banning"];
+  const BanningStageParams truth{};
+  EXPECT_NEAR(b["hysteresis"]["a"].as<double>(), truth.hysteresis.a, 0.005 * truth.hysteresis.a) << r.output;
+  EXPECT_NEAR(b["hysteresis"]["b"].as<double>(), truth.hysteresis.b, 0.01 * truth.hysteresis.b) << r.output;
+  EXPECT_NEAR(b["hysteresis"]["alpha"].as<double>(), truth.hysteresis.alpha, 0.05 * truth.hysteresis.alpha) << r.output;
+  EXPECT_NEAR(b["stage"]["k"].as<double>(), truth.stage.k, 0.02 * truth.stage.k) << r.output;
+  EXPECT_NEAR(b["stage"]["c"].as<double>(), truth.stage.c, 0.05 * truth.stage.c) << r.output;
+}
+
+}  // namespace
+}  // namespace hystloop
