@@ -1,15 +1,19 @@
 #include "ctl_link.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
 
 #include "core/process.hpp"
 #include "ctl_health.hpp"
+#include "ctl_requests.hpp"
 #include "ctl_watch.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/subscription.hpp"
 #include "lcm/url.hpp"
+#include "runtime/status_reporter.hpp"
 
 namespace hystloop::ctl {
 
@@ -133,6 +137,108 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
     }
     if (now >= end) break;
   }
+  return 0;
+}
+
+int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& o) {
+  install_stop_handlers();
+  SeriesTracker tracker(steps, o.dt_s);
+  const double total_s = series_duration_s(steps);
+  std::optional<std::int8_t> mode;  // of the latest command
+  std::optional<std::int64_t> last_seq;
+  bool sent = false;
+  auto on_command = [&](const actuator_command_t& c, std::int64_t) {
+    mode = c.mode;
+    last_seq = c.seq;
+    if (!sent || !o.wait) return;
+    if (const auto step = tracker.on_command(c.seq, c.mode == actuator_command_t::MODE_EXPERIMENT)) {
+      std::printf("[%zu/%zu] %s\n", *step + 1, steps.size(), steps[*step].what.c_str());
+      std::fflush(stdout);
+    }
+  };
+  Subscription<actuator_command_t>::Options fast;
+  fast.queue_capacity = 40'000;
+  Subscription<actuator_command_t> commands(link.lcm(), link.channels().command, on_command, fast);
+  auto pump = [&](Clock::time_point until_time) {
+    return handle_pending(link.lcm(), std::min(until(until_time), std::chrono::microseconds(50'000)), 4096) >= 0;
+  };
+
+  // Commands must flow, and no experiment may be running: ours would queue behind it.
+  const auto listen_end = after(1.0);
+  while (!mode && Clock::now() < listen_end && !stop_requested()) {
+    if (!pump(listen_end)) return 1;
+  }
+  if (!mode) {
+    std::fprintf(stderr, "hystloop-ctl: no command on %s within 1 s: is the compensator running and the bridge "
+                         "sending samples? (hystloop-ctl status)\n", link.channels().command.c_str());
+    return 1;
+  }
+  if (*mode == actuator_command_t::MODE_EXPERIMENT) {
+    std::fprintf(stderr, "hystloop-ctl: an experiment is running: wait for it to end, or hystloop-ctl stop-experiment\n");
+    return 1;
+  }
+
+  const std::int64_t base_id = new_request_id(wall_utime(), static_cast<int>(::getpid()));
+  std::printf("hystloop-ctl: sending %zu experiment requests on %s (%.1f s back to back)\n", steps.size(),
+              link.channels().control.c_str(), total_s);
+  std::fflush(stdout);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const std::int64_t now = wall_utime();
+    control_t msg = make_control(control_t::START_EXPERIMENT, o.target, base_id + static_cast<std::int64_t>(i), now);
+    apply(steps[i].request, msg);
+    if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
+      std::fprintf(stderr, "hystloop-ctl: could not publish request %zu on %s%s\n", i + 1,
+                   link.channels().control.c_str(), i > 0 ? ": sending STOP_EXPERIMENT" : "");
+      if (i > 0) {
+        publish_repeated(link.lcm(), link.channels().control,
+                         make_control(control_t::STOP_EXPERIMENT, o.target, base_id + 100'000, wall_utime()));
+      }
+      return 1;
+    }
+    sent = true;
+    if (!pump(Clock::now())) return 1;  // keep the command queue short while sending
+  }
+  if (!o.wait) {
+    std::printf("hystloop-ctl: sent %zu experiment requests on %s (%.1f s back to back)\n", steps.size(),
+                link.channels().control.c_str(), total_s);
+    return 0;
+  }
+
+  const auto start_deadline = after(o.start_timeout_s);
+  const auto end_deadline = after(total_s + o.start_timeout_s + 5.0);
+  while (!tracker.finished() && !tracker.ended_early() && !stop_requested()) {
+    const auto deadline = tracker.started() ? end_deadline : start_deadline;
+    if (Clock::now() >= deadline) break;
+    if (!pump(deadline)) {
+      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
+      return 1;
+    }
+  }
+  if (stop_requested()) {
+    publish_repeated(link.lcm(), link.channels().control,
+                     make_control(control_t::STOP_EXPERIMENT, o.target, base_id + 100'000, wall_utime()));
+    std::fprintf(stderr, "hystloop-ctl: interrupted: sent STOP_EXPERIMENT (the queued experiments are dropped)\n");
+    return 1;
+  }
+  if (!tracker.started()) {
+    std::fprintf(stderr, "hystloop-ctl: no experiment command within %g s of the requests: the compensator refused "
+                         "them or did not get them (see its log; hystloop-ctl status)\n", o.start_timeout_s);
+    return 1;
+  }
+  if (tracker.ended_early()) {
+    std::fprintf(stderr, "hystloop-ctl: the series ended at tick %lld, before its end at tick %lld: stopped, or the "
+                         "compensator restarted\n", static_cast<long long>(last_seq.value_or(0)),
+                 static_cast<long long>(tracker.end_tick()));
+    return 1;
+  }
+  if (!tracker.finished()) {
+    std::fprintf(stderr, "hystloop-ctl: the series did not end within %.1f s (commands stopped arriving?)\n",
+                 total_s + o.start_timeout_s + 5.0);
+    return 1;
+  }
+  std::printf("hystloop-ctl: series done: %zu steps, ticks %lld .. %lld (%.1f s)\n", steps.size(),
+              static_cast<long long>(tracker.first_tick().value_or(0)), static_cast<long long>(tracker.end_tick()),
+              total_s);
   return 0;
 }
 

@@ -11,6 +11,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "ctl_series.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 
@@ -69,6 +70,18 @@ struct WatchOptions {
 
 // Prints a line per second; returns 0 (1 if LCM failed).
 int run_watch(CtlLink& link, const WatchOptions& options);
+
+struct SeriesRunOptions {
+  std::string target;            // control_t.target of the requests (empty: every process)
+  double dt_s = 1e-4;            // the rig's tick [s], to follow the series from the commands
+  bool wait = true;              // follow the series until it ends (else: send and return)
+  double start_timeout_s = 3.0;  // the first experiment command must arrive within this
+};
+
+// Sends the steps as START_EXPERIMENT requests (the compensator queues them) and, with wait,
+// prints each step as it starts. Refuses to start while an experiment runs or no commands flow.
+// On SIGINT/SIGTERM it sends STOP_EXPERIMENT. Returns 0 when the series ran to its end, 1 if not.
+int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& options);
 
 // The highest parameter version seen on HX_PARAMS or in HX_COMMAND within listen_s, plus one
 // (1 when nothing was seen), so that a set sent by hand supersedes the one in use.

@@ -5,7 +5,9 @@
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
 //   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd
-//   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine]
+//   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
+//   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
+//   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
 //   trajectory --shape cosine|sine|triangle|hold|points --amplitude M --frequency HZ --offset M
 //              --blend S [--points-csv FILE]   |   trajectory --mem-paper
 //   params --c1 --c2 --c3 [--residual M] [--version N]
@@ -42,6 +44,11 @@ struct Options {
   std::string mode;
   GainsRequest gains;
   ExperimentRequest experiment;
+  bool experiment_mem_paper = false;
+  bool banning_series = false;
+  bool series_list = false;
+  BanningPlanOptions plan;
+  SeriesRunOptions series;
   TrajectoryRequest trajectory;
   std::string points_csv;
   bool mem_paper = false;
@@ -105,6 +112,20 @@ int send_params(const Options& o) {
   return 0;
 }
 
+int run_banning_series(Options& o) {
+  const std::vector<SeriesStep> steps = banning_series(o.plan);
+  std::size_t experiments = steps.empty() ? 0 : steps.back().experiment + 1;
+  std::printf("hystloop-ctl: Banning series: %zu experiments, %zu steps, %.1f s\n", experiments, steps.size(),
+              series_duration_s(steps));
+  if (o.series_list) {
+    for (std::size_t i = 0; i < steps.size(); ++i) std::printf("  %2zu  %s\n", i + 1, steps[i].what.c_str());
+    return 0;
+  }
+  o.series.target = o.target;
+  CtlLink link(o.link);
+  return run_series(link, steps, o.series);
+}
+
 CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, Options& o) {
   CLI::App* sub = app.add_subcommand(name, help);
   sub->add_option("--target", o.target, "Process the request is for (default: every process)");
@@ -150,12 +171,48 @@ int main(int argc, char** argv) {
   gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();
   gains->add_option("--kd", o.gains.kd, "Derivative gain [s]")->capture_default_str();
 
-  CLI::App* experiment = control_subcommand(app, "experiment", "Compensator: run an identification experiment", o);
-  experiment->add_option("--amplitude", o.experiment.amplitude_V, "Excitation amplitude [V], > 0")->required();
-  experiment->add_option("--frequency", o.experiment.frequency_Hz, "Excitation frequency [Hz], > 0")->required();
-  experiment->add_option("--duration", o.experiment.duration_s, "Duration [s], > 0")->required();
-  experiment->add_option("--offset", o.experiment.offset_V, "Offset [V]")->capture_default_str();
-  experiment->add_option("--kind", o.experiment.kind, "Experiment: sine, triangle, chirp, ...")->capture_default_str();
+  CLI::App* experiment = control_subcommand(
+      app, "experiment",
+      "Compensator: run an identification experiment (a sine, the MEM paper's input, or Banning's series); "
+      "requests sent while one runs wait and run back to back",
+      o);
+  auto* amplitude = experiment->add_option("--amplitude", o.experiment.amplitude_V, "Excitation amplitude [V], > 0");
+  auto* frequency = experiment->add_option("--frequency", o.experiment.frequency_Hz, "Excitation frequency [Hz], > 0");
+  auto* duration = experiment->add_option("--duration", o.experiment.duration_s,
+                                          "Duration [s], > 0, rounded up to whole periods (--mem-paper: default 2)");
+  auto* offset = experiment->add_option("--offset", o.experiment.offset_V, "Offset [V]")->capture_default_str();
+  auto* kind = experiment->add_option("--kind", o.experiment.kind,
+                                      "sine, or settle (the same sine, marked for identification to skip)")
+                   ->capture_default_str();
+  auto* mem_paper_exp = experiment->add_flag("--mem-paper", o.experiment_mem_paper,
+                                             "The MEM paper's identification input u = 250 sin(20 pi t) V")
+                            ->excludes(amplitude, frequency, offset, kind);
+  auto* series = experiment->add_flag("--banning-series", o.banning_series,
+                                      "Banning et al.'s series: offsets, small and large amplitudes (each settled "
+                                      "at --settle-frequency, then measured at --hysteresis-frequency), and the "
+                                      "frequency response; fit the log with hystloop-identify --model banning")
+                     ->excludes(amplitude, frequency, duration, offset, kind, mem_paper_exp);
+  auto plan_option = [&](const char* name, auto& value, const char* help) {
+    experiment->add_option(name, value, help)->capture_default_str()->needs(series);
+  };
+  plan_option("--offsets", o.plan.offsets_V, "series: offsets of the centre experiments [V]");
+  plan_option("--offset-amplitude", o.plan.offset_amplitude_V, "series: their amplitude [V]");
+  plan_option("--small-amplitudes", o.plan.small_amplitudes_V, "series: small amplitudes (slope -> b) [V]");
+  plan_option("--amplitudes", o.plan.amplitudes_V, "series: amplitudes (areas -> alpha) [V]");
+  plan_option("--hysteresis-frequency", o.plan.hysteresis_frequency_Hz, "series: frequency of the measured loops [Hz]");
+  plan_option("--measure-periods", o.plan.measure_periods, "series: periods measured per loop");
+  plan_option("--settle-frequency", o.plan.settle_frequency_Hz, "series: frequency of the settling cycles [Hz]");
+  plan_option("--settle-periods", o.plan.settle_periods, "series: settling cycles before each experiment (at least)");
+  plan_option("--settle-path", o.plan.settle_path_V,
+              "series: ... and at least this much input path, 4 x amplitude per cycle [V]");
+  plan_option("--frequencies", o.plan.frequencies_Hz, "series: frequency-response points (k, c) [Hz]");
+  plan_option("--frequency-amplitude", o.plan.frequency_amplitude_V, "series: their amplitude [V]");
+  experiment->add_flag("--list", o.series_list, "series: print the steps and their duration, send nothing")->needs(series);
+  experiment->add_flag("--no-wait", [&](std::int64_t) { o.series.wait = false; }, "series: send and return at once")
+      ->needs(series);
+  experiment->add_option("--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")
+      ->capture_default_str()
+      ->needs(series);
 
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
   trajectory->add_option("--shape", o.trajectory.shape, "cosine, sine, triangle, hold or points");
@@ -217,6 +274,13 @@ int main(int argc, char** argv) {
       return send_control(o, control_t::SET_GAINS, o.target, "SET_GAINS", [&](control_t& msg) { apply(o.gains, msg); });
     }
     if (*experiment) {
+      if (o.banning_series) return run_banning_series(o);
+      if (o.experiment_mem_paper) {
+        o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
+      } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
+        throw ParameterError("experiment", "give --amplitude, --frequency and --duration, or --mem-paper, or "
+                                           "--banning-series");
+      }
       o.experiment.validate();
       return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT",
                           [&](control_t& msg) { apply(o.experiment, msg); });

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <algorithm>
 #include <random>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "core/errors.hpp"
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
+#include "ctl_series.hpp"
 #include "ctl_watch.hpp"
 #include "hystloop/actuator_command_t.hpp"
 #include "lcm/message_checks.hpp"
@@ -274,4 +276,74 @@ TEST(CtlWatch, LineIsTidy) {
             "lat p99 120 us  bridge HEALTHY");
   EXPECT_EQ(format_watch_line(WatchLine{}),
             "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  lat p99 --  bridge --");
+}
+
+// Banning's series as requests: per planned experiment a settling sine then the measured one,
+// each a whole number of periods, together the plan's input sample for sample.
+TEST(CtlSeries, BanningSeriesIsThePlanAsSettleAndMeasureRequests) {
+  BanningPlanOptions plan;
+  const auto experiments = plan_banning_experiments(plan);
+  const auto steps = banning_series(plan);
+  ASSERT_EQ(steps.size(), 2 * experiments.size());
+  double total = 0.0;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const auto& r = steps[i].request;
+    const auto& e = experiments[steps[i].experiment];
+    EXPECT_EQ(steps[i].experiment, i / 2);
+    EXPECT_EQ(r.kind, i % 2 == 0 ? "settle" : "sine");
+    EXPECT_EQ(r.offset_V, e.offset_V);
+    EXPECT_EQ(r.amplitude_V, e.amplitude_V);
+    const double periods = r.duration_s * r.frequency_Hz;
+    EXPECT_NEAR(periods, std::round(periods), 1e-9) << i;
+    total += r.duration_s;
+    // The request reproduces the plan's samples: the settling part, then the measured part.
+    const double fs = e.sample_rate_Hz;
+    const std::size_t begin = i % 2 == 0 ? 0 : e.measure_begin;
+    const std::size_t end = i % 2 == 0 ? e.measure_begin : e.u.size();
+    EXPECT_EQ(static_cast<double>(end - begin), std::round(r.duration_s * fs)) << i;
+    for (std::size_t k = begin; k < end; k += 97) {
+      const double t = static_cast<double>(k - begin) / fs;
+      EXPECT_NEAR(e.u[k], r.offset_V + r.amplitude_V * std::sin(2.0 * std::numbers::pi * r.frequency_Hz * t), 1e-9);
+    }
+  }
+  EXPECT_NEAR(series_duration_s(steps), total, 1e-9);
+  EXPECT_LT(total, 45.0);  // about 36 s with the default plan
+  BanningPlanOptions too_long = plan;
+  too_long.frequencies_Hz.assign(200, 100.0);
+  EXPECT_EQ(field_of([&] { banning_series(too_long); }), "banning-series");
+  BanningPlanOptions bad = plan;
+  bad.hysteresis_frequency_Hz = -1.0;
+  EXPECT_EQ(field_of([&] { banning_series(bad); }), "hysteresis_frequency_Hz");
+}
+
+TEST(CtlSeries, TrackerFollowsTheStepsFromTheCommands) {
+  BanningPlanOptions plan;
+  plan.offsets_V = {0.0};
+  plan.small_amplitudes_V = {};
+  plan.amplitudes_V = {};
+  plan.frequencies_Hz = {1000.0};
+  const auto steps = banning_series(plan);
+  ASSERT_EQ(steps.size(), 4u);
+  SeriesTracker tracker(steps, 1e-4);
+  EXPECT_FALSE(tracker.on_command(100, false));  // before the series
+  EXPECT_FALSE(tracker.started());
+  std::vector<std::size_t> entered;
+  std::int64_t seq = 101;
+  for (; !tracker.finished(); ++seq) {
+    if (seq % 50 == 7) continue;  // commands lost on the way
+    const bool experiment = !tracker.started() || seq < tracker.end_tick();
+    if (const auto s = tracker.on_command(seq, experiment)) entered.push_back(*s);
+  }
+  EXPECT_EQ(entered, (std::vector<std::size_t>{0, 1, 2, 3}));
+  EXPECT_EQ(*tracker.first_tick(), 101);
+  // 20 periods at 50 Hz + 2 s + 50 periods at 1 kHz (400 V of path at 2 V) + 100 periods.
+  EXPECT_EQ(tracker.end_tick() - 101, 4000 + 20000 + 500 + 1000);
+  EXPECT_FALSE(tracker.ended_early());
+
+  SeriesTracker stopped(steps, 1e-4);
+  stopped.on_command(10, true);
+  stopped.on_command(11, true);
+  stopped.on_command(12, false);
+  EXPECT_TRUE(stopped.ended_early());
+  EXPECT_FALSE(stopped.finished());
 }
