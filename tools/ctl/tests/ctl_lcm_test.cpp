@@ -337,6 +337,31 @@ TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfMatchedTicks) {
   EXPECT_NE(last.find("lat p99 95 us"), std::string::npos) << last;
 }
 
+// The series needs a running loop that is not in an experiment: both refusals name the cause.
+TEST_F(CtlLcmTest, BanningSeriesRefusesWithoutCommandsOrWhileAnExperimentRuns) {
+  Result r = run_ctl(with_url({"experiment", "--banning-series"}));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no command on HX_COMMAND within 1 s"), std::string::npos) << r.err;
+
+  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  std::vector<control_t> requests;
+  Subscription<control_t> control(*lcm_, ch_.control, [&](const control_t& c, std::int64_t) { requests.push_back(c); });
+  std::int64_t k = 0;
+  auto experiment_running = [&] {
+    actuator_command_t c{};
+    c.utime = now_us();
+    c.seq = k++;
+    c.sample_seq = c.seq - 2;
+    c.y_ref_m = std::nan("");
+    c.mode = actuator_command_t::MODE_EXPERIMENT;
+    commands.publish(c);
+  };
+  r = run_ctl(with_url({"experiment", "--banning-series"}), lcm_.get(), experiment_running);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("an experiment is running"), std::string::npos) << r.err;
+  EXPECT_TRUE(requests.empty()) << "nothing may be sent";
+}
+
 // No LCM needed below: arguments are checked before the tool opens a connection.
 TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
   struct Case {
@@ -353,6 +378,9 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
       {{"gains", "--kp", "-0.1"}, "kp:"},
       {{"experiment", "--amplitude", "0", "--frequency", "1", "--duration", "1"}, "amplitude:"},
       {{"experiment", "--amplitude", "1", "--frequency", "1"}, "--duration"},
+      {{"experiment", "--banning-series", "--amplitude", "3"}, "excludes"},
+      {{"experiment", "--hysteresis-frequency", "4"}, "requires --banning-series"},
+      {{"experiment", "--banning-series", "--hysteresis-frequency", "-1"}, "hysteresis_frequency_Hz: must be > 0"},
       {{"trajectory", "--shape", "square"}, "shape:"},
       {{"trajectory", "--shape", "sine", "--frequency", "0"}, "frequency:"},
       {{"trajectory", "--shape", "sine", "--blend", "-1"}, "blend:"},
