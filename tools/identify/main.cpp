@@ -1,7 +1,7 @@
 // hystloop-identify data.csv|run.NNN.lcmlog... --model mem|banning|katalenic|pi|linear|auto
 //                   [--form integrated|derivative] [--out params.yaml]
 //                   [--log] [--rig HX_] [--dt 1e-4 | --time-from utime] [--from S] [--to S]
-//                   [--compensator NAME --max-late F --max-missing F]   (banning on logs)
+//                   [--experiment N] [--compensator NAME --max-late F --max-missing F]   (experiments on logs)
 //                   [--publish [--version N] [--listen-s 0.5] [--lcm-url URL] [--allow-network]]
 // Input: CSV t,u,y (sample_csv.hpp), or LCM event logs (files ending in .lcmlog, or --log): the
 // rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp);
@@ -49,6 +49,7 @@ struct Args {
   std::string time_from = "seq";
   std::optional<double> from_s, to_s;
   std::string compensator = "compensator";
+  std::optional<std::size_t> experiment;
   double max_late = 0.02;
   double max_missing = 0.01;
   // --publish
@@ -233,6 +234,21 @@ int fit_banning_and_emit(const Args& args, const std::vector<BanningExperimentDa
   return emit(args, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
 }
 
+LoggedExperiments read_experiments(const Args& args) {
+  ExperimentLogOptions o;
+  o.control_channel = channel_name(args.rig, kControlSuffix);
+  o.command_channel = channel_name(args.rig, kCommandSuffix);
+  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.compensator_process = args.compensator;
+  o.dt_s = args.dt_s;
+  o.max_not_as_commanded = args.max_late;
+  o.max_missing = args.max_missing;
+  o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
+  LoggedExperiments logged = read_logged_experiments(args.files, o);
+  std::cout << describe(logged);
+  return logged;
+}
+
 // Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError / SampleLogError.
 std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
   std::vector<SampleTable> tables;
@@ -246,6 +262,25 @@ std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
   o.dt_s = args.dt_s;
   o.from_s = args.from_s;
   o.to_s = args.to_s;
+  if (args.experiment) {
+    // One experiment the loop ran (e.g. hystloop-ctl experiment --mem-paper), as listed.
+    LoggedExperiments logged = read_experiments(args);
+    if (*args.experiment >= logged.experiments.size()) {
+      throw SampleLogError("--experiment " + std::to_string(*args.experiment) + ": the log holds " +
+                           std::to_string(logged.experiments.size()) + " experiment(s), numbered from 0");
+    }
+    LoggedExperiment& e = logged.experiments[*args.experiment];
+    // Late commands and skipped ticks do not spoil a rate-independent fit; these do.
+    std::string why;
+    if (!e.complete) why = e.problem;
+    if (e.safe_state > 0) why = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
+    if (e.sensor_fault > 0) why = std::to_string(e.sensor_fault) + " sample(s) flagged SENSOR_FAULT";
+    if (!why.empty()) throw SampleLogError("--experiment " + std::to_string(*args.experiment) + " cannot be used: " + why);
+    std::cout << "fitting experiment " << *args.experiment << ": " << e.samples.t.size()
+              << " samples (for this rate-independent fit, late commands and skipped ticks do no harm)\n";
+    tables.push_back(std::move(e.samples));
+    return tables;
+  }
   LogSamples samples = read_sample_logs(args.files, o);
   std::cout << describe(samples, o);
   tables.push_back(std::move(samples.table));
@@ -255,17 +290,7 @@ std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
 // --model banning on logs: the experiments the live loop ran (hystloop-ctl experiment
 // --banning-series), one table per measured experiment that can be used.
 int fit_banning_logs(const Args& args) {
-  ExperimentLogOptions o;
-  o.control_channel = channel_name(args.rig, kControlSuffix);
-  o.command_channel = channel_name(args.rig, kCommandSuffix);
-  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
-  o.compensator_process = args.compensator;
-  o.dt_s = args.dt_s;
-  o.max_not_as_commanded = args.max_late;
-  o.max_missing = args.max_missing;
-  o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
-  const LoggedExperiments logged = read_logged_experiments(args.files, o);
-  std::cout << describe(logged);
+  const LoggedExperiments logged = read_experiments(args);
   std::vector<BanningExperimentData> data;
   for (const auto& e : logged.experiments) {
     // The requested frequency is known: no need to estimate it from a u with held samples.
@@ -319,6 +344,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   logs->add_option("--from", args.from_s, "fit only samples at t >= this [s after the record's first sample]");
   logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
+  logs->add_option("--experiment", args.experiment,
+                   "fit only this experiment the loop ran (numbered from 0 as listed; e.g. the one hystloop-ctl "
+                   "experiment --mem-paper ran)");
   logs->add_option("--compensator", args.compensator,
                    "banning: process name of the compensator whose HX_CONTROL experiment requests count")
       ->capture_default_str();
@@ -347,6 +375,7 @@ int main(int argc, char** argv) {
   const bool from_logs = args.log || log_names == args.files.size();
   if (!from_logs && log_names > 0) return usage_error("mixed inputs: give either CSV files or LCM logs (*.lcmlog)");
   if (!from_logs && (args.from_s || args.to_s)) return usage_error("--from/--to select a range of an LCM log");
+  if (!from_logs && args.experiment) return usage_error("--experiment selects an experiment of an LCM log");
   if (args.publish && args.model != "mem") {
     return usage_error("--publish sends MEM parameters (mem_params_t on HX_PARAMS): only with --model mem (got --model " +
                        args.model + ")");
@@ -363,6 +392,9 @@ int main(int argc, char** argv) {
       link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
     } else {
       validate_rig_prefix(args.rig);
+    }
+    if (args.experiment && (args.from_s || args.to_s)) {
+      return usage_error("--experiment selects its own samples: not with --from/--to");
     }
     if (from_logs && args.model == "banning") {
       if (args.from_s || args.to_s) {

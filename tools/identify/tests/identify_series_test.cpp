@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <set>
 #include <string>
@@ -299,6 +300,30 @@ TEST_F(IdentifySeries, ToolFitsTheStageFromTheLog) {
   EXPECT_NEAR(b["hysteresis"]["alpha"].as<double>(), truth.hysteresis.alpha, 0.05 * truth.hysteresis.alpha) << r.output;
   EXPECT_NEAR(b["stage"]["k"].as<double>(), truth.stage.k, 0.02 * truth.stage.k) << r.output;
   EXPECT_NEAR(b["stage"]["c"].as<double>(), truth.stage.c, 0.05 * truth.stage.c) << r.output;
+}
+
+// --experiment N: any model on one experiment the loop ran, as listed.
+TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
+  record_series(path("run.lcmlog"), steps_, {}, seconds_);
+  const std::string tool = std::string(HYSTLOOP_IDENTIFY_EXE) + " " + path("run.lcmlog");
+  // Experiment 3 is the +60 V offset loop (4000 samples): a line through it passes through
+  // the loop's centre, which lies on y = a u (Banning, Theorem 3).
+  auto r = testing::run_tool(tool + " --model linear --experiment 3");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fitting experiment 3: 4000 samples"), std::string::npos) << r.output;
+  double gain = 0.0, offset = 0.0;
+  ASSERT_EQ(std::sscanf(r.output.substr(r.output.find("linear: gain = ")).c_str(),
+                        "linear: gain = %lf m/V, offset = %lf m", &gain, &offset), 2)
+      << r.output;
+  const double a = BanningStageParams{}.hysteresis.a;
+  EXPECT_NEAR(offset + gain * 60.0, a * 60.0, 0.005 * a * 60.0) << r.output;
+  r = testing::run_tool(tool + " --model mem --experiment 99");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("the log holds " + std::to_string(steps_.size()) + " experiment(s)"), std::string::npos)
+      << r.output;
+  r = testing::run_tool(tool + " --model mem --experiment 1 --from 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("not with --from/--to"), std::string::npos) << r.output;
 }
 
 }  // namespace
