@@ -56,6 +56,20 @@ void ExperimentSpec::validate() const {
   require_positive("experiment.duration_s", duration_s);
 }
 
+ExperimentSpec make_experiment_spec(std::string_view kind, double amplitude_V, double offset_V, double frequency_hz,
+                                    double duration_s) {
+  if (kind != "sine" && kind != "settle") {
+    throw ParameterError("experiment", "'" + std::string(kind) + "' unknown (sine, or settle: a sine identification skips)");
+  }
+  const ExperimentSpec spec{amplitude_V, offset_V, frequency_hz, duration_s, kind == "settle"};
+  spec.validate();
+  return spec;
+}
+
+double experiment_voltage(const ExperimentSpec& spec, double t_s) noexcept {
+  return spec.offset_V + spec.amplitude_V * std::sin(2.0 * std::numbers::pi * spec.frequency_hz * t_s);
+}
+
 double experiment_end_s(double start_s, const ExperimentSpec& spec) noexcept {
   const double periods = std::ceil(spec.duration_s * spec.frequency_hz - 1e-9);
   return start_s + periods / spec.frequency_hz;
@@ -222,7 +236,7 @@ std::optional<CompensatorOutput> Compensator::update(const CompensatorInput& sam
     }
     if (t_cmd < experiment_->end_s) {
       const ExperimentSpec& e = experiment_->spec;
-      out.u_V = e.offset_V + e.amplitude_V * std::sin(2.0 * std::numbers::pi * e.frequency_hz * (t_cmd - experiment_->start_s));
+      out.u_V = experiment_voltage(e, t_cmd - experiment_->start_s);
       out.u_ff_V = out.u_V;
       out.y_ref_m = kNaN;
       out.error_m = kNaN;

@@ -15,6 +15,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -70,6 +71,12 @@ struct ExperimentSpec {
   void validate() const;
 };
 
+// The experiment a START_EXPERIMENT request names: kind "sine", or "settle" (the same sine,
+// labelled). Validated; throws ParameterError ("experiment" for another kind).
+ExperimentSpec make_experiment_spec(std::string_view kind, double amplitude_V, double offset_V, double frequency_hz,
+                                    double duration_s);
+// The voltage an experiment commands t_s after its start [V].
+double experiment_voltage(const ExperimentSpec& spec, double t_s) noexcept;
 // Loop time [s] at which an experiment started at start_s ends: after its whole periods.
 double experiment_end_s(double start_s, const ExperimentSpec& spec) noexcept;
 // The first tick k whose loop time k * dt_s is at or after t_s: the first command past an

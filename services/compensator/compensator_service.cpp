@@ -197,15 +197,9 @@ void CompensatorService::on_control(const control_t& msg) {
         break;
       }
       case control_t::START_EXPERIMENT: {
-        if (msg.experiment != "sine" && msg.experiment != "settle") {
-          return refuse("experiment '" + msg.experiment + "' unknown (sine, or settle: a sine identification skips)");
-        }
-        ExperimentSpec e;
-        e.amplitude_V = msg.experiment_amplitude_V;
-        e.offset_V = msg.experiment_offset_V;
-        e.frequency_hz = msg.experiment_frequency_Hz;
-        e.duration_s = msg.experiment_duration_s;
-        e.settle = msg.experiment == "settle";
+        const ExperimentSpec e = make_experiment_spec(msg.experiment, msg.experiment_amplitude_V,
+                                                      msg.experiment_offset_V, msg.experiment_frequency_Hz,
+                                                      msg.experiment_duration_s);
         const bool queued = compensator_->experiment_running();
         compensator_->start_experiment(e);
         spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {})", msg.experiment, e.amplitude_V,

@@ -179,6 +179,10 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   }
 
   const std::int64_t base_id = new_request_id(wall_utime(), static_cast<int>(::getpid()));
+  auto send_stop = [&] {
+    publish_repeated(link.lcm(), link.channels().control,
+                     make_control(control_t::STOP_EXPERIMENT, o.target, base_id + 100'000, wall_utime()));
+  };
   std::printf("hystloop-ctl: sending %zu experiment requests on %s (%.1f s back to back)\n", steps.size(),
               link.channels().control.c_str(), total_s);
   std::fflush(stdout);
@@ -189,10 +193,7 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
     if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
       std::fprintf(stderr, "hystloop-ctl: could not publish request %zu on %s%s\n", i + 1,
                    link.channels().control.c_str(), i > 0 ? ": sending STOP_EXPERIMENT" : "");
-      if (i > 0) {
-        publish_repeated(link.lcm(), link.channels().control,
-                         make_control(control_t::STOP_EXPERIMENT, o.target, base_id + 100'000, wall_utime()));
-      }
+      if (i > 0) send_stop();
       return 1;
     }
     sent = true;
@@ -215,8 +216,7 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
     }
   }
   if (stop_requested()) {
-    publish_repeated(link.lcm(), link.channels().control,
-                     make_control(control_t::STOP_EXPERIMENT, o.target, base_id + 100'000, wall_utime()));
+    send_stop();
     std::fprintf(stderr, "hystloop-ctl: interrupted: sent STOP_EXPERIMENT (the queued experiments are dropped)\n");
     return 1;
   }

@@ -24,17 +24,11 @@ ExperimentRequest sine(const char* kind, double offset_V, double amplitude_V, do
   return r;
 }
 
-ExperimentSpec to_spec(const ExperimentRequest& r) {
-  ExperimentSpec s;
-  s.amplitude_V = r.amplitude_V;
-  s.offset_V = r.offset_V;
-  s.frequency_hz = r.frequency_Hz;
-  s.duration_s = r.duration_s;
-  s.settle = r.kind == "settle";
-  return s;
-}
-
 }  // namespace
+
+ExperimentSpec to_spec(const ExperimentRequest& r) {
+  return make_experiment_spec(r.kind, r.amplitude_V, r.offset_V, r.frequency_Hz, r.duration_s);
+}
 
 std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {
   std::vector<SeriesStep> steps;

@@ -22,6 +22,9 @@ struct SeriesStep {
   ExperimentRequest request;
 };
 
+// The experiment the compensator runs for a request (throws ParameterError if it would refuse it).
+ExperimentSpec to_spec(const ExperimentRequest& request);
+
 // Throws ParameterError for a bad plan, or one with more steps than the compensator queues.
 std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan);
 

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <numbers>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -89,24 +88,15 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
           continue;
         }
         if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) continue;
-        Request q{event->timestamp, control.request_id, {}};
-        q.spec.amplitude_V = control.experiment_amplitude_V;
-        q.spec.offset_V = control.experiment_offset_V;
-        q.spec.frequency_hz = control.experiment_frequency_Hz;
-        q.spec.duration_s = control.experiment_duration_s;
-        q.spec.settle = control.experiment == "settle";
-        if (control.experiment != "sine" && control.experiment != "settle") {
-          out.notes.push_back("request " + std::to_string(q.id) + ": experiment '" + control.experiment +
-                              "' (the compensator refuses it)");
-          continue;
-        }
-        try {
-          q.spec.validate();
+        try {  // what the compensator accepts (CompensatorService::on_control)
+          r.starts.push_back({event->timestamp, control.request_id,
+                              make_experiment_spec(control.experiment, control.experiment_amplitude_V,
+                                                   control.experiment_offset_V, control.experiment_frequency_Hz,
+                                                   control.experiment_duration_s)});
         } catch (const ParameterError& e) {
-          out.notes.push_back("request " + std::to_string(q.id) + ": refused by the compensator's rules: " + e.what());
-          continue;
+          out.notes.push_back("request " + std::to_string(control.request_id) +
+                              ": refused by the compensator's rules: " + e.what());
         }
-        r.starts.push_back(q);
       }
     }
   }
@@ -149,19 +139,22 @@ std::vector<Block> find_blocks(const std::vector<Command>& commands) {
   return blocks;
 }
 
-// The first tick of [begin, end) whose logged command is not the requested sine, if any.
-std::optional<std::int64_t> first_mismatch(const std::vector<Command>& commands, std::size_t& index,
-                                           const ExperimentSpec& e, double start_s, std::int64_t begin,
-                                           std::int64_t end, double dt_s, double& expected, double& got) {
+struct Mismatch {
+  std::int64_t tick = 0;
+  double expected_V = 0.0, commanded_V = 0.0;
+};
+
+// The first logged command of [begin, end) that is not the requested sine, if any.
+std::optional<Mismatch> first_mismatch(const std::vector<Command>& commands, std::size_t& index,
+                                       const ExperimentSpec& e, double start_s, std::int64_t begin, std::int64_t end,
+                                       double dt_s) {
   while (index < commands.size() && commands[index].seq < begin) ++index;
   for (; index < commands.size() && commands[index].seq < end; ++index) {
     const Command& c = commands[index];
-    const double t_cmd = static_cast<double>(c.seq) * dt_s;
-    // The compensator's own expression (Compensator::update).
-    expected = e.offset_V + e.amplitude_V * std::sin(2.0 * std::numbers::pi * e.frequency_hz * (t_cmd - start_s));
+    // Loop time as the compensator computes it (Compensator::loop_time).
+    const double expected = experiment_voltage(e, static_cast<double>(c.seq) * dt_s - start_s);
     if (!c.experiment || !(std::abs(c.u_V - expected) <= 1e-9 * (1.0 + std::abs(expected)))) {
-      got = c.u_V;
-      return c.seq;
+      return Mismatch{c.seq, expected, c.u_V};
     }
   }
   return std::nullopt;
@@ -260,11 +253,11 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
       e.complete = e.end_tick <= b.end_max;
       if (!mismatch.empty()) {
         e.problem = mismatch;
-      } else if (double expected = 0.0, got = 0.0;
-                 const auto tick = first_mismatch(r.commands, command_index, e.spec, start_s, e.begin_tick,
-                                                  std::min(e.end_tick, b.end_max), o.dt_s, expected, got)) {
-        mismatch = "the commands differ from the requested sines from tick " + std::to_string(*tick) + " (expected " +
-                   number(expected) + " V, commanded " + number(got) + " V): a request is missing from the log";
+      } else if (const auto m = first_mismatch(r.commands, command_index, e.spec, start_s, e.begin_tick,
+                                               std::min(e.end_tick, b.end_max), o.dt_s)) {
+        mismatch = "the commands differ from the requested sines from tick " + std::to_string(m->tick) +
+                   " (expected " + number(m->expected_V) + " V, commanded " + number(m->commanded_V) +
+                   " V): a request is missing from the log";
         e.problem = mismatch;
       } else if (!e.complete) {
         e.problem = "cut short at tick " + std::to_string(b.last) + " (STOP_EXPERIMENT, or the compensator restarted)";

@@ -63,16 +63,6 @@ struct Recording {
   std::int64_t first_experiment_tick = -1;
 };
 
-ExperimentSpec spec_of(const ctl::ExperimentRequest& r) {
-  ExperimentSpec s;
-  s.amplitude_V = r.amplitude_V;
-  s.offset_V = r.offset_V;
-  s.frequency_hz = r.frequency_Hz;
-  s.duration_s = r.duration_s;
-  s.settle = r.kind == "settle";
-  return s;
-}
-
 // The loop: the command for tick k + 2 answers the sample of tick k and is applied on time.
 Recording record_series(const std::string& path, const std::vector<ctl::SeriesStep>& steps, const Faults& faults,
                         double seconds) {
@@ -117,7 +107,7 @@ Recording record_series(const std::string& path, const std::vector<ctl::SeriesSt
           write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));
           write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));  // ctl repeats a request
         }
-        rec.specs.push_back(spec_of(steps[i].request));
+        rec.specs.push_back(ctl::to_spec(steps[i].request));
         comp.start_experiment(rec.specs.back());
       }
     }
