@@ -142,7 +142,7 @@ TEST_F(IdentifyTool, HelpDescribesTheModels) {
   EXPECT_NE(r.output.find("--publish"), std::string::npos) << r.output;
 }
 
-TEST_F(IdentifyTool, PublishIsOnlyForMemAndNeedsALocalUrl) {
+TEST_F(IdentifyTool, PublishIsOnlyForMem) {
   const MemParams truth = MemParams::paper_like();
   MemModel model(truth);
   model.reset(0.0);
@@ -153,9 +153,8 @@ TEST_F(IdentifyTool, PublishIsOnlyForMemAndNeedsALocalUrl) {
   const ToolRun pi = run_tool(path("mem.csv") + " --model pi --publish");
   EXPECT_EQ(pi.exit_code, 2) << pi.output;
   EXPECT_NE(pi.output.find("only with --model mem"), std::string::npos) << pi.output;
-  const ToolRun net = run_tool(path("mem.csv") + " --model mem --publish --lcm-url 'udpm://239.255.76.67:7667?ttl=3'");
-  EXPECT_EQ(net.exit_code, 2) << net.output;
-  EXPECT_NE(net.output.find("lcm.url"), std::string::npos) << net.output;
+  // A URL whose packets could leave the host is refused: tools/identify/tests/identify_publish_test.cpp,
+  // inside a private network namespace.
   // A time range is for logs.
   EXPECT_EQ(run_tool(path("mem.csv") + " --model mem --to 1").exit_code, 2);
 }

@@ -24,6 +24,8 @@ refused "rt.io_priority" --set rt.priority=50 --set rt.io_priority=60
 refused "did you mean 'actuator.watchdog_s'" --set actuator.watchdog=0.1
 printf 'actuator:\n  slew_V_per_s: -5\n' >"$dir/bad.yaml"
 refused "bad.yaml: actuator.slew_V_per_s" --config "$dir/bad.yaml"
+# A URL whose packets could leave the host is refused before LCM starts (this script runs inside
+# tools/netns-run: even if it were not, nothing could leave the private namespace).
 refused "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
 # The default configuration is valid: a short run on the in-process provider.
 "$bridge" --config "$config/bridge.yaml" --lcm-url memq:// --seconds 0.2 --set rt.priority=0 --set rt.io_priority=0 \

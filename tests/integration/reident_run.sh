@@ -57,6 +57,7 @@ case "$what" in
     check_bad "mem.c1" --set mem.c1=0
     printf 'reident:\n  window_sec: 2\n' >"$dir/typo.yaml"
     check_bad "reident.window_sec" --config "$dir/typo.yaml"
+    # Refused before LCM starts; and this runs inside tools/netns-run, so nothing could leave anyway.
     check_bad "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
     check_bad "reident.lcm_queue" --set reident.lcm_queue=10
     start

@@ -327,15 +327,12 @@ TEST_F(IdentifyLog, ToolReadsAnyNameWithLogAndRefusesBadInput) {
   EXPECT_NE(range.output.find("to: must be > from"), std::string::npos) << range.output;
 }
 
-TEST_F(IdentifyLog, ToolPublishesOnlyMemAndOnlyOnALocalUrl) {
+TEST_F(IdentifyLog, ToolPublishesOnlyMem) {
   write_log(path("run.lcmlog"), mem_record(truth_));
   const ToolRun pi = run_tool(path("run.lcmlog") + " --model pi --publish");
   EXPECT_EQ(pi.exit_code, 2) << pi.output;
   EXPECT_NE(pi.output.find("only with --model mem"), std::string::npos) << pi.output;
-  const ToolRun ttl = run_tool(path("run.lcmlog") + " --model mem --publish --lcm-url 'udpm://239.255.76.67:7667?ttl=1'");
-  EXPECT_EQ(ttl.exit_code, 2) << ttl.output;
-  EXPECT_NE(ttl.output.find("lcm.url"), std::string::npos) << ttl.output;
-  EXPECT_EQ(ttl.output.find("MEM ("), std::string::npos) << "fitted before the URL was checked: " << ttl.output;
+  // A URL whose packets could leave the host: identify_publish_test.cpp, inside a private namespace.
 }
 
 }  // namespace

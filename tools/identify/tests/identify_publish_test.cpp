@@ -192,6 +192,30 @@ TEST_F(IdentifyPublish, VersionSupersedesTheSetInUse) {
   EXPECT_NEAR(rig3.front().c2, truth_.c2, 0.01 * truth_.c2);
 }
 
+// A URL whose packets could leave the host (ttl > 0) is refused before the fit, from a log or a
+// CSV, and nothing is sent. Inside this namespace such packets could not leave anyway; they would
+// reach the test's own subscription on the same group and port, which must stay silent.
+TEST_F(IdentifyPublish, AUrlThatCouldLeaveTheHostIsRefusedBeforeTheFit) {
+  const auto record = mem_record(truth_);
+  write_log(path("run.lcmlog"), record);
+  {
+    std::ofstream csv(path("run.csv"));
+    csv << "t,u,y\n";
+    for (const auto& s : record) {
+      csv << static_cast<double>(s.seq - record.front().seq) * 1e-4 << "," << s.u_V << "," << s.y_m << "\n";
+    }
+  }
+  for (const std::string input : {"run.lcmlog", "run.csv"}) {
+    const Result r = run_tool({path(input), "--model", "mem", "--publish", "--lcm-url",
+                               "udpm://239.255.76.67:7667?ttl=1", "--listen-s", "0"},
+                              *lcm_);
+    EXPECT_EQ(r.exit_code, 2) << input << ": " << r.out;
+    EXPECT_NE(r.out.find("lcm.url"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("MEM ("), std::string::npos) << "fitted before the URL was checked: " << r.out;
+  }
+  EXPECT_TRUE(received_.empty());
+}
+
 TEST_F(IdentifyPublish, RefusedFitPublishesNothing) {
   auto record = mem_record(truth_);
   for (auto& s : record) {
