@@ -16,22 +16,22 @@ inline constexpr std::string_view kDefaultRigPrefix = "HX_";
 void validate_rig_prefix(std::string_view prefix);
 
 // The six channels of DESIGN.md, by suffix.
-inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_sample_t, 10 kHz
-inline constexpr std::string_view kCommandSuffix = "COMMAND";        // actuator_command_t, 10 kHz
+inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_block_t, 10 kHz of ticks in blocks
+inline constexpr std::string_view kCommandSuffix = "COMMAND";        // command_block_t, one block per sensor block
 inline constexpr std::string_view kTrajectorySuffix = "TRAJECTORY";  // trajectory_t, on change
 inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_params_t, on refit
 inline constexpr std::string_view kStatusSuffix = "STATUS";          // service_status_t, 1 Hz per process
 inline constexpr std::string_view kControlSuffix = "CONTROL";        // control_t, on demand
 
-// Suffix and LCM type name ("hystloop.sensor_sample_t") of every channel, e.g. for a
+// Suffix and LCM type name ("hystloop.sensor_block_t") of every channel, e.g. for a
 // logger that records them all or a tool that lists them.
 struct ChannelSpec {
   std::string_view suffix;
   std::string_view type_name;
 };
 inline constexpr std::array<ChannelSpec, 6> kChannelSpecs{{
-    {kSensorSuffix, "hystloop.sensor_sample_t"},
-    {kCommandSuffix, "hystloop.actuator_command_t"},
+    {kSensorSuffix, "hystloop.sensor_block_t"},
+    {kCommandSuffix, "hystloop.command_block_t"},
     {kTrajectorySuffix, "hystloop.trajectory_t"},
     {kParamsSuffix, "hystloop.mem_params_t"},
     {kStatusSuffix, "hystloop.service_status_t"},

@@ -1,5 +1,7 @@
 #include "lcm/message_checks.hpp"
 
+#include "lcm/message_storage.hpp"
+
 #include <cmath>
 #include <cstddef>
 
@@ -34,29 +36,44 @@ class Findings {
 constexpr double kHuge = 1.0e300;  // "any finite value"
 
 bool is_command_mode(std::int8_t mode) noexcept {
-  return mode >= actuator_command_t::MODE_OFF && mode <= actuator_command_t::MODE_EXPERIMENT;
+  return mode >= command_block_t::MODE_OFF && mode <= command_block_t::MODE_EXPERIMENT;
 }
 
 }  // namespace
 
-Verdict check_message(const sensor_sample_t& msg) noexcept {
+Verdict check_message(const sensor_block_t& msg) noexcept {
   Findings f;
-  f.require(msg.utime >= 0 && msg.seq >= 0);
-  f.within(msg.u_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
-  f.within(msg.y_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
-  f.require(msg.flags >= 0 && (msg.flags & ~kKnownSampleFlags) == 0);
+  f.require(msg.utime >= 0 && msg.seq >= 0 && msg.buffer_depth_ticks >= 0);
+  f.within(msg.dt_s, 1e-7, 1.0);
+  f.require(msg.dt_s > 0.0);
+  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= sensor_block_t::MAX_TICKS && arrays_consistent(msg);
+  f.require(count_ok);
+  if (count_ok) {
+    for (std::size_t i = 0; i < msg.u_V.size(); ++i) {
+      f.within(msg.u_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+      f.within(msg.u_ff_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+      f.within(msg.u_fb_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+      f.nan_or_within(msg.y_ref_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
+      f.within(msg.y_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
+      f.require(msg.flags[i] >= 0 && (msg.flags[i] & ~kKnownSampleFlags) == 0);
+    }
+  }
   return f.verdict();
 }
 
-Verdict check_message(const actuator_command_t& msg) noexcept {
+Verdict check_message(const command_block_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.seq >= 0 && msg.sample_seq >= -1);
-  f.within(msg.u_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
-  f.within(msg.u_ff_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
-  f.within(msg.u_fb_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
-  f.nan_or_within(msg.y_ref_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
-  f.require(msg.params_version >= 0);
-  f.require(is_command_mode(msg.mode));
+  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= command_block_t::MAX_TICKS && arrays_consistent(msg);
+  f.require(count_ok);
+  if (count_ok) {
+    for (std::size_t i = 0; i < msg.u_ff_V.size(); ++i) {
+      f.within(msg.u_ff_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
+      f.nan_or_within(msg.y_ref_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
+      f.require(msg.params_version[i] >= 0);
+      f.require(is_command_mode(msg.mode[i]));
+    }
+  }
   return f.verdict();
 }
 

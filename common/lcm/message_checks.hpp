@@ -7,10 +7,10 @@
 
 #include <cstdint>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/reject_reason.hpp"
@@ -23,11 +23,14 @@ inline constexpr double kMaxAbsFrequency_Hz = 1.0e5;
 inline constexpr double kMaxDuration_s = 86400.0;
 inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FAULT
 
-// sensor_sample_t: finite u and y within the sanity bounds, seq and utime >= 0, known flags.
-Verdict check_message(const sensor_sample_t& msg) noexcept;
-// actuator_command_t: finite u, u_ff, u_fb; y_ref finite or NaN (no reference); seq >= 0,
-// sample_seq >= -1, params_version >= 0, a known mode.
-Verdict check_message(const actuator_command_t& msg) noexcept;
+// sensor_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u, u_ff,
+// u_fb and y within the sanity bounds, y_ref finite or NaN (none), known flags; seq, utime and
+// buffer depth >= 0, 0 < dt_s <= 1 s.
+Verdict check_message(const sensor_block_t& msg) noexcept;
+// command_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u_ff,
+// y_ref finite or NaN (no reference), params_version >= 0, a known mode; seq >= 0,
+// sample_seq >= -1, utime >= 0.
+Verdict check_message(const command_block_t& msg) noexcept;
 // trajectory_t: known shape, finite numbers, frequency > 0 for periodic shapes, version >= 1,
 // 0..MAX_POINTS points (>= 1 for POINTS) with strictly increasing times >= 0, array sizes
 // equal to n_points (so that encoding never reads past a vector).

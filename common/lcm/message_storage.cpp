@@ -2,6 +2,49 @@
 
 namespace hystloop {
 
+namespace {
+template <class... V>
+void reserve_all(std::size_t n, V&... vectors) {
+  (vectors.reserve(n), ...);
+}
+template <class... V>
+bool all_sized(std::int32_t n, const V&... vectors) noexcept {
+  return n >= 0 && ((vectors.size() == static_cast<std::size_t>(n)) && ...);
+}
+}  // namespace
+
+void reserve_storage(sensor_block_t& m) {
+  reserve_all(sensor_block_t::MAX_TICKS, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
+}
+
+void reserve_storage(command_block_t& m) {
+  reserve_all(command_block_t::MAX_TICKS, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
+}
+
+void clear_arrays(sensor_block_t& m) noexcept {
+  m.u_V.clear();
+  m.u_ff_V.clear();
+  m.u_fb_V.clear();
+  m.y_ref_m.clear();
+  m.y_m.clear();
+  m.flags.clear();
+}
+
+void clear_arrays(command_block_t& m) noexcept {
+  m.u_ff_V.clear();
+  m.y_ref_m.clear();
+  m.params_version.clear();
+  m.mode.clear();
+}
+
+bool arrays_consistent(const sensor_block_t& m) noexcept {
+  return all_sized(m.n_ticks, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
+}
+
+bool arrays_consistent(const command_block_t& m) noexcept {
+  return all_sized(m.n_ticks, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
+}
+
 void reserve_storage(trajectory_t& msg) {
   msg.points_t_s.reserve(trajectory_t::MAX_POINTS);
   msg.points_y_m.reserve(trajectory_t::MAX_POINTS);

@@ -8,10 +8,10 @@
 
 #include <cstddef>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 
@@ -19,8 +19,8 @@ namespace hystloop {
 
 inline constexpr std::size_t kReservedStringChars = 64;
 
-inline void reserve_storage(sensor_sample_t&) {}
-inline void reserve_storage(actuator_command_t&) {}
+void reserve_storage(sensor_block_t& msg);
+void reserve_storage(command_block_t& msg);
 void reserve_storage(trajectory_t& msg);
 void reserve_storage(mem_params_t& msg);
 void reserve_storage(service_status_t& msg);
@@ -29,8 +29,8 @@ void reserve_storage(control_t& msg);
 // clear_arrays: empties every variable array, keeping its capacity. Needed before decoding
 // into a reused message: lcm-gen's decode skips a primitive array whose count is 0, so it
 // would keep the previous message's elements.
-inline void clear_arrays(sensor_sample_t&) noexcept {}
-inline void clear_arrays(actuator_command_t&) noexcept {}
+void clear_arrays(sensor_block_t& msg) noexcept;
+void clear_arrays(command_block_t& msg) noexcept;
 inline void clear_arrays(mem_params_t&) noexcept {}
 inline void clear_arrays(control_t&) noexcept {}
 void clear_arrays(trajectory_t& msg) noexcept;
@@ -39,8 +39,8 @@ void clear_arrays(service_status_t& msg) noexcept;
 // arrays_consistent: every variable array holds exactly its count (lcm-gen's encode reads
 // `count` elements whatever the vector's size). Publisher refuses an inconsistent
 // message even when its value check is switched off.
-inline bool arrays_consistent(const sensor_sample_t&) noexcept { return true; }
-inline bool arrays_consistent(const actuator_command_t&) noexcept { return true; }
+bool arrays_consistent(const sensor_block_t& msg) noexcept;
+bool arrays_consistent(const command_block_t& msg) noexcept;
 inline bool arrays_consistent(const mem_params_t&) noexcept { return true; }
 inline bool arrays_consistent(const control_t&) noexcept { return true; }
 bool arrays_consistent(const trajectory_t& msg) noexcept;

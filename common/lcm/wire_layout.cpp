@@ -17,9 +17,11 @@ std::int64_t read_be(const unsigned char* p, int bytes) noexcept {
 
 // The fingerprints below are T::getHash() of the .lcm files as committed; the layout test
 // checks them, so a changed type fails loudly rather than being walked with a stale layout.
-constexpr std::array kSensor{F::kInt64, F::kInt64, F::kDouble, F::kDouble, F::kInt32};
-constexpr std::array kCommand{F::kInt64,  F::kInt64,  F::kInt64, F::kDouble, F::kDouble,
-                              F::kDouble, F::kDouble, F::kInt32, F::kInt8};
+constexpr std::array kSensor{F::kInt64,       F::kInt64,       F::kDouble,      F::kInt32,       F::kCount,
+                             F::kDoubleArray, F::kDoubleArray, F::kDoubleArray, F::kDoubleArray, F::kDoubleArray,
+                             F::kInt32Array};
+constexpr std::array kCommand{F::kInt64,       F::kInt64,       F::kInt64,      F::kCount,
+                              F::kDoubleArray, F::kDoubleArray, F::kInt32Array, F::kInt8Array};
 constexpr std::array kTrajectory{F::kInt64,  F::kInt64,  F::kInt8,  F::kDouble,      F::kDouble,      F::kDouble,
                                  F::kDouble, F::kInt64,  F::kDouble, F::kCount, F::kDoubleArray, F::kDoubleArray};
 constexpr std::array kParams{F::kInt64, F::kInt32, F::kDouble, F::kDouble, F::kDouble,
@@ -32,8 +34,10 @@ constexpr std::array kControl{F::kInt64,  F::kInt64,  F::kInt8,   F::kString, F:
 
 }  // namespace
 
-WireLayout wire_layout(const sensor_sample_t*) noexcept { return {7786445219695628610, kSensor, 0}; }
-WireLayout wire_layout(const actuator_command_t*) noexcept { return {-6278125682187443296, kCommand, 0}; }
+WireLayout wire_layout(const sensor_block_t*) noexcept { return {5057741610172088436, kSensor, sensor_block_t::MAX_TICKS}; }
+WireLayout wire_layout(const command_block_t*) noexcept {
+  return {6289571984888529779, kCommand, command_block_t::MAX_TICKS};
+}
 WireLayout wire_layout(const trajectory_t*) noexcept {
   return {-2105350467762901674, kTrajectory, trajectory_t::MAX_POINTS};
 }
@@ -84,6 +88,8 @@ std::int64_t walk_wire_layout(const WireLayout& layout, const void* data, std::s
         break;
       case F::kDoubleArray:
       case F::kInt64Array: ok = count >= 0 && take(static_cast<std::size_t>(count) * 8); break;
+      case F::kInt32Array: ok = count >= 0 && take(static_cast<std::size_t>(count) * 4); break;
+      case F::kInt8Array: ok = count >= 0 && take(static_cast<std::size_t>(count)); break;
       case F::kStringArray:
         ok = count >= 0;
         for (std::int64_t i = 0; ok && i < count; ++i) ok = take_string();

@@ -13,10 +13,10 @@
 #include <cstdint>
 #include <span>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 
@@ -31,6 +31,8 @@ enum class WireField : std::uint8_t {
   kCount,        // int32 element count of the arrays that follow, 0..max_count
   kDoubleArray,  // [count] doubles
   kInt64Array,   // [count] int64
+  kInt32Array,   // [count] int32
+  kInt8Array,    // [count] int8
   kStringArray,  // [count] strings
 };
 
@@ -40,8 +42,8 @@ struct WireLayout {
   std::int32_t max_count;    // bound on every kCount field
 };
 
-WireLayout wire_layout(const sensor_sample_t*) noexcept;
-WireLayout wire_layout(const actuator_command_t*) noexcept;
+WireLayout wire_layout(const sensor_block_t*) noexcept;
+WireLayout wire_layout(const command_block_t*) noexcept;
 WireLayout wire_layout(const trajectory_t*) noexcept;
 WireLayout wire_layout(const mem_params_t*) noexcept;
 WireLayout wire_layout(const service_status_t*) noexcept;

@@ -2,10 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.hpp"
 
 namespace hystloop {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+FeedbackGains with_actuator_limit(FeedbackGains gains, const ActuatorLimits& limits) {
+  gains.u_limit_V = std::max(std::abs(limits.u_min_V), std::abs(limits.u_max_V));
+  return gains;
+}
+
+}  // namespace
 
 void ActuatorLimits::validate() const {
   require_finite("actuator.u_min_V", u_min_V);
@@ -17,42 +28,46 @@ void ActuatorLimits::validate() const {
   require_positive("actuator.watchdog_s", watchdog_s);
 }
 
-BridgeCore::BridgeCore(const ActuatorLimits& limits, double dt_s) : limits_(limits), dt_s_(dt_s) {
-  limits_.validate();
-  require_positive("bridge.dt_s", dt_s);
+BridgeCore::BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo, double dt_s)
+    : limits_((limits.validate(), limits)),
+      dt_s_((require_positive("bridge.dt_s", dt_s), dt_s)),
+      servo_(with_actuator_limit(servo, limits)),
+      servo_ref_m_(kNaN) {
   u_applied_ = limits_.safe_u_V;
-  u_held_ = limits_.safe_u_V;
+  held_.u_ff_V = limits_.safe_u_V;
+  held_.y_ref_m = kNaN;
 }
 
-bool BridgeCore::submit(std::int64_t seq, double u_V, std::int32_t params_version, double now_s) noexcept {
-  if (!std::isfinite(u_V)) {
+bool BridgeCore::submit(const CommandTick& command) noexcept {
+  if (!std::isfinite(command.u_ff_V) || std::isinf(command.y_ref_m)) {
     ++counters_.rejected_nonfinite;
     return false;
   }
-  if (seq < next_tick_) {
-    ++counters_.stale;
-    return false;
+  switch (buffer_.insert(command)) {
+    case CommandBuffer::Insert::kStored: return true;
+    case CommandBuffer::Insert::kDuplicate: ++counters_.duplicates; return false;
+    case CommandBuffer::Insert::kStale: ++counters_.stale; return false;
+    case CommandBuffer::Insert::kTooFarAhead: ++counters_.rejected_future; return false;
   }
-  if (seq >= next_tick_ + kBufferTicks) {
-    ++counters_.rejected_future;
-    return false;
-  }
-  if (!armed_) {
-    ++counters_.ignored_disarmed;
-    last_fresh_s_ = now_s;  // the command stream is alive: arm() may rely on it
-    return false;
-  }
-  slots_[static_cast<std::size_t>(seq % kBufferTicks)] = Slot{seq, u_V, params_version};
-  last_fresh_s_ = now_s;
-  return true;
+  return false;
 }
 
-BridgeTick BridgeCore::tick(std::int64_t k, double t_s) noexcept {
-  ++counters_.ticks;
-  next_tick_ = k + 1;
-  BridgeTick out;
+void BridgeCore::set_servo_gains(const FeedbackGains& gains) noexcept {
+  try {
+    servo_.set_gains(with_actuator_limit(gains, limits_));
+  } catch (...) {  // validated by the caller; an invalid set keeps the gains in force
+  }
+}
 
-  if (armed_ && t_s - last_fresh_s_ > limits_.watchdog_s) {
+BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
+  ++counters_.ticks;
+  const double step_s = last_tick_ >= 0 ? dt_s_ * static_cast<double>(std::max<std::int64_t>(1, k - last_tick_)) : dt_s_;
+  last_tick_ = k;
+  BridgeTick out;
+  const CommandTick* command = buffer_.take(k);
+  out.buffer_depth = buffer_.depth();
+
+  if (armed_ && command == nullptr && static_cast<double>(k - last_supplied_tick_) * dt_s_ > limits_.watchdog_s) {
     armed_ = false;
     ++counters_.watchdog_trips;
   }
@@ -60,22 +75,34 @@ BridgeTick BridgeCore::tick(std::int64_t k, double t_s) noexcept {
   double target;
   double max_step;
   if (!armed_) {
+    // Safe state: ramp to the safe voltage; the servo holds its state for the re-arm.
     target = limits_.safe_u_V;
     max_step = limits_.safe_ramp_V_per_s * dt_s_;
     out.flags |= sample_flags::kSafeState;
+    out.y_ref_m = kNaN;
+    servo_ref_m_ = kNaN;
+    ++counters_.safe_ticks;
   } else {
-    Slot& slot = slots_[static_cast<std::size_t>(k % kBufferTicks)];
-    if (slot.seq == k) {
-      u_held_ = slot.u_V;
-      held_version_ = slot.params_version;
+    if (command != nullptr) {
+      held_ = *command;
+      last_supplied_tick_ = k;
       ++counters_.applied;
     } else {
       ++counters_.late;
       out.flags |= sample_flags::kLateCommand;
     }
-    target = u_held_;
+    // The servo: the previous tick's reference against the position measured at its end.
+    if (!std::isfinite(held_.y_ref_m)) {
+      servo_.reset();  // no reference (an experiment): nothing to track, nothing to remember
+    } else if (std::isfinite(servo_ref_m_) && servo_.gains().enabled()) {
+      out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s);
+    }
+    servo_ref_m_ = held_.y_ref_m;
+    out.u_ff_V = held_.u_ff_V;
+    out.y_ref_m = held_.y_ref_m;
+    out.params_version = held_.params_version;
+    target = held_.u_ff_V + out.u_fb_V;
     max_step = limits_.slew_V_per_s * dt_s_;
-    out.params_version = held_version_;
   }
 
   const double clamped = std::clamp(target, limits_.u_min_V, limits_.u_max_V);
@@ -96,11 +123,14 @@ BridgeTick BridgeCore::tick(std::int64_t k, double t_s) noexcept {
   return out;
 }
 
-void BridgeCore::arm(double now_s) noexcept {
+void BridgeCore::arm(std::int64_t k) noexcept {
   armed_ = true;
-  // Hold where we are until the first command arrives; the watchdog starts now.
-  u_held_ = u_applied_;
-  last_fresh_s_ = std::max(last_fresh_s_, now_s);
+  // Hold where we are until the first command's tick; the watchdog counts from now.
+  held_.u_ff_V = u_applied_;
+  held_.y_ref_m = kNaN;
+  held_.params_version = 0;
+  servo_ref_m_ = kNaN;
+  last_supplied_tick_ = k;
 }
 
 void BridgeCore::disarm() noexcept { armed_ = false; }

@@ -1,21 +1,28 @@
 #pragma once
-// The bridge's decision logic, without I/O or a clock: which voltage reaches the
-// actuator at tick k. It owns the safety rules of DESIGN.md — range and slew clamp,
-// non-finite and stale rejection, the watchdog and the safe-state ramp — so that
-// they are tested here, faster than real time, and the service only wires I/O to it.
+// The bridge's decision logic, without I/O or a clock: which voltage reaches the actuator at
+// tick k. The compensator sends its feedforward and reference ahead of time; they wait in a
+// jitter buffer indexed by tick (CommandBuffer). At tick k the core takes the command for k
+// (or holds the last one: a late tick), adds the servo's correction on y_ref - y, clamps to the
+// actuator's range and slew rate, and applies. It owns the safety rules of DESIGN.md: range and
+// slew clamp, non-finite and stale rejection, the watchdog on an empty buffer and the ramp to
+// the safe voltage. Time is an argument, so all of it is tested faster than real time.
 
-#include <array>
 #include <cstdint>
+
+#include "core/ticks.hpp"
+#include "loop/command_buffer.hpp"
+#include "loop/feedback.hpp"
 
 namespace hystloop {
 
-// Bits of sensor_sample_t.flags (the LCM type repeats these values).
+// Bits of sensor_block_t.flags (the LCM type repeats these values).
 namespace sample_flags {
 inline constexpr std::int32_t kSaturated = 1;     // the command was clamped to the range
 inline constexpr std::int32_t kSafeState = 2;     // watchdog tripped or not armed: ramping to / holding safe_u_V
 inline constexpr std::int32_t kSimulated = 4;     // the stage is the built-in simulator
 inline constexpr std::int32_t kSlewLimited = 8;   // the command was slew-limited
-inline constexpr std::int32_t kLateCommand = 16;  // no command for this tick: the last one was held
+inline constexpr std::int32_t kLateCommand = 16;  // no command for this tick: the last feedforward was held
+inline constexpr std::int32_t kSensorFault = 32;  // the backend reports the sensor reading unreliable
 }  // namespace sample_flags
 
 struct ActuatorLimits {
@@ -24,67 +31,73 @@ struct ActuatorLimits {
   double slew_V_per_s = 5.0e4;       // 5 V per 100 us tick; the MEM paper's 250 V, 10 Hz sine needs 1.6e4 V/s
   double safe_u_V = 0.0;             // where the watchdog takes the actuator
   double safe_ramp_V_per_s = 1.0e3;  // how fast it goes there (250 V in 0.25 s)
-  double watchdog_s = 2.0e-3;        // no fresh command for this long -> safe state
+  double watchdog_s = 2.0e-3;        // the buffer empty for this long -> safe state
 
   void validate() const;  // throws ParameterError naming the field
 };
 
 struct BridgeCounters {
   std::uint64_t ticks = 0;
-  std::uint64_t applied = 0;            // ticks that applied a command meant for them
-  std::uint64_t late = 0;               // armed ticks with no command for them (last one held)
+  std::uint64_t applied = 0;            // armed ticks that applied a command meant for them
+  std::uint64_t late = 0;               // armed ticks with no command for them (last feedforward held)
   std::uint64_t stale = 0;              // commands that arrived after their tick had passed
+  std::uint64_t duplicates = 0;         // commands for a tick that had one already (the first stays)
   std::uint64_t rejected_nonfinite = 0;
   std::uint64_t rejected_future = 0;    // seq too far ahead to buffer
   std::uint64_t clamped = 0;
   std::uint64_t slew_limited = 0;
   std::uint64_t watchdog_trips = 0;
-  std::uint64_t ignored_disarmed = 0;   // commands received while in the safe state
+  std::uint64_t safe_ticks = 0;         // ticks in the safe state
 };
 
 struct BridgeTick {
   double u_applied_V = 0.0;
+  double u_ff_V = 0.0;                  // feedforward part (held when late; 0 in the safe state)
+  double u_fb_V = 0.0;                  // servo part (0 when off, held or without reference)
+  double y_ref_m = 0.0;                 // reference of the command in force; NaN = none
   std::int32_t flags = 0;
-  std::int32_t params_version = 0;      // of the command applied (0 when none)
+  std::int32_t params_version = 0;      // of the command in force (0 when none)
+  std::int64_t buffer_depth = 0;        // consecutive ticks buffered after this one
 };
 
 class BridgeCore {
  public:
-  static constexpr std::int64_t kBufferTicks = 64;  // how far ahead a command may be sent
+  // servo.u_limit_V is taken from the actuator's range (the anti-windup limit).
+  BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo, double dt_s = 1e-4);
 
-  explicit BridgeCore(const ActuatorLimits& limits, double dt_s = 1e-4);
+  // A command received at any time before its tick. Returns false if refused (counted).
+  bool submit(const CommandTick& command) noexcept;
 
-  // A command for tick `seq`, received at loop time now_s. Returns false if rejected.
-  bool submit(std::int64_t seq, double u_V, std::int32_t params_version, double now_s) noexcept;
+  // Decides the voltage for tick k (k increases between calls; a skipped tick is simply not
+  // called). y_measured_m is the stage's position sampled at the end of the previous tick;
+  // the servo acts on that tick's reference minus it.
+  BridgeTick tick(std::int64_t k, double y_measured_m) noexcept;
 
-  // Decide the voltage for tick k at loop time t_s (k increases by one per call).
-  BridgeTick tick(std::int64_t k, double t_s) noexcept;
-
-  // Leave the safe state: commands are applied again, reached from the current voltage
-  // under the slew limit. Disarm enters the safe state at once.
-  void arm(double now_s) noexcept;
+  // Leave the safe state at tick k: commands are applied again, reached from the current
+  // voltage under the slew limit; the watchdog counts from k. Disarm enters the safe state.
+  void arm(std::int64_t k) noexcept;
   void disarm() noexcept;
   bool armed() const noexcept { return armed_; }
+
+  // New servo gains (validated by the caller: FeedbackGains::validate), bumplessly.
+  void set_servo_gains(const FeedbackGains& gains) noexcept;
+  const FeedbackGains& servo_gains() const noexcept { return servo_.gains(); }
 
   const BridgeCounters& counters() const noexcept { return counters_; }
   const ActuatorLimits& limits() const noexcept { return limits_; }
   double last_applied_V() const noexcept { return u_applied_; }
+  std::int64_t buffer_depth() const noexcept { return buffer_.depth(); }
 
  private:
-  struct Slot {
-    std::int64_t seq = -1;
-    double u_V = 0.0;
-    std::int32_t params_version = 0;
-  };
-
   ActuatorLimits limits_;
   double dt_s_;
-  std::array<Slot, kBufferTicks> slots_{};
-  std::int64_t next_tick_ = 0;     // the tick tick() will be called with next
-  double last_fresh_s_ = -1e300;   // when the last accepted command arrived
-  double u_applied_ = 0.0;         // last voltage applied (starts at the safe voltage)
-  double u_held_ = 0.0;            // last command applied, held when one is late
-  std::int32_t held_version_ = 0;
+  CommandBuffer buffer_;
+  FeedbackController servo_;
+  std::int64_t last_supplied_tick_ = 0;  // last armed tick whose command was in the buffer (or the arm tick)
+  std::int64_t last_tick_ = -1;
+  double u_applied_ = 0.0;               // last voltage applied (starts at the safe voltage)
+  CommandTick held_{};                   // command in force, held when one is late
+  double servo_ref_m_;                   // reference of the previous tick, for the servo's error (NaN: none)
   bool armed_ = false;
   BridgeCounters counters_;
 };

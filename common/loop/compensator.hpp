@@ -1,36 +1,40 @@
 #pragma once
-// The compensator's control law without I/O or a clock: for each sensor sample of
-// tick k it produces the command for tick k + lead_ticks,
+// The compensator's control law without I/O or a clock. It runs ahead of the bridge: after
+// each sensor tick k it has planned the commands for every tick through k + horizon_ticks,
 //
-//   u = u_ff + u_fb,   u_ff = H^-1( y_ref(t_{k+lead}) ),   u_fb = PID( y_ref(t_k) - y_k ),
+//   u_ff(j) = H^-1( y_ref(t_j) ),   y_ref(t_j) = the trajectory at t_j = j * dt,
 //
-// with H^-1 the inverse of the selected hysteresis model. Loop time is t_k = k * dt,
-// so the output is a deterministic function of the messages it is given, in order:
-// a recorded log replays to the same commands (tools/replay-check relies on it).
-// New MEM parameters are validated when offered and swapped in at the next reversal
-// of the reference, where the inverse's branch restarts, so the voltage does not jump.
+// one inverse-model step per planned tick, with H^-1 the inverse of the selected hysteresis
+// model. The bridge adds its servo on y_ref - y beside the sensor. Loop time is tick * dt, so
+// the plan is a deterministic function of the messages given, in order: a recorded log
+// replays to the same commands (tools/replay-check relies on it).
+//
+// A new trajectory, mode or experiment takes effect at the first tick not yet planned. New MEM
+// parameters are validated when offered and swapped in at the next reversal of the reference,
+// where the inverse's branch restarts, so the voltage does not jump. After an experiment the
+// plan holds the last voltage (no reference) until the sample of the experiment's end arrives;
+// the inverse is then anchored at that measured (u, y) and the reference approaches from there.
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
-#include <string_view>
-#include <variant>
-#include <vector>
 
-#include "loop/feedback.hpp"
+#include "core/ticks.hpp"
+#include "loop/experiment.hpp"
+#include "loop/experiment_queue.hpp"
 #include "loop/trajectory.hpp"
 #include "models/katalenic.hpp"
 #include "models/linear.hpp"
 #include "models/mem.hpp"
 #include "models/prandtl_ishlinskii.hpp"
+#include "models/reversal_detector.hpp"
 
 namespace hystloop {
 
-// Which feedforward; numbering shared with actuator_command_t.mode / control_t.mode.
+// Which feedforward; numbering shared with command_block_t.mode / control_t.mode.
 enum class FeedforwardMode : std::int8_t {
-  kOff = 0,        // no feedforward: u = u_fb (0 V without feedback)
+  kOff = 0,        // no feedforward: u_ff = 0 (the bridge's servo alone)
   kLinear = 1,     // static gain: the MEM paper's "linear feedforward"
   kMem = 2,        // hybrid MEM element inverse (Strijbosch et al., Theorem 10)
   kPi = 3,         // Prandtl-Ishlinskii inverse
@@ -48,50 +52,12 @@ struct CompensatorConfig {
   PiParams pi = pi_params_from_mem(MemParams::paper_like(), 15, 250.0);  // the MEM paper's 15 plays
   KatalenicParams katalenic{};
   LinearParams linear{};
-  FeedbackGains feedback{};   // all zero = feedforward only
-  std::int64_t lead_ticks = 2;  // command for tick k + lead answers sample k
-  double dt_s = 1e-4;           // the bridge's tick
+  std::int64_t horizon_ticks = 300;  // plan this many ticks ahead of the last sample (30 ms at 10 kHz)
+  double dt_s = 1e-4;                // the bridge's tick
 
+  static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer
   void validate() const;  // throws ParameterError naming the field
 };
-
-// An identification excitation u(t) = offset + amplitude * sin(2 pi f (t - start)),
-// run for a whole number of periods. It starts at the first command produced after it was
-// given (start = that command's loop time); experiments given while one runs wait in a queue
-// and run back to back (the next starts at the loop time the previous ended, so a series of
-// whole-period sines is one continuous input); when none is left the compensator returns to
-// its mode. `settle` only labels the segment: the same sine, run to bring the hysteresis to
-// its stationary loop, whose samples identification skips (Banning's series).
-struct ExperimentSpec {
-  double amplitude_V = 250.0;
-  double offset_V = 0.0;
-  double frequency_hz = 10.0;  // the MEM paper's identification input: 250 sin(20 pi t)
-  double duration_s = 2.0;     // rounded up to whole periods
-  bool settle = false;
-  void validate() const;
-};
-
-// The experiment a START_EXPERIMENT request names: kind "sine", or "settle" (the same sine,
-// labelled). Validated; throws ParameterError ("experiment" for another kind).
-ExperimentSpec make_experiment_spec(std::string_view kind, double amplitude_V, double offset_V, double frequency_hz,
-                                    double duration_s);
-// The voltage an experiment commands t_s after its start [V].
-double experiment_voltage(const ExperimentSpec& spec, double t_s) noexcept;
-// Loop time [s] at which an experiment started at start_s ends: after its whole periods.
-double experiment_end_s(double start_s, const ExperimentSpec& spec) noexcept;
-// The first tick k whose loop time k * dt_s is at or after t_s: the first command past an
-// experiment that ends at t_s. With experiment_end_s this reproduces the compensator's
-// schedule from a log (tools/identify splits Banning's series with it).
-std::int64_t first_tick_at_or_after(double t_s, double dt_s) noexcept;
-
-// The command ticks [begin, end) of experiments run back to back, the first starting at
-// first_tick: what the compensator commands when all of them were given in time.
-struct ExperimentTicks {
-  std::int64_t begin = 0;
-  std::int64_t end = 0;
-};
-std::vector<ExperimentTicks> experiment_schedule(std::int64_t first_tick, std::span<const ExperimentSpec> specs,
-                                                 double dt_s);
 
 struct CompensatorInput {
   std::int64_t seq = 0;  // tick of the sample
@@ -99,26 +65,16 @@ struct CompensatorInput {
   double y_m = 0.0;      // measured position
 };
 
-struct CompensatorOutput {
-  std::int64_t seq = 0;          // tick the command is for
-  std::int64_t sample_seq = 0;   // tick of the sample it answers
-  double u_V = 0.0;
-  double u_ff_V = 0.0;
-  double u_fb_V = 0.0;
-  double y_ref_m = 0.0;          // reference for tick `seq` (NaN during an experiment)
-  double error_m = 0.0;          // y_ref - y at the sample's tick (NaN when no reference)
-  std::int32_t params_version = 0;
-  FeedforwardMode mode = FeedforwardMode::kOff;
-  bool reversal = false;         // the reference reversed at this command
-};
-
 struct CompensatorCounters {
   std::uint64_t samples = 0;
   std::uint64_t out_of_order = 0;   // samples whose seq did not increase (ignored)
   std::uint64_t gaps = 0;           // missing sample ticks
+  std::uint64_t planned = 0;        // command ticks planned
+  std::uint64_t ticks_behind = 0;   // ticks the bridge reached before they were planned (never sent)
   std::uint64_t params_accepted = 0;
   std::uint64_t params_rejected = 0;
   std::uint64_t params_swapped = 0;
+  std::uint64_t reversals = 0;      // of the planned reference
   std::uint64_t nonfinite_outputs = 0;  // model produced NaN/Inf: the last voltage was held
 };
 
@@ -126,73 +82,70 @@ class Compensator {
  public:
   explicit Compensator(const CompensatorConfig& config);  // validates
 
-  // One sample in, one command out. Allocation-, lock- and throw-free.
-  // Nothing when the sample is out of order (its seq did not increase).
-  std::optional<CompensatorOutput> update(const CompensatorInput& sample) noexcept;
+  // A sensor tick, in order. Sets how far the plan must reach. Allocation-, lock-, throw-free.
+  void observe(const CompensatorInput& sample) noexcept;
+  // Plans the next ticks not yet planned, up to out.size() of them and no further than the
+  // horizon after the last sample; returns how many were written (0: the plan is complete).
+  std::size_t plan(std::span<CommandTick> out) noexcept;
 
-  // A new reference; spec.start_s is loop time (k * dt). Validated here (throws).
-  void set_trajectory(const TrajectorySpec& spec);
-  // Starts the approach to the reference `lead_ticks` after the last sample, from where
-  // the reference is now; the shape itself starts blend_s later.
-  void start_trajectory_now(TrajectorySpec spec);
+  // A new reference starting at loop time start_s (NaN or earlier than the next planned tick
+  // + blend_s: as soon as possible, approaching from the reference planned last over
+  // spec.blend_s). Returns false when a start time was given but already passed. Validated
+  // here (throws ParameterError).
+  bool set_trajectory(TrajectorySpec spec, double start_s);
 
   // New MEM parameters; validated (throws ParameterError) and swapped at the next reversal.
   void offer_mem_params(const MemParams& params, std::int32_t version);
-  void set_mode(FeedforwardMode mode);   // re-initialises that inverse at the current reference
-  void set_gains(const FeedbackGains& gains);
-  // Starts the experiment with the next command, or queues it behind the running one.
-  // Validated here (throws ParameterError; also when kExperimentQueue are already waiting).
+  void set_mode(FeedforwardMode mode);   // re-initialises that inverse where the plan is
+  // Starts the experiment at the next planned tick, or queues it behind the running one.
+  // Validated here (throws ParameterError; also when the queue is full).
   void start_experiment(const ExperimentSpec& spec);
-  // Ends the running experiment after the commands already produced and drops the queue.
+  // Ends the running experiment at the next planned tick and drops the queue.
   void stop_experiment() noexcept;
-  static constexpr std::size_t kExperimentQueue = 128;
 
   const CompensatorCounters& counters() const noexcept { return counters_; }
   FeedforwardMode mode() const noexcept { return mode_; }
   const MemParams& mem_params() const noexcept { return mem_.params(); }
   std::int32_t params_version() const noexcept { return params_version_; }
-  bool experiment_running() const noexcept { return experiment_.has_value(); }
-  std::size_t experiments_queued() const noexcept { return queued_; }
+  bool experiment_running() const noexcept { return experiments_.running(); }
+  std::size_t experiments_queued() const noexcept { return experiments_.queued(); }
+  const TrajectorySpec& trajectory() const noexcept { return trajectory_; }
   double loop_time(std::int64_t seq) const noexcept { return static_cast<double>(seq) * config_.dt_s; }
-  std::int64_t last_seq() const noexcept { return last_seq_; }
+  std::int64_t last_seq() const noexcept { return last_seq_; }  // last sample observed (-1: none)
+  // First tick not yet planned (-1 before the first sample).
+  std::int64_t next_tick() const noexcept { return next_tick_; }
   const CompensatorConfig& config() const noexcept { return config_; }
 
  private:
+  CommandTick plan_tick(std::int64_t k) noexcept;
+  CommandTick tracking_tick(std::int64_t k) noexcept;
   double feedforward(double y_ref) noexcept;
   void reset_inverse(double y0) noexcept;
+  void restart_reference(double t_s, double from_m) noexcept;
 
   CompensatorConfig config_;
   FeedforwardMode mode_;
   TrajectorySpec trajectory_{};
+  bool trajectory_starts_now_ = true;  // start_s is set at the next planned tick
   MemInverse mem_;
   PiInverse pi_;
   KatalenicInverse katalenic_;
   LinearInverse linear_;
-  FeedbackController feedback_;
   std::optional<MemParams> pending_mem_;
   std::int32_t pending_version_ = 0;
   std::int32_t params_version_ = 0;
+  ExperimentQueue experiments_;
+  ReversalDetector reversals_;
 
-  struct RunningExperiment {
-    ExperimentSpec spec;
-    bool started = false;  // start_s/end_s are set by the first command it produces
-    double start_s = 0.0;
-    double end_s = 0.0;
-  };
-  std::optional<RunningExperiment> experiment_;
-  std::array<ExperimentSpec, kExperimentQueue> queue_{};  // ring: waiting experiments
-  std::size_t queue_head_ = 0;
-  std::size_t queued_ = 0;
-
-  // References already commanded, by tick, for the error at the sample's tick.
-  static constexpr std::size_t kRefRing = 256;
-  std::array<double, kRefRing> ref_by_tick_{};
-  std::array<std::int64_t, kRefRing> ref_tick_{};  // which tick each slot holds (-1: none)
   std::int64_t last_seq_ = -1;
-  double last_ref_ = 0.0;       // last reference commanded
-  double last_u_ = 0.0;         // last voltage commanded
-  double last_dir_ = 0.0;       // sign of the last non-zero reference change
-  bool inverse_fresh_ = true;   // next reference initialises the inverse
+  std::int64_t next_tick_ = -1;
+  std::int64_t plan_end_ = -1;   // last tick the plan must reach
+  double last_ref_ = 0.0;        // last reference planned
+  double last_u_ = 0.0;          // last voltage planned
+  bool inverse_fresh_ = true;    // next reference initialises the inverse
+  // After an experiment: hold last_u_ until the sample of tick anchor_tick_ is observed.
+  bool awaiting_anchor_ = false;
+  std::int64_t anchor_tick_ = 0;
   struct Anchor {
     double u_V;
     double y_m;

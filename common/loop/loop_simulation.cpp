@@ -3,24 +3,19 @@
 #include <cmath>
 #include <limits>
 
-namespace hystloop {
+#include "core/errors.hpp"
 
-namespace {
-constexpr std::size_t kRing = 64;
-}
+namespace hystloop {
 
 LoopSimulation::LoopSimulation(const LoopSimulationConfig& config)
     : config_(config),
       dt_s_(config.compensator.dt_s),
-      bridge_(config.limits, config.compensator.dt_s),
+      bridge_(config.limits, config.servo, config.compensator.dt_s),
       stage_(config.stage),
       compensator_(config.compensator),
-      ref_by_tick_(kRing, std::numeric_limits<double>::quiet_NaN()) {
-  bridge_.arm(0.0);
-  // Prime the bridge: the commands for the first `lead` ticks hold the safe voltage.
-  for (std::int64_t k = 0; k < config.compensator.lead_ticks; ++k) {
-    bridge_.submit(k, config.limits.safe_u_V, 0, 0.0);
-  }
+      plan_(1000) {
+  require_in_range("loop.block_ticks", config.block_ticks, 1, 1000);
+  bridge_.arm(0);
 }
 
 void LoopSimulation::run(double seconds, const std::function<void(const LoopTick&)>& on_tick) {
@@ -28,8 +23,9 @@ void LoopSimulation::run(double seconds, const std::function<void(const LoopTick
   if (keep_history_) history_.reserve(history_.size() + static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i, ++k_) {
     const double t = static_cast<double>(k_) * dt_s_;
-    const BridgeTick b = bridge_.tick(k_, t);
+    const BridgeTick b = bridge_.tick(k_, y_last_m_);
     const double y = stage_.step(b.u_applied_V, t, dt_s_);
+    y_last_m_ = y;
 
     LoopTick rec;
     rec.k = k_;
@@ -37,15 +33,15 @@ void LoopSimulation::run(double seconds, const std::function<void(const LoopTick
     rec.u_V = b.u_applied_V;
     rec.y_m = y;
     rec.y_true_m = stage_.true_position_m();
+    rec.y_ref_m = b.y_ref_m;
     rec.flags = b.flags | sample_flags::kSimulated;
     rec.params_version = b.params_version;
-    double& slot = ref_by_tick_[static_cast<std::size_t>(k_) % kRing];
-    rec.y_ref_m = slot;
-    slot = std::numeric_limits<double>::quiet_NaN();
 
-    if (const auto cmd = compensator_.update({k_, b.u_applied_V, y})) {
-      bridge_.submit(cmd->seq, cmd->u_V, cmd->params_version, t);
-      ref_by_tick_[static_cast<std::size_t>(cmd->seq) % kRing] = cmd->y_ref_m;
+    compensator_.observe({k_, b.u_applied_V, y});
+    if ((k_ + 1) % config_.block_ticks == 0) {  // a sensor block is complete: the compensator answers it
+      while (const std::size_t planned = compensator_.plan(plan_)) {
+        for (std::size_t j = 0; j < planned; ++j) bridge_.submit(plan_[j]);
+      }
     }
     if (keep_history_) history_.push_back(rec);
     if (on_tick) on_tick(rec);

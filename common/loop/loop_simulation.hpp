@@ -1,9 +1,9 @@
 #pragma once
-// The whole control loop in one process, faster than real time: the bridge's safety
-// logic, the simulated stage and the compensator, exchanging samples and commands tick
-// by tick exactly as the services do over LCM (the command for tick k + lead answers the
-// sample of tick k), with time as an argument. Used by the tracking tests and the
-// tracking benchmark; the services run the same classes.
+// The whole control loop in one process, faster than real time: the bridge's logic (jitter
+// buffer, servo, safety), the simulated stage and the compensator, exchanging samples and
+// commands as the services do over LCM — samples in blocks of block_ticks, each block
+// answered by the commands planned through the horizon — with time as an argument. Used by
+// the tracking tests and the tracking benchmark; the services run the same classes.
 
 #include <cstdint>
 #include <functional>
@@ -20,6 +20,8 @@ struct LoopSimulationConfig {
   SimulatedStageConfig stage{};
   ActuatorLimits limits{};
   CompensatorConfig compensator{};
+  FeedbackGains servo{};   // the bridge's servo (all zero: feedforward only)
+  int block_ticks = 10;    // samples reach the compensator in blocks of this many ticks
 };
 
 // One tick as the loop saw it.
@@ -71,7 +73,8 @@ class LoopSimulation {
   std::int64_t k_ = 0;
   bool keep_history_ = true;
   std::vector<LoopTick> history_;
-  std::vector<double> ref_by_tick_;  // reference sent for each future tick (ring)
+  std::vector<CommandTick> plan_;    // scratch for the compensator's plan
+  double y_last_m_ = 0.0;
 };
 
 }  // namespace hystloop

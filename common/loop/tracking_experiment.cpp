@@ -52,12 +52,13 @@ TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& mo
   c.compensator.katalenic = models.katalenic;
   c.compensator.linear = models.linear;
   if (feedback) {
-    c.compensator.feedback.kp = e.kp;
-    c.compensator.feedback.ki = e.ki;
-    c.compensator.feedback.nominal_gain_m_per_V = models.linear.gain;
+    c.servo.kp = e.kp;
+    c.servo.ki = e.ki;
+    c.servo.nominal_gain_m_per_V = models.linear.gain;
   }
   LoopSimulation sim(c);
-  sim.compensator().set_trajectory(mem_paper_reference(0.5, 0.5, 0.0));  // approach over 0.5 s
+  const TrajectorySpec reference = mem_paper_reference(0.5, 0.5, 0.0);  // approach over 0.5 s
+  sim.compensator().set_trajectory(reference, reference.start_s);
 
   OnlineMemOptions opt;
   opt.window_samples = 40000;          // 4 s: four branches of the 1 Hz reference

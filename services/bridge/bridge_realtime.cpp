@@ -3,6 +3,7 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <ctime>
 #include <system_error>
@@ -23,7 +24,7 @@ std::int64_t wall_utime_now() noexcept {
 BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<StageBackend> backend)
     : settings_(settings),
       backend_(std::move(backend)),
-      core_(settings.limits, settings.dt_s()),
+      core_(settings.limits, settings.servo, settings.dt_s()),
       dt_s_(settings.dt_s()),
       auto_arm_pending_(settings.auto_arm) {
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -60,23 +61,36 @@ void BridgeRealtime::run() noexcept {
   } else {
     priority_status_ = {true, "normal scheduling"};
   }
-  PeriodicTimer timer(period_ns_from_rate_hz(settings_.rate_hz));
+  const std::int64_t per_wake = settings_.rt.ticks_per_wake;
+  PeriodicTimer timer(period_ns_from_rate_hz(settings_.rate_hz) * per_wake);
   started_.store(true, std::memory_order_release);
 
+  // A simulated stage has no wall clock: ticks whose deadline passed are run late, back to back
+  // (counted), so its samples never have gaps. Hardware cannot go back in time: they are skipped.
+  const bool catch_up = backend_->simulated();
   while (!stop_.load(std::memory_order_acquire)) {  // the I/O thread stops us after a last report
     const TickInfo info = timer.wait_next();
-    tick(static_cast<std::int64_t>(info.tick), info.skipped, info.lateness_ns);
+    const auto missed = static_cast<std::int64_t>(info.skipped) * per_wake;
+    const std::int64_t last = (static_cast<std::int64_t>(info.tick) + 1) * per_wake;  // one past the last tick due
+    std::int64_t first = last - per_wake;
+    if (catch_up) {
+      first -= missed;
+      ticks_caught_up_ += static_cast<std::uint64_t>(missed);
+    } else {
+      ticks_skipped_ += static_cast<std::uint64_t>(missed);
+    }
+    for (std::int64_t k = first; k < last; ++k) tick(k, k == first && !catch_up ? static_cast<std::uint64_t>(missed) : 0);
+    RtReport& report = reports_.current();
+    report.lateness.add(info.lateness_ns);
   }
 }
 
-void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t lateness_ns) noexcept {
+void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
-  const double t_s = static_cast<double>(k) * dt_s_;
-  ticks_skipped_ += skipped;
 
   switch (arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel)) {
     case ArmRequest::kArm:
-      core_.arm(t_s);
+      core_.arm(k);
       tripped_ = false;
       break;
     case ArmRequest::kDisarm:
@@ -86,59 +100,75 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t la
       break;
     case ArmRequest::kNone: break;
   }
+  while (const auto gains = gains_.try_pop()) core_.set_servo_gains(*gains);
   while (const auto command = commands_.try_pop()) {
     ++commands_processed_;
-    if (auto_arm_pending_ && !core_.armed()) {
-      core_.arm(t_s);
+    commands_seen_ = true;
+    core_.submit(*command);
+  }
+  if (commands_seen_ && core_.buffer_depth() > 0 && !core_.armed()) {
+    if (auto_arm_pending_) {
+      core_.arm(k);
       auto_arm_pending_ = false;
       ++auto_arms_;
-    }
-    // Opt-in (actuator.rearm_after_trip_s > 0): after a watchdog trip, re-arm once commands
-    // flow again and the safe state has lasted that long. For demos and soak runs on shared
-    // machines; counted, and off by default.
-    if (tripped_ && !core_.armed() && settings_.rearm_after_trip_s > 0.0 &&
-        static_cast<double>(k - last_trip_tick_) * dt_s_ >= settings_.rearm_after_trip_s) {
-      core_.arm(t_s);
+    } else if (tripped_ && settings_.rearm_after_trip_s > 0.0 &&
+               static_cast<double>(k - last_trip_tick_) * dt_s_ >= settings_.rearm_after_trip_s) {
+      // Opt-in (actuator.rearm_after_trip_s > 0): after a watchdog trip, re-arm once commands
+      // are buffered again and the safe state has lasted that long. For soak runs; counted.
+      core_.arm(k);
       tripped_ = false;
       ++auto_arms_;
     }
-    core_.submit(command->seq, command->u_V, command->params_version, t_s);
   }
   if (core_.armed()) auto_arm_pending_ = false;  // armed by HX_CONTROL: no auto-arm later
 
-  const BridgeTick decided = core_.tick(k, t_s);
+  const BridgeTick decided = core_.tick(k, y_last_m_);
   if (core_.counters().watchdog_trips != trips_seen_) {
     trips_seen_ = core_.counters().watchdog_trips;
     last_trip_tick_ = k;
     tripped_ = true;
   }
+  if (core_.armed() && commands_seen_) {
+    min_depth_period_ = min_depth_period_ < 0 ? decided.buffer_depth : std::min(min_depth_period_, decided.buffer_depth);
+    min_depth_total_ = min_depth_total_ < 0 ? decided.buffer_depth : std::min(min_depth_total_, decided.buffer_depth);
+  }
   // After an overrun the stage has been holding the last voltage for the skipped ticks too.
   const double step_s = dt_s_ * static_cast<double>(1 + skipped);
+  const double t_s = static_cast<double>(k) * dt_s_;
   const StageReading reading = backend_->step(decided.u_applied_V, t_s, step_s);
+  y_last_m_ = reading.y_m;
   last_tick_ = k;
 
-  const OutgoingSample sample{k, wall_utime_now(), decided.u_applied_V, reading.y_m, decided.flags | reading.flags};
-  if (samples_.try_push(sample)) {
-    const std::uint64_t one = 1;
-    [[maybe_unused]] const ssize_t n = ::write(wake_fd_, &one, sizeof one);
+  const OutgoingTick out{SensorTick{wall_utime_now(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
+                                    decided.y_ref_m, reading.y_m, decided.flags | reading.flags},
+                         static_cast<std::int32_t>(std::min<std::int64_t>(decided.buffer_depth, INT32_MAX))};
+  if (samples_.try_push(out)) {
+    if ((k + 1) % settings_.block_ticks == 0) {  // a block is complete: wake the I/O thread
+      const std::uint64_t one = 1;
+      [[maybe_unused]] const ssize_t n = ::write(wake_fd_, &one, sizeof one);
+    }
   } else {
     ++samples_dropped_;
   }
 
   RtReport& report = reports_.current();
-  report.lateness.add(lateness_ns);
   report.work.add(monotonic_now_ns() - start_ns);
   reports_.serve_request([&](RtReport& r) {
     r.core = core_.counters();
     r.ticks_skipped = ticks_skipped_;
+    r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;
     r.auto_arms = auto_arms_;
     r.last_tick = last_tick_;
     r.last_trip_tick = last_trip_tick_;
+    r.min_depth_period = min_depth_period_;
+    r.min_depth_total = min_depth_total_;
+    r.buffer_depth = core_.buffer_depth();
     r.u_applied_V = core_.last_applied_V();
     r.gain_scale = backend_->gain_scale();
     r.armed = core_.armed();
+    min_depth_period_ = -1;
   });
 }
 

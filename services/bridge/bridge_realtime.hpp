@@ -1,7 +1,9 @@
 #pragma once
-// The bridge's real-time thread: at each tick of the 10 kHz clock it takes the commands
-// the I/O thread received, lets BridgeCore decide the voltage for tick k, steps the
-// backend, and hands the sample back to the I/O thread (waking it through an eventfd).
+// The bridge's real-time thread: at each tick of the 10 kHz clock it moves the commands the
+// I/O thread received into BridgeCore's jitter buffer, lets BridgeCore decide the voltage for
+// tick k (feedforward + servo, clamped), steps the backend, and hands the tick to the I/O
+// thread, waking it through an eventfd once a block is complete. With rt.ticks_per_wake > 1 it
+// wakes once per that many ticks and runs them back to back (a simulator's choice).
 // Nothing here allocates, locks, logs or does I/O other than that eventfd write.
 
 #include <atomic>
@@ -14,31 +16,25 @@
 #include "bridge/rt_report.hpp"
 #include "bridge/stage_backend.hpp"
 #include "core/process.hpp"
+#include "core/ticks.hpp"
 #include "loop/bridge_core.hpp"
 #include "loop/spsc_queue.hpp"
 
 namespace hystloop {
 
-struct IncomingCommand {
-  std::int64_t seq = 0;
-  double u_V = 0.0;
-  std::int32_t params_version = 0;
-};
-
-struct OutgoingSample {
-  std::int64_t seq = 0;
-  std::int64_t utime = 0;  // wall time of the sample [us]
-  double u_V = 0.0;
-  double y_m = 0.0;
-  std::int32_t flags = 0;
+// A tick the real-time thread did, with the buffer's depth after it, for the I/O thread to
+// publish in blocks.
+struct OutgoingTick {
+  SensorTick tick;
+  std::int32_t buffer_depth = 0;
 };
 
 enum class ArmRequest : std::uint8_t { kNone = 0, kArm = 1, kDisarm = 2 };
 
 class BridgeRealtime {
  public:
-  static constexpr std::size_t kCommandQueue = 4096;  // 400 ms of commands
-  static constexpr std::size_t kSampleQueue = 4096;
+  static constexpr std::size_t kCommandQueue = 16384;  // 1.6 s of commands
+  static constexpr std::size_t kSampleQueue = 8192;
 
   BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<StageBackend> backend);
   ~BridgeRealtime();
@@ -51,8 +47,9 @@ class BridgeRealtime {
   void stop();
 
   // I/O thread side.
-  bool push_command(const IncomingCommand& command) noexcept { return commands_.try_push(command); }
-  std::optional<OutgoingSample> pop_sample() noexcept { return samples_.try_pop(); }
+  bool push_command(const CommandTick& command) noexcept { return commands_.try_push(command); }
+  bool push_gains(const FeedbackGains& gains) noexcept { return gains_.try_push(gains); }
+  std::optional<OutgoingTick> pop_tick() noexcept { return samples_.try_pop(); }
   void request_arm(ArmRequest request) noexcept { arm_request_.store(request, std::memory_order_release); }
   RtReportExchange& reports() noexcept { return reports_; }
   int wake_fd() const noexcept { return wake_fd_; }  // readable when samples are queued
@@ -64,14 +61,15 @@ class BridgeRealtime {
 
  private:
   void run() noexcept;
-  void tick(std::int64_t k, std::uint64_t skipped, std::int64_t lateness_ns) noexcept;
+  void tick(std::int64_t k, std::uint64_t skipped) noexcept;
 
   BridgeSettings settings_;
   std::unique_ptr<StageBackend> backend_;
   BridgeCore core_;
   double dt_s_;
-  SpscQueue<IncomingCommand, kCommandQueue> commands_;
-  SpscQueue<OutgoingSample, kSampleQueue> samples_;
+  SpscQueue<CommandTick, kCommandQueue> commands_;
+  SpscQueue<FeedbackGains, 8> gains_;
+  SpscQueue<OutgoingTick, kSampleQueue> samples_;
   std::atomic<ArmRequest> arm_request_{ArmRequest::kNone};
   RtReportExchange reports_;
   int wake_fd_ = -1;
@@ -85,12 +83,17 @@ class BridgeRealtime {
   bool auto_arm_pending_ = false;
   bool tripped_ = false;  // in the safe state because of the watchdog (not an operator)
   std::uint64_t ticks_skipped_ = 0;
+  std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;
   std::uint64_t auto_arms_ = 0;
   std::uint64_t trips_seen_ = 0;
   std::int64_t last_tick_ = -1;
   std::int64_t last_trip_tick_ = -1;
+  double y_last_m_ = 0.0;                 // the stage's last measured position
+  std::int64_t min_depth_period_ = -1;    // lowest buffer depth at an armed tick this report period
+  std::int64_t min_depth_total_ = -1;     // ... since start (after the first command)
+  bool commands_seen_ = false;
 };
 
 }  // namespace hystloop

@@ -12,28 +12,14 @@
 
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
+#include "lcm/blocks.hpp"
 #include "runtime/counter_baseline.hpp"
 
 namespace hystloop {
 namespace {
 
-BridgeCounters core_since(const BridgeCounters& n, const BridgeCounters& b) noexcept {
-  BridgeCounters d;
-  d.ticks = n.ticks - b.ticks;
-  d.applied = n.applied - b.applied;
-  d.late = n.late - b.late;
-  d.stale = n.stale - b.stale;
-  d.rejected_nonfinite = n.rejected_nonfinite - b.rejected_nonfinite;
-  d.rejected_future = n.rejected_future - b.rejected_future;
-  d.clamped = n.clamped - b.clamped;
-  d.slew_limited = n.slew_limited - b.slew_limited;
-  d.watchdog_trips = n.watchdog_trips - b.watchdog_trips;
-  d.ignored_disarmed = n.ignored_disarmed - b.ignored_disarmed;
-  return d;
-}
-
-Subscription<actuator_command_t>::Options command_options(int capacity) {
-  Subscription<actuator_command_t>::Options o;
+Subscription<command_block_t>::Options command_options(int capacity) {
+  Subscription<command_block_t>::Options o;
   o.queue_capacity = capacity;
   return o;
 }
@@ -46,17 +32,24 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
       rt_(settings, make_stage_backend(settings.backend, settings.stage)),
       sensor_pub_(lcm, channels.sensor),
       commands_(lcm, channels.command,
-                [this](const actuator_command_t& msg, std::int64_t) { on_command(msg); },
+                [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
                 command_options(settings.command_queue_capacity)),
       control_(lcm, channels.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }),
-      status_(lcm, channels.status, "bridge") {}
+      status_(lcm, channels.status, "bridge"),
+      gains_(settings.servo) {
+  reserve_storage(block_);
+  begin_block(block_, 0, 0, settings_.dt_s());
+}
 
-void BridgeService::on_command(const actuator_command_t& msg) noexcept {
+void BridgeService::on_command(const command_block_t& msg) noexcept {
+  ++command_blocks_;
   if (const auto elapsed = sent_.elapsed_since(msg.sample_seq, monotonic_now_ns())) {
     latency_.add(*elapsed);
     latency_total_.add(*elapsed);
   }
-  if (!rt_.push_command({msg.seq, msg.u_V, msg.params_version})) ++command_queue_full_;
+  for (std::size_t i = 0; i < msg.u_ff_V.size(); ++i) {
+    if (!rt_.push_command(command_tick(msg, i))) ++command_queue_full_;
+  }
 }
 
 void BridgeService::on_control(const control_t& msg) {
@@ -73,16 +66,34 @@ void BridgeService::on_control(const control_t& msg) {
       safe_reason_ = "disarmed via HX_CONTROL";
       spdlog::info("DISARM (request {})", msg.request_id);
       return;
+    case control_t::SET_GAINS: {
+      FeedbackGains g = gains_;
+      g.kp = msg.kp;
+      g.ki = msg.ki;
+      g.kd = msg.kd;
+      try {
+        g.validate();
+      } catch (const std::exception& e) {
+        ++control_refused_;
+        spdlog::warn("SET_GAINS (request {}) refused: {}", msg.request_id, e.what());
+        return;
+      }
+      if (!rt_.push_gains(g)) {
+        ++control_refused_;
+        spdlog::warn("SET_GAINS (request {}) refused: the real-time thread has not taken the last ones yet",
+                     msg.request_id);
+        return;
+      }
+      ++control_acted_;
+      gains_ = g;
+      spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s (request {})", g.kp, g.ki, g.kd, msg.request_id);
+      return;
+    }
     case control_t::RESET_COUNTERS:
       ++control_acted_;
-      // The I/O thread's counters from now; the real-time thread's from its next report (asked
-      // for at once, so at most a tick of its events is not counted).
-      baseline_.queue_full = command_queue_full_;
-      baseline_.acted = control_acted_;
-      baseline_.refused = control_refused_;
-      baseline_.commands = commands_.counters();
-      baseline_.control = control_.counters();
-      baseline_.sensor = sensor_pub_.counters();
+      // All counters from the next report on (asked for at once, so at most a tick of the
+      // real-time thread's events is not counted).
+      endpoint_base_ = {commands_.counters(), control_.counters(), sensor_pub_.counters()};
       reset_pending_ = true;
       spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
       return;
@@ -102,16 +113,23 @@ void BridgeService::on_control(const control_t& msg) {
   }
 }
 
-void BridgeService::publish_samples() noexcept {
-  while (const auto s = rt_.pop_sample()) {
-    sample_msg_.utime = s->utime;
-    sample_msg_.seq = s->seq;
-    sample_msg_.u_V = s->u_V;
-    sample_msg_.y_m = s->y_m;
-    sample_msg_.flags = s->flags;
-    sensor_pub_.publish(sample_msg_);
-    sent_.record(s->seq, monotonic_now_ns());
+void BridgeService::publish_block() noexcept {
+  if (block_.n_ticks == 0) return;
+  if (sensor_pub_.publish(block_)) ++sensor_blocks_;
+  sent_.record(last_seq(block_), monotonic_now_ns());
+  begin_block(block_, 0, 0, settings_.dt_s());
+}
+
+void BridgeService::publish_samples(bool flush) noexcept {
+  while (const auto t = rt_.pop_tick()) {
+    // A block holds consecutive ticks and ends at a multiple of block_ticks (or at a gap).
+    if (block_.n_ticks > 0 && t->tick.seq != last_seq(block_) + 1) publish_block();
+    if (block_.n_ticks == 0) begin_block(block_, t->tick.seq, t->tick.utime, settings_.dt_s());
+    append_tick(block_, t->tick);
+    block_.buffer_depth_ticks = t->buffer_depth;
+    if ((t->tick.seq + 1) % settings_.block_ticks == 0 || block_.n_ticks == sensor_block_t::MAX_TICKS) publish_block();
   }
+  if (flush) publish_block();
 }
 
 int BridgeService::run() {
@@ -139,7 +157,7 @@ int BridgeService::run() {
       std::uint64_t count = 0;
       [[maybe_unused]] const ssize_t n = ::read(rt_.wake_fd(), &count, sizeof count);
     }
-    publish_samples();
+    publish_samples(false);
     if (fds[0].revents & POLLIN) {
       for (int i = 0; i < 256; ++i) {
         const int rc = lcm_.handleTimeout(0);
@@ -175,7 +193,7 @@ int BridgeService::run() {
     last = rt_.reports().take();
   }
   rt_.stop();
-  publish_samples();
+  publish_samples(true);
   if (last == nullptr) last = rt_.reports().take();
   if (last != nullptr) {
     report(*last, wall_utime(), true);
@@ -185,22 +203,42 @@ int BridgeService::run() {
 }
 
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
+  const BridgeCounters& k = rt.core;
+  const CounterSet::Entries now = {
+      {"ticks", k.ticks},
+      {"applied", k.applied},
+      {"late", k.late},
+      {"stale", k.stale},
+      {"duplicates", k.duplicates},
+      {"rejected_nonfinite", k.rejected_nonfinite},
+      {"rejected_future", k.rejected_future},
+      {"clamped", k.clamped},
+      {"slew_limited", k.slew_limited},
+      {"watchdog_trips", k.watchdog_trips},
+      {"safe_ticks", k.safe_ticks},
+      {"ticks_skipped", rt.ticks_skipped},
+      {"ticks_caught_up", rt.ticks_caught_up},
+      {"samples_dropped", rt.samples_dropped},
+      {"command_queue_full", command_queue_full_},
+      {"command_blocks", command_blocks_},
+      {"sensor_blocks", sensor_blocks_},
+      {"control_acted", control_acted_},
+      {"control_refused", control_refused_},
+  };
   if (reset_pending_) {
-    baseline_.core = rt.core;
-    baseline_.skipped = rt.ticks_skipped;
-    baseline_.dropped = rt.samples_dropped;
+    counters_.rebase(now);
     reset_pending_ = false;
   }
   // Late fraction of this report period, over the ticks that were armed.
-  const std::uint64_t late = rt.core.late - previous_core_.late;
-  const std::uint64_t armed_ticks = late + (rt.core.applied - previous_core_.applied);
+  const std::uint64_t late = k.late - previous_core_.late;
+  const std::uint64_t armed_ticks = late + (k.applied - previous_core_.applied);
   const double late_fraction = armed_ticks > 0 ? static_cast<double>(late) / static_cast<double>(armed_ticks) : 0.0;
   const std::uint64_t dropped = rt.samples_dropped - previous_dropped_;
-  previous_core_ = rt.core;
+  previous_core_ = k;
   previous_dropped_ = rt.samples_dropped;
-  if (rt.core.watchdog_trips != trips_reported_) {
-    trips_reported_ = rt.core.watchdog_trips;
-    safe_reason_ = fmt::format("watchdog: no command for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
+  if (k.watchdog_trips != trips_reported_) {
+    trips_reported_ = k.watchdog_trips;
+    safe_reason_ = fmt::format("watchdog: no command buffered for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
                                settings_.limits.watchdog_s, rt.last_trip_tick);
     spdlog::warn("{}", safe_reason_);
   }
@@ -222,28 +260,19 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     detail = fmt::format("{} samples dropped: the I/O thread fell behind", dropped);
   }
   if (rt.armed) safe_reason_ = "not armed";  // the next safe state says its own reason
-  detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period", detail.empty() ? "" : "; ",
-                        rt_.backend().name(), rt.u_applied_V, rt.gain_scale, 100.0 * late_fraction);
+  detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
+                        detail.empty() ? "" : "; ", rt_.backend().name(), rt.u_applied_V, rt.gain_scale,
+                        100.0 * late_fraction, rt.buffer_depth);
 
-  const BridgeCounters c = core_since(rt.core, baseline_.core);
   status_.begin(state, detail);
-  status_.counter("ticks", c.ticks);
-  status_.counter("applied", c.applied);
-  status_.counter("late", c.late);
-  status_.counter("stale", c.stale);
-  status_.counter("rejected_nonfinite", c.rejected_nonfinite);
-  status_.counter("rejected_future", c.rejected_future);
-  status_.counter("clamped", c.clamped);
-  status_.counter("slew_limited", c.slew_limited);
-  status_.counter("watchdog_trips", c.watchdog_trips);
-  status_.counter("ignored_disarmed", c.ignored_disarmed);
-  status_.counter("ticks_skipped", rt.ticks_skipped - baseline_.skipped);
-  status_.counter("samples_dropped", rt.samples_dropped - baseline_.dropped);
-  status_.counter("command_queue_full", command_queue_full_ - baseline_.queue_full);
-  status_.counter("control_acted", control_acted_ - baseline_.acted);
-  status_.counter("control_refused", control_refused_ - baseline_.refused);
+  counters_.report(status_, now);
   status_.counter("armed", rt.armed ? 1 : 0);
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
+  status_.counter("buffer_depth_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, rt.buffer_depth)));
+  if (rt.min_depth_period >= 0) {
+    status_.counter("buffer_min_depth_period_ticks", static_cast<std::uint64_t>(rt.min_depth_period));
+  }
+  if (rt.min_depth_total >= 0) status_.counter("buffer_min_depth_ticks", static_cast<std::uint64_t>(rt.min_depth_total));
   if (rt.lateness.count() > 0) {  // the timer's wake-up lateness this period
     status_.counter("timer_lateness_p50_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.5)));
     status_.counter("timer_lateness_p99_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.99)));
@@ -253,13 +282,13 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   status_.counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
   status_.counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
   status_.counter("peak_rss_kB", static_cast<std::uint64_t>(usage.peak_rss_bytes / 1024));
-  status_.endpoint("command", counters_since(commands_.counters(), baseline_.commands));
-  status_.endpoint("control", counters_since(control_.counters(), baseline_.control));
-  status_.publisher("sensor", counters_since(sensor_pub_.counters(), baseline_.sensor));
-  status_.add_rejected(static_cast<std::int64_t>(c.rejected_nonfinite + c.rejected_future +
-                                                 (command_queue_full_ - baseline_.queue_full) +
-                                                 (control_refused_ - baseline_.refused)));
-  status_.late(static_cast<std::int64_t>(c.late));
+  status_.endpoint("command", counters_since(commands_.counters(), endpoint_base_.commands));
+  status_.endpoint("control", counters_since(control_.counters(), endpoint_base_.control));
+  status_.publisher("sensor", counters_since(sensor_pub_.counters(), endpoint_base_.sensor));
+  status_.add_rejected(static_cast<std::int64_t>(
+      counters_.since("rejected_nonfinite", k.rejected_nonfinite) + counters_.since("rejected_future", k.rejected_future) +
+      counters_.since("command_queue_full", command_queue_full_) + counters_.since("control_refused", control_refused_)));
+  status_.late(static_cast<std::int64_t>(counters_.since("late", k.late)));
   status_.loop_timing(rt.work);
   status_.latency(latency_);
   status_.publish(utime);
@@ -269,16 +298,18 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
 void BridgeService::log_summary(const RtReport& rt) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
-  spdlog::info("summary: {} ticks ({} skipped), {} commands applied, {} late ({:.3g} % of armed ticks), {} stale, "
-               "{} clamped, {} slew-limited, {} watchdog trips, {} non-finite and {} too-far-ahead rejected",
-               c.ticks, rt.ticks_skipped, c.applied, c.late, armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0,
-               c.stale, c.clamped, c.slew_limited, c.watchdog_trips, c.rejected_nonfinite, c.rejected_future);
+  spdlog::info("summary: {} ticks ({} skipped, {} run late to catch up), {} commands applied, {} late ({:.3g} % of armed ticks), {} stale, "
+               "{} duplicate, {} clamped, {} slew-limited, {} watchdog trips, {} non-finite and {} too-far-ahead "
+               "rejected; lowest buffer depth {} ticks",
+               c.ticks, rt.ticks_skipped, rt.ticks_caught_up, c.applied, c.late, armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0,
+               c.stale, c.duplicates, c.clamped, c.slew_limited, c.watchdog_trips, c.rejected_nonfinite,
+               c.rejected_future, rt.min_depth_total);
   if (latency_total_.count() > 0) {
-    spdlog::info("summary: sample-to-command latency p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} commands",
+    spdlog::info("summary: sensor block sent -> its answer received p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} commands",
                  latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
                  static_cast<double>(latency_total_.max_ns()) / 1e3, latency_total_.count());
   }
-  spdlog::info("summary: {} samples published, {} commands received ({} rejected), {} dropped samples",
+  spdlog::info("summary: {} sensor blocks published, {} command blocks received ({} rejected), {} dropped samples",
                sensor_pub_.counters().published, commands_.counters().received,
                commands_.counters().rejected_total(), rt.samples_dropped);
 }

@@ -1,8 +1,8 @@
 #pragma once
-// hystloop-bridge's I/O thread: owns lcm::LCM. Publishes the samples the real-time thread
-// queues (HX_SENSOR), receives HX_COMMAND into the real-time thread's queue (measuring
-// sample-to-command latency), acts on HX_CONTROL (ARM, DISARM, RESET_COUNTERS, SHUTDOWN),
-// and reports HX_STATUS at 1 Hz.
+// hystloop-bridge's I/O thread: owns lcm::LCM. Publishes the ticks the real-time thread
+// queues as HX_SENSOR blocks of bridge.block_ticks, receives HX_COMMAND blocks into the
+// real-time thread's queue (measuring block-to-answer latency), acts on HX_CONTROL (ARM,
+// DISARM, SET_GAINS, RESET_COUNTERS, SHUTDOWN), and reports HX_STATUS at 1 Hz.
 
 #include <cstdint>
 #include <memory>
@@ -14,13 +14,14 @@
 #include "bridge/bridge_settings.hpp"
 #include "bridge/send_time_ring.hpp"
 #include "core/latency_stats.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "runtime/control_filter.hpp"
+#include "runtime/counter_set.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -35,29 +36,33 @@ class BridgeService {
   int run();
 
  private:
-  void on_command(const actuator_command_t& msg) noexcept;
+  void on_command(const command_block_t& msg) noexcept;
   void on_control(const control_t& msg);
-  void publish_samples() noexcept;
+  void publish_samples(bool flush) noexcept;
+  void publish_block() noexcept;
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
   void log_summary(const RtReport& rt) const;
 
   BridgeSettings settings_;
   lcm::LCM& lcm_;
   BridgeRealtime rt_;
-  Publisher<sensor_sample_t> sensor_pub_;
-  sensor_sample_t sample_msg_{};
-  Subscription<actuator_command_t> commands_;
+  Publisher<sensor_block_t> sensor_pub_;
+  sensor_block_t block_{};  // being filled; storage reserved
+  Subscription<command_block_t> commands_;
   Subscription<control_t> control_;
   ControlFilter filter_{"bridge"};
   StatusReporter status_;
   SendTimeRing sent_;
-  LatencyStats latency_;  // sample sent -> its command received, this report period
+  LatencyStats latency_;  // sensor block sent -> the command block answering it received, this period
   LatencyStats latency_total_;  // since start, for the summary
 
   // I/O-thread counters (cumulative).
   std::uint64_t command_queue_full_ = 0;
   std::uint64_t control_acted_ = 0;
   std::uint64_t control_refused_ = 0;
+  std::uint64_t command_blocks_ = 0;
+  std::uint64_t sensor_blocks_ = 0;
+  FeedbackGains gains_;  // the servo's, as last set
 
   // Report bookkeeping.
   std::string safe_reason_ = "not armed";
@@ -65,12 +70,11 @@ class BridgeService {
   BridgeCounters previous_core_{};
   std::uint64_t previous_dropped_ = 0;
   bool reset_pending_ = false;
-  struct Baseline {
-    BridgeCounters core{};
-    std::uint64_t skipped = 0, dropped = 0, queue_full = 0, acted = 0, refused = 0;
+  CounterSet counters_;
+  struct EndpointBaseline {
     EndpointCounters commands{}, control{};
     PublisherCounters sensor{};
-  } baseline_;
+  } endpoint_base_;
 };
 
 }  // namespace hystloop

@@ -2,6 +2,8 @@
 
 #include <cstdint>
 #include <climits>
+#include <algorithm>
+#include <cmath>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -12,10 +14,11 @@ const std::vector<std::string>& bridge_config_keys() {
   static const std::vector<std::string> keys = {
       "bridge.backend", "bridge.rate_hz", "bridge.noise_rms_m", "bridge.seed", "bridge.drift_fraction",
       "bridge.drift_start_s", "bridge.drift_duration_s", "bridge.auto_arm", "actuator.rearm_after_trip_s", "bridge.degraded_late_fraction",
-      "bridge.run_seconds", "bridge.command_queue_capacity",
+      "bridge.run_seconds", "bridge.command_queue_capacity", "bridge.block_ticks",
+      "servo.kp", "servo.ki", "servo.kd", "servo.nominal_gain_m_per_V", "servo.d_filter_hz",
       "actuator.u_min_V", "actuator.u_max_V", "actuator.slew_V_per_s", "actuator.safe_u_V",
       "actuator.safe_ramp_V_per_s", "actuator.watchdog_s",
-      "rt.priority", "rt.io_priority", "rt.lock_memory", "rt.cpu",
+      "rt.ticks_per_wake", "rt.priority", "rt.io_priority", "rt.lock_memory", "rt.cpu",
       "banning.hysteresis.a", "banning.hysteresis.b", "banning.hysteresis.alpha", "banning.hysteresis.s_max",
       "banning.stage.k", "banning.stage.c", "banning.order",
       "ro.c1", "ro.c2", "ro.c3"};
@@ -33,7 +36,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
   s.degraded_late_fraction = config.get_in_range("bridge.degraded_late_fraction", s.degraded_late_fraction, 0.0, 1.0);
   s.run_seconds = config.get_non_negative("bridge.run_seconds", s.run_seconds);
   s.command_queue_capacity =
-      static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 1000, 1000000));
+      static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 16, 100000));
+  s.block_ticks = static_cast<int>(config.get_int_in_range("bridge.block_ticks", s.block_ticks, 1, 1000));
 
   SimulatedStageConfig& st = s.stage;
   st.noise_rms_m = config.get_in_range("bridge.noise_rms_m", st.noise_rms_m, 0.0, 1e-6);
@@ -75,6 +79,20 @@ BridgeSettings load_bridge_settings(const Config& config) {
     config.fail("actuator.watchdog_s", "must be at least two ticks (" + std::to_string(2.0 * s.dt_s()) + " s)");
   }
 
+  FeedbackGains& g = s.servo;
+  g.kp = config.get_non_negative("servo.kp", g.kp);
+  g.ki = config.get_non_negative("servo.ki", g.ki);
+  g.kd = config.get_non_negative("servo.kd", g.kd);
+  g.nominal_gain_m_per_V = config.get_positive("servo.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
+  g.d_filter_hz = config.get_positive("servo.d_filter_hz", g.d_filter_hz);
+  g.u_limit_V = std::max(std::abs(a.u_min_V), std::abs(a.u_max_V));
+  validate_config_section(config, "servo.", [&] { g.validate(); });
+
+  s.rt.ticks_per_wake = static_cast<int>(config.get_int_in_range("rt.ticks_per_wake", s.rt.ticks_per_wake, 1, 1000));
+  if (s.rt.ticks_per_wake > s.block_ticks) {
+    config.fail("rt.ticks_per_wake", "must not exceed bridge.block_ticks (" + std::to_string(s.block_ticks) +
+                                         "): a block is published when its last tick has run");
+  }
   s.rt.priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt.priority, 0, 99));
   s.rt.io_priority = static_cast<int>(config.get_int_in_range("rt.io_priority", s.rt.io_priority, 0, 99));
   if (s.rt.io_priority > 0 && s.rt.io_priority >= s.rt.priority) {
@@ -104,8 +122,13 @@ std::vector<std::string> describe(const BridgeSettings& s) {
     lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
                                 st.ramberg_osgood.c3));
   }
-  lines.push_back(fmt::format("rt: priority {}, I/O priority {}, lock_memory {}, cpu {}", s.rt.priority,
-                              s.rt.io_priority, s.rt.lock_memory, s.rt.cpu));
+  lines.push_back(fmt::format("servo: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V{}", s.servo.kp,
+                              s.servo.ki, s.servo.kd, s.servo.nominal_gain_m_per_V,
+                              s.servo.enabled() ? "" : " (off: feedforward only)"));
+  lines.push_back(fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s)", s.block_ticks,
+                              s.rate_hz / s.block_ticks));
+  lines.push_back(fmt::format("rt: {} tick(s) per wake-up, priority {}, I/O priority {}, lock_memory {}, cpu {}",
+                              s.rt.ticks_per_wake, s.rt.priority, s.rt.io_priority, s.rt.lock_memory, s.rt.cpu));
   return lines;
 }
 

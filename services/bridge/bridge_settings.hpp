@@ -14,6 +14,8 @@
 namespace hystloop {
 
 struct RtSettings {
+  int ticks_per_wake = 1;    // the clock thread wakes once per this many ticks and runs them back to back
+                             // (1 for hardware; the simulator may batch: its stage has no wall clock)
   int priority = 0;          // SCHED_FIFO priority 1..99 of the real-time thread; 0 = normal scheduling
   int io_priority = 0;       // SCHED_FIFO priority of the I/O thread (below `priority`); 0 = normal scheduling
   bool lock_memory = false;  // mlockall at start
@@ -25,12 +27,14 @@ struct BridgeSettings {
   double rate_hz = 10000.0;        // the loop's clock
   SimulatedStageConfig stage{};    // noise, seed, drift and the plants' parameters
   ActuatorLimits limits{};
+  FeedbackGains servo{};           // the servo on y_ref - y (all gains 0 = feedforward only)
+  int block_ticks = 10;            // ticks per HX_SENSOR block (1 = a message per tick)
   RtSettings rt{};
   bool auto_arm = false;           // arm as soon as commands flow (first arm only)
   double rearm_after_trip_s = 0.0; // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
   double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
   double run_seconds = 0.0;        // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
-  int command_queue_capacity = 4096;  // LCM's queue for HX_COMMAND (>= 1000: 100 ms at 10 kHz)
+  int command_queue_capacity = 256;  // LCM's queue for HX_COMMAND [blocks]
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
 };

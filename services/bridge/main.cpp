@@ -16,8 +16,10 @@
 
 int main(int argc, char** argv) {
   using namespace hystloop;
-  CLI::App app{"hystloop-bridge: owns the loop's clock; applies HX_COMMAND to the stage and publishes HX_SENSOR "
-               "every tick. Starts in the safe state: arm it with an ARM request on HX_CONTROL (or --auto-arm)."};
+  CLI::App app{"hystloop-bridge: owns the loop's clock. Buffers the feedforward and reference that HX_COMMAND sends "
+               "ahead of time, adds its servo (PI/PID on y_ref - y) at every tick, clamps, applies, samples the stage "
+               "and publishes HX_SENSOR in blocks. Starts in the safe state: arm it with an ARM request on HX_CONTROL "
+               "(or --auto-arm)."};
   ServiceOptions options;
   add_service_options(app, options);
   std::string backend, noise, drift, seconds;

@@ -25,6 +25,9 @@ class StageBackend {
   virtual const std::string& name() const noexcept = 0;
   // Stage gain relative to its start (1 for hardware: unknown), for the status detail.
   virtual double gain_scale() const noexcept { return 1.0; }
+  // True when the stage has no wall clock of its own (a simulator): ticks the clock thread
+  // could not run on time are then run late, back to back, instead of being skipped.
+  virtual bool simulated() const noexcept { return false; }
 };
 
 // The built-in simulator (Banning stage or Ramberg-Osgood plant) with noise and drift.
@@ -34,6 +37,7 @@ class SimulatedBackend final : public StageBackend {
   StageReading step(double u_V, double t_s, double dt_s) noexcept override;
   const std::string& name() const noexcept override { return name_; }
   double gain_scale() const noexcept override { return stage_.gain_scale(); }
+  bool simulated() const noexcept override { return true; }
 
  private:
   std::string name_;

@@ -2,12 +2,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
 #include "compensator/trajectory_message.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
+#include "lcm/blocks.hpp"
 #include "runtime/counter_baseline.hpp"
 #include "runtime/io_loop.hpp"
 
@@ -16,17 +18,13 @@ namespace {
 
 // A sample seq this far below the last one means the bridge restarted its clock.
 constexpr std::int64_t kRestartTicks = 1000;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <class T>
 typename Subscription<T>::Options queue_of(int capacity) {
   typename Subscription<T>::Options o;
   o.queue_capacity = capacity;
   return o;
-}
-
-FeedbackGains held(FeedbackGains g) noexcept {
-  g.kp = g.ki = g.kd = 0.0;
-  return g;
 }
 
 }  // namespace
@@ -36,38 +34,23 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       lcm_(lcm),
       compensator_(std::in_place, settings.control),
       command_pub_(lcm, channels.command),
-      samples_(lcm, channels.sensor, [this](const sensor_sample_t& m, std::int64_t t) { on_sample(m, t); },
-               queue_of<sensor_sample_t>(settings.sample_queue_capacity)),
+      samples_(lcm, channels.sensor, [this](const sensor_block_t& m, std::int64_t t) { on_sensor(m, t); },
+               queue_of<sensor_block_t>(settings.sample_queue_capacity)),
       trajectories_(lcm, channels.trajectory, [this](const trajectory_t& m, std::int64_t) { on_trajectory(m); }),
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
-      status_(lcm, channels.status, "compensator"),
-      gains_(settings.control.feedback) {
-  pending_trajectory_ = settings.trajectory;  // the configured reference starts with the first sample
-  baseline_ = collect_counters();
-  for (auto& [name, value] : baseline_) value = 0;
+      status_(lcm, channels.status, "compensator") {
+  reserve_storage(command_);
+  compensator_->set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
 }
 
-void CompensatorService::on_sample(const sensor_sample_t& msg, std::int64_t recv_utime) noexcept {
+void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
-  if (have_sample_ && msg.seq + kRestartTicks < last_sample_seq_) restart_control_law();
-  last_sample_utime_ = msg.utime;
-  last_sample_seq_ = msg.seq;
-  ++samples_in_period_;
-
-  // While the bridge holds its safe voltage, the error says nothing about our commands:
-  // integrating it would wind the feedback up for the moment the bridge is re-armed.
-  const bool safe = (msg.flags & sensor_sample_t::SAFE_STATE) != 0;
-  if (safe != feedback_held_) {
-    feedback_held_ = safe;
-    if (safe) ++counters_.feedback_holds;
-    try {
-      compensator_->set_gains(safe ? held(gains_) : gains_);
-    } catch (...) {  // the gains were validated when they were set
-    }
-  }
-
-  const auto out = compensator_->update({msg.seq, msg.u_V, msg.y_m});
+  if (have_sample_ && msg.seq + kRestartTicks < compensator_->last_seq()) restart_control_law();
+  const SensorTick last = sensor_tick(msg, msg.u_V.size() - 1);
+  for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m}); });
+  last_sample_utime_ = last.utime;
+  ++blocks_in_period_;
   if (!have_sample_) {
     have_sample_ = true;
     if (pending_trajectory_) {  // now the loop time is known
@@ -80,51 +63,37 @@ void CompensatorService::on_sample(const sensor_sample_t& msg, std::int64_t recv
       }
     }
   }
-  if (out) {
-    command_.utime = wall_utime();
-    command_.seq = out->seq;
-    command_.sample_seq = out->sample_seq;
-    command_.u_V = out->u_V;
-    command_.u_ff_V = out->u_ff_V;
-    command_.u_fb_V = out->u_fb_V;
-    command_.y_ref_m = out->y_ref_m;
-    command_.params_version = out->params_version;
-    command_.mode = static_cast<std::int8_t>(out->mode);
-    if (command_pub_.publish(command_)) ++counters_.commands_published;
-    // recv_utime is LCM's receive time on this host's clock; a value outside [0, 10 s) is not a latency.
-    const std::int64_t latency_us = wall_utime() - recv_utime;
-    if (latency_us >= 0 && latency_us < 10'000'000) latency_.add(latency_us * 1000);
-  }
+  publish_plan();
+  // recv_utime is LCM's receive time on this host's clock; a value outside [0, 10 s) is not a latency.
+  const std::int64_t latency_us = wall_utime() - recv_utime;
+  if (latency_us >= 0 && latency_us < 10'000'000) latency_.add(latency_us * 1000);
   work_.add(monotonic_now_ns() - start_ns);
 }
 
-void CompensatorService::apply_trajectory(TrajectorySpec spec, std::int64_t start_utime) {
-  if (!have_sample_) {
+void CompensatorService::publish_plan() noexcept {
+  while (const std::size_t n = compensator_->plan(plan_)) {
+    begin_block(command_, plan_[0].seq, wall_utime(), compensator_->last_seq());
+    for (std::size_t i = 0; i < n; ++i) append_tick(command_, plan_[i]);
+    if (command_pub_.publish(command_)) {
+      ++counters_.command_blocks_published;
+      counters_.command_ticks_published += n;
+    }
+  }
+}
+
+void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime) {
+  if (start_utime == 0) {
+    compensator_->set_trajectory(spec, kNaN);
+  } else if (!have_sample_) {
     spec.validate();
     pending_trajectory_ = spec;
     pending_start_utime_ = start_utime;
     return;
-  }
-  Compensator& c = *compensator_;
-  const double t_next = c.loop_time(c.last_seq() + c.config().lead_ticks + 1);
-  const double here = evaluate(trajectory_, t_next - c.config().dt_s);
-  bool now = start_utime == 0;
-  if (!now) {
-    spec.start_s = loop_time_of_utime(start_utime, last_sample_utime_, last_sample_seq_, c.config().dt_s);
-    if (spec.start_s - spec.blend_s < t_next) {
-      ++counters_.trajectory_late_start;
-      now = true;
-    }
-  }
-  if (now) {
-    c.start_trajectory_now(spec);
-    spec.start_s = t_next + spec.blend_s;
-    spec.hold_m = std::isfinite(here) ? here : 0.0;
   } else {
-    spec.hold_m = std::isfinite(here) ? here : 0.0;
-    c.set_trajectory(spec);
+    Compensator& c = *compensator_;
+    const double start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
+    if (!c.set_trajectory(spec, start_s)) ++counters_.trajectory_late_start;
   }
-  trajectory_ = spec;
   ++counters_.trajectories;
 }
 
@@ -179,23 +148,12 @@ void CompensatorService::on_control(const control_t& msg) {
   try {
     switch (msg.command) {
       case control_t::SET_MODE:
-        if (msg.mode < actuator_command_t::MODE_OFF || msg.mode > actuator_command_t::MODE_KATALENIC) {
+        if (msg.mode < command_block_t::MODE_OFF || msg.mode > command_block_t::MODE_KATALENIC) {
           return refuse("mode " + std::to_string(msg.mode) + " is not selectable (off, linear, mem, pi, katalenic)");
         }
         compensator_->set_mode(static_cast<FeedforwardMode>(msg.mode));
         spdlog::info("mode {} (request {})", to_string(compensator_->mode()), msg.request_id);
         break;
-      case control_t::SET_GAINS: {
-        FeedbackGains g = gains_;
-        g.kp = msg.kp;
-        g.ki = msg.ki;
-        g.kd = msg.kd;
-        g.validate();
-        if (!feedback_held_) compensator_->set_gains(g);
-        gains_ = g;
-        spdlog::info("gains kp {}, ki {} 1/s, kd {} s (request {})", g.kp, g.ki, g.kd, msg.request_id);
-        break;
-      }
       case control_t::START_EXPERIMENT: {
         const ExperimentSpec e = make_experiment_spec(msg.experiment, msg.experiment_amplitude_V,
                                                       msg.experiment_offset_V, msg.experiment_frequency_Hz,
@@ -214,7 +172,7 @@ void CompensatorService::on_control(const control_t& msg) {
         compensator_->stop_experiment();
         break;
       case control_t::RESET_COUNTERS:
-        baseline_ = collect_counters();
+        reported_.rebase(collect_counters());
         endpoint_base_ = {samples_.counters(), trajectories_.counters(), params_.counters(), control_.counters(),
                           command_pub_.counters()};
         spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
@@ -223,8 +181,8 @@ void CompensatorService::on_control(const control_t& msg) {
         spdlog::info("SHUTDOWN (request {})", msg.request_id);
         request_stop();
         break;
-      default:  // the bridge's (ARM, DISARM)
-        if (msg.target == "compensator") return refuse("not a compensator command");
+      default:  // the bridge's (ARM, DISARM, SET_GAINS: the servo runs beside the sensor)
+        if (msg.target == "compensator") return refuse("not a compensator command (the bridge's)");
         return;
     }
     ++counters_.control_acted;
@@ -239,26 +197,26 @@ void CompensatorService::restart_control_law() {
   const Compensator& old = *compensator_;
   config.mem = old.mem_params();
   config.mode = old.experiment_running() ? settings_.control.mode : old.mode();
-  config.feedback = gains_;
+  TrajectorySpec reference = old.trajectory();
+  reference.hold_m = 0.0;
   compensator_.emplace(config);
-  feedback_held_ = false;
+  compensator_->set_trajectory(reference, kNaN);
   have_sample_ = false;
-  TrajectorySpec spec = trajectory_;
-  spec.hold_m = 0.0;
-  pending_trajectory_ = spec;
-  trajectory_ = TrajectorySpec{};
-  pending_start_utime_ = 0;
   ++counters_.bridge_restarts;
 }
 
-std::vector<std::pair<std::string, std::uint64_t>> CompensatorService::collect_counters() const {
+CounterSet::Entries CompensatorService::collect_counters() const {
   const CompensatorCounters& c = compensator_->counters();
   const CompensatorServiceCounters& s = counters_;
   return {{"samples", c.samples},
-          {"commands_published", s.commands_published},
+          {"command_blocks_published", s.command_blocks_published},
+          {"command_ticks_published", s.command_ticks_published},
+          {"planned", c.planned},
+          {"ticks_behind", c.ticks_behind},
           {"gaps", c.gaps},
           {"out_of_order", c.out_of_order},
           {"nonfinite_outputs", c.nonfinite_outputs},
+          {"reversals", c.reversals},
           {"params_accepted", c.params_accepted},
           {"params_rejected", c.params_rejected + s.params_refused},
           {"params_invalid", s.params_invalid},
@@ -270,7 +228,6 @@ std::vector<std::pair<std::string, std::uint64_t>> CompensatorService::collect_c
           {"trajectory_late_start", s.trajectory_late_start},
           {"control_acted", s.control_acted},
           {"control_refused", s.control_refused},
-          {"feedback_holds", s.feedback_holds},
           {"bridge_restarts", s.bridge_restarts}};
 }
 
@@ -291,25 +248,25 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   } else if (!have_sample_) {
     state = service_status_t::STARTING;
     detail = "waiting for samples; ";
-  } else if (samples_in_period_ == 0) {
+  } else if (blocks_in_period_ == 0) {
     state = service_status_t::DEGRADED;
     detail = "no samples from the bridge this period; ";
   }
   const MemParams& m = c.mem_params();
-  detail += fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, feedback kp={} ki={} kd={}{}{}",
+  detail += fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
                         to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(),
-                        m.c1, m.c2, m.c3, gains_.kp, gains_.ki, gains_.kd,
-                        feedback_held_ ? ", bridge in safe state: feedback held" : "",
+                        m.c1, m.c2, m.c3, c.config().horizon_ticks,
                         c.experiment_running() ? ", experiment running" : "");
   status_.begin(state, detail);
+  reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;
-  for (std::size_t i = 0; i < counters.size(); ++i) {
-    const std::uint64_t value = counters[i].second - baseline_[i].second;
-    status_.counter(counters[i].first, value);
-    const std::string& n = counters[i].first;
-    if (n == "params_rejected" || n == "params_invalid" || n == "trajectory_refused" || n == "control_refused") {
-      semantic_rejects += value;
+  for (const char* name : {"params_rejected", "params_invalid", "trajectory_refused", "control_refused"}) {
+    for (const auto& [n, value] : counters) {
+      if (n == name) semantic_rejects += reported_.since(n, value);
     }
+  }
+  if (c.next_tick() >= 0) {
+    status_.counter("plan_ahead_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
   }
   const ResourceUsage usage = read_resource_usage();
   status_.counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
@@ -327,7 +284,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   latency_total_.merge(latency_);
   latency_.reset();
   work_.reset();
-  samples_in_period_ = 0;
+  blocks_in_period_ = 0;
 }
 
 int CompensatorService::run() {
@@ -348,12 +305,13 @@ int CompensatorService::run() {
   spdlog::info("stopping{}", stop_signal() ? fmt::format(" on signal {}", stop_signal()) : std::string());
   report(wall_utime(), true);
   const CompensatorCounters& c = compensator_->counters();
-  spdlog::info("summary: {} samples, {} commands published, {} gaps, {} out of order, params {} accepted / {} refused "
-               "/ {} swapped, {} invalid sets ignored",
-               c.samples, counters_.commands_published, c.gaps, c.out_of_order, c.params_accepted,
+  spdlog::info("summary: {} samples, {} command ticks published in {} blocks, {} ticks planned too late, {} gaps, "
+               "{} out of order, params {} accepted / {} refused / {} swapped, {} invalid sets ignored",
+               c.samples, counters_.command_ticks_published, counters_.command_blocks_published, c.ticks_behind, c.gaps,
+               c.out_of_order, c.params_accepted,
                c.params_rejected + counters_.params_refused, c.params_swapped, counters_.params_invalid);
   if (latency_total_.count() > 0) {
-    spdlog::info("summary: sample received -> command published p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us",
+    spdlog::info("summary: sensor block received -> its answer published p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us",
                  latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
                  static_cast<double>(latency_total_.max_ns()) / 1e3);
   }

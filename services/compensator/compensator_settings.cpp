@@ -1,5 +1,7 @@
 #include "compensator/compensator_settings.hpp"
 
+#include <cmath>
+
 #include <cstdio>
 
 #include <spdlog/fmt/fmt.h>
@@ -52,15 +54,14 @@ ShapingFunction read_shaping(const Config& config, const std::string& prefix, co
 
 const std::vector<std::string>& compensator_config_keys() {
   static const std::vector<std::string> keys = {
-      "compensator.mode", "compensator.lead_ticks", "compensator.dt_s", "compensator.run_seconds",
+      "compensator.mode", "compensator.horizon_s", "compensator.dt_s", "compensator.run_seconds",
       "compensator.sample_queue_capacity", "rt.priority", "rt.lock_memory",
       "mem.c1", "mem.c2", "mem.c3",
       "pi.count", "pi.thresholds", "pi.weights", "pi.range_V",
       "linear.gain", "linear.offset",
       "katalenic.k1", "katalenic.k2", "katalenic.k2_slope", "katalenic.k2_domain_min", "katalenic.k2_domain_max",
       "katalenic.initial_offset", "katalenic.input_shaping.*", "katalenic.output_shaping.*",
-      "feedback.kp", "feedback.ki", "feedback.kd", "feedback.nominal_gain_m_per_V", "feedback.u_limit_V",
-      "feedback.d_filter_hz",
+
       "trajectory.shape", "trajectory.amplitude_m", "trajectory.offset_m", "trajectory.frequency_hz",
       "trajectory.phase_rad", "trajectory.blend_s", "trajectory.points_t_s", "trajectory.points_y_m"};
   return keys;
@@ -72,11 +73,20 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   CompensatorConfig& c = s.control;
   const std::string mode = config.get<std::string>("compensator.mode", "mem");
   validate_config_section(config, "", [&] { c.mode = parse_feedforward_mode(mode, "compensator.mode"); });
-  c.lead_ticks = config.get_int_in_range("compensator.lead_ticks", c.lead_ticks, 1, 32);
+  for (const std::string& key : config.keys()) {
+    if (key.rfind("feedback.", 0) == 0) {
+      config.fail(key, "the servo runs in the bridge now, beside the sensor: set servo.kp, servo.ki, servo.kd in "
+                       "the bridge's config (deploy/config/bridge.yaml) or at run time with `hystloop-ctl gains`");
+    }
+  }
+  if (config.has("compensator.lead_ticks")) {
+    config.fail("compensator.lead_ticks", "replaced by compensator.horizon_s: commands are planned that far ahead "
+                                          "of the bridge's clock");
+  }
   c.dt_s = config.get_in_range("compensator.dt_s", c.dt_s, 1e-6, 1.0);
   s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
   s.sample_queue_capacity =
-      static_cast<int>(config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 1000, 1000000));
+      static_cast<int>(config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 16, 100000));
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
@@ -122,14 +132,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   k.output_shaping = read_shaping(config, "katalenic.output_shaping", k.output_shaping);
   validate_config_section(config, "katalenic.", [&] { k.validate(); });
 
-  FeedbackGains& g = c.feedback;
-  g.kp = config.get_non_negative("feedback.kp", g.kp);
-  g.ki = config.get_non_negative("feedback.ki", g.ki);
-  g.kd = config.get_non_negative("feedback.kd", g.kd);
-  g.nominal_gain_m_per_V = config.get_positive("feedback.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
-  g.u_limit_V = config.get_positive("feedback.u_limit_V", g.u_limit_V);
-  g.d_filter_hz = config.get_positive("feedback.d_filter_hz", g.d_filter_hz);
-  validate_config_section(config, "", [&] { g.validate(); });
+  const double horizon_s = config.get_in_range("compensator.horizon_s", static_cast<double>(c.horizon_ticks) * c.dt_s,
+                                               2.0 * c.dt_s, static_cast<double>(CompensatorConfig::kMaxHorizonTicks) * c.dt_s);
+  c.horizon_ticks = static_cast<std::int64_t>(std::llround(horizon_s / c.dt_s));
   validate_config_section(config, "", [&] { c.validate(); });
 
   TrajectorySpec& t = s.trajectory;
@@ -174,16 +179,14 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   const CompensatorConfig& c = s.control;
   const TrajectorySpec& t = s.trajectory;
   std::vector<std::string> lines;
-  lines.push_back(fmt::format("compensator: mode {}, lead {} ticks, dt {} s{}", to_string(c.mode), c.lead_ticks, c.dt_s,
+  lines.push_back(fmt::format("compensator: mode {}, plans {} ticks ({:.4g} s) ahead, dt {} s{}", to_string(c.mode),
+                              c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
                               s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
   lines.push_back(fmt::format("mem: c1 {:.6g} m/V, c2 {:.6g} m/V^(1+c3), c3 {:.6g}", c.mem.c1, c.mem.c2, c.mem.c3));
   lines.push_back(fmt::format("pi: {} plays up to {:.4g} V", c.pi.count, c.pi.count ? c.pi.thresholds[c.pi.count - 1] : 0.0));
   lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
   lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
                               c.katalenic.k2_slope));
-  lines.push_back(fmt::format("feedback: kp {}, ki {} 1/s, kd {} s, nominal gain {:.4g} m/V, limit {} V{}", c.feedback.kp,
-                              c.feedback.ki, c.feedback.kd, c.feedback.nominal_gain_m_per_V, c.feedback.u_limit_V,
-                              c.feedback.enabled() ? "" : " (off)"));
   lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
   static const char* shapes[] = {"hold", "sine", "cosine", "triangle", "points"};
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",

@@ -1,5 +1,5 @@
 // hystloop-compensator: answers every HX_SENSOR sample with the HX_COMMAND for a later tick,
-// feedforward through the selected model's inverse plus optional feedback.
+// feedforward through the selected model's inverse, planned ahead of the bridge's clock.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -16,9 +16,11 @@
 
 int main(int argc, char** argv) {
   using namespace hystloop;
-  CLI::App app{"hystloop-compensator: turns the reference (HX_TRAJECTORY) into the voltage (HX_COMMAND) that makes "
-               "the stage follow it, through the inverse of the selected hysteresis model plus optional PID feedback; "
-               "swaps in new MEM parameters (HX_PARAMS) at reversals; mode and gains change through HX_CONTROL."};
+  CLI::App app{"hystloop-compensator: turns the reference (HX_TRAJECTORY) into the feedforward voltage that makes "
+               "the stage follow it, through the inverse of the selected hysteresis model, one step per tick; answers "
+               "each HX_SENSOR block with the commands (HX_COMMAND) for compensator.horizon_s ahead of the bridge's "
+               "clock; swaps in new MEM parameters (HX_PARAMS) at reversals; mode and experiments change through "
+               "HX_CONTROL (the servo's gains are the bridge's)."};
   ServiceOptions options;
   add_service_options(app, options);
   std::vector<std::filesystem::path> params_files;
