@@ -28,14 +28,17 @@ constexpr int kExitBadConfiguration = 2;
 int main(int argc, char** argv) {
   using namespace hystloop;
   CLI::App app{
-      "hystloop-reidentifier: feeds <rig>SENSOR to the online MEM estimator, refits every\n"
-      "reident.refit_period_s on a worker thread, and publishes on <rig>PARAMS only candidates that pass\n"
-      "validation (signs, ranges, residual, a held-out branch better than the set in use), with their\n"
-      "held-out residual. The initial set in use is mem.c1/c2/c3 (the compensator's keys, version 1);\n"
-      "a newer valid set published by anyone else on <rig>PARAMS replaces it. Status on <rig>STATUS\n"
+      "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
+      "to the online MEM estimator, refits every reident.refit_period_s on a worker thread, and publishes\n"
+      "on <rig>PARAMS only candidates that pass validation (signs, ranges, residual, a held-out branch\n"
+      "better than the set in use), with their held-out residual. The initial set in use is mem.c1/c2/c3\n"
+      "(the compensator's keys, version 1); a newer valid set published by anyone else on <rig>PARAMS\n"
+      "replaces it, and new versions are numbered above every one seen there or applied by the\n"
+      "compensator on <rig>COMMAND. Status on <rig>STATUS\n"
       "(process \"reident\") at 1 Hz. Configuration keys: mem.{c1,c2,c3}, reident.{rate_hz, refit_period_s,\n"
       "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
-      "max_solver_time_s, publish_invalid, stale_after_s, degraded_after_poisoned, lcm_queue}\n"
+      "max_solver_time_s, reversal_dead_band_V, publish_invalid, stale_after_s, degraded_after_poisoned,\n"
+      "lcm_queue}\n"
       "(see deploy/config/reidentifier.yaml). Exit codes: 0 clean stop, 1 runtime error, 2 bad configuration."};
   ServiceOptions service;
   bool publish_invalid = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace hystloop {
 
@@ -37,6 +38,17 @@ ParamsOffer ParamsInUse::offer(const MemParams& params, std::int32_t version, bo
   version_ = version;
   source_.assign(source.begin(), source.end());  // off the per-sample path (HX_PARAMS is rare)
   return ParamsOffer::adopted;
+}
+
+void ParamsInUse::on_command(std::int64_t seq, std::int32_t params_version) noexcept {
+  highest_seen_ = std::max(highest_seen_, params_version);
+  applied_.record(seq, params_version);
+}
+
+std::int32_t ParamsInUse::on_sample(std::int64_t seq) noexcept {
+  applied_version_ = applied_.at(seq);
+  applied_.forget_before(seq);
+  return applied_version_;
 }
 
 std::int32_t ParamsInUse::claim_version() noexcept {

@@ -9,13 +9,21 @@
 // than the set in use: the compensator would switch to it, so candidates must beat it.
 // Our own sets come back to us over LCM (same source, a version we published): ignored.
 // Every version seen, valid or not, is remembered so the next version is above all of them:
-//   version = max(highest seen on HX_PARAMS, ours) + 1.
+//   version = max(highest seen on HX_PARAMS or HX_COMMAND, ours) + 1.
+//
+// HX_COMMAND tells which version the compensator actually applies, per tick (it swaps only at
+// a reversal, and a compensator does not repeat the set it uses on HX_PARAMS). Its versions
+// count as seen, so a re-identifier started after a set was published (or restarted after
+// publishing some) still numbers above the compensator's, which ignores a version not above
+// the last it was offered. The applied version at a sample is looked up by tick
+// (VersionTimeline): commands run ahead of the samples, so the last block received is not it.
 
 #include <cstdint>
 #include <string>
 #include <string_view>
 
 #include "models/mem.hpp"
+#include "reidentifier/version_timeline.hpp"
 
 namespace hystloop {
 
@@ -30,6 +38,7 @@ std::string_view to_string(ParamsOffer offer) noexcept;
 class ParamsInUse {
  public:
   static constexpr std::int32_t kInitialVersion = 1;
+  static constexpr std::int32_t kUnknownVersion = VersionTimeline::kUnknown;
 
   ParamsInUse(const MemParams& initial, std::string own_source);  // validates `initial`
 
@@ -40,6 +49,16 @@ class ParamsInUse {
   std::int32_t adopt_own(const MemParams& params) noexcept;
   // A version for a diagnostic (valid = false) set we publish: unique, changes nothing in use.
   std::int32_t claim_version() noexcept;
+
+  // HX_COMMAND: one command tick (params_version >= 0, checked on the wire), in arrival order.
+  void on_command(std::int64_t seq, std::int32_t params_version) noexcept;
+  // A sensor tick: returns the version the compensator applied at it, kUnknownVersion when no
+  // command at or before it was heard. Ticks come in order: change points before it are forgotten.
+  std::int32_t on_sample(std::int64_t seq) noexcept;
+  // At the last sample.
+  std::int32_t applied_version() const noexcept { return applied_version_; }
+  // Version change points dropped because more than VersionTimeline::kCapacity were pending.
+  std::uint64_t command_versions_dropped() const noexcept { return applied_.overflows(); }
 
   const MemParams& params() const noexcept { return params_; }
   std::int32_t version() const noexcept { return version_; }
@@ -54,6 +73,8 @@ class ParamsInUse {
   std::int32_t own_published_ = 0;               // highest version we published
   std::string own_source_;
   std::string source_ = "config";
+  VersionTimeline applied_;
+  std::int32_t applied_version_ = kUnknownVersion;
 };
 
 }  // namespace hystloop

@@ -4,7 +4,6 @@
 #include <limits>
 #include <utility>
 
-#include "hystloop/sensor_sample_t.hpp"
 
 namespace hystloop {
 
@@ -17,11 +16,15 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
       period_us_(std::llround(options.refit_period_s * 1e6)),
       stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
 
-void ReidentCore::on_sample(std::int64_t seq, double u_V, double y_m, std::int32_t flags,
-                            std::int64_t now_us) noexcept {
+void ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept {
+  for_each_tick(block, [this, now_us](const SensorTick& tick) { on_sample(tick, now_us); });
+}
+
+void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcept {
   last_sample_us_ = now_us;
+  const std::int64_t seq = tick.seq;
   if (last_seq_ >= 0) {
-    // Samples refused on the wire since the last one were not lost: they are no gap.
+    // Ticks refused on the wire since the last one were not lost: they are no gap.
     const std::int64_t missing = seq - last_seq_ - 1 - refused_since_last_;
     if (seq > last_seq_ + 1 && missing > 0) {
       counters_.add(ReidentCounter::seq_gaps);
@@ -32,24 +35,28 @@ void ReidentCore::on_sample(std::int64_t seq, double u_V, double y_m, std::int32
   }
   last_seq_ = seq;
   refused_since_last_ = 0;
-  if ((flags & sensor_sample_t::SAFE_STATE) != 0) {
+  in_use_.on_sample(seq);
+  if ((tick.flags & sensor_block_t::SAFE_STATE) != 0) {
     counters_.add(ReidentCounter::skipped_safe_state);
     return;
   }
-  if ((flags & sensor_sample_t::SENSOR_FAULT) != 0) {
+  if ((tick.flags & sensor_block_t::SENSOR_FAULT) != 0) {
     counters_.add(ReidentCounter::skipped_sensor_fault);
     return;
   }
-  estimator_.feed(u_V, y_m);
+  estimator_.feed(tick.u_V, tick.y_m);
 }
 
-void ReidentCore::on_refused_sample(std::int64_t now_us) noexcept {
-  // The wire check refused a NaN/Inf or absurd value: mark the window as holding one, so no
-  // refit straddles it (the estimator counts it as non-finite).
+void ReidentCore::on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept {
+  // The estimator counts the marker as non-finite: one per block is enough to poison the window.
   last_sample_us_ = now_us;
-  ++refused_since_last_;
+  refused_since_last_ += ticks > 0 ? ticks : 1;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   estimator_.feed(kNaN, kNaN);
+}
+
+void ReidentCore::on_command_block(const command_block_t& block) noexcept {
+  for_each_tick(block, [this](const CommandTick& tick) { in_use_.on_command(tick.seq, tick.params_version); });
 }
 
 ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, bool valid,
@@ -132,6 +139,7 @@ const ReidentCounters& ReidentCore::counters() noexcept {
   counters_.set(ReidentCounter::samples_fed, estimator_.samples_fed());
   counters_.set(ReidentCounter::non_finite, estimator_.non_finite_samples());
   counters_.set(ReidentCounter::dropouts, estimator_.dropouts());
+  counters_.set(ReidentCounter::command_versions_dropped, in_use_.command_versions_dropped());
   return counters_;
 }
 

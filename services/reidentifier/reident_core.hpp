@@ -1,11 +1,13 @@
 #pragma once
-// The re-identifier without LCM and without a clock: samples in, refit decisions out.
-// It owns the OnlineMemEstimator (fed on the calling thread, the "I/O thread"), the refit
-// worker, the set in use and the counters. Time is an argument (now_us, any monotonic
-// microsecond clock).
+// The re-identifier without a connection and without a clock: blocks in, refit decisions
+// out. It owns the OnlineMemEstimator (fed on the calling thread, the "I/O thread"), the
+// refit worker, the set in use and the counters. Time is an argument (now_us, any monotonic
+// microsecond clock). The blocks are decoded messages; their ticks are walked with
+// for_each_tick (lcm/blocks.hpp), so a block is what a sequence of on_sample calls would be.
 //
-//   per sample:     on_sample(seq, u, y, flags, now_us)    noexcept, no allocation, no lock
-//   refused sample: on_refused_sample(now_us)              a NaN/out-of-range sample poisons the window
+//   HX_SENSOR:      on_sensor_block(block, now_us)        per tick: on_sample; no allocation, no lock
+//   refused block:  on_refused_block(ticks, now_us)       a NaN/out-of-range block poisons the window
+//   HX_COMMAND:     on_command_block(block)               the params_version applied, by tick
 //   HX_PARAMS:      on_params(...)                        a newer valid set becomes the set in use
 //   often (~10 ms): poll(now_us) -> RefitDecision          collects a finished refit, starts the next
 //
@@ -20,6 +22,7 @@
 
 #include "core/latency_stats.hpp"
 #include "ident/online_mem_estimator.hpp"
+#include "lcm/blocks.hpp"
 #include "reidentifier/params_in_use.hpp"
 #include "reidentifier/refit_worker.hpp"
 #include "reidentifier/reident_counters.hpp"
@@ -49,8 +52,17 @@ class ReidentCore {
   ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread = true,
               RefitWorker::OnEvaluated on_evaluated = {});
 
-  void on_sample(std::int64_t seq, double u_V, double y_m, std::int32_t flags, std::int64_t now_us) noexcept;
-  void on_refused_sample(std::int64_t now_us) noexcept;
+  // An accepted HX_SENSOR block (check_message passed): every tick, in order, through on_sample.
+  void on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept;
+  // One tick: the applied voltage u_V and the measured y_m feed the estimator, unless the tick
+  // is flagged SAFE_STATE or SENSOR_FAULT (skipped and counted); seq gaps are counted.
+  void on_sample(const SensorTick& tick, std::int64_t now_us) noexcept;
+  // A block the wire check refused (NaN/Inf or absurd values) of about `ticks` ticks (the
+  // service's estimate, >= 1): its ticks are no gap, and the window is marked as holding a
+  // non-finite sample, so no refit straddles it.
+  void on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept;
+  // An accepted HX_COMMAND block: which parameter version the compensator applies, by tick.
+  void on_command_block(const command_block_t& block) noexcept;
   ParamsOffer on_params(const MemParams& params, std::int32_t version, bool valid, std::string_view source) noexcept;
   RefitDecision poll(std::int64_t now_us) noexcept;
 
@@ -87,7 +99,7 @@ class ReidentCore {
   std::int64_t next_refit_us_ = INT64_MIN;
   std::uint64_t fed_at_last_snapshot_ = 0;
   std::int64_t last_seq_ = -1;
-  std::int64_t refused_since_last_ = 0;  // samples refused on the wire since last_seq_
+  std::int64_t refused_since_last_ = 0;  // ticks refused on the wire since last_seq_ (estimated)
   std::int64_t last_sample_us_ = -1;
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;

@@ -19,6 +19,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "params_echo",
     "params_stale",
     "params_invalid",
+    "command_versions_dropped",
     // One per FitStatus, in its order ("ok" is never counted as a refusal).
     "refits_rejected_ok",
     "refits_rejected_invalid_options",
@@ -32,6 +33,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "refits_rejected_no_improvement",
     "refits_rejected_poisoned_window",
 };
+static_assert(!kNames.back().empty(), "a counter without a name: kNames must follow ReidentCounter");
 }  // namespace
 
 std::string_view counter_name(std::size_t index) noexcept {

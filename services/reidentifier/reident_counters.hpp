@@ -13,13 +13,13 @@
 namespace hystloop {
 
 enum class ReidentCounter : std::uint8_t {
-  samples_fed,           // handed to the estimator (incl. poison markers for refused samples)
+  samples_fed,           // handed to the estimator (incl. one poison marker per refused block)
   skipped_safe_state,    // flagged SAFE_STATE: the bridge is ramping/holding, not following commands
   skipped_sensor_fault,  // flagged SENSOR_FAULT: y is the last good value
   seq_gaps,              // a jump forward in seq not explained by samples refused on the wire
   samples_missed,        // ticks missing in those gaps
   seq_restarts,          // seq went backwards (a bridge restart)
-  non_finite,            // NaN/Inf samples (refused on the wire or fed): poison the window
+  non_finite,            // NaN/Inf samples (a marker per block refused on the wire, or fed): poison the window
   dropouts,              // y stuck while u moves: poisons the window
   refits_attempted,
   refits_accepted,
@@ -28,6 +28,7 @@ enum class ReidentCounter : std::uint8_t {
   params_echo,           // our own sets coming back
   params_stale,          // valid sets not newer than the set in use
   params_invalid,        // valid = false sets
+  command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
   refits_rejected_first  // + static_cast<int>(FitStatus) for each refusal reason
 };
 

@@ -3,7 +3,7 @@
 // keys the compensator reads and hystloop-identify writes (mem: {c1, c2, c3}), so one YAML
 // snippet configures both; the rest is the `reident:` section (each key also --set reident.KEY=V):
 //
-//   reident.rate_hz                   sample rate of HX_SENSOR [Hz], converts s -> samples (10000)
+//   reident.rate_hz                   tick rate of HX_SENSOR [Hz], converts s -> samples (10000)
 //   reident.refit_period_s            time between refits [s] (1)
 //   reident.window_s                  data fitted per refit [s] (2)
 //   reident.capacity_s                samples kept in the estimator's ring [s] (>= window_s; 10)
@@ -11,10 +11,11 @@
 //   reident.min_relative_improvement  held-out RMS must drop by this fraction vs the set in use (0.02)
 //   reident.max_residual_rms_m        bound on the fit residual [m] (20e-9)
 //   reident.max_solver_time_s         time bound of the nonlinear refinement [s] (0.05)
+//   reident.reversal_dead_band_V      reversals of u smaller than this are not branches [V] (servo jitter; 0)
 //   reident.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
 //   reident.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
 //   reident.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
-//   reident.lcm_queue                 HX_SENSOR messages LCM holds before dropping (>= 1000; 20000)
+//   reident.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 1000; 20000)
 
 #include <cstdint>
 

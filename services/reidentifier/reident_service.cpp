@@ -58,15 +58,21 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {
   out_.source = own_source_;
-  Subscription<sensor_sample_t>::Options sensor_options;
+  Subscription<sensor_block_t>::Options sensor_options;
   sensor_options.queue_capacity = static_cast<int>(options.lcm_queue);
   sensor_options.on_reject = [this](RejectReason reason) {
     if (reason == RejectReason::kNonFinite || reason == RejectReason::kOutOfRange) {
-      core_->on_refused_sample(steady_us());
+      // Its size is unknown (refused before use): the bridge's blocks have one size, the last one's.
+      core_->on_refused_block(sensor_->latest().n_ticks, steady_us());
     }
   };
-  sensor_ = std::make_unique<Subscription<sensor_sample_t>>(
-      lcm, names.sensor, [this](const sensor_sample_t& msg, std::int64_t) { on_sample(msg); }, sensor_options);
+  sensor_ = std::make_unique<Subscription<sensor_block_t>>(
+      lcm, names.sensor, [this](const sensor_block_t& msg, std::int64_t) { on_sensor_block(msg); }, sensor_options);
+  Subscription<command_block_t>::Options command_options;
+  command_options.queue_capacity = static_cast<int>(options.lcm_queue);
+  command_ = std::make_unique<Subscription<command_block_t>>(
+      lcm, names.command, [this](const command_block_t& msg, std::int64_t) { core_->on_command_block(msg); },
+      command_options);
   params_in_ = std::make_unique<Subscription<mem_params_t>>(
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
   control_ = std::make_unique<Subscription<control_t>>(
@@ -75,10 +81,10 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
 
 ReidentService::~ReidentService() = default;
 
-void ReidentService::on_sample(const sensor_sample_t& msg) noexcept {
+void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
   const std::int64_t t0 = steady_ns();
-  core_->on_sample(msg.seq, msg.u_V, msg.y_m, msg.flags, t0 / 1000);
-  sample_cost_.add(steady_ns() - t0);
+  core_->on_sensor_block(msg, t0 / 1000);
+  block_cost_.add(steady_ns() - t0);
 }
 
 void ReidentService::on_params(const mem_params_t& msg) {
@@ -102,6 +108,7 @@ void ReidentService::on_control(const control_t& msg) {
     spdlog::info("counters reset (request {})", msg.request_id);
     core_->reset_counters();
     sensor_base_ = sensor_->counters();
+    command_base_ = command_->counters();
     params_in_base_ = params_in_->counters();
     control_base_ = control_->counters();
     params_out_base_ = params_out_.counters();
@@ -155,6 +162,10 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   const LatencyStats& refit = core_->refit_time();
   why += fmt::format("params version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", in_use.version(),
                      in_use.source(), in_use.params().c1, in_use.params().c2, in_use.params().c3);
+  const std::int32_t applied = in_use.applied_version();
+  if (applied != ParamsInUse::kUnknownVersion && applied != in_use.version()) {
+    why += fmt::format("; the compensator applies version {}", applied);
+  }
   if (refit.count() > 0) {
     why += fmt::format("; refit last {:.1f} ms, p50 {:.1f} ms, max {:.1f} ms", core_->last_refit_s() * 1e3,
                        refit.percentile(0.5) * 1e-6, static_cast<double>(refit.max_ns()) * 1e-6);
@@ -167,17 +178,21 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   }
   status_.counter("refits_rejected", c.rejected_total());
   status_.counter("params_version", static_cast<std::uint64_t>(in_use.version()));
+  if (applied != ParamsInUse::kUnknownVersion) {  // absent until a command at or before a sample is heard
+    status_.counter("params_version_applied", static_cast<std::uint64_t>(applied));
+  }
   if (refit.count() > 0) {
     status_.counter("refit_last_us", static_cast<std::uint64_t>(std::llround(core_->last_refit_s() * 1e6)));
     status_.counter("refit_p50_us", static_cast<std::uint64_t>(std::llround(refit.percentile(0.5) * 1e-3)));
     status_.counter("refit_max_us", static_cast<std::uint64_t>(refit.max_ns() / 1000));
   }
   status_.endpoint("sensor", counters_since(sensor_->counters(), sensor_base_));
+  status_.endpoint("command", counters_since(command_->counters(), command_base_));
   status_.endpoint("params_in", counters_since(params_in_->counters(), params_in_base_));
   status_.endpoint("control", counters_since(control_->counters(), control_base_));
   status_.publisher("params_out", counters_since(params_out_.counters(), params_out_base_));
-  status_.loop_timing(sample_cost_);  // per-sample handler cost
-  sample_cost_.reset();
+  status_.loop_timing(block_cost_);  // per-block handler cost
+  block_cost_.reset();
   status_.publish(wall_utime());
 }
 
@@ -205,7 +220,7 @@ int ReidentService::run() {
   spdlog::info(
       "stopping: {} samples fed, {} skipped (safe state {}, sensor fault {}), {} gaps, {} non-finite, {} dropouts; "
       "refits {} attempted, {} accepted, {} rejected, {} superseded; refit p50 {:.1f} ms max {:.1f} ms; "
-      "params version {} c1 {:.6g} c2 {:.6g} c3 {:.6g}; {} LCM errors",
+      "params version {} c1 {:.6g} c2 {:.6g} c3 {:.6g} (compensator applied {}); {} LCM errors",
       c.get(ReidentCounter::samples_fed),
       c.get(ReidentCounter::skipped_safe_state) + c.get(ReidentCounter::skipped_sensor_fault),
       c.get(ReidentCounter::skipped_safe_state), c.get(ReidentCounter::skipped_sensor_fault),
@@ -213,7 +228,11 @@ int ReidentService::run() {
       c.get(ReidentCounter::refits_attempted), c.get(ReidentCounter::refits_accepted), c.rejected_total(),
       c.get(ReidentCounter::refits_superseded), refit.count() ? refit.percentile(0.5) * 1e-6 : 0.0,
       static_cast<double>(refit.max_ns()) * 1e-6, core_->in_use().version(), core_->in_use().params().c1,
-      core_->in_use().params().c2, core_->in_use().params().c3, lcm_errors);
+      core_->in_use().params().c2, core_->in_use().params().c3,
+      core_->in_use().applied_version() == ParamsInUse::kUnknownVersion
+          ? std::string("unknown")
+          : std::to_string(core_->in_use().applied_version()),
+      lcm_errors);
   return 0;
 }
 

@@ -2,8 +2,11 @@
 // hystloop-reidentifier's LCM shell around ReidentCore. One I/O thread (the caller of run())
 // owns lcm::LCM and the estimator; the refit runs on the core's worker thread.
 //
-//   <rig>SENSOR  -> ReidentCore::on_sample (samples flagged SAFE_STATE / SENSOR_FAULT skipped and
-//                   counted; refused non-finite ones poison the window)
+//   <rig>SENSOR  -> ReidentCore::on_sensor_block: each tick's applied u_V and measured y_m feed
+//                   the estimator (ticks flagged SAFE_STATE / SENSOR_FAULT skipped and counted;
+//                   a block refused as non-finite or out of range poisons the window)
+//   <rig>COMMAND -> ReidentCore::on_command_block: the parameter version the compensator applies,
+//                   by tick (versions seen there are numbered above; status params_version_applied)
 //   <rig>PARAMS  -> a newer valid set from someone else becomes the set in use; our echo ignored
 //   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to "reident" (or to all)
 //   every 10 ms  -> poll the core: publish an accepted candidate on <rig>PARAMS (valid = true,
@@ -20,7 +23,8 @@
 #include "core/latency_stats.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
@@ -42,7 +46,7 @@ class ReidentService {
   int run();
 
  private:
-  void on_sample(const sensor_sample_t& msg) noexcept;
+  void on_sensor_block(const sensor_block_t& msg) noexcept;
   void on_params(const mem_params_t& msg);
   void on_control(const control_t& msg);
   void on_tick(std::int64_t now_us);
@@ -56,14 +60,15 @@ class ReidentService {
   Publisher<mem_params_t> params_out_;
   StatusReporter status_;
   ControlFilter control_filter_;
-  LatencyStats sample_cost_;  // per-sample handler (feed) cost [ns], per status period
+  LatencyStats block_cost_;  // HX_SENSOR handler (feed of one block) cost [ns], per status period
   // RESET_COUNTERS: the endpoints' counts at the reset (they only count up).
-  EndpointCounters sensor_base_{}, params_in_base_{}, control_base_{};
+  EndpointCounters sensor_base_{}, command_base_{}, params_in_base_{}, control_base_{};
   PublisherCounters params_out_base_{};
   mem_params_t out_{};
   std::int64_t next_status_us_ = 0;
   // Last: their handlers use everything above.
-  std::unique_ptr<Subscription<sensor_sample_t>> sensor_;
+  std::unique_ptr<Subscription<sensor_block_t>> sensor_;
+  std::unique_ptr<Subscription<command_block_t>> command_;
   std::unique_ptr<Subscription<mem_params_t>> params_in_;
   std::unique_ptr<Subscription<control_t>> control_;
 };

@@ -5,20 +5,24 @@
 //   reident_stream garbage --url U [--phase-s 2]
 //   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reident" (after its first status)
 //
-// Both wait for the re-identifier's first HX_STATUS, then stream sensor_sample_t at 10 kHz of
-// real time (bursts of 10 samples per millisecond), reading HX_PARAMS and HX_STATUS between
-// bursts, then wait --settle-s for the last reports.
+// Both wait for the re-identifier's first HX_STATUS, then stream 10 kHz of real time as the
+// bridge and compensator do: one sensor_block_t of 10 ticks per millisecond, and command_block_t
+// for the ticks up to 30 ms (300 ticks) ahead of it, reading HX_PARAMS and HX_STATUS between
+// blocks, then wait --settle-s for the last reports.
 //  good:    first announces an external valid set (version 5, source "probe") equal to the
-//           re-identifier's initial params; then streams u = 250 sin(2 pi f t), y from the MEM
-//           model (common/models/mem.hpp) with gain 1.1 x the initial params + 1 nm noise.
-//           Passes if a valid HX_PARAMS from "reident@..." arrives with version >= 6 and c1, c2
-//           within --tolerance of the truth, and the status shows the external set adopted.
+//           re-identifier's initial params; the commands say the compensator applies version 7
+//           (a set the re-identifier never heard on HX_PARAMS); then streams u = 250 sin(2 pi f t),
+//           y from the MEM model (common/models/mem.hpp) with gain 1.1 x the initial params + 1 nm
+//           noise. Passes if a valid HX_PARAMS from "reident@..." arrives with version >= 8 (above
+//           the applied 7) and c1, c2 within --tolerance of the truth, and the status shows the
+//           external set adopted and version 7 applied.
 //           With --expect-invalid 1 (re-identifier run with --publish-invalid), the later refused
 //           refits must arrive as valid = false, with their own versions, and not become the set in use.
-//  garbage: three phases: y NaN on every 200th sample (sine u), constant u with noisy y,
-//           y stuck while u moves. Passes if no valid set is ever published and the status
-//           counts poisoned-window and constant-input refusals, non-finite samples and dropouts.
-// Prints the figures (refit time p50/max, per-sample feed cost) from the last status.
+//  garbage: three phases: y NaN on every 200th tick (sine u; the bridge's block holding it is
+//           refused on the wire), constant u with noisy y, y stuck while u moves. Passes if no
+//           valid set is ever published and the status counts poisoned-window and constant-input
+//           refusals, non-finite samples and dropouts, and no gap for the refused blocks.
+// Prints the figures (refit time p50/max, per-block feed cost) from the last status.
 // Exit status 0 = pass, 1 = fail, 2 = usage.
 #include <algorithm>
 #include <chrono>
@@ -37,10 +41,13 @@
 
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
+#include "lcm/message_storage.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "models/mem.hpp"
@@ -49,6 +56,10 @@ namespace hystloop {
 namespace {
 
 using clock = std::chrono::steady_clock;
+
+constexpr std::int64_t kBlockTicks = 10;     // the bridge's default: 1 kHz of blocks
+constexpr std::int64_t kHorizonTicks = 300;  // commands planned 30 ms ahead
+constexpr std::int32_t kAppliedVersion = 7;  // what the commands of the good mode say is applied
 
 struct Options {
   std::string mode;
@@ -95,7 +106,7 @@ struct Observed {
   int statuses = 0;
   service_status_t last_status{};
   std::map<std::string, std::int64_t> counters;  // of the last status
-  // Per-sample feed cost over the reports that measured one (the last ones have no samples).
+  // Per-block feed cost over the reports that measured one (the last ones have no blocks).
   double feed_p50_us = std::nan(""), feed_p99_us = std::nan(""), feed_max_us = 0.0;
 };
 
@@ -106,9 +117,13 @@ class Stream {
         names_(o.prefix),
         lcm_(open_lcm(o.url)),
         sensor_(*lcm_, names_.sensor, nullptr),  // unchecked: the garbage mode sends NaN on purpose
+        command_pub_(*lcm_, names_.command),
         params_pub_(*lcm_, names_.params),
         params_(*lcm_, names_.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
-        status_(*lcm_, names_.status, [this](const service_status_t& m, std::int64_t) { on_status(m); }) {}
+        status_(*lcm_, names_.status, [this](const service_status_t& m, std::int64_t) { on_status(m); }) {
+    reserve_storage(block_);
+    reserve_storage(commands_);
+  }
 
   int run() {
     if (!wait_for_status(10.0)) {
@@ -163,22 +178,43 @@ class Stream {
     return seen_.statuses > 0;
   }
 
-  // Streams n samples at 10 kHz of real time; sample(k, u, y, flags) fills one.
+  static std::int64_t wall_us() {
+    return std::chrono::duration_cast<std::chrono::microseconds>(
+               std::chrono::system_clock::now().time_since_epoch()).count();
+  }
+
+  // Commands for the ticks not yet commanded, up to (excluding) `until`, in one block.
+  void command_until(std::int64_t until, std::int32_t params_version) {
+    if (commanded_ >= until) return;
+    begin_block(commands_, commanded_, wall_us(), seq_ - 1);
+    constexpr double kNoReference = std::numeric_limits<double>::quiet_NaN();
+    for (; commanded_ < until; ++commanded_) {
+      append_tick(commands_, CommandTick{.seq = commanded_, .u_ff_V = 0.0, .y_ref_m = kNoReference,
+                                         .params_version = params_version, .mode = command_block_t::MODE_MEM});
+    }
+    command_pub_.publish(commands_);
+  }
+
+  // Streams n ticks at 10 kHz of real time, a block of kBlockTicks per millisecond, each with the
+  // commands up to kHorizonTicks ahead of it; fill(k, u, y) fills tick k.
   template <class Fill>
-  void stream(std::int64_t n, Fill fill) {
-    sensor_sample_t s{};
+  void stream(std::int64_t n, std::int32_t params_version, Fill fill) {
     const auto start = clock::now();
-    for (std::int64_t k = 0; k < n; ++k) {
-      s.seq = seq_++;
-      s.flags = sensor_sample_t::SIMULATED;
-      fill(k, s.u_V, s.y_m);
-      s.utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                    std::chrono::system_clock::now().time_since_epoch()).count();
-      sensor_.publish(s);
-      if ((k + 1) % 10 == 0) {  // a burst per millisecond
-        handle_pending(*lcm_, std::chrono::microseconds(0));
-        std::this_thread::sleep_until(start + std::chrono::microseconds((k + 1) * 100));
+    constexpr double kNoReference = std::numeric_limits<double>::quiet_NaN();
+    for (std::int64_t k = 0; k < n; k += kBlockTicks) {
+      const std::int64_t ticks = std::min(kBlockTicks, n - k);
+      command_until(seq_ + ticks + kHorizonTicks, params_version);
+      begin_block(block_, seq_, wall_us(), 1e-4);
+      for (std::int64_t i = 0; i < ticks; ++i) {
+        double u = 0.0, y = 0.0;
+        fill(k + i, u, y);
+        append_tick(block_, SensorTick{.u_V = u, .u_ff_V = u, .y_ref_m = kNoReference, .y_m = y,
+                                       .flags = sensor_block_t::SIMULATED});
       }
+      sensor_.publish(block_);
+      seq_ += ticks;
+      handle_pending(*lcm_, std::chrono::microseconds(0));
+      std::this_thread::sleep_until(start + std::chrono::microseconds((k + ticks) * 100));
     }
   }
 
@@ -200,7 +236,7 @@ class Stream {
   void print_figures() const {
     const service_status_t& st = seen_.last_status;
     std::printf(
-        "reident_stream: figures: refit p50 %.1f ms, max %.1f ms (%lld refits); per-sample feed p50 %.3f us, "
+        "reident_stream: figures: refit p50 %.1f ms, max %.1f ms (%lld refits); per-block feed p50 %.3f us, "
         "worst p99 %.3f us, max %.3f us (over the stream's reports); samples fed %lld, sensor rejected %lld, gaps %lld\n",
         static_cast<double>(counter("refit_p50_us")) * 1e-3, static_cast<double>(counter("refit_max_us")) * 1e-3,
         static_cast<long long>(counter("refits_attempted")), seen_.feed_p50_us, seen_.feed_p99_us, seen_.feed_max_us,
@@ -228,7 +264,7 @@ class Stream {
     std::normal_distribution<double> noise(0.0, 1e-9);
     const double w = 2.0 * std::numbers::pi * o_.frequency_hz;
     stream_start_ = clock::now();
-    stream(std::llround(o_.duration_s * 1e4), [&](std::int64_t k, double& u, double& y) {
+    stream(std::llround(o_.duration_s * 1e4), kAppliedVersion, [&](std::int64_t k, double& u, double& y) {
       u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
       y = model.forward(u) + noise(rng);
     });
@@ -250,7 +286,8 @@ class Stream {
                   100 * e1, 100 * e2, b.c3, truth.c3, b.version, seen_.first_valid_after_s);
       check(e1 <= o_.tolerance, "c1 off by " + std::to_string(100 * e1) + " %");
       check(e2 <= 3 * o_.tolerance, "c2 off by " + std::to_string(100 * e2) + " %");
-      check(b.version >= 6, "version " + std::to_string(b.version) + " is not above the external set's 5");
+      check(b.version >= kAppliedVersion + 1, "version " + std::to_string(b.version) +
+                                                  " is not above the applied version 7 (nor the external set's 5)");
       check(std::isfinite(b.residual_m) && b.residual_m > 0 && b.residual_m < 20e-9, "residual_m out of range");
       check(b.samples_used > 0 && b.window_s > 0, "samples_used/window_s missing");
     }
@@ -264,6 +301,7 @@ class Stream {
     }
     check(!seen_.duplicate_version, "two sets with one version");
     check(counter("params_adopted") == 1, "the external set was not adopted");
+    check(counter("params_version_applied") == kAppliedVersion, "the applied version (HX_COMMAND) is not reported");
     check(counter("refits_accepted") >= 1, "status does not count the accepted refit");
     check(counter("seq_gaps") == 0, "samples were lost on the way");
     return failures == 0 ? 0 : 1;
@@ -278,16 +316,16 @@ class Stream {
     const auto n = std::llround(o_.phase_s * 1e4);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     stream_start_ = clock::now();
-    stream(n, [&](std::int64_t k, double& u, double& y) {  // NaN y now and then
+    stream(n, 1, [&](std::int64_t k, double& u, double& y) {  // NaN y now and then
       u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
       y = k % 200 == 0 ? nan : model.forward(u) + noise(rng);
     });
-    stream(n, [&](std::int64_t, double& u, double& y) {  // constant input
+    stream(n, 1, [&](std::int64_t, double& u, double& y) {  // constant input
       u = 12.0;
       y = 3e-8 + noise(rng);
     });
     model = truth_model;
-    stream(n, [&](std::int64_t k, double& u, double& y) {  // y stuck while u moves
+    stream(n, 1, [&](std::int64_t k, double& u, double& y) {  // y stuck while u moves
       u = 250.0 * std::sin(w * static_cast<double>(k) * 1e-4);
       y = 1e-7;
     });
@@ -307,7 +345,7 @@ class Stream {
     check(counter("refits_rejected_constant_input") >= 1, "constant input not refused");
     check(counter("non_finite") > 0 && counter("sensor.rejected_non_finite") > 0, "NaN samples not counted");
     check(counter("dropouts") >= 1, "stuck y not counted as a dropout");
-    check(counter("seq_gaps") == 0, "refused samples counted as a gap (or samples lost)");
+    check(counter("seq_gaps") == 0, "refused blocks counted as a gap (or ticks lost)");
     check(counter("params_version") == 1, "the set in use changed");
     for (const auto& [name, value] : seen_.counters) {
       if (name.rfind("refits_", 0) == 0 && value > 0) std::printf("reident_stream: %s = %lld\n", name.c_str(),
@@ -319,12 +357,16 @@ class Stream {
   Options o_;
   ChannelNames names_;
   std::unique_ptr<lcm::LCM> lcm_;
-  Publisher<sensor_sample_t> sensor_;
+  Publisher<sensor_block_t> sensor_;
+  Publisher<command_block_t> command_pub_;
   Publisher<mem_params_t> params_pub_;
   Subscription<mem_params_t> params_;
   Subscription<service_status_t> status_;
   Observed seen_;
-  std::int64_t seq_ = 0;
+  sensor_block_t block_{};
+  command_block_t commands_{};
+  std::int64_t seq_ = 0;        // next sensor tick
+  std::int64_t commanded_ = 0;  // next tick without a command
   clock::time_point stream_start_ = clock::now();
 };
 

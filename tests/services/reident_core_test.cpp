@@ -1,13 +1,14 @@
 // ReidentCore with a fake clock and the worker stepped by hand: scheduling (one job in flight,
 // the period, a full window of new data), adoption and versions, garbage refused and counted,
-// skipped and missing samples, health, and an allocation-free per-sample path.
+// skipped, refused and missing ticks, the version the compensator applies (HX_COMMAND ahead of
+// the samples), health, and an allocation-free block path.
 #include "reidentifier/reident_core.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "services/reident_test_data.hpp"
 #include "support/allocation_counter.hpp"
 
@@ -15,15 +16,17 @@ namespace hystloop {
 namespace {
 
 using testdata::gain_scaled;
+using testdata::sample_tick;
 using Kind = RefitDecision::Kind;
 
 constexpr std::int64_t kSecond = 1'000'000;  // us
+constexpr std::size_t kBlockTicks = 10;      // the bridge's default block
 // The flag bits as plain ints (LCM's constants are distinct unnamed enums).
-constexpr std::int32_t kSaturated = sensor_sample_t::SATURATED;
-constexpr std::int32_t kSafeState = sensor_sample_t::SAFE_STATE;
-constexpr std::int32_t kSimulated = sensor_sample_t::SIMULATED;
-constexpr std::int32_t kLateCommand = sensor_sample_t::LATE_COMMAND;
-constexpr std::int32_t kSensorFault = sensor_sample_t::SENSOR_FAULT;
+constexpr std::int32_t kSaturated = sensor_block_t::SATURATED;
+constexpr std::int32_t kSafeState = sensor_block_t::SAFE_STATE;
+constexpr std::int32_t kSimulated = sensor_block_t::SIMULATED;
+constexpr std::int32_t kLateCommand = sensor_block_t::LATE_COMMAND;
+constexpr std::int32_t kSensorFault = sensor_block_t::SENSOR_FAULT;
 
 struct Rig {
   MemParams initial = testdata::piezo_truth();
@@ -31,25 +34,34 @@ struct Rig {
   ReidentCore core{testdata::small_reident_options(initial), "reident@test", /*start_thread=*/false};
   std::int64_t seq = 0;
   std::int64_t now = 10 * kSecond;  // fake clock [us]
+  sensor_block_t block = testdata::reserved_sensor_block();
 
   // One continuous 10 Hz record of the truth (the MEM state carries over between slices).
   testdata::SineRecord truth_record = testdata::sine_record(truth, 1, 6.0);
   std::size_t position = 0;
 
+  // Sends u/y[from, from + n) as HX_SENSOR blocks of kBlockTicks, 10 kHz of fake time.
+  void send(const std::vector<double>& u, const std::vector<double>& y, std::size_t from, std::size_t n,
+            std::int32_t flags = 0) {
+    for (std::size_t k = from; k < from + n; k += kBlockTicks) {
+      const std::size_t ticks = std::min(kBlockTicks, from + n - k);
+      testdata::fill_sensor_block(block, seq, now, u, y, k, ticks, flags);
+      core.on_sensor_block(block, now);
+      seq += static_cast<std::int64_t>(ticks);
+      now += static_cast<std::int64_t>(ticks) * testdata::kTickPeriod_us;
+    }
+  }
   // Streams the next `seconds` of the truth's record.
   void advance(double seconds = 1.0) {
     const auto n = static_cast<std::size_t>(std::llround(seconds * 1e4));
-    for (std::size_t k = 0; k < n; ++k, ++position) {
-      core.on_sample(seq++, truth_record.u.at(position), truth_record.y.at(position), 0, now);
-      now += 100;
-    }
+    send(truth_record.u, truth_record.y, position, n);
+    position += n;
   }
-  // Streams `rec` at 10 kHz of fake time.
-  void stream(const testdata::SineRecord& rec, std::int32_t flags = 0) {
-    for (std::size_t k = 0; k < rec.u.size(); ++k) {
-      core.on_sample(seq++, rec.u[k], rec.y[k], flags, now);
-      now += 100;
-    }
+  // Streams `rec`.
+  void stream(const testdata::SineRecord& rec, std::int32_t flags = 0) { send(rec.u, rec.y, 0, rec.u.size(), flags); }
+  // One tick, seq given.
+  void tick(std::int64_t s, std::int32_t flags = 0) {
+    core.on_sample(SensorTick{.seq = s, .u_V = 1.0, .y_m = 1e-9, .flags = flags}, now);
   }
   // poll; if that started a job, run it and poll again for the decision.
   RefitDecision refit() {
@@ -142,12 +154,15 @@ TEST(ReidentCore, AnOutcomeJudgedAgainstAReplacedSetIsNotAdopted) {
 TEST(ReidentCore, GarbageIsRefusedCountedAndNeverAdopted) {
   Rig rig;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  // NaN samples refused on the wire poison every window that holds them.
+  // A block refused on the wire (NaN) poisons every window that holds it.
   rig.advance();
-  rig.core.on_refused_sample(rig.now);
+  rig.core.on_refused_block(10, rig.now);
+  rig.seq += 10;
   EXPECT_EQ(rig.refit().status, FitStatus::poisoned_window);
   // A NaN that reached the core some other way does the same.
-  rig.core.on_sample(rig.seq++, 1.0, nan, 0, rig.now);
+  SensorTick bad = sample_tick(1.0, nan);
+  bad.seq = rig.seq++;
+  rig.core.on_sample(bad, rig.now);
   rig.now += kSecond;
   EXPECT_EQ(rig.refit().status, FitStatus::poisoned_window);
   EXPECT_FALSE(rig.core.poisoned());
@@ -179,56 +194,115 @@ TEST(ReidentCore, GarbageIsRefusedCountedAndNeverAdopted) {
   EXPECT_DOUBLE_EQ(rig.core.in_use().params().c1, rig.initial.c1);
 }
 
-TEST(ReidentCore, SkipsFlaggedSamplesAndCountsGapsAndRestarts) {
+TEST(ReidentCore, SkipsFlaggedTicksAndCountsGapsAndRestarts) {
   Rig rig;
-  rig.core.on_sample(0, 1.0, 1e-9, 0, rig.now);
-  rig.core.on_sample(1, 1.0, 1e-9, kSafeState | kSimulated, rig.now);
-  rig.core.on_sample(2, 1.0, 1e-9, kSensorFault, rig.now);
-  rig.core.on_sample(3, 1.0, 1e-9, kSaturated | kLateCommand, rig.now);
-  rig.core.on_sample(10, 1.0, 1e-9, 0, rig.now);  // 6 missing
-  rig.core.on_sample(12, 1.0, 1e-9, 0, rig.now);  // 1 missing
-  rig.core.on_refused_sample(rig.now);            // 13 (NaN, refused on the wire) ...
-  rig.core.on_sample(14, 1.0, 1e-9, 0, rig.now);  // ... is no gap
-  rig.core.on_refused_sample(rig.now);            // 15
-  rig.core.on_sample(17, 1.0, 1e-9, 0, rig.now);  // 16 missing
-  rig.core.on_sample(0, 1.0, 1e-9, 0, rig.now);   // the bridge restarted
+  rig.tick(0);
+  rig.tick(1, kSafeState | kSimulated);
+  rig.tick(2, kSensorFault);
+  rig.tick(3, kSaturated | kLateCommand);
+  rig.tick(10);                             // 6 missing
+  rig.tick(12);                             // 1 missing
+  rig.core.on_refused_block(1, rig.now);    // 13 (NaN, refused on the wire) ...
+  rig.tick(14);                             // ... is no gap
+  rig.core.on_refused_block(1, rig.now);    // 15
+  rig.tick(17);                             // 16 missing
+  rig.core.on_refused_block(10, rig.now);   // 18 .. 27, a block the size of the bridge's
+  rig.tick(28);                             // no gap
+  rig.core.on_refused_block(10, rig.now);   // 29 .. 38
+  rig.tick(40);                             // 39 missing
+  rig.tick(0);                              // the bridge restarted
   const ReidentCounters& c = rig.core.counters();
-  EXPECT_EQ(c.get(ReidentCounter::samples_fed), 9u);  // incl. the two poison markers
-  EXPECT_EQ(c.get(ReidentCounter::non_finite), 2u);
+  EXPECT_EQ(c.get(ReidentCounter::samples_fed), 13u);  // nine ticks and four poison markers
+  EXPECT_EQ(c.get(ReidentCounter::non_finite), 4u);
   EXPECT_EQ(c.get(ReidentCounter::skipped_safe_state), 1u);
   EXPECT_EQ(c.get(ReidentCounter::skipped_sensor_fault), 1u);
-  EXPECT_EQ(c.get(ReidentCounter::seq_gaps), 3u);
-  EXPECT_EQ(c.get(ReidentCounter::samples_missed), 8u);
+  EXPECT_EQ(c.get(ReidentCounter::seq_gaps), 4u);
+  EXPECT_EQ(c.get(ReidentCounter::samples_missed), 9u);
   EXPECT_EQ(c.get(ReidentCounter::seq_restarts), 1u);
   rig.core.reset_counters();
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::samples_fed), 0u);
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::seq_gaps), 0u);
-  rig.core.on_sample(1, 1.0, 2e-9, 0, rig.now);
+  rig.tick(1);
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::samples_fed), 1u);
+}
+
+TEST(ReidentCore, ABlockIsItsTicksInOrder) {
+  Rig rig;
+  sensor_block_t b = testdata::reserved_sensor_block();
+  const std::vector<double> u{1.0, 2.0, 3.0, 4.0}, y{1e-9, 2e-9, 3e-9, 4e-9};
+  testdata::fill_sensor_block(b, 100, rig.now, u, y, 0, 4);
+  b.flags[1] = kSafeState;
+  b.flags[2] = kSensorFault;
+  rig.core.on_sensor_block(b, rig.now);
+  testdata::fill_sensor_block(b, 110, rig.now, u, y, 0, 4);  // 104 .. 109 missing
+  rig.core.on_sensor_block(b, rig.now);
+  const ReidentCounters& c = rig.core.counters();
+  EXPECT_EQ(c.get(ReidentCounter::samples_fed), 6u);
+  EXPECT_EQ(c.get(ReidentCounter::skipped_safe_state), 1u);
+  EXPECT_EQ(c.get(ReidentCounter::skipped_sensor_fault), 1u);
+  EXPECT_EQ(c.get(ReidentCounter::seq_gaps), 1u);
+  EXPECT_EQ(c.get(ReidentCounter::samples_missed), 6u);
+  EXPECT_TRUE(rig.core.seen_samples());
+}
+
+TEST(ReidentCore, TheAppliedVersionIsTheCommandsAtTheSampleTickAndNumberingGoesAboveIt) {
+  Rig rig;
+  command_block_t cmd = testdata::reserved_command_block();
+  // The compensator runs 300 ticks ahead and swaps to version 7 (a set published before we
+  // started: HX_PARAMS will not repeat it) at tick 250.
+  testdata::fill_command_block(cmd, 0, 250, 3);
+  rig.core.on_command_block(cmd);
+  testdata::fill_command_block(cmd, 250, 50, 7);
+  rig.core.on_command_block(cmd);
+  rig.advance(0.02);  // ticks 0 .. 199
+  EXPECT_EQ(rig.core.in_use().applied_version(), 3);
+  rig.advance(0.006);  // .. 259
+  EXPECT_EQ(rig.core.in_use().applied_version(), 7);
+  EXPECT_EQ(rig.core.in_use().version(), 1);  // judged against the configured set: 7's parameters are unknown
+  // An accepted refit is published above every version the compensator applied.
+  rig.advance();
+  const RefitDecision d = rig.refit();
+  ASSERT_EQ(d.kind, Kind::accepted) << to_string(d.status);
+  EXPECT_EQ(d.version, 8);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::command_versions_dropped), 0u);
 }
 
 TEST(ReidentCore, StaleWhenNoSampleForLongerThanConfigured) {
   Rig rig;
   EXPECT_TRUE(rig.core.stale(rig.now));  // none yet
   EXPECT_FALSE(rig.core.seen_samples());
-  rig.core.on_sample(0, 0.0, 0.0, 0, rig.now);
+  rig.core.on_sample(sample_tick(0.0, 0.0), rig.now);
   EXPECT_FALSE(rig.core.stale(rig.now + kSecond));
   EXPECT_TRUE(rig.core.stale(rig.now + kSecond + 1));
   EXPECT_DOUBLE_EQ(rig.core.seconds_since_sample(rig.now + 2 * kSecond), 2.0);
 }
 
-TEST(ReidentCore, ThePerSamplePathAllocatesNothing) {
+TEST(ReidentCore, TheBlockPathAllocatesNothing) {
+  // What the service's handlers do per message: blocks decoded into reserved storage, walked
+  // tick by tick (sensor and command), refused blocks, and polls with a job in flight.
   Rig rig;
   const auto rec = testdata::sine_record(rig.truth, 12, 0.6);
   rig.stream(rec);
   rig.core.poll(rig.now);  // a job in flight: snapshotted
+  command_block_t cmd = testdata::reserved_command_block();
   testing::AllocationCounter counter;
-  for (std::size_t k = 0; k < rec.u.size(); ++k) {
-    rig.core.on_sample(rig.seq++, rec.u[k], rec.y[k], k % 7 == 0 ? kSafeState : 0, rig.now);
-    if (k % 1000 == 0) rig.core.on_refused_sample(rig.now);
+  for (std::size_t k = 0; k < rec.u.size(); k += kBlockTicks) {
+    testdata::fill_command_block(cmd, rig.seq + 300, kBlockTicks, 2 + static_cast<std::int32_t>(k / 2000));
+    rig.core.on_command_block(cmd);
+    testdata::fill_sensor_block(rig.block, rig.seq, rig.now, rec.u, rec.y, k, kBlockTicks,
+                                k % 70 == 0 ? kSafeState : 0);
+    rig.core.on_sensor_block(rig.block, rig.now);
+    rig.seq += static_cast<std::int64_t>(kBlockTicks);
+    if (k % 1000 == 0) {
+      rig.core.on_refused_block(static_cast<std::int64_t>(kBlockTicks), rig.now);
+      rig.seq += static_cast<std::int64_t>(kBlockTicks);
+    }
   }
   rig.core.poll(rig.now);  // in flight: nothing to do
-  EXPECT_EQ(counter.allocations(), 0u);
+  const std::size_t allocations = counter.allocations();
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::seq_gaps), 0u);
+  EXPECT_GE(rig.core.in_use().applied_version(), 2);
 }
 
 TEST(ReidentCore, SnapshotAndCollectAllocateNothingOnTheOwnerThread) {

@@ -1,11 +1,16 @@
 #pragma once
 // Shared by the re-identifier's unit tests: a small, fast configuration (10 Hz sine, 0.5 s
-// window at 10 kHz: ten branches per window) and MEM data from the test generator of
-// tests/ident (independent of common/models).
+// window at 10 kHz: ten branches per window), MEM data from the test generator of
+// tests/ident (independent of common/models), and blocks as the bridge and compensator send them.
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "ident/mem_test_data.hpp"
+#include "lcm/blocks.hpp"
+#include "lcm/message_storage.hpp"
 #include "reidentifier/reident_options.hpp"
 
 namespace hystloop::testdata {
@@ -38,6 +43,46 @@ inline SineRecord sine_record(const MemParams& truth, std::uint64_t seed, double
   r.y = mem_branches(r.u, truth);
   add_noise(r.y, 1e-9, seed);
   return r;
+}
+
+constexpr double kTickPeriod_s = 1e-4;  // 10 kHz
+constexpr std::int64_t kTickPeriod_us = 100;
+
+// Blocks whose storage is reserved, as a Subscription decodes into: appending allocates nothing.
+inline sensor_block_t reserved_sensor_block() {
+  sensor_block_t b{};
+  reserve_storage(b);
+  return b;
+}
+inline command_block_t reserved_command_block() {
+  command_block_t b{};
+  reserve_storage(b);
+  return b;
+}
+
+// A bridge tick that applied u_V (all feedforward, no reference) and measured y_m.
+inline SensorTick sample_tick(double u_V, double y_m, std::int32_t flags = 0) {
+  return SensorTick{.u_V = u_V,
+                    .u_ff_V = u_V,
+                    .y_ref_m = std::numeric_limits<double>::quiet_NaN(),
+                    .y_m = y_m,
+                    .flags = flags};
+}
+
+// Fills `b` with ticks seq .. seq + n - 1 of u/y from index `from` on.
+inline void fill_sensor_block(sensor_block_t& b, std::int64_t seq, std::int64_t utime, const std::vector<double>& u,
+                              const std::vector<double>& y, std::size_t from, std::size_t n, std::int32_t flags = 0) {
+  begin_block(b, seq, utime, kTickPeriod_s);
+  for (std::size_t k = from; k < from + n; ++k) append_tick(b, sample_tick(u[k], y[k], flags));
+}
+
+// Fills `b` with commands for ticks seq .. seq + n - 1, all from parameter version `version`.
+inline void fill_command_block(command_block_t& b, std::int64_t seq, std::int64_t n, std::int32_t version,
+                               std::int8_t mode = command_block_t::MODE_MEM) {
+  begin_block(b, seq, 0, seq - 1);
+  for (std::int64_t k = 0; k < n; ++k) {
+    append_tick(b, CommandTick{.seq = seq + k, .u_ff_V = 0.0, .y_ref_m = 0.0, .params_version = version, .mode = mode});
+  }
 }
 
 }  // namespace hystloop::testdata
