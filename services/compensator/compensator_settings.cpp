@@ -68,11 +68,7 @@ const std::vector<std::string>& compensator_config_keys() {
 }
 
 CompensatorSettings load_compensator_settings(const Config& config) {
-  config.check_no_unknown_keys(compensator_config_keys());
-  CompensatorSettings s;
-  CompensatorConfig& c = s.control;
-  const std::string mode = config.get<std::string>("compensator.mode", "mem");
-  validate_config_section(config, "", [&] { c.mode = parse_feedforward_mode(mode, "compensator.mode"); });
+  // Keys of earlier versions say where their setting went.
   for (const std::string& key : config.keys()) {
     if (key.rfind("feedback.", 0) == 0) {
       config.fail(key, "the servo runs in the bridge now, beside the sensor: set servo.kp, servo.ki, servo.kd in "
@@ -83,6 +79,11 @@ CompensatorSettings load_compensator_settings(const Config& config) {
     config.fail("compensator.lead_ticks", "replaced by compensator.horizon_s: commands are planned that far ahead "
                                           "of the bridge's clock");
   }
+  config.check_no_unknown_keys(compensator_config_keys());
+  CompensatorSettings s;
+  CompensatorConfig& c = s.control;
+  const std::string mode = config.get<std::string>("compensator.mode", "mem");
+  validate_config_section(config, "", [&] { c.mode = parse_feedforward_mode(mode, "compensator.mode"); });
   c.dt_s = config.get_in_range("compensator.dt_s", c.dt_s, 1e-6, 1.0);
   s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
   s.sample_queue_capacity =

@@ -21,6 +21,9 @@ refused "bridge.drift_fraction" --drift 5
 refused "banning.hysteresis.b" --set banning.hysteresis.b=1e-8
 refused "ro.c3" --set ro.c3=0
 refused "rt.io_priority" --set rt.priority=50 --set rt.io_priority=60
+refused "servo.ki" --set servo.ki=-600
+refused "bridge.block_ticks" --set bridge.block_ticks=0
+refused "rt.ticks_per_wake" --set bridge.block_ticks=5 --set rt.ticks_per_wake=10
 refused "did you mean 'actuator.watchdog_s'" --set actuator.watchdog=0.1
 printf 'actuator:\n  slew_V_per_s: -5\n' >"$dir/bad.yaml"
 refused "bad.yaml: actuator.slew_V_per_s" --config "$dir/bad.yaml"

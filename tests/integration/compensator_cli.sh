@@ -17,13 +17,15 @@ refused "mem.c3" --set mem.c3=-1
 refused "mem.c1" --set mem.c1=abc
 refused "compensator.mode" --mode experiment
 refused "compensator.mode" --mode prandtl
-refused "compensator.lead_ticks" --set compensator.lead_ticks=0
-refused "feedback.ki" --set feedback.ki=-600
+refused "compensator.horizon_s" --set compensator.horizon_s=0
+refused "compensator.horizon_s" --set compensator.horizon_s=5
+refused "replaced by compensator.horizon_s" --set compensator.lead_ticks=2
+refused "the servo runs in the bridge now" --set feedback.ki=600
 refused "linear.gain" --set linear.gain=0
 refused "pi.weights" --set "pi.thresholds=[0, 10]" --set "pi.weights=[1e-9]"
 refused "katalenic.k1" --set katalenic.k1=-40
 refused "trajectory.shape" --set trajectory.shape=square
-refused "did you mean 'feedback.kp'" --set feedback.kpp=1
+refused "did you mean 'compensator.horizon_s'" --set compensator.horizon=0.1
 printf 'mem:\n  c1: -5e-9\n' >"$dir/bad_params.yaml"
 refused "mem.c1" --params "$dir/bad_params.yaml"
 

@@ -33,6 +33,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/process.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
@@ -61,26 +62,30 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
     std::fprintf(stderr, "loop_probe: cannot write into %s\n", dir.c_str());
     return 2;
   }
-  std::fprintf(sensor, "seq,utime,u_V,y_m,flags\n");
-  std::fprintf(command, "seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode\n");
-  Subscription<sensor_sample_t>::Options so;
+  std::fprintf(sensor, "seq,utime,u_V,y_m,flags,y_ref_m,u_ff_V,u_fb_V\n");
+  std::fprintf(command, "seq,sample_seq,u_ff_V,y_ref_m,params_version,mode\n");
+  Subscription<sensor_block_t>::Options so;
   so.queue_capacity = 100000;
-  Subscription<sensor_sample_t> s(
+  Subscription<sensor_block_t> s(
       lcm, ch.sensor,
-      [&](const sensor_sample_t& m, std::int64_t) {
-        std::fprintf(sensor, "%lld,%lld,%.17g,%.17g,%d\n", static_cast<long long>(m.seq),
-                     static_cast<long long>(m.utime), m.u_V, m.y_m, m.flags);
+      [&](const sensor_block_t& m, std::int64_t) {
+        for_each_tick(m, [&](const SensorTick& t) {
+          std::fprintf(sensor, "%lld,%lld,%.17g,%.17g,%d,%.17g,%.17g,%.17g\n", static_cast<long long>(t.seq),
+                       static_cast<long long>(t.utime), t.u_V, t.y_m, t.flags, t.y_ref_m, t.u_ff_V, t.u_fb_V);
+        });
       },
       so);
-  Subscription<actuator_command_t>::Options co;
+  Subscription<command_block_t>::Options co;
   co.queue_capacity = 100000;
   co.check = nullptr;  // record what the bridge is sent, including what it rejects
-  Subscription<actuator_command_t> c(
+  Subscription<command_block_t> c(
       lcm, ch.command,
-      [&](const actuator_command_t& m, std::int64_t) {
-        std::fprintf(command, "%lld,%lld,%.17g,%.17g,%.17g,%.17g,%d,%d\n", static_cast<long long>(m.seq),
-                     static_cast<long long>(m.sample_seq), m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.params_version,
-                     m.mode);
+      [&](const command_block_t& m, std::int64_t) {
+        if (!arrays_consistent(m)) return;
+        for_each_tick(m, [&](const CommandTick& t) {
+          std::fprintf(command, "%lld,%lld,%.17g,%.17g,%d,%d\n", static_cast<long long>(t.seq),
+                       static_cast<long long>(m.sample_seq), t.u_ff_V, t.y_ref_m, t.params_version, t.mode);
+        });
       },
       co);
   Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
@@ -150,6 +155,14 @@ int control(lcm::LCM& lcm, const ChannelNames& ch, const ControlArgs& a) {
   return 0;
 }
 
+// A valid one-tick sensor block (a probe's bad messages are variations of it).
+sensor_block_t one_tick_sensor_block() {
+  sensor_block_t s{};
+  begin_block(s, 1, now_utime(), 1e-4);
+  append_tick(s, SensorTick{});
+  return s;
+}
+
 // Publishes `msg` encoded, cut to half its length.
 template <class T>
 void publish_truncated(lcm::LCM& lcm, const std::string& channel, const T& msg) {
@@ -180,32 +193,29 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
     // HX_CONTROL (both services).
     control_t c = valid_control(base_id + i);
     publish_truncated(lcm, ch.control, c);
-    publish_unchecked(lcm, ch.control, sensor_sample_t{});  // wrong type
+    publish_unchecked(lcm, ch.control, one_tick_sensor_block());  // wrong type
     c.kp = kNaN;
     publish_unchecked(lcm, ch.control, c);
     c.kp = 0.0;
     c.command = 99;
     publish_unchecked(lcm, ch.control, c);
     if (target == "bridge") {
-      actuator_command_t m{};
-      m.utime = now_utime();
-      m.seq = 1;
-      m.sample_seq = -1;
+      command_block_t m{};
+      begin_block(m, 1, now_utime(), -1);
+      append_tick(m, CommandTick{1, 0.0, 0.0, 0, command_block_t::MODE_MEM});
       publish_truncated(lcm, ch.command, m);
       publish_unchecked(lcm, ch.command, control_t{});  // wrong type
-      m.u_V = kNaN;
+      m.u_ff_V[0] = kNaN;
       publish_unchecked(lcm, ch.command, m);
-      m.u_V = 1e6;  // beyond any amplifier: a unit mistake
+      m.u_ff_V[0] = 1e6;  // beyond any amplifier: a unit mistake
       publish_unchecked(lcm, ch.command, m);
     } else {
-      sensor_sample_t s{};
-      s.utime = now_utime();
-      s.seq = 1;
+      sensor_block_t s = one_tick_sensor_block();
       publish_truncated(lcm, ch.sensor, s);
       publish_unchecked(lcm, ch.sensor, control_t{});
-      s.y_m = kNaN;
+      s.y_m[0] = kNaN;
       publish_unchecked(lcm, ch.sensor, s);
-      s.y_m = 0.0;
+      s.y_m[0] = 0.0;
       s.seq = -5;
       publish_unchecked(lcm, ch.sensor, s);
 
@@ -241,39 +251,39 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
   return 0;
 }
 
-// Reference per tick from the recorded commands (the last one sent for each tick).
-std::map<std::int64_t, double> references(const std::string& dir) {
-  std::map<std::int64_t, double> ref;
+// The most ticks any command block planned ahead of the last sample the compensator had.
+std::int64_t max_planned_ahead(const std::string& dir) {
   std::ifstream in(dir + "/command.csv");
   std::string line;
   std::getline(in, line);
+  std::int64_t worst = 0;
   while (std::getline(in, line)) {
     long long seq = 0, sample_seq = 0;
-    double u = 0, uff = 0, ufb = 0, y_ref = 0;
-    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%lf,%lf", &seq, &sample_seq, &u, &uff, &ufb, &y_ref) == 6) {
-      ref[seq] = y_ref;
+    if (std::sscanf(line.c_str(), "%lld,%lld", &seq, &sample_seq) == 2 && sample_seq >= 0) {
+      worst = std::max<std::int64_t>(worst, seq - sample_seq);
     }
   }
-  return ref;
+  return worst;
 }
 
 int analyze(const std::string& dir, double u_min, double u_max, double slew, double ramp, double dt, double watchdog) {
-  const std::map<std::int64_t, double> ref = references(dir);
   std::vector<double> run_errors;  // y - y_ref over the current armed run
   std::ifstream in(dir + "/sensor.csv");
   std::string line;
   std::getline(in, line);
   const double max_step = std::max(slew, ramp) * dt * (1 + 1e-9) + 1e-9;
   const auto watchdog_ticks = static_cast<std::int64_t>(std::llround(watchdog / dt));
-  std::int64_t n = 0, gaps = 0, out_of_range = 0, too_fast = 0, trips = 0, slow_trips = 0, applied = 0;
+  std::int64_t n = 0, gaps = 0, out_of_range = 0, too_fast = 0, trips = 0, slow_trips = 0, applied = 0, late_ticks = 0;
   std::int64_t prev_seq = -1, last_applied = -1, worst_trip_ticks = 0;
   double prev_u = kNaN, max_du = 0.0;
   bool prev_safe = true;
   while (std::getline(in, line)) {
     long long seq = 0, utime = 0;
-    double u = 0, y = 0;
+    double u = 0, y = 0, y_ref = 0;
     int flags = 0;
-    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%d", &seq, &utime, &u, &y, &flags) != 5) continue;
+    char ref_text[64] = {0};
+    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%d,%63[^,]", &seq, &utime, &u, &y, &flags, ref_text) != 6) continue;
+    y_ref = std::strtod(ref_text, nullptr);  // "nan" (no reference) reads as NaN
     ++n;
     const bool consecutive = prev_seq >= 0 && seq == prev_seq + 1;
     if (prev_seq >= 0 && !consecutive) ++gaps;
@@ -283,16 +293,18 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
       max_du = std::max(max_du, du);
       if (du > max_step) ++too_fast;
     }
-    const bool safe = (flags & sensor_sample_t::SAFE_STATE) != 0;
-    const bool fresh = !safe && (flags & sensor_sample_t::LATE_COMMAND) == 0;
+    const bool safe = (flags & sensor_block_t::SAFE_STATE) != 0;
+    const bool late = !safe && (flags & sensor_block_t::LATE_COMMAND) != 0;
+    const bool fresh = !safe && !late;
+    if (late) ++late_ticks;
     if (fresh) {
       last_applied = seq;
       ++applied;
     }
     if (safe) {
       run_errors.clear();
-    } else if (const auto r = ref.find(seq); r != ref.end() && std::isfinite(r->second)) {
-      run_errors.push_back(y - r->second);
+    } else if (std::isfinite(y_ref)) {
+      run_errors.push_back(y - y_ref);
     }
     if (safe && !prev_safe && last_applied >= 0) {  // a trip (or a disarm) after commands were applied
       ++trips;
@@ -312,11 +324,13 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
   std::printf("last_run_ticks=%zu\ntracking_rms_m=%.6g\n", run_errors.size(),
               n_track > 0 ? std::sqrt(sum2 / static_cast<double>(n_track)) : kNaN);
   std::printf("samples=%lld\nseq_gaps=%lld\napplied=%lld\nout_of_range=%lld\nmax_step_V=%.6g\nallowed_step_V=%.6g\n"
-              "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n",
+              "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n"
+              "late_ticks=%lld\nmax_planned_ahead_ticks=%lld\n",
               static_cast<long long>(n), static_cast<long long>(gaps), static_cast<long long>(applied),
               static_cast<long long>(out_of_range), max_du, max_step, static_cast<long long>(too_fast),
               static_cast<long long>(trips), static_cast<long long>(worst_trip_ticks),
-              static_cast<long long>(watchdog_ticks), static_cast<long long>(slow_trips));
+              static_cast<long long>(watchdog_ticks), static_cast<long long>(slow_trips),
+              static_cast<long long>(late_ticks), static_cast<long long>(max_planned_ahead(dir)));
   return (n > 0 && out_of_range == 0 && too_fast == 0 && slow_trips == 0) ? 0 : 1;
 }
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Bridge + compensator for 3 s: samples flow at 10 kHz, commands are applied, the bridge reports
-# HEALTHY with its latency figures; both stop on a SHUTDOWN request. Inside tools/netns-run.
+# Bridge + compensator for 3 s with the product's defaults: samples flow at 10 kHz in blocks,
+# commands planned ahead are applied, the bridge reports HEALTHY, never trips its 2 ms watchdog;
+# both stop on a SHUTDOWN request. Inside tools/netns-run.
 #   loop_run.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
 start_recording
@@ -20,7 +21,9 @@ stop_recording
 cat "$dir/analysis.txt"
 get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
 [ "$(get samples)" -ge 30000 ] || fail "only $(get samples) samples in ~3.5 s at 10 kHz"
+[ "$(get seq_gaps)" -eq 0 ] || fail "$(get seq_gaps) gaps in the sample ticks"
 [ "$(get applied)" -ge 25000 ] || fail "only $(get applied) commands applied"
+[ "$(get max_planned_ahead_ticks)" -le "$horizon_ticks" ] || fail "a command was planned $(get max_planned_ahead_ticks) ticks ahead (horizon $horizon_ticks)"
 grep -q "state=4" "$dir/status.log" || fail "no STOPPING report"
 # HEALTHY while it ran (a report may say DEGRADED when the shared machine stalled the loop for
 # tens of milliseconds; that is what DEGRADED is for), never SAFE once armed, no watchdog trip.
@@ -29,7 +32,7 @@ grep '^process=compensator ' "$dir/status.log" | grep -q ' state=1 ' || fail "th
 grep '^process=bridge ' "$dir/status.log" | grep -q ' state=3 ' && fail "the bridge reported SAFE while armed"
 expect_value bridge watchdog_trips 0
 late=$(value bridge late); ticks=$(value bridge ticks)
-[ $((late * 4)) -le "$ticks" ] || fail "late fraction $late / $ticks above 25 %"
+[ $((late * 100)) -le "$ticks" ] || fail "late fraction $late / $ticks above 1 %: the horizon did not cover the stalls"
 echo "bridge: $(grep '^process=bridge' "$dir/status.log" | grep -v ' state=4 ' | tail -n 1 | cut -d' ' -f1-15)"
 echo "bridge late fraction this period: $(value bridge late_ppm_period) ppm; cpu user $(value bridge cpu_user_us) us"
 echo "compensator: $(grep '^process=compensator' "$dir/status.log" | grep -v ' state=4 ' | tail -n 1 | cut -d' ' -f1-11)"

@@ -11,6 +11,8 @@ if(TARGET hystloop-bridge AND TARGET hystloop-compensator)
     add_test(NAME ${_script}
       COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/${_script}.sh
               $<TARGET_FILE:hystloop-bridge> $<TARGET_FILE:hystloop-compensator> $<TARGET_FILE:loop_probe>)
-    set_tests_properties(${_script} PROPERTIES LABELS integration TIMEOUT 60)
+    # One 10 kHz loop of real processes at a time (RESOURCE_LOCK); unit tests may run beside it:
+    # what these tests check must hold on a busy machine.
+    set_tests_properties(${_script} PROPERTIES LABELS integration TIMEOUT 60 RESOURCE_LOCK hystloop_live_loop)
   endforeach()
 endif()

@@ -1,19 +1,33 @@
 #!/usr/bin/env bash
-# kill -9 the compensator mid-run: the bridge reaches the safe state within watchdog_s + a few
-# ticks of the last command it applied, never applies a voltage outside [u_min, u_max] or a step
-# above the slew limit (checked on every recorded HX_SENSOR sample); a restarted compensator and
-# a re-ARM resume tracking. Inside tools/netns-run.
+# The compensator plans ahead, so (1) stopping it (SIGSTOP) for less than its horizon costs no
+# late tick; (2) killing it (SIGKILL) puts the bridge in the safe state within horizon +
+# watchdog_s: every plan reaches at most the horizon ahead of the last sample, and the trip
+# follows the last planned tick by at most watchdog_s + a few ticks; no applied voltage ever
+# leaves the actuator's range or slew limit (checked on every recorded sample); (3) a restarted
+# compensator and a re-ARM resume tracking. Inside tools/netns-run.
 #   loop_watchdog.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
+# A horizon of 0.2 s and a stop of 0.05 s: a wide margin whatever else the machine runs.
+horizon_s=0.2
+horizon_ticks=2000
+stop_s=0.05
 start_recording
-"$compensator" "${compensator_args[@]}" >"$dir/compensator1.log" 2>&1 & c1=$!; pids+=($c1)
+"$compensator" "${compensator_args[@]}" --set compensator.horizon_s=$horizon_s >"$dir/compensator1.log" 2>&1 & c1=$!; pids+=($c1)
 "$bridge" "${bridge_args[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 wait_log "$dir/compensator1.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
 sleep 0.2
 "$probe" control --command arm
 wait_log "$dir/bridge.log" "ARM (request"
-sleep 1.6
+sleep 1.0
+"$probe" control --command reset_counters
+sleep 0.2
+kill -STOP $c1
+sleep $stop_s
+kill -CONT $c1
+sleep 0.5
+late_after_stop=$(value bridge late)
+trips_after_stop=$(value bridge watchdog_trips)
 kill -KILL $c1
 wait $c1 2>/dev/null || true
 sleep 1.0
@@ -31,11 +45,15 @@ stop_recording
 "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples or a slow trip"; }
 cat "$dir/analysis.txt"
 get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
+[ "$late_after_stop" -eq 0 ] || fail "a ${stop_s} s stop of the compensator cost $late_after_stop late ticks (horizon $horizon_s s)"
+[ "$trips_after_stop" -eq 0 ] || fail "the watchdog tripped during a stop shorter than the horizon"
 [ "$(get safe_entries)" -ge 1 ] || fail "the bridge never entered the safe state after the kill"
+[ "$(get max_planned_ahead_ticks)" -le "$horizon_ticks" ] || fail "a plan reached $(get max_planned_ahead_ticks) ticks ahead"
 [ "$(get last_run_ticks)" -ge 15000 ] || fail "tracking did not resume for long after re-arm ($(get last_run_ticks) ticks)"
 awk -v e="$(get tracking_rms_m)" 'BEGIN { exit !(e < 2e-7) }' || fail "tracking error $(get tracking_rms_m) m RMS after re-arm"
 trips=$(grep -c "watchdog: no command" "$dir/bridge.log" || true)
 [ "$trips" -ge 1 ] || fail "the bridge did not log a watchdog trip"
 grep -q "re-arm via HX_CONTROL" "$dir/status.log" || fail "no SAFE status naming the watchdog"
-echo "loop_watchdog: ok (trip $(get worst_trip_ticks) ticks after the last command applied, watchdog $(get watchdog_ticks) ticks;" \
+echo "loop_watchdog: ok (stopped ${stop_s} s: 0 late ticks; killed: trip $(get worst_trip_ticks) ticks after the last" \
+     "planned tick (watchdog $(get watchdog_ticks) ticks), plans at most $(get max_planned_ahead_ticks) ticks ahead;" \
      "tracking after re-arm $(get tracking_rms_m) m RMS)"
