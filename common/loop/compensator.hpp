@@ -52,7 +52,7 @@ struct CompensatorConfig {
   PiParams pi = pi_params_from_mem(MemParams::paper_like(), 15, 250.0);  // the MEM paper's 15 plays
   KatalenicParams katalenic{};
   LinearParams linear{};
-  std::int64_t horizon_ticks = 300;  // plan this many ticks ahead of the last sample (30 ms at 10 kHz)
+  std::int64_t horizon_ticks = 500;  // plan this many ticks ahead of the last sample (50 ms at 10 kHz)
   double dt_s = 1e-4;                // the bridge's tick
 
   static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <ctime>
 #include <thread>
@@ -198,6 +199,7 @@ int BridgeService::run() {
   if (last != nullptr) {
     report(*last, wall_utime(), true);
     log_summary(*last);
+    if (!summary_json_path_.empty()) write_summary_json(*last);
   }
   return lcm_errors > 0 ? 1 : 0;
 }
@@ -312,6 +314,30 @@ void BridgeService::log_summary(const RtReport& rt) const {
   spdlog::info("summary: {} sensor blocks published, {} command blocks received ({} rejected), {} dropped samples",
                sensor_pub_.counters().published, commands_.counters().received,
                commands_.counters().rejected_total(), rt.samples_dropped);
+}
+
+void BridgeService::write_summary_json(const RtReport& rt) const {
+  const BridgeCounters& c = rt.core;
+  const double armed_ticks = static_cast<double>(c.applied + c.late);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  const ResourceUsage usage = read_resource_usage();
+  const auto pct = [&](double q) { return latency_total_.count() > 0 ? latency_total_.percentile(q) / 1e3 : -1.0; };
+  const std::string json = fmt::format(
+      "{{\"ticks\": {}, \"armed_ticks\": {}, \"late_ticks\": {}, \"late_tick_fraction\": {:.9g}, "
+      "\"watchdog_trips\": {}, \"buffer_min_depth_ticks\": {}, \"ticks_skipped\": {}, \"ticks_caught_up\": {}, "
+      "\"stale\": {}, \"duplicates\": {}, \"rejected\": {}, \"samples_dropped\": {}, \"sensor_blocks\": {}, "
+      "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}}}, "
+      "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}}}\n",
+      c.ticks, static_cast<std::uint64_t>(armed_ticks), c.late,
+      armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0, c.watchdog_trips, rt.min_depth_total,
+      rt.ticks_skipped, rt.ticks_caught_up, c.stale, c.duplicates, c.rejected_nonfinite + c.rejected_future,
+      rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
+      latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, wall_s,
+      usage.user_cpu_s + usage.system_cpu_s, wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0);
+  std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");
+  if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
+    spdlog::error("could not write the summary to {}", summary_json_path_);
+  }
 }
 
 }  // namespace hystloop

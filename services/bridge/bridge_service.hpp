@@ -4,6 +4,7 @@
 // real-time thread's queue (measuring block-to-answer latency), acts on HX_CONTROL (ARM,
 // DISARM, SET_GAINS, RESET_COUNTERS, SHUTDOWN), and reports HX_STATUS at 1 Hz.
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -35,6 +36,9 @@ class BridgeService {
   // LCM reported errors.
   int run();
 
+  // At exit, also write the summary's figures as JSON to `path` (empty: don't).
+  void write_summary_to(std::string path) { summary_json_path_ = std::move(path); }
+
  private:
   void on_command(const command_block_t& msg) noexcept;
   void on_control(const control_t& msg);
@@ -42,6 +46,7 @@ class BridgeService {
   void publish_block() noexcept;
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
   void log_summary(const RtReport& rt) const;
+  void write_summary_json(const RtReport& rt) const;
 
   BridgeSettings settings_;
   lcm::LCM& lcm_;
@@ -63,6 +68,8 @@ class BridgeService {
   std::uint64_t command_blocks_ = 0;
   std::uint64_t sensor_blocks_ = 0;
   FeedbackGains gains_;  // the servo's, as last set
+  std::string summary_json_path_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 
   // Report bookkeeping.
   std::string safe_reason_ = "not armed";

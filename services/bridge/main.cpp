@@ -22,12 +22,15 @@ int main(int argc, char** argv) {
                "(or --auto-arm)."};
   ServiceOptions options;
   add_service_options(app, options);
-  std::string backend, noise, drift, seconds;
+  std::string backend, noise, drift, seconds, summary_json;
   bool auto_arm = false;
   app.add_option("--backend", backend, "Stage backend: sim (Banning stage) or ro (Ramberg-Osgood) [bridge.backend]");
   app.add_option("--noise-rms-m", noise, "Sensor noise RMS [m] [bridge.noise_rms_m]");
   app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");
+  app.add_option("--summary-json", summary_json,
+                 "At exit, write the run's figures (ticks, late, watchdog trips, lowest buffer depth, block-to-answer "
+                 "latency, CPU) to this JSON file");
   app.add_flag("--auto-arm", auto_arm, "Arm as soon as commands flow (first arm only) [bridge.auto_arm]");
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
     auto lcm = open_lcm(url, options.allow_network);
     spdlog::info("lcm: {}", url);
     BridgeService service(settings, *lcm, channels);
+    service.write_summary_to(summary_json);
     const int rc = service.run();
     flush_logging();
     return rc;
