@@ -10,6 +10,7 @@
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
 #include "ctl_watch.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/subscription.hpp"
 #include "lcm/url.hpp"
@@ -81,28 +82,22 @@ int run_status(CtlLink& link, const StatusOptions& o) {
 
 int run_watch(CtlLink& link, const WatchOptions& o) {
   install_stop_handlers();
-  TickMatcher matcher;
   WatchLine line;
   std::optional<std::int64_t> late_before_report;
-  Subscription<sensor_sample_t>::Options fast;
-  fast.queue_capacity = 20'000;
-  Subscription<sensor_sample_t> samples(
+  Subscription<sensor_block_t>::Options sensor_queue;
+  sensor_queue.queue_capacity = 4'000;  // blocks: a few seconds of them
+  Subscription<sensor_block_t> samples(
       link.lcm(), link.channels().sensor,
-      [&](const sensor_sample_t& s, std::int64_t) {
-        ++line.second.samples;
-        if (const auto e = matcher.on_sample(s.seq, s.y_m)) line.second.add_error(*e);
-      },
-      fast);
-  Subscription<actuator_command_t>::Options fast_commands;
-  fast_commands.queue_capacity = 20'000;
-  Subscription<actuator_command_t> commands(
+      [&](const sensor_block_t& b, std::int64_t) { line.second.add_sensor_block(b); }, sensor_queue);
+  Subscription<command_block_t>::Options command_queue;
+  command_queue.queue_capacity = 4'000;
+  Subscription<command_block_t> commands(
       link.lcm(), link.channels().command,
-      [&](const actuator_command_t& c, std::int64_t) {
-        ++line.second.commands;
-        line.params_in_use = c.params_version;
-        if (const auto e = matcher.on_command(c.seq, c.y_ref_m)) line.second.add_error(*e);
+      [&](const command_block_t& c, std::int64_t) {
+        line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
+        line.params_in_use = command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
       },
-      fast_commands);
+      command_queue);
   Subscription<mem_params_t> params(link.lcm(), link.channels().params,
                                     [&](const mem_params_t& p, std::int64_t) {
                                       if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
@@ -113,7 +108,6 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
                                           line.late_delta = s.late - late_before_report.value_or(s.late);
                                           late_before_report = s.late;
                                           line.late_total = s.late;
-                                          line.latency_p99_us = s.latency_p99_us;
                                           line.bridge_state = state_name(s.state);
                                         });
 
@@ -147,18 +141,20 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   std::optional<std::int8_t> mode;  // of the latest command
   std::optional<std::int64_t> last_seq;
   bool sent = false;
-  auto on_command = [&](const actuator_command_t& c, std::int64_t) {
-    mode = c.mode;
-    last_seq = c.seq;
-    if (!sent || !o.wait) return;
-    if (const auto step = tracker.on_command(c.seq, c.mode == actuator_command_t::MODE_EXPERIMENT)) {
-      std::printf("[%zu/%zu] %s\n", *step + 1, steps.size(), steps[*step].what.c_str());
-      std::fflush(stdout);
-    }
+  auto on_command = [&](const command_block_t& c, std::int64_t) {
+    for_each_tick(c, [&](const CommandTick& t) {
+      mode = t.mode;
+      last_seq = t.seq;
+      if (!sent || !o.wait) return;
+      if (const auto step = tracker.on_command(t.seq, t.mode == command_block_t::MODE_EXPERIMENT)) {
+        std::printf("[%zu/%zu] %s\n", *step + 1, steps.size(), steps[*step].what.c_str());
+        std::fflush(stdout);
+      }
+    });
   };
-  Subscription<actuator_command_t>::Options fast;
-  fast.queue_capacity = 40'000;
-  Subscription<actuator_command_t> commands(link.lcm(), link.channels().command, on_command, fast);
+  Subscription<command_block_t>::Options queue;
+  queue.queue_capacity = 4'000;
+  Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command, queue);
   auto pump = [&](Clock::time_point until_time) {
     return handle_pending(link.lcm(), std::min(until(until_time), std::chrono::microseconds(50'000)), 4096) >= 0;
   };
@@ -173,7 +169,7 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
                          "sending samples? (hystloop-ctl status)\n", link.channels().command.c_str());
     return 1;
   }
-  if (*mode == actuator_command_t::MODE_EXPERIMENT) {
+  if (*mode == command_block_t::MODE_EXPERIMENT) {
     std::fprintf(stderr, "hystloop-ctl: an experiment is running: wait for it to end, or hystloop-ctl stop-experiment\n");
     return 1;
   }
@@ -246,11 +242,14 @@ std::int32_t next_params_version(CtlLink& link, double listen_s) {
   std::int32_t highest = 0;
   Subscription<mem_params_t> params(link.lcm(), link.channels().params,
                                     [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
-  Subscription<actuator_command_t>::Options fast;
-  fast.queue_capacity = 20'000;
-  Subscription<actuator_command_t> commands(
+  Subscription<command_block_t>::Options queue;
+  queue.queue_capacity = 4'000;
+  Subscription<command_block_t> commands(
       link.lcm(), link.channels().command,
-      [&](const actuator_command_t& c, std::int64_t) { highest = std::max(highest, c.params_version); }, fast);
+      [&](const command_block_t& c, std::int64_t) {
+        for_each_tick(c, [&](const CommandTick& t) { highest = std::max(highest, t.params_version); });
+      },
+      queue);
   const auto deadline = after(listen_s);
   while (Clock::now() < deadline) {
     if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(50'000)), 1024) < 0) break;

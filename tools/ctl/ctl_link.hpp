@@ -73,7 +73,7 @@ int run_watch(CtlLink& link, const WatchOptions& options);
 
 struct SeriesRunOptions {
   std::string target;            // control_t.target of the requests (empty: every process)
-  double dt_s = 1e-4;            // the rig's tick [s], to follow the series from the commands
+  double dt_s = 1e-4;            // the rig's tick [s], to follow the series from the command ticks
   bool wait = true;              // follow the series until it ends (else: send and return)
   double start_timeout_s = 3.0;  // the first experiment command must arrive within this
 };
@@ -83,7 +83,7 @@ struct SeriesRunOptions {
 // On SIGINT/SIGTERM it sends STOP_EXPERIMENT. Returns 0 when the series ran to its end, 1 if not.
 int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& options);
 
-// The highest parameter version seen on HX_PARAMS or in HX_COMMAND within listen_s, plus one
+// The highest parameter version seen on HX_PARAMS or in HX_COMMAND's ticks within listen_s, plus one
 // (1 when nothing was seen), so that a set sent by hand supersedes the one in use.
 std::int32_t next_params_version(CtlLink& link, double listen_s);
 

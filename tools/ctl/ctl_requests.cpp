@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "lcm/message_checks.hpp"
 
 namespace hystloop::ctl {
@@ -14,11 +14,11 @@ namespace hystloop::ctl {
 namespace {
 
 constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kModes{{
-    {"off", actuator_command_t::MODE_OFF},
-    {"linear", actuator_command_t::MODE_LINEAR},
-    {"mem", actuator_command_t::MODE_MEM},
-    {"pi", actuator_command_t::MODE_PI},
-    {"katalenic", actuator_command_t::MODE_KATALENIC},
+    {"off", command_block_t::MODE_OFF},
+    {"linear", command_block_t::MODE_LINEAR},
+    {"mem", command_block_t::MODE_MEM},
+    {"pi", command_block_t::MODE_PI},
+    {"katalenic", command_block_t::MODE_KATALENIC},
 }};
 
 constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kShapes{{

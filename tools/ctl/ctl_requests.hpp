@@ -19,7 +19,7 @@ namespace hystloop::ctl {
 // A request id unique per sender and request (> 0): wall time [us] and the pid.
 std::int64_t new_request_id(std::int64_t utime, int pid) noexcept;
 
-// "off"|"linear"|"mem"|"pi"|"katalenic" -> actuator_command_t::MODE_*; throws ParameterError("mode").
+// "off"|"linear"|"mem"|"pi"|"katalenic" -> command_block_t::MODE_*; throws ParameterError("mode").
 std::int8_t parse_mode(std::string_view name);
 
 // A control_t with the common fields set and every other field neutral (0 / empty).

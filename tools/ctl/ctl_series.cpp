@@ -47,10 +47,10 @@ std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {
                      sine("sine", e.offset_V, e.amplitude_V, e.frequency_Hz, e.measure_periods)});
   }
   for (const auto& s : steps) s.request.validate();
-  if (steps.size() > Compensator::kExperimentQueue + 1) {
+  if (steps.size() > ExperimentQueue::kCapacity + 1) {
     throw ParameterError("banning-series", std::to_string(steps.size()) + " experiments (settling included) exceed what "
                                            "the compensator queues (" +
-                                               std::to_string(Compensator::kExperimentQueue + 1) +
+                                               std::to_string(ExperimentQueue::kCapacity + 1) +
                                                "): give fewer offsets, amplitudes or frequencies");
   }
   return steps;

@@ -12,7 +12,7 @@
 
 #include "ctl_requests.hpp"
 #include "ident/banning_experiments.hpp"
-#include "loop/compensator.hpp"
+#include "loop/experiment_queue.hpp"
 
 namespace hystloop::ctl {
 
@@ -34,13 +34,15 @@ ExperimentRequest mem_paper_experiment(double duration_s);
 // Total time of the steps, run back to back [s].
 double series_duration_s(const std::vector<SeriesStep>& steps);
 
-// Where a running series is, from the commands' ticks: the schedule starts at the first
-// EXPERIMENT command (the compensator's experiment_schedule).
+// Where a running series is, from the command ticks (HX_COMMAND blocks carry a mode per tick):
+// the schedule starts at the first EXPERIMENT tick (the compensator's experiment_schedule). After
+// the last experiment the compensator holds its voltage in the tracking mode: a tick past the
+// series' end in any mode finishes it.
 class SeriesTracker {
  public:
   SeriesTracker(const std::vector<SeriesStep>& steps, double dt_s);
-  // A command of tick `seq`; returns the index of a step that this tick starts (in order,
-  // each once), if any.
+  // The command tick `seq`, in tick order; returns the index of a step that this tick starts
+  // (in order, each once), if any.
   std::optional<std::size_t> on_command(std::int64_t seq, bool experiment_mode);
   bool started() const noexcept { return first_tick_.has_value(); }
   bool finished() const noexcept { return finished_; }

@@ -1,38 +1,27 @@
 #include "ctl_watch.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
+#include "lcm/blocks.hpp"
+
 namespace hystloop::ctl {
-
-std::optional<double> TickMatcher::on_command(std::int64_t seq, double y_ref_m) noexcept {
-  if (seq < 0) return std::nullopt;
-  Slot& sample = samples_[slot(seq)];
-  if (sample.seq == seq) {
-    sample.seq = -1;
-    if (!std::isfinite(y_ref_m)) return std::nullopt;
-    return sample.value - y_ref_m;
-  }
-  commands_[slot(seq)] = {seq, y_ref_m};
-  return std::nullopt;
-}
-
-std::optional<double> TickMatcher::on_sample(std::int64_t seq, double y_m) noexcept {
-  if (seq < 0) return std::nullopt;
-  Slot& command = commands_[slot(seq)];
-  if (command.seq == seq) {
-    command.seq = -1;
-    if (!std::isfinite(command.value)) return std::nullopt;
-    return y_m - command.value;
-  }
-  samples_[slot(seq)] = {seq, y_m};
-  return std::nullopt;
-}
 
 void WatchSecond::add_error(double e_m) noexcept {
   ++tracking;
   sum_sq_m2 += e_m * e_m;
   max_abs_m = std::max(max_abs_m, std::abs(e_m));
+}
+
+void WatchSecond::add_sensor_block(const sensor_block_t& block) noexcept {
+  bool armed = true;
+  for_each_tick(block, [&](const SensorTick& t) {
+    ++samples;
+    if (std::isfinite(t.y_ref_m)) add_error(t.y_ref_m - t.y_m);
+    armed = armed && (t.flags & sensor_block_t::SAFE_STATE) == 0;
+  });
+  if (armed) buffer_min_ticks = std::min(buffer_min_ticks.value_or(block.buffer_depth_ticks), block.buffer_depth_ticks);
 }
 
 std::optional<double> WatchSecond::rms_m() const noexcept {
@@ -63,12 +52,7 @@ std::string format_watch_line(const WatchLine& l) {
   } else {
     out += "  late --";
   }
-  if (l.latency_p99_us && std::isfinite(*l.latency_p99_us)) {
-    std::snprintf(buf, sizeof buf, "  lat p99 %.0f us", *l.latency_p99_us);
-    out += buf;
-  } else {
-    out += "  lat p99 --";
-  }
+  out += l.second.buffer_min_ticks ? "  buf min " + std::to_string(*l.second.buffer_min_ticks) : std::string("  buf min --");
   out += l.bridge_state.empty() ? "  bridge --" : "  bridge " + l.bridge_state;
   return out;
 }

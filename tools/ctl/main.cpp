@@ -4,7 +4,7 @@
 //
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
-//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd
+//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd [--target bridge]
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
@@ -43,6 +43,7 @@ struct Options {
   std::string process;  // positional of shutdown / reset-counters
   std::string mode;
   GainsRequest gains;
+  std::string gains_target = "bridge";  // the servo runs in the bridge
   ExperimentRequest experiment;
   bool experiment_mem_paper = false;
   bool banning_series = false;
@@ -136,7 +137,7 @@ CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, 
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, gains, "
+  CLI::App app{"hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
                "experiments, trajectories, parameters, live tracking error)"};
   app.require_subcommand(1);
   app.fallthrough();
@@ -166,7 +167,8 @@ int main(int argc, char** argv) {
   CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
   mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
 
-  CLI::App* gains = control_subcommand(app, "gains", "Compensator: feedback gains (normalised PID, all >= 0)", o);
+  CLI::App* gains = app.add_subcommand("gains", "Bridge: the servo's gains (normalised PID, all >= 0)");
+  gains->add_option("--target", o.gains_target, "Process of the servo (the bridge)")->capture_default_str();
   gains->add_option("--kp", o.gains.kp, "Proportional gain [-]")->capture_default_str();
   gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();
   gains->add_option("--kd", o.gains.kd, "Derivative gain [s]")->capture_default_str();
@@ -238,8 +240,8 @@ int main(int argc, char** argv) {
   params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
       ->capture_default_str();
 
-  CLI::App* watch = app.add_subcommand("watch", "Print the tracking error, params version, late commands and latency "
-                                                "once a second");
+  CLI::App* watch = app.add_subcommand("watch", "Print the tracking error (from HX_SENSOR), params version, late "
+                                                "commands and the bridge's lowest buffer depth once a second");
   watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
   watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
       ->capture_default_str();
@@ -271,7 +273,9 @@ int main(int argc, char** argv) {
     }
     if (*gains) {
       o.gains.validate();
-      return send_control(o, control_t::SET_GAINS, o.target, "SET_GAINS", [&](control_t& msg) { apply(o.gains, msg); });
+      if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
+      return send_control(o, control_t::SET_GAINS, o.gains_target, "SET_GAINS",
+                          [&](control_t& msg) { apply(o.gains, msg); });
     }
     if (*experiment) {
       if (o.banning_series) return run_banning_series(o);

@@ -11,9 +11,10 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/errors.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
 #include "log_samples.hpp"
 
@@ -26,14 +27,14 @@ struct Request {
   ExperimentSpec spec;
 };
 
-struct Command {
+struct Command {  // one command tick
   std::int64_t seq = 0;
-  std::int64_t log_utime = 0;
-  double u_V = 0.0;
+  std::int64_t log_utime = 0;  // of its block
+  double u_ff_V = 0.0;         // what the compensator commanded (an experiment's voltage; no servo then)
   bool experiment = false;
 };
 
-struct Sample {
+struct Sample {  // one sensor tick
   std::int64_t seq = 0;
   double u_V = 0.0;
   double y_m = 0.0;
@@ -63,8 +64,8 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   Record r;
   std::set<std::int64_t> ids;
   control_t control{};
-  actuator_command_t command{};
-  sensor_sample_t sample{};
+  command_block_t command{};
+  sensor_block_t sensor{};
   for (const auto& file : files) {
     if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
     lcm::LogFile log(file, "r");
@@ -72,13 +73,14 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
     ++out.files;
     while (const lcm::LogEvent* event = log.readNextEvent()) {
       if (event->channel == o.sensor_channel) {
-        if (decode_logged(*event, sample) && check_message(sample) == Verdict::kOk) {
-          r.samples.push_back({sample.seq, sample.u_V, sample.y_m, sample.flags});
+        if (decode_logged(*event, sensor) && check_message(sensor) == Verdict::kOk) {
+          for_each_tick(sensor, [&](const SensorTick& t) { r.samples.push_back({t.seq, t.u_V, t.y_m, t.flags}); });
         }
       } else if (event->channel == o.command_channel) {
         if (decode_logged(*event, command) && check_message(command) == Verdict::kOk) {
-          r.commands.push_back({command.seq, event->timestamp, command.u_V,
-                                command.mode == actuator_command_t::MODE_EXPERIMENT});
+          for_each_tick(command, [&](const CommandTick& t) {
+            r.commands.push_back({t.seq, event->timestamp, t.u_ff_V, t.mode == command_block_t::MODE_EXPERIMENT});
+          });
         }
       } else if (event->channel == o.control_channel) {
         if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
@@ -110,8 +112,8 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   return r;
 }
 
-// A run of EXPERIMENT commands: ticks first..last logged; the block certainly ended by end_max
-// (the next logged non-experiment command, or last + 1 when the log ends).
+// A run of EXPERIMENT command ticks: ticks first..last logged; the run certainly ended by end_max
+// (the next logged non-experiment command tick, or last + 1 when the log ends).
 struct Block {
   std::int64_t first = 0, last = 0, end_max = 0;
   std::int64_t first_log_utime = 0, last_log_utime = 0;
@@ -153,8 +155,8 @@ std::optional<Mismatch> first_mismatch(const std::vector<Command>& commands, std
     const Command& c = commands[index];
     // Loop time as the compensator computes it (Compensator::loop_time).
     const double expected = experiment_voltage(e, static_cast<double>(c.seq) * dt_s - start_s);
-    if (!c.experiment || !(std::abs(c.u_V - expected) <= 1e-9 * (1.0 + std::abs(expected)))) {
-      return Mismatch{c.seq, expected, c.u_V};
+    if (!c.experiment || !(std::abs(c.u_ff_V - expected) <= 1e-9 * (1.0 + std::abs(expected)))) {
+      return Mismatch{c.seq, expected, c.u_ff_V};
     }
   }
   return std::nullopt;
@@ -164,18 +166,18 @@ void collect_samples(const std::vector<Sample>& samples, const ExperimentLogOpti
   const double dt_s = o.dt_s;
   auto it = std::lower_bound(samples.begin(), samples.end(), e.begin_tick,
                              [](const Sample& s, std::int64_t seq) { return s.seq < seq; });
-  constexpr std::int32_t kNotAsCommanded = std::int32_t{sensor_sample_t::LATE_COMMAND} |
-                                           std::int32_t{sensor_sample_t::SATURATED} |
-                                           std::int32_t{sensor_sample_t::SLEW_LIMITED};
+  constexpr std::int32_t kNotAsCommanded = std::int32_t{sensor_block_t::LATE_COMMAND} |
+                                           std::int32_t{sensor_block_t::SATURATED} |
+                                           std::int32_t{sensor_block_t::SLEW_LIMITED};
   std::int64_t expected_seq = e.begin_tick;
   for (; it != samples.end() && it->seq < e.end_tick; ++it) {
     e.missing += static_cast<std::size_t>(it->seq - expected_seq);
     expected_seq = it->seq + 1;
-    if ((it->flags & sensor_sample_t::SAFE_STATE) != 0) {
+    if ((it->flags & sensor_block_t::SAFE_STATE) != 0) {
       ++e.safe_state;
       continue;
     }
-    if ((it->flags & sensor_sample_t::SENSOR_FAULT) != 0) {
+    if ((it->flags & sensor_block_t::SENSOR_FAULT) != 0) {
       ++e.sensor_fault;
       continue;
     }
@@ -222,8 +224,8 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
   out.blocks = blocks.size();
   const std::string where = files.size() == 1 ? files.front() : files.front() + " ... " + files.back();
   if (blocks.empty()) {
-    throw SampleLogError(where + ": no experiment ran (no " + o.command_channel + " command in mode EXPERIMENT; " +
-                         std::to_string(r.commands.size()) + " commands, " + std::to_string(out.requests) +
+    throw SampleLogError(where + ": no experiment ran (no " + o.command_channel + " command tick in mode EXPERIMENT; " +
+                         std::to_string(r.commands.size()) + " command ticks, " + std::to_string(out.requests) +
                          " START_EXPERIMENT requests logged)");
   }
   std::size_t next = 0;  // first request not yet accounted for

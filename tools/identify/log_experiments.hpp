@@ -2,17 +2,19 @@
 // The identification experiments a live loop ran (hystloop-ctl experiment, e.g.
 // --banning-series), cut out of its LCM log: which samples belong to which experiment.
 //
-// The log holds the requests (<rig>CONTROL START_EXPERIMENT / STOP_EXPERIMENT), the commands
-// (<rig>COMMAND, mode EXPERIMENT while one runs) and the samples (<rig>SENSOR). The compensator
-// runs the requested sines back to back from the first experiment command on a schedule that
-// is a function of the requests alone (experiment_schedule, common/loop/compensator.hpp), so:
-//  - each block of consecutive EXPERIMENT commands is explained by the requests logged before
-//    its end, in order; a block that ends inside an experiment was stopped (or the compensator
+// The log holds the requests (<rig>CONTROL START_EXPERIMENT / STOP_EXPERIMENT), the command
+// ticks (<rig>COMMAND blocks, mode EXPERIMENT per tick while one runs) and the sensor ticks
+// (<rig>SENSOR blocks). The compensator runs the requested sines back to back from the first
+// experiment tick on a schedule that is a function of the requests alone (experiment_schedule,
+// common/loop/experiment.hpp); after the last one it holds the last voltage in its tracking
+// mode until it has the measured sample of the end, so:
+//  - each run of consecutive EXPERIMENT ticks is explained by the requests logged before its
+//    end, in order; a run that ends inside an experiment was stopped (or the compensator
 //    restarted): that experiment is cut short, and the requests still queued were dropped;
-//  - every experiment is checked against its commands: the commanded voltage must be the
+//  - every experiment is checked against its commands: the commanded feedforward must be the
 //    requested sine at every logged tick (so a request missing from the log, which would shift
 //    the schedule, is found, not silently mislabelled);
-//  - an experiment is usable when it ran to its end and no sample is SAFE_STATE / SENSOR_FAULT.
+//  - an experiment is usable when it ran to its end and no tick is SAFE_STATE / SENSOR_FAULT.
 //    A frequency-response experiment (at or above rate_independent_below_Hz) must also have a
 //    sample for every tick and at most max_not_as_commanded of them LATE_COMMAND, SATURATED or
 //    SLEW_LIMITED: its time base and its input's spectrum matter. A slower one is a hysteresis
@@ -27,7 +29,7 @@
 #include <vector>
 
 #include "ident/sample_csv.hpp"
-#include "loop/compensator.hpp"
+#include "loop/experiment.hpp"
 
 namespace hystloop {
 
@@ -46,7 +48,7 @@ struct ExperimentLogOptions {
 struct LoggedExperiment {
   std::int64_t request_id = 0;
   ExperimentSpec spec;          // as requested; spec.settle for "settle"
-  std::int64_t begin_tick = 0;  // [begin, end): the commands of this experiment
+  std::int64_t begin_tick = 0;  // [begin, end): the command ticks of this experiment
   std::int64_t end_tick = 0;
   bool complete = false;        // ran to its last period
   std::size_t missing = 0;      // ticks without a sample in the log
@@ -63,11 +65,11 @@ struct LoggedExperiments {
   std::vector<std::string> notes;             // what else was found: dropped requests, unexplained ticks
   std::size_t files = 0;
   std::size_t requests = 0;                   // distinct START_EXPERIMENT requests for the compensator
-  std::size_t blocks = 0;                     // runs of EXPERIMENT commands
+  std::size_t blocks = 0;                     // runs of EXPERIMENT command ticks
 };
 
 // Reads the files in order as one record. Throws SampleLogError (log_samples.hpp) for a file
-// that cannot be read or a log without any experiment command; ParameterError for bad options.
+// that cannot be read or a log without any experiment tick; ParameterError for bad options.
 LoggedExperiments read_logged_experiments(const std::vector<std::string>& files, const ExperimentLogOptions& options);
 
 // A table, one line per experiment, and the notes.

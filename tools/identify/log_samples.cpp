@@ -1,5 +1,6 @@
 #include "log_samples.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,7 +9,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/errors.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
 
 namespace hystloop {
@@ -31,15 +33,30 @@ class RecordBuilder {
  public:
   explicit RecordBuilder(const LogReadOptions& options) : options_(options) {}
 
-  void add(const std::string& file, std::int64_t eventnum, const sensor_sample_t& s) {
-    if (!std::isfinite(s.u_V) || !std::isfinite(s.y_m)) {
+  // One block: refused if a tick's u or y is not finite, counted if it breaks the contract,
+  // else its ticks in order.
+  void add(const std::string& file, std::int64_t eventnum, const sensor_block_t& block) {
+    for_each_tick(block, [&](const SensorTick& s) {
+      if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
       throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) + "): " +
                            (std::isfinite(s.u_V) ? "y_m" : "u_V") + " is not finite (u_V = " + number(s.u_V) +
                            ", y_m = " + number(s.y_m) + ")");
-    }
-    if (check_message(s) != Verdict::kOk) return void(++out_.undecodable);
+    });
+    if (check_message(block) != Verdict::kOk) return void(++out_.undecodable);
+    out_.sensor_ticks += static_cast<std::size_t>(block.n_ticks);
+    for_each_tick(block, [&](const SensorTick& s) { add_tick(file, eventnum, s); });
+    previous_block_first_ = std::max(previous_block_first_.value_or(block.seq), block.seq);
+  }
+
+  LogSamples& result() noexcept { return out_; }
+
+ private:
+  void add_tick(const std::string& file, std::int64_t eventnum, const SensorTick& s) {
     if (previous_seq_) {
-      if (s.seq == *previous_seq_) return void(++out_.duplicates);
+      // A tick again that the last block held (a block logged twice): a repeat.
+      if (s.seq <= *previous_seq_ && s.seq >= previous_block_first_.value_or(*previous_seq_)) {
+        return void(++out_.duplicates);
+      }
       if (s.seq < *previous_seq_) {
         throw SampleLogError(where(file, eventnum) + ": seq goes back from " + std::to_string(*previous_seq_) + " to " +
                              std::to_string(s.seq) +
@@ -67,8 +84,8 @@ class RecordBuilder {
       if (out_.first_gaps.size() < kGapsListed) out_.first_gaps.push_back({before + 1, missing});
     }
     in_range_before_ = true;
-    if ((s.flags & sensor_sample_t::SAFE_STATE) != 0) return void(++out_.safe_state);
-    if ((s.flags & sensor_sample_t::SENSOR_FAULT) != 0) return void(++out_.sensor_fault);
+    if ((s.flags & sensor_block_t::SAFE_STATE) != 0) return void(++out_.safe_state);
+    if ((s.flags & sensor_block_t::SENSOR_FAULT) != 0) return void(++out_.sensor_fault);
     out_.table.t.push_back(t);
     out_.table.u.push_back(s.u_V);
     out_.table.y.push_back(s.y_m);
@@ -76,12 +93,10 @@ class RecordBuilder {
     out_.last_seq = s.seq;
   }
 
-  LogSamples& result() noexcept { return out_; }
-
- private:
   const LogReadOptions& options_;
   LogSamples out_;
   std::optional<std::int64_t> previous_seq_;
+  std::optional<std::int64_t> previous_block_first_;  // first tick of the last block read
   std::int64_t first_seq_ = 0;
   std::int64_t first_utime_ = 0;
   bool in_range_before_ = false;
@@ -109,7 +124,7 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
   options.validate();
   if (files.empty()) throw SampleLogError("no log file given");
   RecordBuilder record(options);
-  sensor_sample_t sample{};
+  sensor_block_t block{};
   for (const auto& file : files) {
     if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
     lcm::LogFile log(file, "r");
@@ -119,19 +134,20 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
       ++record.result().events;
       if (event->channel != options.sensor_channel) continue;
       ++record.result().sensor_events;
-      if (!decode_logged(*event, sample)) {
+      if (!decode_logged(*event, block)) {
         ++record.result().undecodable;
         continue;
       }
-      record.add(file, event->eventnum, sample);
+      record.add(file, event->eventnum, block);
     }
   }
   LogSamples& out = record.result();
   if (out.table.t.empty()) {
     std::ostringstream s;
     s << (files.size() == 1 ? files.front() : files.front() + " ... " + files.back()) << ": no usable "
-      << options.sensor_channel << " sample (" << out.sensor_events << " on the channel, " << out.outside_range
-      << " outside the time range, " << out.skipped() << " skipped)";
+      << options.sensor_channel << " sample (" << out.sensor_events << " blocks on the channel with "
+      << out.sensor_ticks << " ticks, " << out.outside_range << " outside the time range, " << out.skipped()
+      << " skipped, " << out.undecodable << " blocks undecodable)";
     throw SampleLogError(s.str());
   }
   return out;
@@ -139,13 +155,13 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
 
 std::string describe(const LogSamples& s, const LogReadOptions& options) {
   std::ostringstream o;
-  o << "log: " << s.files << " file(s), " << s.events << " events, " << s.sensor_events << " on "
-    << options.sensor_channel << "\n";
+  o << "log: " << s.files << " file(s), " << s.events << " events, " << s.sensor_events << " blocks on "
+    << options.sensor_channel << " (" << s.sensor_ticks << " ticks)\n";
   o << "samples: " << s.table.t.size() << " kept (seq " << s.first_seq.value_or(0) << " .. " << s.last_seq.value_or(0)
     << ", t " << number(s.table.t.front()) << " .. " << number(s.table.t.back()) << " s), " << s.outside_range
     << " outside the time range\n";
   o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
-    << " repeated seq, " << s.undecodable << " undecodable or out of contract\n";
+    << " repeated seq, " << s.undecodable << " block(s) undecodable or out of contract\n";
   o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";
   for (const auto& g : s.first_gaps) o << "; seq " << g.first_missing << " +" << g.missing;
   if (s.gaps > s.first_gaps.size()) o << "; ...";

@@ -1,20 +1,22 @@
 #pragma once
-// Identification samples from LCM event logs: the rig's HX_SENSOR sensor_sample_t messages,
-// read with lcm::LogFile from one or several files in the order given (a rotated recording is
-// one record), into the same SampleTable the CSV reader makes: u = u_V, y = y_m, and
-// t = (seq - seq of the first sample) * dt, or from utime.
+// Identification samples from LCM event logs: the ticks of the rig's HX_SENSOR sensor_block_t
+// messages (common/lcm/blocks.hpp), read with lcm::LogFile from one or several files in the
+// order given (a rotated recording is one record), into the same SampleTable the CSV reader
+// makes: one sample per tick, u = u_V, y = y_m, and t = (seq - seq of the first tick) * dt, or
+// from the tick's utime.
 //
 // What a recording may hold and what becomes of it:
-//  - samples flagged SAFE_STATE (the bridge holding the safe voltage, not the experiment) or
+//  - ticks flagged SAFE_STATE (the bridge holding the safe voltage, not the experiment) or
 //    SENSOR_FAULT (y_m is a stale value): skipped and counted;
 //  - missing ticks (seq jumps): counted; they split nothing (MEM is rate independent, the
 //    record simply continues), but the report says how many samples were lost;
-//  - the same seq twice: the repeat is skipped and counted;
+//  - a tick again that the previous block held (the same block logged twice): the repeat is
+//    skipped and counted;
 //  - seq going back (files out of order, or the bridge restarted): refused, the message names
 //    the file and event;
 //  - a non-finite u or y: refused like a malformed CSV field, naming file, event and seq;
-//  - an event on the sensor channel that does not decode as sensor_sample_t, or whose values
-//    break the message contract (range, flag bits): skipped and counted;
+//  - an event on the sensor channel that does not decode as sensor_block_t, or whose values
+//    break the message contract (range, flag bits, array sizes): skipped whole and counted;
 //  - other channels: ignored.
 
 #include <cstddef>
@@ -27,6 +29,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ident/sample_csv.hpp"
+#include "lcm/message_storage.hpp"
 #include "lcm/wire_layout.hpp"
 
 namespace hystloop {
@@ -60,30 +63,34 @@ struct LogSamples {
   SampleTable table;                 // the samples kept (t relative to the record's first sample)
   std::size_t files = 0;
   std::size_t events = 0;            // events of any channel read
-  std::size_t sensor_events = 0;     // events on the sensor channel
-  std::size_t outside_range = 0;     // valid samples outside [from, to)
-  std::size_t safe_state = 0;        // skipped: flagged SAFE_STATE
-  std::size_t sensor_fault = 0;      // skipped: flagged SENSOR_FAULT (and not SAFE_STATE)
-  std::size_t duplicates = 0;        // skipped: the same seq again
-  std::size_t undecodable = 0;       // skipped: not a sensor_sample_t, or out of contract
+  std::size_t sensor_events = 0;     // events (blocks) on the sensor channel
+  std::size_t sensor_ticks = 0;      // ticks of the blocks that decoded and met the contract
+  std::size_t outside_range = 0;     // valid ticks outside [from, to)
+  std::size_t safe_state = 0;        // skipped ticks: flagged SAFE_STATE
+  std::size_t sensor_fault = 0;      // skipped ticks: flagged SENSOR_FAULT (and not SAFE_STATE)
+  std::size_t duplicates = 0;        // skipped ticks: the same seq again
+  std::size_t undecodable = 0;       // skipped events: not a sensor_block_t, or out of contract
   std::size_t gaps = 0;              // seq jumps among the samples in range
   std::size_t missing = 0;           // ticks missing in those jumps
   std::vector<SeqGap> first_gaps;    // the first few, for the report
   std::optional<std::int64_t> first_seq, last_seq;  // of the samples kept
 
   double window_s() const noexcept { return table.t.size() < 2 ? 0.0 : table.t.back() - table.t.front(); }
-  std::size_t skipped() const noexcept { return safe_state + sensor_fault + duplicates + undecodable; }
+  // Ticks skipped (the undecodable events are counted apart).
+  std::size_t skipped() const noexcept { return safe_state + sensor_fault + duplicates; }
 };
 
 // Decodes one logged event as T exactly as a Subscription would (fingerprint, length fields,
 // whole buffer used), but without the contract's value check, which the caller makes (a
-// non-finite sample is refused, an out-of-contract one counted).
+// non-finite sample is refused, an out-of-contract one counted). The arrays of a message
+// that decodes hold their counts.
 template <class T>
 bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
   if (event.datalen < 8) return false;
   const auto size = static_cast<std::size_t>(event.datalen);
   if (wire_fingerprint(event.data, size) != T::getHash()) return false;
   if (walk_wire_layout(wire_layout_of<T>(), event.data, size) < 0) return false;
+  clear_arrays(msg);
   try {
     return msg.decode(event.data, 0, event.datalen) == event.datalen;
   } catch (...) {

@@ -6,7 +6,8 @@
 
 #include "core/errors.hpp"
 #include "core/process.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
@@ -56,11 +57,14 @@ std::int32_t ParamsLink::highest_version_heard() {
   std::int32_t highest = 0;
   Subscription<mem_params_t> params(*lcm_, channels_.params,
                                     [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
-  Subscription<actuator_command_t>::Options fast;
-  fast.queue_capacity = 20'000;  // 10 kHz for the whole listening time
-  Subscription<actuator_command_t> commands(
+  Subscription<command_block_t>::Options queue;
+  queue.queue_capacity = 4'000;  // blocks of the whole listening time
+  Subscription<command_block_t> commands(
       *lcm_, channels_.command,
-      [&](const actuator_command_t& c, std::int64_t) { highest = std::max(highest, c.params_version); }, fast);
+      [&](const command_block_t& c, std::int64_t) {
+        for_each_tick(c, [&](const CommandTick& t) { highest = std::max(highest, t.params_version); });
+      },
+      queue);
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(options_.listen_s));

@@ -48,8 +48,8 @@ class ParamsLink {
   // Throws ParameterError for a refused URL or rig prefix, std::runtime_error if LCM cannot start.
   explicit ParamsLink(const PublishOptions& options);
 
-  // Listens options.listen_s on HX_PARAMS (and HX_COMMAND's params_version: a compensator
-  // does not repeat the set it uses) and returns the highest version heard, 0 if none.
+  // Listens options.listen_s on HX_PARAMS (and the params_version of HX_COMMAND's ticks: a
+  // compensator does not repeat the set it uses) and returns the highest version heard, 0 if none.
   std::int32_t highest_version_heard();
 
   // Publishes msg options.repeats times, options.gap apart. Returns how many were handed to

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "decode.hpp"
+#include "lcm/blocks.hpp"
 #include "log_reader.hpp"
 
 namespace hystloop::report {
@@ -39,8 +40,8 @@ std::string joined(const std::vector<double>& values) {
 }
 
 Kind kind_of(const lcm::LogEvent& e) {
-  if (has_fingerprint_of<sensor_sample_t>(e)) return Kind::kSensor;
-  if (has_fingerprint_of<actuator_command_t>(e)) return Kind::kCommand;
+  if (has_fingerprint_of<sensor_block_t>(e)) return Kind::kSensor;
+  if (has_fingerprint_of<command_block_t>(e)) return Kind::kCommand;
   if (has_fingerprint_of<trajectory_t>(e)) return Kind::kTrajectory;
   if (has_fingerprint_of<mem_params_t>(e)) return Kind::kParams;
   if (has_fingerprint_of<service_status_t>(e)) return Kind::kStatus;
@@ -50,8 +51,8 @@ Kind kind_of(const lcm::LogEvent& e) {
 
 const char* type_name(Kind kind) {
   switch (kind) {
-    case Kind::kSensor: return "hystloop.sensor_sample_t";
-    case Kind::kCommand: return "hystloop.actuator_command_t";
+    case Kind::kSensor: return "hystloop.sensor_block_t";
+    case Kind::kCommand: return "hystloop.command_block_t";
     case Kind::kTrajectory: return "hystloop.trajectory_t";
     case Kind::kParams: return "hystloop.mem_params_t";
     case Kind::kStatus: return "hystloop.service_status_t";
@@ -62,8 +63,9 @@ const char* type_name(Kind kind) {
 
 const char* header(Kind kind) {
   switch (kind) {
-    case Kind::kSensor: return "utime_us,seq,u_V,y_m,flags";
-    case Kind::kCommand: return "utime_us,seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode";
+    case Kind::kSensor:
+      return "block_utime_us,block_seq,dt_s,buffer_depth_ticks,utime_us,seq,u_V,u_ff_V,u_fb_V,y_ref_m,y_m,flags";
+    case Kind::kCommand: return "block_utime_us,block_seq,sample_seq,seq,u_ff_V,y_ref_m,params_version,mode";
     case Kind::kTrajectory:
       return "utime_us,version,shape,amplitude_m,offset_m,frequency_Hz,phase_rad,start_utime_us,blend_s,n_points,"
              "points_t_s,points_y_m";
@@ -98,24 +100,47 @@ class Fields {
   bool first_ = true;
 };
 
-// The decoded fields of one event after "t_s,recv_utime_us,", or false if it does not decode.
+// The rows of one event: emit(t_s, fields) for each, fields after "t_s,recv_utime_us,"; false
+// (and no row) if the event does not decode. One row per event, or per tick for the blocks of
+// HX_SENSOR (each tick dated as the report's time axis dates it) and HX_COMMAND (the event's time).
 class RowDecoder {
  public:
-  bool row(Kind kind, const lcm::LogEvent& e, std::string& out) {
+  template <class Emit>
+  bool rows(Kind kind, const lcm::LogEvent& e, std::int64_t t0_utime, std::string& out, Emit&& emit) {
+    auto t_of = [t0_utime](std::int64_t utime) { return static_cast<double>(utime - t0_utime) * 1e-6; };
     switch (kind) {
       case Kind::kSensor: {
-        const auto& m = sample_;
-        if (!decode_checked(e, sample_)) return false;
-        Fields(out).i(m.utime).i(m.seq).d(m.u_V).d(m.y_m).i(m.flags);
+        const auto& m = sensor_;
+        if (!decode_checked(e, sensor_)) return false;
+        std::size_t i = 0;
+        for_each_tick(m, [&](const SensorTick& k) {
+          const double t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
+          Fields(out).i(m.utime).i(m.seq).d(m.dt_s).i(m.buffer_depth_ticks).i(k.utime).i(k.seq).d(k.u_V).d(k.u_ff_V)
+              .d(k.u_fb_V).d(k.y_ref_m).d(k.y_m).i(k.flags);
+          emit(t, out);
+        });
         return true;
       }
       case Kind::kCommand: {
         const auto& m = command_;
         if (!decode_checked(e, command_)) return false;
-        Fields(out).i(m.utime).i(m.seq).i(m.sample_seq).d(m.u_V).d(m.u_ff_V).d(m.u_fb_V).d(m.y_ref_m)
-            .i(m.params_version).i(m.mode);
+        for_each_tick(m, [&](const CommandTick& k) {
+          Fields(out).i(m.utime).i(m.seq).i(m.sample_seq).i(k.seq).d(k.u_ff_V).d(k.y_ref_m).i(k.params_version)
+              .i(k.mode);
+          emit(t_of(e.timestamp), out);
+        });
         return true;
       }
+      default:
+        if (!row(kind, e, out)) return false;
+        emit(t_of(e.timestamp), out);
+        return true;
+    }
+  }
+
+ private:
+  bool row(Kind kind, const lcm::LogEvent& e, std::string& out) {
+    switch (kind) {
       case Kind::kTrajectory: {
         const auto& m = trajectory_;
         if (!decode_checked(e, trajectory_)) return false;
@@ -161,8 +186,8 @@ class RowDecoder {
   }
 
  private:
-  sensor_sample_t sample_;
-  actuator_command_t command_;
+  sensor_block_t sensor_;
+  command_block_t command_;
   trajectory_t trajectory_;
   mem_params_t params_;
   service_status_t status_;
@@ -209,14 +234,12 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
         w->result.type_name = type_name(w->kind);
         w->out << "t_s,recv_utime_us," << header(w->kind) << '\n';
       }
-      const double t = static_cast<double>(e.timestamp - t0_utime) * 1e-6;
-      if (t < lower_s || t > upper_s) continue;
-      if (!decoder.row(w->kind, e, row)) {
-        ++w->result.skipped;
-        continue;
-      }
-      w->out << num(t) << ',' << e.timestamp << ',' << row << '\n';
-      ++w->result.rows;
+      const bool decoded = decoder.rows(w->kind, e, t0_utime, row, [&](double row_t, const std::string& fields) {
+        if (row_t < lower_s || row_t > upper_s) return;
+        w->out << num(row_t) << ',' << e.timestamp << ',' << fields << '\n';
+        ++w->result.rows;
+      });
+      if (!decoded) ++w->result.skipped;
     }
   });
   std::vector<CsvExport> results;

@@ -1,8 +1,10 @@
 #include "log_reader.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "decode.hpp"
+#include "lcm/blocks.hpp"
 
 namespace hystloop::report {
 
@@ -16,33 +18,55 @@ void for_each_event(const std::vector<std::filesystem::path>& files,
   }
 }
 
+std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept {
+  const double back_us = static_cast<double>(static_cast<std::int64_t>(n_ticks) - 1 - static_cast<std::int64_t>(i)) *
+                         dt_s * 1e6;
+  return block_recv_utime - static_cast<std::int64_t>(std::llround(back_us));
+}
+
 RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels) {
   RunData run;
-  sensor_sample_t sample;
-  actuator_command_t command;
+  sensor_block_t sensor;
+  command_block_t command;
   mem_params_t params;
   service_status_t status;
+  control_t control;
   for_each_event(files, [&](const lcm::LogEvent& event) {
     ++run.events;
     ++run.channel_counts[event.channel];
+    run.event_times[event.channel].push_back(event.timestamp);
     if (!run.first_event_utime) run.first_event_utime = event.timestamp;
     const std::int64_t t = event.timestamp;
     if (event.channel == channels.sensor) {
-      if (!decode_checked(event, sample)) return void(++run.undecodable);
-      run.samples.push_back({t, sample.seq, sample.u_V, sample.y_m, sample.flags});
+      if (!decode_checked(event, sensor)) return void(++run.undecodable);
+      bool armed = true;
+      std::size_t i = 0;
+      for_each_tick(sensor, [&](const SensorTick& k) {
+        run.samples.push_back({tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m,
+                               k.flags});
+        armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
+      });
+      run.sensor_blocks.push_back({t, sensor.seq, sensor.n_ticks, sensor.dt_s, sensor.buffer_depth_ticks, armed});
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
-      run.commands.push_back({t, command.seq, command.sample_seq, command.u_V, command.y_ref_m, command.params_version});
+      run.command_blocks.push_back({t, command.seq, command.sample_seq, command.n_ticks});
+      for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version); });
     } else if (event.channel == channels.params) {
       if (!decode_checked(event, params)) return void(++run.undecodable);
       run.params.push_back({t, params.version, params.c1, params.c2, params.c3, params.residual_m, params.valid != 0});
     } else if (event.channel == channels.status) {
       if (!decode_checked(event, status)) return void(++run.undecodable);
-      StatusRecord record{t, status.process, status.state, status.late, status.rejected, {}};
+      StatusRecord record{t, status.process, status.state, status.late, status.rejected, {}, status.utime,
+                          status.start_utime};
       for (std::size_t i = 0; i < status.counter_names.size(); ++i) {
         record.counters.emplace_back(status.counter_names[i], status.counter_values[i]);
       }
       run.statuses.push_back(std::move(record));
+    } else if (event.channel == channels.control) {
+      if (!decode_checked(event, control)) return void(++run.undecodable);
+      if (control.command == control_t::DISARM || control.command == control_t::SHUTDOWN) {
+        run.safe_requests.push_back({t, control.target});
+      }
     }
   });
   return run;

@@ -2,8 +2,11 @@
 // Reads LCM event logs (lcm::LogFile) into RunData. Several files are read in the order
 // given, as one log (a rotated recording). Which channel is which comes from the rig
 // prefix; a message on a known channel that does not decode or fails the contract's value
-// check is counted in RunData::undecodable and skipped.
+// check is counted in RunData::undecodable and skipped (a whole block, for HX_SENSOR and
+// HX_COMMAND).
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <vector>
@@ -17,6 +20,10 @@ namespace hystloop::report {
 
 // Throws std::runtime_error naming the file if one cannot be opened.
 RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels);
+
+// The time of tick i of a sensor block of n_ticks received at block_recv_utime (run_data.hpp):
+// block_recv_utime - (n_ticks - 1 - i) * dt_s [us].
+std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept;
 
 // Calls visit(event) for every event of every file, in order (for exports that need
 // whole messages). Throws std::runtime_error naming the file if one cannot be opened.

@@ -83,7 +83,7 @@ int run(const Options& o) {
 
   const ReportMetrics metrics = compute_metrics(data, ro);
   if (data.samples.empty()) {
-    std::fprintf(stderr, "hystloop-report: warning: no %s samples in the log; most figures are null\n",
+    std::fprintf(stderr, "hystloop-report: warning: no %s ticks in the log; most figures are null\n",
                  channels.sensor.c_str());
   }
   write_text(o.out / "summary.json", summary_json(metrics, ro, o.logs));
@@ -94,7 +94,7 @@ int run(const Options& o) {
   }
   PlotResult plots;
   if (!o.no_plots) {
-    plots = write_plots(matched_ticks(data, ro), metrics, o.out, o.plots);
+    plots = write_plots(track_points(data, ro), metrics, o.out, o.plots);
     if (!plots.warning.empty()) std::fprintf(stderr, "hystloop-report: warning: %s\n", plots.warning.c_str());
   }
 
@@ -113,15 +113,16 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"hystloop-report: tracking error, latency, late commands, parameter history and plots of a recorded "
-               "run, from LCM event logs (times are the log's receive timestamps, relative to the first sensor sample)"};
+  CLI::App app{"hystloop-report: tracking error, late ticks, buffer depth, run-ahead margin, watchdog trips, CPU, message "
+               "rates, parameter history and plots of a recorded run, from LCM event logs (times are the log's receive "
+               "timestamps, relative to the first sensor tick)"};
   app.add_option("logs", o.logs, "LCM event log file(s); rotated files in recording order")
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--out", o.out, "Output folder (created if missing)")->required();
   app.add_option("--csv", o.csv, "Export a channel to DIR/<channel>.csv, e.g. HX_SENSOR or SENSOR (repeatable)");
-  app.add_option("--from", o.from_s, "Start of the analysed range [s after the first sensor sample]");
-  app.add_option("--to", o.to_s, "End of the analysed range [s after the first sensor sample]");
+  app.add_option("--from", o.from_s, "Start of the analysed range [s after the first sensor tick]");
+  app.add_option("--to", o.to_s, "End of the analysed range [s after the first sensor tick]");
   app.add_option("--skip-initial", o.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
       ->capture_default_str();
   app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();

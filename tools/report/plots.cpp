@@ -61,25 +61,23 @@ int run_in(const std::filesystem::path& dir, const std::filesystem::path& exe, c
 }
 
 struct Histogram {
-  double lo = 0.0, width = 1.0;
+  double lo = 0.0;
+  double width = 1.0;
   std::vector<std::size_t> counts;
-  std::size_t above = 0;  // values beyond the last bin (folded into it)
-  double cap = 0.0;
 };
 
-// 60 bins from the minimum to the maximum, or to 3 x p99 when the tail is longer.
-Histogram latency_histogram(const ReportMetrics& m) {
+// Whole-tick bins from the smallest to the largest run-ahead margin, at most 60 of them.
+Histogram run_ahead_histogram(const ReportMetrics& m) {
   Histogram h;
-  const auto& v = m.latencies_us;
+  const auto& v = m.run_ahead_ticks;
   if (v.empty()) return h;
   h.lo = v.front();
-  h.cap = std::min(v.back(), std::max(3.0 * m.latency_p99_us.value_or(v.back()), h.lo + 1.0));
-  h.counts.assign(60, 0);
-  h.width = std::max((h.cap - h.lo) / 60.0, 1e-3);
+  const double span = v.back() - v.front() + 1.0;
+  h.width = std::max(1.0, std::ceil(span / 60.0));
+  h.counts.assign(static_cast<std::size_t>(std::ceil(span / h.width)), 0);
   for (const double x : v) {
-    if (x > h.cap) ++h.above;
-    const auto bin = static_cast<std::size_t>(std::clamp((x - h.lo) / h.width, 0.0, 59.0));
-    ++h.counts[bin];
+    const auto bin = static_cast<std::size_t>(std::floor((x - h.lo) / h.width));
+    ++h.counts[std::min(bin, h.counts.size() - 1)];
   }
   return h;
 }
@@ -104,17 +102,17 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
   PlotResult result;
   const bool have_ticks = !ticks.empty();
   const bool have_tracking = m.tracking_samples > 0;
-  const bool have_latency = !m.latencies_us.empty();
+  const bool have_run_ahead = !m.run_ahead_ticks.empty();
 
   {  // track.dat: every n-th tick.
     const auto path = dir / "track.dat";
     auto out = open_for_writing(path);
-    out << "# t_s u_V y_um y_ref_um e_nm   (NaN: no reference for the tick)\n";
+    out << "# t_s u_V y_um y_ref_um e_nm   (e = y_ref - y; NaN: no reference for the tick)\n";
     const std::size_t step = std::max<std::size_t>(1, (ticks.size() + options.max_points - 1) / std::max<std::size_t>(options.max_points, 1));
     for (std::size_t i = 0; i < ticks.size(); i += step) {
       const auto& p = ticks[i];
       out << num(p.t_s) << ' ' << num(p.u_V) << ' ' << num(p.y_m * 1e6) << ' ' << num(p.y_ref_m * 1e6) << ' '
-          << num((p.y_m - p.y_ref_m) * 1e9) << '\n';
+          << num((p.y_ref_m - p.y_m) * 1e9) << '\n';
     }
     close_checked(out, path);
     result.data_files.push_back(path);
@@ -130,14 +128,13 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     close_checked(out, path);
     result.data_files.push_back(path);
   }
-  const Histogram hist = latency_histogram(m);
+  const Histogram hist = run_ahead_histogram(m);
   {
-    const auto path = dir / "latency_hist.dat";
+    const auto path = dir / "run_ahead_hist.dat";
     auto out = open_for_writing(path);
-    out << "# bin_low_us bin_high_us count   (the last bin also holds " << hist.above << " values above "
-        << num(hist.cap) << " us)\n";
+    out << "# bin_low_ticks bin_high_ticks count   (run-ahead margin of each command block: seq - sample_seq)\n";
     for (std::size_t i = 0; i < hist.counts.size(); ++i) {
-      const double lo = hist.lo + hist.width * static_cast<double>(i);
+      const double lo = hist.lo - 0.5 + hist.width * static_cast<double>(i);  // edges between whole ticks
       out << num(lo) << ' ' << num(lo + hist.width) << ' ' << hist.counts[i] << '\n';
     }
     close_checked(out, path);
@@ -163,18 +160,18 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
        << "plot 'track.dat' using 4:3 with lines lw 1 title 'y(y_ref)', x with lines dt 2 lc rgb 'gray' title 'y = y_ref'\n"
        << "set size noratio\n";
     images.push_back("tracking_error.png");
-    gp << "\nset output 'tracking_error.png'\nset title 'Tracking error e = y - y_ref'\n"
+    gp << "\nset output 'tracking_error.png'\nset title 'Tracking error e = y_ref - y'\n"
        << "set xlabel 't [s]'\nset ylabel 'e [nm]'\n"
        << "plot 'track.dat' using 1:5 with lines lw 1 title 'e', "
        << "'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n";
   }
-  if (have_latency) {
-    images.push_back("latency_histogram.png");
-    gp << "\nset output 'latency_histogram.png'\n"
-       << "set title 'Sample-to-command latency (log receive times), n = " << m.latencies_us.size()
-       << (hist.above > 0 ? ", " + std::to_string(hist.above) + " above " + num(hist.cap) + " us in the last bin" : "")
-       << "'\nset xlabel 'latency [us]'\nset ylabel 'commands'\nset style fill solid 0.6\nset boxwidth 0.9 relative\n"
-       << "plot 'latency_hist.dat' using (($1+$2)/2):3 with boxes title 'count'\n";
+  if (have_run_ahead) {
+    images.push_back("run_ahead_histogram.png");
+    gp << "\nset output 'run_ahead_histogram.png'\n"
+       << "set title 'Run-ahead margin of the command blocks (seq - sample_seq), n = " << m.run_ahead_ticks.size()
+       << "'\nset xlabel 'margin [ticks]'\nset ylabel 'command blocks'\nset style fill solid 0.6\n"
+       << "set boxwidth 0.9 relative\n"
+       << "plot 'run_ahead_hist.dat' using ($1+($2-$1)/2):3 with boxes title 'count'\n";
   }
   gp << "\nunset output\n";
 

@@ -4,8 +4,8 @@
 // gnuplot's pngcairo terminal, or its libgd png terminal where cairo is missing.
 //   hysteresis_u_y.png     applied voltage u -> measured y (the stage's hysteresis loop)
 //   hysteresis_yref_y.png  reference y_ref -> measured y (as the MEM paper's Fig. 11)
-//   tracking_error.png     e = y - y_ref over time [nm], with the per-second RMS
-//   latency_histogram.png  sample-to-command latency [us]
+//   tracking_error.png     e = y_ref - y over time [nm], with the per-second RMS
+//   run_ahead_histogram.png  run-ahead margin of the command blocks [ticks]
 // A plot whose data is empty is left out of the script.
 
 #include <cstddef>

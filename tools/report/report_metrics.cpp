@@ -1,105 +1,34 @@
 #include "report_metrics.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <string_view>
-#include <unordered_map>
 
 #include "core/errors.hpp"
+#include "hystloop/sensor_block_t.hpp"
+#include "status_figures.hpp"
 
 namespace hystloop::report {
 
 namespace {
 
-constexpr std::int32_t kSafeStateFlag = 2;    // sensor_sample_t::SAFE_STATE
-constexpr std::int32_t kLateCommandFlag = 16; // sensor_sample_t::LATE_COMMAND
-
-// Index of the first logged command for each tick.
-std::unordered_map<std::int64_t, std::size_t> first_command_by_seq(const RunData& run) {
-  std::unordered_map<std::int64_t, std::size_t> index;
-  index.reserve(run.commands.size());
-  for (std::size_t i = 0; i < run.commands.size(); ++i) index.emplace(run.commands[i].seq, i);
-  return index;
-}
+constexpr std::int32_t kSafeStateFlag = sensor_block_t::SAFE_STATE;
+constexpr std::int32_t kLateCommandFlag = sensor_block_t::LATE_COMMAND;
+// A SAFE_STATE transition up to this long after a DISARM/SHUTDOWN request for the bridge is its
+// answer, not a watchdog trip (a tick is dated no earlier than it was sampled, but allow for the
+// request reaching the logger after the bridge).
+constexpr std::int64_t kRequestBefore_us = 200'000;
+constexpr std::int64_t kRequestAfter_us = 50'000;
 
 double rms(double sum_sq, std::size_t n) { return std::sqrt(sum_sq / static_cast<double>(n)); }
 
-std::string_view leaf(std::string_view name) {
-  const auto dot = name.rfind('.');
-  return dot == std::string_view::npos ? name : name.substr(dot + 1);
-}
+bool armed(const SampleRecord& s) { return (s.flags & kSafeStateFlag) == 0; }
 
-std::string_view endpoint(std::string_view name) {
-  const auto dot = name.rfind('.');
-  return dot == std::string_view::npos ? std::string_view{} : name.substr(0, dot);
-}
-
-// The last status of `process` received at or before t_s <= upper.
-const StatusRecord* last_status(const RunData& run, const std::string& process, std::int64_t upper_utime) {
-  const StatusRecord* last = nullptr;
-  for (const auto& status : run.statuses) {
-    if (status.process == process && status.recv_utime <= upper_utime) last = &status;
-  }
-  return last;
-}
-
-// A bridge counter counts as a rejected command when its leaf is "rejected*" or "stale"
-// (DESIGN.md: stale commands are rejected) and it is not another endpoint's counter.
-bool is_command_reject_counter(std::string_view name) {
-  const std::string_view l = leaf(name);
-  const std::string_view e = endpoint(name);
-  const bool reject = l.starts_with("rejected") || l == "stale";
-  const bool commands = e.empty() || e.find("command") != std::string_view::npos || e.find("cmd") != std::string_view::npos;
-  return reject && commands;
-}
-
-void fill_commands_rejected(const RunData& run, const ReportOptions& options, std::int64_t upper_utime,
-                            ReportMetrics& m) {
-  const StatusRecord* bridge = last_status(run, options.bridge_process, upper_utime);
-  if (bridge == nullptr) {
-    m.commands_rejected_source = "no status of process '" + options.bridge_process + "' in the log";
-    return;
-  }
-  std::int64_t sum = 0;
-  for (const auto& [name, value] : bridge->counters) {
-    if (!is_command_reject_counter(name)) continue;
-    sum += value;
-    m.commands_rejected_counters.emplace_back(name, value);
-  }
-  if (!m.commands_rejected_counters.empty()) {
-    m.commands_rejected = sum;
-    m.commands_rejected_source = "last " + options.bridge_process + " status: sum of its command reject counters";
-  } else {
-    m.commands_rejected = bridge->rejected;
-    m.commands_rejected_source = "last " + options.bridge_process + " status: 'rejected' (no command reject counters)";
-  }
-}
-
-void fill_logger_gaps(const RunData& run, const ReportOptions& options, std::int64_t upper_utime, ReportMetrics& m) {
-  if (const StatusRecord* logger = last_status(run, options.logger_process, upper_utime)) {
-    // Most specific name first: "gaps", then "*gaps", then anything with "gap".
-    const std::array<bool (*)(std::string_view), 3> tiers{
-        [](std::string_view l) { return l == "gaps"; },
-        [](std::string_view l) { return l.ends_with("gaps"); },
-        [](std::string_view l) { return l.find("gap") != std::string_view::npos; }};
-    for (const auto& matches : tiers) {
-      std::int64_t sum = 0;
-      std::string names;
-      for (const auto& [name, value] : logger->counters) {
-        if (!matches(leaf(name))) continue;
-        sum += value;
-        names += (names.empty() ? "" : "+") + name;
-      }
-      if (!names.empty()) {
-        m.logger_gaps = sum;
-        m.logger_gaps_source = "last " + options.logger_process + " status: " + names;
-        return;
-      }
-    }
-  }
-  m.logger_gaps = m.seq_gaps;
-  m.logger_gaps_source = "sensor seq (no gap counter from '" + options.logger_process + "')";
+// True when a DISARM or SHUTDOWN request for the bridge explains a safe state entered at utime.
+bool requested_safe(const RunData& run, const std::string& bridge, std::int64_t utime) {
+  return std::any_of(run.safe_requests.begin(), run.safe_requests.end(), [&](const SafeRequestRecord& r) {
+    return (r.target.empty() || r.target == bridge) && r.recv_utime >= utime - kRequestBefore_us &&
+           r.recv_utime <= utime + kRequestAfter_us;
+  });
 }
 
 void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, ReportMetrics& m) {
@@ -137,6 +66,45 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
   m.params_final = current;
 }
 
+// Buffer depth of the armed sensor blocks, and the tick period.
+void fill_blocks(const RunData& run, double lo, double hi, std::int64_t t0, ReportMetrics& m) {
+  for (const auto& b : run.sensor_blocks) {
+    const double t = static_cast<double>(b.recv_utime - t0) * 1e-6;
+    if (t < lo || t > hi) continue;
+    ++m.sensor_blocks;
+    if (!m.tick_period_s) m.tick_period_s = b.dt_s;
+    if (!b.armed) continue;
+    ++m.armed_blocks;
+    m.buffer_min_depth_ticks = std::min(m.buffer_min_depth_ticks.value_or(b.buffer_depth_ticks), b.buffer_depth_ticks);
+  }
+  for (const auto& c : run.command_blocks) {
+    const double t = static_cast<double>(c.recv_utime - t0) * 1e-6;
+    if (t < lo || t > hi || c.sample_seq < 0) continue;
+    m.run_ahead_ticks.push_back(static_cast<double>(c.seq - c.sample_seq));
+  }
+  std::sort(m.run_ahead_ticks.begin(), m.run_ahead_ticks.end());
+  m.run_ahead_min_ticks = nearest_rank(m.run_ahead_ticks, 0.0);
+  m.run_ahead_p01_ticks = nearest_rank(m.run_ahead_ticks, 0.01);
+  m.run_ahead_p50_ticks = nearest_rank(m.run_ahead_ticks, 0.50);
+  m.run_ahead_max_ticks = nearest_rank(m.run_ahead_ticks, 1.0);
+}
+
+// Events of each channel received within the sampled span, per second of it.
+void fill_message_rates(const RunData& run, std::int64_t t0, ReportMetrics& m) {
+  for (const auto& [channel, times] : run.event_times) {
+    if (!m.first_sample_t_s || !(m.duration_s > 0.0)) {
+      m.messages_per_s[channel] = std::nullopt;
+      continue;
+    }
+    const double first = *m.first_sample_t_s, last = *m.last_sample_t_s;
+    const auto n = std::count_if(times.begin(), times.end(), [&](std::int64_t utime) {
+      const double t = static_cast<double>(utime - t0) * 1e-6;
+      return t >= first && t <= last;
+    });
+    m.messages_per_s[channel] = static_cast<double>(n) / m.duration_s;
+  }
+}
+
 }  // namespace
 
 void ReportOptions::validate() const {
@@ -164,8 +132,7 @@ std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) 
   return sorted[rank - 1];
 }
 
-std::vector<TrackPoint> matched_ticks(const RunData& run, const ReportOptions& options) {
-  const auto commands = first_command_by_seq(run);
+std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& options) {
   const std::int64_t t0 = run.time_zero_utime();
   const double lo = options.lower_s(), hi = options.upper_s();
   std::vector<TrackPoint> points;
@@ -173,9 +140,7 @@ std::vector<TrackPoint> matched_ticks(const RunData& run, const ReportOptions& o
   for (const auto& s : run.samples) {
     const double t = static_cast<double>(s.recv_utime - t0) * 1e-6;
     if (t < lo || t > hi) continue;
-    const auto it = commands.find(s.seq);
-    const double y_ref = it == commands.end() ? std::nan("") : run.commands[it->second].y_ref_m;
-    points.push_back({t, s.u_V, s.y_m, y_ref});
+    points.push_back({t, s.u_V, s.y_m, s.y_ref_m});
   }
   return points;
 }
@@ -189,7 +154,6 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   const std::int64_t t0 = run.time_zero_utime();
   auto t_of = [t0](std::int64_t utime) { return static_cast<double>(utime - t0) * 1e-6; };
   const double lo = options.lower_s(), hi = options.upper_s();
-  const auto commands = first_command_by_seq(run);
 
   struct BinSum {
     double sum_sq = 0.0;
@@ -197,11 +161,10 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     std::optional<std::int32_t> version;
   };
   std::map<std::int64_t, BinSum> bins;
-  std::unordered_map<std::int64_t, std::int64_t> sample_recv;  // seq -> receive time of the sample
-  sample_recv.reserve(run.samples.size());
   std::vector<std::pair<double, double>> track;  // (t_s, e_m)
   double sum_sq = 0.0;
-  std::optional<std::int64_t> prev_seq;
+  const SampleRecord* prev = nullptr;
+  std::int64_t safe_transitions = 0;
 
   for (const auto& s : run.samples) {
     const double t = t_of(s.recv_utime);
@@ -209,23 +172,21 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     ++m.samples;
     if (!m.first_sample_t_s) m.first_sample_t_s = t;
     m.last_sample_t_s = t;
-    sample_recv.emplace(s.seq, s.recv_utime);
-    if (prev_seq && s.seq > *prev_seq + 1) {
+    if (prev != nullptr && s.seq > prev->seq + 1) {
       ++m.seq_gaps;
-      m.missing_samples += s.seq - *prev_seq - 1;
+      m.missing_samples += s.seq - prev->seq - 1;
     }
-    prev_seq = s.seq;
-    if ((s.flags & kSafeStateFlag) == 0) {
+    if (armed(s)) {
       ++m.armed_samples;
       if ((s.flags & kLateCommandFlag) != 0) ++m.late_samples;
+    } else if (prev != nullptr && armed(*prev) && !requested_safe(run, options.bridge_process, s.recv_utime)) {
+      ++safe_transitions;
     }
+    prev = &s;
     BinSum& bin = bins[static_cast<std::int64_t>(std::floor(t))];
-    const auto it = commands.find(s.seq);
-    if (it == commands.end()) continue;
-    const CommandRecord& c = run.commands[it->second];
-    bin.version = c.params_version;
-    if (!std::isfinite(c.y_ref_m)) continue;
-    const double e = s.y_m - c.y_ref_m;
+    if (const auto version = run.command_versions.at(s.seq)) bin.version = *version;
+    if (!std::isfinite(s.y_ref_m)) continue;
+    const double e = s.y_ref_m - s.y_m;
     bin.sum_sq += e * e;
     ++bin.n;
     sum_sq += e * e;
@@ -273,22 +234,17 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   if (m.armed_samples > 0) {
     m.late_command_fraction = static_cast<double>(m.late_samples) / static_cast<double>(m.armed_samples);
   }
-
-  for (const auto& c : run.commands) {
-    if (c.sample_seq < 0) continue;
-    const auto it = sample_recv.find(c.sample_seq);
-    if (it == sample_recv.end()) continue;
-    m.latencies_us.push_back(static_cast<double>(c.recv_utime - it->second));
-  }
-  std::sort(m.latencies_us.begin(), m.latencies_us.end());
-  m.latency_p50_us = nearest_rank(m.latencies_us, 0.50);
-  m.latency_p99_us = nearest_rank(m.latencies_us, 0.99);
-  m.latency_max_us = nearest_rank(m.latencies_us, 1.0);
+  fill_blocks(run, lo, hi, t0, m);
+  fill_message_rates(run, t0, m);
 
   const std::int64_t upper_utime =
       std::isfinite(hi) ? t0 + static_cast<std::int64_t>(std::floor(hi * 1e6)) : std::numeric_limits<std::int64_t>::max();
+  const std::int64_t lower_utime =
+      std::isfinite(lo) ? t0 + static_cast<std::int64_t>(std::ceil(lo * 1e6)) : std::numeric_limits<std::int64_t>::min();
   fill_commands_rejected(run, options, upper_utime, m);
   fill_logger_gaps(run, options, upper_utime, m);
+  fill_watchdog_trips(run, options, upper_utime, safe_transitions, m);
+  fill_cpu_fraction(run, lower_utime, upper_utime, m);
   fill_params(run, lo, hi, t0, m);
   return m;
 }

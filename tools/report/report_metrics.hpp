@@ -2,11 +2,14 @@
 // The figures of a recorded run, computed from RunData alone (no I/O), so that each can
 // be checked against an independent computation in a test.
 //
-// Time axis: t_s = (log receive time - receive time of the first HX_SENSOR event) [s].
-// Tracking error of tick k: e_k = y_k - y_ref_k, with y_k from the sample with seq k and
-// y_ref_k from the first logged command with seq k (the command meant for that tick);
-// only ticks with a finite y_ref count ("tracking"). Latency of a command that answers
-// sample k: its receive time minus the receive time of sample k, both as logged.
+// Time axis: t_s = (time of a tick or event - time of the first HX_SENSOR tick) [s], both on
+// the log's receive clock (run_data.hpp dates the ticks of a block).
+// Tracking error of tick k: e_k = y_ref_k - y_k, both as the bridge recorded them in HX_SENSOR;
+// only ticks with a finite y_ref count ("tracking").
+// Run-ahead margin of a command block: block.seq - sample_seq [ticks], how far ahead of the
+// newest sensor tick the compensator knew its first new command was (blocks with sample_seq
+// -1 are left out).
+// Armed: a tick without SAFE_STATE; a sensor block with no SAFE_STATE tick.
 // Percentiles are nearest-rank: the ceil(q*n)-th smallest value.
 
 #include <cstdint>
@@ -64,12 +67,23 @@ struct ReportMetrics {
   std::optional<double> rms_error_first_5s_m, rms_error_last_5s_m;
   std::vector<SecondBin> per_second;
 
-  std::size_t armed_samples = 0;     // samples without SAFE_STATE
-  std::size_t late_samples = 0;      // armed samples with LATE_COMMAND
-  std::optional<double> late_command_fraction;
+  std::size_t armed_samples = 0;     // ticks without SAFE_STATE
+  std::size_t late_samples = 0;      // armed ticks with LATE_COMMAND
+  std::optional<double> late_command_fraction;  // late / armed ticks (summary: also late_tick_fraction)
 
-  std::vector<double> latencies_us;  // sorted ascending
-  std::optional<double> latency_p50_us, latency_p99_us, latency_max_us;
+  std::size_t sensor_blocks = 0;     // HX_SENSOR blocks in the range
+  std::size_t armed_blocks = 0;
+  std::optional<std::int32_t> buffer_min_depth_ticks;  // lowest buffer_depth_ticks of an armed block
+  std::optional<double> tick_period_s;                 // dt_s of the first sensor block in the range
+
+  std::vector<double> run_ahead_ticks;  // per command block in the range, sorted ascending
+  std::optional<double> run_ahead_min_ticks, run_ahead_p01_ticks, run_ahead_p50_ticks, run_ahead_max_ticks;
+
+  std::optional<std::int64_t> watchdog_trips;
+  std::string watchdog_trips_source;  // the bridge counter, or the SAFE_STATE transitions counted
+
+  std::map<std::string, std::optional<double>> messages_per_s;  // events in the sampled span / duration_s
+  std::map<std::string, std::optional<double>> cpu_fraction;    // per process [cores], from its HX_STATUS
 
   std::optional<std::int64_t> commands_rejected;
   std::string commands_rejected_source;  // which counters of which status, or why none
@@ -94,14 +108,14 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options);
 // Nearest-rank percentile of an ascending vector, q in [0, 1]; nullopt when empty.
 std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) noexcept;
 
-// One matched tick (for plots): time, applied voltage, measured and reference position.
+// One tick (for plots): time, applied voltage, measured and reference position.
 struct TrackPoint {
   double t_s;
   double u_V;
   double y_m;
   double y_ref_m;  // NaN when the tick had no reference
 };
-// Every sample of the range with its reference (if any), in log order.
-std::vector<TrackPoint> matched_ticks(const RunData& run, const ReportOptions& options);
+// Every sensor tick of the range, in log order.
+std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& options);
 
 }  // namespace hystloop::report

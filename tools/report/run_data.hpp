@@ -1,9 +1,15 @@
 #pragma once
-// What hystloop-report keeps of an LCM event log: the fields the figures need, one
-// record per logged message. Times are the log's event timestamps, i.e. the logger's
-// RECEIVE times [us since the epoch], not the senders' utime fields: one clock for
-// every channel, so sample-to-command latency can be taken from the log alone.
+// What hystloop-report keeps of an LCM event log: the fields the figures need. Times are the
+// log's event timestamps, i.e. the logger's RECEIVE times [us since the epoch], not the
+// senders' utime fields: one clock for every channel.
+//
+// HX_SENSOR and HX_COMMAND carry blocks of ticks (common/lcm/blocks.hpp). A sensor block is
+// received after its last tick was sampled, so tick i of a block of n received at time R is
+// dated R - (n - 1 - i) * dt_s: the last tick at the receive time, the others a tick period
+// apart before it. Command ticks are planned ahead of the clock and keep only what the figures
+// need: the parameter version each tick was computed with.
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -13,21 +19,53 @@
 
 namespace hystloop::report {
 
+// One tick of HX_SENSOR.
 struct SampleRecord {
-  std::int64_t recv_utime = 0;
+  std::int64_t recv_utime = 0;  // the block's receive time, back-dated to this tick (above)
   std::int64_t seq = 0;
   double u_V = 0.0;
+  double y_ref_m = 0.0;  // NaN: no reference
   double y_m = 0.0;
   std::int32_t flags = 0;
 };
 
-struct CommandRecord {
+// One HX_SENSOR block (its ticks are in RunData::samples).
+struct SensorBlockRecord {
   std::int64_t recv_utime = 0;
-  std::int64_t seq = 0;         // the tick it is meant for
-  std::int64_t sample_seq = -1; // the sample it answers (-1: none)
-  double u_V = 0.0;
-  double y_ref_m = 0.0;         // NaN: no reference
-  std::int32_t params_version = 0;
+  std::int64_t seq = 0;
+  std::int32_t n_ticks = 0;
+  double dt_s = 0.0;
+  std::int32_t buffer_depth_ticks = 0;
+  bool armed = false;  // no tick of the block is SAFE_STATE
+};
+
+// One HX_COMMAND block.
+struct CommandBlockRecord {
+  std::int64_t recv_utime = 0;
+  std::int64_t seq = 0;          // first tick it plans
+  std::int64_t sample_seq = -1;  // last sensor tick the compensator had (-1: none)
+  std::int32_t n_ticks = 0;
+};
+
+// params_version of the command ticks [first_seq, end_seq): consecutive ticks with one version.
+struct VersionRun {
+  std::int64_t first_seq = 0;
+  std::int64_t end_seq = 0;
+  std::int32_t version = 0;
+};
+
+// The parameter version each commanded tick was computed with. A tick is normally sent once;
+// a command tick at or before the highest one already logged is a re-send and is ignored (the
+// first logged command for a tick is the one the bridge used).
+class CommandVersions {
+ public:
+  void add(std::int64_t seq, std::int32_t version);
+  // The version of tick `seq`, if a command for it was logged.
+  std::optional<std::int32_t> at(std::int64_t seq) const noexcept;
+  const std::vector<VersionRun>& runs() const noexcept { return runs_; }
+
+ private:
+  std::vector<VersionRun> runs_;  // increasing, disjoint
 };
 
 struct ParamsRecord {
@@ -45,19 +83,36 @@ struct StatusRecord {
   std::int64_t late = 0;
   std::int64_t rejected = 0;
   std::vector<std::pair<std::string, std::int64_t>> counters;
+  std::int64_t utime = 0;        // the sender's time of the report [us]
+  std::int64_t start_utime = 0;  // the sender's start [us]
+
+  std::optional<std::int64_t> counter(const std::string& name) const {
+    const auto it = std::find_if(counters.begin(), counters.end(), [&](const auto& c) { return c.first == name; });
+    return it == counters.end() ? std::nullopt : std::optional<std::int64_t>(it->second);
+  }
+};
+
+// A DISARM or SHUTDOWN request on HX_CONTROL (what puts a bridge in the safe state on purpose).
+struct SafeRequestRecord {
+  std::int64_t recv_utime = 0;
+  std::string target;  // empty: every process
 };
 
 struct RunData {
-  std::vector<SampleRecord> samples;     // in log order
-  std::vector<CommandRecord> commands;
+  std::vector<SampleRecord> samples;  // every tick, in log order
+  std::vector<SensorBlockRecord> sensor_blocks;
+  std::vector<CommandBlockRecord> command_blocks;
+  CommandVersions command_versions;
   std::vector<ParamsRecord> params;
   std::vector<StatusRecord> statuses;
-  std::map<std::string, std::uint64_t> channel_counts;  // every event of every channel
+  std::vector<SafeRequestRecord> safe_requests;
+  std::map<std::string, std::uint64_t> channel_counts;           // every event of every channel
+  std::map<std::string, std::vector<std::int64_t>> event_times;  // receive time of every event, by channel
   std::uint64_t events = 0;
   std::uint64_t undecodable = 0;  // events on a known channel that failed to decode or validate
   std::optional<std::int64_t> first_event_utime;
 
-  // Time zero of every t_s: the first HX_SENSOR event, else the first event.
+  // Time zero of every t_s: the first HX_SENSOR tick, else the first event.
   std::int64_t time_zero_utime() const noexcept {
     if (!samples.empty()) return samples.front().recv_utime;
     return first_event_utime.value_or(0);

@@ -30,8 +30,9 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   for (const auto& file : files) json.value(file.string());
   json.end_array();
   json.field("time_axis",
-             "t_s = LCM event-log timestamp minus that of the first sensor sample [s]; the log's timestamps are the "
-             "logger's receive times");
+             "t_s = LCM event-log timestamp minus that of the first sensor tick [s]; the log's timestamps are the "
+             "logger's receive times; tick i of a sensor block of n received at R is dated R - (n - 1 - i) * dt_s");
+  json.field("error_definition", "e = y_ref_m - y_m of each HX_SENSOR tick with a finite y_ref_m");
   json.key("range").begin_object();
   json.field("from_s", finite_or_null(options.lower_s()));
   json.field("to_s", finite_or_null(options.upper_s()));
@@ -59,13 +60,24 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   json.field("armed_samples", m.armed_samples);
   json.field("late_samples", m.late_samples);
   json.field("late_command_fraction", m.late_command_fraction);
+  json.field("late_tick_fraction", m.late_command_fraction);
 
-  json.field("latency_definition",
-             "receive time of the command with sample_seq = k minus receive time of sample k, both as logged");
-  json.field("latency_samples", m.latencies_us.size());
-  json.field("latency_p50_us", m.latency_p50_us);
-  json.field("latency_p99_us", m.latency_p99_us);
-  json.field("latency_max_us", m.latency_max_us);
+  json.field("tick_period_s", m.tick_period_s);
+  json.field("sensor_blocks", m.sensor_blocks);
+  json.field("armed_blocks", m.armed_blocks);
+  json.field("buffer_min_depth_ticks", m.buffer_min_depth_ticks);
+
+  json.field("run_ahead_definition",
+             "per HX_COMMAND block: its first tick (seq) minus the last sensor tick the compensator had (sample_seq), "
+             "in ticks; blocks without a sample_seq are left out");
+  json.field("run_ahead_blocks", m.run_ahead_ticks.size());
+  json.field("run_ahead_min_ticks", m.run_ahead_min_ticks);
+  json.field("run_ahead_p01_ticks", m.run_ahead_p01_ticks);
+  json.field("run_ahead_p50_ticks", m.run_ahead_p50_ticks);
+  json.field("run_ahead_max_ticks", m.run_ahead_max_ticks);
+
+  json.field("watchdog_trips", m.watchdog_trips);
+  json.field("watchdog_trips_source", m.watchdog_trips_source);
 
   json.field("commands_rejected", m.commands_rejected);
   json.field("commands_rejected_source", m.commands_rejected_source);
@@ -99,6 +111,17 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   json.field("undecodable_events", m.undecodable);
   json.key("channels").begin_object();
   for (const auto& [name, count] : m.channels) json.field(name, count);
+  json.end_object();
+  json.field("messages_per_s_definition", "events of each channel received between the first and the last sensor "
+                                          "tick of the range, divided by duration_s");
+  json.key("messages_per_s").begin_object();
+  for (const auto& [name, rate] : m.messages_per_s) json.field(name, rate);
+  json.end_object();
+  json.field("cpu_fraction_definition", "per process: cpu_user_us + cpu_system_us of its HX_STATUS counters, last "
+                                        "minus first status in the range, over the wall time between them (1 = one "
+                                        "core busy)");
+  json.key("cpu_fraction").begin_object();
+  for (const auto& [process, fraction] : m.cpu_fraction) json.field(process, fraction);
   json.end_object();
   json.end_object();
   return json.str();

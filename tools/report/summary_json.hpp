@@ -1,6 +1,6 @@
 #pragma once
-// summary.json: every figure of ReportMetrics, in SI units (metres, seconds; latencies
-// in microseconds as the names say), null where a figure could not be computed.
+// summary.json: every figure of ReportMetrics, in SI units (metres, seconds; ticks and
+// fractions as the names say), null where a figure could not be computed.
 
 #include <filesystem>
 #include <string>

@@ -1,5 +1,5 @@
 // hystloop-ctl's plain parts: request validation and conversion, the health verdict, the
-// tick matcher and the watch line.
+// watch arithmetic and its line, the series tracker.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +15,9 @@
 #include "ctl_requests.hpp"
 #include "ctl_series.hpp"
 #include "ctl_watch.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "lcm/blocks.hpp"
+#include "lcm/message_storage.hpp"
 #include "lcm/message_checks.hpp"
 
 using namespace hystloop;
@@ -36,9 +38,9 @@ std::string field_of(F&& f) {
 }  // namespace
 
 TEST(CtlRequests, ModesByName) {
-  EXPECT_EQ(parse_mode("mem"), actuator_command_t::MODE_MEM);
-  EXPECT_EQ(parse_mode("katalenic"), actuator_command_t::MODE_KATALENIC);
-  EXPECT_EQ(parse_mode("off"), actuator_command_t::MODE_OFF);
+  EXPECT_EQ(parse_mode("mem"), command_block_t::MODE_MEM);
+  EXPECT_EQ(parse_mode("katalenic"), command_block_t::MODE_KATALENIC);
+  EXPECT_EQ(parse_mode("off"), command_block_t::MODE_OFF);
   try {
     parse_mode("experiment");  // has its own subcommand
     FAIL();
@@ -211,52 +213,40 @@ TEST(CtlHealth, StatusLine) {
   EXPECT_NE(line.find("ticks = 100"), std::string::npos) << line;
 }
 
-TEST(CtlWatch, MatcherPairsTicksInEitherOrder) {
-  TickMatcher m;
-  EXPECT_FALSE(m.on_command(10, 1e-6));
-  EXPECT_NEAR(*m.on_sample(10, 1.02e-6), 0.02e-6, 1e-18);
-  EXPECT_FALSE(m.on_sample(10, 5.0));  // already matched: no second pairing
-  EXPECT_FALSE(m.on_sample(11, 2e-6));
-  EXPECT_NEAR(*m.on_command(11, 1.5e-6), 0.5e-6, 1e-18);
-  EXPECT_FALSE(m.on_command(12, NAN));  // no reference
-  EXPECT_FALSE(m.on_sample(12, 1e-6));
-  // A stale half kSlots ticks back is overwritten, not matched.
-  EXPECT_FALSE(m.on_command(13, 1e-6));
-  EXPECT_FALSE(m.on_command(13 + static_cast<std::int64_t>(TickMatcher::kSlots), 2e-6));
-  EXPECT_FALSE(m.on_sample(13, 1e-6));
-}
-
-TEST(CtlWatch, RandomInterleavingGivesTheExactRms) {
+// The error of a tick is y_ref - y as the bridge recorded both; ticks without a reference have
+// none; the buffer depth counts only for blocks with no tick in the safe state.
+TEST(CtlWatch, SensorBlocksGiveTheExactRmsAndTheLowestArmedBufferDepth) {
   std::mt19937_64 rng(11);
   std::normal_distribution<double> noise(0.0, 25e-9);
-  std::uniform_real_distribution<double> lag(-3.5, 3.5);  // a command arrives a few ticks before/after its sample
-  constexpr std::int64_t kTicks = 10'000;
+  constexpr std::int64_t kBlocks = 1000, kBlockTicks = 10;
   auto ref = [](std::int64_t k) { return 1e-6 * std::sin(0.01 * static_cast<double>(k)); };
-  std::vector<double> errors(kTicks);
-  struct Arrival {
-    double at;
-    std::int64_t seq;
-    bool command;
-  };
-  std::vector<Arrival> arrivals;
-  double sum = 0;
-  for (std::int64_t k = 0; k < kTicks; ++k) {
-    const double e = noise(rng);
-    errors[static_cast<std::size_t>(k)] = e;
-    sum += e * e;
-    arrivals.push_back({static_cast<double>(k) + lag(rng), k, true});
-    arrivals.push_back({static_cast<double>(k), k, false});
-  }
-  std::sort(arrivals.begin(), arrivals.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
-  TickMatcher m;
+  sensor_block_t b{};
+  reserve_storage(b);
   WatchSecond second;
-  for (const auto& a : arrivals) {
-    const auto e = a.command ? m.on_command(a.seq, ref(a.seq))
-                             : m.on_sample(a.seq, ref(a.seq) + errors[static_cast<std::size_t>(a.seq)]);
-    if (e) second.add_error(*e);
+  double sum = 0.0, max_abs = 0.0;
+  std::uint64_t tracking = 0;
+  for (std::int64_t n = 0; n < kBlocks; ++n) {
+    begin_block(b, n * kBlockTicks, 1'000'000 + n * 1000, 1e-4);
+    for (std::int64_t k = n * kBlockTicks; k < (n + 1) * kBlockTicks; ++k) {
+      const double e = noise(rng);
+      const bool has_ref = k % 7 != 0;
+      if (has_ref) sum += e * e, max_abs = std::max(max_abs, std::abs(e)), ++tracking;
+      SensorTick t{};
+      t.y_ref_m = has_ref ? ref(k) : std::nan("");
+      t.y_m = ref(k) - e;  // e = y_ref - y
+      t.flags = n == 3 && k % 10 == 9 ? sensor_block_t::SAFE_STATE : 0;
+      append_tick(b, t);
+    }
+    b.buffer_depth_ticks = n == 3 ? 0 : static_cast<std::int32_t>(100 + n % 50);
+    second.add_sensor_block(b);
   }
-  ASSERT_EQ(second.tracking, static_cast<std::uint64_t>(kTicks));
-  EXPECT_NEAR(*second.rms_m(), std::sqrt(sum / static_cast<double>(kTicks)), 1e-15);
+  EXPECT_EQ(second.samples, static_cast<std::uint64_t>(kBlocks * kBlockTicks));
+  ASSERT_EQ(second.tracking, tracking);
+  EXPECT_NEAR(*second.rms_m(), std::sqrt(sum / static_cast<double>(tracking)), 1e-15);
+  EXPECT_NEAR(second.max_abs_m, max_abs, 1e-18);
+  EXPECT_EQ(*second.buffer_min_ticks, 100);  // block 3's 0 was in the safe state
+  EXPECT_FALSE(WatchSecond{}.rms_m());
+  EXPECT_FALSE(WatchSecond{}.buffer_min_ticks);
 }
 
 TEST(CtlWatch, LineIsTidy) {
@@ -269,13 +259,13 @@ TEST(CtlWatch, LineIsTidy) {
   l.params_latest = 4;
   l.late_total = 5;
   l.late_delta = 1;
-  l.latency_p99_us = 120.4;
+  l.second.buffer_min_ticks = 212;
   l.bridge_state = "HEALTHY";
   EXPECT_EQ(format_watch_line(l),
             "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
-            "lat p99 120 us  bridge HEALTHY");
+            "buf min 212  bridge HEALTHY");
   EXPECT_EQ(format_watch_line(WatchLine{}),
-            "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  lat p99 --  bridge --");
+            "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  buf min --  bridge --");
 }
 
 // Banning's series as requests: per planned experiment a settling sine then the measured one,

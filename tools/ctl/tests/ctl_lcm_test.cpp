@@ -21,6 +21,9 @@
 #include <thread>
 #include <vector>
 
+#include "hystloop/command_block_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
@@ -149,15 +152,17 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
       {{"reset-counters", "bridge"}, control_t::RESET_COUNTERS, "bridge", {}},
       {{"stop-experiment"}, control_t::STOP_EXPERIMENT, "", {}},
       {{"mode", "mem"}, control_t::SET_MODE, "",
-       [](const control_t& c) { EXPECT_EQ(c.mode, actuator_command_t::MODE_MEM); }},
+       [](const control_t& c) { EXPECT_EQ(c.mode, command_block_t::MODE_MEM); }},
       {{"mode", "pi", "--target", "compensator"}, control_t::SET_MODE, "compensator",
-       [](const control_t& c) { EXPECT_EQ(c.mode, actuator_command_t::MODE_PI); }},
-      {{"gains", "--kp", "0.5", "--ki", "20", "--kd", "1e-5"}, control_t::SET_GAINS, "",
+       [](const control_t& c) { EXPECT_EQ(c.mode, command_block_t::MODE_PI); }},
+      {{"gains", "--kp", "0.5", "--ki", "20", "--kd", "1e-5"}, control_t::SET_GAINS, "bridge",  // the servo's home
        [](const control_t& c) {
          EXPECT_EQ(c.kp, 0.5);
          EXPECT_EQ(c.ki, 20.0);
          EXPECT_EQ(c.kd, 1e-5);
        }},
+      {{"gains", "--kp", "0.1", "--target", "bridge2"}, control_t::SET_GAINS, "bridge2",
+       [](const control_t& c) { EXPECT_EQ(c.kp, 0.1); }},
       {{"experiment", "--amplitude", "50", "--frequency", "2", "--duration", "10", "--offset", "-5", "--kind",
         "triangle"},
        control_t::START_EXPERIMENT, "",
@@ -240,16 +245,14 @@ TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
   EXPECT_TRUE(got[0].valid);
   EXPECT_EQ(got[0].source, "hystloop-ctl");
 
-  // Without --version: one above the version the rig uses (here: commands with v5).
-  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
-  actuator_command_t cmd{};
-  cmd.utime = now_us();
-  cmd.sample_seq = -1;
-  cmd.y_ref_m = 0.0;
-  cmd.params_version = 5;
+  // Without --version: one above the version the rig uses (here: command ticks with v5, one v4).
+  Publisher<command_block_t> commands(*lcm_, ch_.command);
+  command_block_t cmd{};
+  std::int64_t seq = 0;
   got.clear();
   r = run_ctl(with_url({"params", "--c1", "1e-7", "--c2", "0", "--c3", "1", "--listen", "0.5"}), lcm_.get(), [&] {
-    ++cmd.seq;
+    begin_block(cmd, seq, now_us(), seq - 1);
+    for (int i = 0; i < 10; ++i, ++seq) append_tick(cmd, {seq, 0.0, 0.0, i == 9 ? 4 : 5, command_block_t::MODE_MEM});
     commands.publish(cmd);
   });
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -299,28 +302,25 @@ TEST_F(CtlLcmTest, WaitHealthyReturnsAsSoonAsEveryoneIsHealthy) {
   EXPECT_NE(r.out.find("HEALTHY"), std::string::npos) << r.out;
 }
 
-TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfMatchedTicks) {
-  Publisher<sensor_sample_t> samples(*lcm_, ch_.sensor);
-  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfTheSensorTicks) {
+  Publisher<sensor_block_t> samples(*lcm_, ch_.sensor);
+  Publisher<command_block_t> commands(*lcm_, ch_.command);
   Publisher<service_status_t> status(*lcm_, ch_.status);
+  sensor_block_t s{};
+  command_block_t c{};
   std::int64_t k = 0;
   int ticks = 0;
-  auto play_rig = [&] {  // ~20 ticks every 2 ms: about 10 kHz; error exactly 20 nm
+  auto play_rig = [&] {  // a block of 20 ticks every ~2 ms: about 10 kHz; error exactly 20 nm
+    begin_block(s, k, now_us(), 1e-4);
+    begin_block(c, k + 300, now_us(), k + 19);
     for (int i = 0; i < 20; ++i, ++k) {
       const double ref = 1e-6 * std::sin(0.001 * static_cast<double>(k));
-      actuator_command_t c{};
-      c.utime = now_us();
-      c.seq = k;
-      c.sample_seq = k - 1;
-      c.y_ref_m = ref;
-      c.params_version = 3;
-      commands.publish(c);
-      sensor_sample_t s{};
-      s.utime = now_us();
-      s.seq = k;
-      s.y_m = ref + 20e-9;
-      samples.publish(s);
+      append_tick(s, {0, k, 0.0, 0.0, 0.0, i == 0 ? std::nan("") : ref, ref - 20e-9, 0});  // one without a reference
+      append_tick(c, {k + 300, 0.0, ref, 3, command_block_t::MODE_MEM});
     }
+    s.buffer_depth_ticks = 280 + static_cast<std::int32_t>(k % 7);
+    samples.publish(s);
+    commands.publish(c);
     if (++ticks % 100 == 0) status.publish(status_of("bridge", service_status_t::HEALTHY, 7));
   };
   const Result r = run_ctl(with_url({"watch", "--seconds", "2.5"}), lcm_.get(), play_rig);
@@ -334,7 +334,7 @@ TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfMatchedTicks) {
   EXPECT_NE(last.find("max    20.0 nm"), std::string::npos) << last;
   EXPECT_NE(last.find("params v3"), std::string::npos) << last;
   EXPECT_NE(last.find("late 7"), std::string::npos) << last;
-  EXPECT_NE(last.find("lat p99 95 us"), std::string::npos) << last;
+  EXPECT_NE(last.find("buf min 280 "), std::string::npos) << last;  // the lowest of 280 .. 286
 }
 
 // The series needs a running loop that is not in an experiment: both refusals name the cause.
@@ -343,17 +343,14 @@ TEST_F(CtlLcmTest, BanningSeriesRefusesWithoutCommandsOrWhileAnExperimentRuns) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no command on HX_COMMAND within 1 s"), std::string::npos) << r.err;
 
-  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  Publisher<command_block_t> commands(*lcm_, ch_.command);
   std::vector<control_t> requests;
   Subscription<control_t> control(*lcm_, ch_.control, [&](const control_t& c, std::int64_t) { requests.push_back(c); });
   std::int64_t k = 0;
+  command_block_t c{};
   auto experiment_running = [&] {
-    actuator_command_t c{};
-    c.utime = now_us();
-    c.seq = k++;
-    c.sample_seq = c.seq - 2;
-    c.y_ref_m = std::nan("");
-    c.mode = actuator_command_t::MODE_EXPERIMENT;
+    begin_block(c, k, now_us(), k - 200);
+    for (int i = 0; i < 10; ++i, ++k) append_tick(c, {k, 1.0, std::nan(""), 0, command_block_t::MODE_EXPERIMENT});
     commands.publish(c);
   };
   r = run_ctl(with_url({"experiment", "--banning-series"}), lcm_.get(), experiment_running);

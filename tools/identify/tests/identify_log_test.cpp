@@ -44,10 +44,11 @@ TEST_F(IdentifyLog, SkipsFlaggedSamplesCountsTheGapAndIgnoresOtherChannels) {
   write_log(path("run.lcmlog"), record, /*corrupt=*/true);
   const LogSamples s = read_sample_logs({path("run.lcmlog")}, {});
   EXPECT_EQ(s.files, 1u);
-  EXPECT_EQ(s.sensor_events, record.size() + 2);
+  EXPECT_EQ(s.sensor_events, blocks_written(record, 0, record.size()) + 2);
+  EXPECT_EQ(s.sensor_ticks, record.size());
   EXPECT_EQ(s.safe_state, kSafeCount);
   EXPECT_EQ(s.sensor_fault, kFaultCount);
-  EXPECT_EQ(s.undecodable, 2u);  // a mem_params_t and a truncated sample on HX_SENSOR
+  EXPECT_EQ(s.undecodable, 2u);  // a mem_params_t and a truncated block on HX_SENSOR
   EXPECT_EQ(s.duplicates, 0u);
   EXPECT_EQ(s.gaps, 1u);
   EXPECT_EQ(s.missing, kGapCount);
@@ -72,12 +73,12 @@ TEST_F(IdentifyLog, SkipsFlaggedSamplesCountsTheGapAndIgnoresOtherChannels) {
 TEST_F(IdentifyLog, TimeFromUtimeAndAnotherRig) {
   auto record = with_faults(mem_record(truth_));
   for (auto& r : record) r.utime += (r.seq - kFirstSeq) * 100;  // a 5 kHz clock in utime: 200 us per tick
-  write_log(path("run.lcmlog"), record);
+  write_log(path("run.lcmlog"), record, 0, record.size(), false, "HX_SENSOR", 2e-4);
   LogReadOptions o;
   o.time_base = LogTimeBase::utime;
   const LogSamples s = read_sample_logs({path("run.lcmlog")}, o);
   EXPECT_NEAR(s.table.t.back(), static_cast<double>(kTicks - 1) * 2e-4, 1e-9);
-  // RIG2_SENSOR holds a copy of every 1000th event (two of them flagged), its own y.
+  // RIG2_SENSOR holds a copy of every 1000th tick (two of them flagged), its own y.
   o = {};
   o.sensor_channel = "RIG2_SENSOR";
   const LogSamples other = read_sample_logs({path("run.lcmlog")}, o);
@@ -138,14 +139,28 @@ TEST_F(IdentifyLog, RotatedFilesAreOneRecordInTheOrderGiven) {
   EXPECT_THROW(read_sample_logs({path("run.001.lcmlog"), path("run.001.lcmlog")}, {}), SampleLogError);
 }
 
-TEST_F(IdentifyLog, RepeatedSeqIsSkippedAndCounted) {
+TEST_F(IdentifyLog, RepeatedTicksAreSkippedAndCounted) {
   auto record = mem_record(truth_);
-  record.insert(record.begin() + 300, record[299]);
+  record.insert(record.begin() + 300, record[299]);  // the next block starts with tick 299 again
   write_log(path("run.lcmlog"), record);
   const LogSamples s = read_sample_logs({path("run.lcmlog")}, {});
   EXPECT_EQ(s.duplicates, 1u);
   EXPECT_EQ(s.table.t.size(), kTicks);
   EXPECT_EQ(s.gaps, 0u);
+  // A whole block logged twice.
+  record = mem_record(truth_);
+  {
+    lcm::LogFile log(path("twice.lcmlog"), "w");
+    std::int64_t eventnum = 0;
+    for (const auto& [first, last] : block_ranges(record, 0, 100)) {
+      const auto bytes = encoded(make_block(record, first, last));
+      write_event(log, eventnum, record[last - 1].utime, "HX_SENSOR", bytes);
+      if (first == 50) write_event(log, eventnum, record[last - 1].utime, "HX_SENSOR", bytes);
+    }
+  }
+  const LogSamples twice = read_sample_logs({path("twice.lcmlog")}, {});
+  EXPECT_EQ(twice.duplicates, kBlockTicks);
+  EXPECT_EQ(twice.table.t.size(), 100u);
 }
 
 TEST_F(IdentifyLog, NonFiniteValueIsRefusedNamingFileEventAndSeq) {
@@ -259,7 +274,8 @@ TEST_F(IdentifyLog, ToolRecoversMemFromRotatedLogsAndReportsSkipsAndTheGap) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("log: 2 file(s)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("samples: " + std::to_string(kKept) + " kept"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("skipped: 10 SAFE_STATE, 3 SENSOR_FAULT, 0 repeated seq, 2 undecodable"), std::string::npos)
+  EXPECT_NE(r.output.find("skipped: 10 SAFE_STATE, 3 SENSOR_FAULT, 0 repeated seq, 2 block(s) undecodable"),
+            std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("seq gaps: 1 (50 samples missing)"), std::string::npos) << r.output;
   EXPECT_GT(fit_residual_nm(r.output), 0.0) << r.output;

@@ -20,7 +20,8 @@
 #include <thread>
 #include <vector>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
@@ -151,16 +152,16 @@ TEST_F(IdentifyPublish, VersionSupersedesTheSetInUse) {
   write_log(path("run.lcmlog"), mem_record(truth_));
   // A rig whose compensator uses v6 (in its commands) and whose re-identifier sent v7.
   Publisher<mem_params_t> params(*lcm_, ch_.params);
-  Publisher<actuator_command_t> commands(*lcm_, ch_.command);
+  Publisher<command_block_t> commands(*lcm_, ch_.command);
   mem_params_t in_use{};
   in_use.version = 7;
   in_use.c1 = 4e-9;
   in_use.c3 = 1.0;
   in_use.valid = true;
   in_use.source = "reident@test";
-  actuator_command_t cmd{};
-  cmd.params_version = 6;
-  cmd.sample_seq = -1;
+  command_block_t cmd{};
+  begin_block(cmd, 0, kFirstUtime, -1);
+  for (std::int64_t k = 0; k < 10; ++k) append_tick(cmd, {k, 0.0, 0.0, k == 9 ? 5 : 6, command_block_t::MODE_MEM});
   int ticks = 0;
   const Result r = run_tool(args(path("run.lcmlog"), {"--listen-s", "0.3"}), *lcm_, [&] {
     commands.publish(cmd);
@@ -171,7 +172,7 @@ TEST_F(IdentifyPublish, VersionSupersedesTheSetInUse) {
   ASSERT_GE(received_.size(), 1u) << r.out;
   EXPECT_EQ(received_.front().version, 8);
 
-  // Only the commands: a compensator does not repeat HX_PARAMS, its commands carry the version.
+  // Only the commands: a compensator does not repeat HX_PARAMS, its command ticks carry the version.
   received_.clear();
   const Result c = run_tool(args(path("run.lcmlog"), {"--listen-s", "0.3"}), *lcm_, [&] { commands.publish(cmd); });
   ASSERT_EQ(c.exit_code, 0) << c.out;

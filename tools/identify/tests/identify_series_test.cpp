@@ -1,8 +1,9 @@
 // Banning's series from a live loop's log: the requests hystloop-ctl sends (its banning_series),
-// run by the real Compensator against the simulated Banning stage tick by tick, recorded as the
-// logger would (HX_CONTROL, HX_COMMAND, HX_SENSOR) with lcm::LogFile. The splitter must find
-// every experiment at the ticks the compensator ran it, label settling, find a stopped series,
-// a request missing from the log and samples missing from it; the tool must fit the stage back.
+// run by the real Compensator (planning ahead, in blocks) against the simulated Banning stage
+// tick by tick, recorded as the logger would (HX_CONTROL, HX_COMMAND and HX_SENSOR blocks) with
+// lcm::LogFile. The splitter must find every experiment at the ticks the compensator ran it,
+// label settling, find a stopped series, a request missing from the log and samples missing
+// from it; the tool must fit the stage back.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -18,9 +19,11 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ctl_series.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
+#include "lcm/blocks.hpp"
+#include "lcm/message_storage.hpp"
 #include "log_experiments.hpp"
 #include "log_samples.hpp"
 #include "loop/compensator.hpp"
@@ -63,7 +66,12 @@ struct Recording {
   std::int64_t first_experiment_tick = -1;
 };
 
-// The loop: the command for tick k + 2 answers the sample of tick k and is applied on time.
+// The loop: the bridge sends a sensor block every kBlockTicks ticks; the compensator observes
+// it and answers with the command ticks it plans up to its horizon ahead, each tick once; the
+// bridge applies the command of each tick (no servo: every tick here has no reference or gains
+// of zero), holding the last one when none arrived.
+constexpr std::int64_t kBlockTicks = 10;
+
 Recording record_series(const std::string& path, const std::vector<ctl::SeriesStep>& steps, const Faults& faults,
                         double seconds) {
   Recording rec;
@@ -76,22 +84,36 @@ Recording record_series(const std::string& path, const std::vector<ctl::SeriesSt
   CompensatorConfig cc;
   cc.mode = FeedforwardMode::kOff;
   Compensator comp(cc);
-  std::array<double, 64> applied{};
+  std::array<CommandTick, 16'384> buffer{};  // the bridge's jitter buffer, by tick
+  for (auto& c : buffer) c.seq = -1;
+  std::array<CommandTick, command_block_t::MAX_TICKS> planned{};
+  std::vector<SensorTick> block;  // the ticks of the block being sampled
+  sensor_block_t sensor{};
+  command_block_t command{};
+  reserve_storage(sensor);
+  reserve_storage(command);
+  CommandTick held{};
+  // Logs ticks [first, last) of `block` as one HX_SENSOR block.
+  auto log_sensor = [&](std::size_t first, std::size_t last) {
+    if (first == last) return;
+    begin_block(sensor, block[first].seq, block[first].utime, cc.dt_s);
+    for (std::size_t i = first; i < last; ++i) append_tick(sensor, block[i]);
+    sensor.buffer_depth_ticks = 200;
+    write_event(log, eventnum, block[last - 1].utime, "HX_SENSOR", encoded(sensor));
+  };
   const auto ticks = static_cast<std::int64_t>(seconds / cc.dt_s);
   for (std::int64_t seq = kFirstSeq; seq < kFirstSeq + ticks; ++seq) {
     const std::int64_t utime = kUtime0 + (seq - kFirstSeq) * 100;
     const double t = static_cast<double>(seq) * cc.dt_s;
-    const double u = applied[static_cast<std::size_t>(seq) % applied.size()];
+    const CommandTick& slot = buffer[static_cast<std::size_t>(seq) % buffer.size()];
+    const bool on_time = slot.seq == seq;
+    if (on_time) held = slot;
+    const double u = held.u_ff_V;
     const double y = stage.step(u, t, cc.dt_s);
-    sensor_sample_t s{};
-    s.utime = utime;
-    s.seq = seq;
-    s.u_V = u;
-    s.y_m = y;
-    s.flags = sensor_sample_t::SIMULATED;
-    if (seq >= faults.late_from && seq < faults.late_from + faults.late_count) s.flags |= sensor_sample_t::LATE_COMMAND;
-    const bool dropped = seq >= faults.drop_samples_from && seq < faults.drop_samples_from + faults.drop_samples_count;
-    if (!dropped) write_event(log, eventnum, utime, "HX_SENSOR", encoded(s));
+    SensorTick s{utime, seq, u, u, 0.0, on_time ? held.y_ref_m : std::nan(""), y, sensor_block_t::SIMULATED};
+    if (!on_time) s.flags |= sensor_block_t::LATE_COMMAND;
+    if (seq >= faults.late_from && seq < faults.late_from + faults.late_count) s.flags |= sensor_block_t::LATE_COMMAND;
+    block.push_back(s);
     if (seq == kRequestTick) {
       for (std::size_t i = 0; i < steps.size(); ++i) {
         control_t c{};
@@ -119,20 +141,31 @@ Recording record_series(const std::string& path, const std::vector<ctl::SeriesSt
       write_event(log, eventnum, utime, "HX_CONTROL", encoded(c));
       comp.stop_experiment();
     }
-    const auto out = comp.update({seq, u, y});
-    if (!out) continue;
-    actuator_command_t cmd{};
-    cmd.utime = utime + 20;
-    cmd.seq = out->seq;
-    cmd.sample_seq = seq;
-    cmd.u_V = out->u_V;
-    cmd.u_ff_V = out->u_ff_V;
-    cmd.u_fb_V = out->u_fb_V;
-    cmd.y_ref_m = out->y_ref_m;
-    cmd.mode = static_cast<std::int8_t>(out->mode);
-    if (out->mode == FeedforwardMode::kExperiment && rec.first_experiment_tick < 0) rec.first_experiment_tick = out->seq;
-    write_event(log, eventnum, utime + 20, "HX_COMMAND", encoded(cmd));
-    applied[static_cast<std::size_t>(out->seq) % applied.size()] = out->u_V;
+    if (static_cast<std::int64_t>(block.size()) < kBlockTicks) continue;
+    // The block goes out; the logger records what was not dropped.
+    std::size_t run = 0;
+    for (std::size_t i = 0; i < block.size(); ++i) {
+      const std::int64_t k = block[i].seq;
+      if (k >= faults.drop_samples_from && k < faults.drop_samples_from + faults.drop_samples_count) {
+        log_sensor(run, i);
+        run = i + 1;
+      }
+    }
+    log_sensor(run, block.size());
+    for (const auto& b : block) comp.observe({b.seq, b.u_V, b.y_m});
+    block.clear();
+    // The compensator answers with the ticks it has not sent yet.
+    while (const std::size_t n = comp.plan(planned)) {
+      begin_block(command, planned[0].seq, utime + 20, comp.last_seq());
+      for (std::size_t i = 0; i < n; ++i) {
+        append_tick(command, planned[i]);
+        buffer[static_cast<std::size_t>(planned[i].seq) % buffer.size()] = planned[i];
+        if (planned[i].mode == command_block_t::MODE_EXPERIMENT && rec.first_experiment_tick < 0) {
+          rec.first_experiment_tick = planned[i].seq;
+        }
+      }
+      write_event(log, eventnum, utime + 20, "HX_COMMAND", encoded(command));
+    }
   }
   return rec;
 }
@@ -294,13 +327,18 @@ TEST_F(IdentifySeries, ToolFitsTheStageFromTheLog) {
 
 // --experiment N: any model on one experiment the loop ran, as listed.
 TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
-  record_series(path("run.lcmlog"), steps_, {}, seconds_);
+  const Recording rec = record_series(path("run.lcmlog"), steps_, {}, seconds_);
+  const auto schedule = experiment_schedule(rec.first_experiment_tick, rec.specs, 1e-4);
   const std::string tool = std::string(HYSTLOOP_IDENTIFY_EXE) + " " + path("run.lcmlog");
-  // Experiment 3 is the +60 V offset loop (4000 samples): a line through it passes through
-  // the loop's centre, which lies on y = a u (Banning, Theorem 3).
+  // Experiment 3 is the +60 V offset loop (2 periods at 5 Hz, 4000 ticks give or take the
+  // schedule's rounding): a line through it passes through the loop's centre, which lies on
+  // y = a u (Banning, Theorem 3).
+  const std::int64_t ticks = schedule[3].end - schedule[3].begin;
+  EXPECT_NEAR(static_cast<double>(ticks), 4000.0, 1.0);
   auto r = testing::run_tool(tool + " --model linear --experiment 3");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("fitting experiment 3: 4000 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fitting experiment 3: " + std::to_string(ticks) + " samples"), std::string::npos)
+      << r.output;
   double gain = 0.0, offset = 0.0;
   ASSERT_EQ(std::sscanf(r.output.substr(r.output.find("linear: gain = ")).c_str(),
                         "linear: gain = %lf m/V, offset = %lf m", &gain, &offset), 2)

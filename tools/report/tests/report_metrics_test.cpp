@@ -14,13 +14,26 @@ namespace {
 
 constexpr std::int64_t kT0 = 1'000'000'000;
 
+SampleRecord tick(std::int64_t t, std::int64_t seq, double y_ref, double y, std::int32_t flags = 0) {
+  return {t, seq, 0.0, y_ref, y, flags};
+}
+
+// ticks at tick_us apart, reference 1 um, y off by 0, 1 or 2 nm; every command at version 0.
 RunData ramp_run(std::int64_t ticks, std::int64_t tick_us) {
   RunData run;
   for (std::int64_t k = 0; k < ticks; ++k) {
-    run.samples.push_back({kT0 + k * tick_us, k, 0.0, 1e-6 + 1e-9 * static_cast<double>(k % 3), 0});
-    run.commands.push_back({kT0 + k * tick_us - 10, k, -1, 0.0, 1e-6, 0});
+    run.samples.push_back(tick(kT0 + k * tick_us, k, 1e-6, 1e-6 + 1e-9 * static_cast<double>(k % 3)));
+    run.command_versions.add(k, 0);
   }
   return run;
+}
+
+StatusRecord status(std::int64_t t, const std::string& process, std::vector<std::pair<std::string, std::int64_t>> c,
+                    std::int64_t start_utime = 0) {
+  StatusRecord s{t, process, 1, 0, 0, std::move(c)};
+  s.utime = t;
+  s.start_utime = start_utime;
+  return s;
 }
 
 }  // namespace
@@ -66,58 +79,155 @@ TEST(ComputeMetrics, RandomErrorsGiveTheirRms) {
   for (std::int64_t k = 0; k < 5000; ++k) {
     const double e = noise(rng);
     sum += e * e;
-    run.samples.push_back({kT0 + k * 100, k, 0.0, 2e-6 + e, 0});
-    run.commands.push_back({kT0 + k * 100 - 50, k, k - 1, 0.0, 2e-6, 3});
+    run.samples.push_back(tick(kT0 + k * 100, k, 2e-6, 2e-6 - e));
+    run.command_versions.add(k, 3);
   }
+  for (std::int64_t b = 0; b < 500; ++b) run.command_blocks.push_back({kT0 + b * 1000, b * 10 + 305, b * 10 + 4 - b % 7, 10});
   const auto m = compute_metrics(run, {});
   EXPECT_NEAR(*m.rms_error_m, std::sqrt(sum / 5000.0), 1e-18);
   EXPECT_NEAR(*m.rms_error_m, 30e-9, 2e-9);
   ASSERT_EQ(m.per_second.size(), 1u);
   EXPECT_EQ(m.per_second[0].params_version, 3);
-  EXPECT_EQ(*m.latency_p50_us, 50.0);  // command k at -50 us, sample k-1 at -100 us
-  EXPECT_EQ(m.latencies_us.size(), 4999u);
+  EXPECT_EQ(m.run_ahead_ticks.size(), 500u);
+  EXPECT_EQ(*m.run_ahead_min_ticks, 301.0);  // b % 7 == 0
+  EXPECT_EQ(*m.run_ahead_max_ticks, 307.0);
+  EXPECT_EQ(*m.run_ahead_p50_ticks, 304.0);  // 7 values nearly equally often
   EXPECT_EQ(*m.late_command_fraction, 0.0);
 }
 
 TEST(ComputeMetrics, EmptySecondsAreListedAndCarryTheVersion) {
   RunData run;
-  run.samples.push_back({kT0, 0, 0, 1e-6, 0});
-  run.commands.push_back({kT0, 0, -1, 0, 1e-6, 5});
-  run.samples.push_back({kT0 + 3'500'000, 1, 0, 1e-6, 0});  // seconds 1 and 2 have nothing
+  run.samples.push_back(tick(kT0, 0, 1e-6, 1e-6));
+  run.command_versions.add(0, 5);
+  run.samples.push_back(tick(kT0 + 3'500'000, 1, std::nan(""), 1e-6));  // seconds 1 and 2 have nothing
   const auto m = compute_metrics(run, {});
   ASSERT_EQ(m.per_second.size(), 4u);
   EXPECT_EQ(m.per_second[2].tracking_samples, 0u);
   EXPECT_FALSE(m.per_second[2].rms_error_m);
   EXPECT_EQ(m.per_second[3].params_version, 5);
   EXPECT_EQ(m.seq_gaps, 0);
-  EXPECT_EQ(m.tracking_samples, 1u);  // sample 1 has no command: not tracking
+  EXPECT_EQ(m.tracking_samples, 1u);  // tick 1 has no reference: not tracking
 }
 
-TEST(ComputeMetrics, FirstCommandForATickWinsAndNanMeansNoReference) {
+TEST(ComputeMetrics, TheErrorIsTheReferenceMinusTheMeasuredPositionOfEachTick) {
   RunData run = ramp_run(10, 100);
-  run.commands.push_back({kT0 + 50, 1, -1, 0, 5e-6, 0});  // a later duplicate for tick 1
-  run.commands[2].y_ref_m = std::nan("");                 // tick 2 has no reference
+  run.samples[2].y_ref_m = std::nan("");  // tick 2 has no reference
+  run.samples[4].y_m = 1e-6 + 7e-9;
   const auto m = compute_metrics(run, {});
   EXPECT_EQ(m.tracking_samples, 9u);
-  EXPECT_NEAR(*m.max_abs_error_m, 2e-9, 1e-18);
+  EXPECT_NEAR(*m.max_abs_error_m, 7e-9, 1e-18);
+  const auto points = track_points(run, {});
+  ASSERT_EQ(points.size(), 10u);
+  EXPECT_TRUE(std::isnan(points[2].y_ref_m));
+  EXPECT_EQ(points[4].y_m, 1e-6 + 7e-9);
+}
+
+TEST(CommandVersions, FirstLoggedCommandForATickWinsAndRunsCoalesce) {
+  CommandVersions v;
+  for (std::int64_t k = 10; k < 20; ++k) v.add(k, 1);
+  for (std::int64_t k = 15; k < 25; ++k) v.add(k, 2);  // 15..19 re-sent: ignored
+  v.add(30, 2);                                         // after a gap
+  EXPECT_EQ(v.runs().size(), 3u);
+  EXPECT_FALSE(v.at(9));
+  EXPECT_EQ(*v.at(10), 1);
+  EXPECT_EQ(*v.at(19), 1);
+  EXPECT_EQ(*v.at(20), 2);
+  EXPECT_EQ(*v.at(24), 2);
+  EXPECT_FALSE(v.at(25));
+  EXPECT_EQ(*v.at(30), 2);
+  EXPECT_FALSE(v.at(31));
 }
 
 TEST(ComputeMetrics, NothingArmedGivesNoLateFraction) {
   RunData run = ramp_run(10, 100);
   for (auto& s : run.samples) s.flags = 2 | 16;  // SAFE_STATE | LATE_COMMAND
+  run.sensor_blocks.push_back({kT0 + 900, 0, 10, 1e-4, 0, false});
   const auto m = compute_metrics(run, {});
   EXPECT_EQ(m.armed_samples, 0u);
   EXPECT_FALSE(m.late_command_fraction);
+  EXPECT_EQ(m.sensor_blocks, 1u);
+  EXPECT_FALSE(m.buffer_min_depth_ticks);  // only armed blocks count
+  EXPECT_EQ(*m.watchdog_trips, 0);         // never armed: nothing tripped
+}
+
+TEST(ComputeMetrics, LateFractionAndBufferDepthCountArmedTicksAndBlocksOnly) {
+  RunData run = ramp_run(100, 100);
+  for (std::int64_t k = 0; k < 100; ++k) {
+    auto& s = run.samples[static_cast<std::size_t>(k)];
+    if (k < 20) s.flags |= 2;                // SAFE_STATE: not counted, late or not
+    if (k % 10 == 3) s.flags |= 16;          // LATE_COMMAND: ticks 3, 13 safe; 23 .. 93 armed
+  }
+  for (std::int64_t b = 0; b < 10; ++b) {
+    run.sensor_blocks.push_back({kT0 + b * 1000 + 900, b * 10, 10, 1e-4, static_cast<std::int32_t>(b == 1 ? 0 : 40 - b), b >= 2});
+  }
+  const auto m = compute_metrics(run, {});
+  EXPECT_EQ(m.armed_samples, 80u);
+  EXPECT_EQ(m.late_samples, 8u);
+  EXPECT_DOUBLE_EQ(*m.late_command_fraction, 0.1);
+  EXPECT_EQ(m.sensor_blocks, 10u);
+  EXPECT_EQ(m.armed_blocks, 8u);
+  EXPECT_EQ(*m.buffer_min_depth_ticks, 31);  // block 9; block 1's 0 was in the safe state
+  EXPECT_EQ(*m.tick_period_s, 1e-4);
+}
+
+TEST(ComputeMetrics, WatchdogTripsFromTheBridgeCounterElseFromTheTicks) {
+  RunData run = ramp_run(100, 10'000);  // 10 ms apart
+  auto safe = [&](std::int64_t from, std::int64_t to) {
+    for (std::int64_t k = from; k < to; ++k) run.samples[static_cast<std::size_t>(k)].flags |= 2;
+  };
+  safe(0, 10);   // the start: not a trip
+  safe(30, 40);  // a trip
+  safe(60, 70);  // a DISARM: not a trip
+  safe(90, 100); // a trip
+  run.safe_requests.push_back({kT0 + 595'000, "bridge"});
+  run.safe_requests.push_back({kT0 + 295'000, "compensator"});  // not for the bridge
+  auto m = compute_metrics(run, {});
+  EXPECT_EQ(*m.watchdog_trips, 2);
+  EXPECT_NE(m.watchdog_trips_source.find("transitions"), std::string::npos);
+  run.statuses.push_back(status(kT0, "bridge", {{"watchdog_trips", 5}}));
+  m = compute_metrics(run, {});
+  EXPECT_EQ(*m.watchdog_trips, 5);
+  EXPECT_NE(m.watchdog_trips_source.find("watchdog_trips"), std::string::npos);
+}
+
+TEST(ComputeMetrics, CpuFractionPerProcessAddsItsSegments) {
+  RunData run = ramp_run(10, 100);
+  // bridge: 0.25 of a core for 2 s, then restarted (counters from 0) and 0.5 for 1 s.
+  run.statuses.push_back(status(kT0, "bridge", {{"cpu_user_us", 1'000'000}, {"cpu_system_us", 0}}, 1));
+  run.statuses.push_back(status(kT0 + 2'000'000, "bridge", {{"cpu_user_us", 1'400'000}, {"cpu_system_us", 100'000}}, 1));
+  run.statuses.push_back(status(kT0 + 3'000'000, "bridge", {{"cpu_user_us", 10}, {"cpu_system_us", 0}}, 2));
+  run.statuses.push_back(status(kT0 + 4'000'000, "bridge", {{"cpu_user_us", 250'010}, {"cpu_system_us", 250'000}}, 2));
+  run.statuses.push_back(status(kT0, "logger", {{"cpu_user_us", 0}}));  // no system time: no figure
+  run.statuses.push_back(status(kT0 + 1'000'000, "logger", {{"cpu_user_us", 5}}));
+  run.statuses.push_back(status(kT0, "compensator", {{"cpu_user_us", 7}, {"cpu_system_us", 1}}));  // one report
+  const auto m = compute_metrics(run, {});
+  ASSERT_EQ(m.cpu_fraction.size(), 3u);
+  EXPECT_NEAR(*m.cpu_fraction.at("bridge"), (500'000.0 + 500'000.0) / 3'000'000.0, 1e-12);
+  EXPECT_FALSE(m.cpu_fraction.at("logger"));
+  EXPECT_FALSE(m.cpu_fraction.at("compensator"));
+}
+
+TEST(ComputeMetrics, MessageRatesCountTheEventsOfTheSampledSpan) {
+  RunData run = ramp_run(10'001, 100);  // 1 s of ticks
+  for (std::int64_t i = 0; i <= 1000; ++i) run.event_times["HX_SENSOR"].push_back(kT0 + i * 1000);
+  run.event_times["HX_STATUS"] = {kT0 - 10, kT0 + 500'000, kT0 + 1'000'000, kT0 + 1'000'001};  // 2 inside
+  const auto m = compute_metrics(run, {});
+  EXPECT_DOUBLE_EQ(m.duration_s, 1.0);
+  EXPECT_DOUBLE_EQ(*m.messages_per_s.at("HX_SENSOR"), 1001.0);
+  EXPECT_DOUBLE_EQ(*m.messages_per_s.at("HX_STATUS"), 2.0);
+  RunData empty;
+  empty.event_times["HX_STATUS"] = {kT0};
+  EXPECT_FALSE(compute_metrics(empty, {}).messages_per_s.at("HX_STATUS"));
 }
 
 TEST(ComputeMetrics, RejectedCommandsFallBackToTheStatusField) {
   RunData run = ramp_run(10, 100);
   auto m = compute_metrics(run, {});
   EXPECT_FALSE(m.commands_rejected);
-  run.statuses.push_back({kT0, "bridge", 1, 0, 9, {{"ticks", 10}, {"control.rejected_out_of_range", 4}}});
+  run.statuses.push_back({kT0, "bridge", 1, 0, 9, {{"ticks", 10}, {"control.rejected_out_of_range", 4}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 9);  // no command reject counter: the 'rejected' field
-  run.statuses.push_back({kT0 + 10, "bridge", 1, 0, 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}});
+  run.statuses.push_back({kT0 + 10, "bridge", 1, 0, 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 3);
   EXPECT_EQ(m.commands_rejected_counters.size(), 2u);
@@ -129,10 +239,10 @@ TEST(ComputeMetrics, LoggerGapsPreferTheExactCounterName) {
   auto m = compute_metrics(run, {});
   EXPECT_EQ(*m.logger_gaps, 1);
   EXPECT_EQ(m.missing_samples, 2);
-  run.statuses.push_back({kT0, "logger", 1, 0, 0, {{"gap_samples", 40}, {"sensor_gaps", 3}}});
+  run.statuses.push_back(status(kT0, "logger", {{"gap_samples", 40}, {"sensor_gaps", 3}}));
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.logger_gaps, 3);
-  run.statuses.push_back({kT0, "logger", 1, 0, 0, {{"gaps", 6}, {"sensor_gaps", 3}}});
+  run.statuses.push_back(status(kT0, "logger", {{"gaps", 6}, {"sensor_gaps", 3}}));
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.logger_gaps, 6);
 }

@@ -17,11 +17,14 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "lcm/blocks.hpp"
+#include "lcm/message_storage.hpp"
 #include "mini_json.hpp"
 
 namespace fs = std::filesystem;
@@ -29,28 +32,52 @@ using namespace hystloop;
 
 namespace {
 
-constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // receive time of the first sample [us]
+constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // time of the first tick [us]
 constexpr std::int64_t kTicks = 12'000;               // 12 s at 1 kHz (the tool does not assume 10 kHz)
 constexpr std::int64_t kTickUs = 1000;
-constexpr std::int64_t kGapFirst = 5000, kGapLen = 10;  // samples 5000..5009 never logged
+constexpr std::int64_t kBlock = 10;                     // ticks per block
+constexpr std::int64_t kGapFirst = 5000, kGapLen = 10;  // ticks 5000..5009 (one block) never logged
 constexpr std::int64_t kFirstReference = 1000;          // ticks before this have y_ref = NaN
 constexpr std::int64_t kFirstArmed = 500;               // ticks before this carry SAFE_STATE
-constexpr std::int64_t kDuplicateSeq = 3000;            // a second command for this tick (ignored)
+constexpr std::int64_t kTripFirst = 8000;               // 8000..8049: a watchdog trip
+constexpr std::int64_t kDisarmFirst = 10'000;           // 10000..10049: a DISARM (not a trip)
+constexpr std::int64_t kSafeLen = 50;
+constexpr std::int64_t kShallowBlock = 700;             // the armed block with the lowest buffer depth
+constexpr std::int64_t kResentFirst = 3990;             // a second command block for 3990..3999 (ignored)
+constexpr std::int64_t kLeadUs = 20'000;                // commands are sent 20 ms ahead of their tick
 
 bool logged(std::int64_t k) { return k < kGapFirst || k >= kGapFirst + kGapLen; }
-std::int64_t sample_recv(std::int64_t k) { return kT0 + k * kTickUs; }
-// The report's time axis, by its definition: (receive time - first sample's) * 1e-6.
+// The tick's time on the log's clock: its block arrives as its last tick is sampled.
+std::int64_t tick_utime(std::int64_t k) { return kT0 + k * kTickUs; }
+// The report's time axis, by its definition: (tick time - first tick's) * 1e-6.
 double tick_time(std::int64_t k) { return static_cast<double>(k * kTickUs) * 1e-6; }
 double reference(std::int64_t k) {
   return k < kFirstReference ? std::nan("") : 1e-6 * std::sin(2.0 * M_PI * 0.5 * static_cast<double>(k) / 1000.0);
 }
-double error_of(std::int64_t k) {  // y - y_ref: larger in the first seconds, with a sign pattern
+double error_of(std::int64_t k) {  // y_ref - y: larger in the first seconds, with a sign pattern
   const double size = k < 4000 ? 40e-9 : 10e-9;
   return size * static_cast<double>(1 + k % 5) * ((k % 2) != 0 ? 1.0 : -1.0);
 }
-bool late(std::int64_t k) { return k >= kFirstArmed && k % 250 == 3; }
-std::int64_t latency_us(std::int64_t k) { return k % 1000 == 7 ? 1900 : 50 + k % 100; }
+bool safe(std::int64_t k) {
+  return k < kFirstArmed || (k >= kTripFirst && k < kTripFirst + kSafeLen) ||
+         (k >= kDisarmFirst && k < kDisarmFirst + kSafeLen);
+}
+bool late(std::int64_t k) { return k % 250 == 3; }
 std::int32_t version_in_use(std::int64_t k) { return k < 3200 ? 1 : (k < 7200 ? 2 : 4); }
+// Sensor block b: ticks b * kBlock ..; its buffer depth while armed.
+std::int32_t buffer_depth(std::int64_t b) { return b == kShallowBlock ? 2 : static_cast<std::int32_t>(30 + b % 17); }
+bool block_armed(std::int64_t b) {
+  for (std::int64_t k = b * kBlock; k < (b + 1) * kBlock; ++k) {
+    if (safe(k)) return false;
+  }
+  return true;
+}
+// Command block c (ticks c * kBlock ..): the compensator had the sensor tick c * kBlock - 20 - c % 5.
+std::int64_t command_sample_seq(std::int64_t c) { return std::max<std::int64_t>(-1, c * kBlock - 20 - c % 5); }
+std::int64_t command_recv(std::int64_t c) { return tick_utime(c * kBlock) - kLeadUs; }
+// CPU time of a process by its status number s (one a second): bridge 0.25 of a core, compensator 0.1.
+std::int64_t cpu_user(const std::string& process, std::int64_t s) { return s * (process == "bridge" ? 200'000 : 60'000); }
+std::int64_t cpu_system(const std::string& process, std::int64_t s) { return s * (process == "bridge" ? 50'000 : 40'000); }
 
 struct Event {
   std::int64_t t;
@@ -97,36 +124,59 @@ service_status_t status(const std::string& process, std::int64_t t, std::vector<
   return s;
 }
 
-// Writes the synthetic run; returns the number of events per channel.
-std::map<std::string, std::size_t> write_log(const fs::path& file, bool with_logger_status) {
+struct LogOptions {
+  bool logger_status = true;
+  bool watchdog_counter = false;  // the bridge reports watchdog_trips = 3
+};
+
+struct LogTruth {
+  std::map<std::string, std::size_t> counts;              // events per channel
+  std::map<std::string, std::vector<std::int64_t>> times;  // their log times
+};
+
+// Writes the synthetic run.
+LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
   std::vector<Event> events;
-  for (std::int64_t k = 0; k < kTicks; ++k) {
-    if (logged(k)) {
-      sensor_sample_t s{};
-      s.utime = sample_recv(k) - 30;
-      s.seq = k;
-      s.u_V = 10.0 * std::sin(static_cast<double>(k) / 300.0);
+  sensor_block_t sb{};
+  reserve_storage(sb);
+  for (std::int64_t b = 0; b < kTicks / kBlock; ++b) {
+    const std::int64_t first = b * kBlock;
+    if (!logged(first)) continue;
+    begin_block(sb, first, tick_utime(first) - 30, 1e-3);
+    for (std::int64_t k = first; k < first + kBlock; ++k) {
       const double ref = reference(k);
-      s.y_m = (std::isfinite(ref) ? ref : 0.0) + error_of(k);
-      s.flags = sensor_sample_t::SIMULATED | (k < kFirstArmed ? sensor_sample_t::SAFE_STATE : 0) |
-                (late(k) ? sensor_sample_t::LATE_COMMAND : 0);
-      events.push_back(event(sample_recv(k), "HX_SENSOR", s));
+      SensorTick t{};
+      t.u_V = 10.0 * std::sin(static_cast<double>(k) / 300.0);
+      t.u_ff_V = 0.9 * t.u_V;
+      t.u_fb_V = 0.1 * t.u_V;
+      t.y_ref_m = ref;
+      t.y_m = (std::isfinite(ref) ? ref : 0.0) - error_of(k);
+      t.flags = sensor_block_t::SIMULATED | (safe(k) ? sensor_block_t::SAFE_STATE : 0) |
+                (late(k) ? sensor_block_t::LATE_COMMAND : 0);
+      append_tick(sb, t);
     }
-    actuator_command_t c{};
-    c.seq = k;
-    c.sample_seq = k >= 2 ? k - 2 : -1;  // answers the sample two ticks earlier
-    c.utime = sample_recv(k - 2) + latency_us(k) + 5;
-    c.u_V = c.u_ff_V = 1.0;
-    c.y_ref_m = reference(k);
-    c.params_version = version_in_use(k);
-    c.mode = actuator_command_t::MODE_MEM;
-    events.push_back(event(sample_recv(k - 2) + latency_us(k), "HX_COMMAND", c));
-    if (k == kDuplicateSeq) {
-      c.y_ref_m = 1.0e-3;  // would ruin the error if the tool used it
-      c.sample_seq = -1;
-      events.push_back(event(sample_recv(k) - 1, "HX_COMMAND", c));
-    }
+    sb.buffer_depth_ticks = block_armed(b) ? buffer_depth(b) : 0;
+    events.push_back(event(tick_utime(first + kBlock - 1), "HX_SENSOR", sb));
   }
+  command_block_t cb{};
+  reserve_storage(cb);
+  auto add_command_block = [&](std::int64_t first, std::int64_t recv, std::int64_t sample_seq, std::int32_t version) {
+    begin_block(cb, first, recv - 5, sample_seq);
+    for (std::int64_t k = first; k < first + kBlock; ++k) {
+      append_tick(cb, {k, 1.0, reference(k), version < 0 ? version_in_use(k) : version, command_block_t::MODE_MEM});
+    }
+    events.push_back(event(recv, "HX_COMMAND", cb));
+  };
+  for (std::int64_t c = 0; c < kTicks / kBlock; ++c) add_command_block(c * kBlock, command_recv(c), command_sample_seq(c), -1);
+  add_command_block(kResentFirst, tick_utime(kResentFirst) - 1, -1, 99);  // a re-send: the first one counts
+
+  control_t disarm{};
+  disarm.utime = tick_utime(kDisarmFirst) - 5000;
+  disarm.request_id = 1;
+  disarm.command = control_t::DISARM;
+  disarm.target = "bridge";
+  events.push_back(event(tick_utime(kDisarmFirst) - 5000, "HX_CONTROL", disarm));
+
   events.push_back(event(kT0 - 500'000, "HX_PARAMS", params(1, 1e-7, true)));
   events.push_back(event(kT0 + 3'000'000, "HX_PARAMS", params(2, 1.1e-7, true)));
   events.push_back(event(kT0 + 3'001'000, "HX_PARAMS", params(2, 1.1e-7, true)));  // a repeat
@@ -134,14 +184,19 @@ std::map<std::string, std::size_t> write_log(const fs::path& file, bool with_log
   events.push_back(event(kT0 + 7'000'000, "HX_PARAMS", params(4, 1.2e-7, true)));
   for (std::int64_t s = 1; s <= 12; ++s) {
     const std::int64_t t = kT0 + s * 1'000'000 - 100;
-    events.push_back(event(t, "HX_STATUS",
-                           status("bridge", t,
-                                  {{"ticks", s * 1000},
-                                   {"rejected_nonfinite", s},  // final 12
-                                   {"stale", 2},
-                                   {"command.rejected_out_of_range", 1},
-                                   {"control.rejected_decode_failed", 5}})));
-    if (with_logger_status) events.push_back(event(t + 10, "HX_STATUS", status("logger", t, {{"sensor.gaps", 1}})));
+    std::vector<std::pair<std::string, std::int64_t>> bridge{{"ticks", s * 1000},
+                                                             {"rejected_nonfinite", s},  // final 12
+                                                             {"stale", 2},
+                                                             {"command.rejected_out_of_range", 1},
+                                                             {"control.rejected_decode_failed", 5},
+                                                             {"cpu_user_us", cpu_user("bridge", s)},
+                                                             {"cpu_system_us", cpu_system("bridge", s)}};
+    if (o.watchdog_counter) bridge.emplace_back("watchdog_trips", 3);
+    events.push_back(event(t, "HX_STATUS", status("bridge", t, bridge)));
+    events.push_back(event(t + 5, "HX_STATUS",
+                           status("compensator", t, {{"cpu_user_us", cpu_user("compensator", s)},
+                                                     {"cpu_system_us", cpu_system("compensator", s)}})));
+    if (o.logger_status) events.push_back(event(t + 10, "HX_STATUS", status("logger", t, {{"sensor.gaps", 1}})));
   }
   trajectory_t traj{};
   traj.utime = kT0;
@@ -154,7 +209,7 @@ std::map<std::string, std::size_t> write_log(const fs::path& file, bool with_log
   std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
   lcm::LogFile log(file.string(), "w");
   EXPECT_TRUE(log.good());
-  std::map<std::string, std::size_t> counts;
+  LogTruth truth;
   for (auto& e : events) {
     lcm::LogEvent le{};
     le.timestamp = e.t;
@@ -162,9 +217,10 @@ std::map<std::string, std::size_t> write_log(const fs::path& file, bool with_log
     le.datalen = static_cast<std::int32_t>(e.bytes.size());
     le.data = e.bytes.data();
     EXPECT_EQ(log.writeEvent(&le), 0);
-    ++counts[e.channel];
+    ++truth.counts[e.channel];
+    truth.times[e.channel].push_back(e.t);
   }
-  return counts;
+  return truth;
 }
 
 struct ToolRun {
@@ -191,11 +247,14 @@ bool is_png(const fs::path& path) {
   return head == std::string("\x89PNG\r\n\x1a\n", 8);
 }
 
-// The expected figures for samples with lo <= t <= hi, computed from the generator's truth.
+// The expected figures for ticks with lo <= t <= hi, computed from the generator's truth.
 struct Expected {
-  std::size_t samples = 0, tracking = 0, armed = 0, late = 0;
+  std::size_t samples = 0, tracking = 0, armed = 0, late = 0, blocks = 0;
   double rms = 0, max_abs = 0, rms_first = 0, rms_last = 0;
-  std::vector<double> latencies;
+  double first_t = -1, last_t = -1;
+  std::int32_t buffer_min = 1 << 30;
+  std::int64_t trips = 0;
+  std::vector<double> run_ahead;
   std::map<std::int64_t, std::pair<double, std::size_t>> bins;  // second -> (sum sq, n)
 };
 
@@ -204,12 +263,16 @@ Expected expected(double lo, double hi) {
   double sum = 0, first_sum = 0, last_sum = 0;
   std::size_t first_n = 0, last_n = 0;
   double t_first = -1, t_last = -1;
+  std::int64_t prev = -1;
   for (std::int64_t k = 0; k < kTicks; ++k) {
     const double t = tick_time(k);
     if (!logged(k) || t < lo || t > hi) continue;
     ++x.samples;
-    if (k >= kFirstArmed) ++x.armed, x.late += late(k) ? 1 : 0;
-    if (k + 2 < kTicks) x.latencies.push_back(static_cast<double>(latency_us(k + 2)));
+    if (x.first_t < 0) x.first_t = t;
+    x.last_t = t;
+    if (!safe(k)) ++x.armed, x.late += late(k) ? 1 : 0;
+    if (safe(k) && prev >= 0 && !safe(prev) && k != kDisarmFirst) ++x.trips;
+    prev = k;
     if (k < kFirstReference) continue;
     if (t_first < 0) t_first = t;
     t_last = t;
@@ -226,10 +289,21 @@ Expected expected(double lo, double hi) {
     auto& bin = x.bins[static_cast<std::int64_t>(std::floor(t))];
     bin.first += e * e, ++bin.second;
   }
+  for (std::int64_t b = 0; b < kTicks / kBlock; ++b) {
+    const double t = tick_time(b * kBlock + kBlock - 1);  // a block is received with its last tick
+    if (!logged(b * kBlock) || t < lo || t > hi) continue;
+    ++x.blocks;
+    if (block_armed(b)) x.buffer_min = std::min(x.buffer_min, buffer_depth(b));
+  }
+  for (std::int64_t c = 0; c < kTicks / kBlock; ++c) {
+    const double t = static_cast<double>(command_recv(c) - kT0) * 1e-6;
+    if (command_sample_seq(c) < 0 || t < lo || t > hi) continue;
+    x.run_ahead.push_back(static_cast<double>(c * kBlock - command_sample_seq(c)));
+  }
   x.rms = std::sqrt(sum / static_cast<double>(x.tracking));
   x.rms_first = std::sqrt(first_sum / static_cast<double>(first_n));
   x.rms_last = std::sqrt(last_sum / static_cast<double>(last_n));
-  std::sort(x.latencies.begin(), x.latencies.end());
+  std::sort(x.run_ahead.begin(), x.run_ahead.end());
   return x;
 }
 
@@ -258,7 +332,8 @@ constexpr double kRel = 1e-9;
 }  // namespace
 
 TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
-  const auto counts = write_log(dir_ / "run.lcmlog", true);
+  const LogTruth truth = write_log(dir_ / "run.lcmlog");
+  const auto& counts = truth.counts;
   const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
                              " --csv HX_SENSOR --csv COMMAND --csv HX_STATUS",
                          dir_);
@@ -296,10 +371,36 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
   EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
   EXPECT_NEAR(j["late_command_fraction"].num(), static_cast<double>(x.late) / static_cast<double>(x.armed), 1e-15);
 
-  EXPECT_EQ(j["latency_samples"].num(), static_cast<double>(x.latencies.size()));
-  EXPECT_EQ(j["latency_p50_us"].num(), rank(x.latencies, 0.50));
-  EXPECT_EQ(j["latency_p99_us"].num(), rank(x.latencies, 0.99));
-  EXPECT_EQ(j["latency_max_us"].num(), 1900.0);
+  EXPECT_EQ(j["late_tick_fraction"].num(), j["late_command_fraction"].num());
+  EXPECT_GT(j["late_samples"].num(), 40.0);  // the test can tell armed from all ticks
+  EXPECT_LT(j["late_samples"].num(), 48.0);
+
+  EXPECT_EQ(j["tick_period_s"].num(), 1e-3);
+  EXPECT_EQ(j["sensor_blocks"].num(), static_cast<double>(x.blocks));
+  EXPECT_EQ(j["buffer_min_depth_ticks"].num(), 2.0);  // the safe blocks' 0 does not count
+  EXPECT_EQ(j["buffer_min_depth_ticks"].num(), x.buffer_min);
+
+  EXPECT_EQ(j["run_ahead_blocks"].num(), static_cast<double>(x.run_ahead.size()));
+  EXPECT_EQ(j["run_ahead_min_ticks"].num(), 20.0);
+  EXPECT_EQ(j["run_ahead_p01_ticks"].num(), rank(x.run_ahead, 0.01));
+  EXPECT_EQ(j["run_ahead_p50_ticks"].num(), rank(x.run_ahead, 0.50));
+  EXPECT_EQ(j["run_ahead_max_ticks"].num(), 24.0);
+
+  // No watchdog_trips counter: the armed -> safe transitions, less the one DISARM explains.
+  EXPECT_EQ(x.trips, 1);
+  EXPECT_EQ(j["watchdog_trips"].num(), static_cast<double>(x.trips));
+  EXPECT_NE(j["watchdog_trips_source"].string.find("transitions"), std::string::npos);
+
+  for (const auto& [channel, times] : truth.times) {
+    const double n = static_cast<double>(std::count_if(times.begin(), times.end(), [&](std::int64_t t) {
+      return t >= kT0 + std::llround(x.first_t * 1e6) && t <= kT0 + std::llround(x.last_t * 1e6);
+    }));
+    EXPECT_NEAR(j["messages_per_s"][channel].num(), n / (x.last_t - x.first_t), 1e-9) << channel;
+  }
+  EXPECT_NEAR(j["messages_per_s"]["HX_SENSOR"].num(), 100.0, 0.1);  // 1 kHz in blocks of 10
+  EXPECT_NEAR(j["cpu_fraction"]["bridge"].num(), 0.25, 1e-12);
+  EXPECT_NEAR(j["cpu_fraction"]["compensator"].num(), 0.1, 1e-12);
+  EXPECT_TRUE(j["cpu_fraction"]["logger"].is_null());  // it reports no CPU time
 
   EXPECT_EQ(j["commands_rejected"].num(), 12 + 2 + 1);  // not the control endpoint's 5, not 'rejected' (77)
   EXPECT_EQ(j["logger_gaps"].num(), 1.0);
@@ -328,32 +429,41 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
   for (const auto& [channel, n] : counts) EXPECT_EQ(j["channels"][channel].num(), static_cast<double>(n)) << channel;
   EXPECT_EQ(j["undecodable_events"].num(), 0);
 
-  // CSV: header of decoded fields with units, one row per event.
+  // CSV: header of decoded fields with units, one row per tick of the block channels.
   const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
-  EXPECT_EQ(sensor.substr(0, sensor.find('\n')), "t_s,recv_utime_us,utime_us,seq,u_V,y_m,flags");
-  EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), counts.at("HX_SENSOR") + 1);
+  EXPECT_EQ(sensor.substr(0, sensor.find('\n')),
+            "t_s,recv_utime_us,block_utime_us,block_seq,dt_s,buffer_depth_ticks,utime_us,seq,u_V,u_ff_V,u_fb_V,y_ref_m,"
+            "y_m,flags");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), x.samples + 1);
+  // Tick 1234 is dated on the report's axis, its block received with tick 1239.
+  const std::string row_1234 = "1.234," + std::to_string(tick_utime(1239)) + "," + std::to_string(tick_utime(1230) - 30) +
+                               ",1230,0.001,";
+  EXPECT_NE(sensor.find("\n" + row_1234), std::string::npos) << row_1234;
   const std::string command = slurp(dir_ / "out" / "HX_COMMAND.csv");
   EXPECT_EQ(command.substr(0, command.find('\n')),
-            "t_s,recv_utime_us,utime_us,seq,sample_seq,u_V,u_ff_V,u_fb_V,y_ref_m,params_version,mode");
-  EXPECT_EQ(static_cast<std::size_t>(std::count(command.begin(), command.end(), '\n')), counts.at("HX_COMMAND") + 1);
+            "t_s,recv_utime_us,block_utime_us,block_seq,sample_seq,seq,u_ff_V,y_ref_m,params_version,mode");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(command.begin(), command.end(), '\n')),
+            counts.at("HX_COMMAND") * kBlock + 1);
   EXPECT_NE(slurp(dir_ / "out" / "HX_STATUS.csv").find("rejected_nonfinite=12"), std::string::npos);
 
   // Plots, when gnuplot is there; their data and script always.
-  for (const char* data : {"track.dat", "per_second.dat", "latency_hist.dat", "plots.gp"}) {
+  for (const char* data : {"track.dat", "per_second.dat", "run_ahead_hist.dat", "plots.gp"}) {
     EXPECT_TRUE(fs::exists(dir_ / "out" / data)) << data;
   }
   if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
-    for (const char* png : {"hysteresis_u_y.png", "hysteresis_yref_y.png", "tracking_error.png", "latency_histogram.png"}) {
+    for (const char* png :
+         {"hysteresis_u_y.png", "hysteresis_yref_y.png", "tracking_error.png", "run_ahead_histogram.png"}) {
       EXPECT_TRUE(is_png(dir_ / "out" / png)) << png << "\n" << r.err;
     }
   }
   // The table.
   EXPECT_NE(r.out.find("tracking RMS error"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("latency p50/p99/max"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("run-ahead min/p1/p50"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("buffer min depth       2 ticks"), std::string::npos) << r.out;
 }
 
 TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
-  write_log(dir_ / "run.lcmlog", false);
+  write_log(dir_ / "run.lcmlog", {.logger_status = false, .watchdog_counter = true});
   const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
                              " --from 2 --to 9 --skip-initial 1 --no-plots --quiet --csv SENSOR",
                          dir_);
@@ -366,6 +476,9 @@ TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
   EXPECT_NEAR(j["rms_error_first_5s_m"].num(), x.rms_first, kRel * x.rms_first);
   EXPECT_NEAR(j["rms_error_last_5s_m"].num(), x.rms_last, kRel * x.rms_last);
   EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
+  EXPECT_EQ(j["armed_samples"].num(), static_cast<double>(x.armed));
+  EXPECT_EQ(j["sensor_blocks"].num(), static_cast<double>(x.blocks));
+  EXPECT_EQ(j["run_ahead_blocks"].num(), static_cast<double>(x.run_ahead.size()));
   EXPECT_EQ(j["range"]["from_s"].num(), 3.0);
   EXPECT_EQ(j["range"]["to_s"].num(), 9.0);
   // Parameters in force at the start (v2), updated once (v4) inside the range.
@@ -375,13 +488,15 @@ TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
   // No logger status: gaps come from the sensor's seq.
   EXPECT_EQ(j["logger_gaps"].num(), 1.0);
   EXPECT_NE(j["logger_gaps_source"].string.find("sensor seq"), std::string::npos);
+  // The bridge counts its watchdog trips: its counter is the figure.
+  EXPECT_EQ(j["watchdog_trips"].num(), 3.0);
   const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), x.samples + 1);
   EXPECT_FALSE(fs::exists(dir_ / "out" / "plots.gp"));
 }
 
 TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
-  write_log(dir_ / "run.lcmlog", true);
+  write_log(dir_ / "run.lcmlog");
   // Split the log into two files at an event boundary.
   {
     lcm::LogFile in((dir_ / "run.lcmlog").string(), "r");
@@ -389,7 +504,7 @@ TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
     std::size_t n = 0;
     while (const lcm::LogEvent* e = in.readNextEvent()) {
       lcm::LogEvent copy = *e;
-      (n++ < 9000 ? a : b).writeEvent(&copy);
+      (n++ < 1500 ? a : b).writeEvent(&copy);
     }
   }
   const ToolRun whole = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "a").string() + " --no-plots", dir_);
@@ -402,11 +517,12 @@ TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
   const auto jb = mini_json::parse(slurp(dir_ / "b" / "summary.json"));
   EXPECT_EQ(ja["samples"].num(), jb["samples"].num());
   EXPECT_EQ(ja["rms_error_m"].num(), jb["rms_error_m"].num());
-  EXPECT_EQ(ja["latency_p99_us"].num(), jb["latency_p99_us"].num());
+  EXPECT_EQ(ja["run_ahead_p50_ticks"].num(), jb["run_ahead_p50_ticks"].num());
+  EXPECT_EQ(ja["buffer_min_depth_ticks"].num(), jb["buffer_min_depth_ticks"].num());
 }
 
 TEST_F(ReportToolTest, MissingGnuplotIsAWarningNotAFailure) {
-  write_log(dir_ / "run.lcmlog", true);
+  write_log(dir_ / "run.lcmlog");
   const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
                              " --gnuplot /nonexistent/gnuplot --quiet",
                          dir_);
@@ -419,7 +535,7 @@ TEST_F(ReportToolTest, MissingGnuplotIsAWarningNotAFailure) {
 }
 
 TEST_F(ReportToolTest, BadArgumentsExitTwoNamingTheOption) {
-  write_log(dir_ / "run.lcmlog", true);
+  write_log(dir_ / "run.lcmlog");
   const std::string log = (dir_ / "run.lcmlog").string();
   const std::string out = " --out " + (dir_ / "out").string();
   ToolRun r = run_tool(log + out + " --skip-initial -1", dir_);
@@ -445,9 +561,9 @@ TEST_F(ReportToolTest, BadArgumentsExitTwoNamingTheOption) {
 TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
   {
     lcm::LogFile log((dir_ / "bad.lcmlog").string(), "w");
-    sensor_sample_t s{};
-    s.seq = 1;
-    s.y_m = 1e-6;
+    sensor_block_t s{};
+    begin_block(s, 1, 0, 1e-4);
+    append_tick(s, {0, 1, 0.0, 0.0, 0.0, std::nan(""), 1e-6, 0});
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(s.getEncodedSize()));
     s.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     lcm::LogEvent e{};
@@ -468,5 +584,6 @@ TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
   EXPECT_EQ(j["samples"].num(), 1);
   EXPECT_EQ(j["undecodable_events"].num(), 2);
   EXPECT_TRUE(j["rms_error_m"].is_null());
-  EXPECT_TRUE(j["latency_p50_us"].is_null());
+  EXPECT_TRUE(j["run_ahead_p50_ticks"].is_null());
+  EXPECT_TRUE(j["cpu_fraction"].object.empty());
 }
