@@ -18,11 +18,11 @@ void copy_name(std::array<char, ChannelSlot::kMaxName + 1>& to, std::string_view
 }  // namespace
 
 ChannelTable::ChannelTable(std::string_view sensor_channel, std::string_view command_channel,
-                           std::int64_t restart_threshold)
-    : slots_() {
+                           std::int64_t restart_threshold, std::int64_t command_resume_us)
+    : slots_(), command_detector_(restart_threshold, command_resume_us) {  // validates both
   copy_name(sensor_, sensor_channel, "sensor_channel");
   copy_name(command_, command_channel, "command_channel");
-  const SequenceGapDetector detector(restart_threshold);  // validates it
+  const SequenceGapDetector detector(restart_threshold);
   for (auto& slot : slots_) slot.sequence = detector;
 }
 
@@ -44,6 +44,7 @@ std::optional<std::uint32_t> ChannelTable::find_or_add(const char* name) noexcep
   slot.kind = std::strcmp(name, sensor_.data()) == 0    ? SequenceKind::kSensor
               : std::strcmp(name, command_.data()) == 0 ? SequenceKind::kCommand
                                                         : SequenceKind::kNone;
+  if (slot.kind == SequenceKind::kCommand) slot.sequence = command_detector_;
   size_.store(n + 1, std::memory_order_release);
   return last_hit_ = static_cast<std::uint32_t>(n);
 }

@@ -34,7 +34,7 @@ struct ChannelSlot {
   std::uint64_t bytes_received = 0;
   std::uint64_t dropped_queue_full = 0;  // the disk thread fell behind: the ring was full
   std::uint64_t dropped_oversize = 0;    // larger than the ring's largest record
-  std::uint64_t undecodable = 0;         // kind != kNone but not that type: recorded, seq not checked
+  std::uint64_t undecodable = 0;         // kind != kNone but not a valid block of that type: recorded, ticks not checked
   SequenceGapDetector sequence;
 
   // Disk thread.
@@ -52,9 +52,11 @@ class ChannelTable {
  public:
   static constexpr std::size_t kMaxChannels = 64;
 
-  // Names whose messages are checked for gaps (the rig's sensor and command channels).
+  // Names whose blocks are checked for gaps (the rig's sensor and command channels), and
+  // the SequenceGapDetector settings: a command channel's forward jump after
+  // `command_resume_us` of silence is a resume, not a gap (0 = always a gap).
   ChannelTable(std::string_view sensor_channel, std::string_view command_channel,
-               std::int64_t restart_threshold = 10000);
+               std::int64_t restart_threshold = 10000, std::int64_t command_resume_us = 0);
 
   // Receiving thread: the index of `name`, adding a slot for a new one; nullopt when the
   // table is full or the name longer than ChannelSlot::kMaxName (the caller counts that).
@@ -72,6 +74,7 @@ class ChannelTable {
   std::atomic<std::size_t> size_{0};
   std::array<char, ChannelSlot::kMaxName + 1> sensor_{};
   std::array<char, ChannelSlot::kMaxName + 1> command_{};
+  SequenceGapDetector command_detector_;  // copied into the command channel's slot
   std::uint32_t last_hit_ = 0;
   std::uint64_t unrecorded_ = 0;
 };

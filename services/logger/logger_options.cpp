@@ -20,7 +20,7 @@ std::string yaml_single_quoted(const std::string& text) {
   return out + "'";
 }
 
-constexpr std::array<FlagSpec, 10> kFlags{{
+constexpr std::array<FlagSpec, 11> kFlags{{
     {"--out-dir", "out_dir", "Directory of the log files (default logs)", "DIR", true},
     {"--file-prefix", "file_prefix", "Text prepended to every file name (default none)", "TEXT", true},
     {"--max-file-mb", "max_file_mb", "Rotate before a file passes this size [10^6 bytes]; 0 = never (default 1024)", "MB"},
@@ -32,6 +32,10 @@ constexpr std::array<FlagSpec, 10> kFlags{{
     {"--flush-interval-s", "flush_interval_s", "How often buffered events are handed to the kernel [s] (default 0.2)", "S"},
     {"--restart-threshold", "restart_threshold",
      "A seq step back by more than this many ticks is a sender restart, not a late message (default 10000)", "N"},
+    {"--command-resume-s", "command_resume_s",
+     "Commands silent this long [s], then starting at a later tick: a resume of the compensator, counted as "
+     "skipped ticks, not as a gap; 0 = always a gap (default 0.1)",
+     "S"},
 }};
 }  // namespace
 
@@ -72,6 +76,7 @@ LoggerOptions read_logger_options(const Config& config) {
   o.lcm_queue = config.get_int_in_range("logger.lcm_queue", o.lcm_queue, 1, 10000000);
   o.flush_interval_s = config.get_in_range("logger.flush_interval_s", o.flush_interval_s, 0.001, 60.0);
   o.restart_threshold = config.get_int_in_range("logger.restart_threshold", o.restart_threshold, 1, INT64_MAX);
+  o.command_resume_s = config.get_in_range("logger.command_resume_s", o.command_resume_s, 0.0, 3600.0);
   return o;
 }
 

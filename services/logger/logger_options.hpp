@@ -12,6 +12,8 @@
 //   --lcm-queue N             logger.lcm_queue          messages LCM holds before dispatch (default 20000)
 //   --flush-interval-s S      logger.flush_interval_s   how often buffered events reach the kernel (default 0.2)
 //   --restart-threshold N     logger.restart_threshold  seq step back (ticks) taken as a sender restart (default 10000)
+//   --command-resume-s S      logger.command_resume_s   HX_COMMAND silent this long, then a jump forward: a resume
+//                                                       (counted as skipped ticks), not a gap (0 = always a gap; default 0.1)
 
 #include <cstdint>
 #include <filesystem>
@@ -35,6 +37,7 @@ struct LoggerOptions {
   std::int64_t lcm_queue = 20000;
   double flush_interval_s = 0.2;
   std::int64_t restart_threshold = 10000;
+  double command_resume_s = 0.1;
 };
 
 // Flag values as given on the command line (text), by configuration key.

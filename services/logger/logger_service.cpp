@@ -1,6 +1,7 @@
 #include "logger/logger_service.hpp"
 
 #include <chrono>
+#include <climits>
 #include <csignal>
 #include <ctime>
 #include <string>
@@ -9,6 +10,8 @@
 
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
+#include "lcm/message_storage.hpp"
+#include "lcm/wire_layout.hpp"
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
@@ -23,6 +26,28 @@ std::int64_t monotonic_ns() noexcept {
   using namespace std::chrono;
   return duration_cast<nanoseconds>(steady_clock::now().time_since_epoch()).count();
 }
+
+// Decodes a block as a Subscription would (fingerprint, length fields walked before decode
+// trusts them, the whole buffer used) but without the value check: a block's ticks count for
+// gap detection whatever its values. False if it is not a block of that type with >= 1 tick.
+template <class Block>
+bool decode_block(Block& block, const void* data, std::size_t size) noexcept {
+  if (size < 8 || size > static_cast<std::size_t>(INT_MAX)) return false;
+  if (wire_fingerprint(data, size) != Block::getHash()) return false;
+  if (walk_wire_layout(wire_layout_of<Block>(), data, size) != static_cast<std::int64_t>(size)) return false;
+  clear_arrays(block);
+  int used = -1;
+  try {
+    used = block.decode(data, 0, static_cast<int>(size));
+  } catch (...) {  // cannot happen within the reserved storage; never let it reach LCM
+    return false;
+  }
+  return used == static_cast<int>(size) && block.n_ticks >= 1;
+}
+
+std::string append(std::string detail, const std::string& what) {
+  return detail.empty() ? what : detail + "; " + what;
+}
 }  // namespace
 
 LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options)
@@ -32,7 +57,10 @@ LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const Log
       start_utime_(wall_utime()),
       start_s_(monotonic_s()),
       reporter_(lcm, names.status, kProcessName) {
-  channels_ = std::make_unique<ChannelTable>(names.sensor, names.command, options.restart_threshold);
+  channels_ = std::make_unique<ChannelTable>(names.sensor, names.command, options.restart_threshold,
+                                             static_cast<std::int64_t>(options.command_resume_s * 1e6));
+  reserve_storage(sensor_block_);
+  reserve_storage(command_block_);
   ring_ = std::make_unique<RecordRing>(static_cast<std::size_t>(options.queue_mb * 1e6));
   const RotationPolicy policy{static_cast<std::uint64_t>(options.max_file_mb * 1e6), options.max_file_s};
   files_ = std::make_unique<LogFileSet>(options.out_dir, options.file_prefix, policy, std::time(nullptr), start_s_);
@@ -67,7 +95,7 @@ void LoggerService::receive(const char* channel, const void* data, std::size_t s
   ChannelSlot& slot = (*channels_)[*index];
   ++slot.received;
   slot.bytes_received += size;
-  if (slot.kind != SequenceKind::kNone) check_sequence(slot, data, size);
+  if (slot.kind != SequenceKind::kNone) check_sequence(slot, data, size, recv_utime);
   switch (ring_->try_push(*index, recv_utime, data, size)) {
     case RecordRing::PushResult::kOk: break;
     case RecordRing::PushResult::kFull: ++slot.dropped_queue_full; break;
@@ -76,23 +104,21 @@ void LoggerService::receive(const char* channel, const void* data, std::size_t s
   handling_.add(monotonic_ns() - t0);
 }
 
-void LoggerService::check_sequence(ChannelSlot& slot, const void* data, std::size_t size) noexcept {
-  // Both types are fixed-size: decode() checks the fingerprint and allocates nothing.
-  const int length = static_cast<int>(size);
-  std::int64_t seq = 0;
-  int decoded = -1;
-  if (slot.kind == SequenceKind::kSensor) {
-    decoded = sample_.decode(data, 0, length);
-    seq = sample_.seq;
+void LoggerService::check_sequence(ChannelSlot& slot, const void* data, std::size_t size,
+                                   std::int64_t recv_utime) noexcept {
+  std::int64_t first = 0;
+  std::int64_t n_ticks = 0;
+  if (slot.kind == SequenceKind::kSensor && decode_block(sensor_block_, data, size)) {
+    first = sensor_block_.seq;
+    n_ticks = sensor_block_.n_ticks;
+  } else if (slot.kind == SequenceKind::kCommand && decode_block(command_block_, data, size)) {
+    first = command_block_.seq;
+    n_ticks = command_block_.n_ticks;
   } else {
-    decoded = command_.decode(data, 0, length);
-    seq = command_.seq;
-  }
-  if (decoded != length) {
     ++slot.undecodable;
     return;
   }
-  slot.sequence.observe(seq);
+  slot.sequence.observe(first, n_ticks, recv_utime);
 }
 
 void LoggerService::on_control(const control_t& msg) {
@@ -111,24 +137,29 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   std::uint64_t bytes_written = 0;
   for (std::size_t i = 0; i < channels_->size(); ++i) {
     const ChannelSlot& c = (*channels_)[i];
-    Seen now{c.dropped(), c.sequence.gap_events(), c.sequence.missing()};
+    const SequenceGapDetector& q = c.sequence;
+    const Seen now{c.dropped(), q.gap_events(), q.missing(), q.overlaps() + q.duplicates(), q.resumes(), q.skipped()};
     Seen& before = seen_[i];
-    if (now.dropped > before.dropped) {
-      detail += std::string(detail.empty() ? "" : "; ") + "dropped " + std::to_string(now.dropped - before.dropped) +
-                " on " + std::string(c.name_view());
-    }
+    const std::string on = " on " + std::string(c.name_view());
+    if (now.dropped > before.dropped) detail = append(detail, "dropped " + std::to_string(now.dropped - before.dropped) + on);
     if (now.gap_events > before.gap_events) {
-      detail += std::string(detail.empty() ? "" : "; ") + std::to_string(now.gap_events - before.gap_events) +
-                " gap(s), " + std::to_string(now.missing - before.missing) + " missing on " +
-                std::string(c.name_view());
+      detail = append(detail, std::to_string(now.gap_events - before.gap_events) + " gap(s), " +
+                                  std::to_string(now.missing - before.missing) + " ticks missing" + on);
+    }
+    if (now.overlaps > before.overlaps) {
+      detail = append(detail, std::to_string(now.overlaps - before.overlaps) + " overlapping/duplicate block(s)" + on);
+    }
+    if (now.resumes > before.resumes) {
+      detail = append(detail, std::to_string(now.resumes - before.resumes) + " resume(s) after silence, " +
+                                  std::to_string(now.skipped - before.skipped) + " ticks skipped" + on);
     }
     before = now;
     bytes_written += c.bytes_written.load(std::memory_order_relaxed);
   }
   const std::uint64_t unrecorded = channels_->unrecorded_channels();
   if (unrecorded > seen_unrecorded_) {
-    detail += std::string(detail.empty() ? "" : "; ") + "dropped " + std::to_string(unrecorded - seen_unrecorded_) +
-              " of channels beyond the table's " + std::to_string(ChannelTable::kMaxChannels);
+    detail = append(detail, "dropped " + std::to_string(unrecorded - seen_unrecorded_) + " of channels beyond the table's " +
+                                std::to_string(ChannelTable::kMaxChannels));
   }
   seen_unrecorded_ = unrecorded;
 
@@ -143,10 +174,18 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     reporter_.counter(name + ".written", c.written.load(std::memory_order_relaxed));
     reporter_.counter(name + ".dropped", c.dropped());
     if (c.kind != SequenceKind::kNone) {
-      reporter_.counter(name + ".gaps", c.sequence.gap_events());
-      reporter_.counter(name + ".missing", c.sequence.missing());
-      reporter_.counter(name + ".out_of_order", c.sequence.out_of_order());
-      reporter_.counter(name + ".duplicates", c.sequence.duplicates());
+      const SequenceGapDetector& q = c.sequence;
+      reporter_.counter(name + ".gaps", q.gap_events());
+      reporter_.counter(name + ".missing", q.missing());
+      reporter_.counter(name + ".overlaps", q.overlaps());
+      reporter_.counter(name + ".duplicates", q.duplicates());
+      reporter_.counter(name + ".out_of_order", q.out_of_order());
+      reporter_.counter(name + ".restarts", q.restarts());
+      reporter_.counter(name + ".undecodable", c.undecodable);
+      if (c.kind == SequenceKind::kCommand) {
+        reporter_.counter(name + ".resumes", q.resumes());
+        reporter_.counter(name + ".skipped", q.skipped());
+      }
     }
   }
   reporter_.counter("files", files_->file_count());

@@ -2,13 +2,15 @@
 // hystloop-logger's wiring: one raw LCM subscription to the rig's channels (every message
 // recorded byte-exact, whatever its type) -> RecordRing -> LogWriter (disk thread) ->
 // LogFileSet. The receive path (LCM's handler, in the thread that calls run()) looks up
-// the channel in a fixed table, checks HX_SENSOR/HX_COMMAND seq for gaps by decoding into
-// preallocated messages, and copies the bytes into the ring: no allocation, no lock, no
-// log, no disk. A full ring drops the message and counts it per channel.
+// the channel in a fixed table, checks the ticks of the HX_SENSOR/HX_COMMAND blocks for
+// gaps by decoding into messages reserved for MAX_TICKS, and copies the bytes into the
+// ring: no allocation, no lock, no log, no disk. A full ring drops the message and counts
+// it per channel.
 //
-// HX_STATUS (process "logger") once a second: per channel received/written/dropped/gaps/
-// missing, files, bytes; DEGRADED with a detail when something was dropped or a gap seen
-// in the last period. On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive
+// HX_STATUS (process "logger") once a second: per channel received/written/dropped, and
+// for the two block channels gaps/missing (ticks)/overlaps/duplicates/out_of_order/restarts
+// (+ resumes/skipped for HX_COMMAND, see SequenceGapDetector), files, bytes; DEGRADED with
+// a detail when something was dropped, a gap, overlap or resume seen in the last period. On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive
 // what LCM already holds, stop receiving, write the queue out, close the file, write the
 // summary (logger_summary.hpp).
 
@@ -20,9 +22,9 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/latency_stats.hpp"
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/subscription.hpp"
 #include "logger/channel_table.hpp"
@@ -55,7 +57,7 @@ class LoggerService {
  private:
   static void on_raw(const lcm_recv_buf_t* rbuf, const char* channel, void* self) noexcept;
   void receive(const char* channel, const void* data, std::size_t size, std::int64_t recv_utime) noexcept;
-  void check_sequence(ChannelSlot& slot, const void* data, std::size_t size) noexcept;
+  void check_sequence(ChannelSlot& slot, const void* data, std::size_t size, std::int64_t recv_utime) noexcept;
   void on_control(const control_t& msg);
   void report(std::int64_t utime, std::int8_t state_override = -1);
   void unsubscribe() noexcept;
@@ -72,8 +74,8 @@ class LoggerService {
   std::unique_ptr<LogFileSet> files_;
   std::unique_ptr<LogWriter> writer_;
   lcm_subscription_t* raw_ = nullptr;
-  sensor_sample_t sample_{};
-  actuator_command_t command_{};
+  sensor_block_t sensor_block_{};  // storage reserved for MAX_TICKS
+  command_block_t command_block_{};
 
   ControlFilter control_filter_{kProcessName};
   std::unique_ptr<Subscription<control_t>> control_;
@@ -86,6 +88,9 @@ class LoggerService {
     std::uint64_t dropped = 0;
     std::uint64_t gap_events = 0;
     std::uint64_t missing = 0;
+    std::uint64_t overlaps = 0;  // overlapping and duplicate blocks
+    std::uint64_t resumes = 0;
+    std::uint64_t skipped = 0;
   };
   std::array<Seen, ChannelTable::kMaxChannels> seen_{};
   std::uint64_t seen_unrecorded_ = 0;

@@ -31,7 +31,7 @@ std::string json_string(std::string_view text) {
 }
 
 struct Totals {
-  std::uint64_t received = 0, written = 0, dropped = 0, bytes_written = 0, gap_events = 0, missing = 0;
+  std::uint64_t received = 0, written = 0, dropped = 0, bytes_written = 0, gap_events = 0, missing = 0, skipped = 0;
   std::uint64_t queue_full = 0, oversize = 0, write_failed = 0;
 };
 
@@ -45,6 +45,7 @@ Totals totals_of(const ChannelTable& channels) {
     t.bytes_written += c.bytes_written.load();
     t.gap_events += c.sequence.gap_events();
     t.missing += c.sequence.missing();
+    t.skipped += c.sequence.skipped();
     t.queue_full += c.dropped_queue_full;
     t.oversize += c.dropped_oversize;
     t.write_failed += c.write_failed.load();
@@ -68,7 +69,8 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
   }
   j << "\n  ],\n  \"totals\": {\"received\": " << t.received << ", \"written\": " << t.written
     << ", \"dropped\": " << t.dropped + s.unrecorded_channel << ", \"bytes_written\": " << t.bytes_written
-    << ", \"gap_events\": " << t.gap_events << ", \"missing\": " << t.missing << "},\n";
+    << ", \"gap_events\": " << t.gap_events << ", \"missing\": " << t.missing << ", \"skipped\": " << t.skipped
+    << "},\n";
   j << "  \"dropped\": {\"queue_full\": " << t.queue_full << ", \"oversize\": " << t.oversize
     << ", \"write_failed\": " << t.write_failed << ", \"unrecorded_channel\": " << s.unrecorded_channel << "},\n";
   j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes << ", \"high_water_bytes\": "
@@ -84,9 +86,12 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
       << ", \"write_failed\": " << c.write_failed.load();
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
-      j << ",\n      \"sequence\": {\"first_seq\": " << q.first_seq() << ", \"last_seq\": " << q.last_seq()
-        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing()
-        << ", \"duplicates\": " << q.duplicates() << ", \"out_of_order\": " << q.out_of_order()
+      j << ",\n      \"sequence\": {\"blocks\": " << q.observed() << ", \"ticks\": " << q.ticks()
+        << ", \"first_seq\": " << q.first_seq() << ", \"last_seq\": " << q.last_seq()
+        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing() << ", \"resumes\": " << q.resumes()
+        << ", \"skipped\": " << q.skipped() << ", \"overlaps\": " << q.overlaps()
+        << ", \"overlap_ticks\": " << q.overlap_ticks() << ", \"duplicates\": " << q.duplicates()
+        << ", \"out_of_order\": " << q.out_of_order()
         << ", \"restarts\": " << q.restarts() << ", \"undecodable\": " << c.undecodable << ", \"gaps\": [";
       for (std::size_t g = 0; g < q.kept_gap_count(); ++g) {
         j << (g ? ", " : "") << "[" << q.kept_gaps()[g].first_missing << ", " << q.kept_gaps()[g].last_missing << "]";
@@ -117,8 +122,11 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
          << c.dropped();
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
-      line << ", seq " << q.first_seq() << ".." << q.last_seq() << ", gaps " << q.gap_events() << " (missing "
-           << q.missing() << "), duplicates " << q.duplicates() << ", out of order " << q.out_of_order();
+      line << ", ticks " << q.first_seq() << ".." << q.last_seq() << ", gaps " << q.gap_events() << " (missing "
+           << q.missing() << " ticks), overlaps " << q.overlaps() << ", duplicates " << q.duplicates()
+           << ", out of order " << q.out_of_order();
+      if (q.resumes() > 0) line << ", resumes " << q.resumes() << " (skipped " << q.skipped() << " ticks)";
+      if (q.restarts() > 0) line << ", restarts " << q.restarts();
       if (c.undecodable > 0) line << ", undecodable " << c.undecodable;
     }
     lines.push_back(line.str());

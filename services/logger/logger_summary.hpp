@@ -5,17 +5,20 @@
 // JSON layout (counts are integers; times in us since the epoch; durations in s):
 //   { "recording", "start_utime", "stop_utime", "duration_s", "stop_reason",
 //     "files": [ {"path", "events", "bytes"} ],
-//     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing" },
+//     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing", "skipped" },
 //     "dropped": { "queue_full", "oversize", "write_failed", "unrecorded_channel" },
 //     "queue": { "capacity_bytes", "high_water_bytes" },
 //     "process": { "cpu_user_s", "cpu_system_s", "peak_rss_bytes" },
 //     "channels": { "<name>": { "received", "bytes_received", "written", "bytes_written",
 //                               "dropped", "dropped_queue_full", "dropped_oversize", "write_failed",
-//                               ["sequence": { "first_seq", "last_seq", "gap_events", "missing",
-//                                              "duplicates", "out_of_order", "restarts",
-//                                              "undecodable", "gaps": [[first_missing, last_missing], ...] }] } } }
-// "gaps" lists the first SequenceGapDetector::kKeptGaps gaps of a channel; "sequence" is
-// present for the channels checked for gaps (the rig's sensor and command channels).
+//                               ["sequence": { "blocks", "ticks", "first_seq", "last_seq", "gap_events", "missing",
+//                                              "resumes", "skipped", "overlaps", "overlap_ticks",
+//                                              "duplicates", "out_of_order", "restarts", "undecodable",
+//                                              "gaps": [[first_missing, last_missing], ...] }] } } }
+// Counts in "sequence" are of blocks, except ticks, missing, skipped and overlap_ticks (ticks);
+// first_seq/last_seq are tick numbers. "gaps" lists the first SequenceGapDetector::kKeptGaps
+// gaps of a channel; "sequence" is present for the channels checked for gaps (the rig's
+// sensor and command channels).
 
 #include <cstdint>
 #include <filesystem>

@@ -1,5 +1,5 @@
 // hystloop-logger: records the rig's channels to rotating LCM event logs (lcm-logplayer
-// and lcm-spy read them), counts every message, drop and sequence gap, reports them in
+// and lcm-spy read them), counts every message, drop and tick gap, reports them in
 // HX_STATUS at 1 Hz and in a summary JSON written at close. See logger_service.hpp and
 // logger_options.hpp; `hystloop-logger --help` lists the options.
 #include <cstdio>
@@ -28,10 +28,11 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hystloop-logger: records the rig's LCM channels to rotating event logs\n"
       "(<out-dir>/<file-prefix>hystloop-YYYYmmdd-HHMMSS.NNN.lcmlog, read by lcm-logplayer and lcm-spy),\n"
-      "detects sequence gaps on <rig>SENSOR and <rig>COMMAND, reports in <rig>STATUS (process \"logger\")\n"
-      "and writes <recording>.summary.json at close (SIGINT, SIGTERM or control SHUTDOWN).\n"
+      "detects missing ticks between the blocks on <rig>SENSOR and <rig>COMMAND, reports in <rig>STATUS\n"
+      "(process \"logger\")"
+      " and writes <recording>.summary.json at close (SIGINT, SIGTERM or control SHUTDOWN).\n"
       "Each logger flag equals --set logger.<key>=VALUE (keys: out_dir, file_prefix, max_file_mb, max_file_s,\n"
-      "summary, channels, queue_mb, lcm_queue, flush_interval_s, restart_threshold)."};
+      "summary, channels, queue_mb, lcm_queue, flush_interval_s, restart_threshold, command_resume_s)."};
   ServiceOptions service;
   LoggerFlags flags;
   add_service_options(app, service);

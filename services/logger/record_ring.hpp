@@ -6,8 +6,9 @@
 // across the end of the buffer (a padding marker skips the tail), so the consumer reads
 // every payload in place, contiguous.
 //
-// Sized in bytes, not messages: a 44-byte sample costs 72 bytes, so 64 MiB holds ~45 s
-// of HX_SENSOR + HX_COMMAND at 10 kHz while the disk is stalled.
+// Sized in bytes, not messages: a 480-byte HX_SENSOR block of 10 ticks costs 504 bytes and
+// its 246-byte HX_COMMAND answer 272, so 64 MiB holds ~85 s of both at 10 kHz of ticks in
+// blocks of 10 while the disk is stalled.
 
 #include <atomic>
 #include <cstddef>

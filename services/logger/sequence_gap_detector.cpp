@@ -1,43 +1,69 @@
 #include "logger/sequence_gap_detector.hpp"
 
+#include <limits>
 #include <string>
 
 #include "core/errors.hpp"
 
 namespace hystloop {
 
-SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold) : restart_threshold_(restart_threshold) {
+SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold, std::int64_t resume_silence_us)
+    : restart_threshold_(restart_threshold), resume_silence_us_(resume_silence_us) {
   if (restart_threshold < 1) {
     throw ParameterError("restart_threshold", "must be >= 1 (got " + std::to_string(restart_threshold) + ")");
   }
+  if (resume_silence_us < 0) {
+    throw ParameterError("resume_silence_us", "must be >= 0 (got " + std::to_string(resume_silence_us) + ")");
+  }
 }
 
-SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t seq) noexcept {
+SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, std::int64_t n_ticks,
+                                                          std::int64_t recv_utime) noexcept {
+  const std::int64_t n = n_ticks < 1 ? 1 : n_ticks;
+  // Last tick of the block, saturated at the largest tick number.
+  const std::int64_t last =
+      first > std::numeric_limits<std::int64_t>::max() - (n - 1) ? std::numeric_limits<std::int64_t>::max() : first + (n - 1);
+  const std::int64_t silence_us = recv_utime - last_utime_;
+  last_utime_ = recv_utime;
+  ticks_ += static_cast<std::uint64_t>(n);
   if (observed_++ == 0) {
-    first_ = last_ = seq;
+    first_ = first;
+    advance(first, last);
     return Outcome::kFirst;
   }
   // Differences in unsigned arithmetic: well defined for any pair of int64 values.
-  const auto useq = static_cast<std::uint64_t>(seq);
+  const auto ufirst = static_cast<std::uint64_t>(first);
   const auto ulast = static_cast<std::uint64_t>(last_);
-  if (seq > last_) {
-    const std::uint64_t step = useq - ulast;
-    if (step > 1) {
+  if (first > last_) {
+    const std::uint64_t jumped = ufirst - ulast - 1;  // ticks between the blocks
+    Outcome outcome = Outcome::kInOrder;
+    if (jumped > 0 && resume_silence_us_ > 0 && silence_us >= resume_silence_us_) {
+      ++resumes_;
+      skipped_ += jumped;
+      outcome = Outcome::kResume;
+    } else if (jumped > 0) {
       ++gap_events_;
-      missing_ += step - 1;
-      if (kept_ < kKeptGaps) gaps_[kept_++] = SequenceGap{last_ + 1, seq - 1};
+      missing_ += jumped;
+      if (kept_ < kKeptGaps) gaps_[kept_++] = SequenceGap{last_ + 1, first - 1};
+      outcome = Outcome::kGap;
     }
-    last_ = seq;
-    return step > 1 ? Outcome::kGap : Outcome::kInOrder;
+    advance(first, last);
+    return outcome;
   }
-  if (seq == last_) {
+  if (ulast - ufirst > static_cast<std::uint64_t>(restart_threshold_)) {
+    ++restarts_;
+    advance(first, last);
+    return Outcome::kRestart;
+  }
+  if (last > last_) {
+    ++overlaps_;
+    overlap_ticks_ += ulast - ufirst + 1;
+    advance(first, last);
+    return Outcome::kOverlap;
+  }
+  if (first == block_first_ && last == last_) {
     ++duplicates_;
     return Outcome::kDuplicate;
-  }
-  if (ulast - useq > static_cast<std::uint64_t>(restart_threshold_)) {
-    ++restarts_;
-    last_ = seq;
-    return Outcome::kRestart;
   }
   ++out_of_order_;
   return Outcome::kOutOfOrder;

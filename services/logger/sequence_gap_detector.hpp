@@ -1,16 +1,22 @@
 #pragma once
-// Watches the tick numbers (`seq`) of one channel that counts +1 per message
-// (HX_SENSOR, HX_COMMAND) and says what each new one means: in order, after a gap of
-// missed ticks, a duplicate, late (out of order), or the sender restarted its count.
-// Pure logic: no clock, no I/O, no allocation; observe() is on the logger's receive path.
+// Watches the ticks the blocks of one channel cover (HX_SENSOR, HX_COMMAND: a block covers
+// ticks seq .. seq + n_ticks - 1, and the next one should start right after it) and says
+// what each new block means, counting in ticks. Pure logic: no clock (the caller passes the
+// receive time), no I/O, no allocation; observe() is on the logger's receive path.
 //
-//   expected = last + 1
-//   seq == expected              in order
-//   seq >  expected              a gap: seq - expected ticks missing, [expected, seq - 1]
-//   seq == last                  duplicate (last is kept)
-//   last - threshold <= seq < last   out of order (a late arrival; last is kept, and the
-//                                    gap it may fill stays counted as missing)
-//   seq <  last - threshold      restart (the sender began counting again; no gap counted)
+//   L = highest tick seen since the last restart, P = first tick of the block that set it;
+//   a new block covers [first, last]:
+//   first == L + 1             in order
+//   first >  L + 1             a gap: first - L - 1 ticks missing, [L + 1, first - 1] --
+//                              or a resume when resume_silence_us > 0 and the channel had been
+//                              silent that long (a sender that stalled or restarted and then
+//                              started later on purpose, as the compensator does: its commands
+//                              run ahead of the bridge's clock): counted apart, as skipped ticks
+//   L - first > threshold      restart (the sender began counting again; no gap counted)
+//   first <= L < last          overlap: ticks first..L seen again (counted), then in order
+//   [first, last] == [P, L]    duplicate of the last block (L kept)
+//   otherwise (last <= L)      out of order: a late or repeated block; L is kept, and the gap
+//                              it may fill stays counted as missing
 
 #include <array>
 #include <cstddef>
@@ -29,38 +35,60 @@ struct SequenceGap {
 
 class SequenceGapDetector {
  public:
-  enum class Outcome { kFirst, kInOrder, kGap, kDuplicate, kOutOfOrder, kRestart };
+  enum class Outcome { kFirst, kInOrder, kGap, kResume, kOverlap, kDuplicate, kOutOfOrder, kRestart };
 
   // The first gaps are kept (ranges for the summary); later ones are only counted.
   static constexpr std::size_t kKeptGaps = 8;
 
   // `restart_threshold` [ticks]: a step back by more than this is a restart, not a late
-  // message. Throws ParameterError("restart_threshold") if < 1.
-  explicit SequenceGapDetector(std::int64_t restart_threshold = 10000);
+  // block. `resume_silence_us` [us]: a forward jump after at least this long without a block
+  // is a resume, not a gap (0 = every jump is a gap). Throws ParameterError naming the
+  // field if restart_threshold < 1 or resume_silence_us < 0.
+  explicit SequenceGapDetector(std::int64_t restart_threshold = 10000, std::int64_t resume_silence_us = 0);
 
-  Outcome observe(std::int64_t seq) noexcept;
+  // A block of `n_ticks` (>= 1; less is taken as 1) from tick `first`, received at
+  // `recv_utime` [us] (only compared with the previous block's, for resumes).
+  Outcome observe(std::int64_t first, std::int64_t n_ticks, std::int64_t recv_utime = 0) noexcept;
 
-  std::uint64_t observed() const noexcept { return observed_; }
+  std::uint64_t observed() const noexcept { return observed_; }  // blocks
+  std::uint64_t ticks() const noexcept { return ticks_; }        // ticks in those blocks
   std::uint64_t gap_events() const noexcept { return gap_events_; }
   std::uint64_t missing() const noexcept { return missing_; }  // ticks never seen in order
+  std::uint64_t resumes() const noexcept { return resumes_; }
+  std::uint64_t skipped() const noexcept { return skipped_; }  // ticks jumped over by resumes
+  std::uint64_t overlaps() const noexcept { return overlaps_; }
+  std::uint64_t overlap_ticks() const noexcept { return overlap_ticks_; }  // ticks seen again by overlaps
   std::uint64_t duplicates() const noexcept { return duplicates_; }
   std::uint64_t out_of_order() const noexcept { return out_of_order_; }
   std::uint64_t restarts() const noexcept { return restarts_; }
   bool started() const noexcept { return observed_ > 0; }
   std::int64_t first_seq() const noexcept { return first_; }  // meaningful once started()
-  std::int64_t last_seq() const noexcept { return last_; }    // highest in-order seq since the last restart
+  std::int64_t last_seq() const noexcept { return last_; }    // highest tick in order since the last restart
 
   // The first min(gap_events, kKeptGaps) gaps, in the order seen.
   std::size_t kept_gap_count() const noexcept { return kept_; }
   const std::array<SequenceGap, kKeptGaps>& kept_gaps() const noexcept { return gaps_; }
 
  private:
+  void advance(std::int64_t first, std::int64_t last) noexcept {
+    block_first_ = first;
+    last_ = last;
+  }
+
   std::int64_t restart_threshold_;
+  std::int64_t resume_silence_us_;
   std::int64_t first_ = 0;
   std::int64_t last_ = 0;
+  std::int64_t block_first_ = 0;
+  std::int64_t last_utime_ = 0;
   std::uint64_t observed_ = 0;
+  std::uint64_t ticks_ = 0;
   std::uint64_t gap_events_ = 0;
   std::uint64_t missing_ = 0;
+  std::uint64_t resumes_ = 0;
+  std::uint64_t skipped_ = 0;
+  std::uint64_t overlaps_ = 0;
+  std::uint64_t overlap_ticks_ = 0;
   std::uint64_t duplicates_ = 0;
   std::uint64_t out_of_order_ = 0;
   std::uint64_t restarts_ = 0;

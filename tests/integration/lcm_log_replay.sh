@@ -15,7 +15,9 @@ echo "== record with lcm-logger"
 lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*' "$dir/run.lcmlog" &
 logger=$!
 sleep 0.5  # lcm-logger gives no ready signal; it subscribes at start-up
-"$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 2000
+# 1000 rounds/s: the loop's own block rate. lcm-logger's subscription queue is LCM's default
+# (30 messages): faster, a loaded machine that deschedules it for ~10 ms makes it drop.
+"$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 1000
 sleep 0.3
 kill -INT "$logger"; wait "$logger" || true; logger=""
 

@@ -4,13 +4,14 @@
 //   lcm_probe subscribe --url U --prefix P --rounds N [--timeout-s T] [--ready-file F]
 //   lcm_probe write-log --file F --prefix P --rounds N      (an LCM event log, no network)
 //   lcm_probe check-log --file F --prefix P --rounds N      (read one back, e.g. lcm-logger's)
-//   lcm_probe echo      --url U --prefix P --rounds N [--ready-file F]   answers N samples
+//   lcm_probe echo      --url U --prefix P --rounds N [--ready-file F]   answers N sensor blocks
 //   lcm_probe ping      --url U --prefix P --rounds N [--rate-hz R]      round-trip percentiles
 //
-// Round k sends fixtures::sample(k) and command(k); every 10th round (j = k / 10) also
-// trajectory(j), params(j), status(j) and control(j). A receiver recovers k or j from the
-// message, and requires every expected message exactly once, byte-identical to the fixture,
-// with nothing rejected. Exit status 0 = all intact, 1 = something missing or altered.
+// Round k sends fixtures::sensor_block(k) and command_block(k) (1..10 ticks each, so the
+// arrays' sizes vary); every 10th round (j = k / 10) also trajectory(j), params(j), status(j)
+// and control(j). A receiver recovers k or j from the message, and requires every expected
+// message exactly once, byte-identical to the fixture, with nothing rejected. Exit status
+// 0 = all intact, 1 = something missing or altered.
 #include <algorithm>
 #include <chrono>
 #include <vector>
@@ -68,8 +69,8 @@ std::int64_t rare_rounds(std::int64_t rounds) { return (rounds + 9) / 10; }
 // Calls emit(channel, message) for every message of round k, in order.
 template <class Emit>
 void emit_round(const ChannelNames& ch, std::int64_t k, Emit&& emit) {
-  emit(ch.sensor, fixtures::sample(k));
-  emit(ch.command, fixtures::command(k));
+  emit(ch.sensor, fixtures::sensor_block(k));
+  emit(ch.command, fixtures::command_block(k));
   if (k % 10 == 0) {
     const std::int64_t j = k / 10;
     emit(ch.trajectory, fixtures::trajectory(j));
@@ -80,14 +81,14 @@ void emit_round(const ChannelNames& ch, std::int64_t k, Emit&& emit) {
 }
 
 // The fixture index a message carries.
-std::int64_t index_of(const sensor_sample_t& m) { return m.seq; }
-std::int64_t index_of(const actuator_command_t& m) { return m.sample_seq; }
+std::int64_t index_of(const sensor_block_t& m) { return m.seq / fixtures::kRoundTicks; }
+std::int64_t index_of(const command_block_t& m) { return m.sample_seq / fixtures::kRoundTicks; }
 std::int64_t index_of(const trajectory_t& m) { return m.version - 1; }
 std::int64_t index_of(const mem_params_t& m) { return m.version - 1; }
 std::int64_t index_of(const service_status_t& m) { return m.pid - 4242; }
 std::int64_t index_of(const control_t& m) { return m.request_id - 100; }
-sensor_sample_t fixture_for(const sensor_sample_t*, std::int64_t i) { return fixtures::sample(i); }
-actuator_command_t fixture_for(const actuator_command_t*, std::int64_t i) { return fixtures::command(i); }
+sensor_block_t fixture_for(const sensor_block_t*, std::int64_t i) { return fixtures::sensor_block(i); }
+command_block_t fixture_for(const command_block_t*, std::int64_t i) { return fixtures::command_block(i); }
 trajectory_t fixture_for(const trajectory_t*, std::int64_t i) { return fixtures::trajectory(i); }
 mem_params_t fixture_for(const mem_params_t*, std::int64_t i) { return fixtures::params(i); }
 service_status_t fixture_for(const service_status_t*, std::int64_t i) { return fixtures::status(i); }
@@ -139,8 +140,8 @@ struct Expectations {
     return sensor.complete() && command.complete() && trajectory.complete() && params.complete() &&
            status.complete() && control.complete();
   }
-  Expectation<sensor_sample_t> sensor;
-  Expectation<actuator_command_t> command;
+  Expectation<sensor_block_t> sensor;
+  Expectation<command_block_t> command;
   Expectation<trajectory_t> trajectory;
   Expectation<mem_params_t> params;
   Expectation<service_status_t> status;
@@ -150,8 +151,8 @@ struct Expectations {
 int publish(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
-  Publisher<sensor_sample_t> sensor(*lcm, ch.sensor);
-  Publisher<actuator_command_t> command(*lcm, ch.command);
+  Publisher<sensor_block_t> sensor(*lcm, ch.sensor);
+  Publisher<command_block_t> command(*lcm, ch.command);
   Publisher<trajectory_t> trajectory(*lcm, ch.trajectory);
   Publisher<mem_params_t> params(*lcm, ch.params);
   Publisher<service_status_t> status(*lcm, ch.status);
@@ -160,8 +161,8 @@ int publish(const Options& o) {
   const auto emit = [&](const std::string& channel, const auto& msg) {
     using T = std::decay_t<decltype(msg)>;
     bool ok = false;
-    if constexpr (std::is_same_v<T, sensor_sample_t>) ok = sensor.publish(msg);
-    else if constexpr (std::is_same_v<T, actuator_command_t>) ok = command.publish(msg);
+    if constexpr (std::is_same_v<T, sensor_block_t>) ok = sensor.publish(msg);
+    else if constexpr (std::is_same_v<T, command_block_t>) ok = command.publish(msg);
     else if constexpr (std::is_same_v<T, trajectory_t>) ok = trajectory.publish(msg);
     else if constexpr (std::is_same_v<T, mem_params_t>) ok = params.publish(msg);
     else if constexpr (std::is_same_v<T, service_status_t>) ok = status.publish(msg);
@@ -186,12 +187,12 @@ int subscribe(const Options& o) {
   auto lcm = open_lcm(o.url);
   Expectations expect(ch, o.rounds);
   const int queue = static_cast<int>(2 * o.rounds + 64);  // a slow start must not drop
-  Subscription<sensor_sample_t>::Options so;
+  Subscription<sensor_block_t>::Options so;
   so.queue_capacity = queue;
-  Subscription<actuator_command_t>::Options co;
+  Subscription<command_block_t>::Options co;
   co.queue_capacity = queue;
-  Subscription<sensor_sample_t> sensor(*lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
-  Subscription<actuator_command_t> command(*lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
+  Subscription<sensor_block_t> sensor(*lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
+  Subscription<command_block_t> command(*lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
   Subscription<trajectory_t> trajectory(*lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(*lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
   Subscription<service_status_t> status(*lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
@@ -243,8 +244,8 @@ int check_log(const Options& o) {
   // A memq LCM only to host the Subscriptions: events are fed to receive() directly.
   lcm::LCM lcm("memq://");
   Expectations expect(ch, o.rounds);
-  Subscription<sensor_sample_t> sensor(lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); });
-  Subscription<actuator_command_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
+  Subscription<sensor_block_t> sensor(lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); });
+  Subscription<command_block_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
   Subscription<trajectory_t> trajectory(lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
   Subscription<service_status_t> status(lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
@@ -270,17 +271,16 @@ int check_log(const Options& o) {
   return ok && other == 0 ? 0 : 1;
 }
 
-// Answers each sample k with the command for tick k + 1, as a compensator would.
+// Answers each sensor block k with command_block(k), as a compensator would.
 int echo(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
-  Publisher<actuator_command_t> command(*lcm, ch.command);
+  Publisher<command_block_t> command(*lcm, ch.command);
   std::int64_t answered = 0;
-  Subscription<sensor_sample_t>::Options so;
+  Subscription<sensor_block_t>::Options so;
   so.queue_capacity = 1000;
-  Subscription<sensor_sample_t> sensor(*lcm, ch.sensor, [&](const sensor_sample_t& m, std::int64_t) {
-    auto c = fixtures::command(m.seq);
-    answered += command.publish(c) ? 1 : 0;
+  Subscription<sensor_block_t> sensor(*lcm, ch.sensor, [&](const sensor_block_t& m, std::int64_t) {
+    answered += command.publish(fixtures::command_block(index_of(m))) ? 1 : 0;
   }, so);
   if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
@@ -290,20 +290,23 @@ int echo(const Options& o) {
   return answered == o.rounds ? 0 : 1;
 }
 
-// Sends samples at rate R and times sample -> command round trips through an echo process.
+// Sends sensor blocks at rate R and times block -> command round trips through an echo process.
 int ping(const Options& o) {
   using Clock = std::chrono::steady_clock;
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
-  Publisher<sensor_sample_t> sensor(*lcm, ch.sensor);
+  Publisher<sensor_block_t> sensor(*lcm, ch.sensor);
   std::vector<Clock::time_point> sent(static_cast<std::size_t>(o.rounds));
+  std::vector<sensor_block_t> blocks;  // built before the clock starts
+  for (std::int64_t k = 0; k < o.rounds; ++k) blocks.push_back(fixtures::sensor_block(k));
   std::vector<double> rtt_us;
   rtt_us.reserve(sent.size());
-  Subscription<actuator_command_t>::Options co;
+  Subscription<command_block_t>::Options co;
   co.queue_capacity = 1000;
-  Subscription<actuator_command_t> command(*lcm, ch.command, [&](const actuator_command_t& m, std::int64_t) {
-    if (m.sample_seq >= 0 && m.sample_seq < o.rounds) {
-      rtt_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent[static_cast<std::size_t>(m.sample_seq)]).count());
+  Subscription<command_block_t> command(*lcm, ch.command, [&](const command_block_t& m, std::int64_t) {
+    const std::int64_t k = index_of(m);
+    if (m.sample_seq >= 0 && k < o.rounds) {
+      rtt_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent[static_cast<std::size_t>(k)]).count());
     }
   }, co);
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / o.rate_hz));
@@ -314,7 +317,7 @@ int ping(const Options& o) {
       handle_pending(*lcm, std::chrono::duration_cast<std::chrono::microseconds>(due - Clock::now()));
     }
     sent[static_cast<std::size_t>(k)] = Clock::now();
-    sensor.publish(fixtures::sample(k));
+    sensor.publish(blocks[static_cast<std::size_t>(k)]);
   }
   const auto deadline = Clock::now() + std::chrono::seconds(2);
   while (static_cast<std::int64_t>(rtt_us.size()) < o.rounds && Clock::now() < deadline) {

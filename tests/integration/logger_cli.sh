@@ -34,7 +34,7 @@ echo "== control SHUTDOWN"
 printf 'logger:\n  out_dir: %s\n  file_prefix: cfg_\n' "$dir/c" >"$dir/good.yaml"
 "$logger" --lcm-url "$url" --config "$dir/good.yaml" --summary "$dir/c/run.json" --log-level warn &
 pid=$!
-"$probe" publish --url "$url" --samples 300 --commands 300 --rate-hz 3000
+"$probe" publish --url "$url" --blocks 300 --commands 300 --rate-hz 2000
 "$probe" shutdown --url "$url"
 rc=0
 for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done

@@ -1,14 +1,16 @@
 // Test program for hystloop-logger (tests/integration/logger_*.sh):
 //
-//   logger_probe publish   --url U --prefix P --samples N [--gap-at G --gap-len L] [--commands M]
-//                          [--rate-hz R] [--wait-logger-s T]
-//   logger_probe check-log --prefix P --samples N [--gap-at G --gap-len L] [--commands M] FILE...
+//   logger_probe publish   --url U --prefix P --blocks N [--block-ticks B] [--gap-at G --gap-len L]
+//                          [--commands M] [--rate-hz R] [--wait-logger-s T]
+//   logger_probe check-log --prefix P --blocks N [--block-ticks B] [--gap-at G --gap-len L] [--commands M] FILE...
 //   logger_probe shutdown  --url U --prefix P          (control_t SHUTDOWN addressed to "logger")
 //   logger_probe wait-logger --url U --prefix P [--wait-logger-s T]   (until the logger reports)
 //
-// The stream, round k = 0..N-1: sensor sample(k) unless G <= k < G+L (the deliberate gap),
-// command(k) if k < M, and every 100th round trajectory(k/100) and params(k/100) (types the
-// logger does not decode: recorded byte-exact all the same). `publish` first waits until
+// The stream, round k = 0..N-1: the sensor block of ticks B*k .. B*k + B - 1 (B = 10 by
+// default) unless G <= k < G+L (the deliberate gap: L*B ticks from B*G missing), the command
+// block answering it (ticks B*k + 500 .. + B - 1) if k < M, and every 100th round
+// trajectory(k/100) and params(k/100) (types the logger does not decode: recorded byte-exact
+// all the same); values from tests/lcm/message_fixtures.hpp. `publish` first waits until
 // the logger's HX_STATUS is heard (it reports once at start), then sends the stream paced
 // at R rounds per second. `check-log` reads the files in the order given with lcm::LogFile
 // and requires exactly that stream on those channels, in order, byte-identical to the
@@ -38,7 +40,8 @@ struct Options {
   std::string mode;
   std::string url;
   std::string prefix{kDefaultRigPrefix};
-  std::int64_t samples = 1000;
+  std::int64_t blocks = 1000;
+  std::int64_t block_ticks = 10;
   std::int64_t gap_at = -1;
   std::int64_t gap_len = 0;
   std::int64_t commands = 0;
@@ -61,7 +64,8 @@ Options parse(int argc, char** argv) {
     const std::string value = argv[++i];
     if (key == "--url") o.url = value;
     else if (key == "--prefix") o.prefix = value;
-    else if (key == "--samples") o.samples = std::stoll(value);
+    else if (key == "--blocks") o.blocks = std::stoll(value);
+    else if (key == "--block-ticks") o.block_ticks = std::stoll(value);
     else if (key == "--gap-at") o.gap_at = std::stoll(value);
     else if (key == "--gap-len") o.gap_len = std::stoll(value);
     else if (key == "--commands") o.commands = std::stoll(value);
@@ -69,6 +73,7 @@ Options parse(int argc, char** argv) {
     else if (key == "--wait-logger-s") o.wait_logger_s = std::stod(value);
     else throw std::invalid_argument("unknown option " + key);
   }
+  if (o.block_ticks < 1 || o.block_ticks > sensor_block_t::MAX_TICKS) throw std::invalid_argument("--block-ticks: 1..1000");
   return o;
 }
 
@@ -87,9 +92,15 @@ struct Event {
 // The stream in publication order.
 std::vector<Event> expected_stream(const Options& o, const ChannelNames& ch) {
   std::vector<Event> events;
-  for (std::int64_t k = 0; k < o.samples; ++k) {
-    if (!(k >= o.gap_at && k < o.gap_at + o.gap_len)) events.push_back({&ch.sensor, encoded(fixtures::sample(k))});
-    if (k < o.commands) events.push_back({&ch.command, encoded(fixtures::command(k))});
+  for (std::int64_t k = 0; k < o.blocks; ++k) {
+    const std::int64_t seq = o.block_ticks * k;
+    if (!(k >= o.gap_at && k < o.gap_at + o.gap_len)) {
+      events.push_back({&ch.sensor, encoded(fixtures::sensor_ticks(seq, o.block_ticks))});
+    }
+    if (k < o.commands) {
+      events.push_back({&ch.command, encoded(fixtures::command_ticks(seq + fixtures::kCommandLead, o.block_ticks,
+                                                                      seq + o.block_ticks - 1))});
+    }
     if (k % 100 == 0) {
       events.push_back({&ch.trajectory, encoded(fixtures::trajectory(k / 100))});
       events.push_back({&ch.params, encoded(fixtures::params(k / 100))});
@@ -121,7 +132,7 @@ int publish(const Options& o) {
   std::size_t next = 0;
   std::int64_t round = 0;
   int failures = 0;
-  for (std::int64_t k = 0; k < o.samples; ++k) {
+  for (std::int64_t k = 0; k < o.blocks; ++k) {
     const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                  std::chrono::duration<double>(static_cast<double>(k) / o.rate_hz));
     std::this_thread::sleep_until(due);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Rotation: by size (--max-file-mb 0.02, i.e. 20 kB) the recording is split into many
+# Rotation: by size (--max-file-mb 0.2, i.e. 200 kB) the recording is split into many
 # files, none larger than the limit and none empty, named in order, whose union read in
 # that order is the complete stream; by age (--max-file-s 0.25) a ~1.2 s recording makes
 # several files too. Run inside tools/netns-run.
@@ -11,7 +11,7 @@ url="udpm://239.255.76.67:7667?ttl=0"
 dir="$(mktemp -d)"; pid=""
 cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
-stream=(--samples 4000 --gap-at 100 --gap-len 3 --commands 4000)
+stream=(--blocks 4000 --block-ticks 10 --gap-at 100 --gap-len 3 --commands 4000)
 
 record() {  # <out dir> <rate> logger options...
   local out="$1" rate="$2"; shift 2
@@ -24,20 +24,20 @@ record() {  # <out dir> <rate> logger options...
 }
 
 echo "== by size"
-record "$dir/size" 8000 --max-file-mb 0.02
+record "$dir/size" 4000 --max-file-mb 0.2
 mapfile -t files < <(ls "$dir"/size/rot_hystloop-*.lcmlog | sort)
 echo "${#files[@]} files"
 [ "${#files[@]}" -ge 10 ] || { echo "expected >= 10 files, got ${#files[@]}" >&2; exit 1; }
 for f in "${files[@]}"; do
   size=$(stat -c %s "$f")
-  [ "$size" -le 20000 ] && [ "$size" -gt 0 ] || { echo "$f has $size bytes (limit 20000)" >&2; exit 1; }
+  [ "$size" -le 200000 ] && [ "$size" -gt 0 ] || { echo "$f has $size bytes (limit 200000)" >&2; exit 1; }
 done
 "$probe" check-log "${stream[@]}" "${files[@]}"
 summary=$(ls "$dir"/size/rot_hystloop-*.summary.json)
 jq -e --argjson n "${#files[@]}" '
   (.files | length) == $n and .totals.dropped == 0 and
   ([.files[].events] | add) == .totals.written and
-  .channels.HX_SENSOR.sequence.missing == 3 and .channels.HX_SENSOR.sequence.gaps == [[100, 102]]
+  .channels.HX_SENSOR.sequence.missing == 30 and .channels.HX_SENSOR.sequence.gaps == [[1000, 1029]]
 ' "$summary" >/dev/null || { echo "summary not as expected:" >&2; cat "$summary" >&2; exit 1; }
 
 echo "== by age"

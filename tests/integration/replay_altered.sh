@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The replay regression notices a change: the golden log with one command's u_V moved by one
+# The replay regression notices a change: the golden log with one command's u_ff_V moved by one
 # ulp must fail the exact comparison (exit 1) naming that tick, and pass within a tolerance.
 # Run inside tools/netns-run.
 #   replay_altered.sh <source dir> <build dir>
@@ -24,8 +24,8 @@ set +e
 rc=${PIPESTATUS[0]}
 set -e
 [ "$rc" = 1 ] || { echo "FAIL: replay-check exited $rc, expected 1 (divergence)" >&2; exit 1; }
-grep -q "FIRST DIVERGENCE at tick $tick (answering sample [0-9]*): u_V expected" "$work/exact.txt" \
-  || { echo "FAIL: the report does not name tick $tick and u_V" >&2; exit 1; }
+grep -q "FIRST DIVERGENCE at tick $tick (answering sample [0-9]*): u_ff_V expected" "$work/exact.txt" \
+  || { echo "FAIL: the report does not name tick $tick and u_ff_V" >&2; exit 1; }
 grep -q "1 differing" "$work/exact.txt" || { echo "FAIL: more than the altered tick differs" >&2; exit 1; }
 
 echo "== within --tolerance-V 1e-9: must pass"

@@ -2,7 +2,9 @@
 // (lcm.spy.LCMTypeDatabase scans the class path, as lcm-spy does): it picks the class by
 // the fingerprint at the start of each message, decodes, re-encodes and requires the same
 // bytes (no field lost or changed), and checks a few values against the C++ fixtures'
-// formulas. It also requires the jar to hold exactly the six hystloop types.
+// formulas (tests/lcm/message_fixtures.hpp: tick t of a block carries values computed from t,
+// every array holds n_ticks elements). It also requires the jar to hold exactly the six
+// hystloop types.
 //
 //   java -cp hystloop_lcmtypes.jar:lcm.jar:. DecodeCheck <jar> <log> <rounds>
 import java.io.EOFException;
@@ -76,9 +78,30 @@ public class DecodeCheck {
       if (!Arrays.equals(out.toByteArray(), ev.data)) fail(ev.channel + ": re-encoding differs");
       counts.merge(ev.channel + " " + type.getSimpleName(), 1L, Long::sum);
 
-      if (msg instanceof hystloop.sensor_sample_t) {
-        hystloop.sensor_sample_t s = (hystloop.sensor_sample_t) msg;
-        if (s.u_V != 12.5 + 0.25 * s.seq || s.y_m != -1.6e-6 + 1.0e-9 * s.seq) fail("sensor values at seq " + s.seq);
+      if (msg instanceof hystloop.sensor_block_t) {
+        hystloop.sensor_block_t s = (hystloop.sensor_block_t) msg;
+        int n = s.n_ticks;
+        if (n < 1 || s.u_V.length != n || s.u_ff_V.length != n || s.u_fb_V.length != n || s.y_ref_m.length != n
+            || s.y_m.length != n || s.flags.length != n) {
+          fail("sensor block at seq " + s.seq + ": arrays do not hold n_ticks = " + n);
+        } else {
+          for (int i = 0; i < n; ++i) {
+            long t = s.seq + i;
+            if (s.u_V[i] != 12.5 + 1.0e-3 * t || s.y_m[i] != -1.6e-6 + 1.0e-12 * t) fail("sensor values at tick " + t);
+            if ((t % 5 == 4) != Double.isNaN(s.y_ref_m[i])) fail("sensor reference (NaN = none) at tick " + t);
+          }
+        }
+      } else if (msg instanceof hystloop.command_block_t) {
+        hystloop.command_block_t c = (hystloop.command_block_t) msg;
+        int n = c.n_ticks;
+        if (n < 1 || c.u_ff_V.length != n || c.y_ref_m.length != n || c.params_version.length != n || c.mode.length != n) {
+          fail("command block at seq " + c.seq + ": arrays do not hold n_ticks = " + n);
+        } else {
+          for (int i = 0; i < n; ++i) {
+            long t = c.seq + i;
+            if (c.u_ff_V[i] != 30.0 + 1.0e-3 * t || c.params_version[i] != 3 + t % 5) fail("command values at tick " + t);
+          }
+        }
       } else if (msg instanceof hystloop.trajectory_t) {
         hystloop.trajectory_t t = (hystloop.trajectory_t) msg;
         if (t.n_points != 1 + (t.version - 1) % 6 || t.points_y_m.length != t.n_points) fail("trajectory points");
@@ -90,8 +113,8 @@ public class DecodeCheck {
     log.close();
 
     Map<String, Long> expected = new TreeMap<>();
-    expected.put("HX_SENSOR sensor_sample_t", rounds);
-    expected.put("HX_COMMAND actuator_command_t", rounds);
+    expected.put("HX_SENSOR sensor_block_t", rounds);
+    expected.put("HX_COMMAND command_block_t", rounds);
     expected.put("HX_TRAJECTORY trajectory_t", rare);
     expected.put("HX_PARAMS mem_params_t", rare);
     expected.put("HX_STATUS service_status_t", rare);

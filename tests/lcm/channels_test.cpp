@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "core/errors.hpp"
+#include "hystloop/command_block_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 
 namespace hystloop {
 namespace {
@@ -38,7 +42,10 @@ TEST(Channels, RefusesPrefixesThatAreNotLiteralRegexes) {
 
 TEST(Channels, SpecsListEveryChannelOnce) {
   EXPECT_EQ(kChannelSpecs.size(), 6u);
-  EXPECT_EQ(kChannelSpecs[0].type_name, "hystloop.sensor_sample_t");
+  EXPECT_EQ(kChannelSpecs[0].type_name, "hystloop.sensor_block_t");
+  EXPECT_EQ(kChannelSpecs[1].type_name, "hystloop.command_block_t");
+  EXPECT_EQ(kChannelSpecs[0].type_name, std::string("hystloop.") + sensor_block_t::getTypeName());
+  EXPECT_EQ(kChannelSpecs[1].type_name, std::string("hystloop.") + command_block_t::getTypeName());
 }
 
 }  // namespace

@@ -31,9 +31,9 @@ TEST(Connection, HandlePendingTimesOutWithoutBlocking) {
 
 TEST(Connection, HandlePendingDispatchesUpToTheLimit) {
   auto lcm = open_lcm("memq://");
-  Subscription<sensor_sample_t> sub(*lcm, "HX_SENSOR");
-  Publisher<sensor_sample_t> pub(*lcm, "HX_SENSOR");
-  for (std::int64_t k = 0; k < 10; ++k) pub.publish(fixtures::sample(k));
+  Subscription<sensor_block_t> sub(*lcm, "HX_SENSOR");
+  Publisher<sensor_block_t> pub(*lcm, "HX_SENSOR");
+  for (std::int64_t k = 0; k < 10; ++k) pub.publish(fixtures::sensor_block(k));
   EXPECT_EQ(handle_pending(*lcm, 1s, 4), 4);
   EXPECT_EQ(handle_pending(*lcm, 0us), 6);
   EXPECT_EQ(handle_pending(*lcm, 0us), 0);

@@ -21,28 +21,52 @@ T round_trip(const T& in) {
   return out;
 }
 
-TEST(LcmTypes, SensorSampleRoundTripsEveryField) {
-  const auto in = fixtures::sample(7);
+TEST(LcmTypes, SensorBlockRoundTripsEveryFieldAndTick) {
+  const auto in = fixtures::sensor_block(7);  // 8 ticks
   const auto out = round_trip(in);
   EXPECT_EQ(out.utime, in.utime);
-  EXPECT_EQ(out.seq, 7);
+  EXPECT_EQ(out.seq, 70);
+  EXPECT_EQ(out.dt_s, in.dt_s);
+  EXPECT_EQ(out.buffer_depth_ticks, in.buffer_depth_ticks);
+  ASSERT_EQ(out.n_ticks, 8);
   EXPECT_EQ(out.u_V, in.u_V);
+  EXPECT_EQ(out.u_ff_V, in.u_ff_V);
+  EXPECT_EQ(out.u_fb_V, in.u_fb_V);
+  EXPECT_TRUE(std::isnan(out.y_ref_m[4]));  // tick 74: no reference
+  EXPECT_EQ(out.y_ref_m[3], in.y_ref_m[3]);
   EXPECT_EQ(out.y_m, in.y_m);
   EXPECT_EQ(out.flags, in.flags);
 }
 
-TEST(LcmTypes, ActuatorCommandRoundTripsEveryField) {
-  const auto in = fixtures::command(11);
+TEST(LcmTypes, CommandBlockRoundTripsEveryFieldAndTick) {
+  const auto in = fixtures::command_block(11);  // 5 ticks from 610, answering tick 111
   const auto out = round_trip(in);
   EXPECT_EQ(out.utime, in.utime);
-  EXPECT_EQ(out.seq, 13);
-  EXPECT_EQ(out.sample_seq, 11);
-  EXPECT_EQ(out.u_V, in.u_V);
+  EXPECT_EQ(out.seq, 610);
+  EXPECT_EQ(out.sample_seq, 111);
+  ASSERT_EQ(out.n_ticks, 5);
   EXPECT_EQ(out.u_ff_V, in.u_ff_V);
-  EXPECT_EQ(out.u_fb_V, in.u_fb_V);
-  EXPECT_EQ(out.y_ref_m, in.y_ref_m);
+  EXPECT_TRUE(std::isnan(out.y_ref_m[1]));  // tick 611: no reference
+  for (std::size_t i : {0u, 2u, 3u, 4u}) EXPECT_EQ(out.y_ref_m[i], in.y_ref_m[i]);
   EXPECT_EQ(out.params_version, in.params_version);
-  EXPECT_EQ(out.mode, actuator_command_t::MODE_KATALENIC);
+  EXPECT_EQ(out.mode, in.mode);
+  EXPECT_EQ(out.mode[0], command_block_t::MODE_KATALENIC);
+}
+
+TEST(LcmTypes, ABlockOfOneTickRoundTrips) {
+  const auto s = round_trip(fixtures::sensor_ticks(5, 1));
+  EXPECT_EQ(s.n_ticks, 1);
+  EXPECT_EQ(s.u_V.size(), 1u);
+  const auto c = round_trip(fixtures::command_ticks(5, 1, -1));
+  EXPECT_EQ(c.n_ticks, 1);
+  EXPECT_EQ(c.sample_seq, -1);
+}
+
+TEST(LcmTypes, TheLargestBlocksRoundTrip) {
+  const auto s = round_trip(fixtures::sensor_ticks(0, sensor_block_t::MAX_TICKS));
+  EXPECT_EQ(s.y_m.size(), static_cast<std::size_t>(sensor_block_t::MAX_TICKS));
+  const auto c = round_trip(fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0));
+  EXPECT_EQ(c.mode.size(), static_cast<std::size_t>(command_block_t::MAX_TICKS));
 }
 
 TEST(LcmTypes, TrajectoryRoundTripsEveryFieldAndPoint) {
@@ -118,7 +142,7 @@ TEST(LcmTypes, ControlRoundTripsEveryField) {
   EXPECT_EQ(out.request_id, 103);
   EXPECT_EQ(out.command, control_t::START_EXPERIMENT);
   EXPECT_EQ(out.target, "compensator");
-  EXPECT_EQ(out.mode, actuator_command_t::MODE_EXPERIMENT);
+  EXPECT_EQ(out.mode, command_block_t::MODE_EXPERIMENT);
   EXPECT_EQ(out.kp, in.kp);
   EXPECT_EQ(out.ki, in.ki);
   EXPECT_EQ(out.kd, in.kd);
@@ -130,20 +154,28 @@ TEST(LcmTypes, ControlRoundTripsEveryField) {
 }
 
 TEST(LcmTypes, NaNSentinelSurvivesTheWire) {
-  auto in = fixtures::command(1);
-  in.y_ref_m = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_TRUE(std::isnan(round_trip(in).y_ref_m));
+  auto in = fixtures::command_block(1);
+  in.y_ref_m.assign(in.y_ref_m.size(), std::numeric_limits<double>::quiet_NaN());
+  for (const double y : round_trip(in).y_ref_m) EXPECT_TRUE(std::isnan(y));
 }
 
 // Values other code depends on: common/loop/bridge_core.hpp's sample_flags and
 // common/loop/trajectory.hpp's TrajectoryShape repeat them.
 TEST(LcmTypes, ConstantsAreTheContractedValues) {
-  EXPECT_EQ(sensor_sample_t::SATURATED, 1);
-  EXPECT_EQ(sensor_sample_t::SAFE_STATE, 2);
-  EXPECT_EQ(sensor_sample_t::SIMULATED, 4);
-  EXPECT_EQ(sensor_sample_t::SLEW_LIMITED, 8);
-  EXPECT_EQ(sensor_sample_t::LATE_COMMAND, 16);
-  EXPECT_EQ(sensor_sample_t::SENSOR_FAULT, 32);
+  EXPECT_EQ(sensor_block_t::SATURATED, 1);
+  EXPECT_EQ(sensor_block_t::SAFE_STATE, 2);
+  EXPECT_EQ(sensor_block_t::SIMULATED, 4);
+  EXPECT_EQ(sensor_block_t::SLEW_LIMITED, 8);
+  EXPECT_EQ(sensor_block_t::LATE_COMMAND, 16);
+  EXPECT_EQ(sensor_block_t::SENSOR_FAULT, 32);
+  EXPECT_EQ(sensor_block_t::MAX_TICKS, 1000);
+  EXPECT_EQ(command_block_t::MAX_TICKS, 1000);
+  EXPECT_EQ(command_block_t::MODE_OFF, 0);
+  EXPECT_EQ(command_block_t::MODE_LINEAR, 1);
+  EXPECT_EQ(command_block_t::MODE_MEM, 2);
+  EXPECT_EQ(command_block_t::MODE_PI, 3);
+  EXPECT_EQ(command_block_t::MODE_KATALENIC, 4);
+  EXPECT_EQ(command_block_t::MODE_EXPERIMENT, 5);
   EXPECT_EQ(trajectory_t::HOLD, 0);
   EXPECT_EQ(trajectory_t::SINE, 1);
   EXPECT_EQ(trajectory_t::COSINE, 2);
@@ -157,11 +189,11 @@ TEST(LcmTypes, ConstantsAreTheContractedValues) {
 }
 
 // The loop core keeps its own copies of these values (it has no LCM); they must agree.
-static_assert(sample_flags::kSaturated == sensor_sample_t::SATURATED);
-static_assert(sample_flags::kSafeState == sensor_sample_t::SAFE_STATE);
-static_assert(sample_flags::kSimulated == sensor_sample_t::SIMULATED);
-static_assert(sample_flags::kSlewLimited == sensor_sample_t::SLEW_LIMITED);
-static_assert(sample_flags::kLateCommand == sensor_sample_t::LATE_COMMAND);
+static_assert(sample_flags::kSaturated == sensor_block_t::SATURATED);
+static_assert(sample_flags::kSafeState == sensor_block_t::SAFE_STATE);
+static_assert(sample_flags::kSimulated == sensor_block_t::SIMULATED);
+static_assert(sample_flags::kSlewLimited == sensor_block_t::SLEW_LIMITED);
+static_assert(sample_flags::kLateCommand == sensor_block_t::LATE_COMMAND);
 static_assert(static_cast<int>(TrajectoryShape::kHold) == trajectory_t::HOLD);
 static_assert(static_cast<int>(TrajectoryShape::kSine) == trajectory_t::SINE);
 static_assert(static_cast<int>(TrajectoryShape::kCosine) == trajectory_t::COSINE);
@@ -169,10 +201,10 @@ static_assert(static_cast<int>(TrajectoryShape::kTriangle) == trajectory_t::TRIA
 static_assert(static_cast<int>(TrajectoryShape::kPoints) == trajectory_t::POINTS);
 static_assert(TrajectorySpec::kMaxPoints == static_cast<std::size_t>(trajectory_t::MAX_POINTS));
 
-TEST(LcmTypes, FixedSizeTypesHaveTheirWireSize) {
-  // 8-byte fingerprint + fields; these two go out at 10 kHz.
-  EXPECT_EQ(fixtures::sample(0).getEncodedSize(), 8 + 8 + 8 + 8 + 8 + 4);
-  EXPECT_EQ(fixtures::command(0).getEncodedSize(), 8 + 3 * 8 + 4 * 8 + 4 + 1);
+TEST(LcmTypes, BlocksHaveTheirWireSize) {
+  // 8-byte fingerprint + header + per-tick arrays: what 10 kHz of ticks costs on the wire.
+  EXPECT_EQ(fixtures::sensor_ticks(0, 10).getEncodedSize(), 8 + 8 + 8 + 8 + 4 + 4 + 10 * (5 * 8 + 4));
+  EXPECT_EQ(fixtures::command_ticks(0, 10, 0).getEncodedSize(), 8 + 3 * 8 + 4 + 10 * (2 * 8 + 4 + 1));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <vector>
 
 #include "lcm/message_fixtures.hpp"
 
@@ -16,8 +17,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 TEST(MessageChecks, FixturesAreValid) {
   for (std::int64_t k = 0; k < 12; ++k) {
-    EXPECT_EQ(check_message(fixtures::sample(k)), Verdict::kOk) << k;
-    EXPECT_EQ(check_message(fixtures::command(k)), Verdict::kOk) << k;
+    EXPECT_EQ(check_message(fixtures::sensor_block(k)), Verdict::kOk) << k;
+    EXPECT_EQ(check_message(fixtures::command_block(k)), Verdict::kOk) << k;
     EXPECT_EQ(check_message(fixtures::trajectory(k)), Verdict::kOk) << k;
     EXPECT_EQ(check_message(fixtures::params(k)), Verdict::kOk) << k;
     EXPECT_EQ(check_message(fixtures::status(k)), Verdict::kOk) << k;
@@ -25,56 +26,182 @@ TEST(MessageChecks, FixturesAreValid) {
   }
 }
 
-TEST(MessageChecks, SensorSample) {
-  for (double sensor_sample_t::*field : {&sensor_sample_t::u_V, &sensor_sample_t::y_m}) {
+using SensorArray = std::vector<double> sensor_block_t::*;
+using CommandArray = std::vector<double> command_block_t::*;
+
+TEST(MessageChecks, SensorBlockRejectsANonFiniteValueAtAnyTick) {
+  for (SensorArray field : {&sensor_block_t::u_V, &sensor_block_t::u_ff_V, &sensor_block_t::u_fb_V,
+                            &sensor_block_t::y_m}) {
     for (double bad : {kNaN, kInf, -kInf}) {
-      auto m = fixtures::sample(1);
-      m.*field = bad;
-      EXPECT_EQ(check_message(m), Verdict::kNonFinite);
+      for (std::size_t tick : {0u, 4u, 9u}) {
+        auto m = fixtures::sensor_ticks(100, 10);
+        (m.*field)[tick] = bad;
+        EXPECT_EQ(check_message(m), Verdict::kNonFinite) << tick;
+      }
     }
   }
-  auto m = fixtures::sample(1);
-  m.y_m = 1.6;  // micrometres sent as metres... or worse
+}
+
+TEST(MessageChecks, SensorBlockAllowsANaNReferenceButNoInfiniteOne) {
+  auto m = fixtures::sensor_ticks(100, 10);
+  m.y_ref_m.assign(10, kNaN);  // "no reference": an experiment, or no command yet
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.y_ref_m[6] = kInf;
+  EXPECT_EQ(check_message(m), Verdict::kNonFinite);
+  m.y_ref_m[6] = 2.0;  // metres, not micrometres
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  m = fixtures::sample(1);
+}
+
+TEST(MessageChecks, SensorBlockRangesAndFlags) {
+  auto m = fixtures::sensor_ticks(100, 10);
+  m.y_m[3] = 1.6;  // micrometres sent as metres... or worse
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::sensor_ticks(100, 10);
+  m.u_fb_V[9] = -2.0e4;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::sensor_ticks(100, 10);
   m.seq = -1;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  m = fixtures::sample(1);
-  m.flags = 64;  // a reserved bit
+  m = fixtures::sensor_ticks(100, 10);
+  m.utime = -1;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  m.flags = -1;
+  m = fixtures::sensor_ticks(100, 10);
+  m.buffer_depth_ticks = -1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.buffer_depth_ticks = 0;  // the next tick will be late: a fact, not an error
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  for (double bad_dt : {0.0, -1e-4, 2.0}) {
+    m = fixtures::sensor_ticks(100, 10);
+    m.dt_s = bad_dt;
+    EXPECT_EQ(check_message(m), Verdict::kOutOfRange) << bad_dt;
+  }
+  m.dt_s = kNaN;
+  EXPECT_EQ(check_message(m), Verdict::kNonFinite);
+  m = fixtures::sensor_ticks(100, 10);
+  m.flags[7] = 64;  // a reserved bit
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.flags[7] = -1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.flags[7] = 63;  // every known bit
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+}
+
+TEST(MessageChecks, SensorBlockTickCountAndArraySizesMustAgree) {
+  auto m = fixtures::sensor_ticks(0, sensor_block_t::MAX_TICKS);
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  const SensorTick extra = sensor_tick(m, 0);  // append_tick refuses a tick past MAX_TICKS: add it by hand
+  m.u_V.push_back(extra.u_V);
+  m.u_ff_V.push_back(extra.u_ff_V);
+  m.u_fb_V.push_back(extra.u_fb_V);
+  m.y_ref_m.push_back(extra.y_ref_m);
+  m.y_m.push_back(extra.y_m);
+  m.flags.push_back(extra.flags);
+  m.n_ticks += 1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::sensor_ticks(0, 0);  // a block of no tick
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::sensor_ticks(0, 1);
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  for (SensorArray field : {&sensor_block_t::u_V, &sensor_block_t::u_ff_V, &sensor_block_t::u_fb_V,
+                            &sensor_block_t::y_ref_m, &sensor_block_t::y_m}) {
+    m = fixtures::sensor_ticks(0, 10);
+    (m.*field).pop_back();
+    EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+    (m.*field).push_back(1e-7);
+    (m.*field).push_back(1e-7);
+    EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  }
+  m = fixtures::sensor_ticks(0, 10);
+  m.flags.pop_back();
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::sensor_ticks(0, 10);
+  m.n_ticks = 9;  // arrays hold 10
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.n_ticks = -10;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
 }
 
 TEST(MessageChecks, NonFiniteOutranksOutOfRange) {
-  auto m = fixtures::sample(1);
+  auto m = fixtures::sensor_block(1);
   m.seq = -5;
-  m.u_V = kNaN;
+  m.u_V[0] = kNaN;
   EXPECT_EQ(check_message(m), Verdict::kNonFinite);
 }
 
-TEST(MessageChecks, ActuatorCommand) {
-  for (double actuator_command_t::*field :
-       {&actuator_command_t::u_V, &actuator_command_t::u_ff_V, &actuator_command_t::u_fb_V}) {
-    auto m = fixtures::command(2);
-    m.*field = kNaN;
-    EXPECT_EQ(check_message(m), Verdict::kNonFinite);
+TEST(MessageChecks, CommandBlockRejectsANonFiniteFeedforwardAtAnyTick) {
+  for (double bad : {kNaN, kInf, -kInf}) {
+    for (std::size_t tick : {0u, 5u, 9u}) {
+      auto m = fixtures::command_ticks(200, 10, 150);
+      m.u_ff_V[tick] = bad;
+      EXPECT_EQ(check_message(m), Verdict::kNonFinite) << tick;
+    }
   }
-  auto m = fixtures::command(2);
-  m.y_ref_m = kNaN;  // "no reference" is a documented sentinel
+  auto m = fixtures::command_ticks(200, 10, 150);
+  m.y_ref_m.assign(10, kNaN);  // "no reference" is a documented sentinel
   EXPECT_EQ(check_message(m), Verdict::kOk);
-  m.y_ref_m = kInf;
+  m.y_ref_m[2] = -kInf;
   EXPECT_EQ(check_message(m), Verdict::kNonFinite);
-  m = fixtures::command(2);
-  m.u_V = 2.0e4;
+  m = fixtures::command_ticks(200, 10, 150);
+  m.u_ff_V[1] = 2.0e4;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  m = fixtures::command(2);
-  m.sample_seq = -1;  // not an answer to a sample: allowed
+}
+
+TEST(MessageChecks, CommandBlockModesVersionsAndSequence) {
+  auto m = fixtures::command_ticks(200, 10, 150);
+  m.sample_seq = -1;  // not an answer to a sample yet: allowed
   EXPECT_EQ(check_message(m), Verdict::kOk);
   m.sample_seq = -2;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  m = fixtures::command(2);
-  m.mode = 6;
+  m = fixtures::command_ticks(200, 10, 150);
+  m.seq = -1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::command_ticks(200, 10, 150);
+  m.utime = -1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  for (const std::int8_t mode : {command_block_t::MODE_OFF, command_block_t::MODE_LINEAR, command_block_t::MODE_MEM,
+                                 command_block_t::MODE_PI, command_block_t::MODE_KATALENIC,
+                                 command_block_t::MODE_EXPERIMENT}) {
+    m = fixtures::command_ticks(200, 10, 150);
+    m.mode[9] = mode;
+    EXPECT_EQ(check_message(m), Verdict::kOk) << int{mode};
+  }
+  for (const std::int8_t bad : {std::int8_t{6}, std::int8_t{-1}, std::int8_t{127}}) {
+    m = fixtures::command_ticks(200, 10, 150);
+    m.mode[9] = bad;
+    EXPECT_EQ(check_message(m), Verdict::kOutOfRange) << int{bad};
+  }
+  m = fixtures::command_ticks(200, 10, 150);
+  m.params_version[4] = 0;  // no identified model
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.params_version[4] = -1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+}
+
+TEST(MessageChecks, CommandBlockTickCountAndArraySizesMustAgree) {
+  auto m = fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0);
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  const CommandTick extra = command_tick(m, 0);
+  m.u_ff_V.push_back(extra.u_ff_V);
+  m.y_ref_m.push_back(extra.y_ref_m);
+  m.params_version.push_back(extra.params_version);
+  m.mode.push_back(extra.mode);
+  m.n_ticks += 1;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::command_ticks(0, 0, 0);
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  for (CommandArray field : {&command_block_t::u_ff_V, &command_block_t::y_ref_m}) {
+    m = fixtures::command_ticks(0, 10, 0);
+    (m.*field).pop_back();
+    EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  }
+  m = fixtures::command_ticks(0, 10, 0);
+  m.params_version.push_back(3);
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::command_ticks(0, 10, 0);
+  m.mode.pop_back();
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::command_ticks(0, 10, 0);
+  m.n_ticks = 11;  // arrays hold 10
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
 }
 

@@ -1,48 +1,80 @@
 #pragma once
 // One fully populated, valid message of each type, deterministic in k: every field differs
 // from its default and from its neighbours, so a round trip that drops or swaps a field
-// shows. Shared by the unit tests and the integration probe (which checks what arrives
+// shows. Shared by the unit tests and the integration probes (which check what arrives
 // against what was sent by comparing encoded bytes).
+//
+// Blocks: sensor_ticks(seq, n) / command_ticks(seq, n, sample_seq) build a block of any
+// ticks, each tick's values a function of its tick number t (tests/java/DecodeCheck.java
+// repeats the sensor formulas). sensor_block(k) / command_block(k) are round k of a probe:
+// ticks 10k .. 10k + n - 1 with n = 1 + k % 10 (the array sizes vary from round to round),
+// and the commands answering it (sample_seq = its last tick, so sample_seq / 10 = k).
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
-#include "hystloop/actuator_command_t.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_sample_t.hpp"
+#include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "lcm/blocks.hpp"
 
 namespace hystloop::fixtures {
 
 inline constexpr std::int64_t kBaseUtime = 1'700'000'000'000'000;
+inline constexpr std::int64_t kRoundTicks = 10;     // ticks reserved per probe round
+inline constexpr std::int64_t kCommandLead = 500;  // command_block(k) starts this many ticks after sensor_block(k)
 
 inline double dk(std::int64_t k) { return static_cast<double>(k); }
 
-inline sensor_sample_t sample(std::int64_t k) {
-  sensor_sample_t m{};
-  m.utime = kBaseUtime + 100 * k;
-  m.seq = k;
-  m.u_V = 12.5 + 0.25 * dk(k);
-  m.y_m = -1.6e-6 + 1.0e-9 * dk(k);
-  m.flags = sensor_sample_t::SIMULATED | (k % 2 == 0 ? sensor_sample_t::SLEW_LIMITED : 0);
+// Tick t of the bridge's record (the Java check repeats u_V and y_m).
+inline SensorTick sensor_tick_values(std::int64_t t) {
+  SensorTick s;
+  s.seq = t;
+  s.u_V = 12.5 + 1.0e-3 * dk(t);
+  s.u_ff_V = 12.0 + 1.0e-3 * dk(t);
+  s.u_fb_V = 0.5 - 0.125 * dk(t % 7);
+  s.y_ref_m = t % 5 == 4 ? std::numeric_limits<double>::quiet_NaN() : 1.25e-6 - 2.0e-13 * dk(t);
+  s.y_m = -1.6e-6 + 1.0e-12 * dk(t);
+  s.flags = sensor_block_t::SIMULATED | (t % 2 == 0 ? sensor_block_t::SLEW_LIMITED : 0) |
+            (t % 5 == 4 ? sensor_block_t::LATE_COMMAND : 0);
+  return s;
+}
+
+// Tick t of the compensator's plan.
+inline CommandTick command_tick_values(std::int64_t t) {
+  CommandTick c;
+  c.seq = t;
+  c.u_ff_V = 30.0 + 1.0e-3 * dk(t);
+  c.y_ref_m = t % 9 == 8 ? std::numeric_limits<double>::quiet_NaN() : 1.25e-6 - 2.0e-13 * dk(t);
+  c.params_version = static_cast<std::int32_t>(3 + t % 5);
+  c.mode = t % 11 == 10 ? command_block_t::MODE_EXPERIMENT : command_block_t::MODE_KATALENIC;
+  return c;
+}
+
+inline sensor_block_t sensor_ticks(std::int64_t seq, std::int64_t n_ticks) {
+  sensor_block_t m{};
+  begin_block(m, seq, kBaseUtime + 100 * seq, 1.0e-4);
+  m.buffer_depth_ticks = static_cast<std::int32_t>(20 + seq % 7);
+  for (std::int64_t t = seq; t < seq + n_ticks; ++t) append_tick(m, sensor_tick_values(t));
   return m;
 }
 
-inline actuator_command_t command(std::int64_t k) {
-  actuator_command_t m{};
-  m.utime = kBaseUtime + 100 * k + 37;
-  m.seq = k + 2;
-  m.sample_seq = k;
-  m.u_ff_V = 30.0 + 0.5 * dk(k);
-  m.u_fb_V = -0.125 * dk(k % 7);
-  m.u_V = m.u_ff_V + m.u_fb_V;
-  m.y_ref_m = 1.25e-6 - 2.0e-10 * dk(k);
-  m.params_version = static_cast<std::int32_t>(3 + k % 5);
-  m.mode = actuator_command_t::MODE_KATALENIC;
+inline command_block_t command_ticks(std::int64_t seq, std::int64_t n_ticks, std::int64_t sample_seq) {
+  command_block_t m{};
+  begin_block(m, seq, kBaseUtime + 100 * (sample_seq < 0 ? seq : sample_seq) + 37, sample_seq);
+  for (std::int64_t t = seq; t < seq + n_ticks; ++t) append_tick(m, command_tick_values(t));
   return m;
+}
+
+inline sensor_block_t sensor_block(std::int64_t k) { return sensor_ticks(kRoundTicks * k, 1 + k % kRoundTicks); }
+
+inline command_block_t command_block(std::int64_t k) {
+  return command_ticks(kRoundTicks * k + kCommandLead, 1 + (k + 3) % kRoundTicks, last_seq(sensor_block(k)));
 }
 
 inline trajectory_t trajectory(std::int64_t k) {
@@ -110,7 +142,7 @@ inline control_t control(std::int64_t k) {
   m.request_id = 100 + k;
   m.command = control_t::START_EXPERIMENT;
   m.target = "compensator";
-  m.mode = actuator_command_t::MODE_EXPERIMENT;
+  m.mode = command_block_t::MODE_EXPERIMENT;
   m.kp = 0.5;
   m.ki = 300.0 + dk(k);
   m.kd = 1.0e-5;

@@ -1,5 +1,5 @@
 // Publisher<T>: refuses what the contract forbids before it leaves the process, and
-// publishes fixed-size types without allocating.
+// publishes blocks without allocating.
 #include "lcm/publisher.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "lcm/connection.hpp"
+#include "lcm/message_storage.hpp"
 #include "lcm/message_fixtures.hpp"
 #include "lcm/subscription.hpp"
 #include "support/allocation_counter.hpp"
@@ -18,12 +19,12 @@ using namespace std::chrono_literals;
 
 TEST(Publisher, RefusesInvalidMessagesAndCountsThem) {
   lcm::LCM lcm("memq://");
-  Subscription<sensor_sample_t> sub(lcm, "HX_SENSOR");
-  Publisher<sensor_sample_t> pub(lcm, "HX_SENSOR");
-  auto bad = fixtures::sample(1);
-  bad.y_m = std::numeric_limits<double>::quiet_NaN();
+  Subscription<sensor_block_t> sub(lcm, "HX_SENSOR");
+  Publisher<sensor_block_t> pub(lcm, "HX_SENSOR");
+  auto bad = fixtures::sensor_block(1);
+  bad.y_m.back() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(pub.publish(bad));
-  EXPECT_TRUE(pub.publish(fixtures::sample(2)));
+  EXPECT_TRUE(pub.publish(fixtures::sensor_block(2)));
   handle_pending(lcm, 0us);
   EXPECT_EQ(pub.counters().invalid, 1u);
   EXPECT_EQ(pub.counters().published, 1u);
@@ -37,6 +38,16 @@ TEST(Publisher, RefusesArraysThatDisagreeWithTheirCountEvenUnchecked) {
   bad.n_points += 10;  // encode would read past the vectors
   EXPECT_FALSE(pub.publish(bad));
   EXPECT_EQ(pub.counters().encode_failed, 1u);
+
+  Publisher<sensor_block_t> sensor(lcm, "HX_SENSOR", nullptr);
+  auto block = fixtures::sensor_block(5);
+  block.flags.pop_back();  // one array a tick short
+  EXPECT_FALSE(sensor.publish(block));
+  Publisher<command_block_t> command(lcm, "HX_COMMAND", nullptr);
+  auto plan = fixtures::command_block(5);
+  plan.n_ticks += 1;
+  EXPECT_FALSE(command.publish(plan));
+  EXPECT_EQ(sensor.counters().encode_failed + command.counters().encode_failed, 2u);
 }
 
 TEST(Publisher, GrowsItsBufferForLargerVariableMessages) {
@@ -51,19 +62,24 @@ TEST(Publisher, GrowsItsBufferForLargerVariableMessages) {
 
 // Counts operator new in this thread: the Publisher and lcm-cpp's raw publish. LCM's C
 // core allocates with malloc, which this counter does not see (memq copies every message
-// into a malloc'd queue entry; udpm sends from the caller's buffer).
-TEST(Publisher, PublishingFixedSizeTypesAllocatesNothingAfterWarmUp) {
+// into a malloc'd queue entry; udpm sends from the caller's buffer). After one block of the
+// largest size, blocks built in place with begin_block/append_tick go out without allocating.
+TEST(Publisher, PublishingBlocksAllocatesNothingAfterWarmUp) {
   lcm::LCM lcm("memq://");
-  Publisher<sensor_sample_t> sensor(lcm, "HX_SENSOR");
-  Publisher<actuator_command_t> command(lcm, "A_LONGER_RIG_PREFIX_COMMAND");
-  auto s = fixtures::sample(0);
-  auto c = fixtures::command(0);
+  Publisher<sensor_block_t> sensor(lcm, "HX_SENSOR");
+  Publisher<command_block_t> command(lcm, "A_LONGER_RIG_PREFIX_COMMAND");
+  auto s = fixtures::sensor_ticks(0, 10);
+  auto c = fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0);
   sensor.publish(s);
   command.publish(c);
+  reserve_storage(s);
+  reserve_storage(c);
   testing::AllocationCounter counter;
   for (std::int64_t k = 1; k <= 1000; ++k) {
-    s.seq = k;
-    c.seq = k;
+    begin_block(s, 10 * k, fixtures::kBaseUtime + 1000 * k, 1e-4);
+    for (std::int64_t t = 10 * k; t < 10 * k + 10; ++t) append_tick(s, fixtures::sensor_tick_values(t));
+    begin_block(c, 10 * k + 200, fixtures::kBaseUtime + 1000 * k, 10 * k + 9);
+    for (std::int64_t t = 10 * k + 200; t < 10 * k + 210; ++t) append_tick(c, fixtures::command_tick_values(t));
     sensor.publish(s);
     command.publish(c);
   }

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -32,33 +34,33 @@ class SubscriptionTest : public ::testing::Test {
 
 TEST_F(SubscriptionTest, DeliversEachTypeIntactThroughLcm) {
   std::vector<std::int64_t> seqs;
-  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_sample_t& m, std::int64_t) {
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_block_t& m, std::int64_t) {
     seqs.push_back(m.seq);
   });
   Subscription<trajectory_t> traj(lcm_, "HX_TRAJECTORY");
   Subscription<service_status_t> status(lcm_, "HX_STATUS");
-  Publisher<sensor_sample_t> pub_sensor(lcm_, "HX_SENSOR");
+  Publisher<sensor_block_t> pub_sensor(lcm_, "HX_SENSOR");
   Publisher<trajectory_t> pub_traj(lcm_, "HX_TRAJECTORY");
   Publisher<service_status_t> pub_status(lcm_, "HX_STATUS");
 
-  for (std::int64_t k = 0; k < 5; ++k) ASSERT_TRUE(pub_sensor.publish(fixtures::sample(k)));
+  for (std::int64_t k = 0; k < 5; ++k) ASSERT_TRUE(pub_sensor.publish(fixtures::sensor_block(k)));
   ASSERT_TRUE(pub_traj.publish(fixtures::trajectory(4)));
   ASSERT_TRUE(pub_status.publish(fixtures::status(3)));
   EXPECT_EQ(drain(), 7);
 
-  EXPECT_EQ(seqs, (std::vector<std::int64_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(seqs, (std::vector<std::int64_t>{0, 10, 20, 30, 40}));
   EXPECT_EQ(sensor.counters().accepted, 5u);
   EXPECT_EQ(sensor.counters().rejected_total(), 0u);
-  EXPECT_EQ(fixtures::encode(sensor.latest()), fixtures::encode(fixtures::sample(4)));
+  EXPECT_EQ(fixtures::encode(sensor.latest()), fixtures::encode(fixtures::sensor_block(4)));
   EXPECT_EQ(fixtures::encode(traj.latest()), fixtures::encode(fixtures::trajectory(4)));
   EXPECT_EQ(fixtures::encode(status.latest()), fixtures::encode(fixtures::status(3)));
 }
 
 TEST_F(SubscriptionTest, EveryTruncationIsRejectedAndCounted) {
   Subscription<service_status_t> status(lcm_, "HX_STATUS");
-  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND");
+  Subscription<command_block_t> command(lcm_, "HX_COMMAND");
   const auto status_bytes = fixtures::encode(fixtures::status(4));
-  const auto command_bytes = fixtures::encode(fixtures::command(4));
+  const auto command_bytes = fixtures::encode(fixtures::command_block(4));
   for (std::size_t n = 0; n < status_bytes.size(); ++n) {
     status.receive(status_bytes.data(), n, 0);
   }
@@ -97,8 +99,8 @@ TEST_F(SubscriptionTest, AnEmptyArrayAfterAFullOneDecodesEmpty) {
 }
 
 TEST_F(SubscriptionTest, TrailingBytesAreASizeMismatch) {
-  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR");
-  auto bytes = fixtures::encode(fixtures::sample(1));
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
+  auto bytes = fixtures::encode(fixtures::sensor_block(1));
   bytes.push_back(0);
   publish_raw("HX_SENSOR", bytes);
   drain();
@@ -107,23 +109,23 @@ TEST_F(SubscriptionTest, TrailingBytesAreASizeMismatch) {
 }
 
 TEST_F(SubscriptionTest, AnotherTypeOnTheChannelIsAWrongType) {
-  Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR");
-  publish_raw("HX_SENSOR", fixtures::encode(fixtures::command(1)));  // 61 bytes: a plausible size
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
+  publish_raw("HX_SENSOR", fixtures::encode(fixtures::command_block(1)));  // a block too: a plausible size
   drain();
   EXPECT_EQ(sensor.counters().rejected(RejectReason::kWrongType), 1u);
 }
 
 TEST_F(SubscriptionTest, InvalidValuesAreRejectedPerReasonAndKeepTheLastGoodMessage) {
-  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND");
-  Publisher<actuator_command_t> unchecked(lcm_, "HX_COMMAND", nullptr);
-  ASSERT_TRUE(unchecked.publish(fixtures::command(1)));
-  auto bad = fixtures::command(2);
-  bad.u_V = std::numeric_limits<double>::quiet_NaN();
+  Subscription<command_block_t> command(lcm_, "HX_COMMAND");
+  Publisher<command_block_t> unchecked(lcm_, "HX_COMMAND", nullptr);
+  ASSERT_TRUE(unchecked.publish(fixtures::command_block(1)));
+  auto bad = fixtures::command_block(2);
+  bad.u_ff_V.back() = std::numeric_limits<double>::quiet_NaN();
   ASSERT_TRUE(unchecked.publish(bad));
-  bad.u_V = std::numeric_limits<double>::infinity();
+  bad.u_ff_V.back() = std::numeric_limits<double>::infinity();
   ASSERT_TRUE(unchecked.publish(bad));
-  bad = fixtures::command(3);
-  bad.mode = 42;
+  bad = fixtures::command_block(3);
+  bad.mode.back() = 42;
   ASSERT_TRUE(unchecked.publish(bad));
   drain();
   const auto& c = command.counters();
@@ -131,17 +133,17 @@ TEST_F(SubscriptionTest, InvalidValuesAreRejectedPerReasonAndKeepTheLastGoodMess
   EXPECT_EQ(c.accepted, 1u);
   EXPECT_EQ(c.rejected(RejectReason::kNonFinite), 2u);
   EXPECT_EQ(c.rejected(RejectReason::kOutOfRange), 1u);
-  EXPECT_EQ(command.latest().seq, fixtures::command(1).seq);
+  EXPECT_EQ(command.latest().seq, fixtures::command_block(1).seq);
 }
 
 TEST_F(SubscriptionTest, ACustomCheckReplacesTheDefault) {
-  Subscription<sensor_sample_t>::Options options;
-  options.check = [](const sensor_sample_t& m) noexcept {
-    return m.seq % 2 == 0 ? Verdict::kOk : Verdict::kOutOfRange;
+  Subscription<sensor_block_t>::Options options;
+  options.check = [](const sensor_block_t& m) noexcept {
+    return m.seq % 20 == 0 ? Verdict::kOk : Verdict::kOutOfRange;  // even rounds
   };
-  Subscription<sensor_sample_t> even(lcm_, "HX_SENSOR", {}, options);
-  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
-  for (std::int64_t k = 0; k < 6; ++k) pub.publish(fixtures::sample(k));
+  Subscription<sensor_block_t> even(lcm_, "HX_SENSOR", {}, options);
+  Publisher<sensor_block_t> pub(lcm_, "HX_SENSOR");
+  for (std::int64_t k = 0; k < 6; ++k) pub.publish(fixtures::sensor_block(k));
   drain();
   EXPECT_EQ(even.counters().accepted, 3u);
   EXPECT_EQ(even.counters().rejected(RejectReason::kOutOfRange), 3u);
@@ -149,18 +151,18 @@ TEST_F(SubscriptionTest, ACustomCheckReplacesTheDefault) {
 
 TEST_F(SubscriptionTest, AThrowingHandlerIsCountedAndLcmCarriesOn) {
   std::vector<RejectReason> reported;
-  Subscription<sensor_sample_t>::Options options;
+  Subscription<sensor_block_t>::Options options;
   options.on_reject = [&](RejectReason r) { reported.push_back(r); };
   int calls = 0;
-  Subscription<sensor_sample_t> sensor(
+  Subscription<sensor_block_t> sensor(
       lcm_, "HX_SENSOR",
-      [&](const sensor_sample_t& m, std::int64_t) {
+      [&](const sensor_block_t& m, std::int64_t) {
         ++calls;
-        if (m.seq == 1) throw std::runtime_error("handler bug");
+        if (m.seq == 10) throw std::runtime_error("handler bug");
       },
       options);
-  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
-  for (std::int64_t k = 0; k < 3; ++k) pub.publish(fixtures::sample(k));
+  Publisher<sensor_block_t> pub(lcm_, "HX_SENSOR");
+  for (std::int64_t k = 0; k < 3; ++k) pub.publish(fixtures::sensor_block(k));
   EXPECT_EQ(drain(), 3);
   EXPECT_EQ(calls, 3);
   EXPECT_EQ(sensor.counters().accepted, 2u);
@@ -215,30 +217,73 @@ std::vector<T> originals(T (*make)(std::int64_t)) {
 }
 
 TEST(SubscriptionFuzz, CorruptedBuffersNeverCrashAndAreAllCounted) {
-  fuzz(originals(&fixtures::sample), 1, kFuzzRounds);
-  fuzz(originals(&fixtures::command), 2, kFuzzRounds);
+  fuzz(originals(&fixtures::sensor_block), 1, kFuzzRounds);
+  fuzz(originals(&fixtures::command_block), 2, kFuzzRounds);
   fuzz(originals(&fixtures::trajectory), 3, kFuzzRounds);
   fuzz(originals(&fixtures::params), 4, kFuzzRounds);
   fuzz(originals(&fixtures::status), 5, kFuzzRounds);
   fuzz(originals(&fixtures::control), 6, kFuzzRounds);
 }
 
-TEST_F(SubscriptionTest, ReceivingAFixedSizeTypeAllocatesNothing) {
+// Storage for MAX_TICKS is reserved at construction: blocks of any size, and the corrupt
+// ones, are received without allocating.
+TEST_F(SubscriptionTest, ReceivingBlocksOfAnySizeAllocatesNothing) {
   std::int64_t last = -1;
-  Subscription<actuator_command_t> command(lcm_, "HX_COMMAND",
-                                           [&](const actuator_command_t& m, std::int64_t) { last = m.seq; });
-  const auto good = fixtures::encode(fixtures::command(9));
-  auto bad = good;
+  std::size_t ticks = 0;
+  Subscription<command_block_t> command(lcm_, "HX_COMMAND", [&](const command_block_t& m, std::int64_t) {
+    last = m.seq;
+    ticks += m.u_ff_V.size();
+  });
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
+  const auto small = fixtures::encode(fixtures::command_block(9));
+  const auto largest = fixtures::encode(fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0));
+  const auto sensor_largest = fixtures::encode(fixtures::sensor_ticks(0, sensor_block_t::MAX_TICKS));
+  auto bad = small;
   bad.resize(20);
-  command.receive(good.data(), good.size(), 0);  // warm-up
   testing::AllocationCounter counter;
-  for (int i = 0; i < 1000; ++i) {
-    command.receive(good.data(), good.size(), 0);
+  for (int i = 0; i < 100; ++i) {
+    command.receive(largest.data(), largest.size(), 0);
+    command.receive(small.data(), small.size(), 0);
     command.receive(bad.data(), bad.size(), 0);
+    sensor.receive(sensor_largest.data(), sensor_largest.size(), 0);
   }
   EXPECT_EQ(counter.allocations(), 0u);
-  EXPECT_EQ(last, 11);
-  EXPECT_EQ(command.counters().rejected(RejectReason::kDecodeFailed), 1000u);
+  EXPECT_EQ(last, fixtures::command_block(9).seq);
+  EXPECT_EQ(ticks, 100u * (static_cast<std::size_t>(command_block_t::MAX_TICKS) + 3u));
+  EXPECT_EQ(command.counters().rejected(RejectReason::kDecodeFailed), 100u);
+  EXPECT_EQ(sensor.counters().accepted, 100u);
+}
+
+// A tick count past MAX_TICKS (or beyond the bytes) must not reach decode, which would
+// resize every array to it: the wire-layout walk refuses it first.
+TEST_F(SubscriptionTest, ACorruptedTickCountIsADecodeFailureAndAllocatesNothing) {
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
+  const auto good = fixtures::encode(fixtures::sensor_block(3));
+  constexpr std::size_t kCountOffset = 8 + 8 + 8 + 8 + 4;
+  ASSERT_EQ(good[kCountOffset + 3], 4u);
+  testing::AllocationCounter counter;
+  for (const std::uint32_t bad : {0x7fffffffu, 0x10000000u, 1001u, 5u, 0xffffffffu}) {
+    std::array<std::uint8_t, 512> bytes{};
+    ASSERT_LE(good.size(), bytes.size());
+    std::copy(good.begin(), good.end(), bytes.begin());
+    for (std::size_t i = 0; i < 4; ++i) bytes[kCountOffset + i] = static_cast<std::uint8_t>(bad >> (24 - 8 * i));
+    sensor.receive(bytes.data(), good.size(), 0);
+  }
+  EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kDecodeFailed), 5u);
+  EXPECT_EQ(sensor.valid_count(), 0u);
+}
+
+// Decoding into the reused message: a short block after a long one holds only its own ticks.
+TEST_F(SubscriptionTest, AShortBlockAfterALongOneDecodesOnlyItsTicks) {
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
+  for (std::int64_t k : {9, 0, 9, 1}) {  // 10, 1, 10, 2 ticks
+    const auto bytes = fixtures::encode(fixtures::sensor_block(k));
+    sensor.receive(bytes.data(), bytes.size(), 0);
+    EXPECT_EQ(fixtures::encode(sensor.latest()), bytes) << k;
+  }
+  EXPECT_EQ(sensor.latest().y_m.size(), 2u);
+  EXPECT_EQ(sensor.counters().accepted, 4u);
 }
 
 TEST_F(SubscriptionTest, ReceivingTheLargestTrajectoryAllocatesNothingAfterConstruction) {
@@ -258,10 +303,10 @@ TEST_F(SubscriptionTest, ReceivingTheLargestTrajectoryAllocatesNothingAfterConst
 TEST_F(SubscriptionTest, UnsubscribesWhenDestroyed) {
   int calls = 0;
   {
-    Subscription<sensor_sample_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_sample_t&, std::int64_t) { ++calls; });
+    Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_block_t&, std::int64_t) { ++calls; });
   }
-  Publisher<sensor_sample_t> pub(lcm_, "HX_SENSOR");
-  pub.publish(fixtures::sample(0));
+  Publisher<sensor_block_t> pub(lcm_, "HX_SENSOR");
+  pub.publish(fixtures::sensor_block(0));
   drain();
   EXPECT_EQ(calls, 0);
 }

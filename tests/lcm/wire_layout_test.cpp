@@ -26,8 +26,8 @@ void put_be32(std::vector<std::uint8_t>& bytes, std::size_t at, std::int32_t val
 
 // If this fails, a .lcm file changed: update kXxx and the fingerprint in wire_layout.cpp.
 TEST(WireLayout, EveryLayoutIsPinnedToItsTypesFingerprint) {
-  EXPECT_TRUE(layout_matches<sensor_sample_t>());
-  EXPECT_TRUE(layout_matches<actuator_command_t>());
+  EXPECT_TRUE(layout_matches<sensor_block_t>());
+  EXPECT_TRUE(layout_matches<command_block_t>());
   EXPECT_TRUE(layout_matches<trajectory_t>());
   EXPECT_TRUE(layout_matches<mem_params_t>());
   EXPECT_TRUE(layout_matches<service_status_t>());
@@ -36,8 +36,8 @@ TEST(WireLayout, EveryLayoutIsPinnedToItsTypesFingerprint) {
 
 TEST(WireLayout, WalkCoversExactlyTheEncodedBytesOfEveryType) {
   for (std::int64_t k = 0; k < 12; ++k) {  // varying array counts and string lengths
-    expect_walk_matches_encoding(fixtures::sample(k));
-    expect_walk_matches_encoding(fixtures::command(k));
+    expect_walk_matches_encoding(fixtures::sensor_block(k));
+    expect_walk_matches_encoding(fixtures::command_block(k));
     expect_walk_matches_encoding(fixtures::trajectory(k));
     expect_walk_matches_encoding(fixtures::params(k));
     expect_walk_matches_encoding(fixtures::status(k));
@@ -51,6 +51,9 @@ TEST(WireLayout, WalkAcceptsTheLargestArraysTheContractAllows) {
   traj.points_t_s.assign(trajectory_t::MAX_POINTS, 0.5);
   traj.points_y_m.assign(trajectory_t::MAX_POINTS, 1e-7);
   expect_walk_matches_encoding(traj);
+
+  expect_walk_matches_encoding(fixtures::sensor_ticks(0, sensor_block_t::MAX_TICKS));
+  expect_walk_matches_encoding(fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0));
 
   auto status = fixtures::status(0);
   status.n_counters = service_status_t::MAX_COUNTERS;
@@ -80,6 +83,45 @@ TEST(WireLayout, CountsDecodeWouldAllocateForAreRefused) {
   EXPECT_LT(walk_wire_layout(wire_layout_of<trajectory_t>(), bytes.data(), bytes.size()), 0);
 }
 
+// n_ticks sits after the fingerprint and sensor_block_t's utime, seq, dt_s, buffer_depth_ticks;
+// after command_block_t's utime, seq, sample_seq.
+constexpr std::size_t kSensorCountOffset = 8 + 8 + 8 + 8 + 4;
+constexpr std::size_t kCommandCountOffset = 8 + 8 + 8 + 8;
+
+// A corrupted tick count is refused by the walk, i.e. before decode would resize six
+// arrays to it (a negative count or one past MAX_TICKS, or more ticks than the bytes hold).
+template <class T>
+void expect_bad_tick_counts_refused(std::vector<std::uint8_t> bytes, std::size_t offset, std::int32_t n_ticks) {
+  ASSERT_EQ(bytes[offset + 3], static_cast<std::uint8_t>(n_ticks));  // the offset is right
+  ASSERT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
+            static_cast<std::int64_t>(bytes.size()));
+  for (const std::int32_t bad : {-1, -2147483647 - 1, T::MAX_TICKS + 1, 1 << 28, 2147483647, n_ticks + 1}) {
+    put_be32(bytes, offset, bad);
+    EXPECT_LT(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), 0) << T::getTypeName() << " " << bad;
+  }
+  // Fewer ticks than the arrays hold: the walk ends early, so the sizes disagree.
+  put_be32(bytes, offset, n_ticks - 1);
+  EXPECT_NE(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
+            static_cast<std::int64_t>(bytes.size()));
+}
+
+TEST(WireLayout, CorruptedTickCountsAreRefusedBeforeDecode) {
+  expect_bad_tick_counts_refused<sensor_block_t>(fixtures::encode(fixtures::sensor_ticks(40, 7)), kSensorCountOffset, 7);
+  expect_bad_tick_counts_refused<command_block_t>(fixtures::encode(fixtures::command_ticks(40, 7, 30)),
+                                                  kCommandCountOffset, 7);
+}
+
+TEST(WireLayout, EveryTruncationOfABlockIsRefused) {
+  const auto sensor = fixtures::encode(fixtures::sensor_block(4));
+  for (std::size_t n = 0; n < sensor.size(); ++n) {
+    EXPECT_LT(walk_wire_layout(wire_layout_of<sensor_block_t>(), sensor.data(), n), 0) << n;
+  }
+  const auto command = fixtures::encode(fixtures::command_block(4));
+  for (std::size_t n = 0; n < command.size(); ++n) {
+    EXPECT_LT(walk_wire_layout(wire_layout_of<command_block_t>(), command.data(), n), 0) << n;
+  }
+}
+
 TEST(WireLayout, StringLengthsDecodeWouldMisreadAreRefused) {
   auto bytes = fixtures::encode(fixtures::params(1));
   const std::size_t string_at = bytes.size() - (4 + fixtures::params(1).source.size() + 1);
@@ -90,8 +132,8 @@ TEST(WireLayout, StringLengthsDecodeWouldMisreadAreRefused) {
 }
 
 TEST(WireLayout, FingerprintIsReadBigEndian) {
-  const auto bytes = fixtures::encode(fixtures::sample(0));
-  EXPECT_EQ(wire_fingerprint(bytes.data(), bytes.size()), sensor_sample_t::getHash());
+  const auto bytes = fixtures::encode(fixtures::sensor_block(0));
+  EXPECT_EQ(wire_fingerprint(bytes.data(), bytes.size()), sensor_block_t::getHash());
   EXPECT_EQ(wire_fingerprint(bytes.data(), 7), 0);
   EXPECT_EQ(wire_fingerprint(nullptr, 100), 0);
 }

@@ -26,6 +26,8 @@ TEST(LoggerOptions, DefaultsWithAnEmptyConfiguration) {
   EXPECT_TRUE(o.summary_file.empty());
   EXPECT_TRUE(o.channels.empty());
   EXPECT_EQ(o.lcm_queue, 20000);
+  EXPECT_EQ(o.restart_threshold, 10000);
+  EXPECT_EQ(o.command_resume_s, 0.1);
 }
 
 TEST(LoggerOptions, ReadsTheFileAndIgnoresOtherSections) {
@@ -50,6 +52,8 @@ TEST(LoggerOptions, BadValuesNameTheField) {
   EXPECT_NE(error_of(Config::from_string("logger:\n  file_prefix: a/b\n", "rig.yaml")).find("logger.file_prefix"),
             std::string::npos);
   EXPECT_NE(error_of(Config::from_string("logger:\n  flush_interval_s: 0\n")).find("logger.flush_interval_s"),
+            std::string::npos);
+  EXPECT_NE(error_of(Config::from_string("logger:\n  command_resume_s: -0.5\n")).find("logger.command_resume_s"),
             std::string::npos);
 }
 
@@ -76,13 +80,14 @@ TEST(LoggerOptions, CommandLineFlagsParse) {
   CLI::App app;
   LoggerFlags flags;
   add_logger_options(app, flags);
-  const char* argv[] = {"hystloop-logger", "--out-dir", "/tmp/x", "--max-file-s", "30"};
-  app.parse(5, const_cast<char**>(argv));
+  const char* argv[] = {"hystloop-logger", "--out-dir", "/tmp/x", "--max-file-s", "30", "--command-resume-s", "0"};
+  app.parse(7, const_cast<char**>(argv));
   Config c;
   apply_logger_flags(flags, c);
   const LoggerOptions o = read_logger_options(c);
   EXPECT_EQ(o.out_dir, "/tmp/x");
   EXPECT_EQ(o.max_file_s, 30.0);
+  EXPECT_EQ(o.command_resume_s, 0.0);  // every command jump a gap
 }
 
 }  // namespace

@@ -9,10 +9,13 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/process.hpp"
+#include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
+#include "lcm/message_storage.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
@@ -25,6 +28,21 @@ void publish(lcm::LCM& lcm, const std::string& channel, const T& msg) {
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
   msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+}
+
+// A valid block of `n` ticks from `seq` (values do not matter to the logger).
+sensor_block_t sensor_block(std::int64_t seq, int n) {
+  sensor_block_t b{};
+  begin_block(b, seq, 1000 + 100 * seq, 1e-4);
+  for (int i = 0; i < n; ++i) append_tick(b, SensorTick{0, seq + i, 1.0, 1.0, 0.0, 1e-6, 1e-6, 4});
+  return b;
+}
+
+command_block_t command_block(std::int64_t seq, int n, std::int64_t sample_seq) {
+  command_block_t b{};
+  begin_block(b, seq, 2000 + 100 * seq, sample_seq);
+  for (int i = 0; i < n; ++i) append_tick(b, CommandTick{seq + i, 1.0, 1e-6, 1, command_block_t::MODE_MEM});
+  return b;
 }
 
 std::string read_text(const fs::path& path) {
@@ -59,22 +77,31 @@ class LoggerServiceTest : public ::testing::Test {
   std::unique_ptr<lcm::LCM> lcm_;
 };
 
-TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocating) {
+// Blocks of 10 ticks; sensor blocks 150..152 (ticks 1500..1529) are lost; commands run 200
+// ticks ahead and, once, a block of 10 command ticks is lost and another one repeated.
+TEST_F(LoggerServiceTest, RecordsEverythingCountsTheTickGapsAndReceivesWithoutAllocating) {
   LoggerService service(*lcm_, names_, options_);
-  sensor_sample_t sample{};
-  actuator_command_t command{};
-  int sent_samples = 0;
+  constexpr int kTicks = 10;
+  int sent_blocks = 0, sent_commands = 0;
   std::size_t allocations = 0;
+  sensor_block_t sensor = sensor_block(0, kTicks);
+  command_block_t command = command_block(200, kTicks, 9);
   for (std::int64_t k = 0; k < 400; ++k) {
-    sample.seq = k;
-    sample.utime = 1000 + k;
-    command.seq = k + 2;
-    command.sample_seq = k;
+    const std::int64_t seq = kTicks * k;
+    sensor = sensor_block(seq, kTicks);
     if (k < 150 || k >= 153) {
-      publish(*lcm_, names_.sensor, sample);
-      ++sent_samples;
+      publish(*lcm_, names_.sensor, sensor);
+      ++sent_blocks;
     }
-    publish(*lcm_, names_.command, command);
+    command = command_block(seq + 200, kTicks, seq + kTicks - 1);
+    if (k != 300) {
+      publish(*lcm_, names_.command, command);
+      ++sent_commands;
+    }
+    if (k == 301) {
+      publish(*lcm_, names_.command, command);  // sent twice
+      ++sent_commands;
+    }
     if (k % 100 == 0) publish(*lcm_, names_.prefix + "OTHER_THING", command);  // any channel, any type
     const hystloop::testing::AllocationCounter counter;
     dispatch_all();
@@ -84,9 +111,16 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
 
   const ChannelTable& channels = service.channels();
   ASSERT_EQ(channels.size(), 3u);
-  EXPECT_EQ(channels[0].received, static_cast<std::uint64_t>(sent_samples));
-  EXPECT_EQ(channels[0].sequence.missing(), 3u);
-  EXPECT_EQ(channels[1].sequence.missing(), 0u);
+  EXPECT_EQ(channels[0].received, static_cast<std::uint64_t>(sent_blocks));
+  EXPECT_EQ(channels[0].sequence.ticks(), static_cast<std::uint64_t>(kTicks * sent_blocks));
+  EXPECT_EQ(channels[0].sequence.gap_events(), 1u);
+  EXPECT_EQ(channels[0].sequence.missing(), 30u);
+  EXPECT_EQ(channels[0].sequence.last_seq(), 3999);
+  EXPECT_EQ(channels[1].sequence.gap_events(), 1u);  // silence of < 0.1 s: a gap, not a resume
+  EXPECT_EQ(channels[1].sequence.missing(), 10u);
+  EXPECT_EQ(channels[1].sequence.duplicates(), 1u);
+  EXPECT_EQ(channels[1].sequence.resumes(), 0u);
+  EXPECT_EQ(channels[0].undecodable + channels[1].undecodable, 0u);
   EXPECT_EQ(channels[2].kind, SequenceKind::kNone);
 
   request_stop();
@@ -105,9 +139,9 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
   std::int64_t last_seq = -1;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (ev->channel == names_.sensor) {
-      ASSERT_EQ(sample.decode(ev->data, 0, ev->datalen), ev->datalen);
-      EXPECT_GT(sample.seq, last_seq);
-      last_seq = sample.seq;
+      ASSERT_EQ(sensor.decode(ev->data, 0, ev->datalen), ev->datalen);
+      EXPECT_GT(sensor.seq, last_seq);
+      last_seq = sensor.seq;
       ++sensor_events;
     }
     if (ev->channel == names_.status) {  // the logger's own first report, recorded too
@@ -115,12 +149,18 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
       ASSERT_EQ(status.decode(ev->data, 0, ev->datalen), ev->datalen);
       EXPECT_EQ(status.process, "logger");
       EXPECT_EQ(status.state, service_status_t::DEGRADED);
-      EXPECT_NE(status.detail.find("1 gap(s), 3 missing on HX_SENSOR"), std::string::npos) << status.detail;
+      EXPECT_NE(status.detail.find("1 gap(s), 30 ticks missing on HX_SENSOR"), std::string::npos) << status.detail;
+      EXPECT_NE(status.detail.find("1 gap(s), 10 ticks missing on HX_COMMAND"), std::string::npos) << status.detail;
+      EXPECT_NE(status.detail.find("1 overlapping/duplicate block(s) on HX_COMMAND"), std::string::npos) << status.detail;
       std::map<std::string, std::int64_t> counters;
       for (int i = 0; i < status.n_counters; ++i) counters[status.counter_names[i]] = status.counter_values[i];
-      EXPECT_EQ(counters["HX_SENSOR.received"], sent_samples);
-      EXPECT_EQ(counters["HX_SENSOR.missing"], 3);
+      EXPECT_EQ(counters["HX_SENSOR.received"], sent_blocks);
+      EXPECT_EQ(counters["HX_SENSOR.missing"], 30);
       EXPECT_EQ(counters["HX_SENSOR.gaps"], 1);
+      EXPECT_EQ(counters["HX_COMMAND.missing"], 10);
+      EXPECT_EQ(counters["HX_COMMAND.duplicates"], 1);
+      EXPECT_EQ(counters.count("HX_COMMAND.resumes"), 1u);
+      EXPECT_EQ(counters.count("HX_SENSOR.resumes"), 0u);
       EXPECT_EQ(counters["HX_COMMAND.dropped"], 0);
       EXPECT_EQ(counters["files"], 1);
       ++status_events;
@@ -128,27 +168,48 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheGapAndReceivesWithoutAllocat
     command_events += ev->channel == names_.command;
     other_events += ev->channel == "HX_OTHER_THING";
   }
-  EXPECT_EQ(sensor_events, sent_samples);
-  EXPECT_EQ(command_events, 400);
+  EXPECT_EQ(sensor_events, sent_blocks);
+  EXPECT_EQ(command_events, sent_commands);
   EXPECT_EQ(other_events, 4);
   EXPECT_EQ(status_events, 1);
 
   const std::string summary = read_text(summaries[0]);
-  EXPECT_NE(summary.find("\"gaps\": [[150, 152]]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"gaps\": [[1500, 1529]]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"gaps\": [[3200, 3209]]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"missing\": 40, \"skipped\": 0"), std::string::npos) << summary;  // totals
   EXPECT_NE(summary.find("\"stop_reason\": \"stop request\""), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"dropped\": {\"queue_full\": 0"), std::string::npos) << summary;
 }
 
+// The compensator stops for longer than logger.command_resume_s, then plans from a later
+// tick: a resume with its skipped ticks on HX_STATUS, not a loss; a block that is not a
+// command block on HX_COMMAND is recorded and counted as undecodable.
+TEST_F(LoggerServiceTest, ACompensatorResumingAfterSilenceIsCountedApart) {
+  options_.command_resume_s = 0.02;
+  LoggerService service(*lcm_, names_, options_);
+  for (std::int64_t k = 0; k < 10; ++k) publish(*lcm_, names_.command, command_block(200 + 10 * k, 10, 10 * k + 9));
+  dispatch_all();
+  std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  publish(*lcm_, names_.command, command_block(1000, 10, 800));
+  publish(*lcm_, names_.command, sensor_block(0, 3));
+  dispatch_all();
+  const ChannelSlot& slot = service.channels()[0];
+  EXPECT_EQ(slot.sequence.resumes(), 1u);
+  EXPECT_EQ(slot.sequence.skipped(), 700u);  // 300..999
+  EXPECT_EQ(slot.sequence.missing(), 0u);
+  EXPECT_EQ(slot.undecodable, 1u);
+  EXPECT_EQ(slot.received, 12u);
+  request_stop();
+  EXPECT_EQ(service.run(), 0);
+  EXPECT_EQ(slot.written.load(), 12u);
+}
+
 TEST_F(LoggerServiceTest, AFullQueueDropsAndCountsEveryMessage) {
-  options_.queue_mb = 0.005;  // 5000 bytes: ~60 samples
+  options_.queue_mb = 0.02;  // 20000 bytes: ~40 blocks
   options_.flush_interval_s = 1.0;
   LoggerService service(*lcm_, names_, options_);
-  sensor_sample_t sample{};
   // Faster than any disk thread wakes (it dozes 1 ms): most of a burst is refused.
-  for (std::int64_t k = 0; k < 2000; ++k) {
-    sample.seq = k;
-    publish(*lcm_, names_.sensor, sample);
-  }
+  for (std::int64_t k = 0; k < 2000; ++k) publish(*lcm_, names_.sensor, sensor_block(10 * k, 10));
   dispatch_all();
   const ChannelSlot& slot = service.channels()[0];
   EXPECT_EQ(slot.received, 2000u);

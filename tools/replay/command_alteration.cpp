@@ -1,10 +1,12 @@
 #include "command_alteration.hpp"
 
 #include <bit>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
 #include "decode.hpp"
+#include "lcm/blocks.hpp"
 #include "log_reader.hpp"
 
 namespace hystloop::replay {
@@ -14,27 +16,40 @@ AlterationResult write_altered_log(const std::filesystem::path& log, const std::
   lcm::LogFile writer(out.string(), "w");
   if (!writer.good()) throw std::runtime_error(out.string() + ": cannot open for writing");
   std::optional<AlterationResult> done;
-  actuator_command_t msg;
+  command_block_t msg, altered;
   std::vector<std::uint8_t> buffer;
-  std::int64_t commands_seen = 0;
+  std::set<std::int64_t> seen;  // ticks commanded so far (for nth)
+  const auto changed = [&](double u) {
+    return alteration.delta_V ? u + *alteration.delta_V : std::bit_cast<double>(std::bit_cast<std::uint64_t>(u) ^ 1u);
+  };
   report::for_each_event({log}, [&](const lcm::LogEvent& event) {
     lcm::LogEvent copy = event;
-    const bool is_command = !done && event.channel == channels.command && report::decode_checked(event, msg);
-    const bool chosen = is_command && (alteration.nth ? ++commands_seen == *alteration.nth : msg.seq == alteration.seq);
-    if (chosen) {
-      const double old_u = msg.u_V;
-      msg.u_V = alteration.delta_V ? old_u + *alteration.delta_V
-                                   : std::bit_cast<double>(std::bit_cast<std::uint64_t>(old_u) ^ 1u);
-      buffer.resize(static_cast<std::size_t>(msg.getEncodedSize()));
-      msg.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
-      copy.data = buffer.data();
-      copy.datalen = static_cast<std::int32_t>(buffer.size());
-      done = AlterationResult{msg.seq, old_u, msg.u_V};
+    if (!done && event.channel == channels.command && report::decode_checked(event, msg)) {
+      std::optional<std::int64_t> target;
+      for_each_tick(msg, [&](const CommandTick& t) {
+        const bool first_time = seen.insert(t.seq).second;
+        const bool wanted = alteration.nth ? static_cast<std::int64_t>(seen.size()) == *alteration.nth : t.seq == alteration.seq;
+        if (!target && first_time && wanted) target = t.seq;
+      });
+      if (target) {
+        begin_block(altered, msg.seq, msg.utime, msg.sample_seq);
+        for_each_tick(msg, [&](CommandTick t) {
+          if (t.seq == *target) {
+            done = AlterationResult{t.seq, t.u_ff_V, changed(t.u_ff_V)};
+            t.u_ff_V = done->new_u_ff_V;
+          }
+          append_tick(altered, t);
+        });
+        buffer.resize(static_cast<std::size_t>(altered.getEncodedSize()));
+        altered.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+        copy.data = buffer.data();
+        copy.datalen = static_cast<std::int32_t>(buffer.size());
+      }
     }
     if (writer.writeEvent(&copy) != 0) throw std::runtime_error(out.string() + ": write failed");
   });
   if (!done) {
-    const std::string which = alteration.nth ? "no command number " + std::to_string(*alteration.nth)
+    const std::string which = alteration.nth ? "no commanded tick number " + std::to_string(*alteration.nth)
                                              : "no command for tick " + std::to_string(alteration.seq);
     throw std::runtime_error(log.string() + ": " + which + " on " + channels.command);
   }

@@ -24,10 +24,8 @@ int compare_tick(const RecordedCommand& e, const RecordedCommand& a, const Compa
     double got;
     double tolerance;
   };
-  const Field fields[] = {
-      {"u_V", e.u_V, a.u_V, tol.voltage_V},
+  const Field fields[kComparedFields] = {
       {"u_ff_V", e.u_ff_V, a.u_ff_V, tol.voltage_V},
-      {"u_fb_V", e.u_fb_V, a.u_fb_V, tol.voltage_V},
       {"y_ref_m", e.y_ref_m, a.y_ref_m, tol.position_m},
       {"mode", static_cast<double>(e.mode), static_cast<double>(a.mode), 0.0},
       {"params_version", static_cast<double>(e.params_version), static_cast<double>(a.params_version), 0.0},
@@ -139,16 +137,16 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
   if (tolerance.voltage_V == 0.0 && tolerance.position_m == 0.0) {
     add("comparison: exact (doubles bitwise equal; mode and params_version equal)\n");
   } else {
-    std::snprintf(line, sizeof line, "comparison: |expected - got| <= %.6g V (voltages), <= %.6g m (y_ref_m); mode and params_version equal\n",
+    std::snprintf(line, sizeof line, "comparison: |expected - got| <= %.6g V (u_ff_V), <= %.6g m (y_ref_m); mode and params_version equal\n",
                   tolerance.voltage_V, tolerance.position_m);
     add(line);
   }
   if (r.first_divergence) {
     const Divergence& d = *r.first_divergence;
     std::snprintf(line, sizeof line,
-                  "FIRST DIVERGENCE at tick %lld (answering sample %lld): %s expected %.17g got %.17g (difference %.3g; %d of 6 fields differ at this tick)\n",
+                  "FIRST DIVERGENCE at tick %lld (answering sample %lld): %s expected %.17g got %.17g (difference %.3g; %d of %d fields differ at this tick)\n",
                   static_cast<long long>(d.seq), static_cast<long long>(d.sample_seq), d.field.c_str(), d.expected, d.got,
-                  d.got - d.expected, d.fields_differing);
+                  d.got - d.expected, d.fields_differing, kComparedFields);
     add(line);
   }
   if (r.first_missing_seq) {
@@ -158,7 +156,7 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
   }
   if (r.lost_in_transport > 0) {
     std::snprintf(line, sizeof line,
-                  "replay transport lost %llu samples (first: sample %lld): played but not answered; not counted as divergence\n",
+                  "replay transport lost %llu commanded ticks (first planned at sample %lld): the sample was played, the command never logged; not counted as divergence\n",
                   static_cast<unsigned long long>(r.lost_in_transport), static_cast<long long>(*r.first_lost_sample));
     add(line);
     if (r.divergence_after_loss) add("the first divergence comes after the first lost sample and may be its consequence: replay again\n");

@@ -3,8 +3,9 @@
 //   hystloop-replay-compare EXPECTED.lcmlog ACTUAL.lcmlog [--inputs INPUTS.lcmlog]
 //                           [--tolerance-V V] [--tolerance-m M] [--rig HX_]
 //
-// Matches actuator_command_t by seq, over the ticks the original commanded; compares u_V,
-// u_ff_V, u_fb_V, y_ref_m, mode, params_version (exact by default: bitwise equal doubles).
+// Takes the command_block_t blocks apart into ticks and matches them by tick, over the ticks
+// the original commanded; compares u_ff_V, y_ref_m, mode, params_version (exact by default:
+// bitwise equal doubles).
 // Prints the first divergence (tick, field, expected, got) and a summary.
 // Exit 0: equal; 1: diverged (or nothing compared); 2: bad arguments or unreadable log;
 // 3: the replay lost samples in transport and no divergence precedes the first loss.
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
   app.add_option("actual", actual_log, "Log of the replayed compensator's HX_COMMAND")->required();
   app.add_option("--inputs", inputs_log,
                  "The inputs log that was played (its samples tell a transport loss from a missing command)");
-  app.add_option("--tolerance-V", tolerance.voltage_V, "Accept |expected - got| up to this on u_V, u_ff_V, u_fb_V [V] (0: bitwise)")
+  app.add_option("--tolerance-V", tolerance.voltage_V, "Accept |expected - got| up to this on u_ff_V [V] (0: bitwise)")
       ->capture_default_str();
   app.add_option("--tolerance-m", tolerance.position_m, "Accept |expected - got| up to this on y_ref_m [m] (0: bitwise)")
       ->capture_default_str();
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
     }
     const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
     if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
-      std::printf("note: ignored commands: expected %llu duplicate / %llu undecodable, actual %llu duplicate / %llu undecodable\n",
+      std::printf("note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu undecodable blocks\n",
                   static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
                   static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
     }

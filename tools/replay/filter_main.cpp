@@ -2,10 +2,11 @@
 //
 //   hystloop-replay-filter inputs LOG OUT [--rig HX_] [--only-answered] [--compensator-process NAME]
 //       OUT = the recorded compensator's inputs (SENSOR, TRAJECTORY, PARAMS, CONTROL) from the
-//       first sample it answered on, to play into a fresh compensator with lcm-logplayer.
+//       sensor block holding the first sample it answered (the lowest sample_seq of its command
+//       blocks) on, to play into a fresh compensator with lcm-logplayer.
 //   hystloop-replay-filter alter LOG OUT (--seq N | --nth K) [--delta-V D]
-//       OUT = LOG with the command for tick N (or the K-th command) changed (u_V + D, default: 1 ulp flipped), to
-//       prove that a replay notices.
+//       OUT = LOG with the command for tick N (or the K-th tick commanded in the log) changed
+//       (u_ff_V + D, default: 1 ulp flipped), to prove that a replay notices.
 // Exit 0 on success, 2 on bad arguments or unreadable logs.
 
 #include <CLI/CLI.hpp>
@@ -29,22 +30,22 @@ int main(int argc, char** argv) {
   inputs->add_option("log", log, "Recorded LCM event log")->required();
   inputs->add_option("out", out, "Inputs-only log to write")->required();
   inputs->add_flag("--only-answered", input_options.only_answered,
-                   "Also leave out samples the recorded compensator did not answer (gaps it saw)");
+                   "Also leave out sensor blocks the recorded compensator did not answer (gaps it saw)");
   inputs->add_option("--compensator-process", input_options.compensator_process,
                      "Process name of the compensator in HX_STATUS (its start time bounds the warm-up)")
       ->capture_default_str();
 
   hystloop::replay::CommandAlteration alteration;
   std::optional<double> delta_V;
-  CLI::App* alter = app.add_subcommand("alter", "Copy a log with one command's u_V changed");
+  CLI::App* alter = app.add_subcommand("alter", "Copy a log with one tick's u_ff_V changed");
   alter->add_option("log", log, "Recorded LCM event log")->required();
   alter->add_option("out", out, "Altered log to write")->required();
   std::optional<std::int64_t> seq;
   CLI::Option* seq_opt = alter->add_option("--seq", seq, "Tick of the command to change");
-  alter->add_option("--nth", alteration.nth, "Change the nth command of the log instead (1 = first)")
+  alter->add_option("--nth", alteration.nth, "Change the nth tick commanded in the log instead (1 = first)")
       ->check(CLI::PositiveNumber)
       ->excludes(seq_opt);
-  alter->add_option("--delta-V", delta_V, "Add this to u_V [V] (default: flip its least significant bit)");
+  alter->add_option("--delta-V", delta_V, "Add this to u_ff_V [V] (default: flip its least significant bit)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
       alteration.seq = seq.value_or(0);
       alteration.delta_V = delta_V;
       const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
-      std::printf("altered tick %lld: u_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_V, r.new_u_V);
+      std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V, r.new_u_ff_V);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "decode.hpp"
+#include "lcm/blocks.hpp"
 #include "log_reader.hpp"
 #include "recorded_commands.hpp"
 
@@ -44,16 +45,19 @@ bool other_input_decodes(const lcm::LogEvent& event, const ChannelNames& c) {
   return decodes<control_t>(event);
 }
 
+// True if one of `answered` lies in the block's ticks.
+bool answers_block(const std::set<std::int64_t>& answered, const sensor_block_t& block) {
+  const auto it = answered.lower_bound(block.seq);
+  return it != answered.end() && *it <= last_seq(block);
+}
+
 }  // namespace
 
 ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const std::filesystem::path& out,
                                          const ChannelNames& channels, const ReplayInputOptions& options) {
   ReplayInputSelection sel;
-  std::set<std::int64_t> answered;
-  for (const auto& [seq, c] : read_commands(log, channels).by_seq) {
-    if (c.sample_seq >= 0) answered.insert(c.sample_seq);
-  }
-  if (answered.empty()) throw std::runtime_error(log.string() + ": no " + channels.command + " command answering a sample: nothing to replay against");
+  const std::set<std::int64_t> answered = read_commands(log, channels).answered_samples;
+  if (answered.empty()) throw std::runtime_error(log.string() + ": no " + channels.command + " command block answering a sample: nothing to replay against");
   sel.first_answered_sample = *answered.begin();
   const LogStart start = read_log_start(log, channels, options.compensator_process);
   sel.compensator_start_utime = start.compensator_start_utime;
@@ -62,19 +66,20 @@ ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const
 
   lcm::LogFile writer(out.string(), "w");
   if (!writer.good()) throw std::runtime_error(out.string() + ": cannot open for writing");
-  bool started = false;  // reached the first answered sample
-  sensor_sample_t sample;
+  bool started = false;  // reached the first answered sensor block
+  sensor_block_t block;
   report::for_each_event({log}, [&](const lcm::LogEvent& event) {
     if (event.channel == channels.sensor) {
-      if (!report::decode_checked(event, sample)) return void(++sel.undecodable);
-      if (!sel.first_log_sample) sel.first_log_sample = sample.seq;
-      if (sample.seq < *sel.first_answered_sample) return void(++sel.samples_before_start);
+      if (!report::decode_checked(event, block)) return void(++sel.undecodable);
+      if (!sel.first_log_sample) sel.first_log_sample = block.seq;
+      if (last_seq(block) < *sel.first_answered_sample) return void(++sel.blocks_before_start);
       started = true;
-      if (answered.count(sample.seq) == 0) {
-        ++sel.samples_unanswered;
-        if (options.only_answered) return void(++sel.samples_unanswered_dropped);
+      if (!answers_block(answered, block)) {
+        ++sel.blocks_unanswered;
+        if (options.only_answered) return void(++sel.blocks_unanswered_dropped);
       }
-      ++sel.samples_written;
+      ++sel.blocks_written;
+      sel.ticks_written += static_cast<std::uint64_t>(block.n_ticks);
     } else if (is_other_input(event.channel, channels)) {
       if (!other_input_decodes(event, channels)) return void(++sel.undecodable);
       const bool running = started || (start.compensator_start_utime && event.timestamp >= *start.compensator_start_utime);
@@ -97,22 +102,22 @@ std::string describe(const ReplayInputSelection& s) {
   std::snprintf(line, sizeof line, "log's first sample: %lld; first sample the recorded compensator answered: %lld\n",
                 ll(s.first_log_sample), ll(s.first_answered_sample));
   out += line;
-  if (s.samples_before_start > 0) {
+  if (s.blocks_before_start > 0) {
     std::snprintf(line, sizeof line,
-                  "warm-up: the recorded compensator started after the log did; the replay starts at sample %lld (%llu earlier samples left out)\n",
-                  ll(s.first_answered_sample), ull(s.samples_before_start));
+                  "warm-up: the recorded compensator started after the log did; the replay starts with the block of sample %lld (%llu earlier sensor blocks left out)\n",
+                  ll(s.first_answered_sample), ull(s.blocks_before_start));
     out += line;
   }
   if (s.log_starts_after_compensator) {
     out += "warning: the log begins after the recorded compensator started: inputs it received before are not in the log, the replay may diverge\n";
   }
   std::snprintf(line, sizeof line,
-                "replay inputs: %llu samples, %llu trajectory/params/control messages (%llu logged before the compensator ran, left out)\n",
-                ull(s.samples_written), ull(s.other_inputs_written), ull(s.other_inputs_skipped));
+                "replay inputs: %llu sensor blocks (%llu ticks), %llu trajectory/params/control messages (%llu logged before the compensator ran, left out)\n",
+                ull(s.blocks_written), ull(s.ticks_written), ull(s.other_inputs_written), ull(s.other_inputs_skipped));
   out += line;
-  if (s.samples_unanswered > 0) {
-    std::snprintf(line, sizeof line, "the recorded compensator did not answer %llu samples after its first (%llu left out)\n",
-                  ull(s.samples_unanswered), ull(s.samples_unanswered_dropped));
+  if (s.blocks_unanswered > 0) {
+    std::snprintf(line, sizeof line, "the recorded compensator did not answer %llu sensor blocks after its first (%llu left out)\n",
+                  ull(s.blocks_unanswered), ull(s.blocks_unanswered_dropped));
     out += line;
   }
   if (s.undecodable > 0) {
