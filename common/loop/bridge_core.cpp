@@ -12,7 +12,8 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 FeedbackGains with_actuator_limit(FeedbackGains gains, const ActuatorLimits& limits) {
-  gains.u_limit_V = std::max(std::abs(limits.u_min_V), std::abs(limits.u_max_V));
+  gains.u_min_V = limits.u_min_V;
+  gains.u_max_V = limits.u_max_V;
   return gains;
 }
 
@@ -31,6 +32,9 @@ void ActuatorLimits::validate() const {
 BridgeCore::BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo, double dt_s)
     : limits_((limits.validate(), limits)),
       dt_s_((require_positive("bridge.dt_s", dt_s), dt_s)),
+      // Whole ticks: k * dt compared with watchdog_s in floating point trips a tick early for
+      // about a third of the values (0.0003 s = 3 ticks reads as 3.0000000000000004e-4).
+      watchdog_ticks_(static_cast<std::int64_t>(std::floor(limits.watchdog_s / dt_s + 1e-9))),
       servo_(with_actuator_limit(servo, limits)),
       servo_ref_m_(kNaN) {
   u_applied_ = limits_.safe_u_V;
@@ -67,7 +71,7 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
   const CommandTick* command = buffer_.take(k);
   out.buffer_depth = buffer_.depth();
 
-  if (armed_ && command == nullptr && static_cast<double>(k - last_supplied_tick_) * dt_s_ > limits_.watchdog_s) {
+  if (armed_ && command == nullptr && k - last_supplied_tick_ > watchdog_ticks_) {
     armed_ = false;
     ++counters_.watchdog_trips;
   }
@@ -77,7 +81,7 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
   if (!armed_) {
     // Safe state: ramp to the safe voltage; the servo holds its state for the re-arm.
     target = limits_.safe_u_V;
-    max_step = limits_.safe_ramp_V_per_s * dt_s_;
+    max_step = std::min(limits_.safe_ramp_V_per_s, limits_.slew_V_per_s) * dt_s_;  // never faster than the slew limit
     out.flags |= sample_flags::kSafeState;
     out.y_ref_m = kNaN;
     servo_ref_m_ = kNaN;
@@ -86,13 +90,16 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
     if (command != nullptr) {
       held_ = *command;
       last_supplied_tick_ = k;
+      command_since_arm_ = true;
       ++counters_.applied;
     } else {
       ++counters_.late;
       out.flags |= sample_flags::kLateCommand;
     }
     // The servo: the previous tick's reference against the position measured at its end.
-    if (!std::isfinite(held_.y_ref_m)) {
+    if (!command_since_arm_) {
+      // Re-armed, no command yet: the servo keeps what it held through the safe state.
+    } else if (!std::isfinite(held_.y_ref_m)) {
       servo_.reset();  // no reference (an experiment): nothing to track, nothing to remember
     } else if (std::isfinite(servo_ref_m_) && servo_.gains().enabled()) {
       out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s);
@@ -131,6 +138,7 @@ void BridgeCore::arm(std::int64_t k) noexcept {
   held_.params_version = 0;
   servo_ref_m_ = kNaN;
   last_supplied_tick_ = k;
+  command_since_arm_ = false;
 }
 
 void BridgeCore::disarm() noexcept { armed_ = false; }

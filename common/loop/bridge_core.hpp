@@ -62,7 +62,7 @@ struct BridgeTick {
 
 class BridgeCore {
  public:
-  // servo.u_limit_V is taken from the actuator's range (the anti-windup limit).
+  // servo.u_min_V/u_max_V are taken from the actuator's range (the anti-windup limits).
   BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo, double dt_s = 1e-4);
 
   // A command received at any time before its tick. Returns false if refused (counted).
@@ -91,6 +91,7 @@ class BridgeCore {
  private:
   ActuatorLimits limits_;
   double dt_s_;
+  std::int64_t watchdog_ticks_;          // dry armed ticks allowed before the trip: floor(watchdog_s / dt)
   CommandBuffer buffer_;
   FeedbackController servo_;
   std::int64_t last_supplied_tick_ = 0;  // last armed tick whose command was in the buffer (or the arm tick)
@@ -99,6 +100,7 @@ class BridgeCore {
   CommandTick held_{};                   // command in force, held when one is late
   double servo_ref_m_;                   // reference of the previous tick, for the servo's error (NaN: none)
   bool armed_ = false;
+  bool command_since_arm_ = false;       // until then the servo neither acts nor forgets its held state
   BridgeCounters counters_;
 };
 

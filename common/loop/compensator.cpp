@@ -65,6 +65,7 @@ bool Compensator::set_trajectory(TrajectorySpec spec, double start_s) {
   if (given && next_tick_ >= 0 && start_s - spec.blend_s < loop_time(next_tick_)) {
     trajectory_ = spec;
     trajectory_starts_now_ = true;
+    trajectory_timed_ = false;
     return false;
   }
   if (given) {
@@ -74,6 +75,7 @@ bool Compensator::set_trajectory(TrajectorySpec spec, double start_s) {
   }
   trajectory_ = spec;
   trajectory_starts_now_ = !given;
+  trajectory_timed_ = given;
   return true;
 }
 
@@ -96,7 +98,7 @@ void Compensator::set_mode(FeedforwardMode mode) {
   if (mode != mode_) {
     mode_ = mode;
     inverse_fresh_ = true;
-    if (counters_.planned > 0) anchor_ = Anchor{last_u_, last_ref_};
+    if (counters_.planned > 0) anchor_ = Anchor{last_u_, last_ref_, kNaN};
   }
 }
 
@@ -109,7 +111,11 @@ void Compensator::reset_inverse(double y0) noexcept {
     case FeedforwardMode::kMem:
       // A virgin stage starts on the skeleton; one that has moved (after an experiment or a
       // mode switch) is on a branch through where it is now, and the voltage must not jump.
-      if (anchor_) {
+      if (anchor_ && std::isfinite(anchor_->branch_u_V)) {
+        // The stage is on the branch that began at branch_u_V (the experiment's last reversal)
+        // and passes through the measured (u, y): continue it there, direction and all.
+        mem_.continue_branch(anchor_->branch_u_V, anchor_->u_V, anchor_->y_m);
+      } else if (anchor_) {
         mem_.reset_to_branch(anchor_->y_m, anchor_->u_V);
       } else {
         mem_.reset(y0);
@@ -143,7 +149,7 @@ void Compensator::observe(const CompensatorInput& sample) noexcept {
   ++counters_.samples;
   if (last_seq_ >= 0) counters_.gaps += static_cast<std::uint64_t>(sample.seq - last_seq_ - 1);
   last_seq_ = sample.seq;
-  if (next_tick_ < 0) {
+  if (next_tick_ < 0 || counters_.planned == 0) {  // nothing was due before the first plan
     next_tick_ = sample.seq + 1;
   } else if (next_tick_ <= sample.seq) {
     // The bridge is past what was planned (a stall longer than the horizon): plan from here on.
@@ -154,14 +160,23 @@ void Compensator::observe(const CompensatorInput& sample) noexcept {
   if (awaiting_anchor_ && sample.seq >= anchor_tick_) {
     // The experiment's end has been measured: track again from where the stage is.
     awaiting_anchor_ = false;
-    anchor_ = Anchor{sample.u_V, sample.y_m};
+    anchor_ = Anchor{sample.u_V, sample.y_m, experiment_branch_u_};
     restart_reference(loop_time(next_tick_), sample.y_m);
   }
 }
 
+void Compensator::take_params_from(const Compensator& old) noexcept {
+  mem_.set_params(old.mem_params());
+  params_version_ = old.params_version_;
+  pending_mem_ = old.pending_mem_;
+  pending_version_ = old.pending_version_;
+}
+
 void Compensator::restart_reference(double t_s, double from_m) noexcept {
   trajectory_.blend_s = std::max(trajectory_.blend_s, 0.5);
-  trajectory_.start_s = t_s + trajectory_.blend_s;
+  const double earliest = t_s + trajectory_.blend_s;
+  // A trajectory given a start time keeps it when it is still ahead; otherwise as soon as possible.
+  trajectory_.start_s = trajectory_timed_ ? std::max(trajectory_.start_s, earliest) : earliest;
   trajectory_.hold_m = from_m;
   trajectory_starts_now_ = false;
   last_ref_ = from_m;
@@ -182,12 +197,20 @@ CommandTick Compensator::plan_tick(std::int64_t k) noexcept {
   constexpr auto kExperimentMode = static_cast<std::int8_t>(FeedforwardMode::kExperiment);
   const ExperimentQueue::Step e = experiments_.step(loop_time(k));
   if (e.active) {
+    if (!in_experiment_) {
+      experiment_u_.reset(e.voltage_V);
+      in_experiment_ = true;
+    } else {
+      experiment_u_.update(e.voltage_V);
+    }
     last_u_ = e.voltage_V;
     return {k, e.voltage_V, kNaN, params_version_, kExperimentMode};
   }
   if (e.ended) {
     awaiting_anchor_ = true;
     anchor_tick_ = k;
+    in_experiment_ = false;
+    experiment_branch_u_ = experiment_u_.turning_point();
   }
   if (awaiting_anchor_) return {k, last_u_, kNaN, params_version_, static_cast<std::int8_t>(mode_)};
   return tracking_tick(k);

@@ -13,7 +13,8 @@
 // parameters are validated when offered and swapped in at the next reversal of the reference,
 // where the inverse's branch restarts, so the voltage does not jump. After an experiment the
 // plan holds the last voltage (no reference) until the sample of the experiment's end arrives;
-// the inverse is then anchored at that measured (u, y) and the reference approaches from there.
+// the inverse is then anchored at that measured (u, y), on the branch that began at the
+// experiment's last reversal, and the reference approaches from there.
 
 #include <cstdint>
 #include <optional>
@@ -115,6 +116,9 @@ class Compensator {
   // First tick not yet planned (-1 before the first sample).
   std::int64_t next_tick() const noexcept { return next_tick_; }
   const CompensatorConfig& config() const noexcept { return config_; }
+  // A restarted control law keeps the parameter sets `old` was given: the one in use with its
+  // version, and one waiting for a reversal.
+  void take_params_from(const Compensator& old) noexcept;
 
  private:
   CommandTick plan_tick(std::int64_t k) noexcept;
@@ -127,6 +131,7 @@ class Compensator {
   FeedforwardMode mode_;
   TrajectorySpec trajectory_{};
   bool trajectory_starts_now_ = true;  // start_s is set at the next planned tick
+  bool trajectory_timed_ = false;      // start_s was given: an experiment's end does not move it
   MemInverse mem_;
   PiInverse pi_;
   KatalenicInverse katalenic_;
@@ -136,6 +141,10 @@ class Compensator {
   std::int32_t params_version_ = 0;
   ExperimentQueue experiments_;
   ReversalDetector reversals_;
+  // The experiment's voltage: where its last branch of the hysteresis began, for the anchor.
+  ReversalDetector experiment_u_;
+  bool in_experiment_ = false;
+  double experiment_branch_u_ = 0.0;  // the voltage of its last reversal [V]
 
   std::int64_t last_seq_ = -1;
   std::int64_t next_tick_ = -1;
@@ -149,6 +158,7 @@ class Compensator {
   struct Anchor {
     double u_V;
     double y_m;
+    double branch_u_V;  // the voltage where the stage's current branch began; NaN = unknown
   };
   std::optional<Anchor> anchor_;  // where the stage is, when it is not virgin
   CompensatorCounters counters_;

@@ -10,7 +10,9 @@ void FeedbackGains::validate() const {
   require_non_negative("feedback.ki", ki);
   require_non_negative("feedback.kd", kd);
   require_positive("feedback.nominal_gain_m_per_V", nominal_gain_m_per_V);
-  require_positive("feedback.u_limit_V", u_limit_V);
+  require_finite("feedback.u_min_V", u_min_V);
+  require_finite("feedback.u_max_V", u_max_V);
+  if (!(u_max_V > u_min_V)) throw ParameterError("feedback.u_max_V", "must be greater than feedback.u_min_V");
   require_positive("feedback.d_filter_hz", d_filter_hz);
 }
 
@@ -51,8 +53,8 @@ double FeedbackController::update(double error_m, double u_ff_V, double dt_s) no
   const double candidate = integral_ + error_m * dt_s;
   const double u_total = u_ff_V + u_pd + gains_.ki * candidate * inv_gain;
   // Conditional integration: integrate unless it pushes further into saturation.
-  const bool saturating_high = u_total > gains_.u_limit_V && error_m > 0.0;
-  const bool saturating_low = u_total < -gains_.u_limit_V && error_m < 0.0;
+  const bool saturating_high = u_total > gains_.u_max_V && error_m > 0.0;
+  const bool saturating_low = u_total < gains_.u_min_V && error_m < 0.0;
   if (gains_.ki > 0.0 && !saturating_high && !saturating_low) integral_ = candidate;
   return u_pd + gains_.ki * integral_ * inv_gain;
 }

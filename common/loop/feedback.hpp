@@ -4,8 +4,8 @@
 //   u_fb [V] = (kp * e + ki * integral(e) + kd * de/dt) / nominal_gain_m_per_V,   e = y_ref - y [m]
 // kp [-], ki [1/s], kd [s]. With the feedforward linearising the stage to ~unit gain,
 // ki is roughly the loop's crossover in rad/s. Anti-windup: the integrator stops
-// growing in the direction in which the total command already saturates
-// (conditional integration), so a clamp never winds it up.
+// growing in the direction in which the total command already saturates at u_min_V or
+// u_max_V (conditional integration), so a clamp never winds it up.
 
 #include "core/errors.hpp"
 
@@ -16,7 +16,8 @@ struct FeedbackGains {
   double ki = 0.0;          // [1/s]
   double kd = 0.0;          // [s]
   double nominal_gain_m_per_V = 6.4e-9;  // stage's mean slope dy/du (Banning stage: ~1.6 um / 250 V)
-  double u_limit_V = 250.0;              // |u_ff + u_fb| the actuator allows (for anti-windup)
+  double u_min_V = -250.0;               // the range of u_ff + u_fb the actuator allows (for anti-windup)
+  double u_max_V = 250.0;
   double d_filter_hz = 1000.0;           // first-order low-pass on the derivative
 
   void validate() const;

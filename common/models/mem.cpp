@@ -223,6 +223,14 @@ void MemInverse::reset_to_branch(double y_origin, double u_origin) noexcept {
   reversals_ = 0;
 }
 
+void MemInverse::continue_branch(double u_origin, double u_now, double y_now) noexcept {
+  reset_to_branch(y_now, u_now);
+  if (u_now == u_origin) return;
+  u_origin_ = u_origin;
+  y_origin_ = y_now - odd_rise(params_, u_now - u_origin, 1.0);
+  direction_ = u_now > u_origin ? 1 : -1;
+}
+
 double MemInverse::solve_run(double rise) noexcept {
   if (!(rise > 0.0)) return 0.0;
   double p;

@@ -133,6 +133,11 @@ class MemInverse {
   void reset(double y0 = 0.0) noexcept;
   // State right after a branching point at (y_origin [m], u_origin [V]) (Theorem 10 starts here).
   void reset_to_branch(double y_origin, double u_origin) noexcept;
+  // State on the branch that began at u_origin [V] and passes through (u_now [V], y_now [m]),
+  // moving away from u_origin: a stage measured there (e.g. after an identification input whose
+  // last reversal was at u_origin) is continued without a branch of its own and without a step
+  // in u (the next call starts from u_now exactly). u_now == u_origin is reset_to_branch.
+  void continue_branch(double u_origin, double u_now, double y_now) noexcept;
 
   double inverse(double y_ref) noexcept;
 

@@ -85,7 +85,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
   g.kd = config.get_non_negative("servo.kd", g.kd);
   g.nominal_gain_m_per_V = config.get_positive("servo.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
   g.d_filter_hz = config.get_positive("servo.d_filter_hz", g.d_filter_hz);
-  g.u_limit_V = std::max(std::abs(a.u_min_V), std::abs(a.u_max_V));
+  g.u_min_V = a.u_min_V;
+  g.u_max_V = a.u_max_V;
   validate_config_section(config, "servo.", [&] { g.validate(); });
 
   s.rt.ticks_per_wake = static_cast<int>(config.get_int_in_range("rt.ticks_per_wake", s.rt.ticks_per_wake, 1, 1000));

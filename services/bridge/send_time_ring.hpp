@@ -1,6 +1,6 @@
 #pragma once
-// When each recent sample was handed to LCM, indexed by its seq, so that the command
-// answering it (actuator_command_t.sample_seq) gives the sample-to-command latency.
+// When each recent sensor block was handed to LCM, indexed by its last tick, so that the command
+// block computed from it (command_block_t.sample_seq) gives the block-to-answer latency.
 // Fixed size, allocation-free; an answer older than the ring is not measured.
 
 #include <array>

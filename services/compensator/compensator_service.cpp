@@ -14,6 +14,21 @@
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
+
+CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounters& b) noexcept {
+  a.samples += b.samples;
+  a.out_of_order += b.out_of_order;
+  a.gaps += b.gaps;
+  a.planned += b.planned;
+  a.ticks_behind += b.ticks_behind;
+  a.params_accepted += b.params_accepted;
+  a.params_rejected += b.params_rejected;
+  a.params_swapped += b.params_swapped;
+  a.reversals += b.reversals;
+  a.nonfinite_outputs += b.nonfinite_outputs;
+  return a;
+}
+
 namespace {
 
 // A sample seq this far below the last one means the bridge restarted its clock.
@@ -84,6 +99,7 @@ void CompensatorService::publish_plan() noexcept {
 void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime) {
   if (start_utime == 0) {
     compensator_->set_trajectory(spec, kNaN);
+    pending_trajectory_.reset();  // a newer trajectory replaces one waiting for the first sample
   } else if (!have_sample_) {
     spec.validate();
     pending_trajectory_ = spec;
@@ -196,17 +212,21 @@ void CompensatorService::restart_control_law() {
   CompensatorConfig config = settings_.control;
   const Compensator& old = *compensator_;
   config.mem = old.mem_params();
-  config.mode = old.experiment_running() ? settings_.control.mode : old.mode();
+  config.mode = old.mode();  // the tracking mode (an experiment is not one)
   TrajectorySpec reference = old.trajectory();
   reference.hold_m = 0.0;
-  compensator_.emplace(config);
-  compensator_->set_trajectory(reference, kNaN);
+  Compensator next(config);
+  next.take_params_from(old);
+  retired_ += old.counters();
+  next.set_trajectory(reference, kNaN);
+  compensator_.emplace(std::move(next));
   have_sample_ = false;
   ++counters_.bridge_restarts;
 }
 
 CounterSet::Entries CompensatorService::collect_counters() const {
-  const CompensatorCounters& c = compensator_->counters();
+  CompensatorCounters c = retired_;
+  c += compensator_->counters();
   const CompensatorServiceCounters& s = counters_;
   return {{"samples", c.samples},
           {"command_blocks_published", s.command_blocks_published},

@@ -32,6 +32,8 @@
 
 namespace hystloop {
 
+CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounters& b) noexcept;
+
 // The compensator's own counters (cumulative; RESET_COUNTERS reports them from a baseline).
 struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;
@@ -95,6 +97,7 @@ class CompensatorService {
   std::int32_t offered_version_ = 0;  // highest mem_params_t.version offered
 
   CompensatorServiceCounters counters_;
+  CompensatorCounters retired_{};  // counted by control laws a bridge restart replaced
   LatencyStats latency_;  // sensor block received (LCM's receive time) -> its answer published [ns]
   LatencyStats work_;     // handler work per sensor block [ns]
   LatencyStats latency_total_;

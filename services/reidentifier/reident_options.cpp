@@ -43,7 +43,7 @@ ReidentOptions read_reident_options(const Config& config) {
   o.stale_after_s = config.get_in_range("reident.stale_after_s", o.stale_after_s, 0.001, 3600.0);
   o.degraded_after_poisoned = config.get_int_in_range("reident.degraded_after_poisoned", o.degraded_after_poisoned, 1,
                                                       1000000);
-  o.lcm_queue = config.get_int_in_range("reident.lcm_queue", o.lcm_queue, 1000, 10000000);
+  o.lcm_queue = config.get_int_in_range("reident.lcm_queue", o.lcm_queue, 100, 10000000);
 
   OnlineMemOptions& e = o.estimator;
   e.window_samples = samples_of(o.window_s, o.rate_hz);

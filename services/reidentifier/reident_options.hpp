@@ -15,7 +15,7 @@
 //   reident.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
 //   reident.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
 //   reident.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
-//   reident.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 1000; 20000)
+//   reident.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2 s)
 
 #include <cstdint>
 
@@ -34,7 +34,7 @@ struct ReidentOptions {
   bool publish_invalid = false;
   double stale_after_s = 1.0;
   std::int64_t degraded_after_poisoned = 3;
-  std::int64_t lcm_queue = 20000;
+  std::int64_t lcm_queue = 2000;
   OnlineMemOptions estimator{};  // window/capacity in samples, gates, fit time bound
 };
 

@@ -36,7 +36,8 @@ TEST(Feedback, AntiWindupStopsIntegratingIntoSaturation) {
   FeedbackGains g;
   g.ki = 1000.0;
   g.nominal_gain_m_per_V = 1e-8;
-  g.u_limit_V = 250.0;
+  g.u_min_V = -250.0;
+  g.u_max_V = 250.0;
   FeedbackController c(g);
   for (int i = 0; i < 100000; ++i) c.update(1e-6, 249.0, 1e-4);  // feedforward near the limit
   // Without anti-windup the integral would be 1e-6 * 10 s = 1e-5 m s.

@@ -619,5 +619,30 @@ TEST(MemRealTime, PerSampleCallsAllocateNothing) {
   EXPECT_TRUE(std::isfinite(sink));
 }
 
+// A stage measured partway along a branch (an identification input ended there) is continued on
+// that branch: driving the model with the inverse's output reproduces the reference exactly, in
+// both directions, and the first command equals the measured voltage (no step, no spurious branch).
+TEST(MemInverse, ContinueBranchPicksUpAStageMeasuredOnItsBranch) {
+  for (const double away : {+1.0, -1.0}) {
+    MemModel plant;
+    for (double u = 0.0; u > -320.0; u -= 1.0) plant.forward(u);  // down to the branching point
+    plant.forward(-320.0);
+    double u_now = -320.0;
+    for (; u_now < -223.0; u_now += 0.7) plant.forward(u_now);     // up its branch: the last input
+    const double y_now = plant.output();
+    const double u_last = plant.input();
+    MemInverse inverse;
+    inverse.continue_branch(-320.0, u_last, y_now);
+    EXPECT_EQ(inverse.inverse(y_now), u_last);
+    EXPECT_EQ(inverse.direction(), 1);
+    double worst = 0.0;
+    for (int k = 1; k <= 2000; ++k) {  // the reference moves on (away = +1) or turns back (-1)
+      const double y_ref = y_now + away * 4e-10 * k;
+      worst = std::max(worst, std::abs(plant.forward(inverse.inverse(y_ref)) - y_ref));
+    }
+    EXPECT_LT(worst, 1e-15) << "reference moving " << (away > 0 ? "on" : "back");
+  }
+}
+
 }  // namespace
 }  // namespace hystloop

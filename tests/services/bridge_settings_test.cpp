@@ -1,9 +1,12 @@
 // hystloop-bridge's configuration: defaults are the papers' and the issue's, every value is
-// validated where it enters and a refusal names the field; the report handoff between the
-// real-time and the I/O thread; the send-time ring behind the latency figures.
+// validated where it enters and a refusal names the field; the servo, the block size and the
+// wake-up batching are the bridge's now (issue 10); every deployed config loads; the report
+// handoff between the real-time and the I/O thread; the send-time ring behind the latency figures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <string>
 #include <thread>
 
 #include "bridge/bridge_settings.hpp"
@@ -15,6 +18,8 @@
 namespace hystloop {
 namespace {
 
+const std::string kConfigDir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
+
 std::string refusal(const std::string& yaml) {
   try {
     load_bridge_settings(Config::from_string(yaml, "bridge.yaml"));
@@ -24,10 +29,13 @@ std::string refusal(const std::string& yaml) {
   return "accepted";
 }
 
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 TEST(BridgeSettings, DefaultsAreTheIssues) {
   const BridgeSettings s = load_bridge_settings(Config());
   EXPECT_EQ(s.backend, "sim");
   EXPECT_EQ(s.rate_hz, 10000.0);
+  EXPECT_EQ(s.dt_s(), 1e-4);
   EXPECT_EQ(s.stage.noise_rms_m, 1e-9);
   EXPECT_EQ(s.limits.u_min_V, -250.0);
   EXPECT_EQ(s.limits.u_max_V, 250.0);
@@ -35,28 +43,126 @@ TEST(BridgeSettings, DefaultsAreTheIssues) {
   EXPECT_EQ(s.stage.banning.hysteresis.a, 8.58e-9);  // Table 1
   EXPECT_EQ(s.stage.banning.stage.k, 1.17e8);        // Table 2
   EXPECT_FALSE(s.auto_arm);
+  // Blocks of 10 ticks (1 kHz of HX_SENSOR messages); the clock wakes every tick; LCM queues
+  // 256 command blocks.
+  EXPECT_EQ(s.block_ticks, 10);
+  EXPECT_EQ(s.rt.ticks_per_wake, 1);
+  EXPECT_EQ(s.command_queue_capacity, 256);
+  // Without a config the servo is off (feedforward only); its anti-windup limit is the range.
+  EXPECT_FALSE(s.servo.enabled());
+  EXPECT_EQ(s.servo.kp, 0.0);
+  EXPECT_EQ(s.servo.ki, 0.0);
+  EXPECT_EQ(s.servo.kd, 0.0);
+  EXPECT_GT(s.servo.nominal_gain_m_per_V, 0.0);
+  EXPECT_EQ(s.servo.d_filter_hz, 1000.0);
+  EXPECT_EQ(s.servo.u_min_V, -250.0);
+  EXPECT_EQ(s.servo.u_max_V, 250.0);
+}
+
+TEST(BridgeSettings, TheServoTakesItsGainsFromServoKeysAndItsLimitFromTheActuatorsRange) {
+  const BridgeSettings s = load_bridge_settings(Config::from_string(
+      "servo: {kp: 0.2, ki: 300, kd: 1.0e-5, nominal_gain_m_per_V: 6.0e-9, d_filter_hz: 500}\n"
+      "actuator: {u_min_V: -100, u_max_V: 200}",
+      "bridge.yaml"));
+  EXPECT_EQ(s.servo.kp, 0.2);
+  EXPECT_EQ(s.servo.ki, 300.0);
+  EXPECT_EQ(s.servo.kd, 1e-5);
+  EXPECT_EQ(s.servo.nominal_gain_m_per_V, 6e-9);
+  EXPECT_EQ(s.servo.d_filter_hz, 500.0);
+  EXPECT_EQ(s.servo.u_min_V, -100.0);
+  EXPECT_EQ(s.servo.u_max_V, 200.0);
+  EXPECT_TRUE(s.servo.enabled());
+  const auto lines = describe(s);
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return contains(l, "servo: kp 0.2"); }));
 }
 
 TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
-  const Config c = Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge.yaml");
+  const Config c = Config::load_file(kConfigDir + "bridge.yaml");
   const BridgeSettings s = load_bridge_settings(c);
   EXPECT_EQ(s.limits.slew_V_per_s, 5e4);
+  EXPECT_EQ(s.limits.watchdog_s, 2e-3);
+  EXPECT_EQ(s.block_ticks, 10);
+  EXPECT_GE(s.rt.ticks_per_wake, 1);
+  EXPECT_LE(s.rt.ticks_per_wake, s.block_ticks);
+  EXPECT_EQ(s.command_queue_capacity, 256);
+  EXPECT_EQ(s.servo.kp, 0.1);
+  EXPECT_EQ(s.servo.ki, 600.0);
+  EXPECT_EQ(s.servo.kd, 0.0);
+  EXPECT_EQ(s.servo.nominal_gain_m_per_V, 6.3e-9);
+  EXPECT_EQ(s.servo.d_filter_hz, 1000.0);
+  // Every key the bridge reads is documented there...
   for (const std::string& key : bridge_config_keys()) EXPECT_TRUE(c.has(key)) << key << " is not documented";
+  // ... and every key listed is really read: a value of the wrong kind is refused by name.
+  for (const std::string& key : bridge_config_keys()) {
+    Config bad(c);
+    bad.apply_override(key + "=[1, 2]");
+    std::string what = "accepted";
+    try {
+      load_bridge_settings(bad);
+    } catch (const ConfigError& e) {
+      what = e.what();
+    }
+    EXPECT_TRUE(contains(what, key)) << key << ": " << what;
+  }
+}
+
+TEST(BridgeSettings, EveryDeployedBridgeConfigLoads) {
+  const BridgeSettings demo = load_bridge_settings(Config::load_file(kConfigDir + "demo/bridge.yaml"));
+  EXPECT_EQ(demo.stage.drift_fraction, 0.10);
+  EXPECT_EQ(demo.limits.watchdog_s, 2e-3);
+  EXPECT_EQ(demo.servo.kp, 0.1);
+  EXPECT_EQ(demo.servo.ki, 600.0);
+  EXPECT_EQ(demo.servo.nominal_gain_m_per_V, 6.3e-9);
+  EXPECT_EQ(demo.block_ticks, 10);
+  EXPECT_LE(demo.rt.ticks_per_wake, demo.block_ticks);
+  EXPECT_TRUE(demo.rt.lock_memory);
+  EXPECT_NO_THROW(load_bridge_settings(Config::load_file(kConfigDir + "banning/bridge.yaml")));
 }
 
 TEST(BridgeSettings, RefusalsNameTheField) {
-  EXPECT_NE(refusal("actuator: {watchdog_s: -1}").find("bridge.yaml: actuator.watchdog_s"), std::string::npos);
-  EXPECT_NE(refusal("actuator: {u_min_V: 10, u_max_V: 5}").find("actuator.u_max_V"), std::string::npos);
-  EXPECT_NE(refusal("actuator: {safe_u_V: 300}").find("actuator.safe_u_V"), std::string::npos);
-  EXPECT_NE(refusal("actuator: {watchdog_s: 0.00015}").find("two ticks"), std::string::npos);
-  EXPECT_NE(refusal("bridge: {backend: daq}").find("bridge.backend"), std::string::npos);
-  EXPECT_NE(refusal("bridge: {noise_rms_m: .nan}").find("bridge.noise_rms_m"), std::string::npos);
-  EXPECT_NE(refusal("banning: {hysteresis: {b: 9.0e-9}}").find("banning.hysteresis.b"), std::string::npos);
-  EXPECT_NE(refusal("banning: {order: sideways}").find("banning.order"), std::string::npos);
-  EXPECT_NE(refusal("ro: {c1: 0}").find("ro.c1"), std::string::npos);
-  EXPECT_NE(refusal("rt: {priority: 50, io_priority: 50}").find("rt.io_priority"), std::string::npos);
-  EXPECT_NE(refusal("actuator: {watchdog: 0.1}").find("did you mean 'actuator.watchdog_s'"), std::string::npos);
+  EXPECT_TRUE(contains(refusal("actuator: {watchdog_s: -1}"), "bridge.yaml: actuator.watchdog_s"));
+  EXPECT_TRUE(contains(refusal("actuator: {u_min_V: 10, u_max_V: 5}"), "actuator.u_max_V"));
+  EXPECT_TRUE(contains(refusal("actuator: {safe_u_V: 300}"), "actuator.safe_u_V"));
+  EXPECT_TRUE(contains(refusal("actuator: {watchdog_s: 0.00015}"), "two ticks"));
+  EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "bridge.backend"));
+  EXPECT_TRUE(contains(refusal("bridge: {noise_rms_m: .nan}"), "bridge.noise_rms_m"));
+  EXPECT_TRUE(contains(refusal("banning: {hysteresis: {b: 9.0e-9}}"), "banning.hysteresis.b"));
+  EXPECT_TRUE(contains(refusal("banning: {order: sideways}"), "banning.order"));
+  EXPECT_TRUE(contains(refusal("ro: {c1: 0}"), "ro.c1"));
+  EXPECT_TRUE(contains(refusal("rt: {priority: 50, io_priority: 50}"), "rt.io_priority"));
+  EXPECT_TRUE(contains(refusal("actuator: {watchdog: 0.1}"), "did you mean 'actuator.watchdog_s'"));
   EXPECT_EQ(refusal("bridge: {backend: ro, drift_fraction: 0.1}\nrt: {priority: 80, io_priority: 70}"), "accepted");
+}
+
+TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
+  EXPECT_TRUE(contains(refusal("servo: {ki: -1}"), "bridge.yaml: servo.ki"));
+  EXPECT_TRUE(contains(refusal("servo: {kp: -0.1}"), "bridge.yaml: servo.kp"));
+  EXPECT_TRUE(contains(refusal("servo: {kd: -1.0e-6}"), "bridge.yaml: servo.kd"));
+  EXPECT_TRUE(contains(refusal("servo: {nominal_gain_m_per_V: 0}"), "bridge.yaml: servo.nominal_gain_m_per_V"));
+  EXPECT_TRUE(contains(refusal("servo: {d_filter_hz: 0}"), "bridge.yaml: servo.d_filter_hz"));
+  EXPECT_TRUE(contains(refusal("servo: {ki: .inf}"), "servo.ki"));
+  EXPECT_TRUE(contains(refusal("bridge: {block_ticks: 0}"), "bridge.yaml: bridge.block_ticks"));
+  EXPECT_TRUE(contains(refusal("bridge: {block_ticks: 1001}"), "bridge.yaml: bridge.block_ticks"));
+  EXPECT_TRUE(contains(refusal("bridge: {command_queue_capacity: 15}"), "bridge.yaml: bridge.command_queue_capacity"));
+  EXPECT_TRUE(contains(refusal("bridge: {command_queue_capacity: 100001}"), "bridge.command_queue_capacity"));
+  EXPECT_TRUE(contains(refusal("rt: {ticks_per_wake: 0}"), "bridge.yaml: rt.ticks_per_wake"));
+  // A block is published when its last tick has run: a wake-up may not run past it.
+  const std::string too_many = refusal("rt: {ticks_per_wake: 11}");
+  EXPECT_TRUE(contains(too_many, "bridge.yaml: rt.ticks_per_wake")) << too_many;
+  EXPECT_TRUE(contains(too_many, "bridge.block_ticks")) << too_many;
+  EXPECT_TRUE(contains(refusal("bridge: {block_ticks: 4}\nrt: {ticks_per_wake: 5}"), "rt.ticks_per_wake"));
+  // The servo's keys were feedback.* in the compensator: not a bridge key.
+  EXPECT_TRUE(contains(refusal("feedback: {kp: 0.1}"), "feedback.kp"));
+
+  EXPECT_EQ(refusal("bridge: {block_ticks: 1}\nrt: {ticks_per_wake: 1}"), "accepted");  // a message per tick
+  EXPECT_EQ(refusal("bridge: {block_ticks: 10}\nrt: {ticks_per_wake: 10}"), "accepted");
+  EXPECT_EQ(refusal("bridge: {block_ticks: 1000, command_queue_capacity: 100000}"), "accepted");
+  EXPECT_EQ(refusal("servo: {kp: 0, ki: 0, kd: 0}"), "accepted");  // off
+  const BridgeSettings s = load_bridge_settings(
+      Config::from_string("bridge: {block_ticks: 20, command_queue_capacity: 16}\nrt: {ticks_per_wake: 20}", "b.yaml"));
+  EXPECT_EQ(s.block_ticks, 20);
+  EXPECT_EQ(s.rt.ticks_per_wake, 20);
+  EXPECT_EQ(s.command_queue_capacity, 16);
 }
 
 TEST(StageBackend, SimulatorsStepAndFlagThemselves) {
@@ -74,17 +180,34 @@ TEST(StageBackend, SimulatorsStepAndFlagThemselves) {
   EXPECT_THROW(make_stage_backend("daq", s.stage), ParameterError);
 }
 
+TEST(RtReport, StartsWithNoDepthMeasured) {
+  const RtReport r{};
+  EXPECT_EQ(r.min_depth_period, -1);
+  EXPECT_EQ(r.min_depth_total, -1);
+  EXPECT_EQ(r.last_tick, -1);
+  EXPECT_EQ(r.last_trip_tick, -1);
+  EXPECT_EQ(r.ticks_caught_up, 0u);
+  EXPECT_EQ(r.commands_processed, 0u);
+  EXPECT_EQ(r.gain_scale, 1.0);
+}
+
 TEST(RtReportExchange, HandsOverWithoutSharingABuffer) {
   RtReportExchange ex;
   std::atomic<bool> stop{false};
-  std::atomic<std::uint64_t> ticks{0};
   std::thread rt([&] {
     std::uint64_t k = 0;
     while (!stop.load()) {
       ex.current().work.add(static_cast<std::int64_t>(k % 100));
       ++k;
-      ex.serve_request([&](RtReport& r) { r.core.ticks = k; });
-      ticks.store(k);
+      ex.serve_request([&](RtReport& r) {
+        // Everything one fill writes is read together.
+        r.core.ticks = k;
+        r.last_tick = static_cast<std::int64_t>(k) - 1;
+        r.buffer_depth = static_cast<std::int64_t>(k % 300);
+        r.min_depth_period = static_cast<std::int64_t>(k % 7);
+        r.ticks_caught_up = 2 * k;
+        r.commands_processed = 3 * k;
+      });
     }
   });
   std::uint64_t seen_ticks = 0, seen_samples = 0;
@@ -93,6 +216,11 @@ TEST(RtReportExchange, HandsOverWithoutSharingABuffer) {
     const RtReport* r = nullptr;
     while ((r = ex.take()) == nullptr) std::this_thread::yield();
     EXPECT_GE(r->core.ticks, seen_ticks);  // cumulative counters only grow
+    EXPECT_EQ(r->last_tick, static_cast<std::int64_t>(r->core.ticks) - 1);
+    EXPECT_EQ(r->buffer_depth, static_cast<std::int64_t>(r->core.ticks % 300));
+    EXPECT_EQ(r->min_depth_period, static_cast<std::int64_t>(r->core.ticks % 7));
+    EXPECT_EQ(r->ticks_caught_up, 2 * r->core.ticks);
+    EXPECT_EQ(r->commands_processed, 3 * r->core.ticks);
     seen_samples += r->work.count();
     seen_ticks = r->core.ticks;
     ex.release();

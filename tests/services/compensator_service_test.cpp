@@ -1,239 +1,682 @@
-// hystloop-compensator's wiring, driven through its handlers over the in-process memq provider:
-// a command per sample for tick k + lead, allocation-free; the commands are a deterministic
-// function of the messages; parameter sets are taken only when valid and newer; a trajectory's
-// version is applied once; feedback is held while the bridge is in its safe state; control
-// requests that make no sense are refused and counted.
+// hystloop-compensator's wiring, driven through its handlers over the in-process memq provider,
+// the command blocks read back from HX_COMMAND: each sensor block is answered with the ticks not
+// yet sent through its last tick + the horizon (each tick once, in blocks of at most MAX_TICKS),
+// allocation-free; the commands are a deterministic function of the messages; parameter sets are
+// taken only when valid and newer and swapped at a reversal; a trajectory's version is applied
+// once, at its start time when it has one; control requests that are not the compensator's are
+// refused or ignored; a bridge restart restarts the control law; old config keys say where they went.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
+#include <chrono>
 #include <cmath>
-#include <cstdio>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "compensator/compensator_service.hpp"
 #include "compensator/trajectory_message.hpp"
+#include "lcm/blocks.hpp"
+#include "hystloop/service_status_t.hpp"
 #include "lcm/connection.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
 namespace {
 
-CompensatorSettings settings() {
-  CompensatorSettings s = load_compensator_settings(
-      Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml"));
+constexpr std::int64_t kBaseUtime = 1'700'000'000'123'456;  // the bridge's wall clock at its tick 0 [us]
+constexpr double kDt = 1e-4;
+constexpr std::int64_t kHorizon = 300;  // 30 ms (fixed here: the deployed value is tuned elsewhere)
+constexpr double kGain = 6.3e-9;        // a crude plant: y follows u with the stage's mean slope
+
+std::int64_t utime_of(std::int64_t tick) { return kBaseUtime + tick * 100; }
+
+const std::string kConfigDir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
+
+CompensatorSettings deployed() {
+  return load_compensator_settings(Config::load_file(kConfigDir + "compensator.yaml"));
+}
+
+// The deployed settings (MEM, holding at 0) with a horizon of kHorizon ticks.
+CompensatorSettings holding() {
+  CompensatorSettings s = deployed();
+  s.control.horizon_ticks = kHorizon;
+  return s;
+}
+
+// The MEM paper's reference, -1.6 um cos(2 pi t), approached over 50 ms from the first tick
+// planned. Its first reversal (the minimum) is 50 ms after that tick, the next 0.5 s later.
+CompensatorSettings cosine() {
+  CompensatorSettings s = holding();
   s.trajectory.shape = TrajectoryShape::kCosine;
   s.trajectory.amplitude_m = -1.6e-6;
   s.trajectory.blend_s = 0.05;
   return s;
 }
 
-sensor_sample_t sample(std::int64_t k, double u, double y, std::int32_t flags = 0) {
-  sensor_sample_t m{};
-  m.seq = k;
-  m.utime = 1'700'000'000'000'000 + k * 100;
-  m.u_V = u;
-  m.y_m = y;
-  m.flags = flags;
-  return m;
-}
-
-control_t request(std::int64_t id, std::int8_t command) {
+control_t request(std::int64_t id, std::int8_t command, const std::string& target = "") {
   control_t c{};
   c.request_id = id;
   c.command = command;
+  c.target = target;
   return c;
 }
 
+mem_params_t params(std::int32_t version, double c1, bool valid = true) {
+  mem_params_t p{};
+  p.version = version;
+  p.c1 = c1;
+  p.c2 = 1.5e-12;
+  p.c3 = 1.1;
+  p.valid = valid;
+  p.source = "test";
+  return p;
+}
+
+struct BlockSeen {
+  std::int64_t seq;
+  std::int32_t n_ticks;
+  std::int64_t sample_seq;
+};
+
+// The service on a memq LCM, a bridge that feeds it sensor blocks (u = the feedforward it was
+// sent for the tick, 0 when none; y = kGain u) and a listener on HX_COMMAND.
 struct Harness {
   std::unique_ptr<lcm::LCM> lcm = open_lcm("memq://");
   ChannelNames channels{};
   CompensatorService service;
-  explicit Harness(const CompensatorSettings& s = settings()) : service(s, *lcm, channels) {}
+  std::vector<BlockSeen> blocks;   // every command block published, in order
+  std::vector<CommandTick> ticks;  // their ticks, in order
+  std::map<std::int64_t, std::size_t> latest;  // tick -> its last entry in `ticks`
+  Subscription<command_block_t> commands;
+  sensor_block_t sensor{};
 
-  // A crude plant: y follows u with the stage's mean slope; returns the commands' voltages.
-  std::vector<double> run(std::int64_t from, std::int64_t ticks, std::int32_t flags = 0) {
-    std::vector<double> u;
-    double applied = 0.0;
-    for (std::int64_t k = from; k < from + ticks; ++k) {
-      service.on_sample(sample(k, applied, 6.3e-9 * applied, flags), wall_utime());
-      u.push_back(service.last_command().u_V);
-      applied = service.last_command().u_V;
-    }
-    return u;
+  explicit Harness(const CompensatorSettings& s = cosine())
+      : service(s, *lcm, channels),
+        commands(*lcm, channels.command, [this](const command_block_t& b, std::int64_t) { record(b); }) {
+    reserve_storage(sensor);
   }
+
+  void record(const command_block_t& b) {
+    blocks.push_back({b.seq, b.n_ticks, b.sample_seq});
+    for_each_tick(b, [&](const CommandTick& t) {
+      latest[t.seq] = ticks.size();
+      ticks.push_back(t);
+    });
+  }
+
+  // Sensor block of ticks [seq, seq + n).
+  const sensor_block_t& build(std::int64_t seq, std::int64_t n, std::int32_t flags = 0) {
+    begin_block(sensor, seq, utime_of(seq), kDt);
+    for (std::int64_t k = seq; k < seq + n; ++k) {
+      const auto it = latest.find(k);
+      const double u = it == latest.end() ? 0.0 : ticks[it->second].u_ff_V;
+      const double y_ref = it == latest.end() ? std::nan("") : ticks[it->second].y_ref_m;
+      append_tick(sensor, SensorTick{utime_of(k), k, u, u, 0.0, y_ref, kGain * u, flags});
+    }
+    return sensor;
+  }
+
+  void drain() {
+    while (handle_pending(*lcm, std::chrono::microseconds(0), 100000) > 0) {
+    }
+  }
+
+  void send(std::int64_t seq, std::int64_t n = 10) {
+    service.on_sensor(build(seq, n), wall_utime());
+    drain();
+  }
+
+  // Ticks [from, from + n) in blocks of `block`.
+  void run(std::int64_t from, std::int64_t n, std::int64_t block = 10) {
+    for (std::int64_t k = from; k < from + n; k += block) send(k, std::min(block, from + n - k));
+  }
+
+  // The command last sent for a tick.
+  const CommandTick& tick(std::int64_t seq) const {
+    const auto it = latest.find(seq);
+    if (it == latest.end()) throw std::out_of_range("no command for tick " + std::to_string(seq));
+    return ticks[it->second];
+  }
+  std::int64_t sent_through() const { return ticks.empty() ? -1 : ticks.back().seq; }
 };
 
-TEST(CompensatorService, AnswersEachSampleWithTheCommandForALaterTick) {
-  Harness h;
-  h.run(5000, 6000);
-  const actuator_command_t& c = h.service.last_command();
-  EXPECT_EQ(c.sample_seq, 10999);
-  EXPECT_EQ(c.seq, 11001);  // lead_ticks = 2
-  EXPECT_EQ(c.mode, actuator_command_t::MODE_MEM);
-  EXPECT_TRUE(std::isfinite(c.y_ref_m));
-  EXPECT_NEAR(c.u_V, c.u_ff_V + c.u_fb_V, 1e-9);
-  // The cosine started 50 ms after the first sample: 0.55 s into -1.6 um cos(2 pi t).
-  EXPECT_NEAR(c.y_ref_m, -1.6e-6 * std::cos(2.0 * M_PI * (0.6001 - 0.5003 - 0.05 + 0.5)), 1e-12);
-  EXPECT_EQ(h.service.counters().commands_published, 6000u);
+// After a sensor block whose last tick is `last`, the blocks published since `from_block` carry
+// exactly the ticks after `before` (the last one sent) and after `last` (the bridge has passed
+// it) through last + horizon: consecutive, each once, at most MAX_TICKS per block, each stamped
+// with the sample it answered.
+void expect_answer(const Harness& h, std::size_t from_block, std::int64_t before, std::int64_t last,
+                   std::int64_t horizon = kHorizon) {
+  std::int64_t next = std::max(before, last) + 1;
+  for (std::size_t i = from_block; i < h.blocks.size(); ++i) {
+    const BlockSeen& b = h.blocks[i];
+    EXPECT_EQ(b.seq, next) << "block " << i;
+    EXPECT_GE(b.n_ticks, 1);
+    EXPECT_LE(b.n_ticks, command_block_t::MAX_TICKS);
+    EXPECT_EQ(b.sample_seq, last);
+    next = b.seq + b.n_ticks;
+  }
+  EXPECT_EQ(next - 1, std::max(before, last + horizon)) << "after the sample of tick " << last;
 }
 
-TEST(CompensatorService, ThePerSamplePathDoesNotAllocate) {
+TEST(CompensatorService, AnswersEachSensorBlockWithTheTicksNotYetSentThroughTheHorizon) {
   Harness h;
-  h.run(0, 1000);  // first sample starts the trajectory (allocates nothing either, but warms up)
-  const sensor_sample_t first = sample(1000, 0.0, 0.0);
-  std::vector<sensor_sample_t> samples(5000, first);
-  for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = sample(1000 + static_cast<std::int64_t>(i), 10.0, 6e-8);
+  // The first block: the whole horizon after it, in one block.
+  h.send(5000);
+  ASSERT_EQ(h.blocks.size(), 1u);
+  EXPECT_EQ(h.blocks[0].seq, 5010);
+  EXPECT_EQ(h.blocks[0].n_ticks, kHorizon);
+  EXPECT_EQ(h.blocks[0].sample_seq, 5009);
+  // Then each block of 10 is answered with the 10 ticks now inside the horizon.
+  for (std::int64_t seq = 5010; seq < 6000; seq += 10) {
+    const std::size_t b = h.blocks.size();
+    h.send(seq);
+    ASSERT_EQ(h.blocks.size(), b + 1) << seq;
+    EXPECT_EQ(h.blocks[b].seq, seq + kHorizon);
+    EXPECT_EQ(h.blocks[b].n_ticks, 10);
+    EXPECT_EQ(h.blocks[b].sample_seq, seq + 9);
+  }
+  // Whatever the bridge's block size (1 is allowed), lost blocks and repeated ones.
+  struct Step {
+    std::int64_t seq, n;
+  };
+  const Step steps[] = {{6000, 1},  {6001, 1},  {6002, 1}, {6003, 7},   {6010, 25},  {6035, 10},
+                        {6065, 10},  // 20 ticks lost: 30 ticks answered
+                        {6065, 10},  // the same block again: nothing new to send
+                        {6050, 10},  // an old one: nothing either
+                        {6075, 250}, {6325, 10}};
+  for (const Step& s : steps) {
+    const std::size_t b = h.blocks.size();
+    const std::int64_t before = h.sent_through();
+    h.send(s.seq, s.n);
+    expect_answer(h, b, before, s.seq + s.n - 1);
+  }
+  EXPECT_EQ(h.service.compensator().counters().out_of_order, 20u);
+  EXPECT_EQ(h.service.compensator().counters().gaps, 20u);
+
+  // A stall longer than the horizon: the ticks the bridge passed are not sent any more.
+  const std::uint64_t behind = h.service.compensator().counters().ticks_behind;
+  const std::size_t b = h.blocks.size();
+  const std::int64_t before = h.sent_through();  // 6334 + 300; the bridge is now at before + 100
+  h.send(before + 100);
+  expect_answer(h, b, before + 109, before + 109);
+  EXPECT_EQ(h.service.compensator().counters().ticks_behind - behind, 109u);
+
+  // No tick was sent twice; every tick from the first on was sent, but those the stall skipped.
+  for (std::size_t i = 1; i < h.ticks.size(); ++i) {
+    if (h.ticks[i].seq == before + 110) continue;
+    ASSERT_EQ(h.ticks[i].seq, h.ticks[i - 1].seq + 1) << "entry " << i;
+  }
+  const CompensatorServiceCounters& c = h.service.counters();
+  EXPECT_EQ(c.command_blocks_published, h.blocks.size());
+  EXPECT_EQ(c.command_ticks_published, h.ticks.size());
+  EXPECT_EQ(h.commands.counters().received, h.blocks.size());  // none failed the receiver's checks
+
+  // What a tick carries: MEM feedforward on the cosine, which started 50 ms after the first
+  // tick planned (5010).
+  const CommandTick& t = h.tick(6000);
+  EXPECT_EQ(t.mode, command_block_t::MODE_MEM);
+  EXPECT_EQ(t.params_version, 0);
+  EXPECT_NEAR(t.y_ref_m, -1.6e-6 * std::cos(2.0 * std::numbers::pi * (0.6 - (0.501 + 0.05))), 1e-12);
+  EXPECT_EQ(h.tick(5010).y_ref_m, 0.0);  // the approach starts where the reference was
+  for (const CommandTick& k : h.ticks) ASSERT_TRUE(std::isfinite(k.u_ff_V) && std::isfinite(k.y_ref_m)) << k.seq;
+}
+
+TEST(CompensatorService, AnswersLongerThanMaxTicksAreSplitIntoBlocks) {
+  CompensatorSettings s = cosine();
+  s.control.horizon_ticks = 2500;
+  Harness h(s);
+  h.send(0);
+  ASSERT_EQ(h.blocks.size(), 3u);
+  EXPECT_EQ(h.blocks[0].n_ticks, command_block_t::MAX_TICKS);
+  EXPECT_EQ(h.blocks[1].n_ticks, command_block_t::MAX_TICKS);
+  EXPECT_EQ(h.blocks[2].n_ticks, 500);
+  expect_answer(h, 0, 9, 9, 2500);
+  std::size_t b = h.blocks.size();
+  h.send(10);
+  expect_answer(h, b, 2509, 19, 2500);
+  EXPECT_EQ(h.blocks.back().n_ticks, 10);
+  // After a long stall the whole horizon again, split the same way.
+  b = h.blocks.size();
+  h.send(10000);
+  ASSERT_EQ(h.blocks.size(), b + 3);
+  expect_answer(h, b, 10009, 10009, 2500);
+  EXPECT_EQ(h.commands.counters().received, h.blocks.size());
+}
+
+// A clean start has no tick "planned too late": the first block's earlier ticks were never due.
+TEST(CompensatorService, AFirstBlockCountsNoTicksBehind) {
+  Harness h;
+  h.run(5000, 1000);
+  EXPECT_EQ(h.service.compensator().counters().ticks_behind, 0u);
+}
+
+// Counts operator new in this thread. LCM's C core allocates with malloc (memq copies each
+// message into a queue entry), which the counter does not see.
+TEST(CompensatorService, TheSensorBlockPathDoesNotAllocate) {
+  Harness h;
+  h.run(0, 1000);  // warm-up: the first answer (a whole horizon) sizes the publisher's buffer
+  h.service.on_params(params(2, 5.5e-9));  // swapped in at the reversal near tick 5510, below
+  std::vector<sensor_block_t> blocks;
+  for (std::int64_t seq = 1000; seq < 7000; seq += 10) {
+    blocks.push_back(h.build(seq, 10));
+    for (std::size_t i = 0; i < 10; ++i) {
+      blocks.back().u_V[i] = 10.0;
+      blocks.back().y_m[i] = 6e-8;
+    }
+  }
+  const std::uint64_t published = h.service.counters().command_blocks_published;
   testing::AllocationCounter counter;
-  for (const sensor_sample_t& s : samples) h.service.on_sample(s, s.utime + 20);
+  for (const sensor_block_t& b : blocks) h.service.on_sensor(b, b.utime + 20);
   EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_EQ(h.service.counters().command_blocks_published - published, blocks.size());
+  EXPECT_EQ(h.service.compensator().counters().params_swapped, 1u);
+  h.drain();
 }
 
-TEST(CompensatorService, CommandsAreADeterministicFunctionOfTheMessages) {
-  Harness a, b;
+std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+void script(Harness& h) {
   trajectory_t t{};
   t.version = 3;
   t.shape = trajectory_t::TRIANGLE;
   t.amplitude_m = 1e-6;
   t.frequency_Hz = 5.0;
   t.blend_s = 0.01;
-  const auto ua1 = a.run(100, 500);
-  const auto ub1 = b.run(100, 500);
-  a.service.on_trajectory(t);
-  b.service.on_trajectory(t);
-  const auto ua2 = a.run(600, 3000);
-  const auto ub2 = b.run(600, 3000);
-  EXPECT_EQ(ua1, ub1);
-  EXPECT_EQ(ua2, ub2);
-  EXPECT_EQ(a.service.counters().trajectories, 2u);  // the configured one, then v3
+  h.run(100, 500);
+  h.service.on_trajectory(t);
+  h.service.on_params(params(2, 5.5e-9));
+  h.run(600, 3000, 10);
+  control_t c = request(1, control_t::SET_MODE);
+  c.mode = command_block_t::MODE_PI;
+  h.service.on_control(c);
+  h.run(3600, 500, 7);
+  c = request(2, control_t::START_EXPERIMENT);
+  c.experiment = "sine";
+  c.experiment_amplitude_V = 50.0;
+  c.experiment_frequency_Hz = 20.0;
+  c.experiment_duration_s = 0.05;
+  h.service.on_control(c);
+  h.run(4100, 1500, 25);
+  for (std::int8_t mode : {command_block_t::MODE_KATALENIC, command_block_t::MODE_LINEAR, command_block_t::MODE_OFF,
+                           command_block_t::MODE_MEM}) {
+    c = request(10 + mode, control_t::SET_MODE);
+    c.mode = mode;
+    h.service.on_control(c);
+    h.run(h.service.compensator().last_seq() + 1, 400);
+  }
 }
 
-TEST(CompensatorService, TakesOnlyValidNewerParameterSets) {
+TEST(CompensatorService, CommandsAreADeterministicFunctionOfTheMessages) {
+  Harness a, b;
+  script(a);
+  script(b);
+  ASSERT_GT(a.ticks.size(), 5000u);
+  ASSERT_EQ(a.ticks.size(), b.ticks.size());
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  for (std::size_t i = 0; i < a.blocks.size(); ++i) {  // (a block's utime is when it was published)
+    ASSERT_EQ(a.blocks[i].seq, b.blocks[i].seq) << i;
+    ASSERT_EQ(a.blocks[i].n_ticks, b.blocks[i].n_ticks) << i;
+    ASSERT_EQ(a.blocks[i].sample_seq, b.blocks[i].sample_seq) << i;
+  }
+  std::vector<bool> modes(6, false);
+  for (std::size_t i = 0; i < a.ticks.size(); ++i) {
+    const CommandTick &x = a.ticks[i], &y = b.ticks[i];
+    ASSERT_EQ(x.seq, y.seq);
+    ASSERT_EQ(bits(x.u_ff_V), bits(y.u_ff_V)) << x.seq;
+    ASSERT_EQ(bits(x.y_ref_m), bits(y.y_ref_m)) << x.seq;  // NaN included
+    ASSERT_EQ(x.params_version, y.params_version) << x.seq;
+    ASSERT_EQ(x.mode, y.mode) << x.seq;
+    modes[static_cast<std::size_t>(x.mode)] = true;
+  }
+  EXPECT_EQ(modes, std::vector<bool>(6, true));  // every mode and an experiment were exercised
+  EXPECT_EQ(a.service.counters().trajectories, 1u);
+  EXPECT_EQ(a.service.compensator().counters().nonfinite_outputs, 0u);
+}
+
+// True when the reference turns at entry i of h.ticks (a reversal of the planned reference).
+bool turns_at(const Harness& h, std::size_t i) {
+  const double d1 = h.ticks[i].y_ref_m - h.ticks[i - 1].y_ref_m;
+  const double d0 = h.ticks[i - 1].y_ref_m - h.ticks[i - 2].y_ref_m;
+  return d1 * d0 < 0.0;
+}
+
+std::size_t first_with_version(const Harness& h, std::int32_t version) {
+  for (std::size_t i = 0; i < h.ticks.size(); ++i) {
+    if (h.ticks[i].params_version == version) return i;
+  }
+  return h.ticks.size();
+}
+
+TEST(CompensatorService, TakesOnlyValidNewerParameterSetsAndSwapsThemAtAReversal) {
   Harness h;
-  h.run(0, 100);
-  mem_params_t p{};
-  p.version = 2;
-  p.c1 = 5.5e-9;
-  p.c2 = 1.5e-12;
-  p.c3 = 1.1;
-  p.valid = false;
-  h.service.on_params(p);
+  h.send(0);  // planned through 309; the cosine's minimum is at tick 510
+  h.service.on_params(params(2, 5.5e-9, false));
   EXPECT_EQ(h.service.counters().params_invalid, 1u);
-  p.valid = true;
-  h.service.on_params(p);
+  h.service.on_params(params(2, 5.5e-9));
   EXPECT_EQ(h.service.compensator().counters().params_accepted, 1u);
-  h.service.on_params(p);  // the same version again
-  EXPECT_EQ(h.service.counters().params_stale, 1u);
-  p.version = 3;
-  p.c1 = -1e-9;  // outside the model's domain: refused by the compensator's own validation
-  h.service.on_params(p);
+  h.service.on_params(params(2, 5.5e-9));  // the same version again
+  h.service.on_params(params(1, 4.0e-9));  // an older one
+  EXPECT_EQ(h.service.counters().params_stale, 2u);
+  h.service.on_params(params(3, -1e-9));  // outside the model's domain: the compensator's own validation
   EXPECT_EQ(h.service.counters().params_refused, 1u);
-  h.run(100, 12000);  // past a reversal of the 1 Hz cosine: v2 swapped in
+  EXPECT_EQ(h.service.compensator().params_version(), 0);  // not before a reversal
+
+  h.run(10, 2990);
+  std::size_t i = first_with_version(h, 2);
+  ASSERT_LT(i, h.ticks.size());
+  EXPECT_TRUE(turns_at(h, i)) << "v2 first used at tick " << h.ticks[i].seq;
+  EXPECT_GE(h.ticks[i].seq, 505);
+  EXPECT_LE(h.ticks[i].seq, 515);
+  for (std::size_t j = 0; j < h.ticks.size(); ++j) ASSERT_EQ(h.ticks[j].params_version, j < i ? 0 : 2) << j;
   EXPECT_EQ(h.service.compensator().params_version(), 2);
-  EXPECT_EQ(h.service.last_command().params_version, 2);
   EXPECT_EQ(h.service.compensator().mem_params().c1, 5.5e-9);
+
+  h.service.on_params(params(4, 6.0e-9));  // the next, at the next reversal (the maximum, tick 5510)
+  h.run(3000, 3000);
+  const std::size_t k = first_with_version(h, 4);
+  ASSERT_LT(k, h.ticks.size());
+  EXPECT_TRUE(turns_at(h, k)) << "v4 first used at tick " << h.ticks[k].seq;
+  EXPECT_GE(h.ticks[k].seq, 5505);
+  EXPECT_LE(h.ticks[k].seq, 5515);
+  for (std::size_t j = i; j < h.ticks.size(); ++j) ASSERT_EQ(h.ticks[j].params_version, j < k ? 2 : 4) << j;
+  EXPECT_EQ(h.service.compensator().mem_params().c1, 6.0e-9);
+  EXPECT_EQ(h.service.compensator().counters().params_swapped, 2u);
+  EXPECT_EQ(first_with_version(h, 3), h.ticks.size());  // the refused one never
 }
 
-TEST(CompensatorService, AppliesATrajectoryVersionOnceAndRefusesABadOne) {
-  Harness h;
-  h.run(0, 10);
+trajectory_t hold(std::int32_t version, double offset_m, double blend_s = 0.0, std::int64_t start_utime = 0) {
   trajectory_t t{};
-  t.version = 1;
+  t.version = version;
   t.shape = trajectory_t::HOLD;
-  t.offset_m = 2e-7;
-  h.service.on_trajectory(t);
-  h.service.on_trajectory(t);
+  t.offset_m = offset_m;
+  t.blend_s = blend_s;
+  t.start_utime = start_utime;
+  return t;
+}
+
+TEST(CompensatorService, AppliesATrajectoryVersionOnceFromTheFirstTickNotSentAndRefusesABadOne) {
+  Harness h;
+  h.send(0);  // planned through 309
+  h.service.on_trajectory(hold(1, 2e-7));
+  h.service.on_trajectory(hold(1, 2e-7));
   EXPECT_EQ(h.service.counters().trajectory_repeats, 1u);
-  t.version = 2;
-  t.shape = trajectory_t::POINTS;  // POINTS without points
-  h.service.on_trajectory(t);
+  trajectory_t bad = hold(2, 0.0);
+  bad.shape = trajectory_t::POINTS;  // POINTS without points
+  h.service.on_trajectory(bad);
   EXPECT_EQ(h.service.counters().trajectory_refused, 1u);
-  h.run(10, 2000);
-  EXPECT_NEAR(h.service.last_command().y_ref_m, 2e-7, 1e-12);  // held at the offset, blend done
+  h.service.on_trajectory(hold(1, 2e-7));  // v1 is still the one in force
+  EXPECT_EQ(h.service.counters().trajectory_repeats, 2u);
+  EXPECT_EQ(h.service.counters().trajectories, 1u);
+
+  h.send(10);
+  EXPECT_LT(h.tick(309).y_ref_m, 0.0);  // sent before: still the cosine's approach
+  for (std::int64_t k = 310; k < 320; ++k) EXPECT_EQ(h.tick(k).y_ref_m, 2e-7) << k;  // no blend: at once
+  h.run(20, 2000);
+  EXPECT_EQ(h.tick(h.sent_through()).y_ref_m, 2e-7);
+
+  // With a blend, from where the reference was, monotone over blend_s.
+  const std::int64_t first = h.sent_through() + 1;
+  h.service.on_trajectory(hold(4, -3e-7, 0.01));
+  h.run(2020, 200);
+  EXPECT_EQ(h.tick(first).y_ref_m, 2e-7);
+  for (std::int64_t k = first + 1; k <= first + 100; ++k) EXPECT_LT(h.tick(k).y_ref_m, h.tick(k - 1).y_ref_m) << k;
+  EXPECT_NEAR(h.tick(first + 100).y_ref_m, -3e-7, 1e-15);
+  EXPECT_EQ(h.tick(first + 101).y_ref_m, -3e-7);
+  EXPECT_EQ(h.service.counters().trajectories, 2u);
+}
+
+// The reference of tick k for a hold at 1e-7 starting at tick 1000, approached from 0 over 10 ms.
+double approach_to_1e7(std::int64_t k) {
+  const double into = static_cast<double>(k) * kDt - 0.09;
+  if (into <= 0.0) return 0.0;
+  if (into >= 0.01) return 1e-7;
+  return 1e-7 * (0.5 - 0.5 * std::cos(std::numbers::pi * into / 0.01));
+}
+
+void expect_starts_at_tick_1000(const Harness& h) {
+  for (std::int64_t k = 310; k < 900; ++k) ASSERT_EQ(h.tick(k).y_ref_m, 0.0) << k;
+  for (std::int64_t k = 900; k <= 1000; ++k) EXPECT_NEAR(h.tick(k).y_ref_m, approach_to_1e7(k), 1e-13) << k;
+  EXPECT_GT(h.tick(950).y_ref_m, 4e-8);
+  EXPECT_LT(h.tick(950).y_ref_m, 6e-8);
+  for (std::int64_t k = 1001; k < 1100; ++k) ASSERT_EQ(h.tick(k).y_ref_m, 1e-7) << k;
 }
 
 TEST(CompensatorService, ATimedTrajectoryStartsAtItsLoopTime) {
-  Harness h;
-  h.run(0, 10);
-  trajectory_t t{};
-  t.version = 5;
-  t.shape = trajectory_t::HOLD;
-  t.offset_m = 1e-7;
-  t.blend_s = 0.01;
-  t.start_utime = sample(1000, 0, 0).utime;  // tick 1000's wall time: approach over ticks 900..1000
-  h.service.on_trajectory(t);
-  h.run(10, 880);
-  EXPECT_LT(std::abs(h.service.last_command().y_ref_m), 1e-8);  // tick 891: still holding near 0
-  h.run(890, 60);
-  EXPECT_GT(h.service.last_command().y_ref_m, 1e-9);  // tick 951: approaching
-  EXPECT_LT(h.service.last_command().y_ref_m, 1e-7);
-  h.run(950, 60);
-  EXPECT_NEAR(h.service.last_command().y_ref_m, 1e-7, 1e-15);  // tick 1011: there
-  t.version = 6;
-  t.start_utime = sample(100, 0, 0).utime;  // already past: started now, counted
-  h.service.on_trajectory(t);
+  Harness h(holding());  // holding at 0
+  h.send(0);
+  // Tick 1000's wall time on the bridge's clock (taken from the samples' utime): approach over
+  // ticks 900..1000.
+  h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  h.run(10, 1100);
+  expect_starts_at_tick_1000(h);
+  EXPECT_EQ(h.service.counters().trajectory_late_start, 0u);
+  h.service.on_trajectory(hold(6, 1e-7, 0.01, utime_of(100)));  // already past: started now, counted
   EXPECT_EQ(h.service.counters().trajectory_late_start, 1u);
+  EXPECT_EQ(h.service.counters().trajectories, 2u);
 }
 
-TEST(CompensatorService, HoldsFeedbackWhileTheBridgeIsSafe) {
-  Harness h;
-  // SAFE_STATE for 0.4 s: the bridge holds 0 V whatever we say, the stage stays at 0 while the
-  // reference moves away (~1 um): integrating that error would saturate the feedback (250 V).
-  for (std::int64_t k = 0; k < 4000; ++k) h.service.on_sample(sample(k, 0.0, 0.0, 2), sample(k, 0, 0).utime);
-  EXPECT_EQ(h.service.counters().feedback_holds, 1u);
-  EXPECT_EQ(h.service.last_command().u_fb_V, 0.0);
-  h.service.on_sample(sample(4000, 0.0, 0.0), sample(4000, 0, 0).utime);  // re-armed
-  const double e = h.service.last_command().y_ref_m;  // ~ the error: y = 0
-  ASSERT_GT(std::abs(e), 5e-7);
-  // Only this tick's proportional and integral parts, (kp + ki dt) e / gain, ~24 V; a wound-up
-  // integrator would be at the 250 V limit.
-  const double expected = (0.1 + 600.0 * 1e-4) * e / 6.3e-9;
-  EXPECT_NEAR(h.service.last_command().u_fb_V, expected, 0.1 * std::abs(expected));
+TEST(CompensatorService, ATimedTrajectoryBeforeTheFirstSampleWaitsForItsLoopTime) {
+  Harness h(holding());
+  h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  EXPECT_EQ(h.service.counters().trajectories, 0u);  // waits for a sample to map its start time
+  h.run(0, 1110);
+  EXPECT_EQ(h.service.counters().trajectories, 1u);
+  expect_starts_at_tick_1000(h);
+}
+
+// A newer trajectory replaces one still waiting for the first sample.
+TEST(CompensatorService, ANewerTrajectoryReplacesOneWaitingForTheFirstSample) {
+  Harness h(holding());
+  h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  h.service.on_trajectory(hold(6, 3e-7));  // untimed, newer: in force from the first tick planned
+  h.run(0, 1200);
+  EXPECT_EQ(h.tick(10).y_ref_m, 3e-7);
+  EXPECT_EQ(h.tick(1100).y_ref_m, 3e-7);
 }
 
 TEST(CompensatorService, ControlRequests) {
-  Harness h;
-  h.run(0, 10);
+  Harness h(holding());
+  h.send(0);  // planned through 309
   control_t c = request(1, control_t::SET_MODE);
-  c.mode = actuator_command_t::MODE_PI;
+  c.mode = command_block_t::MODE_PI;
   h.service.on_control(c);
   EXPECT_EQ(h.service.compensator().mode(), FeedforwardMode::kPi);
   h.service.on_control(c);  // a repeat of request 1: acted on once
   EXPECT_EQ(h.service.counters().control_acted, 1u);
+  h.send(10);
+  EXPECT_EQ(h.tick(309).mode, command_block_t::MODE_MEM);  // sent before the request
+  EXPECT_EQ(h.tick(310).mode, command_block_t::MODE_PI);
+
   c = request(2, control_t::SET_MODE);
-  c.mode = actuator_command_t::MODE_EXPERIMENT;
+  c.mode = command_block_t::MODE_EXPERIMENT;  // started, not selected
   h.service.on_control(c);
-  EXPECT_EQ(h.service.counters().control_refused, 1u);
-  c = request(3, control_t::START_EXPERIMENT);
+  c = request(3, control_t::SET_MODE);
+  c.mode = 9;
+  h.service.on_control(c);
+  EXPECT_EQ(h.service.counters().control_refused, 2u);
+  EXPECT_EQ(h.service.compensator().mode(), FeedforwardMode::kPi);
+
+  c = request(4, control_t::START_EXPERIMENT);
   c.experiment = "sine";
   c.experiment_amplitude_V = 100.0;
   c.experiment_frequency_Hz = 10.0;
   c.experiment_duration_s = 0.1;
   h.service.on_control(c);
   EXPECT_TRUE(h.service.compensator().experiment_running());
-  h.run(10, 10);
-  EXPECT_EQ(h.service.last_command().mode, actuator_command_t::MODE_EXPERIMENT);
-  EXPECT_TRUE(std::isnan(h.service.last_command().y_ref_m));
-  c = request(4, control_t::STOP_EXPERIMENT);
-  h.service.on_control(c);
-  h.run(20, 5);
+  h.run(20, 210);  // ticks 320..529: the experiment
+  for (std::int64_t k = 320; k < 530; ++k) {
+    ASSERT_EQ(h.tick(k).mode, command_block_t::MODE_EXPERIMENT) << k;
+    ASSERT_TRUE(std::isnan(h.tick(k).y_ref_m)) << k;
+    ASSERT_LE(std::abs(h.tick(k).u_ff_V), 100.0) << k;
+  }
+  for (std::int64_t k = 320; k < 530; ++k) {  // started at the first tick not sent
+    EXPECT_NEAR(h.tick(k).u_ff_V, 100.0 * std::sin(2.0 * std::numbers::pi * 10.0 * static_cast<double>(k - 320) * kDt),
+                1e-9) << k;
+  }
+
+  h.service.on_control(request(5, control_t::STOP_EXPERIMENT));  // ends at the first tick not sent (530)
+  h.send(230);
   EXPECT_FALSE(h.service.compensator().experiment_running());
-  c = request(5, control_t::ARM);
-  c.target = "compensator";  // the bridge's command, addressed to us
-  h.service.on_control(c);
-  EXPECT_EQ(h.service.counters().control_refused, 2u);
-  c = request(6, control_t::SET_GAINS);
-  c.kp = 0.2;
-  c.ki = 300.0;
-  h.service.on_control(c);
+  // Then the last voltage is held, without a reference, until the sample of tick 530 arrives;
+  // from there the reference approaches again from where the stage is.
+  h.run(240, 600);
+  const double held = h.tick(529).u_ff_V;
+  std::int64_t tracking = 530;
+  while (std::isnan(h.tick(tracking).y_ref_m)) {
+    ASSERT_EQ(h.tick(tracking).u_ff_V, held) << tracking;
+    ASSERT_EQ(h.tick(tracking).mode, command_block_t::MODE_PI) << tracking;
+    ++tracking;
+  }
+  EXPECT_GT(tracking, 539);                // not before the sample of tick 530 (in the block 530..539)
+  EXPECT_LE(tracking, 539 + kHorizon + 1);  // planned with the answer to that block
+  for (std::int64_t k = tracking; k <= h.sent_through(); ++k) ASSERT_TRUE(std::isfinite(h.tick(k).y_ref_m)) << k;
+
+  h.service.on_control(request(6, control_t::ARM, "compensator"));  // the bridge's, addressed to us
+  EXPECT_EQ(h.service.counters().control_refused, 3u);
+  control_t gains = request(7, control_t::SET_GAINS, "compensator");  // the servo is the bridge's now
+  gains.kp = 0.2;
+  gains.ki = 300.0;
+  h.service.on_control(gains);
+  EXPECT_EQ(h.service.counters().control_refused, 4u);
+  for (const char* target : {"", "bridge"}) {  // to everyone, or the bridge's: not ours, not an error
+    gains.request_id += 1;
+    gains.target = target;
+    h.service.on_control(gains);
+  }
+  h.service.on_control(request(10, control_t::DISARM));
+  EXPECT_EQ(h.service.counters().control_refused, 4u);
+  EXPECT_EQ(h.service.counters().control_acted, 3u);  // SET_MODE, START_EXPERIMENT, STOP_EXPERIMENT
+  h.service.on_control(request(11, control_t::RESET_COUNTERS));
   EXPECT_EQ(h.service.counters().control_acted, 4u);
 }
 
 TEST(CompensatorService, RestartsTheControlLawWhenTheBridgeRestarts) {
   Harness h;
   h.run(50000, 100);
+  control_t c = request(1, control_t::SET_MODE);
+  c.mode = command_block_t::MODE_PI;
+  h.service.on_control(c);
+  const std::size_t b = h.blocks.size();
   h.run(0, 100);  // seq went back by far more than a reorder: a new bridge
   EXPECT_EQ(h.service.counters().bridge_restarts, 1u);
-  EXPECT_EQ(h.service.last_command().seq, 101);
   EXPECT_EQ(h.service.compensator().counters().out_of_order, 0u);
+  EXPECT_EQ(h.service.compensator().last_seq(), 99);
+  // The new clock's ticks, from the first block's on, each once.
+  ASSERT_LT(b, h.blocks.size());
+  EXPECT_EQ(h.blocks[b].seq, 10);
+  EXPECT_EQ(h.blocks[b].n_ticks, kHorizon);
+  EXPECT_EQ(h.blocks[b].sample_seq, 9);
+  std::int64_t next = 10;
+  for (std::size_t i = b; i < h.blocks.size(); ++i) {
+    EXPECT_EQ(h.blocks[i].seq, next) << i;
+    next += h.blocks[i].n_ticks;
+  }
+  EXPECT_EQ(h.sent_through(), 99 + kHorizon);
+  // The mode in force is kept; the reference restarts from 0.
+  EXPECT_EQ(h.tick(10).mode, command_block_t::MODE_PI);
+  EXPECT_EQ(h.tick(10).y_ref_m, 0.0);
+  EXPECT_LT(h.tick(300).y_ref_m, 0.0);
+}
+
+// What produced a tick's u_ff is labelled with that set's version, also after a restart.
+TEST(CompensatorService, ABridgeRestartKeepsTheParameterSetInUseAndItsVersion) {
+  Harness h;
+  h.send(50000);
+  h.service.on_params(params(2, 5.5e-9));
+  h.run(50010, 990);  // past the reversal near tick 50510
+  ASSERT_EQ(h.service.compensator().params_version(), 2);
+  const std::size_t from = h.ticks.size();
+  h.run(0, 100);
+  ASSERT_EQ(h.service.counters().bridge_restarts, 1u);
+  EXPECT_EQ(h.service.compensator().mem_params().c1, 5.5e-9);
+  EXPECT_EQ(h.service.compensator().params_version(), 2);
+  ASSERT_LT(from, h.ticks.size());
+  EXPECT_EQ(h.ticks[from].params_version, 2);
+  EXPECT_EQ(h.ticks.back().params_version, 2);
+}
+
+TEST(CompensatorService, AParameterSetWaitingForAReversalSurvivesABridgeRestart) {
+  Harness h;
+  h.run(50000, 100);
+  h.service.on_params(params(2, 5.5e-9));  // accepted; its reversal (near 50510) is not planned yet
+  h.run(0, 1000);                          // restarted: the new reference's reversal is near tick 510
+  ASSERT_EQ(h.service.counters().bridge_restarts, 1u);
+  EXPECT_EQ(h.service.compensator().params_version(), 2);
+  EXPECT_EQ(h.service.compensator().mem_params().c1, 5.5e-9);
+}
+
+// HX_STATUS counters only count up (CounterSet): a bridge restart replaces the control law but
+// not what it counted.
+TEST(CompensatorService, StatusCountersKeepCountingAcrossABridgeRestart) {
+  Harness h;
+  Subscription<service_status_t> status(*h.lcm, h.channels.status);
+  h.run(50000, 100);
+  h.run(0, 100);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  ASSERT_EQ(status.counters().accepted, 1u);
+  const service_status_t& s = status.latest();
+  const auto value = [&](const std::string& name) -> std::int64_t {
+    for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
+      if (s.counter_names[i] == name) return s.counter_values[i];
+    }
+    ADD_FAILURE() << name << " not reported";
+    return -1;
+  };
+  EXPECT_EQ(value("bridge_restarts"), 1);
+  EXPECT_EQ(value("command_ticks_published"), static_cast<std::int64_t>(h.ticks.size()));
+  EXPECT_EQ(value("samples"), 200);
+  EXPECT_EQ(value("planned"), static_cast<std::int64_t>(h.ticks.size()));
+}
+
+std::string settings_refusal(const std::string& yaml) {
+  try {
+    load_compensator_settings(Config::from_string(yaml, "compensator.yaml"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(CompensatorSettings, RefusedOldKeysSayWhereTheyWent) {
+  const std::string lead = settings_refusal("compensator: {mode: mem, lead_ticks: 2}");
+  EXPECT_TRUE(contains(lead, "compensator.yaml: compensator.lead_ticks")) << lead;
+  EXPECT_TRUE(contains(lead, "compensator.horizon_s")) << lead;
+  for (const char* key : {"kp", "ki", "kd"}) {
+    const std::string why = settings_refusal(std::string("feedback: {") + key + ": 0.1}");
+    EXPECT_TRUE(contains(why, std::string("compensator.yaml: feedback.") + key)) << why;
+    EXPECT_TRUE(contains(why, "servo.kp")) << why;
+    EXPECT_TRUE(contains(why, "bridge")) << why;
+  }
+}
+
+TEST(CompensatorSettings, TheHorizonIsGivenInSecondsAndPlannedInTicks) {
+  const auto ticks_in = [](const std::string& file) {
+    const Config c = Config::load_file(kConfigDir + file);
+    return std::llround(c.get<double>("compensator.horizon_s") / c.get<double>("compensator.dt_s", 1e-4));
+  };
+  const CompensatorSettings deploy = deployed();
+  EXPECT_EQ(deploy.control.horizon_ticks, ticks_in("compensator.yaml"));
+  const auto load = [](const std::string& yaml) {
+    return load_compensator_settings(Config::from_string(yaml, "compensator.yaml")).control;
+  };
+  EXPECT_EQ(load("compensator: {horizon_s: 0.25}").horizon_ticks, 2500);
+  EXPECT_EQ(load("compensator: {horizon_s: 0.03, dt_s: 2.0e-4}").horizon_ticks, 150);
+  EXPECT_TRUE(contains(settings_refusal("compensator: {horizon_s: 0.0001}"), "compensator.yaml: compensator.horizon_s"));
+  EXPECT_TRUE(contains(settings_refusal("compensator: {horizon_s: 1.0}"), "compensator.yaml: compensator.horizon_s"));
+  const CompensatorSettings demo = load_compensator_settings(Config::load_file(kConfigDir + "demo/compensator.yaml"));
+  EXPECT_EQ(demo.control.horizon_ticks, ticks_in("demo/compensator.yaml"));
+  const auto lines = describe(deploy);
+  const std::string plans = "plans " + std::to_string(deploy.control.horizon_ticks) + " ticks";
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return contains(l, plans); }));
 }
 
 TEST(TrajectoryMessage, MapsWallTimeToLoopTime) {
