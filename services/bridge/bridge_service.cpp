@@ -280,10 +280,6 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     status_.counter("timer_lateness_p99_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.99)));
     status_.counter("timer_lateness_max_ns", static_cast<std::uint64_t>(rt.lateness.max_ns()));
   }
-  const ResourceUsage usage = read_resource_usage();
-  status_.counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
-  status_.counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
-  status_.counter("peak_rss_kB", static_cast<std::uint64_t>(usage.peak_rss_bytes / 1024));
   status_.endpoint("command", counters_since(commands_.counters(), endpoint_base_.commands));
   status_.endpoint("control", counters_since(control_.counters(), endpoint_base_.control));
   status_.publisher("sensor", counters_since(sensor_pub_.counters(), endpoint_base_.sensor));

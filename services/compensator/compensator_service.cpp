@@ -288,10 +288,6 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   if (c.next_tick() >= 0) {
     status_.counter("plan_ahead_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
   }
-  const ResourceUsage usage = read_resource_usage();
-  status_.counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
-  status_.counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
-  status_.counter("peak_rss_kB", static_cast<std::uint64_t>(usage.peak_rss_bytes / 1024));
   status_.endpoint("sensor", counters_since(samples_.counters(), endpoint_base_.sensor));
   status_.endpoint("trajectory", counters_since(trajectories_.counters(), endpoint_base_.trajectory));
   status_.endpoint("params", counters_since(params_.counters(), endpoint_base_.params));

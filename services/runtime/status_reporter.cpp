@@ -64,6 +64,11 @@ void StatusReporter::latency(const LatencyStats& stats) {
 }
 
 bool StatusReporter::publish(std::int64_t utime) {
+  // Every process reports what it costs (hystloop-report turns these into cpu_fraction).
+  const ResourceUsage usage = read_resource_usage();
+  counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
+  counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
+  counter("peak_rss_kB", static_cast<std::uint64_t>(usage.peak_rss_bytes / 1024));
   status_.utime = utime;
   return publisher_.publish(status_);
 }

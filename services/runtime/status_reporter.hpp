@@ -29,6 +29,7 @@ class StatusReporter {
   void latency(const LatencyStats& stats);      // sample-to-command
   void late(std::int64_t count) { status_.late = count; }
   void add_rejected(std::int64_t count) { status_.rejected += count; }
+  // Adds the process's CPU time and peak memory (cpu_user_us, cpu_system_us, peak_rss_kB), then publishes.
   bool publish(std::int64_t utime);
 
   const service_status_t& status() const noexcept { return status_; }
