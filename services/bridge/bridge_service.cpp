@@ -94,7 +94,9 @@ void BridgeService::on_control(const control_t& msg) {
       ++control_acted_;
       // All counters from the next report on (asked for at once, so at most a tick of the
       // real-time thread's events is not counted).
-      endpoint_base_ = {commands_.counters(), control_.counters(), sensor_pub_.counters()};
+      counters_.rebase("command", commands_.counters());
+      counters_.rebase("control", control_.counters());
+      counters_.rebase("sensor", sensor_pub_.counters());
       reset_pending_ = true;
       spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
       return;
@@ -280,9 +282,9 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     status_.counter("timer_lateness_p99_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.99)));
     status_.counter("timer_lateness_max_ns", static_cast<std::uint64_t>(rt.lateness.max_ns()));
   }
-  status_.endpoint("command", counters_since(commands_.counters(), endpoint_base_.commands));
-  status_.endpoint("control", counters_since(control_.counters(), endpoint_base_.control));
-  status_.publisher("sensor", counters_since(sensor_pub_.counters(), endpoint_base_.sensor));
+  counters_.report(status_, "command", commands_.counters());
+  counters_.report(status_, "control", control_.counters());
+  counters_.report(status_, "sensor", sensor_pub_.counters());
   status_.add_rejected(static_cast<std::int64_t>(
       counters_.since("rejected_nonfinite", k.rejected_nonfinite) + counters_.since("rejected_future", k.rejected_future) +
       counters_.since("command_queue_full", command_queue_full_) + counters_.since("control_refused", control_refused_)));

@@ -78,10 +78,6 @@ class BridgeService {
   std::uint64_t previous_dropped_ = 0;
   bool reset_pending_ = false;
   CounterSet counters_;
-  struct EndpointBaseline {
-    EndpointCounters commands{}, control{};
-    PublisherCounters sensor{};
-  } endpoint_base_;
 };
 
 }  // namespace hystloop

@@ -28,7 +28,7 @@ struct BridgeSettings {
   SimulatedStageConfig stage{};    // noise, seed, drift and the plants' parameters
   ActuatorLimits limits{};
   FeedbackGains servo{};           // the servo on y_ref - y (all gains 0 = feedforward only)
-  int block_ticks = 10;            // ticks per HX_SENSOR block (1 = a message per tick)
+  int block_ticks = 20;            // ticks per HX_SENSOR block: 500 messages/s (1 = a message per tick)
   RtSettings rt{};
   bool auto_arm = false;           // arm as soon as commands flow (first arm only)
   double rearm_after_trip_s = 0.0; // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)

@@ -189,8 +189,11 @@ void CompensatorService::on_control(const control_t& msg) {
         break;
       case control_t::RESET_COUNTERS:
         reported_.rebase(collect_counters());
-        endpoint_base_ = {samples_.counters(), trajectories_.counters(), params_.counters(), control_.counters(),
-                          command_pub_.counters()};
+        reported_.rebase("sensor", samples_.counters());
+        reported_.rebase("trajectory", trajectories_.counters());
+        reported_.rebase("params", params_.counters());
+        reported_.rebase("control", control_.counters());
+        reported_.rebase("command", command_pub_.counters());
         spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
         break;
       case control_t::SHUTDOWN:
@@ -288,11 +291,11 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   if (c.next_tick() >= 0) {
     status_.counter("plan_ahead_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
   }
-  status_.endpoint("sensor", counters_since(samples_.counters(), endpoint_base_.sensor));
-  status_.endpoint("trajectory", counters_since(trajectories_.counters(), endpoint_base_.trajectory));
-  status_.endpoint("params", counters_since(params_.counters(), endpoint_base_.params));
-  status_.endpoint("control", counters_since(control_.counters(), endpoint_base_.control));
-  status_.publisher("command", counters_since(command_pub_.counters(), endpoint_base_.command));
+  reported_.report(status_, "sensor", samples_.counters());
+  reported_.report(status_, "trajectory", trajectories_.counters());
+  reported_.report(status_, "params", params_.counters());
+  reported_.report(status_, "control", control_.counters());
+  reported_.report(status_, "command", command_pub_.counters());
   status_.add_rejected(static_cast<std::int64_t>(semantic_rejects));
   status_.loop_timing(work_);
   status_.latency(latency_);

@@ -104,10 +104,6 @@ class CompensatorService {
   std::uint64_t blocks_in_period_ = 0;
   std::uint64_t swaps_reported_ = 0;
   CounterSet reported_;
-  struct EndpointBaselines {
-    EndpointCounters sensor, trajectory, params, control;
-    PublisherCounters command;
-  } endpoint_base_{};
 };
 
 }  // namespace hystloop

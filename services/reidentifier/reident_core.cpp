@@ -143,10 +143,6 @@ const ReidentCounters& ReidentCore::counters() noexcept {
   return counters_;
 }
 
-void ReidentCore::reset_counters() noexcept {
-  counters();
-  counters_.reset();
-  refit_time_.reset();
-}
+void ReidentCore::reset_refit_time() noexcept { refit_time_.reset(); }
 
 }  // namespace hystloop

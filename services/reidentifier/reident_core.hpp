@@ -77,7 +77,7 @@ class ReidentCore {
   double seconds_since_sample(std::int64_t now_us) const noexcept;
 
   const ReidentCounters& counters() noexcept;  // refreshes the estimator's mirrored totals
-  void reset_counters() noexcept;
+  void reset_refit_time() noexcept;  // RESET_COUNTERS: the refit-time statistics start again
   const LatencyStats& refit_time() const noexcept { return refit_time_; }  // ns, since start
   double last_refit_s() const noexcept { return last_refit_s_; }
   const ParamsInUse& in_use() const noexcept { return in_use_; }

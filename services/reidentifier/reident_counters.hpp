@@ -1,7 +1,7 @@
 #pragma once
 // The re-identifier's counters, by name, as HX_STATUS reports them. Every sample that is not
-// fed and every refit that is not published is counted under its reason. Reset (control_t
-// RESET_COUNTERS) keeps a baseline, so the counts stay cheap increments.
+// fed and every refit that is not published is counted under its reason. They only count up;
+// RESET_COUNTERS is the service's CounterSet (services/runtime/counter_set.hpp), as everywhere.
 
 #include <array>
 #include <cstddef>
@@ -44,12 +44,11 @@ class ReidentCounters {
   void add(ReidentCounter c, std::uint64_t n = 1) noexcept { values_[index(c)] += n; }
   void add_rejected(FitStatus s) noexcept { values_[rejected_index(s)] += 1; }
   void set(ReidentCounter c, std::uint64_t total) noexcept { values_[index(c)] = total; }  // mirrored totals
-  // Since start or the last reset.
+  // Since start.
   std::uint64_t get(ReidentCounter c) const noexcept { return at(index(c)); }
   std::uint64_t rejected(FitStatus s) const noexcept { return at(rejected_index(s)); }
   std::uint64_t rejected_total() const noexcept;
-  std::uint64_t at(std::size_t i) const noexcept { return values_[i] - baseline_[i]; }
-  void reset() noexcept { baseline_ = values_; }
+  std::uint64_t at(std::size_t i) const noexcept { return values_[i]; }
 
   static constexpr std::size_t index(ReidentCounter c) noexcept { return static_cast<std::size_t>(c); }
   static constexpr std::size_t rejected_index(FitStatus s) noexcept {
@@ -58,7 +57,6 @@ class ReidentCounters {
 
  private:
   std::array<std::uint64_t, kReidentCounterCount> values_{};
-  std::array<std::uint64_t, kReidentCounterCount> baseline_{};
 };
 
 }  // namespace hystloop

@@ -7,7 +7,6 @@
 #include <spdlog/spdlog.h>
 
 #include "core/process.hpp"
-#include "runtime/counter_baseline.hpp"
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
@@ -99,6 +98,18 @@ void ReidentService::on_params(const mem_params_t& msg) {
   }
 }
 
+CounterSet::Entries ReidentService::counter_entries() {
+  const ReidentCounters& c = core_->counters();
+  const std::size_t ok_index = ReidentCounters::rejected_index(FitStatus::ok);
+  CounterSet::Entries entries;
+  entries.reserve(kReidentCounterCount + 1);
+  for (std::size_t i = 0; i < kReidentCounterCount; ++i) {
+    if (i != ok_index) entries.emplace_back(std::string(counter_name(i)), c.at(i));
+  }
+  entries.emplace_back("refits_rejected", c.rejected_total());
+  return entries;
+}
+
 void ReidentService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
   if (msg.command == control_t::SHUTDOWN) {
@@ -106,12 +117,13 @@ void ReidentService::on_control(const control_t& msg) {
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
     spdlog::info("counters reset (request {})", msg.request_id);
-    core_->reset_counters();
-    sensor_base_ = sensor_->counters();
-    command_base_ = command_->counters();
-    params_in_base_ = params_in_->counters();
-    control_base_ = control_->counters();
-    params_out_base_ = params_out_.counters();
+    core_->reset_refit_time();
+    reported_.rebase(counter_entries());
+    reported_.rebase("sensor", sensor_->counters());
+    reported_.rebase("command", command_->counters());
+    reported_.rebase("params_in", params_in_->counters());
+    reported_.rebase("control", control_->counters());
+    reported_.rebase("params_out", params_out_.counters());
   }
 }
 
@@ -171,12 +183,7 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
                        refit.percentile(0.5) * 1e-6, static_cast<double>(refit.max_ns()) * 1e-6);
   }
   status_.begin(state, std::move(why));
-  const ReidentCounters& c = core_->counters();
-  const std::size_t ok_index = ReidentCounters::rejected_index(FitStatus::ok);
-  for (std::size_t i = 0; i < kReidentCounterCount; ++i) {
-    if (i != ok_index) status_.counter(counter_name(i), c.at(i));
-  }
-  status_.counter("refits_rejected", c.rejected_total());
+  reported_.report(status_, counter_entries());
   status_.counter("params_version", static_cast<std::uint64_t>(in_use.version()));
   if (applied != ParamsInUse::kUnknownVersion) {  // absent until a command at or before a sample is heard
     status_.counter("params_version_applied", static_cast<std::uint64_t>(applied));
@@ -186,11 +193,11 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
     status_.counter("refit_p50_us", static_cast<std::uint64_t>(std::llround(refit.percentile(0.5) * 1e-3)));
     status_.counter("refit_max_us", static_cast<std::uint64_t>(refit.max_ns() / 1000));
   }
-  status_.endpoint("sensor", counters_since(sensor_->counters(), sensor_base_));
-  status_.endpoint("command", counters_since(command_->counters(), command_base_));
-  status_.endpoint("params_in", counters_since(params_in_->counters(), params_in_base_));
-  status_.endpoint("control", counters_since(control_->counters(), control_base_));
-  status_.publisher("params_out", counters_since(params_out_.counters(), params_out_base_));
+  reported_.report(status_, "sensor", sensor_->counters());
+  reported_.report(status_, "command", command_->counters());
+  reported_.report(status_, "params_in", params_in_->counters());
+  reported_.report(status_, "control", control_->counters());
+  reported_.report(status_, "params_out", params_out_.counters());
   status_.loop_timing(block_cost_);  // per-block handler cost
   block_cost_.reset();
   status_.publish(wall_utime());

@@ -31,6 +31,7 @@
 #include "reidentifier/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_filter.hpp"
+#include "runtime/counter_set.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -51,6 +52,7 @@ class ReidentService {
   void on_control(const control_t& msg);
   void on_tick(std::int64_t now_us);
   void publish_decision(const RefitDecision& d);
+  CounterSet::Entries counter_entries();  // the core's counters by name, cumulative
   void publish_status(std::int64_t now_us, bool stopping);
 
   lcm::LCM& lcm_;
@@ -62,8 +64,7 @@ class ReidentService {
   ControlFilter control_filter_;
   LatencyStats block_cost_;  // HX_SENSOR handler (feed of one block) cost [ns], per status period
   // RESET_COUNTERS: the endpoints' counts at the reset (they only count up).
-  EndpointCounters sensor_base_{}, command_base_{}, params_in_base_{}, control_base_{};
-  PublisherCounters params_out_base_{};
+  CounterSet reported_;  // RESET_COUNTERS baselines of the counters and endpoints
   mem_params_t out_{};
   std::int64_t next_status_us_ = 0;
   // Last: their handlers use everything above.

@@ -1,5 +1,7 @@
 #include "runtime/counter_set.hpp"
 
+#include "runtime/counter_baseline.hpp"
+
 namespace hystloop {
 
 void CounterSet::report(StatusReporter& status, const Entries& now) const {
@@ -14,6 +16,16 @@ std::uint64_t CounterSet::since(const std::string& name, std::uint64_t value) co
 
 void CounterSet::rebase(const Entries& now) {
   for (const auto& [name, value] : now) baseline_[name] = value;
+}
+
+void CounterSet::report(StatusReporter& status, const std::string& name, const EndpointCounters& now) const {
+  const auto it = endpoint_baseline_.find(name);
+  status.endpoint(name, it == endpoint_baseline_.end() ? now : counters_since(now, it->second));
+}
+
+void CounterSet::report(StatusReporter& status, const std::string& name, const PublisherCounters& now) const {
+  const auto it = publisher_baseline_.find(name);
+  status.publisher(name, it == publisher_baseline_.end() ? now : counters_since(now, it->second));
 }
 
 }  // namespace hystloop
