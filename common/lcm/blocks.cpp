@@ -1,5 +1,7 @@
 #include "lcm/blocks.hpp"
 
+#include "lcm/message_storage.hpp"
+
 namespace hystloop {
 
 void begin_block(sensor_block_t& b, std::int64_t seq, std::int64_t utime, double dt_s) noexcept {
@@ -8,12 +10,7 @@ void begin_block(sensor_block_t& b, std::int64_t seq, std::int64_t utime, double
   b.dt_s = dt_s;
   b.buffer_depth_ticks = 0;
   b.n_ticks = 0;
-  b.u_V.clear();
-  b.u_ff_V.clear();
-  b.u_fb_V.clear();
-  b.y_ref_m.clear();
-  b.y_m.clear();
-  b.flags.clear();
+  clear_arrays(b);
 }
 
 void begin_block(command_block_t& b, std::int64_t seq, std::int64_t utime, std::int64_t sample_seq) noexcept {
@@ -21,10 +18,7 @@ void begin_block(command_block_t& b, std::int64_t seq, std::int64_t utime, std::
   b.seq = seq;
   b.sample_seq = sample_seq;
   b.n_ticks = 0;
-  b.u_ff_V.clear();
-  b.y_ref_m.clear();
-  b.params_version.clear();
-  b.mode.clear();
+  clear_arrays(b);
 }
 
 bool append_tick(sensor_block_t& b, const SensorTick& t) noexcept {

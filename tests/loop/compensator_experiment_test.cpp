@@ -25,12 +25,7 @@ using testing::kDt;
 constexpr auto kExperimentMode = static_cast<std::int8_t>(FeedforwardMode::kExperiment);
 
 ExperimentSpec sine(double amplitude_V, double frequency_hz, double duration_s, double offset_V = 0.0) {
-  ExperimentSpec s;
-  s.amplitude_V = amplitude_V;
-  s.frequency_hz = frequency_hz;
-  s.duration_s = duration_s;
-  s.offset_V = offset_V;
-  return s;
+  return make_experiment_spec("sine", amplitude_V, offset_V, frequency_hz, duration_s);
 }
 
 // 1 um cosine around 0: within the default MEM stage's reach.
