@@ -76,41 +76,51 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
     ++counters_.watchdog_trips;
   }
 
-  double target;
-  double max_step;
   if (!armed_) {
     // Safe state: ramp to the safe voltage; the servo holds its state for the re-arm.
-    target = limits_.safe_u_V;
-    max_step = std::min(limits_.safe_ramp_V_per_s, limits_.slew_V_per_s) * dt_s_;  // never faster than the slew limit
     out.flags |= sample_flags::kSafeState;
     out.y_ref_m = kNaN;
     servo_ref_m_ = kNaN;
     ++counters_.safe_ticks;
-  } else {
-    if (command != nullptr) {
-      held_ = *command;
-      last_supplied_tick_ = k;
-      command_since_arm_ = true;
-      ++counters_.applied;
-    } else {
-      ++counters_.late;
-      out.flags |= sample_flags::kLateCommand;
+    // The ramp is anchored at the voltage it started from and counts whole ticks (never faster
+    // than the slew limit), so no rounding accumulates: it arrives exactly at safe_u_V, within
+    // ceil(|u0 - safe_u_V| / (rate * dt)) ticks.
+    if (!safe_ramp_active_) {
+      safe_ramp_active_ = true;
+      safe_ramp_from_V_ = u_applied_;
+      safe_ramp_ticks_ = 0;
     }
-    // The servo: the previous tick's reference against the position measured at its end.
-    if (!command_since_arm_) {
-      // Re-armed, no command yet: the servo keeps what it held through the safe state.
-    } else if (!std::isfinite(held_.y_ref_m)) {
-      servo_.reset();  // no reference (an experiment): nothing to track, nothing to remember
-    } else if (std::isfinite(servo_ref_m_) && servo_.gains().enabled()) {
-      out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s);
-    }
-    servo_ref_m_ = held_.y_ref_m;
-    out.u_ff_V = held_.u_ff_V;
-    out.y_ref_m = held_.y_ref_m;
-    out.params_version = held_.params_version;
-    target = held_.u_ff_V + out.u_fb_V;
-    max_step = limits_.slew_V_per_s * dt_s_;
+    ++safe_ramp_ticks_;
+    const double distance = limits_.safe_u_V - safe_ramp_from_V_;
+    const double travelled = static_cast<double>(safe_ramp_ticks_) * limits_.safe_ramp_rate_V_per_s() * dt_s_;
+    u_applied_ = travelled >= std::abs(distance) ? limits_.safe_u_V : safe_ramp_from_V_ + std::copysign(travelled, distance);
+    out.u_applied_V = u_applied_;
+    return out;
   }
+  safe_ramp_active_ = false;
+  if (command != nullptr) {
+    held_ = *command;
+    last_supplied_tick_ = k;
+    command_since_arm_ = true;
+    ++counters_.applied;
+  } else {
+    ++counters_.late;
+    out.flags |= sample_flags::kLateCommand;
+  }
+  // The servo: the previous tick's reference against the position measured at its end.
+  if (!command_since_arm_) {
+    // Re-armed, no command yet: the servo keeps what it held through the safe state.
+  } else if (!std::isfinite(held_.y_ref_m)) {
+    servo_.reset();  // no reference (an experiment): nothing to track, nothing to remember
+  } else if (std::isfinite(servo_ref_m_) && servo_.gains().enabled()) {
+    out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s);
+  }
+  servo_ref_m_ = held_.y_ref_m;
+  out.u_ff_V = held_.u_ff_V;
+  out.y_ref_m = held_.y_ref_m;
+  out.params_version = held_.params_version;
+  const double target = held_.u_ff_V + out.u_fb_V;
+  const double max_step = limits_.slew_V_per_s * dt_s_;
 
   const double clamped = std::clamp(target, limits_.u_min_V, limits_.u_max_V);
   if (clamped != target) {
@@ -120,10 +130,8 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
   double u = clamped;
   if (std::abs(u - u_applied_) > max_step) {
     u = u_applied_ + std::copysign(max_step, u - u_applied_);
-    if (armed_) {
-      ++counters_.slew_limited;
-      out.flags |= sample_flags::kSlewLimited;
-    }
+    ++counters_.slew_limited;
+    out.flags |= sample_flags::kSlewLimited;
   }
   u_applied_ = u;
   out.u_applied_V = u;

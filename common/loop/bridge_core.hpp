@@ -34,6 +34,13 @@ struct ActuatorLimits {
   double watchdog_s = 2.0e-3;        // the buffer empty for this long -> safe state
 
   void validate() const;  // throws ParameterError naming the field
+  // The rate the safe state ramps at: safe_ramp_V_per_s, never faster than the slew limit.
+  double safe_ramp_rate_V_per_s() const noexcept { return safe_ramp_V_per_s < slew_V_per_s ? safe_ramp_V_per_s : slew_V_per_s; }
+  // The longest ramp to safe_u_V: from the end of the range farthest from it [s].
+  double longest_safe_ramp_s() const noexcept {
+    const double far_V = u_max_V - safe_u_V > safe_u_V - u_min_V ? u_max_V - safe_u_V : safe_u_V - u_min_V;
+    return far_V / safe_ramp_rate_V_per_s();
+  }
 };
 
 struct BridgeCounters {
@@ -101,6 +108,9 @@ class BridgeCore {
   double servo_ref_m_;                   // reference of the previous tick, for the servo's error (NaN: none)
   bool armed_ = false;
   bool command_since_arm_ = false;       // until then the servo neither acts nor forgets its held state
+  bool safe_ramp_active_ = false;        // in the safe state: ramping from safe_ramp_from_V_ (or there)
+  double safe_ramp_from_V_ = 0.0;
+  std::int64_t safe_ramp_ticks_ = 0;     // safe-state ticks since the ramp started
   BridgeCounters counters_;
 };
 

@@ -6,7 +6,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <ctime>
+#include <chrono>
 #include <system_error>
+#include <thread>
+
+#include <spdlog/spdlog.h>
 
 #include "core/periodic_timer.hpp"
 
@@ -32,7 +36,19 @@ BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<S
 }
 
 BridgeRealtime::~BridgeRealtime() {
-  stop();
+  // The service stops us after the ramp; still running here means it did not get there (an
+  // exception unwinding): the ramp happens now, before the thread ends.
+  const bool running = thread_.joinable();
+  const SafeStopResult r = stop();
+  if (running) {
+    if (r.reached) {
+      spdlog::warn("stopped without the service's stop: ramped from {:.6g} V to the safe {} V in {} ticks ({:.4g} s)",
+                   r.u_start_V, settings_.limits.safe_u_V, r.ramp_ticks, r.ramp_s);
+    } else {
+      spdlog::error("stopped without the service's stop: the ramp to the safe {} V did not end within {} s",
+                    settings_.limits.safe_u_V, settings_.stop_ramp_timeout_s);
+    }
+  }
   if (wake_fd_ >= 0) ::close(wake_fd_);
 }
 
@@ -40,9 +56,32 @@ void BridgeRealtime::start() {
   thread_ = std::thread([this] { run(); });
 }
 
-void BridgeRealtime::stop() {
-  stop_.store(true, std::memory_order_release);
-  if (thread_.joinable()) thread_.join();
+void BridgeRealtime::begin_safe_stop() noexcept {
+  if (stop_result_.requested) return;
+  stop_result_.requested = true;
+  safe_stop_begin_ns_ = monotonic_now_ns();
+  safe_stop_.store(true, std::memory_order_release);
+}
+
+SafeStopResult BridgeRealtime::stop() {
+  if (thread_.joinable()) {
+    begin_safe_stop();
+    const std::int64_t deadline_ns =
+        safe_stop_begin_ns_ + static_cast<std::int64_t>(settings_.stop_ramp_timeout_s * 1e9);
+    while (!safe_reached() && monotonic_now_ns() < deadline_ns) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const std::int64_t waited_ns = monotonic_now_ns() - safe_stop_begin_ns_;
+    stop_.store(true, std::memory_order_release);
+    thread_.join();
+    // Joined: the thread's stop_* fields are ours to read.
+    stop_result_.reached = safe_reached();
+    stop_result_.u_start_V = stop_u_start_V_;
+    stop_result_.ramp_ticks = stop_ramp_ticks_;
+    stop_result_.ramp_s = static_cast<double>(stop_ramp_ticks_) * dt_s_;
+    stop_result_.wall_s =
+        static_cast<double>(stop_result_.reached ? stop_reached_ns_ - safe_stop_begin_ns_ : waited_ns) * 1e-9;
+  }
+  backend_->hold_safe(settings_.limits.safe_u_V);  // after the ramp, and whatever happened before
+  return stop_result_;
 }
 
 void BridgeRealtime::run() noexcept {
@@ -88,8 +127,16 @@ void BridgeRealtime::run() noexcept {
 void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
 
+  if (!stopping_ && safe_stop_.load(std::memory_order_acquire)) {
+    stopping_ = true;  // from this tick the core ramps to the safe voltage and is never armed again
+    stop_u_start_V_ = core_.last_applied_V();
+    core_.disarm();
+    auto_arm_pending_ = false;
+    tripped_ = false;
+  }
   switch (arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel)) {
     case ArmRequest::kArm:
+      if (stopping_) break;
       core_.arm(k);
       tripped_ = false;
       break;
@@ -106,7 +153,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
     commands_seen_ = true;
     core_.submit(*command);
   }
-  if (commands_seen_ && core_.buffer_depth() > 0 && !core_.armed()) {
+  if (commands_seen_ && core_.buffer_depth() > 0 && !core_.armed() && !stopping_) {
     if (auto_arm_pending_) {
       core_.arm(k);
       auto_arm_pending_ = false;
@@ -122,6 +169,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   }
   if (core_.armed()) auto_arm_pending_ = false;  // armed by HX_CONTROL: no auto-arm later
 
+  const double u_before_V = core_.last_applied_V();
   const BridgeTick decided = core_.tick(k, y_last_m_);
   if (core_.counters().watchdog_trips != trips_seen_) {
     trips_seen_ = core_.counters().watchdog_trips;
@@ -138,6 +186,15 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const StageReading reading = backend_->step(decided.u_applied_V, t_s, step_s);
   y_last_m_ = reading.y_m;
   last_tick_ = k;
+  bool reached_now = false;
+  if (stopping_ && !safe_reached_.load(std::memory_order_relaxed)) {
+    if (decided.u_applied_V != u_before_V) ++stop_ramp_ticks_;
+    if (!core_.armed() && decided.u_applied_V == settings_.limits.safe_u_V) {
+      stop_reached_ns_ = monotonic_now_ns();
+      backend_->hold_safe(settings_.limits.safe_u_V);
+      reached_now = true;  // published once this tick's sample is queued
+    }
+  }
 
   const OutgoingTick out{SensorTick{wall_utime_now(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
                                     decided.y_ref_m, reading.y_m, decided.flags | reading.flags},
@@ -150,6 +207,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   } else {
     ++samples_dropped_;
   }
+  if (reached_now) safe_reached_.store(true, std::memory_order_release);
 
   RtReport& report = reports_.current();
   report.work.add(monotonic_now_ns() - start_ns);

@@ -31,6 +31,16 @@ struct OutgoingTick {
 
 enum class ArmRequest : std::uint8_t { kNone = 0, kArm = 1, kDisarm = 2 };
 
+// How the stop's ramp to actuator.safe_u_V went (BridgeRealtime::begin_safe_stop / stop).
+struct SafeStopResult {
+  bool requested = false;     // begin_safe_stop() was called
+  bool reached = false;       // the ramp applied safe_u_V before the thread ended
+  double u_start_V = 0.0;     // applied when the real-time thread took the request
+  std::int64_t ramp_ticks = 0;  // ticks that moved the voltage (0: it was already safe)
+  double ramp_s = 0.0;        // ramp_ticks * dt: loop time
+  double wall_s = 0.0;        // from the request to the tick that applied safe_u_V (or to the timeout)
+};
+
 class BridgeRealtime {
  public:
   static constexpr std::size_t kCommandQueue = 16384;  // 1.6 s of commands
@@ -43,8 +53,16 @@ class BridgeRealtime {
 
   // Starts the thread (scheduling set-up happens on it; see setup_status()).
   void start();
-  // Asks the thread to stop after its current tick and joins it.
-  void stop();
+  // The first half of every stop: from its next tick the thread disarms BridgeCore, refuses to
+  // arm again and lets it ramp to actuator.safe_u_V (BridgeCore's safe state: min(ramp, slew)),
+  // then tells the backend to hold_safe(). Idempotent; does not wait. I/O thread.
+  void begin_safe_stop() noexcept;
+  bool safe_reached() const noexcept { return safe_reached_.load(std::memory_order_acquire); }
+  // Ends the thread, safely on every path (also from the destructor while an exception unwinds):
+  // begins the safe stop if nobody did, waits until the ramp reached safe_u_V or
+  // BridgeSettings::stop_ramp_timeout_s after the request passed, stops and joins the thread, then
+  // calls backend.hold_safe(). Returns how the ramp went (also when called again).
+  SafeStopResult stop();
 
   // I/O thread side.
   bool push_command(const CommandTick& command) noexcept { return commands_.try_push(command); }
@@ -76,12 +94,20 @@ class BridgeRealtime {
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> started_{false};
+  std::atomic<bool> safe_stop_{false};     // I/O -> RT: ramp to safe, refuse arming
+  std::atomic<bool> safe_reached_{false};  // RT -> I/O: the ramp applied safe_u_V (stop_* below are written)
+  std::int64_t safe_stop_begin_ns_ = 0;    // I/O thread: when begin_safe_stop() was first called
+  SafeStopResult stop_result_;             // I/O thread, after the join or safe_reached()
   SetupStatus priority_status_;
   SetupStatus affinity_status_;
 
   // RT-thread state.
   bool auto_arm_pending_ = false;
   bool tripped_ = false;  // in the safe state because of the watchdog (not an operator)
+  bool stopping_ = false;                 // took the safe-stop request: never arms again
+  double stop_u_start_V_ = 0.0;
+  std::int64_t stop_ramp_ticks_ = 0;
+  std::int64_t stop_reached_ns_ = 0;
   std::uint64_t ticks_skipped_ = 0;
   std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;

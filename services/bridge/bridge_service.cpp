@@ -57,6 +57,11 @@ void BridgeService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   switch (msg.command) {
     case control_t::ARM:
+      if (stopping_) {  // the real-time thread would not arm either
+        ++control_refused_;
+        spdlog::warn("ARM (request {}) refused: the bridge is stopping (ramping to the safe voltage)", msg.request_id);
+        return;
+      }
       ++control_acted_;
       rt_.request_arm(ArmRequest::kArm);
       spdlog::info("ARM (request {})", msg.request_id);
@@ -135,6 +140,41 @@ void BridgeService::publish_samples(bool flush) noexcept {
   if (flush) publish_block();
 }
 
+void BridgeService::serve(bool stopping) {
+  using clock = std::chrono::steady_clock;
+  // Once a stop is requested its eventfd stays readable: the stopping phase polls without it.
+  pollfd fds[3] = {{lcm_.getFileno(), POLLIN, 0}, {rt_.wake_fd(), POLLIN, 0}, {stop_fd(), POLLIN, 0}};
+  const nfds_t nfds = stop_fd() >= 0 && !stopping ? 3 : 2;
+  const timespec timeout{0, stopping ? 2'000'000 : 20'000'000};  // status, --seconds and the ramp checked this often
+  const int ready = ppoll(fds, nfds, &timeout, nullptr);
+  if (ready < 0 && errno != EINTR) ++lcm_errors_;
+  if (fds[1].revents & POLLIN) {
+    std::uint64_t count = 0;
+    [[maybe_unused]] const ssize_t n = ::read(rt_.wake_fd(), &count, sizeof count);
+  }
+  publish_samples(false);
+  if (fds[0].revents & POLLIN) {
+    for (int i = 0; i < 256; ++i) {
+      const int rc = lcm_.handleTimeout(0);
+      if (rc < 0) ++lcm_errors_;
+      if (rc <= 0) break;
+    }
+  }
+  const auto now = clock::now();
+  if ((now >= next_report_ || reset_pending_) && !awaiting_report_) {
+    rt_.reports().request();
+    awaiting_report_ = true;
+    if (now >= next_report_) next_report_ += std::chrono::seconds(1);
+  }
+  if (awaiting_report_) {
+    if (const RtReport* r = rt_.reports().take()) {
+      report(*r, wall_utime(), stopping);
+      rt_.reports().release();
+      awaiting_report_ = false;
+    }
+  }
+}
+
 int BridgeService::run() {
   for (const std::string& line : describe(settings_)) spdlog::info("{}", line);
   spdlog::info("channels: {} out, {} and {} in", sensor_pub_.channel(), commands_.channel(), control_.channel());
@@ -147,63 +187,55 @@ int BridgeService::run() {
 
   using clock = std::chrono::steady_clock;
   const auto started = clock::now();
-  auto next_report = started + std::chrono::seconds(1);
-  bool awaiting_report = false;
-  int lcm_errors = 0;
-  pollfd fds[3] = {{lcm_.getFileno(), POLLIN, 0}, {rt_.wake_fd(), POLLIN, 0}, {stop_fd(), POLLIN, 0}};
-  const nfds_t nfds = stop_fd() >= 0 ? 3 : 2;
+  next_report_ = started + std::chrono::seconds(1);
   while (!stop_requested()) {
-    const timespec timeout{0, 20'000'000};  // status and --seconds are checked at least every 20 ms
-    const int ready = ppoll(fds, nfds, &timeout, nullptr);
-    if (ready < 0 && errno != EINTR) ++lcm_errors;
-    if (fds[1].revents & POLLIN) {
-      std::uint64_t count = 0;
-      [[maybe_unused]] const ssize_t n = ::read(rt_.wake_fd(), &count, sizeof count);
-    }
-    publish_samples(false);
-    if (fds[0].revents & POLLIN) {
-      for (int i = 0; i < 256; ++i) {
-        const int rc = lcm_.handleTimeout(0);
-        if (rc < 0) ++lcm_errors;
-        if (rc <= 0) break;
-      }
-    }
-    const auto now = clock::now();
-    if ((now >= next_report || reset_pending_) && !awaiting_report) {
-      rt_.reports().request();
-      awaiting_report = true;
-      if (now >= next_report) next_report += std::chrono::seconds(1);
-    }
-    if (awaiting_report) {
-      if (const RtReport* r = rt_.reports().take()) {
-        report(*r, wall_utime(), false);
-        rt_.reports().release();
-        awaiting_report = false;
-      }
-    }
-    if (settings_.run_seconds > 0 && now - started >= std::chrono::duration<double>(settings_.run_seconds)) {
+    serve(false);
+    if (settings_.run_seconds > 0 && clock::now() - started >= std::chrono::duration<double>(settings_.run_seconds)) {
       spdlog::info("--seconds {} reached", settings_.run_seconds);
       request_stop();
     }
   }
 
-  spdlog::info("stopping{}", stop_signal() ? fmt::format(" on signal {}", stop_signal()) : std::string());
+  // Every stop goes through the safe state first: BridgeCore disarms and ramps to safe_u_V while
+  // the real-time thread still runs and its samples are still published, for at most
+  // stop_ramp_timeout_s (the longest ramp plus kStopRampMargin_s).
+  spdlog::info("stopping{}: ramping to the safe {} V at {} V/s (at most {} s) before the real-time thread ends",
+               stop_signal() ? fmt::format(" on signal {}", stop_signal()) : std::string(), settings_.limits.safe_u_V,
+               settings_.limits.safe_ramp_rate_V_per_s(), settings_.stop_ramp_timeout_s);
+  stopping_ = true;
+  rt_.begin_safe_stop();
+  const auto deadline = clock::now() + std::chrono::duration<double>(settings_.stop_ramp_timeout_s);
+  while (!rt_.safe_reached() && clock::now() < deadline) serve(true);
+
   // One last report from the real-time thread before it stops.
-  if (!awaiting_report) rt_.reports().request();
+  if (!awaiting_report_) rt_.reports().request();
   const RtReport* last = nullptr;
   for (int i = 0; i < 100 && last == nullptr; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     last = rt_.reports().take();
   }
-  rt_.stop();
+  const SafeStopResult safe = rt_.stop();
   publish_samples(true);
+  log_safe_stop(safe);
   if (last == nullptr) last = rt_.reports().take();
   if (last != nullptr) {
     report(*last, wall_utime(), true);
-    log_summary(*last);
-    if (!summary_json_path_.empty()) write_summary_json(*last);
+    log_summary(*last, safe);
+    if (!summary_json_path_.empty()) write_summary_json(*last, safe);
   }
-  return lcm_errors > 0 ? 1 : 0;
+  return lcm_errors_ > 0 || !safe.reached ? 1 : 0;
+}
+
+void BridgeService::log_safe_stop(const SafeStopResult& r) const {
+  if (r.reached) {
+    spdlog::info("safe state reached: ramped from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s "
+                 "wall; bound {} s); the real-time thread has ended",
+                 r.u_start_V, settings_.limits.safe_u_V, r.ramp_ticks, r.ramp_s, r.wall_s, settings_.stop_ramp_timeout_s);
+  } else {
+    spdlog::error("the ramp to the safe {} V did not end within {} s (the longest ramp + margin; from {:.6g} V, "
+                  "{} ticks ramped); the backend was told to hold the safe voltage",
+                  settings_.limits.safe_u_V, settings_.stop_ramp_timeout_s, r.u_start_V, r.ramp_ticks);
+  }
 }
 
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
@@ -251,7 +283,9 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   std::string detail;
   if (stopping) {
     state = service_status_t::STOPPING;
-    detail = "stopping";
+    detail = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed
+                 ? fmt::format("stopping: at the safe {} V", settings_.limits.safe_u_V)
+                 : fmt::format("stopping: ramping to the safe {} V", settings_.limits.safe_u_V);
   } else if (!rt.armed) {
     state = service_status_t::SAFE;
     detail = safe_reason_;
@@ -295,7 +329,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   latency_.reset();
 }
 
-void BridgeService::log_summary(const RtReport& rt) const {
+void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
   spdlog::info("summary: {} ticks ({} skipped, {} run late to catch up), {} commands applied, {} late ({:.3g} % of armed ticks), {} stale, "
@@ -312,9 +346,13 @@ void BridgeService::log_summary(const RtReport& rt) const {
   spdlog::info("summary: {} sensor blocks published, {} command blocks received ({} rejected), {} dropped samples",
                sensor_pub_.counters().published, commands_.counters().received,
                commands_.counters().rejected_total(), rt.samples_dropped);
+  spdlog::info("summary: stop: {} from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s wall; "
+               "bound {} s)",
+               safe.reached ? "ramped" : "ramp NOT finished", safe.u_start_V, settings_.limits.safe_u_V,
+               safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
 }
 
-void BridgeService::write_summary_json(const RtReport& rt) const {
+void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult& safe) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
@@ -325,13 +363,16 @@ void BridgeService::write_summary_json(const RtReport& rt) const {
       "\"watchdog_trips\": {}, \"buffer_min_depth_ticks\": {}, \"ticks_skipped\": {}, \"ticks_caught_up\": {}, "
       "\"stale\": {}, \"duplicates\": {}, \"rejected\": {}, \"samples_dropped\": {}, \"sensor_blocks\": {}, "
       "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}}}, "
-      "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}}}\n",
+      "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}, "
+      "\"stop\": {{\"safe_reached\": {}, \"u_start_V\": {:.9g}, \"ramp_ticks\": {}, \"ramp_s\": {:.6g}, "
+      "\"wall_s\": {:.6g}, \"bound_s\": {:.6g}}}}}\n",
       c.ticks, static_cast<std::uint64_t>(armed_ticks), c.late,
       armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0, c.watchdog_trips, rt.min_depth_total,
       rt.ticks_skipped, rt.ticks_caught_up, c.stale, c.duplicates, c.rejected_nonfinite + c.rejected_future,
       rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
       latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, wall_s,
-      usage.user_cpu_s + usage.system_cpu_s, wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0);
+      usage.user_cpu_s + usage.system_cpu_s, wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0,
+      safe.reached, safe.u_start_V, safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
   std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");
   if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
     spdlog::error("could not write the summary to {}", summary_json_path_);

@@ -31,9 +31,10 @@ class BridgeService {
  public:
   BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, const ChannelNames& channels);
 
-  // Runs until SIGINT/SIGTERM, a SHUTDOWN request or bridge.run_seconds; then stops the
-  // real-time thread, publishes what it still holds and a last status. Returns 0, or 1 if
-  // LCM reported errors.
+  // Runs until SIGINT/SIGTERM, a SHUTDOWN request or bridge.run_seconds; then ramps the
+  // actuator to actuator.safe_u_V (still publishing the samples), stops the real-time thread,
+  // publishes what it still holds and a last status. Returns 0, or 1 if LCM reported errors or
+  // the ramp did not end within stop_ramp_timeout_s (the longest ramp + kStopRampMargin_s).
   int run();
 
   // At exit, also write the summary's figures as JSON to `path` (empty: don't).
@@ -44,9 +45,11 @@ class BridgeService {
   void on_control(const control_t& msg);
   void publish_samples(bool flush) noexcept;
   void publish_block() noexcept;
+  void serve(bool stopping);  // one pass of the I/O loop: samples out, LCM in, status
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
-  void log_summary(const RtReport& rt) const;
-  void write_summary_json(const RtReport& rt) const;
+  void log_safe_stop(const SafeStopResult& safe) const;
+  void log_summary(const RtReport& rt, const SafeStopResult& safe) const;
+  void write_summary_json(const RtReport& rt, const SafeStopResult& safe) const;
 
   BridgeSettings settings_;
   lcm::LCM& lcm_;
@@ -70,6 +73,12 @@ class BridgeService {
   FeedbackGains gains_;  // the servo's, as last set
   std::string summary_json_path_;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+
+  // I/O loop state.
+  std::chrono::steady_clock::time_point next_report_{};
+  bool awaiting_report_ = false;
+  bool stopping_ = false;  // ramping to the safe voltage: ARM refused
+  int lcm_errors_ = 0;
 
   // Report bookkeeping.
   std::string safe_reason_ = "not armed";

@@ -78,6 +78,7 @@ BridgeSettings load_bridge_settings(const Config& config) {
   if (a.watchdog_s < 2.0 * s.dt_s()) {
     config.fail("actuator.watchdog_s", "must be at least two ticks (" + std::to_string(2.0 * s.dt_s()) + " s)");
   }
+  s.stop_ramp_timeout_s = a.longest_safe_ramp_s() + kStopRampMargin_s;
 
   FeedbackGains& g = s.servo;
   g.kp = config.get_non_negative("servo.kp", g.kp);
@@ -114,8 +115,10 @@ std::vector<std::string> describe(const BridgeSettings& s) {
       s.rate_hz, st.noise_rms_m, st.seed, st.drift_fraction, st.drift_duration_s, st.drift_start_s,
       s.auto_arm ? "auto-arm" : "arm via HX_CONTROL",
       s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
-  lines.push_back(fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s",
-                              a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_V_per_s, a.watchdog_s));
+  lines.push_back(fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s, "
+                              "stop: ramp to safe (at most {:.4g} s) within {} s",
+                              a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_rate_V_per_s(), a.watchdog_s,
+                              a.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
   if (s.backend == "sim") {
     lines.push_back(fmt::format("banning: a {} m/V, b {} m/V, alpha {} 1/V, s_max {} V, k {} 1/s^2, c {} 1/s", h.a, h.b,
                                 h.alpha, h.s_max, st.banning.stage.k, st.banning.stage.c));

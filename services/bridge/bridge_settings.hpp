@@ -32,12 +32,19 @@ struct BridgeSettings {
   RtSettings rt{};
   bool auto_arm = false;           // arm as soon as commands flow (first arm only)
   double rearm_after_trip_s = 0.0; // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
+  double stop_ramp_timeout_s = 0.75; // on every stop, the ramp to actuator.safe_u_V must end within this:
+                                     // the longest ramp + kStopRampMargin_s (set from the actuator's keys)
   double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
   double run_seconds = 0.0;        // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
   int command_queue_capacity = 256;  // LCM's queue for HX_COMMAND [blocks]
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
 };
+
+// How long a stop's ramp to actuator.safe_u_V may take beyond the longest one (from the end of
+// the range farthest from it at min(safe_ramp, slew)): the real-time thread's next wake-up and a
+// busy machine. 250 V at 1e3 V/s: 0.25 s + 0.5 s.
+inline constexpr double kStopRampMargin_s = 0.5;
 
 // Every key the bridge reads (for check_no_unknown_keys and the docs).
 const std::vector<std::string>& bridge_config_keys();

@@ -301,11 +301,10 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
       last_applied = seq;
       ++applied;
     }
-    if (safe) {
-      run_errors.clear();
-    } else if (std::isfinite(y_ref)) {
-      run_errors.push_back(y - y_ref);
-    }
+    // An armed run starts after a safe stretch (the start, a trip, a disarm) and ends with the
+    // next one: the stop's ramp to the safe voltage ends the last run, it does not erase it.
+    if (!safe && prev_safe) run_errors.clear();
+    if (!safe && std::isfinite(y_ref)) run_errors.push_back(y - y_ref);
     if (safe && !prev_safe && last_applied >= 0) {  // a trip (or a disarm) after commands were applied
       ++trips;
       const std::int64_t ticks = seq - last_applied;

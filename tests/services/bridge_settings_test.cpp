@@ -165,6 +165,37 @@ TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_EQ(s.command_queue_capacity, 16);
 }
 
+// Every stop ramps to actuator.safe_u_V first (issue 12, item 2); how long it may take follows
+// from the actuator's keys: the longest ramp (from the range's end farthest from safe_u_V, at
+// min(safe_ramp, slew)) plus kStopRampMargin_s.
+TEST(BridgeSettings, TheStopRampBoundFollowsTheActuator) {
+  const BridgeSettings d = load_bridge_settings(Config::load_file(kConfigDir + "bridge.yaml"));
+  EXPECT_DOUBLE_EQ(d.limits.longest_safe_ramp_s(), 0.25);  // 250 V at 1e3 V/s
+  EXPECT_DOUBLE_EQ(d.stop_ramp_timeout_s, 0.25 + kStopRampMargin_s);
+  const BridgeSettings slow = load_bridge_settings(
+      Config::from_string("actuator: {safe_u_V: -50, safe_ramp_V_per_s: 100}", "bridge.yaml"));
+  EXPECT_DOUBLE_EQ(slow.stop_ramp_timeout_s, 300.0 / 100.0 + kStopRampMargin_s);  // from +250 V
+  const BridgeSettings slew = load_bridge_settings(
+      Config::from_string("actuator: {safe_ramp_V_per_s: 1.0e6, slew_V_per_s: 1.0e4}", "bridge.yaml"));
+  EXPECT_DOUBLE_EQ(slew.stop_ramp_timeout_s, 250.0 / 1e4 + kStopRampMargin_s);  // never faster than the slew
+  bool said = false;
+  for (const std::string& line : describe(d)) said = said || contains(line, "stop: ramp to safe (at most 0.25 s) within 0.75 s");
+  EXPECT_TRUE(said);
+}
+
+// The safe-state hook: the simulators have no output stage to hold; it must be callable at any
+// time, more than once, without stepping.
+TEST(StageBackend, SimulatorsHoldSafeTrivially) {
+  BridgeSettings s;
+  for (const char* name : {"sim", "ro"}) {
+    auto backend = make_stage_backend(name, s.stage);
+    backend->hold_safe(0.0);
+    backend->step(10.0, 0.0, 1e-4);
+    backend->hold_safe(0.0);
+    backend->hold_safe(-5.0);
+  }
+}
+
 TEST(StageBackend, SimulatorsStepAndFlagThemselves) {
   BridgeSettings s;
   s.stage.noise_rms_m = 0.0;

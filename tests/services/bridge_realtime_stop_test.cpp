@@ -1,0 +1,155 @@
+// The bridge's stop on its real-time thread (issue 12, item 2): every stop ramps the actuator to
+// actuator.safe_u_V before the thread ends, also when nobody asked (the destructor while an
+// exception unwinds), refuses to arm again once begun, tells the backend to hold_safe() after the
+// ramp and at the end, and gives up after bridge's stop_ramp_timeout_s. Real threads, real time,
+// a fast ramp: a few tenths of a second in all.
+#include "bridge/bridge_realtime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <thread>
+#include <vector>
+
+namespace hystloop {
+namespace {
+
+constexpr double kDt = 1e-4;
+
+// What the backend saw. Written on the real-time thread (step, the first hold_safe) and the
+// test's thread (the later hold_safe calls, after the join); read after the join.
+struct Record {
+  std::vector<double> u_V;             // every step's voltage
+  std::atomic<double> last_u_V{0.0};
+  std::atomic<int> holds{0};
+  std::size_t steps_at_first_hold = 0;
+  double u_at_first_hold_V = std::nan("");
+  double hold_arg_V = std::nan("");
+};
+
+class RecordingBackend final : public StageBackend {
+ public:
+  explicit RecordingBackend(Record& r) : r_(r) { r_.u_V.reserve(1 << 20); }
+  StageReading step(double u_V, double, double) noexcept override {
+    if (r_.u_V.size() < r_.u_V.capacity()) r_.u_V.push_back(u_V);
+    r_.last_u_V.store(u_V);
+    return {0.0, 4};
+  }
+  const std::string& name() const noexcept override { return name_; }
+  bool simulated() const noexcept override { return true; }  // ticks run late, never skipped: no gaps
+  void hold_safe(double safe_u_V) noexcept override {
+    if (r_.holds.fetch_add(1) == 0) {
+      r_.steps_at_first_hold = r_.u_V.size();
+      r_.u_at_first_hold_V = r_.u_V.empty() ? std::nan("") : r_.u_V.back();
+    }
+    r_.hold_arg_V = safe_u_V;
+  }
+
+ private:
+  Record& r_;
+  std::string name_ = "recording";
+};
+
+BridgeSettings fast_ramp_settings() {
+  BridgeSettings s;
+  s.rt.ticks_per_wake = 20;
+  s.block_ticks = 20;
+  s.auto_arm = true;
+  s.limits.safe_u_V = 0.0;
+  s.limits.safe_ramp_V_per_s = 1e4;  // 1 V per tick: 200 V in 200 ticks (20 ms)
+  s.limits.watchdog_s = 1.0;         // the commands below last 0.8 s: no trip in these tests
+  s.stop_ramp_timeout_s = 2.0;
+  return s;
+}
+
+// Started, armed by the first command and driven to `u_V` (the slew limit: 5 V per tick).
+std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, Record& record, double u_V) {
+  auto rt = std::make_unique<BridgeRealtime>(s, std::make_unique<RecordingBackend>(record));
+  for (std::int64_t k = 0; k < 8000; ++k) EXPECT_TRUE(rt->push_command({k, u_V, std::nan(""), 1, 2}));
+  rt->start();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (record.last_u_V.load() != u_V && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(record.last_u_V.load(), u_V) << "the stage never got there";
+  return rt;
+}
+
+// Every step within the slew limit, those after the peak within the ramp; the last at safe.
+void expect_safe_ramp(const Record& r, const BridgeSettings& s, double peak_V) {
+  ASSERT_FALSE(r.u_V.empty());
+  bool past_peak = false;
+  for (std::size_t i = 1; i < r.u_V.size(); ++i) {
+    const double du = std::abs(r.u_V[i] - r.u_V[i - 1]);
+    ASSERT_LE(du, s.limits.slew_V_per_s * kDt * (1 + 1e-12)) << "tick " << i;
+    if (past_peak) {
+      ASSERT_LE(du, s.limits.safe_ramp_V_per_s * kDt * (1 + 1e-12)) << "tick " << i;
+    }
+    if (r.u_V[i - 1] == peak_V) past_peak = true;
+  }
+  EXPECT_TRUE(past_peak);
+  EXPECT_EQ(r.u_V.back(), s.limits.safe_u_V);
+  EXPECT_EQ(r.u_at_first_hold_V, s.limits.safe_u_V);  // hold_safe came after the ramp
+  EXPECT_EQ(r.hold_arg_V, s.limits.safe_u_V);
+}
+
+TEST(BridgeRealtimeStop, DestroyedWhileArmedRampsToSafeFirst) {  // an exception unwinding the service
+  const BridgeSettings s = fast_ramp_settings();
+  Record record;
+  auto rt = drive_to(s, record, 200.0);
+  rt.reset();
+  expect_safe_ramp(record, s, 200.0);
+  EXPECT_GE(record.holds.load(), 2);  // after the ramp (real-time thread) and at the end
+}
+
+TEST(BridgeRealtimeStop, StopRampsRefusesToArmAndReportsTheRamp) {
+  const BridgeSettings s = fast_ramp_settings();
+  Record record;
+  auto rt = drive_to(s, record, -200.0);
+  rt->begin_safe_stop();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!rt->safe_reached() && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(rt->safe_reached());
+  rt->request_arm(ArmRequest::kArm);  // a late ARM: refused, the commands keep coming
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const SafeStopResult r = rt->stop();
+  EXPECT_TRUE(r.requested);
+  EXPECT_TRUE(r.reached);
+  EXPECT_EQ(r.u_start_V, -200.0);
+  EXPECT_EQ(r.ramp_ticks, 200);
+  EXPECT_NEAR(r.ramp_s, 0.02, 1e-12);
+  EXPECT_GT(r.wall_s, 0.0);
+  EXPECT_LT(r.wall_s, s.stop_ramp_timeout_s);
+  expect_safe_ramp(record, s, -200.0);
+  // Nothing moved after the safe voltage was first applied.
+  for (std::size_t i = record.steps_at_first_hold; i < record.u_V.size(); ++i) ASSERT_EQ(record.u_V[i], 0.0) << i;
+  EXPECT_EQ(rt->stop().ramp_ticks, 200);  // idempotent
+}
+
+TEST(BridgeRealtimeStop, GivesUpAfterTheTimeoutAndStillHoldsSafe) {
+  BridgeSettings s = fast_ramp_settings();
+  s.limits.safe_ramp_V_per_s = 10.0;  // 20 s for 200 V
+  s.stop_ramp_timeout_s = 0.05;       // not a valid configuration (load_bridge_settings refuses it)
+  Record record;
+  auto rt = drive_to(s, record, 200.0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const SafeStopResult r = rt->stop();
+  const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(r.requested);
+  EXPECT_FALSE(r.reached);
+  EXPECT_GE(waited_s, 0.05);
+  EXPECT_LT(waited_s, 1.0);
+  EXPECT_GE(r.wall_s, 0.05);
+  EXPECT_GT(r.ramp_ticks, 0);
+  EXPECT_LT(record.u_V.back(), 200.0);  // it was ramping
+  EXPECT_EQ(record.holds.load(), 1);    // told to hold safe at the end anyway
+  EXPECT_EQ(record.hold_arg_V, 0.0);
+}
+
+}  // namespace
+}  // namespace hystloop
