@@ -8,22 +8,34 @@
 namespace hystloop {
 
 namespace {
-void copy_name(std::array<char, ChannelSlot::kMaxName + 1>& to, std::string_view name, const char* field) {
-  if (name.size() > ChannelSlot::kMaxName) {
-    throw ParameterError(field, "longer than " + std::to_string(ChannelSlot::kMaxName) + " characters");
-  }
-  std::memcpy(to.data(), name.data(), name.size());
-  to[name.size()] = '\0';
+void set_name(ChannelSlot& slot, const char* name, std::size_t length) noexcept {
+  std::memcpy(slot.name.data(), name, length);
+  slot.name[length] = '\0';
+  slot.name_length = length;
 }
 }  // namespace
 
-ChannelTable::ChannelTable(std::string_view sensor_channel, std::string_view command_channel,
-                           std::int64_t restart_threshold, std::int64_t command_resume_us)
-    : slots_(), command_detector_(restart_threshold, command_resume_us) {  // validates both
-  copy_name(sensor_, sensor_channel, "sensor_channel");
-  copy_name(command_, command_channel, "command_channel");
-  const SequenceGapDetector detector(restart_threshold);
+ChannelTable::ChannelTable(const ChannelNames& rig, std::int64_t restart_threshold, std::int64_t command_resume_us)
+    : slots_() {
+  const SequenceGapDetector detector(restart_threshold);  // validates both settings
+  const SequenceGapDetector command_detector(restart_threshold, command_resume_us);
   for (auto& slot : slots_) slot.sequence = detector;
+  static_assert(kRigChannels < kMaxChannels);
+  for (std::size_t i = 0; i < kRigChannels; ++i) {
+    const std::string name = rig.prefix + std::string(kChannelSpecs[i].suffix);
+    if (name.size() > ChannelSlot::kMaxName) {  // cannot happen: the prefix has <= 32 characters
+      throw ParameterError("rig.prefix", "makes channel names longer than " + std::to_string(ChannelSlot::kMaxName));
+    }
+    ChannelSlot& slot = slots_[i];
+    set_name(slot, name.c_str(), name.size());
+    slot.rig = true;
+    if (name == rig.sensor) slot.kind = SequenceKind::kSensor;
+    if (name == rig.command) {
+      slot.kind = SequenceKind::kCommand;
+      slot.sequence = command_detector;
+    }
+  }
+  size_.store(kRigChannels, std::memory_order_release);
 }
 
 std::optional<std::uint32_t> ChannelTable::find_or_add(const char* name) noexcept {
@@ -35,16 +47,10 @@ std::optional<std::uint32_t> ChannelTable::find_or_add(const char* name) noexcep
   }
   const std::size_t length = std::strlen(name);
   if (n == kMaxChannels || length > ChannelSlot::kMaxName) {
-    ++unrecorded_;
+    unknown_.count(name, length);
     return std::nullopt;
   }
-  ChannelSlot& slot = slots_[n];
-  std::memcpy(slot.name.data(), name, length + 1);
-  slot.name_length = length;
-  slot.kind = std::strcmp(name, sensor_.data()) == 0    ? SequenceKind::kSensor
-              : std::strcmp(name, command_.data()) == 0 ? SequenceKind::kCommand
-                                                        : SequenceKind::kNone;
-  if (slot.kind == SequenceKind::kCommand) slot.sequence = command_detector_;
+  set_name(slots_[n], name, length);
   size_.store(n + 1, std::memory_order_release);
   return last_hit_ = static_cast<std::uint32_t>(n);
 }

@@ -1,7 +1,10 @@
 #pragma once
-// The channels the logger has seen, each with its counters: a fixed table filled by the
-// receiving thread as new channel names appear (no allocation: names live in fixed
-// arrays), read by the disk thread (the name, by index) and by the status/summary code.
+// The channels the logger records, each with its counters: a fixed table (no allocation:
+// names live in fixed arrays). The rig's six channels (common/lcm/channels.hpp) hold the
+// first kRigChannels slots from the start, so no other traffic can take their place; other
+// channels the subscription lets through get the remaining slots as they appear, and once
+// those are gone their messages are counted in UnknownChannels (bounded), not recorded.
+// Read by the disk thread (the name, by index) and by the status/summary code.
 //
 // Threading: the receive-side fields belong to the receiving thread; a slot's name is
 // written before the first record that refers to it is pushed through the RecordRing,
@@ -15,7 +18,9 @@
 #include <optional>
 #include <string_view>
 
+#include "lcm/channels.hpp"
 #include "logger/sequence_gap_detector.hpp"
+#include "logger/unknown_channels.hpp"
 
 namespace hystloop {
 
@@ -28,6 +33,7 @@ struct ChannelSlot {
   std::array<char, kMaxName + 1> name{};
   std::size_t name_length = 0;
   SequenceKind kind = SequenceKind::kNone;
+  bool rig = false;  // one of the rig's six channels: reported one by one on HX_STATUS
 
   // Receiving thread.
   std::uint64_t received = 0;
@@ -51,15 +57,16 @@ struct ChannelSlot {
 class ChannelTable {
  public:
   static constexpr std::size_t kMaxChannels = 64;
+  static constexpr std::size_t kRigChannels = kChannelSpecs.size();  // slots 0..5, in kChannelSpecs' order
 
-  // Names whose blocks are checked for gaps (the rig's sensor and command channels), and
-  // the SequenceGapDetector settings: a command channel's forward jump after
+  // The rig's channels (its sensor and command blocks are checked for gaps), and the
+  // SequenceGapDetector settings: a command channel's forward jump after
   // `command_resume_us` of silence is a resume, not a gap (0 = always a gap).
-  ChannelTable(std::string_view sensor_channel, std::string_view command_channel,
-               std::int64_t restart_threshold = 10000, std::int64_t command_resume_us = 0);
+  explicit ChannelTable(const ChannelNames& rig, std::int64_t restart_threshold = 10000,
+                        std::int64_t command_resume_us = 0);
 
   // Receiving thread: the index of `name`, adding a slot for a new one; nullopt when the
-  // table is full or the name longer than ChannelSlot::kMaxName (the caller counts that).
+  // table is full or the name longer than ChannelSlot::kMaxName (then counted in unknown()).
   std::optional<std::uint32_t> find_or_add(const char* name) noexcept;
 
   std::size_t size() const noexcept { return size_.load(std::memory_order_acquire); }
@@ -67,16 +74,14 @@ class ChannelTable {
   const ChannelSlot& operator[](std::size_t i) const noexcept { return slots_[i]; }
 
   // Messages refused because the table was full or the name too long.
-  std::uint64_t unrecorded_channels() const noexcept { return unrecorded_; }
+  std::uint64_t unrecorded_channels() const noexcept { return unknown_.messages(); }
+  const UnknownChannels& unknown() const noexcept { return unknown_; }
 
  private:
   std::array<ChannelSlot, kMaxChannels> slots_;
   std::atomic<std::size_t> size_{0};
-  std::array<char, ChannelSlot::kMaxName + 1> sensor_{};
-  std::array<char, ChannelSlot::kMaxName + 1> command_{};
-  SequenceGapDetector command_detector_;  // copied into the command channel's slot
   std::uint32_t last_hit_ = 0;
-  std::uint64_t unrecorded_ = 0;
+  UnknownChannels unknown_;
 };
 
 }  // namespace hystloop

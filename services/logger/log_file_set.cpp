@@ -1,17 +1,16 @@
 #include "logger/log_file_set.hpp"
 
-#include <lcm/eventlog.h>
-#include <unistd.h>
-
-#include <cinttypes>
-#include <ctime>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <system_error>
 
 namespace hystloop {
 
 namespace {
-constexpr std::size_t kStdioBufferBytes = std::size_t{1} << 20;
+constexpr std::uint32_t kEventMagic = 0xEDA1DA01u;  // LCM's event log framing (lcm/eventlog.c)
 
 std::string recording_name(const std::string& file_prefix, std::time_t start_time) {
   std::tm local{};
@@ -26,11 +25,46 @@ std::filesystem::path numbered(const std::filesystem::path& base, std::size_t in
   std::snprintf(suffix, sizeof suffix, ".%03zu.lcmlog", index);
   return base.string() + suffix;
 }
+
+std::uint8_t* put_be(std::uint8_t* at, std::uint64_t value, int bytes) noexcept {
+  for (int i = bytes - 1; i >= 0; --i) *at++ = static_cast<std::uint8_t>(value >> (8 * i));
+  return at;
+}
+
+std::string error_text(int error) { return std::error_code(error, std::generic_category()).message(); }
+
+const char* op_name(DiskOp op) noexcept {
+  switch (op) {
+    case DiskOp::kCreate: return "create";
+    case DiskOp::kWrite: return "write";
+    case DiskOp::kTruncate: return "truncate";
+    case DiskOp::kFsync: return "fsync";
+    case DiskOp::kClose: return "close";
+    case DiskOp::kNone: break;
+  }
+  return "none";
+}
 }  // namespace
 
+std::string DiskFaults::reason() const {
+  if (last_op == DiskOp::kNone) return "no disk fault";
+  const std::string kind = last_errno == ENOSPC || last_errno == EDQUOT ? "disk full"
+                           : last_errno == 0                            ? "short write"
+                           : last_errno == EIO                          ? "I/O error"
+                                                                        : "disk error";
+  const std::string text = last_errno == 0 ? "the kernel took fewer bytes than given" : error_text(last_errno);
+  return kind + " (" + op_name(last_op) + ": " + text + ")";
+}
+
 LogFileSet::LogFileSet(std::filesystem::path dir, std::string file_prefix, RotationPolicy policy,
-                       std::time_t start_time, double now_s)
-    : policy_(policy), stdio_buffer_(new char[kStdioBufferBytes]) {
+                       std::time_t start_time, double now_s, Listener* listener, LogFileIo& io)
+    : io_(io),
+      listener_(listener),
+      policy_(policy),
+      buffer_(new std::uint8_t[kBufferBytes]),
+      buffered_(new Buffered[kMaxBufferedEvents]),
+      now_s_(now_s),
+      retry_at_s_(-std::numeric_limits<double>::infinity()) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create the log directory " + dir.string() + ": " + ec.message());
@@ -42,72 +76,215 @@ LogFileSet::LogFileSet(std::filesystem::path dir, std::string file_prefix, Rotat
     base_ = dir / (name + "-" + std::to_string(n));
   }
   files_.reserve(256);
-  if (!open_next(now_s)) throw std::runtime_error("cannot open the log file " + numbered(base_, 0).string());
+  if (!open_next(now_s)) {
+    throw std::runtime_error("cannot open the log file " + numbered(base_, 0).string() + ": " +
+                             error_text(last_errno_.load()));
+  }
 }
 
 LogFileSet::~LogFileSet() { close(); }
 
 bool LogFileSet::open_next(double now_s) noexcept {
-  last_open_attempt_s_ = now_s;
   try {
     const std::filesystem::path path = numbered(base_, files_.size());
-    log_ = lcm_eventlog_create(path.c_str(), "w");
-    if (log_ == nullptr) {
-      ++open_failures_;
+    const int fd = io_.create(path.c_str());
+    if (fd < 0) {
+      fault(DiskOp::kCreate, -fd);
       return false;
     }
-    // Large writes: the disk sees a few big writes per second instead of one per message.
-    std::setvbuf(log_->f, stdio_buffer_.get(), _IOFBF, kStdioBufferBytes);
-    const std::lock_guard lock(names_mutex_);
-    files_.push_back(LogFileInfo{path, 0, 0});
+    try {
+      const std::lock_guard lock(names_mutex_);
+      files_.push_back(LogFileInfo{path, 0, 0});
+    } catch (...) {
+      io_.close(fd);
+      io_.remove(path.c_str());
+      throw;
+    }
+    fd_ = fd;
   } catch (...) {  // path building or the (rare) vector growth failed
-    if (log_ != nullptr) lcm_eventlog_destroy(log_);
-    log_ = nullptr;
-    ++open_failures_;
+    fault(DiskOp::kCreate, ENOMEM);
     return false;
   }
   opened_s_ = now_s;
+  file_events_taken_ = 0;
+  file_bytes_taken_ = 0;
   return true;
 }
 
-void LogFileSet::close_current() noexcept {
-  if (log_ == nullptr) return;
-  std::fflush(log_->f);
-  ::fsync(fileno(log_->f));
-  lcm_eventlog_destroy(log_);  // fclose: the stdio buffer is free again after this
-  log_ = nullptr;
+void LogFileSet::fault(DiskOp op, int error) noexcept {
+  errors_.fetch_add(1, std::memory_order_relaxed);
+  last_errno_.store(error, std::memory_order_relaxed);
+  last_op_.store(op, std::memory_order_relaxed);
+  writing_.store(false, std::memory_order_release);
+  retry_at_s_ = now_s_ + kRetryInterval_s;
 }
 
-bool LogFileSet::write(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
-                       std::int64_t utime, double now_s) noexcept {
-  if (closed_) return false;
-  const std::uint64_t bytes = event_bytes(channel_length, size);
-  if (log_ != nullptr && files_.back().events > 0) {
-    const bool too_big = policy_.max_file_bytes > 0 && files_.back().bytes + bytes > policy_.max_file_bytes;
-    const bool too_old = policy_.max_file_s > 0 && now_s - opened_s_ >= policy_.max_file_s;
-    if (too_big || too_old) {
-      close_current();
-      if (!open_next(now_s)) return false;
-    }
-  }
-  // After a failed open, retry at most once a second (each refused event is counted).
-  if (log_ == nullptr && (now_s - last_open_attempt_s_ < 1.0 || !open_next(now_s))) return false;
-
-  lcm_eventlog_event_t event{};
-  event.timestamp = utime;
-  event.channellen = static_cast<std::int32_t>(channel_length);
-  event.datalen = static_cast<std::int32_t>(size);
-  event.channel = const_cast<char*>(channel);  // LCM's struct is not const-correct; it only reads
-  event.data = const_cast<void*>(data);
-  if (lcm_eventlog_write_event(log_, &event) != 0) return false;
+void LogFileSet::commit(std::uint32_t tag, std::uint64_t bytes, std::size_t payload_bytes) noexcept {
   LogFileInfo& file = files_.back();
   ++file.events;
   file.bytes += bytes;
+  if (!writing_.load(std::memory_order_relaxed)) {
+    writing_.store(true, std::memory_order_release);
+    recoveries_.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (listener_ != nullptr) listener_->written(tag, payload_bytes);
+}
+
+void LogFileSet::lose(std::uint32_t tag) noexcept {
+  events_lost_.fetch_add(1, std::memory_order_relaxed);
+  if (listener_ != nullptr) listener_->lost(tag);
+}
+
+std::size_t LogFileSet::write_all(const void* data, std::size_t size, int& error) noexcept {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  std::size_t done = 0;
+  error = 0;
+  while (done < size) {
+    const ssize_t rc = io_.write(fd_, bytes + done, size - done);
+    if (rc < 0) {
+      error = static_cast<int>(-rc);
+      break;
+    }
+    if (rc == 0) break;  // a short write without an error: counted as one
+    done += static_cast<std::size_t>(rc) < size - done ? static_cast<std::size_t>(rc) : size - done;
+  }
+  return done;
+}
+
+// After a failed write: the file must end at its last complete event, so every reader
+// reads it to the end; then it is closed (and removed if that leaves it empty).
+void LogFileSet::cut_back() noexcept {
+  const int rc = io_.truncate(fd_, files_.back().bytes);
+  if (rc < 0) {
+    fault(DiskOp::kTruncate, -rc);
+  } else {
+    files_truncated_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void LogFileSet::close_current() noexcept {
+  if (fd_ < 0) return;
+  if (!flush_buffer()) return;  // the fault closed it
+  LogFileInfo& file = files_.back();
+  bool confirmed = true;
+  if (file.events > 0) {
+    if (const int rc = io_.fsync(fd_); rc < 0) {
+      fault(DiskOp::kFsync, -rc);
+      confirmed = false;
+    }
+  }
+  if (const int rc = io_.close(fd_); rc < 0) {
+    fault(DiskOp::kClose, -rc);
+    confirmed = false;
+  }
+  fd_ = -1;
+  if (!confirmed) unconfirmed_events_.fetch_add(file.events, std::memory_order_relaxed);
+  if (file.events == 0) {
+    io_.remove(file.path.c_str());
+    const std::lock_guard lock(names_mutex_);
+    files_.pop_back();
+    files_removed_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+bool LogFileSet::flush_buffer() noexcept {
+  if (buffer_used_ == 0) return true;
+  int error = 0;
+  const std::size_t done = write_all(buffer_.get(), buffer_used_, error);
+  std::size_t start = 0;
+  std::size_t complete = 0;  // bytes of the events the kernel took whole
+  for (std::size_t i = 0; i < buffered_count_; ++i) {
+    const Buffered& event = buffered_[i];
+    if (event.end <= done) {
+      commit(event.tag, event.end - start, event.payload_bytes);
+      complete = event.end;
+    } else {
+      lose(event.tag);
+    }
+    start = event.end;
+  }
+  const bool ok = done == buffer_used_;
+  buffer_used_ = 0;
+  buffered_count_ = 0;
+  if (!ok) {
+    fault(DiskOp::kWrite, error);
+    if (done > complete) cut_back();
+    close_current();  // buffer empty now: fsync, close, remove if empty
+  }
+  return ok;
+}
+
+void LogFileSet::frame(std::uint8_t* at, std::size_t channel_length, std::size_t size, std::int64_t utime) noexcept {
+  at = put_be(at, kEventMagic, 4);
+  at = put_be(at, file_events_taken_, 8);
+  at = put_be(at, static_cast<std::uint64_t>(utime), 8);
+  at = put_be(at, channel_length, 4);
+  put_be(at, size, 4);
+}
+
+bool LogFileSet::write_direct(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
+                              std::int64_t utime, std::uint32_t tag) noexcept {
+  std::uint8_t header[kEventHeaderBytes];
+  frame(header, channel_length, size, utime);
+  int error = 0;
+  std::size_t done = write_all(header, sizeof header, error);
+  if (done == sizeof header) done += write_all(channel, channel_length, error);
+  if (done == sizeof header + channel_length) done += write_all(data, size, error);
+  if (done == event_bytes(channel_length, size)) {
+    ++file_events_taken_;
+    file_bytes_taken_ += done;
+    commit(tag, done, size);
+    return true;
+  }
+  lose(tag);
+  fault(DiskOp::kWrite, error);
+  if (done > 0) cut_back();
+  close_current();
+  return false;
+}
+
+bool LogFileSet::write(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
+                       std::int64_t utime, double now_s, std::uint32_t tag) noexcept {
+  if (closed_ || channel_length > static_cast<std::size_t>(INT32_MAX) || size > static_cast<std::size_t>(INT32_MAX)) {
+    lose(tag);
+    return false;
+  }
+  now_s_ = now_s;
+  const std::uint64_t bytes = event_bytes(channel_length, size);
+  if (fd_ >= 0 && file_events_taken_ > 0) {
+    const bool too_big = policy_.max_file_bytes > 0 && file_bytes_taken_ + bytes > policy_.max_file_bytes;
+    const bool too_old = policy_.max_file_s > 0 && now_s - opened_s_ >= policy_.max_file_s;
+    if (too_big || too_old) close_current();
+  }
+  // After a fault, nothing for kRetryInterval_s (each refused event is counted), then a new file.
+  if (fd_ < 0 && (now_s < retry_at_s_ || !open_next(now_s))) {
+    lose(tag);
+    return false;
+  }
+  if (bytes > kBufferBytes) {
+    if (!flush_buffer()) {
+      lose(tag);
+      return false;
+    }
+    return write_direct(channel, channel_length, data, size, utime, tag);
+  }
+  if ((buffer_used_ + bytes > kBufferBytes || buffered_count_ == kMaxBufferedEvents) && !flush_buffer()) {
+    lose(tag);
+    return false;
+  }
+  std::uint8_t* at = buffer_.get() + buffer_used_;
+  frame(at, channel_length, size, utime);
+  std::memcpy(at + kEventHeaderBytes, channel, channel_length);
+  if (size > 0) std::memcpy(at + kEventHeaderBytes + channel_length, data, size);
+  buffer_used_ += bytes;
+  buffered_[buffered_count_++] = Buffered{static_cast<std::uint32_t>(buffer_used_), tag, static_cast<std::uint32_t>(size)};
+  ++file_events_taken_;
+  file_bytes_taken_ += bytes;
   return true;
 }
 
 void LogFileSet::flush() noexcept {
-  if (log_ != nullptr) std::fflush(log_->f);
+  if (fd_ >= 0) flush_buffer();
 }
 
 void LogFileSet::close() noexcept {
@@ -123,6 +300,20 @@ std::filesystem::path LogFileSet::current_file() const {
 std::size_t LogFileSet::file_count() const {
   const std::lock_guard lock(names_mutex_);
   return files_.size();
+}
+
+DiskFaults LogFileSet::faults() const noexcept {
+  DiskFaults f;
+  f.errors = errors_.load(std::memory_order_relaxed);
+  f.events_lost = events_lost_.load(std::memory_order_relaxed);
+  f.files_truncated = files_truncated_.load(std::memory_order_relaxed);
+  f.files_removed = files_removed_.load(std::memory_order_relaxed);
+  f.unconfirmed_events = unconfirmed_events_.load(std::memory_order_relaxed);
+  f.recoveries = recoveries_.load(std::memory_order_relaxed);
+  f.last_errno = last_errno_.load(std::memory_order_relaxed);
+  f.last_op = last_op_.load(std::memory_order_relaxed);
+  f.writing = writing_.load(std::memory_order_acquire);
+  return f;
 }
 
 }  // namespace hystloop

@@ -15,7 +15,18 @@ double monotonic_s() noexcept {
 }
 }  // namespace
 
-LogWriter::LogWriter(RecordRing& ring, ChannelTable& channels, LogFileSet& files, double flush_interval_s)
+void ChannelWriteCounter::written(std::uint32_t tag, std::size_t payload_bytes) noexcept {
+  ChannelSlot& slot = channels_[tag];
+  slot.written.fetch_add(1, std::memory_order_relaxed);
+  slot.bytes_written.fetch_add(payload_bytes, std::memory_order_relaxed);
+  written_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void ChannelWriteCounter::lost(std::uint32_t tag) noexcept {
+  channels_[tag].write_failed.fetch_add(1, std::memory_order_relaxed);
+}
+
+LogWriter::LogWriter(RecordRing& ring, const ChannelTable& channels, LogFileSet& files, double flush_interval_s)
     : ring_(ring), channels_(channels), files_(files), flush_interval_s_(flush_interval_s) {
   require_positive("flush_interval_s", flush_interval_s);
 }
@@ -35,14 +46,8 @@ void LogWriter::stop() {
 }
 
 void LogWriter::write_record(const RecordRing::Record& record, double now_s) noexcept {
-  ChannelSlot& slot = channels_[record.channel];
-  if (files_.write(slot.name.data(), slot.name_length, record.data, record.size, record.recv_utime, now_s)) {
-    slot.written.fetch_add(1, std::memory_order_relaxed);
-    slot.bytes_written.fetch_add(record.size, std::memory_order_relaxed);
-    written_.fetch_add(1, std::memory_order_relaxed);
-  } else {
-    slot.write_failed.fetch_add(1, std::memory_order_relaxed);
-  }
+  const ChannelSlot& slot = channels_[record.channel];
+  files_.write(slot.name.data(), slot.name_length, record.data, record.size, record.recv_utime, now_s, record.channel);
 }
 
 void LogWriter::run() noexcept {

@@ -1,5 +1,7 @@
 #include "logger/logger_options.hpp"
 
+#include <glib.h>
+
 #include <array>
 #include <vector>
 
@@ -18,6 +20,21 @@ std::string yaml_single_quoted(const std::string& text) {
   std::string out = "'";
   for (const char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
   return out + "'";
+}
+
+// The check LCM's lcm_subscribe makes on a channel regex (GLib's GRegex on "^REGEX$"): the
+// reason it refuses one, or "" if it accepts it. Done here so a bad --channels is refused
+// with the other options (exit 2), and because LCM 1.3.1 leaks a string when it refuses one.
+std::string lcm_regex_error(const std::string& regex) {
+  const std::string anchored = "^" + regex + "$";
+  GError* error = nullptr;
+  GRegex* compiled = g_regex_new(anchored.c_str(), static_cast<GRegexCompileFlags>(0),
+                                 static_cast<GRegexMatchFlags>(0), &error);
+  if (compiled != nullptr) g_regex_unref(compiled);
+  if (error == nullptr) return {};
+  std::string reason = error->message;
+  g_error_free(error);
+  return reason;
 }
 
 constexpr std::array<FlagSpec, 11> kFlags{{
@@ -71,7 +88,14 @@ LoggerOptions read_logger_options(const Config& config) {
   o.max_file_mb = config.get_in_range("logger.max_file_mb", o.max_file_mb, 0.0, 1e9);
   o.max_file_s = config.get_in_range("logger.max_file_s", o.max_file_s, 0.0, 1e9);
   o.summary_file = config.get<std::string>("logger.summary", "");
+  // Refused now rather than found out at shutdown, after the whole recording.
+  if (!o.summary_file.empty() && (std::filesystem::is_directory(o.summary_file) || o.summary_file.filename().empty())) {
+    config.fail("logger.summary", "'" + o.summary_file.string() + "' is a directory; give the summary file's path");
+  }
   o.channels = config.get<std::string>("logger.channels", "");
+  if (const std::string reason = lcm_regex_error(o.channels); !reason.empty()) {
+    config.fail("logger.channels", "not a regular expression LCM accepts: " + reason);
+  }
   o.queue_mb = config.get_in_range("logger.queue_mb", o.queue_mb, 0.01, 2000.0);
   o.lcm_queue = config.get_int_in_range("logger.lcm_queue", o.lcm_queue, 1, 10000000);
   o.flush_interval_s = config.get_in_range("logger.flush_interval_s", o.flush_interval_s, 0.001, 60.0);

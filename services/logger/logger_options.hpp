@@ -6,7 +6,8 @@
 //   --file-prefix TEXT        logger.file_prefix        prepended to every file name (default none)
 //   --max-file-mb MB          logger.max_file_mb        rotate before a file passes this size, 10^6 bytes (0 = never; default 1024)
 //   --max-file-s S            logger.max_file_s         rotate a file this old [s] (0 = never; default 0)
-//   --summary FILE            logger.summary            summary JSON (default <dir>/<recording>.summary.json)
+//   --summary FILE            logger.summary            summary JSON (default <dir>/<recording>.summary.json;
+//                                                       a directory is refused at start)
 //   --channels REGEX          logger.channels           channels recorded (default the rig's: "<rig>.*")
 //   --queue-mb MB             logger.queue_mb           receive->disk buffer, 10^6 bytes (default 64)
 //   --lcm-queue N             logger.lcm_queue          messages LCM holds before dispatch (default 20000)

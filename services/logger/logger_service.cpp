@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/errors.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_storage.hpp"
@@ -46,6 +47,7 @@ bool decode_block(Block& block, const void* data, std::size_t size) noexcept {
 }
 
 std::string append(std::string detail, const std::string& what) {
+  if (what.empty()) return detail;
   return detail.empty() ? what : detail + "; " + what;
 }
 }  // namespace
@@ -57,25 +59,37 @@ LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const Log
       start_utime_(wall_utime()),
       start_s_(monotonic_s()),
       reporter_(lcm, names.status, kProcessName) {
-  channels_ = std::make_unique<ChannelTable>(names.sensor, names.command, options.restart_threshold,
-                                             static_cast<std::int64_t>(options.command_resume_s * 1e6));
-  reserve_storage(sensor_block_);
-  reserve_storage(command_block_);
-  ring_ = std::make_unique<RecordRing>(static_cast<std::size_t>(options.queue_mb * 1e6));
-  const RotationPolicy policy{static_cast<std::uint64_t>(options.max_file_mb * 1e6), options.max_file_s};
-  files_ = std::make_unique<LogFileSet>(options.out_dir, options.file_prefix, policy, std::time(nullptr), start_s_);
-  writer_ = std::make_unique<LogWriter>(*ring_, *channels_, *files_, options.flush_interval_s);
-  writer_->start();
-
+  // First, before anything is created on disk: LCM refuses a regular expression it cannot
+  // compile (no message is dispatched before run()).
   raw_ = lcm_subscribe(lcm_.getUnderlyingLCM(), channels_regex_.c_str(), &LoggerService::on_raw, this);
-  if (raw_ == nullptr) throw std::runtime_error("LCM could not subscribe to " + channels_regex_);
-  // LCM's default of 30 queued messages is 1.5 ms at 2 x 10 kHz.
-  lcm_subscription_set_queue_capacity(raw_, static_cast<int>(options.lcm_queue));
+  if (raw_ == nullptr) {
+    throw ParameterError("logger.channels", "LCM refuses '" + escaped_for_log(channels_regex_) +
+                                                "' (not a regular expression it can compile)");
+  }
+  try {
+    // LCM's default of 30 queued messages is 1.5 ms at 2 x 10 kHz.
+    lcm_subscription_set_queue_capacity(raw_, static_cast<int>(options.lcm_queue));
+    channels_ = std::make_unique<ChannelTable>(names, options.restart_threshold,
+                                               static_cast<std::int64_t>(options.command_resume_s * 1e6));
+    write_counter_ = std::make_unique<ChannelWriteCounter>(*channels_);
+    reserve_storage(sensor_block_);
+    reserve_storage(command_block_);
+    ring_ = std::make_unique<RecordRing>(static_cast<std::size_t>(options.queue_mb * 1e6));
+    const RotationPolicy policy{static_cast<std::uint64_t>(options.max_file_mb * 1e6), options.max_file_s};
+    files_ = std::make_unique<LogFileSet>(options.out_dir, options.file_prefix, policy, std::time(nullptr), start_s_,
+                                          write_counter_.get());
+    writer_ = std::make_unique<LogWriter>(*ring_, *channels_, *files_, options.flush_interval_s);
+    writer_->start();
 
-  Subscription<control_t>::Options control_options;
-  control_options.queue_capacity = 64;
-  control_ = std::make_unique<Subscription<control_t>>(
-      lcm_, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }, control_options);
+    Subscription<control_t>::Options control_options;
+    control_options.queue_capacity = 64;
+    control_ = std::make_unique<Subscription<control_t>>(
+        lcm_, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }, control_options);
+  } catch (...) {
+    unsubscribe();
+    if (writer_) writer_->stop();
+    throw;
+  }
 }
 
 LoggerService::~LoggerService() {
@@ -128,15 +142,91 @@ void LoggerService::on_control(const control_t& msg) {
     shutdown_requested_ = true;
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
-    spdlog::info("RESET_COUNTERS ignored: the logger's counters describe the whole recording (see the summary)");
+    // Anyone can send these: at most one line every 10 s, saying how many were not logged.
+    const double now_s = monotonic_s();
+    if (now_s - reset_logged_s_ < 10.0) {
+      ++reset_log_suppressed_;
+      return;
+    }
+    spdlog::info("RESET_COUNTERS ignored: the logger's counters describe the whole recording (see the summary){}",
+                 reset_log_suppressed_ > 0 ? " [" + std::to_string(reset_log_suppressed_) + " more not logged]" : "");
+    reset_logged_s_ = now_s;
+    reset_log_suppressed_ = 0;
   }
 }
 
-void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
+void LoggerService::on_tick(std::int64_t utime) {
+  // A disk fault (or the recovery from one) is reported at once, the rest once a second.
+  const DiskFaults f = files_->faults();
+  const bool disk_news = f.errors != seen_faults_.errors || f.writing != seen_faults_.writing;
+  if (disk_news || utime - last_report_utime_ >= 1000000) report(utime);
+}
+
+std::string LoggerService::fault_detail(const DiskFaults& f) {
   std::string detail;
+  const std::string file = escaped_for_log(files_->current_file().filename().string());
+  if (!f.writing || f.errors > seen_faults_.errors) {
+    detail = "FAULT: " + f.reason() + "; " + std::to_string(f.events_lost) + " events not written so far";
+    if (!f.writing) detail += ", retrying in a new file every " + fmt::format("{}", LogFileSet::kRetryInterval_s) + " s";
+  } else if (!seen_faults_.writing) {
+    detail = "recovered from the disk fault: writing again to " + file + " after " + std::to_string(f.events_lost) +
+             " events not written";
+  }
+  if (!seen_faults_.writing && f.writing && f.recoveries > seen_faults_.recoveries) {
+    spdlog::warn("disk: writing again to {} ({} events not written during the fault)", file, f.events_lost);
+  } else if (seen_faults_.writing && !f.writing) {
+    // Once per fault: the retries that follow are counted, not logged.
+    spdlog::error("disk fault: {}; events are counted as dropped until a new file can be written (retried every {} s)",
+                  f.reason(), LogFileSet::kRetryInterval_s);
+  } else if (f.errors > seen_faults_.errors && f.writing) {
+    spdlog::error("disk fault: {} (writing continues)", f.reason());
+  }
+  seen_faults_ = f;
+  return detail;
+}
+
+std::string LoggerService::unknown_channels_detail() {
+  const UnknownChannels& u = channels_->unknown();
+  if (u.messages() <= seen_unrecorded_) return {};
+  std::string names;
+  for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escaped_for_log(u.kept_name(i)) + "'";
+  const std::string distinct = (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct());
+  std::string detail = "not recorded: " + std::to_string(u.messages() - seen_unrecorded_) + " message(s) on " +
+                       distinct + " channel(s) beyond the table's " + std::to_string(ChannelTable::kMaxChannels) +
+                       " (first: " + names + ")";
+  const double now_s = monotonic_s();
+  if (u.distinct() > seen_unknown_names_ && now_s - unknown_logged_s_ >= 10.0) {
+    spdlog::warn("{}{}", detail,
+                 unknown_log_suppressed_ > 0 ? " [" + std::to_string(unknown_log_suppressed_) + " similar warnings suppressed]"
+                                             : std::string());
+    unknown_logged_s_ = now_s;
+    unknown_log_suppressed_ = 0;
+  } else if (u.distinct() > seen_unknown_names_) {
+    ++unknown_log_suppressed_;
+  }
+  seen_unrecorded_ = u.messages();
+  seen_unknown_names_ = u.distinct();
+  return detail;
+}
+
+void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
+  last_report_utime_ = utime;
+  const DiskFaults faults = files_->faults();
+  std::string detail = fault_detail(faults);
   std::uint64_t bytes_written = 0;
+  std::uint64_t dropped = 0;
+  std::uint64_t other_channels = 0, other_received = 0, other_written = 0, other_dropped = 0;
   for (std::size_t i = 0; i < channels_->size(); ++i) {
     const ChannelSlot& c = (*channels_)[i];
+    bytes_written += c.bytes_written.load(std::memory_order_relaxed);
+    dropped += c.dropped();
+    if (!c.rig) {  // names off the wire: summed, never put in the detail one by one
+      ++other_channels;
+      other_received += c.received;
+      other_written += c.written.load(std::memory_order_relaxed);
+      other_dropped += c.dropped();
+      continue;
+    }
     const SequenceGapDetector& q = c.sequence;
     const Seen now{c.dropped(), q.gap_events(), q.missing(), q.overlaps() + q.duplicates(), q.resumes(), q.skipped()};
     Seen& before = seen_[i];
@@ -154,20 +244,21 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
                                   std::to_string(now.skipped - before.skipped) + " ticks skipped" + on);
     }
     before = now;
-    bytes_written += c.bytes_written.load(std::memory_order_relaxed);
   }
+  if (other_dropped > seen_other_dropped_) {
+    detail = append(detail, "dropped " + std::to_string(other_dropped - seen_other_dropped_) + " on other channels");
+  }
+  seen_other_dropped_ = other_dropped;
   const std::uint64_t unrecorded = channels_->unrecorded_channels();
-  if (unrecorded > seen_unrecorded_) {
-    detail = append(detail, "dropped " + std::to_string(unrecorded - seen_unrecorded_) + " of channels beyond the table's " +
-                                std::to_string(ChannelTable::kMaxChannels));
-  }
-  seen_unrecorded_ = unrecorded;
+  detail = append(detail, unknown_channels_detail());
 
   std::int8_t state = detail.empty() ? service_status_t::HEALTHY : service_status_t::DEGRADED;
   if (state_override >= 0) state = state_override;
-  if (state == service_status_t::DEGRADED) detail += " (file " + files_->current_file().filename().string() + ")";
+  if (state == service_status_t::DEGRADED) {
+    detail += " (file " + escaped_for_log(files_->current_file().filename().string()) + ")";
+  }
   reporter_.begin(state, detail);
-  for (std::size_t i = 0; i < channels_->size(); ++i) {
+  for (std::size_t i = 0; i < ChannelTable::kRigChannels; ++i) {
     const ChannelSlot& c = (*channels_)[i];
     const std::string name(c.name_view());
     reporter_.counter(name + ".received", c.received);
@@ -188,12 +279,23 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
       }
     }
   }
+  reporter_.counter("other_channels", other_channels);
+  reporter_.counter("other.received", other_received);
+  reporter_.counter("other.written", other_written);
+  reporter_.counter("other.dropped", other_dropped);
   reporter_.counter("files", files_->file_count());
   reporter_.counter("bytes_written", bytes_written);
-  reporter_.counter("events_written", writer_->events_written());
+  reporter_.counter("events_written", write_counter_->events_written());
+  reporter_.counter("dropped", dropped + unrecorded);
+  reporter_.counter("disk_errors", faults.errors);
+  reporter_.counter("disk_events_lost", faults.events_lost);
+  reporter_.counter("disk_files_truncated", faults.files_truncated);
+  reporter_.counter("disk_files_removed", faults.files_removed);
+  reporter_.counter("disk_unconfirmed_events", faults.unconfirmed_events);
   reporter_.counter("queue_used_bytes", ring_->used_bytes());
   reporter_.counter("queue_high_water_bytes", writer_->queue_high_water_bytes());
   reporter_.counter("unrecorded_channel", unrecorded);
+  reporter_.counter("unknown_channel_names", channels_->unknown().distinct());
   reporter_.endpoint("control", control_->counters());
   reporter_.loop_timing(handling_);
   handling_.reset();
@@ -208,7 +310,9 @@ void LoggerService::unsubscribe() noexcept {
 int LoggerService::run() {
   spdlog::info("recording '{}' to {}.NNN.lcmlog", channels_regex_, files_->base_path().string());
   report(wall_utime());  // at once: tells a waiting publisher the logger is listening
-  const int lcm_errors = run_io_loop(lcm_, IoLoopOptions{}, [this](std::int64_t utime) { report(utime); });
+  IoLoopOptions loop;
+  loop.period = std::chrono::milliseconds(100);  // on_tick reports a disk fault within 0.1 s
+  const int lcm_errors = run_io_loop(lcm_, loop, [this](std::int64_t utime) { on_tick(utime); });
   if (lcm_errors > 0) spdlog::warn("LCM reported {} errors while receiving", lcm_errors);
 
   const RecordingSummary summary = finish();
@@ -223,6 +327,13 @@ int LoggerService::run() {
     spdlog::info("summary written to {}", path.string());
   } catch (const std::exception& e) {
     spdlog::error("summary not written: {}", e.what());
+    rc = 1;
+  }
+  if (summary.disk.errors > 0) {
+    spdlog::error("disk faults during the recording: {} failed call(s), last {}; {} events not written, {} unconfirmed "
+                  "(fsync/close failed), {} file(s) cut back to their last complete event, {} empty file(s) removed",
+                  summary.disk.errors, summary.disk.reason(), summary.disk.events_lost, summary.disk.unconfirmed_events,
+                  summary.disk.files_truncated, summary.disk.files_removed);
     rc = 1;
   }
   report(wall_utime(), service_status_t::STOPPING);
@@ -250,6 +361,7 @@ RecordingSummary LoggerService::finish() {
                   : signal != 0        ? "signal " + std::to_string(signal)
                                        : "stop request";
   s.files = files_->files();
+  s.disk = files_->faults();
   s.unrecorded_channel = channels_->unrecorded_channels();
   s.queue_capacity_bytes = ring_->capacity_bytes();
   s.queue_high_water_bytes = writer_->queue_high_water_bytes();

@@ -7,12 +7,18 @@
 // ring: no allocation, no lock, no log, no disk. A full ring drops the message and counts
 // it per channel.
 //
-// HX_STATUS (process "logger") once a second: per channel received/written/dropped, and
-// for the two block channels gaps/missing (ticks)/overlaps/duplicates/out_of_order/restarts
-// (+ resumes/skipped for HX_COMMAND, see SequenceGapDetector), files, bytes; DEGRADED with
-// a detail when something was dropped, a gap, overlap or resume seen in the last period. On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive
-// what LCM already holds, stop receiving, write the queue out, close the file, write the
-// summary (logger_summary.hpp).
+// HX_STATUS (process "logger") once a second, and at once when the disk fails or recovers:
+// per rig channel received/written/dropped, and for the two block channels gaps/missing
+// (ticks)/overlaps/duplicates/out_of_order/restarts (+ resumes/skipped for HX_COMMAND, see
+// SequenceGapDetector); other recorded channels summed under "other.*"; channels without a
+// slot as unrecorded_channel (messages) and unknown_channel_names; files, bytes, dropped and
+// the disk faults (disk_errors, disk_events_lost, ...; see LogFileSet). DEGRADED with a
+// detail when something was dropped, a gap, overlap or resume seen in the last period. A
+// disk fault is DEGRADED with a detail starting "FAULT: " and the reason ("FAULT: disk full
+// (write: No space left on device); ...") for as long as nothing can be written
+// (service_status_t has no FAULT state; DEGRADED + this prefix needs no type change).
+// On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive what LCM already holds,
+// stop receiving, write the queue out, close the file, write the summary (logger_summary.hpp).
 
 #include <array>
 #include <cstdint>
@@ -42,14 +48,16 @@ class LoggerService {
  public:
   static constexpr const char* kProcessName = "logger";
 
-  // Opens the first log file and subscribes. Throws ParameterError / std::runtime_error.
+  // Subscribes and opens the first log file. Throws ParameterError (logger.channels not a
+  // regular expression LCM accepts) / std::runtime_error.
   LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options);
   ~LoggerService();
   LoggerService(const LoggerService&) = delete;
   LoggerService& operator=(const LoggerService&) = delete;
 
   // Records until a stop is requested, then closes and writes the summary.
-  // Returns 0, or 1 if the summary could not be written.
+  // Returns 0, or 1 if a disk fault lost events (or left some unconfirmed) or the summary
+  // could not be written.
   int run();
 
   const ChannelTable& channels() const noexcept { return *channels_; }
@@ -59,7 +67,10 @@ class LoggerService {
   void receive(const char* channel, const void* data, std::size_t size, std::int64_t recv_utime) noexcept;
   void check_sequence(ChannelSlot& slot, const void* data, std::size_t size, std::int64_t recv_utime) noexcept;
   void on_control(const control_t& msg);
+  void on_tick(std::int64_t utime);
   void report(std::int64_t utime, std::int8_t state_override = -1);
+  std::string fault_detail(const DiskFaults& faults);
+  std::string unknown_channels_detail();
   void unsubscribe() noexcept;
   RecordingSummary finish();
 
@@ -70,6 +81,7 @@ class LoggerService {
   double start_s_;
 
   std::unique_ptr<ChannelTable> channels_;
+  std::unique_ptr<ChannelWriteCounter> write_counter_;
   std::unique_ptr<RecordRing> ring_;
   std::unique_ptr<LogFileSet> files_;
   std::unique_ptr<LogWriter> writer_;
@@ -93,7 +105,15 @@ class LoggerService {
     std::uint64_t skipped = 0;
   };
   std::array<Seen, ChannelTable::kMaxChannels> seen_{};
+  std::uint64_t seen_other_dropped_ = 0;
   std::uint64_t seen_unrecorded_ = 0;
+  std::uint64_t seen_unknown_names_ = 0;
+  DiskFaults seen_faults_{};
+  std::int64_t last_report_utime_ = 0;
+  double unknown_logged_s_ = -1e300;  // unknown channels are logged at most every 10 s
+  std::uint64_t unknown_log_suppressed_ = 0;
+  double reset_logged_s_ = -1e300;  // so are ignored RESET_COUNTERS
+  std::uint64_t reset_log_suppressed_ = 0;
 };
 
 }  // namespace hystloop

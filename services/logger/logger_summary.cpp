@@ -18,7 +18,7 @@ std::string json_string(std::string_view text) {
       case '\n': out += "\\n"; break;
       case '\t': out += "\\t"; break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) {  // keep the JSON valid UTF-8
           char escaped[8];
           std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
           out += escaped;
@@ -73,6 +73,16 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
     << "},\n";
   j << "  \"dropped\": {\"queue_full\": " << t.queue_full << ", \"oversize\": " << t.oversize
     << ", \"write_failed\": " << t.write_failed << ", \"unrecorded_channel\": " << s.unrecorded_channel << "},\n";
+  const DiskFaults& d = s.disk;
+  j << "  \"disk\": {\"ok\": " << (d.errors == 0 ? "true" : "false") << ", \"errors\": " << d.errors
+    << ", \"last_error\": " << json_string(d.errors == 0 ? "" : d.reason()) << ", \"events_lost\": " << d.events_lost
+    << ", \"files_truncated\": " << d.files_truncated << ", \"files_removed\": " << d.files_removed
+    << ", \"unconfirmed_events\": " << d.unconfirmed_events << ", \"recoveries\": " << d.recoveries << "},\n";
+  const UnknownChannels& u = channels.unknown();
+  j << "  \"unknown_channels\": {\"messages\": " << u.messages() << ", \"distinct\": " << u.distinct()
+    << ", \"distinct_is_lower_bound\": " << (u.distinct_is_lower_bound() ? "true" : "false") << ", \"first\": [";
+  for (std::size_t i = 0; i < u.kept_count(); ++i) j << (i ? ", " : "") << json_string(u.kept_name(i));
+  j << "]},\n";
   j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes << ", \"high_water_bytes\": "
     << s.queue_high_water_bytes << "},\n";
   j << "  \"process\": {\"cpu_user_s\": " << s.cpu_user_s << ", \"cpu_system_s\": " << s.cpu_system_s
@@ -115,10 +125,25 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
        << ", oversize " << t.oversize << ", write failed " << t.write_failed << ", no channel slot "
        << s.unrecorded_channel << ")";
   lines.push_back(head.str());
+  if (s.disk.errors > 0) {
+    lines.push_back("  DISK FAULT: " + std::to_string(s.disk.errors) + " failed call(s), last " + s.disk.reason() + "; " +
+                    std::to_string(s.disk.events_lost) + " events not written, " +
+                    std::to_string(s.disk.files_truncated) + " file(s) cut back to their last complete event, " +
+                    std::to_string(s.disk.files_removed) + " empty file(s) removed, " +
+                    std::to_string(s.disk.unconfirmed_events) + " events unconfirmed (fsync/close failed)");
+  }
+  if (channels.unknown().messages() > 0) {
+    const UnknownChannels& u = channels.unknown();
+    std::string names;
+    for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escaped_for_log(u.kept_name(i)) + "'";
+    lines.push_back("  not recorded: " + std::to_string(u.messages()) + " message(s) on " +
+                    (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct()) +
+                    " channel(s) without a slot (first: " + names + ")");
+  }
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
     std::ostringstream line;
-    line << "  " << c.name_view() << ": received " << c.received << ", written " << c.written.load() << ", dropped "
+    line << "  " << escaped_for_log(c.name_view()) << ": received " << c.received << ", written " << c.written.load() << ", dropped "
          << c.dropped();
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
@@ -140,16 +165,20 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
   const std::filesystem::path tmp = path.string() + ".tmp";
+  std::error_code ec;
+  const auto fail = [&](const std::string& what) {
+    std::filesystem::remove(tmp, ec);  // no stray temporary file left behind
+    throw std::runtime_error(what);
+  };
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    if (!out) fail("cannot write " + tmp.string());
     out << text;
     out.flush();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    if (!out) fail("cannot write " + tmp.string() + " (disk full?)");
   }
-  std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
+  if (ec) fail("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
 }
 
 }  // namespace hystloop

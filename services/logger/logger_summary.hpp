@@ -7,6 +7,9 @@
 //     "files": [ {"path", "events", "bytes"} ],
 //     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing", "skipped" },
 //     "dropped": { "queue_full", "oversize", "write_failed", "unrecorded_channel" },
+//     "disk": { "ok", "errors", "last_error", "events_lost", "files_truncated", "files_removed",
+//               "unconfirmed_events", "recoveries" },
+//     "unknown_channels": { "messages", "distinct", "distinct_is_lower_bound", "first": [names] },
 //     "queue": { "capacity_bytes", "high_water_bytes" },
 //     "process": { "cpu_user_s", "cpu_system_s", "peak_rss_bytes" },
 //     "channels": { "<name>": { "received", "bytes_received", "written", "bytes_written",
@@ -18,7 +21,9 @@
 // Counts in "sequence" are of blocks, except ticks, missing, skipped and overlap_ticks (ticks);
 // first_seq/last_seq are tick numbers. "gaps" lists the first SequenceGapDetector::kKeptGaps
 // gaps of a channel; "sequence" is present for the channels checked for gaps (the rig's
-// sensor and command channels).
+// sensor and command channels). "disk.ok" is false after any disk fault (LogFileSet): then
+// "events_lost" events were not written (also in dropped.write_failed) and the process exits 1.
+// "unknown_channels" are the channels the table had no slot for (UnknownChannels).
 
 #include <cstdint>
 #include <filesystem>
@@ -37,6 +42,7 @@ struct RecordingSummary {
   double duration_s = 0.0;
   std::string stop_reason;
   std::vector<LogFileInfo> files;
+  DiskFaults disk;
   std::uint64_t unrecorded_channel = 0;  // messages of channels the table had no room for
   std::uint64_t queue_capacity_bytes = 0;
   std::uint64_t queue_high_water_bytes = 0;
@@ -51,7 +57,7 @@ std::string summary_json(const RecordingSummary& summary, const ChannelTable& ch
 std::vector<std::string> summary_lines(const RecordingSummary& summary, const ChannelTable& channels);
 
 // Writes `text` to `path` (through a temporary file and a rename, so a reader never sees
-// half of it). Throws std::runtime_error naming the path.
+// half of it; the temporary file is removed if that fails). Throws std::runtime_error naming the path.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace hystloop

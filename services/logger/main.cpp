@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
       "(process \"logger\")"
       " and writes <recording>.summary.json at close (SIGINT, SIGTERM or control SHUTDOWN).\n"
       "Each logger flag equals --set logger.<key>=VALUE (keys: out_dir, file_prefix, max_file_mb, max_file_s,\n"
-      "summary, channels, queue_mb, lcm_queue, flush_interval_s, restart_threshold, command_resume_s)."};
+      "summary, channels, queue_mb, lcm_queue, flush_interval_s, restart_threshold, command_resume_s).\n"
+      "Exit status: 0; 1 if a disk fault lost events (see the summary's \"disk\") or the summary could not be\n"
+      "written; 2 for a bad option or configuration."};
   ServiceOptions service;
   LoggerFlags flags;
   add_service_options(app, service);

@@ -7,6 +7,15 @@
 
 namespace hystloop {
 
+namespace {
+// Counters fed by what came off the wire (a forged seq can jump by 2^64 - 1 ticks): they
+// stop at the largest value instead of wrapping.
+void add_saturating(std::uint64_t& counter, std::uint64_t n) noexcept {
+  counter = n > std::numeric_limits<std::uint64_t>::max() - counter ? std::numeric_limits<std::uint64_t>::max()
+                                                                     : counter + n;
+}
+}  // namespace
+
 SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold, std::int64_t resume_silence_us)
     : restart_threshold_(restart_threshold), resume_silence_us_(resume_silence_us) {
   if (restart_threshold < 1) {
@@ -25,8 +34,9 @@ SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, st
       first > std::numeric_limits<std::int64_t>::max() - (n - 1) ? std::numeric_limits<std::int64_t>::max() : first + (n - 1);
   const std::int64_t silence_us = recv_utime - last_utime_;
   last_utime_ = recv_utime;
-  ticks_ += static_cast<std::uint64_t>(n);
-  if (observed_++ == 0) {
+  add_saturating(ticks_, static_cast<std::uint64_t>(n));
+  add_saturating(observed_, 1);
+  if (observed_ == 1) {
     first_ = first;
     advance(first, last);
     return Outcome::kFirst;
@@ -38,12 +48,12 @@ SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, st
     const std::uint64_t jumped = ufirst - ulast - 1;  // ticks between the blocks
     Outcome outcome = Outcome::kInOrder;
     if (jumped > 0 && resume_silence_us_ > 0 && silence_us >= resume_silence_us_) {
-      ++resumes_;
-      skipped_ += jumped;
+      add_saturating(resumes_, 1);
+      add_saturating(skipped_, jumped);
       outcome = Outcome::kResume;
     } else if (jumped > 0) {
-      ++gap_events_;
-      missing_ += jumped;
+      add_saturating(gap_events_, 1);
+      add_saturating(missing_, jumped);
       if (kept_ < kKeptGaps) gaps_[kept_++] = SequenceGap{last_ + 1, first - 1};
       outcome = Outcome::kGap;
     }
@@ -51,21 +61,21 @@ SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, st
     return outcome;
   }
   if (ulast - ufirst > static_cast<std::uint64_t>(restart_threshold_)) {
-    ++restarts_;
+    add_saturating(restarts_, 1);
     advance(first, last);
     return Outcome::kRestart;
   }
   if (last > last_) {
-    ++overlaps_;
-    overlap_ticks_ += ulast - ufirst + 1;
+    add_saturating(overlaps_, 1);
+    add_saturating(overlap_ticks_, ulast - ufirst + 1);
     advance(first, last);
     return Outcome::kOverlap;
   }
   if (first == block_first_ && last == last_) {
-    ++duplicates_;
+    add_saturating(duplicates_, 1);
     return Outcome::kDuplicate;
   }
-  ++out_of_order_;
+  add_saturating(out_of_order_, 1);
   return Outcome::kOutOfOrder;
 }
 

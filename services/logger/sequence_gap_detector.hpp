@@ -17,6 +17,10 @@
 //   [first, last] == [P, L]    duplicate of the last block (L kept)
 //   otherwise (last <= L)      out of order: a late or repeated block; L is kept, and the gap
 //                              it may fill stays counted as missing
+//
+// The ticks come off the wire, so anyone can forge them (seq = INT64_MAX, then 0, ...): the
+// differences are taken in unsigned arithmetic (defined for any pair of int64) and every
+// counter saturates at UINT64_MAX instead of wrapping.
 
 #include <array>
 #include <cstddef>

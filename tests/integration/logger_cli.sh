@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # hystloop-logger's command line and control: --help works; a bad value exits 2 naming
-# the field; an unknown logger.* key in the configuration file exits 2 with a suggestion;
+# the field (also a --channels regex LCM cannot compile, and a --summary that is a directory,
+# both before anything is created); an unknown logger.* key in the configuration file exits 2 with a suggestion;
 # a control_t SHUTDOWN addressed to "logger" stops it cleanly with a summary.
 # Run inside tools/netns-run.
 #   logger_cli.sh <hystloop-logger> <logger_probe>
@@ -26,6 +27,10 @@ expect_exit 2 "logger.max_file_mb: must be in [0, 1e+09] (got -1)" --max-file-mb
 expect_exit 2 "logger.max_file_s: expected a number, got 'soon'" --max-file-s soon --out-dir "$dir/x"
 expect_exit 2 "logger.queue_mb" --set logger.queue_mb=0 --out-dir "$dir/x"
 expect_exit 2 "rig.prefix" --rig hx --out-dir "$dir/x"
+expect_exit 2 "logger.channels: not a regular expression LCM accepts" --channels 'HX_([' --lcm-url "$url" --out-dir "$dir/x"
+mkdir "$dir/sumdir"
+expect_exit 2 "logger.summary: '$dir/sumdir' is a directory" --summary "$dir/sumdir" --lcm-url "$url" --out-dir "$dir/x"
+[ -z "$(ls -A "$dir/sumdir")" ] || { echo "a refused --summary left files behind" >&2; ls -la "$dir/sumdir" >&2; exit 1; }
 printf 'logger:\n  max_file_mbb: 5\nbridge:\n  anything: 1\n' >"$dir/bad.yaml"
 expect_exit 2 "did you mean 'logger.max_file_mb'" --config "$dir/bad.yaml" --out-dir "$dir/x"
 [ ! -e "$dir/x" ] || { echo "a refused configuration still created the log directory" >&2; exit 1; }

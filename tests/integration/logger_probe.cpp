@@ -5,6 +5,8 @@
 //   logger_probe check-log --prefix P --blocks N [--block-ticks B] [--gap-at G --gap-len L] [--commands M] FILE...
 //   logger_probe shutdown  --url U --prefix P          (control_t SHUTDOWN addressed to "logger")
 //   logger_probe wait-logger --url U --prefix P [--wait-logger-s T]   (until the logger reports)
+//   logger_probe read-logs FILE...      (every event of every file, whatever the channel)
+//   logger_probe watch-status --url U --prefix P [--seconds S]   (the logger's HX_STATUS as JSON lines)
 //
 // The stream, round k = 0..N-1: the sensor block of ticks B*k .. B*k + B - 1 (B = 10 by
 // default) unless G <= k < G+L (the deliberate gap: L*B ticks from B*G missing), the command
@@ -15,9 +17,15 @@
 // at R rounds per second. `check-log` reads the files in the order given with lcm::LogFile
 // and requires exactly that stream on those channels, in order, byte-identical to the
 // fixtures, with event numbers and timestamps non-decreasing in each file. Other channels
-// (HX_STATUS) are ignored. Exit status 0 = as expected, 1 = not, 2 = usage.
+// (HX_STATUS) are ignored. `read-logs` reads each file with lcm::LogFile and requires it to
+// hold at least one event and to end exactly where its last complete event ends (what
+// lcm-logplayer needs to play it to the end); it prints {"files": F, "events": N} with N
+// the events read. `watch-status` prints every status of process "logger" for S seconds
+// (default 10) as one JSON object a line: {"state", "detail", "counters": {...}}.
+// Exit status 0 = as expected, 1 = not, 2 = usage.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -47,6 +55,7 @@ struct Options {
   std::int64_t commands = 0;
   double rate_hz = 2000.0;
   double wait_logger_s = 5.0;
+  double seconds = 10.0;
   std::vector<std::string> files;
 };
 
@@ -71,6 +80,7 @@ Options parse(int argc, char** argv) {
     else if (key == "--commands") o.commands = std::stoll(value);
     else if (key == "--rate-hz") o.rate_hz = std::stod(value);
     else if (key == "--wait-logger-s") o.wait_logger_s = std::stod(value);
+    else if (key == "--seconds") o.seconds = std::stod(value);
     else throw std::invalid_argument("unknown option " + key);
   }
   if (o.block_ticks < 1 || o.block_ticks > sensor_block_t::MAX_TICKS) throw std::invalid_argument("--block-ticks: 1..1000");
@@ -201,6 +211,71 @@ int check_log(const Options& o) {
   return errors == 0 ? 0 : 1;
 }
 
+int read_logs(const Options& o) {
+  std::uint64_t events = 0;
+  int errors = 0;
+  for (const std::string& file : o.files) {
+    lcm::LogFile log(file, "r");
+    if (!log.good()) {
+      std::fprintf(stderr, "logger_probe read-logs: cannot open %s\n", file.c_str());
+      ++errors;
+      continue;
+    }
+    std::uint64_t in_file = 0;
+    std::uint64_t bytes = 0;  // LCM's framing: 28 bytes + channel + data per event
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      ++in_file;
+      bytes += 28u + ev->channel.size() + static_cast<std::uint64_t>(ev->datalen);
+    }
+    const std::uint64_t size = std::filesystem::file_size(file);
+    if (in_file == 0 || bytes != size) {
+      std::fprintf(stderr, "logger_probe read-logs: %s: %llu events read, ending at byte %llu of %llu\n", file.c_str(),
+                   static_cast<unsigned long long>(in_file), static_cast<unsigned long long>(bytes),
+                   static_cast<unsigned long long>(size));
+      ++errors;
+    }
+    events += in_file;
+  }
+  std::printf("{\"files\": %zu, \"events\": %llu, \"errors\": %d}\n", o.files.size(),
+              static_cast<unsigned long long>(events), errors);
+  return errors == 0 ? 0 : 1;
+}
+
+std::string json_text(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    const auto b = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (b < 0x20 || b >= 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\u%04x", static_cast<unsigned>(b));
+      out += hex;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+int watch_status(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  Subscription<service_status_t> status(*lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
+    if (m.process != "logger") return;
+    std::string line = "{\"state\": " + std::to_string(m.state) + ", \"detail\": " + json_text(m.detail) + ", \"counters\": {";
+    for (int i = 0; i < m.n_counters; ++i) {
+      line += (i ? ", " : "") + json_text(m.counter_names[i]) + ": " + std::to_string(m.counter_values[i]);
+    }
+    std::printf("%s}}\n", line.c_str());
+    std::fflush(stdout);
+  });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.seconds);
+  while (std::chrono::steady_clock::now() < until) handle_pending(*lcm, std::chrono::milliseconds(50));
+  return 0;
+}
+
 int wait_logger(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
@@ -234,6 +309,8 @@ int main(int argc, char** argv) {
     if (o.mode == "check-log") return hystloop::check_log(o);
     if (o.mode == "shutdown") return hystloop::shutdown(o);
     if (o.mode == "wait-logger") return hystloop::wait_logger(o);
+    if (o.mode == "read-logs") return hystloop::read_logs(o);
+    if (o.mode == "watch-status") return hystloop::watch_status(o);
     std::fprintf(stderr, "logger_probe: unknown mode %s\n", o.mode.c_str());
     return 2;
   } catch (const std::exception& e) {

@@ -13,4 +13,9 @@ if(TARGET hystloop-logger)
               $<TARGET_FILE:hystloop-logger> $<TARGET_FILE:logger_probe>)
     set_tests_properties(${_script} PROPERTIES LABELS integration TIMEOUT 60)
   endforeach()
+  # A 2 MB tmpfs in a private mount namespace (needs root: skipped otherwise).
+  add_test(NAME logger_full_disk
+    COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/logger_full_disk.sh
+            $<TARGET_FILE:hystloop-logger> $<TARGET_FILE:logger_probe>)
+  set_tests_properties(logger_full_disk PROPERTIES LABELS integration TIMEOUT 60 SKIP_RETURN_CODE 77)
 endif()

@@ -141,6 +141,38 @@ TEST(SequenceGapDetector, ExtremeValuesDoNotOverflow) {
   EXPECT_EQ(e.last_seq(), 0);
 }
 
+// Forged ticks (issue 12: a gap counter wrapped to 1.69e19): INT64_MAX after INT64_MIN, again
+// and again, saturates every counter instead of wrapping.
+TEST(SequenceGapDetector, ForgedTicksSaturateTheCountersInsteadOfWrapping) {
+  constexpr auto kMin = std::numeric_limits<std::int64_t>::min();
+  constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
+  constexpr auto kTop = std::numeric_limits<std::uint64_t>::max();
+  SequenceGapDetector d(1, 1);
+  std::uint64_t last_missing = 0, last_skipped = 0;
+  for (int i = 0; i < 4; ++i) {
+    d.observe(kMin, 1, 0);
+    EXPECT_EQ(d.observe(kMax, 1, 0), Outcome::kGap);   // no silence: a gap of 2^64 - 2 ticks
+    EXPECT_GE(d.missing(), last_missing) << i;        // never goes down (no wrap)
+    last_missing = d.missing();
+    d.observe(kMin, 1, 0);
+    EXPECT_EQ(d.observe(kMax, 1, 10), Outcome::kResume);  // after silence: skipped ticks
+    EXPECT_GE(d.skipped(), last_skipped) << i;
+    last_skipped = d.skipped();
+  }
+  EXPECT_EQ(d.missing(), kTop);
+  EXPECT_EQ(d.skipped(), kTop);
+  EXPECT_EQ(d.gap_events(), 4u);
+  SequenceGapDetector e(std::numeric_limits<std::int64_t>::max());
+  e.observe(kMin, 1000);
+  for (int i = 0; i < 3; ++i) {
+    e.observe(kMax - 1, 2);  // a jump of ~2^64 ticks...
+    e.observe(kMin, 1000);   // ...then all the way back: a restart
+  }
+  EXPECT_EQ(e.missing(), kTop);
+  EXPECT_EQ(e.restarts(), 3u);
+  EXPECT_EQ(e.ticks(), 3u * 1000u + 3u * 2u + 1000u);
+}
+
 TEST(SequenceGapDetector, RefusesBadSettingsNamingTheField) {
   EXPECT_THROW(SequenceGapDetector(0), ParameterError);
   try {

@@ -110,7 +110,7 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheTickGapsAndReceivesWithoutAl
   EXPECT_EQ(allocations, 0u);
 
   const ChannelTable& channels = service.channels();
-  ASSERT_EQ(channels.size(), 3u);
+  ASSERT_EQ(channels.size(), ChannelTable::kRigChannels + 1);  // the rig's six from the start, + OTHER_THING
   EXPECT_EQ(channels[0].received, static_cast<std::uint64_t>(sent_blocks));
   EXPECT_EQ(channels[0].sequence.ticks(), static_cast<std::uint64_t>(kTicks * sent_blocks));
   EXPECT_EQ(channels[0].sequence.gap_events(), 1u);
@@ -121,7 +121,9 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheTickGapsAndReceivesWithoutAl
   EXPECT_EQ(channels[1].sequence.duplicates(), 1u);
   EXPECT_EQ(channels[1].sequence.resumes(), 0u);
   EXPECT_EQ(channels[0].undecodable + channels[1].undecodable, 0u);
-  EXPECT_EQ(channels[2].kind, SequenceKind::kNone);
+  EXPECT_EQ(channels[6].name_view(), "HX_OTHER_THING");
+  EXPECT_EQ(channels[6].kind, SequenceKind::kNone);
+  EXPECT_FALSE(channels[6].rig);
 
   request_stop();
   EXPECT_EQ(service.run(), 0);
@@ -163,6 +165,10 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheTickGapsAndReceivesWithoutAl
       EXPECT_EQ(counters.count("HX_SENSOR.resumes"), 0u);
       EXPECT_EQ(counters["HX_COMMAND.dropped"], 0);
       EXPECT_EQ(counters["files"], 1);
+      EXPECT_EQ(counters["other_channels"], 1);
+      EXPECT_EQ(counters["other.received"], 4);
+      EXPECT_EQ(counters["disk_errors"], 0);
+      EXPECT_EQ(counters["dropped"], 0);
       ++status_events;
     }
     command_events += ev->channel == names_.command;
@@ -193,7 +199,8 @@ TEST_F(LoggerServiceTest, ACompensatorResumingAfterSilenceIsCountedApart) {
   publish(*lcm_, names_.command, command_block(1000, 10, 800));
   publish(*lcm_, names_.command, sensor_block(0, 3));
   dispatch_all();
-  const ChannelSlot& slot = service.channels()[0];
+  const ChannelSlot& slot = service.channels()[1];
+  EXPECT_EQ(slot.name_view(), "HX_COMMAND");
   EXPECT_EQ(slot.sequence.resumes(), 1u);
   EXPECT_EQ(slot.sequence.skipped(), 700u);  // 300..999
   EXPECT_EQ(slot.sequence.missing(), 0u);
@@ -218,6 +225,41 @@ TEST_F(LoggerServiceTest, AFullQueueDropsAndCountsEveryMessage) {
   EXPECT_EQ(service.run(), 0);
   EXPECT_EQ(slot.written.load() + slot.dropped(), 2000u);
   EXPECT_EQ(slot.sequence.missing(), 0u);  // the network lost nothing: drops are the logger's own
+}
+
+// Issue 12: 64+ junk channel names sent before the rig starts filled the table and nothing of
+// the rig was recorded. Now the rig's channels are recorded whatever came first, the junk is
+// counted (bounded), and its names reach HX_STATUS escaped.
+TEST_F(LoggerServiceTest, JunkChannelsSentFirstDoNotBlindTheLogger) {
+  LoggerService service(*lcm_, names_, options_);
+  const command_block_t junk = command_block(0, 1, 0);
+  for (int i = 0; i < 200; ++i) {
+    std::string name = names_.prefix + "JUNK";
+    name += std::to_string(i);
+    if (i == 60) name += "\x1b[2J";  // a terminal escape off the wire
+    publish(*lcm_, name, junk);
+  }
+  dispatch_all();
+  for (std::int64_t k = 0; k < 50; ++k) {
+    publish(*lcm_, names_.sensor, sensor_block(10 * k, 10));
+    publish(*lcm_, names_.command, command_block(10 * k + 200, 10, 10 * k + 9));
+  }
+  dispatch_all();
+  const ChannelTable& channels = service.channels();
+  EXPECT_EQ(channels[0].received, 50u);
+  EXPECT_EQ(channels[1].received, 50u);
+  EXPECT_EQ(channels.unknown().messages(), 200u - (ChannelTable::kMaxChannels - ChannelTable::kRigChannels));
+  request_stop();
+  EXPECT_EQ(service.run(), 0);
+  EXPECT_EQ(channels[0].written.load(), 50u);
+  EXPECT_EQ(channels[1].written.load(), 50u);
+  std::string summary;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    if (entry.path().string().ends_with(".summary.json")) summary = read_text(entry.path());
+  }
+  EXPECT_NE(summary.find("\"unknown_channels\": {\"messages\": 142, \"distinct\": 142"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"HX_JUNK60\\u001b[2J\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"disk\": {\"ok\": true"), std::string::npos) << summary;
 }
 
 TEST_F(LoggerServiceTest, ShutdownForTheLoggerStopsIt) {
