@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <optional>
 #include <type_traits>
 
@@ -30,6 +31,32 @@ std::string describe(const YAML::Node& node) {
     case YAML::NodeType::Sequence: return "a list";
     case YAML::NodeType::Map: return "a map";
     default: return "no value";
+  }
+}
+
+// yaml-cpp keeps every entry of a map with a repeated key but answers a lookup with the first,
+// so a second `u_max_V:` further down a file would be silently ignored. Refused instead, naming
+// the key and both lines. `prefix` is the dotted path of `node`.
+void refuse_duplicate_keys(const YAML::Node& node, const std::string& source, const std::string& prefix) {
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      refuse_duplicate_keys(node[i], source, prefix + "[" + std::to_string(i) + "]");
+    }
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::map<std::string, int> first_line;  // key -> its line (1-based)
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string key = it->first.IsScalar() ? it->first.Scalar() : describe(it->first);
+    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    const int line = it->first.Mark().line + 1;
+    const auto [seen, inserted] = first_line.emplace(key, line);
+    if (!inserted) {
+      throw ConfigError(source, path,
+                        "duplicate key at line " + std::to_string(line) + " (first at line " +
+                            std::to_string(seen->second) + "): remove one of them");
+    }
+    refuse_duplicate_keys(it->second, source, path);
   }
 }
 
@@ -168,6 +195,7 @@ Config Config::from_string(std::string_view yaml_text, std::string source_name) 
                           std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   if (root.IsNull() || !root.IsDefined()) return cfg;  // empty file: empty map
+  refuse_duplicate_keys(root, cfg.impl_->source, "");
   if (!root.IsMap()) {
     throw ConfigError(cfg.impl_->source, "", "the top level must be a map of keys, got " + describe(root));
   }
@@ -283,6 +311,7 @@ void Config::apply_override(std::string_view assignment) {
   } catch (const YAML::ParserException& e) {
     throw ConfigError(kOverrideSource, key, "cannot parse value '" + text + "': " + e.msg);
   }
+  refuse_duplicate_keys(value, kOverrideSource, key);
   std::string walked;
   set_node(impl_->root, parts, 0, value, walked);
   impl_->overridden.push_back(key);

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "ident/fit_checks.hpp"
 
 namespace hystloop {
 
@@ -196,17 +197,8 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
   for (std::size_t i = 0; i < experiments.size(); ++i) {
     const auto& ex = experiments[i];
     BanningPoint pt;
-    if (ex.u.size() != ex.y.size() || ex.u.empty()) {
-      std::ostringstream s;
-      s << "experiment " << i << ": u has " << ex.u.size() << " samples, y " << ex.y.size();
-      return stamp(refuse(res, FitStatus::size_mismatch, s.str()));
-    }
-    for (std::size_t k = 0; k < ex.u.size(); ++k) {
-      if (!std::isfinite(ex.u[k]) || !std::isfinite(ex.y[k])) {
-        std::ostringstream s;
-        s << "experiment " << i << ", sample " << k << " is not finite";
-        return stamp(refuse(res, FitStatus::non_finite_data, s.str()));
-      }
+    if (FitCheck c = check_fit_samples(ex.u, ex.y); !c.ok()) {
+      return stamp(refuse(res, c.status, "experiment " + std::to_string(i) + ": " + c.reason));
     }
     SineEstimate se;
     if (ex.frequency_Hz > 0.0) {
@@ -334,6 +326,9 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
     }
     res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
     res.area_rel_rms = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
+    if (!std::isfinite(res.slope_rel_rms) || !std::isfinite(res.area_rel_rms)) {
+      return stamp(refuse(res, FitStatus::solver_failure, "the slope or area residual is not finite: no usable solution"));
+    }
   }
   // 5. k, c from the magnitudes.
   if (mags.size() < 3) {
@@ -379,6 +374,9 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
     return stamp(refuse(res, FitStatus::out_of_range, std::string("stage: ") + e.what()));
   }
   res.magnitude_rel_rms = std::sqrt(2.0 * summary.final_cost / static_cast<double>(mags.size()));
+  if (!std::isfinite(res.magnitude_rel_rms)) {
+    return stamp(refuse(res, FitStatus::solver_failure, "the magnitude residual is not finite: no usable solution"));
+  }
   res.stage_identified = true;
   res.status = FitStatus::ok;
   return stamp(res);

@@ -14,7 +14,7 @@ enum class FitStatus {
   constant_input,    // u spans less than the minimum input range
   too_few_branches,  // fewer complete branches (after the first reversal) than required
   too_few_samples,   // too few usable samples (e.g. all below the SNR threshold)
-  out_of_range,      // the optimum lies outside the physical range (c1 <= 0, c2 < 0, ...)
+  out_of_range,      // samples beyond the sanity bounds, or the optimum outside the model's domain
   solver_failure,    // the nonlinear solver did not return a usable solution
   no_improvement,    // (online) valid, but does not predict held-out data better than the set in use
   poisoned_window,   // (online) the window holds dropped / stuck / non-finite samples

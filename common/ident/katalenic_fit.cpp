@@ -11,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
+#include "ident/fit_checks.hpp"
 
 namespace hystloop {
 
@@ -99,12 +100,7 @@ KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const doub
     return r;
   };
   KatalenicFitResult res;
-  if (u.size() != y.size() || u.empty()) return stamp(refuse(res, FitStatus::size_mismatch, "u and y differ in length or are empty"));
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) {
-      return stamp(refuse(res, FitStatus::non_finite_data, "sample " + std::to_string(k) + " is not finite"));
-    }
-  }
+  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return stamp(refuse(res, c.status, std::move(c.reason)));
   const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
   const double half = 0.5 * (*uhi - *ulo);
   if (!(2.0 * half >= o.min_input_range_V) || half == 0.0) return stamp(refuse(res, FitStatus::constant_input, "u does not move"));
@@ -160,12 +156,11 @@ KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const doub
     }
     res.params.output_shaping = s;
   }
-  try {
-    res.params.validate();
-  } catch (const ParameterError& e) {
-    return stamp(refuse(res, FitStatus::out_of_range, e.what()));
-  }
   res.residual_rms_m = p.y_scale * std::sqrt(2.0 * summary.final_cost / static_cast<double>(res.samples_used));
+  // A fit that is not a fit (k1 run off to 1e301, a NaN residual) is a refusal.
+  FitCheck check = check_katalenic_params(res.params, 2.0 * half);
+  if (check.ok()) check = check_fit_residual(res.residual_rms_m, *yhi - *ylo);
+  if (!check.ok()) return stamp(refuse(res, check.status, std::move(check.reason)));
   res.status = FitStatus::ok;
   return stamp(res);
 }

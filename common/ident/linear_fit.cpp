@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "ident/fit_checks.hpp"
+
 namespace hystloop {
 
 LinearParams to_linear_params(const LinearFitResult& fit) {
@@ -19,13 +21,13 @@ LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y,
     r.reason = "u and y differ in length or have fewer than 2 samples";
     return r;
   }
+  if (FitCheck c = check_fit_samples(u, y); !c.ok()) {
+    r.status = c.status;
+    r.reason = std::move(c.reason);
+    return r;
+  }
   double su = 0.0, sy = 0.0, umin = u[0], umax = u[0];
   for (std::size_t k = 0; k < u.size(); ++k) {
-    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) {
-      r.status = FitStatus::non_finite_data;
-      r.reason = "sample " + std::to_string(k) + " is not finite";
-      return r;
-    }
     su += u[k], sy += y[k];
     umin = std::min(umin, u[k]), umax = std::max(umax, u[k]);
   }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "ident/fit_checks.hpp"
 #include "ident/mem_projection.hpp"
 #include "ident/mem_refine.hpp"
 
@@ -254,18 +255,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     return r;
   };
   MemFitResult result;
-  if (u.size() != y.size() || u.empty()) {
-    std::ostringstream s;
-    s << "u has " << u.size() << " samples, y has " << y.size();
-    return stamp(refuse(result, FitStatus::size_mismatch, s.str()));
-  }
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) {
-      std::ostringstream s;
-      s << "sample " << k << " is not finite (u = " << u[k] << ", y = " << y[k] << ")";
-      return stamp(refuse(result, FitStatus::non_finite_data, s.str()));
-    }
-  }
+  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return stamp(refuse(result, c.status, std::move(c.reason)));
   const auto [umin, umax] = std::minmax_element(u.begin(), u.end());
   if (*umax - *umin < std::max(o.min_input_range_V, 0.0) || *umax == *umin) {
     std::ostringstream s;
@@ -328,6 +318,12 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
   }
   if (result.status == FitStatus::ok || result.status == FitStatus::out_of_range) {
     result.residual_rms_m = mem_branch_rms(u, y, branches, result.params);
+  }
+  if (result.ok()) {
+    // A fit that is not a fit (NaN residual, c2 collapsed by overflow, ...) is a refusal.
+    FitCheck c = check_mem_params(result.params);
+    if (c.ok()) c = check_fit_residual(result.residual_rms_m, sc.y_span);
+    if (!c.ok()) result = refuse(std::move(result), c.status, std::move(c.reason));
   }
   return stamp(std::move(result));
 }

@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
+#include "ident/fit_checks.hpp"
 #include "ident/nnls.hpp"
 
 namespace hystloop {
@@ -59,10 +60,7 @@ PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const P
     res.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   };
-  if (u.size() != y.size() || u.empty()) return done(FitStatus::size_mismatch, "u and y differ in length or are empty");
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    if (!std::isfinite(u[k]) || !std::isfinite(y[k])) return done(FitStatus::non_finite_data, "sample " + std::to_string(k) + " is not finite");
-  }
+  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return done(c.status, std::move(c.reason));
   const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
   const double half = 0.5 * (*hi - *lo);
   if (!(2.0 * half >= o.min_input_range_V) || half == 0.0) return done(FitStatus::constant_input, "u does not move");
@@ -97,6 +95,9 @@ PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const P
   res.offset_m = bmean - amean.dot(w);
   res.residual_rms_m = std::sqrt((bc - ac * w).squaredNorm() / static_cast<double>(m));
   if (!(w.sum() > 0.0)) return done(FitStatus::out_of_range, "all weights are zero: y does not follow u");
+  if (FitCheck c = check_fit_residual(res.residual_rms_m, 2.0 * bc.cwiseAbs().maxCoeff()); !c.ok()) {
+    return done(c.status, std::move(c.reason));
+  }
   return done(FitStatus::ok, "");
 }
 

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
+
+#include "ident/fit_checks.hpp"
 
 namespace hystloop {
 namespace {
@@ -80,9 +83,21 @@ SampleTable parse_sample_csv(std::istream& in, const std::string& name) {
       }
       return v;
     };
+    // Beyond 10 kV or 1 m is a unit mistake (mV, nm?) or corruption: refused here, where the
+    // line and column can still be named, rather than fitted into Inf and NaN.
+    auto bounded = [&](int col, double bound, const char* unit) {
+      const double v = number(col);
+      if (std::abs(v) > bound) {
+        std::ostringstream s;
+        s << "column '" << header[static_cast<std::size_t>(col)] << "' (" << col + 1 << "): " << v << " " << unit
+          << " is beyond the sanity bound +-" << bound << " " << unit << " (columns in SI units: s, V, m)";
+        throw CsvError(name, line_no, s.str());
+      }
+      return v;
+    };
     table.t.push_back(number(ct));
-    table.u.push_back(number(cu));
-    table.y.push_back(number(cy));
+    table.u.push_back(bounded(cu, kFitMaxAbsVoltage_V, "V"));
+    table.y.push_back(bounded(cy, kFitMaxAbsPosition_m, "m"));
     if (ce >= 0) table.experiment.push_back(fields[static_cast<std::size_t>(ce)]);
   }
   if (header.empty()) throw CsvError(name, line_no, "no header row (expected t,u,y)");

@@ -18,12 +18,32 @@ bool parse_int(std::string_view text, int& value) {
   return !text.empty() && result.ec == std::errc{} && result.ptr == end;
 }
 
-// "a.b.c.d[:port]" with a in 224..239.
-bool is_ipv4_multicast_group(std::string_view network) {
-  const auto dot = network.find('.');
-  int first = 0;
-  return dot != std::string_view::npos && parse_int(network.substr(0, dot), first) && first >= 224 &&
-         first <= 239;
+// "a.b.c.d" with every part 0..255 and a in 224..239.
+bool is_ipv4_multicast_group(std::string_view address) {
+  int parts = 0, first = 0;
+  while (true) {
+    const auto dot = address.find('.');
+    int value = 0;
+    if (!parse_int(address.substr(0, dot), value) || value < 0 || value > 255) return false;
+    if (parts++ == 0) first = value;
+    if (dot == std::string_view::npos) break;
+    address.remove_prefix(dot + 1);
+  }
+  return parts == 4 && first >= 224 && first <= 239;
+}
+
+// "host[:port]": the port, when given, must be an integer 1..65535. LCM itself would fail
+// only when it starts (atoi takes "77x" as 77, "99999" wraps), and the process exit 1 as if
+// the network were down, without saying which part was wrong.
+std::string_view checked_port(std::string_view url, std::string_view network) {
+  const auto colon = network.rfind(':');
+  if (colon == std::string_view::npos) return network;
+  const std::string_view port = network.substr(colon + 1);
+  int value = 0;
+  if (!parse_int(port, value) || value < 1 || value > 65535) {
+    refuse(url, "port must be an integer 1..65535, got '" + std::string(port) + "'");
+  }
+  return network.substr(0, colon);
 }
 
 }  // namespace
@@ -76,12 +96,13 @@ std::string checked_lcm_url(std::string_view url, bool allow_network) {
   const LcmUrl parsed = parse_lcm_url(url);
   if (parsed.provider == "memq" || parsed.provider == "file") return std::string(url);
   if (parsed.provider == "tcpq") {
+    checked_port(url, parsed.network);
     if (!allow_network) refuse(url, "tcpq reaches a hub over the network; pass the allow-network flag to use it");
     return std::string(url);
   }
   if (parsed.provider != "udpm") refuse(url, "provider must be udpm, memq, file or tcpq");
 
-  if (!is_ipv4_multicast_group(parsed.network)) refuse(url, "udpm needs an IPv4 multicast group 224.0.0.0/4");
+  if (!is_ipv4_multicast_group(checked_port(url, parsed.network))) refuse(url, "udpm needs an IPv4 multicast group 224.0.0.0/4");
   const std::string ttl_text = lcm_url_option(parsed, "ttl");
   int ttl = 0;
   if (!ttl_text.empty() && (!parse_int(ttl_text, ttl) || ttl < 0 || ttl > 255)) {

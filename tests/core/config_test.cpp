@@ -206,6 +206,31 @@ TEST(Config, LoadsFilesAndReportsSyntaxErrorsWithALine) {
   for (const auto& p : {good, bad, empty}) std::filesystem::remove(p);
 }
 
+// yaml-cpp keeps the first of two equal keys and answers with it: the second `u_max_V` of a file
+// edited in a hurry was silently ignored. Refused, naming the file, the key and both lines.
+TEST(Config, DuplicateKeysAreRefusedWithTheFileLineAndKey) {
+  EXPECT_EQ(error_of([] { (void)Config::from_string("bridge:\n  u_max_V: 120\n  noise_rms_m: 1e-9\n  u_max_V: 250\n",
+                                                   "bridge.yaml"); }),
+            "bridge.yaml: bridge.u_max_V: duplicate key at line 4 (first at line 2): remove one of them");
+  EXPECT_EQ(error_of([] { (void)Config::from_string("a: 1\nb: {c: 2}\na: 3\n", "top.yaml"); }),
+            "top.yaml: a: duplicate key at line 3 (first at line 1): remove one of them");
+  // Flow maps, maps inside lists, and --set values too.
+  EXPECT_NE(error_of([] { (void)Config::from_string("s: [{k: 1, k: 2}]\n", "l.yaml"); }).find("s[0].k: duplicate key"),
+            std::string::npos);
+  Config cfg;
+  EXPECT_NE(error_of([&] { cfg.apply_override("bridge.gains={a: 1, a: 2}"); }).find("--set: bridge.gains.a: duplicate key"),
+            std::string::npos);
+  // The same key in different sections is not a duplicate.
+  const Config ok = Config::from_string("a: {x: 1}\nb: {x: 2}\n", "ok.yaml");
+  EXPECT_EQ(ok.get<int>("b.x", 0), 2);
+
+  const auto file = std::filesystem::temp_directory_path() / ("hystloop_cfg_" + std::to_string(::getpid()) + "_dup.yaml");
+  std::ofstream(file) << kBridge << "bridge:\n  u_max_V: 5\n";
+  EXPECT_EQ(error_of([&] { (void)Config::load_file(file); }),
+            file.string() + ": bridge: duplicate key at line 11 (first at line 2): remove one of them");
+  std::filesystem::remove(file);
+}
+
 TEST(Config, DumpRoundTrips) {
   Config cfg = Config::from_string(kBridge, "bridge.yaml");
   cfg.apply_override("bridge.u_max_V=77");

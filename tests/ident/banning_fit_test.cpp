@@ -143,6 +143,12 @@ TEST(BanningFit, RefusalsSayWhy) {
   EXPECT_EQ(fit_banning(bad).status, FitStatus::non_finite_data);
   const BanningExperimentData mismatch[] = {{u, std::span(y).first(2), 1e4}};
   EXPECT_EQ(fit_banning(mismatch).status, FitStatus::size_mismatch);
+  // Beyond the sanity bounds (a record scaled by 1e300): refused naming experiment and sample.
+  std::vector<double> huge{0.0, 2.5e302, 0.0}, y0{0.0, 1e-9, 0.0};
+  const BanningExperimentData scaled[] = {{u, y0, 1e4}, {huge, y0, 1e4}};
+  const BanningFitResult h = fit_banning(scaled);
+  EXPECT_EQ(h.status, FitStatus::out_of_range) << h.reason;
+  EXPECT_NE(h.reason.find("experiment 1: sample 1: u = "), std::string::npos) << h.reason;
 
   // Hysteresis only (no frequency sweep): ok, but the stage is not identified and it says so.
   BanningPlanOptions no_sweep = test_plan();

@@ -131,6 +131,75 @@ TEST_F(IdentifyTool, BanningFromOneFileWithAnExperimentColumn) {
   EXPECT_NEAR(doc["banning"]["stage"]["c"].as<double>(), truth.stage.c, 0.05 * truth.stage.c);
 }
 
+// The probe's fits that were not fits: a record scaled by 1e300 gave "residual -nan" (mem) and
+// k1 = 5.4e301 (katalenic), both with exit 0. Refused by the reader, naming line and column.
+TEST_F(IdentifyTool, DataBeyondPhysicalSanityIsRefusedNamingLineAndColumn) {
+  auto u = testdata::paper_identification_input();
+  u.resize(4000);
+  MemModel model(MemParams::paper_like());
+  model.reset(0.0);
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]) * 1e300, u[k] *= 1e300;
+  write_csv(path("huge.csv"), u, y, 1e4);
+  for (const char* m : {"mem", "katalenic", "auto"}) {
+    const ToolRun r = run_tool(path("huge.csv") + " --model " + m);
+    EXPECT_EQ(r.exit_code, 2) << m << ": " << r.output;
+    EXPECT_EQ(r.output.find("nan"), std::string::npos) << m << ": " << r.output;
+    EXPECT_NE(r.output.find("huge.csv:3: column 'u' (2)"), std::string::npos) << m << ": " << r.output;
+    EXPECT_NE(r.output.find("sanity bound"), std::string::npos) << m << ": " << r.output;
+  }
+}
+
+TEST_F(IdentifyTool, AFolderInsteadOfAFileIsAUsageError) {
+  const ToolRun r = run_tool(scratch_.path("") + " --model mem");
+  EXPECT_EQ(r.exit_code, 2) << r.output;  // was CLI11's 105
+  EXPECT_NE(r.output.find("directory"), std::string::npos) << r.output;
+  EXPECT_EQ(run_tool("--model nope x.csv").exit_code, 2);
+}
+
+TEST_F(IdentifyTool, MoreSamplesThanTheBoundAreRefusedWithAHint) {
+  const MemParams truth = MemParams::paper_like();
+  MemModel model(truth);
+  model.reset(0.0);
+  const auto u = testdata::paper_identification_input();  // 20000 samples
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  write_csv(path("mem.csv"), u, y, 1e4);
+  const ToolRun r = run_tool(path("mem.csv") + " --model mem --max-samples 5000");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("20000 samples exceed --max-samples 5000"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--decimate 4"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("c1 = "), std::string::npos) << r.output;  // refused before any fit
+  // Decimated to the bound, the rate-independent MEM still fits.
+  const ToolRun d = run_tool(path("mem.csv") + " --model mem --max-samples 5000 --decimate 4 --out " +
+                             path("params.yaml"));
+  ASSERT_EQ(d.exit_code, 0) << d.output;
+  EXPECT_NEAR(YAML::LoadFile(path("params.yaml"))["mem"]["c1"].as<double>(), truth.c1, 0.02 * truth.c1);
+}
+
+TEST_F(IdentifyTool, ProgressOfALongFitOnStderr) {
+  auto u = testdata::paper_identification_input();
+  u.resize(6000);  // three periods
+  MemModel model(MemParams::paper_like());
+  model.reset(0.0);
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  write_csv(path("mem.csv"), u, y, 1e4);
+  // Katalenic simulates its operator per evaluation: hundreds of milliseconds, many periods.
+  // Only stderr is collected: { tool 2>&1 >/dev/null; }.
+  auto stderr_of = [&](const std::string& args) {
+    return testing::run_tool("{ " + kTool + " " + path("mem.csv") + " " + args + " 2>&1 >/dev/null; }");
+  };
+  const ToolRun r = stderr_of("--model katalenic --progress --progress-period-s 0.02");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("hystloop-identify: fitting katalenic on 6000 samples: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fitting katalenic on 6000 samples: done in "), std::string::npos) << r.output;
+  // Without the flag, and stderr not a terminal: quiet.
+  const ToolRun q = stderr_of("--model katalenic");
+  EXPECT_EQ(q.exit_code, 0) << q.output;
+  EXPECT_EQ(q.output, "") << q.output;
+}
+
 TEST_F(IdentifyTool, HelpDescribesTheModels) {
   const ToolRun r = run_tool("--help");
   EXPECT_EQ(r.exit_code, 0) << r.output;

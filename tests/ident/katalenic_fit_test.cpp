@@ -65,5 +65,19 @@ TEST(KatalenicFit, RefusalsSayWhy) {
   EXPECT_THROW(fit_katalenic(ramp, y, bad), ParameterError);
 }
 
+// The probe's case: valid data scaled by 1e300 "fitted" k1 = 5.4e301 and exited 0.
+TEST(KatalenicFit, DataScaledBeyondPhysicsIsRefusedNotFitted) {
+  KatalenicParams truth;
+  truth.k2_slope = 0.0;
+  auto u = paper_input();
+  u.resize(4000);
+  auto y = simulate(truth, u);
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] *= 1e300, y[k] *= 1e300;
+  const KatalenicFitResult r = fit_katalenic(u, y);
+  EXPECT_FALSE(r.ok()) << "k1 = " << r.params.k1;
+  EXPECT_EQ(r.status, FitStatus::out_of_range) << r.reason;
+  EXPECT_NE(r.reason.find("sanity bound"), std::string::npos) << r.reason;
+}
+
 }  // namespace
 }  // namespace hystloop

@@ -170,6 +170,21 @@ TEST(MemFit, RefusalsSayWhy) {
   EXPECT_NE(dead.status, FitStatus::ok) << dead.reason;
 }
 
+// The probe's case: valid data scaled by 1e300 gave "residual -nan", c2 = 0 and exit 0. Both
+// forms must refuse, naming the sample beyond the sanity bounds.
+TEST(MemFit, DataScaledBeyondPhysicsIsRefusedNotFitted) {
+  const MemParams truth = testdata::piezo_truth();
+  auto u = testdata::paper_identification_input();
+  auto y = testdata::mem_branches(u, truth);
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] *= 1e300, y[k] *= 1e300;
+  for (MemFitForm f : {MemFitForm::integrated, MemFitForm::derivative}) {
+    const MemFitResult r = fit_mem(u, y, form(f));
+    EXPECT_FALSE(r.ok()) << "residual " << r.residual_rms_m << ", c2 = " << r.params.c2;
+    EXPECT_EQ(r.status, FitStatus::out_of_range) << r.reason;
+    EXPECT_NE(r.reason.find("sanity bound"), std::string::npos) << r.reason;
+  }
+}
+
 TEST(MemFit, InvalidOptionsNameTheField) {
   MemFitOptions o;
   o.c3_max = -1.0;

@@ -27,7 +27,7 @@ TEST(SampleCsv, ReadsColumnsByNameInAnyOrder) {
 }
 
 TEST(SampleCsv, GroupsExperimentsInOrderOfAppearance) {
-  const SampleTable t = parse("experiment,t,u,y\nb,0,1,1\na,0,2,2\nb,1,3,3\n");
+  const SampleTable t = parse("experiment,t,u,y\nb,0,1,1e-9\na,0,2,2e-9\nb,1,3,3e-9\n");
   const auto groups = split_experiments(t);
   ASSERT_EQ(groups.size(), 2u);
   EXPECT_EQ(groups[0].experiment.front(), "b");
@@ -44,13 +44,32 @@ TEST(SampleCsv, ErrorsNameFileLineAndColumn) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(message("t,u,y\n0,1,2\n0,1,x2\n"), "x.csv:3: column 'y' (3): cannot read 'x2' as a number");
+  EXPECT_EQ(message("t,u,y\n0,1,2e-9\n0,1,x2\n"), "x.csv:3: column 'y' (3): cannot read 'x2' as a number");
   EXPECT_EQ(message("t,u,y\n0,1\n"), "x.csv:2: 2 fields, the header has 3");
-  EXPECT_NE(message("t,v,y\n0,1,2\n").find("lacks column(s) u"), std::string::npos);
+  EXPECT_NE(message("t,v,y\n0,1,2e-9\n").find("lacks column(s) u"), std::string::npos);
   EXPECT_NE(message("t,u,y\n").find("no samples"), std::string::npos);
   EXPECT_NE(message("").find("no header"), std::string::npos);
   EXPECT_NE(message("t,u,y\n0,,1\n").find("column 'u' (2)"), std::string::npos);
   EXPECT_THROW(read_sample_csv("/nonexistent/file.csv"), CsvError);
+}
+
+// Values beyond physical sanity (the probe scaled a record by 1e300) are refused where the file,
+// line and column can be named, not fitted into Inf and NaN.
+TEST(SampleCsv, ValuesBeyondTheSanityBoundsNameLineAndColumn) {
+  auto message = [](const std::string& text) {
+    try {
+      parse(text);
+    } catch (const CsvError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("t,u,y\n0,10000,-1\n"), "no error");  // the bounds themselves are allowed
+  EXPECT_EQ(message("t,u,y\n0,1,2e-9\n0,2.5e302,3e-9\n"),
+            "x.csv:3: column 'u' (2): 2.5e+302 V is beyond the sanity bound +-10000 V (columns in SI units: s, V, m)");
+  EXPECT_EQ(message("t,y,u\n0,0,1\n0,-1.5,1\n"),
+            "x.csv:3: column 'y' (2): -1.5 m is beyond the sanity bound +-1 m (columns in SI units: s, V, m)");
+  EXPECT_NE(message("t,u,y\n0,inf,0\n").find("column 'u' (2): inf V is beyond"), std::string::npos);
 }
 
 TEST(ParamsYaml, KeysAreTheParameterNamesAndValuesRoundTrip) {

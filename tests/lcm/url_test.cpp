@@ -48,6 +48,30 @@ TEST(LcmUrl, RefusesMalformedUrls) {
   }
 }
 
+// A bad port reached LCM, which failed at start-up (exit 1, "LCM could not start") without
+// naming it; refused here, naming the port, so that a service exits 2 with the reason.
+TEST(LcmUrl, BadPortIsRefusedNamingIt) {
+  for (const char* bad : {"udpm://239.255.76.67:99999?ttl=0", "udpm://239.255.76.67:0?ttl=0",
+                          "udpm://239.255.76.67:77x?ttl=0", "udpm://239.255.76.67:?ttl=0",
+                          "udpm://239.255.76.67:-1", "tcpq://lab-hub:70000"}) {
+    try {
+      checked_lcm_url(bad, true);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.field(), "lcm.url");
+      EXPECT_NE(std::string(e.what()).find("port must be an integer 1..65535"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(checked_lcm_url("udpm://239.255.76.67:1?ttl=0"));
+  EXPECT_NO_THROW(checked_lcm_url("udpm://239.255.76.67:65535?ttl=0"));
+  EXPECT_NO_THROW(checked_lcm_url("udpm://239.255.76.67?ttl=0"));  // LCM's default port
+  EXPECT_NO_THROW(checked_lcm_url("tcpq://lab-hub:7700", true));
+  // The group's every part is an octet.
+  expect_refused("udpm://239.255.76.300:7667?ttl=0");
+  expect_refused("udpm://239.255.76:7667?ttl=0");
+  expect_refused("udpm://239.255.76.67.1:7667?ttl=0");
+}
+
 TEST(LcmUrl, LocalProvidersAreAlwaysFine_TcpqNeedsTheFlag) {
   EXPECT_NO_THROW(checked_lcm_url("memq://"));
   EXPECT_NO_THROW(checked_lcm_url("file:///tmp/x.lcmlog?mode=r"));

@@ -3,12 +3,19 @@
 //                   [--log] [--rig HX_] [--dt 1e-4 | --time-from utime] [--from S] [--to S]
 //                   [--experiment N] [--compensator NAME --max-late F --max-missing F]   (experiments on logs)
 //                   [--publish [--version N] [--listen-s 0.5] [--lcm-url URL] [--allow-network]]
+//                   [--max-samples 2000000] [--decimate K] [--progress]
 // Input: CSV t,u,y (sample_csv.hpp), or LCM event logs (files ending in .lcmlog, or --log): the
 // rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp);
 // for --model banning, the experiments the loop ran, found by their requests (log_experiments.hpp).
 // --publish (MEM only) sends the fitted set on HX_PARAMS (params_publish.hpp).
+// Memory bound (sample_budget.hpp): more than --max-samples samples (after --decimate) are refused
+// with the reason and the ways out, before any fit (a CSV before it is even read). Progress (fit_progress.hpp): every 2 s on stderr while a stage
+// runs, with --progress or when stderr is a terminal.
+// A fit that is not a fit (non-finite residual, parameters outside the model's domain) is refused
+// by the fitter (ident/fit_checks.hpp); samples beyond +-10 kV / +-1 m are refused by the reader.
 // Exit status: 0 fitted (and published), 1 the data cannot support a fit (the reason is printed;
-// nothing is published), 2 usage, file or LCM setup error, 3 fitted but not published.
+// nothing is published), 2 usage, file (not found, a folder, malformed, values beyond the sanity
+// bounds, too many samples) or LCM setup error, 3 fitted but not published.
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -17,21 +24,30 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "fit_progress.hpp"
+#include "ident/fit_checks.hpp"
 #include "ident/banning_fit.hpp"
 #include "ident/model_selection.hpp"
 #include "ident/params_yaml.hpp"
 #include "ident/sample_csv.hpp"
 #include "log_experiments.hpp"
+#include "lcm/message_checks.hpp"
 #include "log_samples.hpp"
 #include "params_publish.hpp"
+#include "sample_budget.hpp"
 
 namespace {
 
 using namespace hystloop;
+
+// ident has no LCM: its sanity bounds are its own constants, kept equal to the contract's here.
+static_assert(kFitMaxAbsVoltage_V == kMaxAbsVoltage_V && kFitMaxAbsPosition_m == kMaxAbsPosition_m,
+              "ident/fit_checks.hpp and lcm/message_checks.hpp disagree on the sanity bounds");
 
 struct Args {
   std::vector<std::string> files;
@@ -58,7 +74,30 @@ struct Args {
   double listen_s = 0.5;
   std::string lcm_url;
   bool allow_network = false;
+  // bounds
+  std::size_t max_samples = kDefaultMaxSamples;
+  std::size_t decimate = 1;
+  bool progress = false;
+  double progress_period_s = 2.0;
 };
+
+// Set in main: reports the stage in progress on stderr (silent unless wanted).
+FitProgress* g_progress = nullptr;
+
+// Reports `label` as running until the scope ends.
+class ProgressStage {
+ public:
+  explicit ProgressStage(std::string label) {
+    if (g_progress != nullptr) g_progress->stage(std::move(label));
+  }
+  ~ProgressStage() {
+    if (g_progress != nullptr) g_progress->done();
+  }
+  ProgressStage(const ProgressStage&) = delete;
+  ProgressStage& operator=(const ProgressStage&) = delete;
+};
+
+std::string on_samples(const std::string& what, std::size_t n) { return what + " on " + std::to_string(n) + " samples"; }
 
 int refuse(FitStatus status, const std::string& reason) {
   std::cerr << "hystloop-identify: no fit (" << to_string(status) << "): " << reason << "\n";
@@ -112,7 +151,11 @@ int fit_mem_and_emit(const Args& args, const SampleTable& s, ParamsLink* link) {
   o.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
   o.noise_rms_m = args.noise_rms_m;
   o.min_snr = args.min_snr;
-  const MemFitResult r = fit_mem(s.u, s.y, o);
+  MemFitResult r;
+  {
+    const ProgressStage stage(on_samples("fitting mem", s.u.size()));
+    r = fit_mem(s.u, s.y, o);
+  }
   if (!r.ok()) {
     if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
     return refuse(r.status, r.reason);
@@ -131,7 +174,11 @@ int fit_single(const Args& args, const SampleTable& s) {
   if (args.model == "pi") {
     PiFitOptions o;
     o.operators = args.operators;
-    const PiFitResult r = fit_pi(s.u, s.y, o);
+    PiFitResult r;
+    {
+      const ProgressStage stage(on_samples("fitting pi", s.u.size()));
+      r = fit_pi(s.u, s.y, o);
+    }
     if (!r.ok()) return refuse(r.status, r.reason);
     std::printf("Prandtl-Ishlinskii: %zu plays, offset %.6g m\n", r.weights.size(), r.offset_m);
     for (std::size_t i = 0; i < r.weights.size(); ++i) std::printf("  r = %8.3f V  w = %.6g m/V\n", r.thresholds_V[i], r.weights[i]);
@@ -145,7 +192,11 @@ int fit_single(const Args& args, const SampleTable& s) {
   if (args.model == "katalenic") {
     KatalenicFitOptions o;
     o.output_polynomial_degree = args.katalenic_degree;
-    const KatalenicFitResult r = fit_katalenic(s.u, s.y, o);
+    KatalenicFitResult r;
+    {
+      const ProgressStage stage(on_samples("fitting katalenic", s.u.size()));
+      r = fit_katalenic(s.u, s.y, o);
+    }
     if (!r.ok()) return refuse(r.status, r.reason);
     std::printf("Katalenic: k1 = %.6g V, k2 = %.6g 1/V, output gain %.6g m/V\n", r.params.k1, r.params.k2,
                 r.params.output_shaping.gain);
@@ -165,7 +216,11 @@ int fit_single(const Args& args, const SampleTable& s) {
   o.mem.noise_rms_m = args.noise_rms_m;
   o.pi.operators = args.operators;
   o.katalenic.output_polynomial_degree = args.katalenic_degree;
-  const ModelSelection sel = select_model(s.u, s.y, o);
+  ModelSelection sel;
+  {
+    const ProgressStage stage(on_samples("fitting and ranking every model (auto)", s.u.size()));
+    sel = select_model(s.u, s.y, o);
+  }
   std::printf("rank  model       status           train [nm]  held-out [nm]  fit [ms]\n");
   for (std::size_t i = 0; i < sel.ranking.size(); ++i) {
     const auto& r = sel.ranking[i];
@@ -206,7 +261,11 @@ int fit_banning_files(const Args& args, const std::vector<SampleTable>& tables) 
 }
 
 int fit_banning_and_emit(const Args& args, const std::vector<BanningExperimentData>& data) {
-  const BanningFitResult r = fit_banning(data);
+  BanningFitResult r;
+  {
+    const ProgressStage stage("fitting banning on " + std::to_string(data.size()) + " experiments");
+    r = fit_banning(data);
+  }
   std::printf("experiment  offset [V]  amplitude [V]  frequency [Hz]  kind       feature\n");
   for (std::size_t i = 0; i < r.points.size(); ++i) {
     const auto& p = r.points[i];
@@ -249,10 +308,22 @@ LoggedExperiments read_experiments(const Args& args) {
   return logged;
 }
 
-// Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError / SampleLogError.
+struct SampleBudgetError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
+// SampleLogError / SampleBudgetError.
 std::vector<SampleTable> read_inputs(const Args& args, bool logs) {
+  const ProgressStage stage("reading " + std::to_string(args.files.size()) + " file(s)");
   std::vector<SampleTable> tables;
   if (!logs) {
+    // Counted first: an oversized CSV is refused before it takes memory.
+    std::size_t rows = 0;
+    for (const auto& f : args.files) rows += count_csv_rows(f);
+    if (auto why = over_sample_budget((rows + args.decimate - 1) / args.decimate, args.max_samples, args.decimate)) {
+      throw SampleBudgetError(*why);
+    }
     for (const auto& f : args.files) tables.push_back(read_sample_csv(f));
     return tables;
   }
@@ -368,7 +439,35 @@ int main(int argc, char** argv) {
   pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
   pub->add_option("--lcm-url", args.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
   pub->add_flag("--allow-network", args.allow_network, "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
-  CLI11_PARSE(app, argc, argv);
+  auto* bounds = app.add_option_group("bounds", "memory and progress of long fits");
+  bounds->add_option("--max-samples", args.max_samples,
+                     "refuse more samples than this (after --decimate): the fit holds its problem in memory, "
+                     "~150 (mem) to ~300 (auto) bytes per sample")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bounds->add_option("--decimate", args.decimate, "keep every K-th sample (rate-independent models lose little)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bounds->add_flag("--progress", args.progress,
+                   "print the running stage and its elapsed time to stderr every 2 s (default: when stderr is a "
+                   "terminal)");
+  bounds->add_option("--progress-period-s", args.progress_period_s, "period of the progress lines [s]")
+      ->check(CLI::Range(0.001, 3600.0))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Every command-line mistake (a folder given as the file, an unknown option) is a usage
+    // error: exit 2, not CLI11's own codes (105, 106, ...).
+    return usage_error(e.what());
+  }
+  FitProgress progress(progress_wanted(args.progress) ? stderr : nullptr, 
+                        std::chrono::milliseconds(static_cast<long>(args.progress_period_s * 1e3)));
+  g_progress = &progress;
 
   std::size_t log_names = 0;
   for (const auto& f : args.files) log_names += looks_like_lcm_log(f) ? 1 : 0;
@@ -403,7 +502,13 @@ int main(int argc, char** argv) {
       }
       return fit_banning_logs(args);
     }
-    const std::vector<SampleTable> tables = read_inputs(args, from_logs);
+    std::vector<SampleTable> tables = read_inputs(args, from_logs);
+    std::size_t samples = 0;
+    for (auto& t : tables) {
+      decimate(t, args.decimate);
+      samples += t.u.size();
+    }
+    if (auto why = over_sample_budget(samples, args.max_samples, args.decimate)) return usage_error(*why);
     if (args.model == "banning") return fit_banning_files(args, tables);
     if (tables.size() != 1) {
       return usage_error("--model " + args.model + " takes one file (got " + std::to_string(tables.size()) + ")");
@@ -413,6 +518,8 @@ int main(int argc, char** argv) {
   } catch (const CsvError& e) {
     return usage_error(e.what());
   } catch (const SampleLogError& e) {
+    return usage_error(e.what());
+  } catch (const SampleBudgetError& e) {
     return usage_error(e.what());
   } catch (const ParameterError& e) {
     return usage_error(e.what());

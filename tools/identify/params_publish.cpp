@@ -12,6 +12,7 @@
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "lcm/url.hpp"
+#include "loop/params_admission.hpp"
 
 namespace hystloop {
 
@@ -34,6 +35,7 @@ mem_params_t to_mem_params(const MemFitResult& fit, double window_s, std::int32_
   mem_params_t m{};
   m.utime = utime_us;
   m.version = version;
+  m.publisher_id = process_publisher_id();  // each run is a new publisher: its version is never "stale"
   m.c1 = fit.params.c1;
   m.c2 = fit.params.c2;
   m.c3 = fit.params.c3;

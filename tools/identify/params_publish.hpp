@@ -1,7 +1,8 @@
 #pragma once
 // hystloop-identify --publish: a fitted MEM set sent on the rig's HX_PARAMS as mem_params_t,
-// so that a running compensator (which takes only a version above the one it was offered)
-// picks it up at its next reversal. The link is opened before the fit, so a refused URL or a
+// so that a running compensator picks it up at its next reversal. Each run publishes with its
+// own publisher_id (process_publisher_id()): the compensator orders versions per publisher, so a
+// new run is never refused as stale, whatever versions others sent. The link is opened before the fit, so a refused URL or a
 // missing multicast route fails fast; the version is looked up after the fit, so it is fresh.
 
 #include <chrono>

@@ -4,18 +4,41 @@
 #include <stdexcept>
 
 #include "decode.hpp"
+#include "event_file.hpp"
 #include "lcm/blocks.hpp"
 
 namespace hystloop::report {
 
-void for_each_event(const std::vector<std::filesystem::path>& files,
-                    const std::function<void(const lcm::LogEvent&)>& visit) {
+std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>& files,
+                                        const std::function<void(const lcm::LogEvent&)>& visit) {
+  std::vector<LogFileScan> scans;
   for (const auto& file : files) {
-    if (!std::filesystem::is_regular_file(file)) throw std::runtime_error(file.string() + ": no such log file");
-    lcm::LogFile log(file.string(), "r");
-    if (!log.good()) throw std::runtime_error(file.string() + ": cannot open as an LCM event log");
-    while (const lcm::LogEvent* event = log.readNextEvent()) visit(*event);
+    EventFileReader reader(file);
+    while (const lcm::LogEvent* event = reader.next()) visit(*event);
+    scans.push_back(reader.scan());
   }
+  return scans;
+}
+
+std::vector<std::string> describe_scan_problems(const std::vector<LogFileScan>& scans) {
+  std::vector<std::string> out;
+  for (const auto& s : scans) {
+    if (s.bytes == 0) {
+      out.push_back(s.file + ": empty (0 bytes)");
+    } else if (s.events == 0) {
+      out.push_back(s.file + ": no LCM event in its " + std::to_string(s.bytes) + " bytes (not an LCM event log?)");
+    } else {
+      if (s.skipped_bytes > 0) {
+        out.push_back(s.file + ": " + std::to_string(s.skipped_bytes) +
+                      " bytes between events are not events (corrupt or torn writes) and were skipped");
+      }
+      if (s.trailing_bytes > 0) {
+        out.push_back(s.file + ": the last " + std::to_string(s.trailing_bytes) + " bytes after event " +
+                      std::to_string(s.events) + " are not a complete event (truncated log?)");
+      }
+    }
+  }
+  return out;
 }
 
 std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept {
@@ -31,7 +54,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
   mem_params_t params;
   service_status_t status;
   control_t control;
-  for_each_event(files, [&](const lcm::LogEvent& event) {
+  run.files = for_each_event(files, [&](const lcm::LogEvent& event) {
     ++run.events;
     ++run.channel_counts[event.channel];
     run.event_times[event.channel].push_back(event.timestamp);

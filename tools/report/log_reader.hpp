@@ -1,5 +1,5 @@
 #pragma once
-// Reads LCM event logs (lcm::LogFile) into RunData. Several files are read in the order
+// Reads LCM event logs (event_file.hpp) into RunData. Several files are read in the order
 // given, as one log (a rotated recording). Which channel is which comes from the rig
 // prefix; a message on a known channel that does not decode or fails the contract's value
 // check is counted in RunData::undecodable and skipped (a whole block, for HX_SENSOR and
@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
@@ -18,7 +19,8 @@
 
 namespace hystloop::report {
 
-// Throws std::runtime_error naming the file if one cannot be opened.
+// Throws std::runtime_error naming the file if one cannot be opened. What each file held
+// beyond its events (junk, a truncated tail) is in RunData::files.
 RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels);
 
 // The time of tick i of a sensor block of n_ticks received at block_recv_utime (run_data.hpp):
@@ -26,8 +28,13 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
 std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept;
 
 // Calls visit(event) for every event of every file, in order (for exports that need
-// whole messages). Throws std::runtime_error naming the file if one cannot be opened.
-void for_each_event(const std::vector<std::filesystem::path>& files,
-                    const std::function<void(const lcm::LogEvent&)>& visit);
+// whole messages), and says what each file held besides (LogFileScan). Throws
+// std::runtime_error naming the file if one cannot be opened.
+std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>& files,
+                                        const std::function<void(const lcm::LogEvent&)>& visit);
+
+// One warning per file that was not read cleanly ("run.lcmlog: the last 17 bytes are not a
+// complete event (truncated?)"); empty when every byte of every file was an event.
+std::vector<std::string> describe_scan_problems(const std::vector<LogFileScan>& scans);
 
 }  // namespace hystloop::report

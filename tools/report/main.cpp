@@ -5,8 +5,12 @@
 //
 // Writes DIR/summary.json, DIR/<channel>.csv for each --csv, and the plots (PNG via
 // gnuplot, with their data files and plots.gp); prints a table of the main figures.
-// Exit status: 0 done (a missing gnuplot is a warning), 1 a log could not be read or an
-// output written, 2 bad arguments.
+// A file that is empty, holds no event, bytes that are not events (skipped by the reader) or a
+// truncated last event is named in a warning on stderr; so are events on the rig's channels
+// that do not decode (summary.json: undecodable_events).
+// Exit status: 0 done (a missing gnuplot is a warning), 1 a log could not be read, nothing in
+// the logs decoded (no output is written then), or an output could not be written, 2 bad
+// arguments.
 
 #include <CLI/CLI.hpp>
 
@@ -74,6 +78,17 @@ int run(const Options& o) {
   if (o.plots.max_points == 0) throw ParameterError("--plot-max-points", "must be > 0 (got 0)");
 
   const RunData data = read_logs(o.logs, channels);
+  for (const auto& problem : describe_scan_problems(data.files)) {
+    std::fprintf(stderr, "hystloop-report: warning: %s\n", problem.c_str());
+  }
+  if (data.undecodable > 0) {
+    std::fprintf(stderr, "hystloop-report: warning: %llu event(s) on the rig's channels did not decode or broke the "
+                 "message contract; they are left out\n", static_cast<unsigned long long>(data.undecodable));
+  }
+  if (data.events == data.undecodable) {
+    std::fprintf(stderr, "hystloop-report: nothing decodable in %zu log file(s): no report written\n", o.logs.size());
+    return 1;
+  }
   std::vector<std::string> csv_channels;
   for (const auto& name : o.csv) csv_channels.push_back(resolve_channel(name, data, channels.prefix));
 

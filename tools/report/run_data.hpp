@@ -98,6 +98,18 @@ struct SafeRequestRecord {
   std::string target;  // empty: every process
 };
 
+// What the event-log layer made of one file. lcm's reader skips bytes silently while it looks
+// for the next event's sync word and stops at the first event it cannot read whole, so a torn
+// write, a truncated tail or a file of random bytes would otherwise pass unnoticed.
+struct LogFileScan {
+  std::string file;
+  std::uint64_t bytes = 0;           // file size
+  std::uint64_t events = 0;          // complete events read
+  std::uint64_t skipped_bytes = 0;   // bytes before or between events that were not an event
+  std::uint64_t trailing_bytes = 0;  // bytes after the last complete event (truncated, or junk)
+  bool clean() const noexcept { return bytes > 0 && skipped_bytes == 0 && trailing_bytes == 0; }
+};
+
 struct RunData {
   std::vector<SampleRecord> samples;  // every tick, in log order
   std::vector<SensorBlockRecord> sensor_blocks;
@@ -111,6 +123,7 @@ struct RunData {
   std::uint64_t events = 0;
   std::uint64_t undecodable = 0;  // events on a known channel that failed to decode or validate
   std::optional<std::int64_t> first_event_utime;
+  std::vector<LogFileScan> files;  // one per file read, in order
 
   // Time zero of every t_s: the first HX_SENSOR tick, else the first event.
   std::int64_t time_zero_utime() const noexcept {

@@ -306,6 +306,22 @@ TEST_F(IdentifyLog, ToolFitsOnlyTheTimeRange) {
   EXPECT_NEAR(yaml_value(path("p.yaml"), "c3"), truth_.c3, 0.01 * truth_.c3) << part.output;
 }
 
+// The memory bound on a log: a record above --max-samples is refused before any fit, with
+// --from/--to and --decimate as the ways out; a range under the bound fits.
+TEST_F(IdentifyLog, ToolRefusesMoreSamplesThanTheBoundAndARangeFits) {
+  write_log(path("run.lcmlog"), with_faults(mem_record(truth_, 0.5e-9)));
+  const ToolRun big = run_tool(path("run.lcmlog") + " --model mem --max-samples 15000");
+  EXPECT_EQ(big.exit_code, 2) << big.output;
+  EXPECT_NE(big.output.find("exceed --max-samples 15000"), std::string::npos) << big.output;
+  EXPECT_NE(big.output.find("--from/--to"), std::string::npos) << big.output;
+  EXPECT_EQ(big.output.find("c1 = "), std::string::npos) << big.output;
+  const ToolRun part = run_tool(path("run.lcmlog") + " --model mem --max-samples 15000 --from 0.5 --to 1.5");
+  EXPECT_EQ(part.exit_code, 0) << part.output;
+  // A folder where a log was expected: a usage error, not CLI11's 105.
+  const ToolRun dir = run_tool(path("") + " --log --model mem");
+  EXPECT_EQ(dir.exit_code, 2) << dir.output;
+}
+
 TEST_F(IdentifyLog, ToolReadsAnyNameWithLogAndRefusesBadInput) {
   const auto record = mem_record(truth_);
   write_log(path("lcmlog-2024-01-01.00"), record);

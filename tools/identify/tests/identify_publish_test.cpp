@@ -132,6 +132,9 @@ TEST_F(IdentifyPublish, FittedSetArrivesOnHxParamsWithTheNextVersion) {
   EXPECT_LE(received_.size(), 3u);
   for (const auto& m : received_) {
     EXPECT_EQ(m.version, 2);
+    // The run's own publisher id (versions are ordered per publisher), the same on every repeat.
+    EXPECT_NE(m.publisher_id, 0);
+    EXPECT_EQ(m.publisher_id, received_.front().publisher_id);
     EXPECT_TRUE(m.valid);
     EXPECT_NEAR(m.c1, truth_.c1, 0.01 * truth_.c1);
     EXPECT_NEAR(m.c2, truth_.c2, 0.01 * truth_.c2);

@@ -587,3 +587,76 @@ TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
   EXPECT_TRUE(j["run_ahead_p50_ticks"].is_null());
   EXPECT_TRUE(j["cpu_fraction"].object.empty());
 }
+
+namespace {
+
+void write_bytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+}  // namespace
+
+// The probe's cases: a truncated log, a 0-byte file and random bytes all gave exit 0 and no
+// word. Now every file that is not cleanly events is named in a warning, and when nothing
+// decodes the tool exits 1 without writing a report.
+TEST_F(ReportToolTest, DamagedLogsAreNamedAndNothingDecodableExitsOne) {
+  write_log(dir_ / "run.lcmlog");
+  const std::string whole = slurp(dir_ / "run.lcmlog");
+  ASSERT_GT(whole.size(), 1000u);
+
+  // Truncated mid-event: the report is still made from what is whole, with a warning.
+  write_bytes(dir_ / "cut.lcmlog", whole.substr(0, whole.size() - 17));
+  ToolRun r = run_tool((dir_ / "cut.lcmlog").string() + " --out " + (dir_ / "cut").string() + " --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("cut.lcmlog: the last "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("are not a complete event (truncated log?)"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "cut" / "summary.json"));
+
+  // Junk between two events (a torn write): lcm skips it silently; the report says so.
+  const auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(whole[at + i]);
+    return v;
+  };
+  const std::size_t first_event = 28 + be32(20) + be32(24);
+  write_bytes(dir_ / "torn.lcmlog", whole.substr(0, first_event) + std::string(13, '\x5a') + whole.substr(first_event));
+  r = run_tool((dir_ / "torn.lcmlog").string() + " --out " + (dir_ / "torn").string() + " --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("torn.lcmlog: 13 bytes between events are not events"), std::string::npos) << r.err;
+  // ... and reading goes on after them (liblcm's reader stopped there, dropping the rest).
+  const ToolRun clean = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean0").string() + " --no-plots", dir_);
+  ASSERT_EQ(clean.exit_code, 0) << clean.err;
+  EXPECT_EQ(mini_json::parse(slurp(dir_ / "torn" / "summary.json"))["samples"].num(),
+            mini_json::parse(slurp(dir_ / "clean0" / "summary.json"))["samples"].num());
+
+  // A clean log: no warning at all.
+  r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean").string() + " --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+
+  // 0 bytes: nothing decodable, exit 1, no report.
+  write_bytes(dir_ / "empty.lcmlog", "");
+  r = run_tool((dir_ / "empty.lcmlog").string() + " --out " + (dir_ / "empty").string() + " --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("empty.lcmlog: empty (0 bytes)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing decodable"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "empty" / "summary.json"));
+
+  // Random bytes (seeded; no LCM sync word in them).
+  std::string noise(4096, '\0');
+  std::uint64_t x = 0x9E3779B97F4A7C15ull;
+  for (char& c : noise) x ^= x << 13, x ^= x >> 7, x ^= x << 17, c = static_cast<char>(x & 0x7f);
+  ASSERT_EQ(noise.find("\xED\xA1\xDA\x01"), std::string::npos);
+  write_bytes(dir_ / "noise.lcmlog", noise);
+  r = run_tool((dir_ / "noise.lcmlog").string() + " --out " + (dir_ / "noise").string() + " --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("noise.lcmlog: no LCM event in its 4096 bytes"), std::string::npos) << r.err;
+
+  // An empty file among good ones: the report is made, the empty one named.
+  r = run_tool((dir_ / "run.lcmlog").string() + " " + (dir_ / "empty.lcmlog").string() + " --out " +
+                   (dir_ / "mixed").string() + " --no-plots",
+               dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("empty.lcmlog: empty (0 bytes)"), std::string::npos) << r.err;
+}
