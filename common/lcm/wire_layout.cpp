@@ -24,7 +24,7 @@ constexpr std::array kCommand{F::kInt64,       F::kInt64,       F::kInt64,      
                               F::kDoubleArray, F::kDoubleArray, F::kInt32Array, F::kInt8Array};
 constexpr std::array kTrajectory{F::kInt64,  F::kInt64,  F::kInt8,  F::kDouble,      F::kDouble,      F::kDouble,
                                  F::kDouble, F::kInt64,  F::kDouble, F::kCount, F::kDoubleArray, F::kDoubleArray};
-constexpr std::array kParams{F::kInt64, F::kInt32, F::kDouble, F::kDouble, F::kDouble,
+constexpr std::array kParams{F::kInt64, F::kInt32, F::kInt64, F::kDouble, F::kDouble, F::kDouble,
                              F::kDouble, F::kInt64, F::kDouble, F::kInt8,   F::kString};
 constexpr std::array kStatus{F::kInt64,  F::kString, F::kString, F::kInt32,  F::kInt8,   F::kString,
                              F::kInt64,  F::kCount,  F::kStringArray, F::kInt64Array, F::kDouble, F::kDouble,
@@ -41,7 +41,7 @@ WireLayout wire_layout(const command_block_t*) noexcept {
 WireLayout wire_layout(const trajectory_t*) noexcept {
   return {-2105350467762901674, kTrajectory, trajectory_t::MAX_POINTS};
 }
-WireLayout wire_layout(const mem_params_t*) noexcept { return {2426068061725658864, kParams, 0}; }
+WireLayout wire_layout(const mem_params_t*) noexcept { return {-5100139363921340702, kParams, 0}; }
 WireLayout wire_layout(const service_status_t*) noexcept {
   return {-2051245413666674676, kStatus, service_status_t::MAX_COUNTERS};
 }

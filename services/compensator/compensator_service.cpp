@@ -31,8 +31,9 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
 
 namespace {
 
-// A sample seq this far below the last one means the bridge restarted its clock.
-constexpr std::int64_t kRestartTicks = 1000;
+// Consecutive blocks of a new numbering whose sample times (utime) are further apart than this
+// are not one stream [us].
+constexpr std::int64_t kConfirmWindowUs = 100'000;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <class T>
@@ -54,14 +55,33 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       trajectories_(lcm, channels.trajectory, [this](const trajectory_t& m, std::int64_t) { on_trajectory(m); }),
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
-      status_(lcm, channels.status, "compensator") {
+      status_(lcm, channels.status, "compensator"),
+      // A block within the horizon of the next expected tick continues the stream (lost blocks
+      // or a reorder: the plan still covers them); one further away must be confirmed.
+      guard_(settings.control.horizon_ticks, kConfirmWindowUs) {
   reserve_storage(command_);
   compensator_->set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
 }
 
 void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
-  if (have_sample_ && msg.seq + kRestartTicks < compensator_->last_seq()) restart_control_law();
+  const std::int64_t before = compensator_->last_seq();
+  // The block's own time, not the receive time: the commands stay a function of the messages.
+  switch (guard_.check(msg.seq, msg.n_ticks, msg.utime)) {
+    case SequenceGuard::Verdict::hold:  // a jump or a restart not confirmed yet: not used
+      work_.add(monotonic_now_ns() - start_ns);
+      return;
+    case SequenceGuard::Verdict::restart:
+      restart_control_law();
+      seq_before_ = before;
+      seq_after_ = msg.seq;
+      break;
+    case SequenceGuard::Verdict::jump:
+      seq_before_ = before;
+      seq_after_ = msg.seq;
+      break;
+    case SequenceGuard::Verdict::take: break;
+  }
   const SensorTick last = sensor_tick(msg, msg.u_V.size() - 1);
   for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m}); });
   last_sample_utime_ = last.utime;
@@ -121,22 +141,43 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
   try {
     apply_trajectory(trajectory_from_message(msg), msg.start_utime);
     trajectory_version_ = msg.version;
-    spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s", msg.version,
-                 msg.shape, msg.amplitude_m, msg.offset_m, msg.frequency_Hz, msg.blend_s);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_now_ns())) {
+      spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", msg.version,
+                   msg.shape, msg.amplitude_m, msg.offset_m, msg.frequency_Hz, msg.blend_s, suppressed_note(g));
+    }
   } catch (const std::exception& e) {
     ++counters_.trajectory_refused;
-    spdlog::warn("trajectory v{} refused: {}", msg.version, e.what());
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_now_ns())) {
+      spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what()), suppressed_note(g));
+    }
   }
 }
 
 void CompensatorService::on_params(const mem_params_t& msg) {
+  // Each refusal is counted; it is logged once per reason and publisher (ParamsAdmission), and
+  // of those at most one line per reason a second (many publishers: forged ids).
+  const std::int64_t from = msg.publisher_id;
+  auto log_refusal = [&](ParamsRefusal reason) {
+    if (!admission_.first_refusal(from, reason)) return LogLimiter::Gate{};
+    return log_limiter_.allow(kLogParamsInvalid + static_cast<std::size_t>(reason), monotonic_now_ns());
+  };
   if (!msg.valid) {
     ++counters_.params_invalid;
-    spdlog::warn("MEM parameters v{} from '{}' are marked invalid; not used", msg.version, msg.source);
+    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::invalid)) {
+      spdlog::warn("MEM parameters v{} from '{}' (publisher {:x}) are marked invalid; not used (further invalid "
+                   "sets from this publisher are counted, params_invalid, not logged){}",
+                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), suppressed_note(g));
+    }
     return;
   }
-  if (msg.version <= offered_version_) {
+  if (!admission_.is_new(from, msg.version)) {
     ++counters_.params_stale;
+    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale)) {
+      spdlog::info("MEM parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
+                   "(further stale sets from this publisher are counted, params_stale, not logged){}",
+                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from),
+                   admission_.last_version(from), suppressed_note(g));
+    }
     return;
   }
   MemParams p;
@@ -145,13 +186,21 @@ void CompensatorService::on_params(const mem_params_t& msg) {
   p.c3 = msg.c3;
   try {
     compensator_->offer_mem_params(p, msg.version);
-    offered_version_ = msg.version;
-    spdlog::info("MEM parameters v{} from '{}' accepted (c1 {:.6g}, c2 {:.6g}, c3 {:.6g}, residual {:.3g} m); "
-                 "swapped in at the next reversal",
-                 msg.version, msg.source, msg.c1, msg.c2, msg.c3, msg.residual_m);
+    admission_.accept(from, msg.version);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_now_ns())) {
+      spdlog::info("MEM parameters v{} from '{}' (publisher {:x}) accepted (c1 {:.6g}, c2 {:.6g}, c3 {:.6g}, "
+                   "residual {:.3g} m); swapped in at the next reversal{}",
+                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), msg.c1, msg.c2, msg.c3,
+                   msg.residual_m, suppressed_note(g));
+    }
   } catch (const ParameterError& e) {
     ++counters_.params_refused;
-    spdlog::warn("MEM parameters v{} refused: {}", msg.version, e.what());
+    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::refused)) {
+      spdlog::warn("MEM parameters v{} from '{}' (publisher {:x}) refused: {} (further refusals from this publisher "
+                   "are counted, params_rejected, not logged){}",
+                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), e.what(),
+                   suppressed_note(g));
+    }
   }
 }
 
@@ -159,8 +208,13 @@ void CompensatorService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   auto refuse = [&](const std::string& why) {
     ++counters_.control_refused;
-    spdlog::warn("control request {} (command {}) refused: {}", msg.request_id, msg.command, why);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogControlRefused, monotonic_now_ns())) {
+      spdlog::warn("control request {} (command {}) refused: {}{}", msg.request_id, msg.command, escape_wire(why),
+                   suppressed_note(g));
+    }
   };
+  // What a request did is logged too, at most once a second (the next line says how many were not).
+  auto acted = [&] { return log_limiter_.allow(kLogControl, monotonic_now_ns()); };
   try {
     switch (msg.command) {
       case control_t::SET_MODE:
@@ -168,7 +222,9 @@ void CompensatorService::on_control(const control_t& msg) {
           return refuse("mode " + std::to_string(msg.mode) + " is not selectable (off, linear, mem, pi, katalenic)");
         }
         compensator_->set_mode(static_cast<FeedforwardMode>(msg.mode));
-        spdlog::info("mode {} (request {})", to_string(compensator_->mode()), msg.request_id);
+        if (const LogLimiter::Gate g = acted()) {
+          spdlog::info("mode {} (request {}){}", to_string(compensator_->mode()), msg.request_id, suppressed_note(g));
+        }
         break;
       case control_t::START_EXPERIMENT: {
         const ExperimentSpec e = make_experiment_spec(msg.experiment, msg.experiment_amplitude_V,
@@ -176,15 +232,20 @@ void CompensatorService::on_control(const control_t& msg) {
                                                       msg.experiment_duration_s);
         const bool queued = compensator_->experiment_running();
         compensator_->start_experiment(e);
-        spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {})", msg.experiment, e.amplitude_V,
-                     e.offset_V, e.frequency_hz, e.duration_s,
-                     queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting" : "started",
-                     msg.request_id);
+        if (const LogLimiter::Gate g = acted()) {
+          spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
+                       e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
+                       queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting"
+                              : "started",
+                       msg.request_id, suppressed_note(g));
+        }
         break;
       }
       case control_t::STOP_EXPERIMENT:
-        spdlog::info("experiment stopped, {} queued dropped (request {})", compensator_->experiments_queued(),
-                     msg.request_id);
+        if (const LogLimiter::Gate g = acted()) {
+          spdlog::info("experiment stopped, {} queued dropped (request {}){}", compensator_->experiments_queued(),
+                       msg.request_id, suppressed_note(g));
+        }
         compensator_->stop_experiment();
         break;
       case control_t::RESET_COUNTERS:
@@ -194,7 +255,9 @@ void CompensatorService::on_control(const control_t& msg) {
         reported_.rebase("params", params_.counters());
         reported_.rebase("control", control_.counters());
         reported_.rebase("command", command_pub_.counters());
-        spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
+        if (const LogLimiter::Gate g = acted()) {
+          spdlog::info("RESET_COUNTERS (request {}){}", msg.request_id, suppressed_note(g));
+        }
         break;
       case control_t::SHUTDOWN:
         spdlog::info("SHUTDOWN (request {})", msg.request_id);
@@ -251,10 +314,39 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"trajectory_late_start", s.trajectory_late_start},
           {"control_acted", s.control_acted},
           {"control_refused", s.control_refused},
-          {"bridge_restarts", s.bridge_restarts}};
+          {"bridge_restarts", s.bridge_restarts},
+          {"sensor_jumps", guard_.counters().jumps},
+          {"sensor_jumps_ignored", guard_.counters().ignored},
+          {"sensor_blocks_held", guard_.counters().held},
+          {"params_publishers_evicted", admission_.evictions()},
+          {"log_lines_suppressed", log_limiter_.suppressed_total()}};
+}
+
+// Off the sensor path: what the SequenceGuard decided since the last report.
+void CompensatorService::log_sequence_events() {
+  const SequenceGuard::Counters& g = guard_.counters();
+  if (g.restarts != restarts_logged_) {
+    spdlog::warn("bridge restart: sensor ticks went back from {} to {} (confirmed by {} blocks): control law restarted "
+                 "({} restarts in all)",
+                 seq_before_, seq_after_, SequenceGuard::kConfirmBlocks, g.restarts);
+  }
+  if (g.jumps != jumps_logged_) {
+    spdlog::warn("sensor ticks jumped ahead from {} to {} (confirmed by {} blocks; {} jumps in all)", seq_before_,
+                 seq_after_, SequenceGuard::kConfirmBlocks, g.jumps);
+  }
+  if (g.ignored != ignored_logged_) {
+    spdlog::warn("{} jump(s) or restart(s) of the sensor ticks not believed since the last report: not confirmed "
+                 "by the blocks that followed (a forged or corrupted block?); sensor_jumps_ignored {}, "
+                 "sensor_blocks_held {} in all",
+                 g.ignored - ignored_logged_, g.ignored, g.held);
+  }
+  restarts_logged_ = g.restarts;
+  jumps_logged_ = g.jumps;
+  ignored_logged_ = g.ignored;
 }
 
 void CompensatorService::report(std::int64_t utime, bool stopping) {
+  log_sequence_events();
   const auto counters = collect_counters();
   const Compensator& c = *compensator_;
   if (c.counters().params_swapped != swaps_reported_) {

@@ -5,6 +5,18 @@
 // reference, the MEM parameters, the mode and the experiments. The commands are a
 // deterministic function of the messages received, in order: no wall clock reaches the
 // control law (a sample's utime only maps a trajectory's start time to loop time).
+//
+// Issue 12 (nothing lost, nothing unsafe):
+// - A sensor block far from the stream (further than the horizon from the next expected tick,
+//   ahead or behind) is held until SequenceGuard::kConfirmBlocks consecutive blocks confirm the
+//   new numbering (a bridge restart restarts the control law; a jump is followed); one forged or
+//   corrupted block is ignored and the real blocks around it answered. Counted on HX_STATUS:
+//   bridge_restarts, sensor_jumps, sensor_jumps_ignored, sensor_blocks_held; logged in report().
+// - HX_PARAMS versions are ordered per publisher (ParamsAdmission): a set is stale only against
+//   the last one accepted from the same mem_params_t.publisher_id. Refusals are counted by reason
+//   (params_invalid, params_stale, params_rejected) and logged once per reason and publisher.
+// - Lines triggered by messages are rate-limited (LogLimiter, one per reason a second) and text
+//   off the wire is escaped (escape_wire).
 
 #include <cstdint>
 #include <optional>
@@ -26,8 +38,11 @@
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "loop/compensator.hpp"
+#include "loop/params_admission.hpp"
+#include "loop/sequence_guard.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
+#include "runtime/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -39,7 +54,7 @@ struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;
   std::uint64_t command_ticks_published = 0;
   std::uint64_t params_invalid = 0;      // valid = false: diagnostic sets, never used
-  std::uint64_t params_stale = 0;        // version not above the last one offered
+  std::uint64_t params_stale = 0;        // version not above the last one accepted from the same publisher
   std::uint64_t params_refused = 0;      // failed the compensator's own validation
   std::uint64_t trajectories = 0;        // applied
   std::uint64_t trajectory_repeats = 0;  // same version again (UDP repeats)
@@ -47,7 +62,10 @@ struct CompensatorServiceCounters {
   std::uint64_t trajectory_late_start = 0;  // start time already past: started now instead
   std::uint64_t control_acted = 0;
   std::uint64_t control_refused = 0;
-  std::uint64_t bridge_restarts = 0;     // sample seq went back: the control law was restarted
+  std::uint64_t bridge_restarts = 0;     // sample seq went back (confirmed): the control law was restarted
+  // On HX_STATUS besides: the SequenceGuard's sensor_blocks_held (not used while a jump or a
+  // restart was unconfirmed), sensor_jumps_ignored (never confirmed: a forged or corrupted
+  // block) and sensor_jumps (confirmed jumps ahead).
 };
 
 class CompensatorService {
@@ -66,6 +84,7 @@ class CompensatorService {
 
   const Compensator& compensator() const noexcept { return *compensator_; }
   const CompensatorServiceCounters& counters() const noexcept { return counters_; }
+  const SequenceGuard::Counters& sequence_counters() const noexcept { return guard_.counters(); }
   // The last command block published (tests look at it).
   const command_block_t& last_command() const noexcept { return command_; }
 
@@ -73,6 +92,11 @@ class CompensatorService {
   void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime);
   void publish_plan() noexcept;
   void restart_control_law();
+  void log_sequence_events();
+  // Log-line reasons (LogLimiter): each at most once a second, the next saying how many were suppressed.
+  // kLogParamsInvalid + ParamsRefusal: one reason each (invalid, stale, refused).
+  enum LogReason : std::size_t { kLogTrajectory, kLogTrajectoryRefused, kLogParamsAccepted, kLogControl,
+                                 kLogControlRefused, kLogParamsInvalid, kLogParamsStale, kLogParamsRefused };
   CounterSet::Entries collect_counters() const;
 
   CompensatorSettings settings_;
@@ -94,7 +118,14 @@ class CompensatorService {
   std::optional<TrajectorySpec> pending_trajectory_;  // a timed start that arrived before the first sample
   std::int64_t pending_start_utime_ = 0;
   std::int64_t trajectory_version_ = 0;
-  std::int32_t offered_version_ = 0;  // highest mem_params_t.version offered
+  ParamsAdmission admission_;  // the last version accepted, per publisher
+  SequenceGuard guard_;         // sensor seq: a jump or a restart is believed once confirmed
+  std::uint64_t restarts_logged_ = 0;
+  std::uint64_t jumps_logged_ = 0;
+  std::uint64_t ignored_logged_ = 0;
+  std::int64_t seq_before_ = -1;  // the last tick before the last confirmed jump or restart
+  std::int64_t seq_after_ = -1;   // the first block's after it
+  LogLimiter log_limiter_;
 
   CompensatorServiceCounters counters_;
   CompensatorCounters retired_{};  // counted by control laws a bridge restart replaced

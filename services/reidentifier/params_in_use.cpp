@@ -17,8 +17,8 @@ std::string_view to_string(ParamsOffer offer) noexcept {
   return "unknown";
 }
 
-ParamsInUse::ParamsInUse(const MemParams& initial, std::string own_source)
-    : params_(initial), own_source_(std::move(own_source)) {
+ParamsInUse::ParamsInUse(const MemParams& initial, std::string own_source, std::int64_t own_publisher_id)
+    : params_(initial), own_publisher_id_(own_publisher_id), own_source_(std::move(own_source)) {
   params_.validate();
 }
 
@@ -28,20 +28,26 @@ bool in_domain(const MemParams& p) noexcept {
 }
 }  // namespace
 
-ParamsOffer ParamsInUse::offer(const MemParams& params, std::int32_t version, bool valid,
+void ParamsInUse::follow(std::int32_t version) noexcept {
+  if (version < kFollowLimit) highest_seen_ = std::max(highest_seen_, version);
+}
+
+ParamsOffer ParamsInUse::offer(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                                std::string_view source) noexcept {
-  if (source == own_source_ && version <= own_published_) return ParamsOffer::echo;
-  highest_seen_ = std::max(highest_seen_, version);
+  if (publisher_id == own_publisher_id_) return ParamsOffer::echo;
+  follow(version);
   if (!valid || !in_domain(params)) return ParamsOffer::invalid;
-  if (version <= version_) return ParamsOffer::stale;
+  if (!admission_.is_new(publisher_id, version)) return ParamsOffer::stale;
+  admission_.accept(publisher_id, version);
   params_ = params;
   version_ = version;
+  ++generation_;
   source_.assign(source.begin(), source.end());  // off the per-sample path (HX_PARAMS is rare)
   return ParamsOffer::adopted;
 }
 
 void ParamsInUse::on_command(std::int64_t seq, std::int32_t params_version) noexcept {
-  highest_seen_ = std::max(highest_seen_, params_version);
+  follow(params_version);
   applied_.record(seq, params_version);
 }
 
@@ -52,7 +58,7 @@ std::int32_t ParamsInUse::on_sample(std::int64_t seq) noexcept {
 }
 
 std::int32_t ParamsInUse::claim_version() noexcept {
-  const std::int32_t top = std::max(highest_seen_, version_);
+  const std::int32_t top = std::max({highest_seen_, own_published_, version_ < kFollowLimit ? version_ : 0});
   const std::int32_t next = top < std::numeric_limits<std::int32_t>::max() ? top + 1 : top;
   highest_seen_ = next;
   own_published_ = next;
@@ -62,6 +68,7 @@ std::int32_t ParamsInUse::claim_version() noexcept {
 std::int32_t ParamsInUse::adopt_own(const MemParams& params) noexcept {
   params_ = params;
   version_ = claim_version();
+  ++generation_;
   source_ = own_source_;
   return version_;
 }

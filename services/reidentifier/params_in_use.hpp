@@ -4,12 +4,17 @@
 //
 // It starts as the configured set (mem.c1/c2/c3) with version 1: the compensator starts from
 // the same configuration, and every set published later carries a higher version.
-// A set published on HX_PARAMS by anyone else (hystloop-identify --publish, hystloop-ctl params,
-// a second re-identifier) becomes the set in use when it is valid and newer (higher version)
-// than the set in use: the compensator would switch to it, so candidates must beat it.
-// Our own sets come back to us over LCM (same source, a version we published): ignored.
-// Every version seen, valid or not, is remembered so the next version is above all of them:
-//   version = max(highest seen on HX_PARAMS or HX_COMMAND, ours) + 1.
+// Versions are ordered per publisher (mem_params_t.publisher_id; ours is drawn per start): the
+// compensator refuses a set as stale only against the last one it accepted from the same
+// publisher (ParamsAdmission), and a set from anyone else (hystloop-identify --publish,
+// hystloop-ctl params, a second or restarted re-identifier) becomes the set in use here by the
+// same rule when it is valid: the compensator would switch to it, so candidates must beat it.
+// Our own sets come back to us over LCM (our publisher id): ignored, whatever set is in use.
+// So that the version on HX_COMMAND tells sets apart, ours are numbered above every version
+// seen, valid or not (on HX_PARAMS or HX_COMMAND), and above our own:
+//   version = max(highest seen, ours) + 1,
+// except that a version seen at or above kFollowLimit (2^30: no honest counter gets there) is
+// not followed: one huge version from anyone must not run our counter into its ceiling.
 //
 // HX_COMMAND tells which version the compensator actually applies, per tick (it swaps only at
 // a reversal, and a compensator does not repeat the set it uses on HX_PARAMS). Its versions
@@ -22,15 +27,16 @@
 #include <string>
 #include <string_view>
 
+#include "loop/params_admission.hpp"
 #include "models/mem.hpp"
 #include "reidentifier/version_timeline.hpp"
 
 namespace hystloop {
 
 enum class ParamsOffer : std::uint8_t {
-  adopted,  // valid, newer: now the set in use
+  adopted,  // valid, newer than its publisher's last: now the set in use
   echo,     // one we published
-  stale,    // not newer than the set in use
+  stale,    // not newer than the last set adopted from the same publisher
   invalid,  // valid = false (diagnostic), or parameters outside the model's domain
 };
 std::string_view to_string(ParamsOffer offer) noexcept;
@@ -39,11 +45,14 @@ class ParamsInUse {
  public:
   static constexpr std::int32_t kInitialVersion = 1;
   static constexpr std::int32_t kUnknownVersion = VersionTimeline::kUnknown;
+  static constexpr std::int32_t kFollowLimit = 1 << 30;
 
-  ParamsInUse(const MemParams& initial, std::string own_source);  // validates `initial`
+  // Validates `initial`. own_publisher_id: the publisher_id our sets carry (non-zero).
+  ParamsInUse(const MemParams& initial, std::string own_source, std::int64_t own_publisher_id);
 
   // A set received on HX_PARAMS (already checked against the wire contract).
-  ParamsOffer offer(const MemParams& params, std::int32_t version, bool valid, std::string_view source) noexcept;
+  ParamsOffer offer(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
+                    std::string_view source) noexcept;
 
   // Our accepted candidate becomes the set in use; returns the version to publish it with.
   std::int32_t adopt_own(const MemParams& params) noexcept;
@@ -62,15 +71,23 @@ class ParamsInUse {
 
   const MemParams& params() const noexcept { return params_; }
   std::int32_t version() const noexcept { return version_; }
+  // Changes whenever the set in use does (versions of two publishers may be equal).
+  std::uint64_t generation() const noexcept { return generation_; }
+  std::int64_t own_publisher_id() const noexcept { return own_publisher_id_; }
   std::int32_t highest_seen() const noexcept { return highest_seen_; }
   const std::string& own_source() const noexcept { return own_source_; }
   const std::string& source() const noexcept { return source_; }  // who made the set in use
 
  private:
+  void follow(std::int32_t version) noexcept;  // a version seen: numbering goes above it
+
   MemParams params_;
   std::int32_t version_ = kInitialVersion;
   std::int32_t highest_seen_ = kInitialVersion;  // over HX_PARAMS and our own
   std::int32_t own_published_ = 0;               // highest version we published
+  std::uint64_t generation_ = 0;
+  std::int64_t own_publisher_id_;
+  ParamsAdmission admission_;                    // the last version adopted, per publisher
   std::string own_source_;
   std::string source_ = "config";
   VersionTimeline applied_;

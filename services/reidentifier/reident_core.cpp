@@ -11,7 +11,7 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
                          RefitWorker::OnEvaluated on_evaluated)
     : options_(options),
       estimator_(options.estimator, options.initial),
-      in_use_(options.initial, std::move(own_source)),
+      in_use_(options.initial, std::move(own_source), new_publisher_id()),
       worker_(options.estimator, estimator_.make_window(), start_thread, std::move(on_evaluated)),
       period_us_(std::llround(options.refit_period_s * 1e6)),
       stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
@@ -59,9 +59,9 @@ void ReidentCore::on_command_block(const command_block_t& block) noexcept {
   for_each_tick(block, [this](const CommandTick& tick) { in_use_.on_command(tick.seq, tick.params_version); });
 }
 
-ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, bool valid,
-                                   std::string_view source) noexcept {
-  const ParamsOffer offer = in_use_.offer(params, version, valid, source);
+ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id,
+                                   bool valid, std::string_view source) noexcept {
+  const ParamsOffer offer = in_use_.offer(params, version, publisher_id, valid, source);
   switch (offer) {
     case ParamsOffer::adopted: counters_.add(ReidentCounter::params_adopted); break;
     case ParamsOffer::echo: counters_.add(ReidentCounter::params_echo); break;
@@ -81,7 +81,7 @@ RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
   if (worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
       fed != fed_at_last_snapshot_) {
     estimator_.snapshot(worker_.job_window());  // no allocation: the worker's window is preallocated
-    worker_.submit(in_use_.params(), static_cast<std::uint64_t>(in_use_.version()));
+    worker_.submit(in_use_.params(), in_use_.generation());  // "version": which set in use it was judged against
     counters_.add(ReidentCounter::refits_attempted);
     fed_at_last_snapshot_ = fed;
     next_refit_us_ = now_us + period_us_;
@@ -111,7 +111,7 @@ RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
     d.kind = RefitDecision::Kind::refused;
     return d;
   }
-  if (o.judged_against_version != static_cast<std::uint64_t>(in_use_.version())) {
+  if (o.judged_against_version != in_use_.generation()) {
     counters_.add(ReidentCounter::refits_superseded);
     d.kind = RefitDecision::Kind::superseded;
     return d;

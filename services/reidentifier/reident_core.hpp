@@ -63,7 +63,9 @@ class ReidentCore {
   void on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept;
   // An accepted HX_COMMAND block: which parameter version the compensator applies, by tick.
   void on_command_block(const command_block_t& block) noexcept;
-  ParamsOffer on_params(const MemParams& params, std::int32_t version, bool valid, std::string_view source) noexcept;
+  // A set on HX_PARAMS; ours (our publisher id, in_use().own_publisher_id()) is an echo.
+  ParamsOffer on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
+                        std::string_view source) noexcept;
   RefitDecision poll(std::int64_t now_us) noexcept;
 
   // A version for a refused candidate published as valid = false (--publish-invalid).

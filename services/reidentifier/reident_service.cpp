@@ -57,6 +57,7 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {
   out_.source = own_source_;
+  out_.publisher_id = core_->in_use().own_publisher_id();
   Subscription<sensor_block_t>::Options sensor_options;
   sensor_options.queue_capacity = static_cast<int>(options.lcm_queue);
   sensor_options.on_reject = [this](RejectReason reason) {
@@ -88,13 +89,25 @@ void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
 
 void ReidentService::on_params(const mem_params_t& msg) {
   const MemParams p{msg.c1, msg.c2, msg.c3};
-  const ParamsOffer offer = core_->on_params(p, msg.version, msg.valid, msg.source);
+  const ParamsOffer offer = core_->on_params(p, msg.version, msg.publisher_id, msg.valid, msg.source);
+  // Counted by the core (params_adopted, _stale, _invalid); logged at most once a second per kind.
+  const auto id = static_cast<std::uint64_t>(msg.publisher_id);
   if (offer == ParamsOffer::adopted) {
-    spdlog::info("params in use now version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", msg.version,
-                 msg.source, msg.c1, msg.c2, msg.c3);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogAdopted, steady_ns())) {
+      spdlog::info("params in use now version {} from '{}' (publisher {:x}): c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}{}",
+                   msg.version, escape_wire(msg.source), id, msg.c1, msg.c2, msg.c3, suppressed_note(g));
+    }
   } else if (offer == ParamsOffer::stale) {
-    spdlog::debug("params version {} from '{}' ignored: not newer than version {} in use", msg.version, msg.source,
-                  core_->in_use().version());
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogStale, steady_ns())) {
+      spdlog::debug("params version {} from '{}' (publisher {:x}) ignored: not newer than the last from it{}",
+                    msg.version, escape_wire(msg.source), id, suppressed_note(g));
+    }
+  } else if (offer == ParamsOffer::invalid) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, steady_ns())) {
+      spdlog::info("params version {} from '{}' (publisher {:x}) not used: marked invalid or outside the model's "
+                   "domain{}",
+                   msg.version, escape_wire(msg.source), id, suppressed_note(g));
+    }
   }
 }
 
@@ -113,10 +126,12 @@ CounterSet::Entries ReidentService::counter_entries() {
 void ReidentService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
   if (msg.command == control_t::SHUTDOWN) {
-    spdlog::info("shutdown requested (request {})", msg.request_id);
+    spdlog::info("shutdown requested (request {})", msg.request_id);  // once: the service stops
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
-    spdlog::info("counters reset (request {})", msg.request_id);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogReset, steady_ns())) {
+      spdlog::info("counters reset (request {}){}", msg.request_id, suppressed_note(g));
+    }
     core_->reset_refit_time();
     reported_.rebase(counter_entries());
     reported_.rebase("sensor", sensor_->counters());
@@ -173,7 +188,7 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   const ParamsInUse& in_use = core_->in_use();
   const LatencyStats& refit = core_->refit_time();
   why += fmt::format("params version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", in_use.version(),
-                     in_use.source(), in_use.params().c1, in_use.params().c2, in_use.params().c3);
+                     escape_wire(in_use.source()), in_use.params().c1, in_use.params().c2, in_use.params().c3);
   const std::int32_t applied = in_use.applied_version();
   if (applied != ParamsInUse::kUnknownVersion && applied != in_use.version()) {
     why += fmt::format("; the compensator applies version {}", applied);

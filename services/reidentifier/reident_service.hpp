@@ -32,6 +32,7 @@
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
+#include "runtime/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -62,6 +63,9 @@ class ReidentService {
   Publisher<mem_params_t> params_out_;
   StatusReporter status_;
   ControlFilter control_filter_;
+  // Log lines triggered by messages: at most one a second per kind (the next says how many were not).
+  enum LogReason : std::size_t { kLogAdopted, kLogStale, kLogInvalid, kLogReset };
+  LogLimiter log_limiter_;
   LatencyStats block_cost_;  // HX_SENSOR handler (feed of one block) cost [ns], per status period
   // RESET_COUNTERS: the endpoints' counts at the reset (they only count up).
   CounterSet reported_;  // RESET_COUNTERS baselines of the counters and endpoints

@@ -102,6 +102,8 @@ TEST(LcmTypes, MemParamsRoundTripsEveryField) {
   const auto out = round_trip(in);
   EXPECT_EQ(out.utime, in.utime);
   EXPECT_EQ(out.version, 5);
+  EXPECT_EQ(out.publisher_id, in.publisher_id);
+  EXPECT_NE(out.publisher_id, 0);
   EXPECT_EQ(out.c1, in.c1);
   EXPECT_EQ(out.c2, in.c2);
   EXPECT_EQ(out.c3, in.c3);

@@ -258,6 +258,11 @@ TEST(MessageChecks, MemParams) {
   m.version = 0;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
   m = fixtures::params(2);
+  for (const std::int64_t id : {std::int64_t{0}, std::int64_t{-7}, std::numeric_limits<std::int64_t>::min()}) {
+    m.publisher_id = id;  // any value names a publisher (0 = unknown): the receiver's table, not a wire error
+    EXPECT_EQ(check_message(m), Verdict::kOk) << id;
+  }
+  m = fixtures::params(2);
   m.valid = false;  // the consumer's decision, not a wire error
   EXPECT_EQ(check_message(m), Verdict::kOk);
 }
@@ -299,6 +304,37 @@ TEST(MessageChecks, Control) {
   m = fixtures::control(1);
   m.request_id = 0;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+}
+
+// Found by tests/fuzz/fuzz_messages: a string with a NUL inside decodes, but is cut when the
+// message is encoded again, so whoever passes it on sends something else than it received.
+TEST(MessageChecks, StringsWithANulInsideAreRefused) {
+  const std::string with_nul("reident\0@host", 13);
+  mem_params_t p = fixtures::params(1);
+  p.source = with_nul;
+  EXPECT_EQ(check_message(p), Verdict::kOutOfRange);
+  service_status_t st = fixtures::status(1);
+  st.detail = with_nul;
+  EXPECT_EQ(check_message(st), Verdict::kOutOfRange);
+  st = fixtures::status(1);
+  if (!st.counter_names.empty()) {
+    st.counter_names[0] = with_nul;
+    EXPECT_EQ(check_message(st), Verdict::kOutOfRange);
+  }
+  control_t c = fixtures::control(1);
+  c.target = with_nul;
+  EXPECT_EQ(check_message(c), Verdict::kOutOfRange);
+}
+
+TEST(MessageChecks, TickNumbersStayBelowTwoToThe53) {
+  sensor_block_t s = fixtures::sensor_block(1);
+  s.seq = (std::int64_t{1} << 53) + 1;
+  EXPECT_EQ(check_message(s), Verdict::kOutOfRange);
+  s.seq = std::int64_t{1} << 53;
+  EXPECT_EQ(check_message(s), Verdict::kOk);
+  command_block_t c = fixtures::command_block(1);
+  c.seq = INT64_MAX;
+  EXPECT_EQ(check_message(c), Verdict::kOutOfRange);
 }
 
 }  // namespace

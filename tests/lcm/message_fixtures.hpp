@@ -100,6 +100,8 @@ inline mem_params_t params(std::int64_t k) {
   mem_params_t m{};
   m.utime = kBaseUtime + 5'000'000 * k;
   m.version = static_cast<std::int32_t>(1 + k);
+  // 0 = legacy (one publisher); any other value, negative too, is an id.
+  m.publisher_id = k % 5 == 0 ? 0 : (k % 2 == 0 ? -1 : 1) * (0x5eed'0000'0000 + k);
   m.c1 = 6.4e-9 + 1.0e-11 * dk(k);
   m.c2 = 2.5e-11;
   m.c3 = 1.3 + 0.01 * dk(k % 10);

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -25,6 +26,11 @@
 #include "hystloop/service_status_t.hpp"
 #include "lcm/connection.hpp"
 #include "support/allocation_counter.hpp"
+
+#include <sstream>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 namespace hystloop {
 namespace {
@@ -67,9 +73,12 @@ control_t request(std::int64_t id, std::int8_t command, const std::string& targe
   return c;
 }
 
-mem_params_t params(std::int32_t version, double c1, bool valid = true) {
+constexpr std::int64_t kReident = 0x7e1d'0001;  // the re-identifier's publisher id
+
+mem_params_t params(std::int32_t version, double c1, bool valid = true, std::int64_t publisher = kReident) {
   mem_params_t p{};
   p.version = version;
+  p.publisher_id = publisher;
   p.c1 = c1;
   p.c2 = 1.5e-12;
   p.c3 = 1.1;
@@ -199,17 +208,22 @@ TEST(CompensatorService, AnswersEachSensorBlockWithTheTicksNotYetSentThroughTheH
   EXPECT_EQ(h.service.compensator().counters().out_of_order, 20u);
   EXPECT_EQ(h.service.compensator().counters().gaps, 20u);
 
-  // A stall longer than the horizon: the ticks the bridge passed are not sent any more.
+  // A stall longer than the horizon (every block lost for 40 ms): a jump, believed once three
+  // blocks confirm it (SequenceGuard); then the ticks the bridge passed are not sent any more.
   const std::uint64_t behind = h.service.compensator().counters().ticks_behind;
   const std::size_t b = h.blocks.size();
   const std::int64_t before = h.sent_through();  // 6334 + 300; the bridge is now at before + 100
   h.send(before + 100);
-  expect_answer(h, b, before + 109, before + 109);
-  EXPECT_EQ(h.service.compensator().counters().ticks_behind - behind, 109u);
+  h.send(before + 110);
+  EXPECT_EQ(h.blocks.size(), b);
+  h.send(before + 120);
+  expect_answer(h, b, before + 129, before + 129);
+  EXPECT_EQ(h.service.compensator().counters().ticks_behind - behind, 129u);
+  EXPECT_EQ(h.service.sequence_counters().jumps, 1u);
 
   // No tick was sent twice; every tick from the first on was sent, but those the stall skipped.
   for (std::size_t i = 1; i < h.ticks.size(); ++i) {
-    if (h.ticks[i].seq == before + 110) continue;
+    if (h.ticks[i].seq == before + 130) continue;
     ASSERT_EQ(h.ticks[i].seq, h.ticks[i - 1].seq + 1) << "entry " << i;
   }
   const CompensatorServiceCounters& c = h.service.counters();
@@ -241,11 +255,13 @@ TEST(CompensatorService, AnswersLongerThanMaxTicksAreSplitIntoBlocks) {
   h.send(10);
   expect_answer(h, b, 2509, 19, 2500);
   EXPECT_EQ(h.blocks.back().n_ticks, 10);
-  // After a long stall the whole horizon again, split the same way.
+  // After a long stall (confirmed by three blocks) the whole horizon again, split the same way.
   b = h.blocks.size();
   h.send(10000);
+  h.send(10010);
+  h.send(10020);
   ASSERT_EQ(h.blocks.size(), b + 3);
-  expect_answer(h, b, 10009, 10009, 2500);
+  expect_answer(h, b, 10029, 10029, 2500);
   EXPECT_EQ(h.commands.counters().received, h.blocks.size());
 }
 
@@ -388,6 +404,139 @@ TEST(CompensatorService, TakesOnlyValidNewerParameterSetsAndSwapsThemAtAReversal
   EXPECT_EQ(h.service.compensator().mem_params().c1, 6.0e-9);
   EXPECT_EQ(h.service.compensator().counters().params_swapped, 2u);
   EXPECT_EQ(first_with_version(h, 3), h.ticks.size());  // the refused one never
+}
+
+// Issue 12: one set with the largest version from anyone (or a re-identifier's earlier run)
+// must not freeze the re-identifier out: versions are ordered per publisher only.
+TEST(CompensatorService, AHugeVersionFromOnePublisherDoesNotFreezeTheReidentifiersLaterSets) {
+  Harness h;
+  h.send(0);
+  constexpr std::int64_t kForger = 0x0bad;
+  h.service.on_params(params(std::numeric_limits<std::int32_t>::max(), 4.0e-9, true, kForger));
+  EXPECT_EQ(h.service.compensator().counters().params_accepted, 1u);
+  h.service.on_params(params(2, 5.0e-9));  // the re-identifier's, versions far below
+  h.service.on_params(params(3, 5.5e-9));
+  EXPECT_EQ(h.service.compensator().counters().params_accepted, 3u);
+  EXPECT_EQ(h.service.counters().params_stale, 0u);
+  h.service.on_params(params(3, 5.5e-9));  // its UDP repeat
+  h.service.on_params(params(2, 5.0e-9));  // an older one of its own
+  EXPECT_EQ(h.service.counters().params_stale, 2u);
+  h.run(10, 990);  // past the reversal near tick 510: the last set offered is swapped in
+  EXPECT_EQ(h.service.compensator().params_version(), 3);
+  EXPECT_EQ(h.service.compensator().mem_params().c1, 5.5e-9);
+  EXPECT_EQ(h.tick(h.sent_through()).params_version, 3);
+
+  // The re-identifier restarted: a new id, its counter from the start again.
+  h.service.on_params(params(2, 6.0e-9, true, kReident + 1));
+  EXPECT_EQ(h.service.compensator().counters().params_accepted, 4u);
+  EXPECT_EQ(h.service.counters().params_stale, 2u);
+  h.service.report(wall_utime(), false);
+}
+
+// Issue 12: a forged sensor block 900 ticks ahead made the compensator skip ahead and drop the
+// real blocks that followed (~50 ms without commands). It is held, then ignored.
+TEST(CompensatorService, AForgedSensorBlockFarAheadIsIgnoredAndTheRealBlocksAreAnswered) {
+  Harness h;
+  h.run(0, 1000);
+  const std::size_t from_block = h.blocks.size();
+  const std::int64_t sent = h.sent_through();
+  h.send(1000 + 900);  // forged
+  EXPECT_EQ(h.blocks.size(), from_block);  // not answered
+  EXPECT_EQ(h.service.compensator().last_seq(), 999);
+  h.send(1000);
+  expect_answer(h, from_block, sent, 1009);
+  h.run(1010, 990);
+  const CompensatorCounters& c = h.service.compensator().counters();
+  EXPECT_EQ(c.out_of_order, 0u);
+  EXPECT_EQ(c.ticks_behind, 0u);
+  EXPECT_EQ(c.gaps, 0u);
+  EXPECT_EQ(c.samples, 2000u);
+  EXPECT_EQ(h.service.compensator().last_seq(), 1999);
+  EXPECT_EQ(h.sent_through(), 1999 + kHorizon);
+  EXPECT_EQ(h.service.sequence_counters().ignored, 1u);
+  EXPECT_EQ(h.service.sequence_counters().held, 1u);
+  EXPECT_EQ(h.service.sequence_counters().jumps, 0u);
+}
+
+// Issue 12: one 5,000 ticks behind silently restarted the control law and reset its counters.
+TEST(CompensatorService, AForgedSensorBlockFarBehindDoesNotRestartTheControlLaw) {
+  Harness h;
+  h.run(50000, 1000);
+  control_t c = request(1, control_t::SET_MODE);
+  c.mode = command_block_t::MODE_PI;
+  h.service.on_control(c);
+  const std::uint64_t samples = h.service.compensator().counters().samples;
+  h.send(51000 - 5000);
+  h.send(51000 - 5000 + 10);  // two consistent ones are not enough either
+  h.run(51000, 1000);
+  EXPECT_EQ(h.service.counters().bridge_restarts, 0u);
+  EXPECT_EQ(h.service.sequence_counters().ignored, 1u);
+  EXPECT_EQ(h.service.compensator().counters().samples, samples + 1000);
+  EXPECT_EQ(h.service.compensator().counters().out_of_order, 0u);
+  EXPECT_EQ(h.service.compensator().mode(), FeedforwardMode::kPi);
+  EXPECT_EQ(h.sent_through(), 51999 + kHorizon);
+}
+
+// Issue 12: 5,804 log lines a minute under malformed input, with raw control bytes from the
+// messages. Repeated warnings are rate-limited (the next line says how many were suppressed),
+// and text off the wire is escaped.
+TEST(CompensatorService, RepeatedWarningsAreRateLimitedAndWireTextIsEscaped) {
+  auto out = std::make_shared<std::ostringstream>();
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(*out);
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", sink));
+  {
+    Harness h;
+    for (std::int64_t id = 1; id <= 1000; ++id) {
+      control_t c = request(id, control_t::START_EXPERIMENT);
+      c.experiment = "evil\x1b[2J\n\r";  // not a known experiment: refused, its name in the reason
+      c.experiment_amplitude_V = 10.0;
+      c.experiment_frequency_Hz = 1.0;
+      c.experiment_duration_s = 1.0;
+      h.service.on_control(c);
+    }
+    for (std::int32_t v = 1; v <= 500; ++v) {  // 500 publishers' invalid sets, and one's stale repeats
+      h.service.on_params(params(v, 5e-9, false, 1000 + v));
+      h.service.on_params(params(1, 5e-9, true, 7));
+    }
+    EXPECT_EQ(h.service.counters().control_refused, 1000u);
+    EXPECT_EQ(h.service.counters().params_invalid, 500u);
+    EXPECT_EQ(h.service.counters().params_stale, 499u);
+    Subscription<service_status_t> status(*h.lcm, h.channels.status);
+    h.service.report(wall_utime(), false);
+    h.drain();
+    ASSERT_EQ(status.counters().accepted, 1u);
+    const service_status_t& st = status.latest();
+    std::map<std::string, std::int64_t> reported;
+    for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+    EXPECT_EQ(reported["params_invalid"], 500);
+    EXPECT_EQ(reported["params_stale"], 499);
+    EXPECT_EQ(reported["control_refused"], 1000);
+    EXPECT_EQ(reported["params_publishers_evicted"], 500 + 1 - 16);  // 501 publishers in a table of 16
+    // 999 control refusals; 499 invalid sets (each publisher's first is due, one a second is written).
+    EXPECT_EQ(reported["log_lines_suppressed"], 999 + 499);
+  }
+  spdlog::set_default_logger(previous);
+  const std::string log = out->str();
+  std::size_t lines = 0;
+  for (const char c : log) lines += c == '\n';
+  // The loop takes well under a second: one control refusal, one invalid set (once per publisher,
+  // and of those one a second), one stale set, one accepted.
+  EXPECT_LE(lines, 4u) << log.substr(0, 2000);
+  EXPECT_EQ(log.find('\x1b'), std::string::npos);
+  EXPECT_EQ(log.find('\r'), std::string::npos);
+  EXPECT_NE(log.find("evil\\x1b[2J\\x0a\\x0d"), std::string::npos) << log.substr(0, 2000);
+}
+
+// A real jump ahead (the bridge's clock skipped) is believed once three blocks confirm it.
+TEST(CompensatorService, AJumpAheadIsFollowedOnceConfirmed) {
+  Harness h;
+  h.run(0, 1000);
+  h.run(5000, 30);
+  EXPECT_EQ(h.service.sequence_counters().jumps, 1u);
+  EXPECT_EQ(h.service.compensator().last_seq(), 5029);
+  EXPECT_EQ(h.sent_through(), 5029 + kHorizon);
+  EXPECT_EQ(h.service.counters().bridge_restarts, 0u);
 }
 
 trajectory_t hold(std::int32_t version, double offset_m, double blend_s = 0.0, std::int64_t start_utime = 0) {
@@ -563,24 +712,29 @@ TEST(CompensatorService, RestartsTheControlLawWhenTheBridgeRestarts) {
   c.mode = command_block_t::MODE_PI;
   h.service.on_control(c);
   const std::size_t b = h.blocks.size();
-  h.run(0, 100);  // seq went back by far more than a reorder: a new bridge
+  h.send(0);
+  h.send(10);
+  EXPECT_EQ(h.blocks.size(), b);  // seq went back by far more than a reorder: held until confirmed
+  EXPECT_EQ(h.service.counters().bridge_restarts, 0u);
+  h.run(20, 80);  // the third block of the new numbering confirms it: a new bridge
   EXPECT_EQ(h.service.counters().bridge_restarts, 1u);
+  EXPECT_EQ(h.service.sequence_counters().held, 2u);
   EXPECT_EQ(h.service.compensator().counters().out_of_order, 0u);
   EXPECT_EQ(h.service.compensator().last_seq(), 99);
-  // The new clock's ticks, from the first block's on, each once.
+  // The new clock's ticks, from the confirming block's on, each once.
   ASSERT_LT(b, h.blocks.size());
-  EXPECT_EQ(h.blocks[b].seq, 10);
+  EXPECT_EQ(h.blocks[b].seq, 30);
   EXPECT_EQ(h.blocks[b].n_ticks, kHorizon);
-  EXPECT_EQ(h.blocks[b].sample_seq, 9);
-  std::int64_t next = 10;
+  EXPECT_EQ(h.blocks[b].sample_seq, 29);
+  std::int64_t next = 30;
   for (std::size_t i = b; i < h.blocks.size(); ++i) {
     EXPECT_EQ(h.blocks[i].seq, next) << i;
     next += h.blocks[i].n_ticks;
   }
   EXPECT_EQ(h.sent_through(), 99 + kHorizon);
   // The mode in force is kept; the reference restarts from 0.
-  EXPECT_EQ(h.tick(10).mode, command_block_t::MODE_PI);
-  EXPECT_EQ(h.tick(10).y_ref_m, 0.0);
+  EXPECT_EQ(h.tick(30).mode, command_block_t::MODE_PI);
+  EXPECT_EQ(h.tick(30).y_ref_m, 0.0);
   EXPECT_LT(h.tick(300).y_ref_m, 0.0);
 }
 
@@ -630,8 +784,10 @@ TEST(CompensatorService, StatusCountersKeepCountingAcrossABridgeRestart) {
     return -1;
   };
   EXPECT_EQ(value("bridge_restarts"), 1);
+  EXPECT_EQ(value("sensor_blocks_held"), 2);  // the new numbering's first two, before the third confirmed it
+  EXPECT_EQ(value("sensor_jumps_ignored"), 0);
   EXPECT_EQ(value("command_ticks_published"), static_cast<std::int64_t>(h.ticks.size()));
-  EXPECT_EQ(value("samples"), 200);
+  EXPECT_EQ(value("samples"), 180);
   EXPECT_EQ(value("planned"), static_cast<std::int64_t>(h.ticks.size()));
 }
 

@@ -135,7 +135,7 @@ TEST(ReidentCore, AnOutcomeJudgedAgainstAReplacedSetIsNotAdopted) {
   rig.advance();
   rig.core.poll(rig.now);  // job judged against version 1
   // Meanwhile hystloop-identify publishes version 4.
-  EXPECT_EQ(rig.core.on_params(rig.initial, 4, true, "identify@lab"), ParamsOffer::adopted);
+  EXPECT_EQ(rig.core.on_params(rig.initial, 4, 0x1de, true, "identify@lab"), ParamsOffer::adopted);
   ASSERT_TRUE(rig.core.worker().run_pending());
   const RefitDecision d = rig.core.poll(rig.now);
   EXPECT_EQ(d.kind, Kind::superseded);
@@ -148,7 +148,9 @@ TEST(ReidentCore, AnOutcomeJudgedAgainstAReplacedSetIsNotAdopted) {
   const RefitDecision next = rig.refit();
   ASSERT_EQ(next.kind, Kind::accepted) << to_string(next.status);
   EXPECT_EQ(next.version, 5);
-  EXPECT_EQ(rig.core.on_params(next.candidate, 5, true, "reident@test"), ParamsOffer::echo);
+  const std::int64_t own = rig.core.in_use().own_publisher_id();
+  EXPECT_NE(own, 0);
+  EXPECT_EQ(rig.core.on_params(next.candidate, 5, own, true, "reident@test"), ParamsOffer::echo);
 }
 
 TEST(ReidentCore, GarbageIsRefusedCountedAndNeverAdopted) {

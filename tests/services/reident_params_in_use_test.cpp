@@ -13,22 +13,25 @@ namespace {
 
 const MemParams kConfig{5e-9, 1.7e-12, 1.2};
 const MemParams kOther{6e-9, 1.0e-12, 1.1};
+constexpr std::int64_t kOwn = 0x4e1d;  // our publisher id
+constexpr std::int64_t kCtl = 0xc71;
+constexpr std::int64_t kIdentify = 0x1de;
 
 TEST(ParamsInUse, StartsAtTheConfiguredSetAsVersionOne) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   EXPECT_EQ(p.version(), 1);
   EXPECT_EQ(p.source(), "config");
   EXPECT_DOUBLE_EQ(p.params().c1, kConfig.c1);
-  EXPECT_THROW(ParamsInUse(MemParams{-1.0, 0.0, 1.0}, "x"), ParameterError);
+  EXPECT_THROW(ParamsInUse(MemParams{-1.0, 0.0, 1.0}, "x", kOwn), ParameterError);
 }
 
 TEST(ParamsInUse, OwnSetsGetTheNextVersionAboveAllSeen) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   EXPECT_EQ(p.adopt_own(kOther), 2);
   EXPECT_EQ(p.version(), 2);
   EXPECT_EQ(p.source(), "reident@a");
   // Someone published version 10 as invalid (diagnostic): not in use, but numbering goes above it.
-  EXPECT_EQ(p.offer(kConfig, 10, false, "ctl"), ParamsOffer::invalid);
+  EXPECT_EQ(p.offer(kConfig, 10, kCtl, false, "ctl"), ParamsOffer::invalid);
   EXPECT_EQ(p.version(), 2);
   EXPECT_EQ(p.adopt_own(kConfig), 11);
   EXPECT_EQ(p.claim_version(), 12);  // a diagnostic set of ours: in use unchanged
@@ -36,33 +39,37 @@ TEST(ParamsInUse, OwnSetsGetTheNextVersionAboveAllSeen) {
 }
 
 TEST(ParamsInUse, ANewerValidSetFromSomeoneElseBecomesTheSetInUse) {
-  ParamsInUse p(kConfig, "reident@a");
-  EXPECT_EQ(p.offer(kOther, 5, true, "identify@b"), ParamsOffer::adopted);
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  EXPECT_EQ(p.offer(kOther, 5, kIdentify, true, "identify@b"), ParamsOffer::adopted);
   EXPECT_EQ(p.version(), 5);
   EXPECT_EQ(p.source(), "identify@b");
   EXPECT_DOUBLE_EQ(p.params().c1, kOther.c1);
-  EXPECT_EQ(p.offer(kConfig, 5, true, "ctl"), ParamsOffer::stale);   // same version: not newer
-  EXPECT_EQ(p.offer(kConfig, 3, true, "ctl"), ParamsOffer::stale);
+  EXPECT_EQ(p.offer(kConfig, 5, kIdentify, true, "identify@b"), ParamsOffer::stale);  // same version: not newer
+  EXPECT_EQ(p.offer(kConfig, 3, kIdentify, true, "identify@b"), ParamsOffer::stale);
   EXPECT_DOUBLE_EQ(p.params().c1, kOther.c1);
   EXPECT_EQ(p.adopt_own(kConfig), 6);
 }
 
 TEST(ParamsInUse, OurOwnEchoIsIgnoredButASecondReidentifierOnTheHostIsNot) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   const std::int32_t v = p.adopt_own(kOther);
-  EXPECT_EQ(p.offer(kOther, v, true, "reident@a"), ParamsOffer::echo);
-  EXPECT_EQ(p.offer(kOther, 1, true, "reident@a"), ParamsOffer::echo);
-  // Same source, a version we never published: another re-identifier on this host.
-  EXPECT_EQ(p.offer(kConfig, v + 3, true, "reident@a"), ParamsOffer::adopted);
-  EXPECT_EQ(p.version(), v + 3);
+  EXPECT_EQ(p.offer(kOther, v, kOwn, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, 1, kOwn, true, "reident@a"), ParamsOffer::echo);
+  // Same source, another publisher id: another re-identifier on this host (or our previous run).
+  EXPECT_EQ(p.offer(kConfig, 1, kOwn + 1, true, "reident@a"), ParamsOffer::adopted);
+  EXPECT_EQ(p.version(), 1);
+  // Having adopted it, our own echo is still ours.
+  const std::int32_t w = p.adopt_own(kOther);
+  EXPECT_EQ(p.offer(kOther, w, kOwn, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.params().c1, kOther.c1);
 }
 
 TEST(ParamsInUse, SetsOutsideTheModelDomainAreNeverInUse) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(p.offer(MemParams{0.0, 1e-12, 1.0}, 4, true, "x"), ParamsOffer::invalid);
-  EXPECT_EQ(p.offer(MemParams{1e-9, -1e-12, 1.0}, 4, true, "x"), ParamsOffer::invalid);
-  EXPECT_EQ(p.offer(MemParams{1e-9, 1e-12, nan}, 4, true, "x"), ParamsOffer::invalid);
+  EXPECT_EQ(p.offer(MemParams{0.0, 1e-12, 1.0}, 4, kCtl, true, "x"), ParamsOffer::invalid);
+  EXPECT_EQ(p.offer(MemParams{1e-9, -1e-12, 1.0}, 4, kCtl, true, "x"), ParamsOffer::invalid);
+  EXPECT_EQ(p.offer(MemParams{1e-9, 1e-12, nan}, 4, kCtl, true, "x"), ParamsOffer::invalid);
   EXPECT_EQ(p.version(), 1);
   EXPECT_EQ(p.highest_seen(), 4);
 }
@@ -73,7 +80,7 @@ void command_ticks(ParamsInUse& p, std::int64_t first, std::int64_t last, std::i
 }
 
 TEST(ParamsInUse, TheAppliedVersionIsUnknownUntilACommandForTheTickOrBefore) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   EXPECT_EQ(p.applied_version(), ParamsInUse::kUnknownVersion);
   EXPECT_EQ(p.on_sample(0), ParamsInUse::kUnknownVersion);  // no compensator yet
   command_ticks(p, 10, 19, 1);
@@ -84,7 +91,7 @@ TEST(ParamsInUse, TheAppliedVersionIsUnknownUntilACommandForTheTickOrBefore) {
 }
 
 TEST(ParamsInUse, TheAppliedVersionAtASampleComesFromTheCommandsAtOrBeforeItsTick) {
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   // Commands run ~30 ms (300 ticks) ahead; the compensator swaps to version 2 at tick 250.
   command_ticks(p, 0, 249, 1);
   command_ticks(p, 250, 299, 2);
@@ -101,7 +108,7 @@ TEST(ParamsInUse, TheAppliedVersionAtASampleComesFromTheCommandsAtOrBeforeItsTic
 TEST(ParamsInUse, VersionsTheCompensatorAppliesAreNumberedAbove) {
   // Started after version 9 was published (or restarted after publishing it): HX_PARAMS
   // does not repeat it, the commands carry it. Our next set must be above it.
-  ParamsInUse p(kConfig, "reident@a");
+  ParamsInUse p(kConfig, "reident@a", kOwn);
   command_ticks(p, 0, 99, 9);
   EXPECT_EQ(p.highest_seen(), 9);
   EXPECT_EQ(p.version(), 1);
@@ -109,7 +116,32 @@ TEST(ParamsInUse, VersionsTheCompensatorAppliesAreNumberedAbove) {
   // Our own set, applied later, is not above anything.
   command_ticks(p, 100, 199, 10);
   EXPECT_EQ(p.claim_version(), 11);
-  EXPECT_EQ(p.offer(kOther, 10, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, 10, kOwn, true, "reident@a"), ParamsOffer::echo);
+}
+
+// Issue 12: versions are per publisher. One huge version from anyone is adopted (the compensator
+// takes it too) but neither freezes another publisher nor runs our numbering into its ceiling.
+TEST(ParamsInUse, AHugeVersionFreezesNoOneAndIsNotFollowed) {
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  const std::int32_t huge = std::numeric_limits<std::int32_t>::max();
+  EXPECT_EQ(p.offer(kOther, huge, kCtl, true, "forged"), ParamsOffer::adopted);
+  EXPECT_EQ(p.offer(kConfig, 2, kIdentify, true, "identify@b"), ParamsOffer::adopted);
+  EXPECT_EQ(p.version(), 2);
+  command_ticks(p, 0, 9, huge);  // the compensator applied it for a while
+  EXPECT_EQ(p.adopt_own(kOther), 3);
+  EXPECT_EQ(p.adopt_own(kConfig), 4);  // still counting up, far below the ceiling
+  EXPECT_EQ(p.offer(kOther, ParamsInUse::kFollowLimit - 1, kCtl, false, "ctl"), ParamsOffer::invalid);
+  EXPECT_EQ(p.claim_version(), ParamsInUse::kFollowLimit);  // below the limit: followed
+}
+
+TEST(ParamsInUse, ARestartedPublisherIsAdoptedWhateverItsVersion) {
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  EXPECT_EQ(p.offer(kOther, 40, kIdentify, true, "reident@b"), ParamsOffer::adopted);
+  const std::uint64_t g = p.generation();
+  EXPECT_EQ(p.offer(kConfig, 2, kIdentify + 1, true, "reident@b"), ParamsOffer::adopted);  // restarted
+  EXPECT_EQ(p.version(), 2);
+  EXPECT_NE(p.generation(), g);  // a refit judged against version 40's set is superseded
+  EXPECT_EQ(p.offer(kOther, 39, kIdentify, true, "reident@b"), ParamsOffer::stale);  // the old run's older one
 }
 
 }  // namespace

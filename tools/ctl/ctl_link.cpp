@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "core/process.hpp"
@@ -254,7 +255,8 @@ std::int32_t next_params_version(CtlLink& link, double listen_s) {
   while (Clock::now() < deadline) {
     if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(50'000)), 1024) < 0) break;
   }
-  return highest + 1;
+  // Saturating: after a forged 2147483647 the set still goes out (as a new publisher it is taken anyway).
+  return highest < std::numeric_limits<std::int32_t>::max() ? highest + 1 : highest;
 }
 
 }  // namespace hystloop::ctl

@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "lcm/message_checks.hpp"
+#include "loop/params_admission.hpp"
 
 namespace hystloop::ctl {
 
@@ -202,6 +203,7 @@ mem_params_t make_params(const ParamsRequest& request, std::int64_t utime) {
   mem_params_t msg{};
   msg.utime = utime;
   msg.version = request.version;
+  msg.publisher_id = process_publisher_id();  // each run is a new publisher: its version is never "stale"
   msg.c1 = request.c1;
   msg.c2 = request.c2;
   msg.c3 = request.c3;

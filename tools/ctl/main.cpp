@@ -236,7 +236,8 @@ int main(int argc, char** argv) {
   params->add_option("--c3", o.params.c3, "Exponent [-], in (0, 50]")->required();
   params->add_option("--residual", o.params.residual_m, "Fit residual to report [m], >= 0")->capture_default_str();
   params->add_option("--version", o.params_version,
-                     "Version (default: 1 + the highest seen on HX_PARAMS/HX_COMMAND within --listen)");
+                     "Version (default: 1 + the highest seen on HX_PARAMS/HX_COMMAND within --listen); each run "
+                     "publishes with a new publisher id, so the compensator takes it whatever others sent");
   params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
       ->capture_default_str();
 

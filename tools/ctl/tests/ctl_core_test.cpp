@@ -142,6 +142,8 @@ TEST(CtlRequests, ParamsValidation) {
   ParamsRequest p{1e-7, 1e-9, 0.5, 0, 1};
   const mem_params_t msg = make_params(p, 5);
   EXPECT_TRUE(msg.valid);
+  EXPECT_NE(msg.publisher_id, 0);  // the run's own: a new publisher, never stale at the compensator
+  EXPECT_EQ(make_params(p, 6).publisher_id, msg.publisher_id);
   EXPECT_EQ(msg.source, "hystloop-ctl");
   EXPECT_EQ(check_message(msg), Verdict::kOk);
   p.c1 = -1;
