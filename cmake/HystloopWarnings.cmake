@@ -9,6 +9,16 @@ target_compile_options(hystloop_warnings INTERFACE
 if(HYSTLOOP_WERROR)
   target_compile_options(hystloop_warnings INTERFACE -Werror)
 endif()
+if(HYSTLOOP_BUILD_FUZZERS)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "HYSTLOOP_BUILD_FUZZERS needs clang (libFuzzer): configure with CXX=clang++")
+  endif()
+  # Every library is instrumented for coverage and checked by ASan + UBSan; the fuzz targets link
+  # libFuzzer's main (tests/fuzz/CMakeLists.txt).
+  target_compile_options(hystloop_warnings INTERFACE
+    -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  target_link_options(hystloop_warnings INTERFACE -fsanitize=address,undefined)
+endif()
 if(HYSTLOOP_SANITIZE)
   target_compile_options(hystloop_warnings INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)

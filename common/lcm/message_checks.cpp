@@ -4,15 +4,23 @@
 
 #include <cmath>
 #include <cstddef>
+#include <string>
 
 namespace hystloop {
 namespace {
+
+constexpr std::int64_t kMaxTick = std::int64_t{1} << 53;  // 28,000 years at 10 kHz
 
 // Collects the findings of one message: any non-finite value outranks a range failure.
 class Findings {
  public:
   void require(bool ok) noexcept { out_of_range_ |= !ok; }
   void finite(double v) noexcept { non_finite_ |= !std::isfinite(v); }
+  // A string field carries text: a NUL inside it would be cut when the message is encoded again
+  // (found by tests/fuzz/fuzz_messages), so the sender and the next receiver would disagree.
+  void text(const std::string& s) noexcept { require(s.find('\0') == std::string::npos); }
+  // A tick number small enough that seq + any horizon or block length stays exact and finite.
+  void tick(std::int64_t seq) noexcept { require(seq >= 0 && seq <= kMaxTick); }
   // NaN is a documented sentinel ("none"); an infinity never is.
   void finite_or_nan(double v) noexcept { non_finite_ |= std::isinf(v); }
   void within(double v, double lo, double hi) noexcept {
@@ -43,7 +51,8 @@ bool is_command_mode(std::int8_t mode) noexcept {
 
 Verdict check_message(const sensor_block_t& msg) noexcept {
   Findings f;
-  f.require(msg.utime >= 0 && msg.seq >= 0 && msg.buffer_depth_ticks >= 0);
+  f.require(msg.utime >= 0 && msg.buffer_depth_ticks >= 0);
+  f.tick(msg.seq);
   f.within(msg.dt_s, 1e-7, 1.0);
   f.require(msg.dt_s > 0.0);
   const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= sensor_block_t::MAX_TICKS && arrays_consistent(msg);
@@ -63,7 +72,8 @@ Verdict check_message(const sensor_block_t& msg) noexcept {
 
 Verdict check_message(const command_block_t& msg) noexcept {
   Findings f;
-  f.require(msg.utime >= 0 && msg.seq >= 0 && msg.sample_seq >= -1);
+  f.require(msg.utime >= 0 && msg.sample_seq >= -1 && msg.sample_seq <= kMaxTick);
+  f.tick(msg.seq);
   const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= command_block_t::MAX_TICKS && arrays_consistent(msg);
   f.require(count_ok);
   if (count_ok) {
@@ -108,6 +118,7 @@ Verdict check_message(const trajectory_t& msg) noexcept {
 Verdict check_message(const mem_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
+  f.text(msg.source);
   f.finite(msg.c1);
   f.require(!(msg.c1 <= 0.0) && !(msg.c1 > 1.0));  // [m/V]
   f.within(msg.c2, 0.0, kHuge);
@@ -121,6 +132,10 @@ Verdict check_message(const mem_params_t& msg) noexcept {
 Verdict check_message(const service_status_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.pid > 0 && !msg.process.empty());
+  f.text(msg.process);
+  f.text(msg.host);
+  f.text(msg.detail);
+  for (const std::string& name : msg.counter_names) f.text(name);
   f.require(msg.state >= service_status_t::STARTING && msg.state <= service_status_t::STOPPING);
   const bool count_ok = msg.n_counters >= 0 && msg.n_counters <= service_status_t::MAX_COUNTERS &&
                         msg.counter_names.size() == static_cast<std::size_t>(msg.n_counters) &&
@@ -140,6 +155,8 @@ Verdict check_message(const service_status_t& msg) noexcept {
 Verdict check_message(const control_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.request_id > 0);
+  f.text(msg.target);
+  f.text(msg.experiment);
   f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::SHUTDOWN);
   f.require(is_command_mode(msg.mode));
   f.within(msg.kp, 0.0, kHuge);

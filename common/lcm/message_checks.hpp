@@ -3,7 +3,9 @@
 // send. Non-finite values are told apart from out-of-range ones so that the counts say
 // which kind of sender bug it is. The bounds are sanity bounds (unit mistakes, corrupted
 // senders), not the actuator's limits: the bridge clamps to those itself.
-// All checks are allocation- and throw-free (they run at 10 kHz).
+// String fields must hold no NUL (it would be cut when the message is encoded again), and tick
+// numbers stay below 2^53 (seq + a horizon is then exact). All checks are allocation- and
+// throw-free (they run at 10 kHz).
 
 #include <cstdint>
 
@@ -36,7 +38,8 @@ Verdict check_message(const command_block_t& msg) noexcept;
 // equal to n_points (so that encoding never reads past a vector).
 Verdict check_message(const trajectory_t& msg) noexcept;
 // mem_params_t: finite, c1 > 0, c2 >= 0, 0 < c3 <= 50, residual, samples and window >= 0,
-// version >= 1. Validity (`valid`) is the consumer's decision, not a wire error.
+// version >= 1. Validity (`valid`) is the consumer's decision, not a wire error; so is
+// publisher_id (any value names a publisher, 0 = unknown).
 Verdict check_message(const mem_params_t& msg) noexcept;
 // service_status_t: non-empty process, pid > 0, known state, 0..MAX_COUNTERS counters >= 0
 // with matching array sizes, timings NaN (not measured) or finite >= 0.
