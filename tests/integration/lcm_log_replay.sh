@@ -12,13 +12,25 @@ cleanup() { [ -n "$logger" ] && kill "$logger" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
 
 echo "== record with lcm-logger"
-lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*' "$dir/run.lcmlog" &
+lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*|WARMUP_.*' "$dir/run.lcmlog" &
 logger=$!
-sleep 0.5  # lcm-logger gives no ready signal; it subscribes at start-up
+# lcm-logger gives no ready signal: warm-up rounds on another prefix until its file shows them
+# (a fixed sleep lost the first rounds on a loaded machine; check-log counts these apart).
+for _ in $(seq 200); do
+  "$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
+  [ -s "$dir/run.lcmlog" ] && break
+  sleep 0.05
+done
+[ -s "$dir/run.lcmlog" ] || { echo "lcm-logger never recorded the warm-up messages" >&2; exit 1; }
 # 1000 rounds/s: the loop's own block rate. lcm-logger's subscription queue is LCM's default
 # (30 messages): faster, a loaded machine that deschedules it for ~10 ms makes it drop.
 "$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 1000
-sleep 0.3
+# The same at the end: the logger handles its socket in order, so once a round sent after them
+# is in the file, so is every HX_ message (channel names are plain text in the log).
+marks() { grep -a -o 'WARMUP_SENSOR' "$dir/run.lcmlog" | wc -l; }
+before=$(marks)
+"$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
+for _ in $(seq 200); do [ "$(marks)" -gt "$before" ] && break; sleep 0.05; done
 kill -INT "$logger"; wait "$logger" || true; logger=""
 
 echo "== read the log back"
