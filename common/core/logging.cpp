@@ -38,6 +38,13 @@ std::shared_ptr<spdlog::logger> init_logging(std::string_view process_name, std:
   std::vector<spdlog::sink_ptr> sinks;
   sinks.push_back(std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
   if (log_file) {
+    // spdlog would create missing folders; a typo in a path is refused like every other path.
+    const std::filesystem::path folder = log_file->has_parent_path() ? log_file->parent_path() : ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) {
+      throw ParameterError("log_file", "'" + log_file->string() + "': the folder '" + folder.string() +
+                                           "' does not exist (create it first)");
+    }
     try {
       sinks.push_back(std::make_shared<spdlog::sinks::basic_file_sink_mt>(log_file->string()));
     } catch (const spdlog::spdlog_ex& e) {

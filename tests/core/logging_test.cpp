@@ -89,5 +89,18 @@ TEST(Logging, UnwritableFileIsAParameterError) {
   }
 }
 
+TEST(Logging, AMissingFolderIsRefusedNotCreated) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "hystloop-no-such-folder-for-logs";
+  std::filesystem::remove_all(folder);
+  try {
+    (void)init_logging("x", "info", folder / "x.log");
+    FAIL() << "expected ParameterError";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "log_file");
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder));
+}
+
 }  // namespace
 }  // namespace hystloop

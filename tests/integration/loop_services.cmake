@@ -16,3 +16,12 @@ if(TARGET hystloop-bridge AND TARGET hystloop-compensator)
     set_tests_properties(${_script} PROPERTIES LABELS integration TIMEOUT 60 RESOURCE_LOCK hystloop_live_loop)
   endforeach()
 endif()
+
+# All four services, the logger and the re-identifier killed and restarted under load.
+if(TARGET hystloop-bridge AND TARGET hystloop-reidentifier AND TARGET hystloop-logger AND TARGET logger_probe)
+  add_test(NAME rig_restart
+    COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/rig_restart.sh
+            $<TARGET_FILE:hystloop-bridge> $<TARGET_FILE:hystloop-compensator> $<TARGET_FILE:loop_probe>
+            $<TARGET_FILE:hystloop-reidentifier> $<TARGET_FILE:hystloop-logger> $<TARGET_FILE:logger_probe>)
+  set_tests_properties(rig_restart PROPERTIES LABELS integration TIMEOUT 120 RESOURCE_LOCK hystloop_live_loop)
+endif()
