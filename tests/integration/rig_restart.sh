@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The rig keeps the stage safe and loses nothing silently while its helpers die: all four services
-# beside two CPU-bound processes (stress-ng --cpu 2), tracking from wrong MEM parameters; the
-# logger and then the re-identifier are killed (SIGKILL) and restarted. Asserts: no applied voltage
-# out of range or slew and no watchdog trip (the bridge and the compensator never stopped); the
+# beside two CPU-bound processes (stress-ng --cpu 2), tracking from wrong MEM parameters; forged
+# traffic arrives (a parameter set with version 2147483647, sensor blocks far behind the clock),
+# then the logger and the re-identifier are killed (SIGKILL) and restarted. Asserts: no applied
+# voltage out of range or slew, no watchdog trip, no late tick, no restart of the control law; the
 # killed logger's file and the new one read to their ends; the restarted re-identifier (a new
-# publisher) gets a parameter set adopted by the compensator. Inside tools/netns-run.
+# publisher) gets a parameter set adopted despite the forged version. Inside tools/netns-run.
 #   rig_restart.sh <bridge> <compensator> <loop_probe> <reidentifier> <logger> <logger_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
 reident="$4" logger="$5" lprobe="$6"
@@ -24,7 +25,12 @@ sleep 0.3
 "$probe" control --command arm
 wait_log "$dir/bridge.log" "ARM (request"
 "$probe" trajectory --version 1 --shape 2 --amplitude-m -1.6e-6 --frequency-hz 1 --blend-s 0.5
-sleep 6
+sleep 3
+# Forged traffic from outside the rig: a parameter set with the highest version there is, and
+# sensor blocks far behind the bridge's clock (loop_probe inject: seq 1, plus malformed ones).
+"$probe" params --version 2147483647 --c1 5e-9 --c2 1e-12 --c3 1.2
+"$probe" inject --target compensator --count 3
+sleep 3
 kill -KILL $lpid; wait $lpid 2>/dev/null || true
 sleep 0.5
 start_logger 2
@@ -48,6 +54,9 @@ wait $cpid || fail "the compensator exited with $?"
 stop_recording
 "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
 [ "$trips" -eq 0 ] || fail "$trips watchdog trips while the logger and the re-identifier were restarted"
+restarts=$(value compensator bridge_restarts)
+[ "$restarts" -eq 0 ] || fail "forged sensor blocks restarted the compensator's control law ($restarts)"
+[ "$(value bridge late)" -eq 0 ] || fail "$(value bridge late) late ticks: forged blocks or restarts disturbed the plan"
 [ "$accepted_after" -gt "$accepted_before" ] || fail "no parameter set accepted from the restarted re-identifier ($accepted_before -> $accepted_after)"
 grep -q "accepted" "$dir/compensator.log" || fail "the compensator logged no accepted set"
 files=$(ls "$dir/logs"/*.lcmlog | wc -l)
