@@ -104,21 +104,27 @@ void BridgeRealtime::run() noexcept {
   PeriodicTimer timer(period_ns_from_rate_hz(settings_.rate_hz) * per_wake);
   started_.store(true, std::memory_order_release);
 
-  // A simulated stage has no wall clock: ticks whose deadline passed are run late, back to back
-  // (counted), so its samples never have gaps. Hardware cannot go back in time: they are skipped.
+  // A simulated stage has no wall clock: ticks whose deadline passed are run late (counted), so
+  // its samples never have gaps; but at most twice a wake-up's ticks per wake-up, so that after a
+  // long stall the simulated clock catches up over a few milliseconds while the compensator keeps
+  // refilling the buffer — one burst of a stall's ticks would run the buffer dry at once and trip
+  // the watchdog (seen on a fresh clone while another build ran: a 50 ms stall, 480 stale
+  // commands). Hardware cannot go back in time: missed deadlines are skipped.
   const bool catch_up = backend_->simulated();
+  std::int64_t next = 0;  // the next tick to run
   while (!stop_.load(std::memory_order_acquire)) {  // the I/O thread stops us after a last report
     const TickInfo info = timer.wait_next();
-    const auto missed = static_cast<std::int64_t>(info.skipped) * per_wake;
-    const std::int64_t last = (static_cast<std::int64_t>(info.tick) + 1) * per_wake;  // one past the last tick due
-    std::int64_t first = last - per_wake;
-    if (catch_up) {
-      first -= missed;
-      ticks_caught_up_ += static_cast<std::uint64_t>(missed);
-    } else {
-      ticks_skipped_ += static_cast<std::uint64_t>(missed);
+    const std::int64_t due = (static_cast<std::int64_t>(info.tick) + 1) * per_wake;  // ticks [0, due) are due
+    std::uint64_t skipped = 0;
+    if (!catch_up && next < due - per_wake) {
+      skipped = static_cast<std::uint64_t>(due - per_wake - next);
+      ticks_skipped_ += skipped;
+      next = due - per_wake;
     }
-    for (std::int64_t k = first; k < last; ++k) tick(k, k == first && !catch_up ? static_cast<std::uint64_t>(missed) : 0);
+    const std::int64_t end = catch_up ? std::min(due, next + 2 * per_wake) : due;
+    if (end - next > per_wake) ticks_caught_up_ += static_cast<std::uint64_t>(end - next - per_wake);
+    for (std::int64_t k = next; k < end; ++k) tick(k, k == next ? skipped : 0);
+    next = end;
     RtReport& report = reports_.current();
     report.lateness.add(info.lateness_ns);
   }
