@@ -10,16 +10,6 @@
 
 namespace hystloop {
 
-std::string_view to_string(ModelKind kind) noexcept {
-  switch (kind) {
-    case ModelKind::mem: return "mem";
-    case ModelKind::pi: return "pi";
-    case ModelKind::katalenic: return "katalenic";
-    case ModelKind::linear: return "linear";
-  }
-  return "unknown";
-}
-
 void ModelSelectionOptions::validate() const {
   require_in_range("holdout_fraction", holdout_fraction, 0.05, 0.8);
   if (candidates.empty()) throw ParameterError("candidates", "must name at least one model");

@@ -17,11 +17,10 @@
 #include "ident/linear_fit.hpp"
 #include "ident/mem_fit.hpp"
 #include "ident/pi_fit.hpp"
+#include "models/model_set.hpp"  // ModelKind
 
 namespace hystloop {
 
-enum class ModelKind { mem, pi, katalenic, linear };
-std::string_view to_string(ModelKind kind) noexcept;
 
 struct ModelSelectionOptions {
   double holdout_fraction = 0.3;  // the held-out part starts at the first reversal after 1 - this
