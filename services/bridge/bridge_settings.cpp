@@ -8,6 +8,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "runtime/config_validation.hpp"
+#include "runtime/rig_auth_config.hpp"
 
 namespace hystloop {
 const std::vector<std::string>& bridge_config_keys() {
@@ -22,14 +23,24 @@ const std::vector<std::string>& bridge_config_keys() {
       "banning.hysteresis.a", "banning.hysteresis.b", "banning.hysteresis.alpha", "banning.hysteresis.s_max",
       "banning.stage.k", "banning.stage.c", "banning.order",
       "ro.c1", "ro.c2", "ro.c3"};
-  return keys;
+  static const std::vector<std::string> all = [] {
+    std::vector<std::string> k = keys;
+    k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
+    return k;
+  }();
+  return all;
 }
 
 BridgeSettings load_bridge_settings(const Config& config) {
-  config.check_no_unknown_keys(bridge_config_keys());
+  std::vector<std::string> known = bridge_config_keys();
+  known.insert(known.end(), rig_auth_config_keys().begin(), rig_auth_config_keys().end());  // read by main
+  config.check_no_unknown_keys(known);
   BridgeSettings s;
   s.backend = config.get<std::string>("bridge.backend", s.backend);
-  if (s.backend != "sim" && s.backend != "ro") config.fail("bridge.backend", "must be sim or ro (got '" + s.backend + "')");
+  if (s.backend != "sim" && s.backend != "ro" && s.backend != "comedi") {
+    config.fail("bridge.backend", "must be sim, ro or comedi (got '" + s.backend + "')");
+  }
+  s.comedi = load_comedi_settings(config);  // validated whatever the backend: one config serves both
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
   s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
   s.rearm_after_trip_s = config.get_in_range("actuator.rearm_after_trip_s", s.rearm_after_trip_s, 0.0, 3600.0);
@@ -95,6 +106,9 @@ BridgeSettings load_bridge_settings(const Config& config) {
     config.fail("rt.ticks_per_wake", "must not exceed bridge.block_ticks (" + std::to_string(s.block_ticks) +
                                          "): a block is published when its last tick has run");
   }
+  if (s.backend == "comedi" && s.rt.ticks_per_wake != 1) {
+    config.fail("rt.ticks_per_wake", "must be 1 with bridge.backend comedi: a card's output cannot run ticks back to back");
+  }
   s.rt.priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt.priority, 0, 99));
   s.rt.io_priority = static_cast<int>(config.get_int_in_range("rt.io_priority", s.rt.io_priority, 0, 99));
   if (s.rt.io_priority > 0 && s.rt.io_priority >= s.rt.priority) {
@@ -119,7 +133,9 @@ std::vector<std::string> describe(const BridgeSettings& s) {
                               "stop: ramp to safe (at most {:.4g} s) within {} s",
                               a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_rate_V_per_s(), a.watchdog_s,
                               a.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
-  if (s.backend == "sim") {
+  if (s.backend == "comedi") {
+    lines.push_back(describe(s.comedi));
+  } else if (s.backend == "sim") {
     lines.push_back(fmt::format("banning: a {} m/V, b {} m/V, alpha {} 1/V, s_max {} V, k {} 1/s^2, c {} 1/s", h.a, h.b,
                                 h.alpha, h.s_max, st.banning.stage.k, st.banning.stage.c));
   } else {

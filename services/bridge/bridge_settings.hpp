@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bridge/comedi_config.hpp"
 #include "core/config.hpp"
 #include "loop/bridge_core.hpp"
 #include "loop/simulated_stage.hpp"
@@ -23,9 +24,10 @@ struct RtSettings {
 };
 
 struct BridgeSettings {
-  std::string backend = "sim";     // sim (Banning stage) | ro (Ramberg-Osgood)
+  std::string backend = "sim";     // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
   double rate_hz = 10000.0;        // the loop's clock
   SimulatedStageConfig stage{};    // noise, seed, drift and the plants' parameters
+  ComediSettings comedi{};         // the comedi.* keys (used when backend is comedi)
   ActuatorLimits limits{};
   FeedbackGains servo{};           // the servo on y_ref - y (all gains 0 = feedforward only)
   int block_ticks = 20;            // ticks per HX_SENSOR block: 500 messages/s (1 = a message per tick)

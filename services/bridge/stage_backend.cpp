@@ -1,5 +1,6 @@
 #include "bridge/stage_backend.hpp"
 
+#include "bridge/comedi_backend.hpp"
 #include "loop/bridge_core.hpp"
 
 namespace hystloop {
@@ -13,8 +14,13 @@ StageReading SimulatedBackend::step(double u_V, double t_s, double dt_s) noexcep
 
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config) {
   config.plant = parse_plant_kind(name, "bridge.backend");  // throws for an unknown name
-  // A hardware backend is added here: `if (name == "mydaq") return std::make_unique<MyDaqBackend>(...);`
   return std::make_unique<SimulatedBackend>(name, config);
+}
+
+std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings) {
+  // A hardware backend is added here, under its bridge.backend name.
+  if (settings.backend == "comedi") return std::make_unique<ComediBackend>(settings.comedi, settings.limits);
+  return make_stage_backend(settings.backend, settings.stage);
 }
 
 }  // namespace hystloop

@@ -6,7 +6,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "bridge/bridge_settings.hpp"
 #include "loop/simulated_stage.hpp"
 
 namespace hystloop {
@@ -14,6 +17,8 @@ namespace hystloop {
 struct StageReading {
   double y_m = 0.0;         // measured position [m]
   std::int32_t flags = 0;   // sample_flags bits the backend adds (kSimulated, a sensor fault, ...)
+  bool go_safe = false;     // the backend asks for the safe state (e.g. its sensor failed too often in a row):
+                            // the bridge disarms as for DISARM (ramp to actuator.safe_u_V; re-arm via ARM)
 };
 
 class StageBackend {
@@ -35,6 +40,9 @@ class StageBackend {
   // takes the actuator there the way the device allows, e.g. its own ramp or output disable).
   // May be called more than once; must not throw, allocate or block for long.
   virtual void hold_safe(double safe_u_V) noexcept = 0;
+  // The backend's own counters (cumulative; read on the I/O thread while step() runs, so kept
+  // in atomics), appended to the bridge's HX_STATUS counters.
+  virtual void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& /*entries*/) const {}
 };
 
 // The built-in simulator (Banning stage or Ramberg-Osgood plant) with noise and drift.
@@ -56,5 +64,9 @@ class SimulatedBackend final : public StageBackend {
 // The backend `name` names: "sim" (Banning) or "ro" (Ramberg-Osgood); the plant kind in
 // `config` is set from the name. Throws ParameterError("bridge.backend") otherwise.
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config);
+
+// The backend bridge.backend names: sim, ro, or comedi (ComediBackend: opens the card; throws
+// ConfigError for a config the card refuses, std::runtime_error when it cannot be opened).
+std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings);
 
 }  // namespace hystloop

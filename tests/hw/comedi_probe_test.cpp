@@ -1,0 +1,107 @@
+// hystloop-bridge itself against the fake card, loaded as libcomedi.so.0 from
+// HYSTLOOP_FAKE_LIBCOMEDI_DIR: --probe-hardware lists the card and, with --yes only, drives the
+// clamped triangle and reports the sensor's gain and sign; a config the card refuses exits 2
+// with the output left safe; a SIGTERM leaves it safe (the fake logs the first and last DAC
+// codes written at comedi_close: HX_FAKE_COMEDI_LOG).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+const std::string kConfig = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge-comedi.yaml";
+const std::string kSafeCode = "first 32768 ";  // 0 V in [-10, 10] V, 16 bit
+
+struct BridgeRun {
+  int rc = -1;
+  std::string out;
+  std::string log;  // the fake's
+};
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+BridgeRun run(const std::string& fake, const std::string& args, const std::string& wrap = "") {
+  const std::string log = ::testing::TempDir() + "/fake_comedi_" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".log";
+  std::remove(log.c_str());
+  const std::string bridge = std::string(HYSTLOOP_BRIDGE_EXE) + " --config " + kConfig + " " + args;
+  const std::string cmd = "LD_LIBRARY_PATH=" HYSTLOOP_FAKE_LIBCOMEDI_DIR " HX_FAKE_COMEDI='" + fake +
+                          "' HX_FAKE_COMEDI_LOG=" + log + " " + (wrap.empty() ? bridge : wrap + " '" + bridge + "'") +
+                          " 2>&1";
+  BridgeRun r;
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p) != nullptr) r.out += buf.data();
+  const int status = ::pclose(p);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream f(log);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  r.log = ss.str();
+  return r;
+}
+
+TEST(ComediProbe, ListsTheCardAndDrivesNothingWithoutYes) {
+  const BridgeRun r = run("", "--probe-hardware");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  EXPECT_TRUE(contains(r.out, "card: driver fake_driver, board fake_board, 3 subdevices")) << r.out;
+  EXPECT_TRUE(contains(r.out, "subdevice 0: analog input, 16 channels, maxdata 65535")) << r.out;
+  EXPECT_TRUE(contains(r.out, "subdevice 1: analog output, 2 channels")) << r.out;
+  EXPECT_TRUE(contains(r.out, "    range 1: [0, 10] V")) << r.out;
+  EXPECT_TRUE(contains(r.out, "calibration: none found (conversions use the range tables)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "not driving the output. With --yes")) << r.out;
+  EXPECT_FALSE(contains(r.out, "measured"));
+  EXPECT_TRUE(contains(r.log, "writes 0 ")) << r.log;
+}
+
+TEST(ComediProbe, WithYesReportsTheSensorsGainAndSign) {
+  BridgeRun r = run("mirror_gain=0.5,calibration=1", "--probe-hardware --yes --duration-s 0.2");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  EXPECT_TRUE(contains(r.out, "calibration: softcal file /var/lib/comedi/calibrations/fake_board_comedi0")) << r.out;
+  EXPECT_TRUE(contains(r.out, "triangle 0 V -> 1 V -> -1 V -> 0 V at the card (x25: -25..25 V at the piezo)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "measured: sensor +0.5")) << r.out;
+  EXPECT_TRUE(contains(r.out, "verdict: sign OK")) << r.out;
+  // The softcal code for 0 V (the fake's output is 2 mV high and 1 % steep): first and last.
+  EXPECT_TRUE(contains(r.log, "first 32761 ") && contains(r.log, "last 32761 ")) << r.log;
+  r = run("mirror_gain=-0.8", "--probe-hardware --yes --duration-s 0.2 --amplitude-V 2");
+  EXPECT_EQ(r.rc, 1) << r.out;
+  EXPECT_TRUE(contains(r.out, "measured: sensor -0.8")) << r.out;
+  EXPECT_TRUE(contains(r.out, "SIGN REVERSED")) << r.out;
+  EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
+  // Clamped to the actuator's range: +-2 V at the card asked, +-50 V / 25 allowed.
+  r = run("mirror_gain=1", "--probe-hardware --yes --duration-s 0.1 --amplitude-V 5 --set actuator.u_min_V=-50 "
+                           "--set actuator.u_max_V=50");
+  EXPECT_TRUE(contains(r.out, "triangle 0 V -> 2 V -> -2 V -> 0 V")) << r.out;
+}
+
+TEST(ComediProbe, ACardThatRefusesTheConfigExitsTwoWithTheOutputSafe) {
+  BridgeRun r = run("", "--probe-hardware --yes --set comedi.amplifier_gain_V_per_V=10");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "comedi.ao.range")) << r.out;
+  EXPECT_TRUE(contains(r.log, "writes 1 first 32768 ")) << r.log;
+  r = run("", "--probe-hardware --yes --set comedi.ai.channel=40");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "comedi.ai.channel")) << r.out;
+  r = run("", "--probe-hardware --device /dev/nothing");
+  EXPECT_EQ(r.rc, 1) << r.out;
+  EXPECT_TRUE(contains(r.out, "comedi_open(/dev/nothing)")) << r.out;
+}
+
+TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
+  const std::string netns = std::string(HYSTLOOP_SOURCE_DIR) + "/tools/netns-run";
+  const BridgeRun r = run("", "--set rt.priority=0 --set rt.io_priority=0 --set rt.lock_memory=false --set rt.cpu=-1",
+                    netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  EXPECT_TRUE(contains(r.out, "the safe 0 V written (DAC code 32768)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "stopping on signal 15")) << r.out;
+  EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
+}
+
+}  // namespace

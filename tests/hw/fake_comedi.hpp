@@ -1,0 +1,71 @@
+#pragma once
+// A fake comedi card at the library boundary: this file's .cpp defines the comedilib calls
+// services/bridge/comedi_backend.cpp and probe_hardware.cpp use (same symbols and signatures as
+// comedilib.h), on a scripted board, and records every instruction list. Test executables link
+// it (hystloop_fake_comedi, a static library: their own definitions come first in ELF symbol
+// lookup, so the real libcomedi.so.0 the bridge library also names is never called); the
+// hystloop-bridge binary is run against it as libcomedi.so.0 on LD_LIBRARY_PATH
+// (hystloop_fake_libcomedi, same source, comedilib's symbol versions), scripted then through
+// the environment: HX_FAKE_COMEDI="mirror_gain=-0.5,calibration=1,open_fails=0" and
+// HX_FAKE_COMEDI_LOG=<file> (at comedi_close: the first and last DAC codes written and counts).
+//
+// The board: subdevice 0 an analog input (16 channels, 16 bit, ranges ±10, ±5, ±1 V, ground/
+// common/diff), 1 an analog output (2 channels, 16 bit, ranges ±10 V and 0..10 V), 2 a digital
+// I/O. The input "mirrors" the output: ai volts = mirror_gain * ao volts + mirror_offset_V,
+// unless scripted reads are queued.
+
+#include <comedilib.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace fake_comedi {
+
+struct Insn {
+  unsigned insn = 0;
+  unsigned subdev = 0;
+  unsigned chanspec = 0;
+  unsigned n = 0;
+  lsampl_t data = 0;  // the first data word: written (INSN_WRITE) or served (INSN_READ)
+};
+
+// One comedi_do_insnlist call (at most 2 instructions recorded).
+struct InsnList {
+  unsigned n_insns = 0;
+  Insn insns[2]{};
+};
+
+struct ScriptedRead {
+  int rc = 2;          // what comedi_do_insnlist returns (2: both done; 1: the read failed; -1: the call failed)
+  lsampl_t counts = 0; // what the read returns
+};
+
+struct State {
+  bool open_fails = false;
+  bool calibration = false;       // the board has a calibration file with softcal polynomials
+  double mirror_gain = 1.0;
+  double mirror_offset_V = 0.0;
+  std::vector<InsnList> lists;    // reserved: recording does not allocate up to its capacity
+  std::vector<ScriptedRead> reads;  // served first, in order, before mirroring
+  std::size_t next_read = 0;
+  int opens = 0;
+  int closes = 0;
+  lsampl_t ao_counts[2] = {0, 0};  // what each output channel holds now
+  unsigned ao_range[2] = {0, 0};   // ... in which range
+  long writes = 0;                 // output writes since reset (also past the record's capacity)
+  lsampl_t first_write = 0;
+  lsampl_t last_write = 0;
+};
+
+// The fake's state; reset() brings back the defaults above and empties the record.
+State& state();
+void reset();
+
+// The range tables' conversions (as comedilib's comedi_to_phys / comedi_from_phys).
+inline constexpr lsampl_t kMaxdata = 65535;
+// The fake softcal polynomials (when calibration is on): counts -> V for the output and input
+// have a 1 % gain error and a 2 mV offset against the range table.
+double softcal_gain() noexcept;
+double softcal_offset_V() noexcept;
+
+}  // namespace fake_comedi
