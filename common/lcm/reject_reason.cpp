@@ -12,6 +12,10 @@ std::string_view to_string(RejectReason reason) noexcept {
     case RejectReason::kNonFinite: return "non_finite";
     case RejectReason::kOutOfRange: return "out_of_range";
     case RejectReason::kHandlerFailed: return "handler_failed";
+    case RejectReason::kUnsigned: return "unsigned";
+    case RejectReason::kBadMac: return "bad_mac";
+    case RejectReason::kReplayed: return "replayed";
+    case RejectReason::kSkewed: return "skewed";
   }
   return "unknown";
 }

@@ -16,10 +16,16 @@ enum class RejectReason : std::uint8_t {
   kNonFinite,      // a NaN/Inf where the contract wants a number
   kOutOfRange,     // a value outside the contract (negative seq, unknown enum, c3 <= 0, ...)
   kHandlerFailed,  // the message was valid but the handler threw
+  // A keyed rig's authenticated channels (lcm/rig_auth.hpp):
+  kUnsigned,       // no authentication trailer
+  kBadMac,         // the MAC does not match: altered, moved from another channel, or another key
+  kReplayed,       // counter not above the last one accepted from its sender (a repeat or a replay)
+  kSkewed,         // counter further than auth.max_skew_s from this host's clock (a recording, or clocks apart)
 };
-inline constexpr std::size_t kRejectReasonCount = 6;
+inline constexpr std::size_t kRejectReasonCount = 10;
 
-// "wrong_type", "decode_failed", "size_mismatch", "non_finite", "out_of_range", "handler_failed".
+// "wrong_type", "decode_failed", "size_mismatch", "non_finite", "out_of_range", "handler_failed",
+// "unsigned", "bad_mac", "replayed", "skewed".
 std::string_view to_string(RejectReason reason) noexcept;
 
 // What a per-type value check says about a decoded message.

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The authenticated rig (README "Authenticated rig"): hystloop-ctl keygen writes a 0600 key and
+# will not overwrite it; a key file open to others stops the bridge at start (exit 2, "chmod 600");
+# a keyed bridge + compensator then run, and a publisher without the key sends ARM, a mode,
+# command blocks, a trajectory and a parameter set: nothing acts, the stage stays in the safe
+# state, and every message is counted as refused on HX_STATUS. A signed command block captured
+# from the running rig and replayed (at once: replayed; after the skew window: skewed) is refused.
+# Inside tools/netns-run.
+#   auth_rig.sh <hystloop-bridge> <hystloop-compensator> <loop_probe> <auth_probe> <hystloop-ctl>
+source "$(dirname "$0")/loop_common.sh" "$1" "$2" "$3"
+authp="$4"; ctl="$5"
+key="$dir/rig.key"
+
+"$ctl" keygen --out "$key" >/dev/null || fail "keygen failed"
+[ "$(stat -c %a "$key")" = 600 ] || fail "keygen wrote mode $(stat -c %a "$key"), expected 600"
+set +e; "$ctl" keygen --out "$key" 2>"$dir/keygen.err"; rc=$?; set -e
+[ "$rc" = 2 ] && grep -q -- "--force" "$dir/keygen.err" || fail "keygen over an existing key: exit $rc"
+
+chmod 644 "$key"
+set +e; "$bridge" "${bridge_args[@]}" --set auth.key_file="$key" --seconds 1 >"$dir/open_key.log" 2>&1; rc=$?; set -e
+[ "$rc" = 2 ] || fail "the bridge started with a key file open to others (exit $rc)"
+grep -q "chmod 600 $key" "$dir/open_key.log" || fail "no 'chmod 600 $key' in: $(cat "$dir/open_key.log")"
+chmod 600 "$key"
+
+auth=(--set auth.key_file="$key")
+start_recording
+"$compensator" "${compensator_args[@]}" "${auth[@]}" >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
+"$bridge" "${bridge_args[@]}" "${auth[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)   # not armed
+wait_log "$dir/compensator.log" "channels:"
+wait_log "$dir/bridge.log" "started in the safe state"
+grep -q "auth: commands, control" "$dir/bridge.log" || fail "the bridge did not say it checks signatures"
+sleep 1.0
+"$authp" capture --channel COMMAND --out "$dir/early.bin" >/dev/null || fail "no command block to capture"
+"$ctl" --key-file "$key" reset-counters >/dev/null   # signed: counts from here on
+sleep 0.3
+
+# The foreign publisher: no key.
+"$ctl" arm >/dev/null
+"$ctl" mode off >/dev/null
+"$ctl" trajectory --shape hold --offset 1e-7 >/dev/null
+"$ctl" params --c1 5e-9 --c2 1e-12 --c3 1.2 --version 9 >/dev/null
+"$authp" commands --count 10 >/dev/null
+# A signed block captured now and replayed at once: its counter was seen.
+"$authp" capture --channel COMMAND --out "$dir/now.bin" >/dev/null
+"$authp" replay --channel COMMAND --in "$dir/now.bin"
+# The one captured before the reset, now older than auth.max_skew_s (2 s): a recording.
+sleep_left=$(awk -v t="$(stat -c %Y "$dir/early.bin")" -v now="$(date +%s)" 'BEGIN { s = t + 3.2 - now; print (s > 0 ? s : 0) }')
+sleep "$sleep_left"
+"$authp" replay --channel COMMAND --in "$dir/early.bin"
+sleep 1.3   # a status report after the last one
+kill -TERM $bpid $cpid
+wait $bpid || fail "the bridge exited with $?"
+wait $cpid || fail "the compensator exited with $?"
+stop_recording
+
+expect_value bridge command.rejected_unsigned 10
+expect_value bridge command.rejected_replayed 1
+expect_value bridge command.rejected_skewed 1
+expect_value bridge command.rejected_bad_mac 0
+[ "$(value bridge command.accepted)" -gt 100 ] || fail "the bridge took few signed command blocks: $(value bridge command.accepted)"
+[ "$(value bridge control.rejected_unsigned)" -ge 3 ] || fail "bridge control.rejected_unsigned = $(value bridge control.rejected_unsigned)"
+expect_value bridge control_acted 0           # ARM never acted on
+expect_value bridge armed 0
+expect_value bridge applied 0                 # no command reached the stage: safe state throughout
+for endpoint in trajectory params control; do
+  [ "$(value compensator $endpoint.rejected_unsigned)" -ge 1 ] || fail "compensator $endpoint.rejected_unsigned = $(value compensator $endpoint.rejected_unsigned)"
+done
+expect_value compensator trajectory.accepted 0
+expect_value compensator params.accepted 0
+expect_value compensator control_acted 1       # the signed reset-counters only
+expect_value compensator trajectories 0
+expect_value compensator params_accepted 0
+echo "bridge refused: command unsigned $(value bridge command.rejected_unsigned), replayed $(value bridge command.rejected_replayed)," \
+     "skewed $(value bridge command.rejected_skewed), control unsigned $(value bridge control.rejected_unsigned)"
+echo "auth_rig: ok"
