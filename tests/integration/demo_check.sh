@@ -14,27 +14,10 @@ rm -rf "$out"
 s="$out/summary.json"
 [ -f "$s" ] || { echo "FAIL: no $s"; exit 1; }
 fail=0
-check() {  # description, jq expression that must be true
-  if jq -e "$2" "$s" >/dev/null; then echo "ok:   $1"; else echo "FAIL: $1 ($2)"; fail=1; fi
-}
-for ch in SENSOR COMMAND TRAJECTORY PARAMS STATUS CONTROL; do
-  check "channel HXT_$ch logged" ".channels.HXT_$ch > 0"
-done
-check "the logger reported every sensor gap in the log" '.logger_gaps >= .seq_gaps'
-check "no sample tick missing" '.missing_samples == 0'
-# The loop's contract (../shared/DESIGN.md, "Timing"): the compensator plans 50 ms ahead, so the
-# stalls of a shared machine (a few ms with SCHED_FIFO, tens without) cost nothing. Judged on
-# every run, with margins: the benchmark (bench/run-all) reports the figures themselves.
-check "no watchdog trip with the 2 ms watchdog" '.watchdog_trips == 0'
-check "late ticks at most 0.1 % of armed ticks" '.late_tick_fraction <= 0.001'
-check "the re-identifier published a new parameter set" '.params_updates >= 1'
-check "the parameters changed from the wrong start" '.params_final.c1 != .params_initial.c1'
-check "tracking with the servo + re-identification within 5 nm RMS in the last 5 s (1 nm sensor noise)" \
-  '.rms_error_last_5s_m < 5e-9'
+source "$(dirname "$0")/summary_checks.sh"
+check_loop_summary "$s" HXT_
 for f in hysteresis_u_y.png tracking_error.png; do
   [ -s "$out/$f" ] && echo "ok:   $f written" || { echo "FAIL: $f missing"; fail=1; }
 done
-jq '{rms_error_first_5s_m, rms_error_last_5s_m, late_tick_fraction, watchdog_trips, buffer_min_depth_ticks,
-     run_ahead_p01_ticks, cpu_fraction, messages_per_s, params_initial, params_final, params_updates, logger_gaps,
-     commands_rejected, duration_s}' "$s"
+print_loop_summary "$s"
 exit "$fail"

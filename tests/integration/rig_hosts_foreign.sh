@@ -1,0 +1,56 @@
+# Sourced by rig_hosts.sh on a keyed rig, after `up` and before the scenario (the bridge is
+# SAFE at 0 V, the compensator waits for a trajectory): a publisher on the desk without the key
+# (hystloop-ctl without --key-file, and a keyless compensator planning commands for 2 s) sends
+# ARM, START_EXPERIMENT, a trajectory, a parameter set and command blocks. Nothing changes on the
+# stage (the bridge stays SAFE, every recorded u is 0 V, the compensator accepts nothing) and each
+# kind is counted refused as unsigned on HX_STATUS (the desk's recording of it).
+# Uses rig_hosts.sh's in_ns, ctl_exe, build, cfg, out, prefix, fail.
+foreign_url="udpm://239.255.76.67:7667?ttl=1"
+last_report() { grep "^process=$1 " "$out/desk/status.log" | tail -n 1; }
+counter() {  # process, counter name -> its value in the last report (the last of duplicate names)
+  last_report "$1" | tr ' ' '\n' | awk -F= -v k="$2" '$1 == k { v = $2 } END { print v + 0 }'
+}
+foreign_counts() {
+  local p k
+  for p in bridge compensator; do
+    for k in control.rejected_unsigned command.rejected_unsigned trajectory.rejected_unsigned \
+      params.rejected_unsigned control.accepted trajectory.accepted params.accepted params_accepted; do
+      echo "$p.$k=$(counter "$p" "$k")"
+    done
+  done
+}
+sleep 1.2  # a status report of each after `up`
+foreign_counts >"$out/foreign-before.txt"
+seq_before=$(tail -n 1 "$out/desk/sensor.csv" | cut -d, -f1)
+foreign() { in_ns desk "$ctl_exe" --lcm-url "$foreign_url" --allow-network --rig "$prefix" "$@" >/dev/null; }
+foreign arm
+foreign experiment --mem-paper --duration 2
+foreign trajectory --mem-paper --blend 0.5
+foreign params --c1 2e-9 --c2 2e-9 --c3 0.3 --version 1000
+in_ns desk timeout -s TERM 2 "$build/services/compensator/hystloop-compensator" --config "$cfg/compensator.yaml" \
+  --lcm-url "$foreign_url" --allow-network --rig "$prefix" >"$out/foreign-compensator.log" 2>&1 || true
+sleep 2.5  # the real compensator's report is the last again (the keyless one also reported as "compensator")
+foreign_counts >"$out/foreign-after.txt"
+value_in() { awk -F= -v k="$1" '$1 == k { print $2 }' "$2"; }
+delta() { echo $(($(value_in "$1" "$out/foreign-after.txt") - $(value_in "$1" "$out/foreign-before.txt"))); }
+foreign_check() {  # description, counter, minimum increase, maximum increase
+  local d; d=$(delta "$2")
+  if [ "$d" -ge "$3" ] && [ "$d" -le "$4" ]; then echo "ok:   keyless $1: $2 +$d"
+  else echo "FAIL: keyless $1: $2 +$d (expected $3..$4)"; fail=1; fi
+}
+big=1000000000
+foreign_check "ARM + START_EXPERIMENT (3 copies each)" bridge.control.rejected_unsigned 6 "$big"
+foreign_check "command blocks" bridge.command.rejected_unsigned 1 "$big"
+foreign_check "ARM + START_EXPERIMENT" compensator.control.rejected_unsigned 6 "$big"
+foreign_check "trajectory (3 copies)" compensator.trajectory.rejected_unsigned 3 "$big"
+foreign_check "parameter set (3 copies)" compensator.params.rejected_unsigned 3 "$big"
+for k in bridge.control.accepted compensator.control.accepted compensator.trajectory.accepted \
+  compensator.params.accepted compensator.params_accepted; do
+  foreign_check "nothing accepted" "$k" 0 0
+done
+if [ "$(counter bridge state)" = 3 ]; then echo "ok:   the bridge stayed SAFE"
+else echo "FAIL: the bridge left SAFE (state $(counter bridge state))"; fail=1; fi
+moved=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s && $3 != 0' "$out/desk/sensor.csv" | wc -l)
+ticks=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s' "$out/desk/sensor.csv" | wc -l)
+if [ "$moved" = 0 ] && [ "$ticks" -gt 0 ]; then echo "ok:   u stayed 0 V over $ticks recorded ticks"
+else echo "FAIL: u moved on $moved of $ticks recorded ticks"; fail=1; fi
