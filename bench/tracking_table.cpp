@@ -1,21 +1,60 @@
-// tracking_table: the tracking figures of docs/BENCHMARKS.md, as tests/loop/tracking_test.cpp
+// tracking_table: the tracking figures of docs/BENCHMARKS.md, as tests/sim/tracking_test.cpp
 // computes them, printed as a Markdown table beside the MEM paper's measured figures.
 //
-// In process and faster than real time (common/loop/loop_simulation.hpp): the Banning stage
+// In process and faster than real time (common/sim/loop_simulation.hpp): the Banning stage
 // (Tables 1-2, 1 nm RMS sensor noise, seed 7), every model identified from the MEM paper's
 // identification experiment (250 V sin(20 pi t), 2 s) run through the loop, then the reference
 // y_d = -1.6 um cos(2 pi t) tracked with each feedforward, without and with PI feedback
 // (kp 0.1, ki 600 1/s); RMS error over t in [4, 8) s against the true position.
 //
-//   tracking_table            prints the table (Markdown) and the identified MEM parameters
+// Then the re-identification table (issue 11), without and with re-identification side by side,
+// from MEM's deliberately wrong start: RMS over [8, 12) s of a 12 s run, and with the stage's
+// gain drifting +10 % over 30 s, over [20, 30) s of a 30 s run.
+//
+//   tracking_table            prints the tables (Markdown) and the identified MEM parameters
+//   tracking_table --help     this text
 
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <string>
 
-#include "loop/tracking_experiment.hpp"
+#include "sim/tracking_experiment.hpp"
 
-int main() {
+namespace {
+
+// One row of the re-identification table: without / with, feedforward only and with the servo.
+void reid_row(const char* name, const hystloop::TrackingExperiment& e, const hystloop::IdentifiedModels& id,
+              hystloop::TrackingOptions o) {
   using namespace hystloop;
+  const Reidentify reid = o.reidentify;
+  double rms[2][2] = {};
+  TrackingRun last;
+  for (int fb = 0; fb < 2; ++fb) {
+    o.feedback = fb == 1;
+    for (int on = 0; on < 2; ++on) {
+      o.reidentify = on == 1 ? reid : Reidentify::off;
+      last = run_tracking(e, id, o);
+      rms[fb][on] = last.stats.rms_true_m * 1e9;
+      if (fb == 0 && on == 1) {
+        std::printf("| %s | %.2f nm | %.2f nm | %s, %zu swaps (%d worse) |", name, rms[0][0], rms[0][1],
+                    std::string(to_string(last.final_kind)).c_str(), last.swaps.size(), last.worse_swaps);
+      }
+    }
+  }
+  std::printf(" %.2f nm | %.2f nm |\n", rms[1][0], rms[1][1]);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace hystloop;
+  if (argc > 1) {
+    const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
+    std::printf("usage: tracking_table [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and docs/TRACKING.md.\n");
+    return help ? 0 : 2;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const TrackingExperiment experiment;
   const IdentifiedModels id = identify_models_through_loop(experiment);
@@ -47,8 +86,32 @@ int main() {
                 fb.rms_true_m * 1e9, fb.rms_measured_m * 1e9, r.paper);
     std::fflush(stdout);
   }
+  std::printf("\n| from MEM's wrong start | ff only | ff + re-identification | model at the end | servo | servo + "
+              "re-identification |\n| --- | --- | --- | --- | --- | --- |\n");
+  TrackingExperiment twelve = experiment;
+  twelve.track_s = 12.0;
+  twelve.settle_s = 8.0;
+  TrackingOptions o;
+  o.start_mem = wrong;
+  o.reidentify = Reidentify::mem;
+  reid_row("MEM estimator, [8, 12) s", twelve, id, o);
+  o.reidentify = Reidentify::select;
+  o.selector.pinned = true;
+  reid_row("selector, MEM pinned, [8, 12) s", twelve, id, o);
+  o.selector.pinned = false;
+  reid_row("selector, automatic, [8, 12) s", twelve, id, o);
+  TrackingExperiment drift = experiment;
+  drift.drift_fraction = 0.1;
+  drift.drift_duration_s = 30.0;
+  drift.track_s = 30.0;
+  drift.settle_s = 20.0;
+  o.start_mem = id.mem;  // the offline fit, then the gain drifts
+  o.reidentify = Reidentify::mem;
+  reid_row("gain +10 %/30 s, offline MEM start, MEM estimator, [20, 30) s", drift, id, o);
+  o.reidentify = Reidentify::select;
+  reid_row("gain +10 %/30 s, offline MEM start, automatic, [20, 30) s", drift, id, o);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("\n(%.0f s of simulated loop at 10 kHz in %.1f s of wall time)\n",
-              experiment.identify_s + 12 * experiment.track_s, seconds);
+              experiment.identify_s + 12 * experiment.track_s + 3 * 4 * 12.0 + 2 * 4 * 30.0, seconds);
   return id.ok ? 0 : 1;
 }

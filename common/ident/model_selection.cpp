@@ -1,7 +1,6 @@
 #include "ident/model_selection.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -43,8 +42,6 @@ std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<c
   return out;
 }
 
-namespace {
-
 // Held-out RMS after removing the offset estimated on [train_begin, split).
 double holdout_rms(std::span<const double> y, const std::vector<double>& pred, std::size_t train_begin,
                    std::size_t split) {
@@ -55,8 +52,6 @@ double holdout_rms(std::span<const double> y, const std::vector<double>& pred, s
   for (std::size_t k = split; k < y.size(); ++k) ss += std::pow(y[k] - pred[k] - off, 2);
   return std::sqrt(ss / static_cast<double>(std::max<std::size_t>(y.size() - split, 1)));
 }
-
-}  // namespace
 
 ModelSelection select_model(std::span<const double> u, std::span<const double> y, const ModelSelectionOptions& o) {
   o.validate();
@@ -83,23 +78,25 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
   for (ModelKind kind : o.candidates) {
     ModelScore score;
     score.kind = kind;
-    const auto t0 = std::chrono::steady_clock::now();
     std::vector<double> pred;
     switch (kind) {
       case ModelKind::mem:
         sel.mem = fit_mem(ut, yt, o.mem);
         score.status = sel.mem.status, score.reason = sel.mem.reason, score.train_rms_m = sel.mem.residual_rms_m;
+        score.fit_time_s = sel.mem.solve_time_s;
         if (sel.mem.ok()) pred = predict_mem(sel.mem.params, u, y);
         break;
       case ModelKind::pi:
         sel.pi = fit_pi(ut, yt, o.pi);
         score.status = sel.pi.status, score.reason = sel.pi.reason, score.train_rms_m = sel.pi.residual_rms_m;
+        score.fit_time_s = sel.pi.solve_time_s;
         if (sel.pi.ok()) pred = predict_pi(sel.pi, u);
         break;
       case ModelKind::katalenic:
         sel.katalenic = fit_katalenic(ut, yt, o.katalenic);
         score.status = sel.katalenic.status, score.reason = sel.katalenic.reason;
         score.train_rms_m = sel.katalenic.residual_rms_m;
+        score.fit_time_s = sel.katalenic.solve_time_s;
         if (sel.katalenic.ok()) pred = predict_katalenic(sel.katalenic.params, u);
         break;
       case ModelKind::linear:
@@ -111,7 +108,6 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
         }
         break;
     }
-    score.fit_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!pred.empty()) score.holdout_rms_m = holdout_rms(y, pred, train_begin, split);
     sel.ranking.push_back(score);
   }

@@ -37,7 +37,7 @@ struct ModelScore {
   std::string reason;
   double train_rms_m = 0.0;    // fit residual as the fitter reports it
   double holdout_rms_m = 0.0;  // prediction error on the held-out part
-  double fit_time_s = 0.0;
+  double fit_time_s = 0.0;    // the fitter's solve_time_s (its options' clock); linear: 0, closed form
 };
 
 struct ModelSelection {
@@ -58,5 +58,9 @@ ModelSelection select_model(std::span<const double> u_V, std::span<const double>
 // Simulations used for the scores (y [m] for every u sample).
 std::vector<double> predict_mem(const MemParams& params, std::span<const double> u_V, std::span<const double> y_m);
 std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<const double> u_V);
+// The score: RMS of y - pred over [split, end) after removing their mean difference over
+// [train_begin, split) (select_model uses train_begin = the second reversal, split = split_index).
+double holdout_rms(std::span<const double> y_m, const std::vector<double>& pred, std::size_t train_begin,
+                   std::size_t split);
 
 }  // namespace hystloop

@@ -9,9 +9,16 @@
 // the plan is a deterministic function of the messages given, in order: a recorded log
 // replays to the same commands (tools/replay-check relies on it).
 //
-// A new trajectory, mode or experiment takes effect at the first tick not yet planned. New MEM
-// parameters are validated when offered and swapped in at the next reversal of the reference,
-// where the inverse's branch restarts, so the voltage does not jump. After an experiment the
+// A new trajectory, mode or experiment takes effect at the first tick not yet planned. New
+// parameters (offer_mem_params, or any model's with offer_model) are validated when offered and
+// swapped in at the next reversal of the reference, where the inverse's branch restarts, so the
+// voltage does not jump. The swap repairs: the plan runs horizon_ticks ahead of the samples, so
+// the reversal's measured position arrives after the swap was planned; when the samples of the
+// first reanchor_ticks of the new branch have arrived, the feedforward is re-anchored there (the
+// mean of y measured - y of the model and of u applied - u of the model over them: output and
+// input offsets the inverse works with, loop/feedforward_anchor.hpp), ramped in so that the
+// voltage never moves faster than slew_fraction of the slew limit on its account
+// (docs/TRACKING.md, "A swap that repairs"). After an experiment the
 // plan holds the last voltage (no reference) until the sample of the experiment's end arrives;
 // the inverse is then anchored at that measured (u, y), on the branch that began at the
 // experiment's last reversal, and the reference approaches from there.
@@ -24,10 +31,12 @@
 #include "core/ticks.hpp"
 #include "loop/experiment.hpp"
 #include "loop/experiment_queue.hpp"
+#include "loop/feedforward_anchor.hpp"
 #include "loop/trajectory.hpp"
 #include "models/katalenic.hpp"
 #include "models/linear.hpp"
 #include "models/mem.hpp"
+#include "models/model_set.hpp"
 #include "models/prandtl_ishlinskii.hpp"
 #include "models/reversal_detector.hpp"
 
@@ -46,6 +55,9 @@ enum class FeedforwardMode : std::int8_t {
 // Parses "off|linear|mem|pi|katalenic"; throws ParameterError naming `field`.
 FeedforwardMode parse_feedforward_mode(const std::string& name, const std::string& field = "compensator.mode");
 const char* to_string(FeedforwardMode mode) noexcept;
+// The mode that inverts `kind`, and the model a mode inverts (none for off and experiment).
+FeedforwardMode mode_of(ModelKind kind) noexcept;
+std::optional<ModelKind> model_kind_of(FeedforwardMode mode) noexcept;
 
 struct CompensatorConfig {
   FeedforwardMode mode = FeedforwardMode::kMem;
@@ -55,6 +67,21 @@ struct CompensatorConfig {
   LinearParams linear{};
   std::int64_t horizon_ticks = 500;  // plan this many ticks ahead of the last sample (50 ms at 10 kHz)
   double dt_s = 1e-4;                // the bridge's tick
+  // The actuator as the bridge limits it (ActuatorLimits' defaults): the feedforward is kept in
+  // [u_min_V, u_max_V] (counted in u_clamped) and a re-anchoring ramp within the slew limit.
+  double u_min_V = -250.0;
+  double u_max_V = 250.0;
+  double slew_V_per_s = 5.0e4;
+  // Re-anchoring after a swap: the offset is measured over this many ticks of the new branch
+  // (averages the sensor noise down; 20 ticks = 2 ms) and ramped in over at least
+  // reanchor_ramp_ticks, longer when the voltage would otherwise move faster than
+  // slew_fraction x the slew limit on its account.
+  std::int64_t reanchor_ticks = 20;
+  std::int64_t reanchor_ramp_ticks = 200;
+  double slew_fraction = 0.05;  // 0.25 V per tick at 5e4 V/s: about what the 1 Hz reference itself needs
+  // The input offset the servo held (u applied - u planned) is taken over at most this fast, so
+  // the servo's integrator hands it over without a visible error (ki x 0.5 nm / gain ~ 60 V/s).
+  double reanchor_u_rate_V_per_s = 50.0;
 
   static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer
   void validate() const;  // throws ParameterError naming the field
@@ -77,6 +104,10 @@ struct CompensatorCounters {
   std::uint64_t params_swapped = 0;
   std::uint64_t reversals = 0;      // of the planned reference
   std::uint64_t nonfinite_outputs = 0;  // model produced NaN/Inf: the last voltage was held
+  std::uint64_t model_switches = 0;     // swaps that changed the model (offer_model)
+  std::uint64_t reanchors = 0;          // swaps re-anchored at the measured position
+  std::uint64_t reanchors_skipped = 0;  // not re-anchored: the branch ended (or the mode changed) first
+  std::uint64_t u_clamped = 0;          // feedforward ticks held inside [u_min_V, u_max_V]
 };
 
 class Compensator {
@@ -95,8 +126,16 @@ class Compensator {
   // here (throws ParameterError).
   bool set_trajectory(TrajectorySpec spec, double start_s);
 
-  // New MEM parameters; validated (throws ParameterError) and swapped at the next reversal.
+  // New MEM parameters; validated (throws ParameterError) and swapped at the next reversal,
+  // re-anchored; the mode does not change (MEM stays the default: the MEM paper's workflow).
   void offer_mem_params(const MemParams& params, std::int32_t version);
+  // A parameter set of any model (models/model_set.hpp), e.g. the online selector's choice.
+  // Validated (throws ParameterError naming the field, counted in params_rejected) and swapped
+  // in at the next reversal of the reference: the model's parameters are replaced and, unless
+  // the mode is off, the feedforward switches to that model, started where the plan is (no
+  // step in u) and re-anchored at the measured position as offer_mem_params' sets are. A later
+  // offer replaces one still waiting. Not on the per-sample path (may be called between plans).
+  void offer_model(const ModelParamSet& params, std::int32_t version);
   void set_mode(FeedforwardMode mode);   // re-initialises that inverse where the plan is
   // Starts the experiment at the next planned tick, or queues it behind the running one.
   // Validated here (throws ParameterError; also when the queue is full).
@@ -107,6 +146,10 @@ class Compensator {
   const CompensatorCounters& counters() const noexcept { return counters_; }
   FeedforwardMode mode() const noexcept { return mode_; }
   const MemParams& mem_params() const noexcept { return mem_.params(); }
+  // The model in use with its parameters (kind follows the mode; MEM when the mode is off).
+  ModelParamSet model_params() const noexcept;
+  bool params_pending() const noexcept { return pending_.has_value(); }
+  double anchor_offset_m() const noexcept { return shift_m_; }  // the re-anchoring's output offset
   std::int32_t params_version() const noexcept { return params_version_; }
   bool experiment_running() const noexcept { return experiments_.running(); }
   std::size_t experiments_queued() const noexcept { return experiments_.queued(); }
@@ -126,6 +169,11 @@ class Compensator {
   double feedforward(double y_ref) noexcept;
   void reset_inverse(double y0) noexcept;
   void restart_reference(double t_s, double from_m) noexcept;
+  void swap_params(std::int64_t k) noexcept;  // at a reversal: the pending set in, re-anchored
+  // Restarts `mode`'s inverse at this reversal (u_rev, model coordinates) without a step; returns
+  // the model's output there.
+  double restart_at_reversal(FeedforwardMode mode, double u_rev) noexcept;
+  double nominal_slope() const noexcept;  // [m/V] for the re-anchoring ramp when no secant is known
 
   CompensatorConfig config_;
   FeedforwardMode mode_;
@@ -136,8 +184,17 @@ class Compensator {
   PiInverse pi_;
   KatalenicInverse katalenic_;
   LinearInverse linear_;
-  std::optional<MemParams> pending_mem_;
+  PiModel pi_model_;            // forward models, to restart PI / Katalenic at a reversal
+  KatalenicModel katalenic_model_;
+  struct Pending {
+    ModelParamSet params;
+    bool switch_model;  // offer_model: make it the feedforward; offer_mem_params: parameters only
+  };
+  std::optional<Pending> pending_;
   std::int32_t pending_version_ = 0;
+  FeedforwardAnchor anchor_offset_;
+  double shift_m_ = 0.0;  // output offset in effect at the last planned tick
+  double u_prev_rev_ = 0.0;  // voltage (model coordinates) at the reversal before the last
   std::int32_t params_version_ = 0;
   ExperimentQueue experiments_;
   ReversalDetector reversals_;

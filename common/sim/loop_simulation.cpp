@@ -1,4 +1,4 @@
-#include "loop/loop_simulation.hpp"
+#include "sim/loop_simulation.hpp"
 
 #include <cmath>
 #include <limits>

@@ -26,6 +26,10 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
   a.params_swapped += b.params_swapped;
   a.reversals += b.reversals;
   a.nonfinite_outputs += b.nonfinite_outputs;
+  a.model_switches += b.model_switches;
+  a.reanchors += b.reanchors;
+  a.reanchors_skipped += b.reanchors_skipped;
+  a.u_clamped += b.u_clamped;
   return a;
 }
 
@@ -35,6 +39,13 @@ namespace {
 // are not one stream [us].
 constexpr std::int64_t kConfirmWindowUs = 100'000;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// HX_MODEL: an unknown kind or format version reaches on_model, which counts it by its reason.
+Subscription<model_params_t>::Options model_envelope() {
+  Subscription<model_params_t>::Options o;
+  o.check = &check_model_params_envelope;
+  return o;
+}
 
 template <class T>
 typename Subscription<T>::Options queue_of(int capacity) {
@@ -54,6 +65,8 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
                queue_of<sensor_block_t>(settings.sample_queue_capacity)),
       trajectories_(lcm, channels.trajectory, [this](const trajectory_t& m, std::int64_t) { on_trajectory(m); }),
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
+      models_(lcm, channels.model, [this](const model_params_t& m, std::int64_t) { on_model(m); },
+              model_envelope()),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
       status_(lcm, channels.status, "compensator"),
       // A block within the horizon of the next expected tick continues the stream (lost blocks
@@ -149,57 +162,6 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
     ++counters_.trajectory_refused;
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_now_ns())) {
       spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what()), suppressed_note(g));
-    }
-  }
-}
-
-void CompensatorService::on_params(const mem_params_t& msg) {
-  // Each refusal is counted; it is logged once per reason and publisher (ParamsAdmission), and
-  // of those at most one line per reason a second (many publishers: forged ids).
-  const std::int64_t from = msg.publisher_id;
-  auto log_refusal = [&](ParamsRefusal reason) {
-    if (!admission_.first_refusal(from, reason)) return LogLimiter::Gate{};
-    return log_limiter_.allow(kLogParamsInvalid + static_cast<std::size_t>(reason), monotonic_now_ns());
-  };
-  if (!msg.valid) {
-    ++counters_.params_invalid;
-    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::invalid)) {
-      spdlog::warn("MEM parameters v{} from '{}' (publisher {:x}) are marked invalid; not used (further invalid "
-                   "sets from this publisher are counted, params_invalid, not logged){}",
-                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), suppressed_note(g));
-    }
-    return;
-  }
-  if (!admission_.is_new(from, msg.version)) {
-    ++counters_.params_stale;
-    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale)) {
-      spdlog::info("MEM parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
-                   "(further stale sets from this publisher are counted, params_stale, not logged){}",
-                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from),
-                   admission_.last_version(from), suppressed_note(g));
-    }
-    return;
-  }
-  MemParams p;
-  p.c1 = msg.c1;
-  p.c2 = msg.c2;
-  p.c3 = msg.c3;
-  try {
-    compensator_->offer_mem_params(p, msg.version);
-    admission_.accept(from, msg.version);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_now_ns())) {
-      spdlog::info("MEM parameters v{} from '{}' (publisher {:x}) accepted (c1 {:.6g}, c2 {:.6g}, c3 {:.6g}, "
-                   "residual {:.3g} m); swapped in at the next reversal{}",
-                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), msg.c1, msg.c2, msg.c3,
-                   msg.residual_m, suppressed_note(g));
-    }
-  } catch (const ParameterError& e) {
-    ++counters_.params_refused;
-    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::refused)) {
-      spdlog::warn("MEM parameters v{} from '{}' (publisher {:x}) refused: {} (further refusals from this publisher "
-                   "are counted, params_rejected, not logged){}",
-                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(from), e.what(),
-                   suppressed_note(g));
     }
   }
 }
@@ -308,6 +270,12 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"params_invalid", s.params_invalid},
           {"params_stale", s.params_stale},
           {"params_swapped", c.params_swapped},
+          {"model_switches", c.model_switches},
+          {"model_unknown_kind", s.model_unknown_kind},
+          {"model_unknown_format", s.model_unknown_format},
+          {"reanchors", c.reanchors},
+          {"reanchors_skipped", c.reanchors_skipped},
+          {"u_clamped", c.u_clamped},
           {"trajectories", s.trajectories},
           {"trajectory_repeats", s.trajectory_repeats},
           {"trajectory_refused", s.trajectory_refused},
@@ -351,8 +319,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   const Compensator& c = *compensator_;
   if (c.counters().params_swapped != swaps_reported_) {
     swaps_reported_ = c.counters().params_swapped;
-    spdlog::info("MEM parameters v{} in use (c1 {:.6g}, c2 {:.6g}, c3 {:.6g})", c.params_version(), c.mem_params().c1,
-                 c.mem_params().c2, c.mem_params().c3);
+    spdlog::info("parameters v{} in use: {}", c.params_version(), describe_model(c.model_params()));
   }
 
   std::int8_t state = service_status_t::HEALTHY;
@@ -375,7 +342,8 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   status_.begin(state, detail);
   reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;
-  for (const char* name : {"params_rejected", "params_invalid", "trajectory_refused", "control_refused"}) {
+  for (const char* name : {"params_rejected", "params_invalid", "model_unknown_kind", "model_unknown_format",
+                           "trajectory_refused", "control_refused"}) {
     for (const auto& [n, value] : counters) {
       if (n == name) semantic_rejects += reported_.since(n, value);
     }
@@ -386,6 +354,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   reported_.report(status_, "sensor", samples_.counters());
   reported_.report(status_, "trajectory", trajectories_.counters());
   reported_.report(status_, "params", params_.counters());
+  reported_.report(status_, "model", models_.counters());
   reported_.report(status_, "control", control_.counters());
   reported_.report(status_, "command", command_pub_.counters());
   status_.add_rejected(static_cast<std::int64_t>(semantic_rejects));
@@ -426,6 +395,7 @@ int CompensatorService::run() {
                  latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
                  static_cast<double>(latency_total_.max_ns()) / 1e3);
   }
+  write_summary_json();
   return errors > 0 ? 1 : 0;
 }
 

@@ -15,6 +15,10 @@
 // - HX_PARAMS versions are ordered per publisher (ParamsAdmission): a set is stale only against
 //   the last one accepted from the same mem_params_t.publisher_id. Refusals are counted by reason
 //   (params_invalid, params_stale, params_rejected) and logged once per reason and publisher.
+// - HX_MODEL (model_params_t, issue 11) carries any model: admitted as HX_PARAMS is (one version
+//   order per publisher over both channels), then Compensator::offer_model switches the
+//   feedforward at the next reversal; a kind or format this build does not know is counted
+//   (model_unknown_kind, model_unknown_format). model_switches and reanchors count the swaps.
 // - Lines triggered by messages are rate-limited (LogLimiter, one per reason a second) and text
 //   off the wire is escaped (escape_wire).
 
@@ -32,6 +36,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
@@ -56,6 +61,8 @@ struct CompensatorServiceCounters {
   std::uint64_t params_invalid = 0;      // valid = false: diagnostic sets, never used
   std::uint64_t params_stale = 0;        // version not above the last one accepted from the same publisher
   std::uint64_t params_refused = 0;      // failed the compensator's own validation
+  std::uint64_t model_unknown_kind = 0;    // HX_MODEL: a kind this build does not know
+  std::uint64_t model_unknown_format = 0;  // HX_MODEL: another format_version
   std::uint64_t trajectories = 0;        // applied
   std::uint64_t trajectory_repeats = 0;  // same version again (UDP repeats)
   std::uint64_t trajectory_refused = 0;
@@ -68,17 +75,24 @@ struct CompensatorServiceCounters {
   // block) and sensor_jumps (confirmed jumps ahead).
 };
 
+// "MEM c1 .., c2 .., c3 ..", "PI, 15 operators to 247 V, w0 ..", ... for log lines and HX_STATUS.
+std::string describe_model(const ModelParamSet& set);
+
 class CompensatorService {
  public:
   CompensatorService(const CompensatorSettings& settings, lcm::LCM& lcm, const ChannelNames& channels);
 
   // Runs until SIGINT/SIGTERM, SHUTDOWN or compensator.run_seconds. Returns 0, or 1 on LCM errors.
   int run();
+  // At exit, run() writes the run's figures (as its summary log lines) to this JSON file.
+  void write_summary_to(std::string path) { summary_json_path_ = std::move(path); }
 
   // The handlers, public so that tests can drive the service without a network.
   void on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept;
   void on_trajectory(const trajectory_t& msg);
   void on_params(const mem_params_t& msg);
+  // HX_MODEL: any model; the feedforward switches to it at the next reversal (compensator_params.cpp).
+  void on_model(const model_params_t& msg);
   void on_control(const control_t& msg);
   void report(std::int64_t utime, bool stopping);
 
@@ -90,13 +104,26 @@ class CompensatorService {
 
  private:
   void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime);
+  // What HX_PARAMS and HX_MODEL sets share: admit() refuses a diagnostic or stale set (counted,
+  // logged once per reason and publisher); offer() validates and offers an admitted one.
+  struct ParamsHeader {
+    std::string_view what;  // "MEM", "pi", ... for the log
+    std::int32_t version;
+    std::int64_t publisher_id;
+    bool valid;
+    std::string_view source;
+    double residual_m;
+  };
+  bool admit(const ParamsHeader& header);
+  void offer(const ParamsHeader& header, const ModelParamSet& set, bool switch_model);
   void publish_plan() noexcept;
   void restart_control_law();
   void log_sequence_events();
   // Log-line reasons (LogLimiter): each at most once a second, the next saying how many were suppressed.
   // kLogParamsInvalid + ParamsRefusal: one reason each (invalid, stale, refused).
   enum LogReason : std::size_t { kLogTrajectory, kLogTrajectoryRefused, kLogParamsAccepted, kLogControl,
-                                 kLogControlRefused, kLogParamsInvalid, kLogParamsStale, kLogParamsRefused };
+                                 kLogControlRefused, kLogParamsInvalid, kLogParamsStale, kLogParamsRefused,
+                                 kLogModelUnknown };
   CounterSet::Entries collect_counters() const;
 
   CompensatorSettings settings_;
@@ -108,6 +135,7 @@ class CompensatorService {
   Subscription<sensor_block_t> samples_;
   Subscription<trajectory_t> trajectories_;
   Subscription<mem_params_t> params_;
+  Subscription<model_params_t> models_;
   Subscription<control_t> control_;
   ControlFilter filter_{"compensator"};
   StatusReporter status_;
@@ -135,6 +163,9 @@ class CompensatorService {
   std::uint64_t blocks_in_period_ = 0;
   std::uint64_t swaps_reported_ = 0;
   CounterSet reported_;
+  std::string summary_json_path_;
+
+  void write_summary_json() const;  // compensator_summary.cpp
 };
 
 }  // namespace hystloop

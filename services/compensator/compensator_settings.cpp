@@ -7,6 +7,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "runtime/config_validation.hpp"
+#include "runtime/rig_auth_config.hpp"
 
 namespace hystloop {
 namespace {
@@ -79,7 +80,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
     config.fail("compensator.lead_ticks", "replaced by compensator.horizon_s: commands are planned that far ahead "
                                           "of the bridge's clock");
   }
-  config.check_no_unknown_keys(compensator_config_keys());
+  std::vector<std::string> known = compensator_config_keys();
+  known.insert(known.end(), rig_auth_config_keys().begin(), rig_auth_config_keys().end());  // read by main
+  config.check_no_unknown_keys(known);
   CompensatorSettings s;
   CompensatorConfig& c = s.control;
   const std::string mode = config.get<std::string>("compensator.mode", "mem");

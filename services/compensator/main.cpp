@@ -12,6 +12,7 @@
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/url.hpp"
+#include "runtime/rig_auth_config.hpp"
 #include "runtime/service_options.hpp"
 
 int main(int argc, char** argv) {
@@ -24,12 +25,15 @@ int main(int argc, char** argv) {
   ServiceOptions options;
   add_service_options(app, options);
   std::vector<std::filesystem::path> params_files;
-  std::string mode, seconds;
+  std::string mode, seconds, summary_json;
   app.add_option("--params", params_files,
                  "Model parameters as `hystloop-identify --out` writes them (merged over the config; repeatable)")
       ->check(CLI::ExistingFile);
   app.add_option("--mode", mode, "Feedforward: mem, pi, katalenic, linear or off [compensator.mode]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [compensator.run_seconds]");
+  app.add_option("--summary-json", summary_json,
+                 "At exit, write the run's figures (samples, command ticks and blocks, ticks planned too late, gaps, "
+                 "parameter sets, block-to-answer latency) to this JSON file");
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
   if (!mode.empty()) options.overrides.push_back("compensator.mode=" + mode);
   if (!seconds.empty()) options.overrides.push_back("compensator.run_seconds=" + seconds);
@@ -43,6 +47,7 @@ int main(int argc, char** argv) {
     for (const auto& file : params_files) merge_params_file(config, file);
     settings = load_compensator_settings(config);
     url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
+    configure_rig_auth(config, url);
   } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
     return 2;
@@ -57,6 +62,7 @@ int main(int argc, char** argv) {
     auto lcm = open_lcm(url, options.allow_network);
     spdlog::info("lcm: {}", url);
     CompensatorService service(settings, *lcm, channels);
+    if (!summary_json.empty()) service.write_summary_to(summary_json);
     const int rc = service.run();
     flush_logging();
     return rc;

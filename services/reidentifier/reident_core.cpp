@@ -78,7 +78,7 @@ RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
     worker_.release();
   }
   const std::uint64_t fed = estimator_.samples_fed();
-  if (worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
+  if (mem_refits_ && worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
       fed != fed_at_last_snapshot_) {
     estimator_.snapshot(worker_.job_window());  // no allocation: the worker's window is preallocated
     worker_.submit(in_use_.params(), in_use_.generation());  // "version": which set in use it was judged against
@@ -107,11 +107,12 @@ RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
 
   if (!o.accepted) {
     // An "accepted" outcome always has status ok; anything else is a refusal with its reason.
-    counters_.add_rejected(o.status == FitStatus::ok ? FitStatus::solver_failure : o.status);
+    counters_.add_rejected(o.status);
     d.kind = RefitDecision::Kind::refused;
     return d;
   }
-  if (o.judged_against_version != in_use_.generation()) {
+  // A refit that finished after the model choice switched away from MEM is not published.
+  if (o.judged_against_version != in_use_.generation() || !mem_refits_) {
     counters_.add(ReidentCounter::refits_superseded);
     d.kind = RefitDecision::Kind::superseded;
     return d;

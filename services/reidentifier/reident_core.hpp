@@ -70,6 +70,11 @@ class ReidentCore {
 
   // A version for a refused candidate published as valid = false (--publish-invalid).
   std::int32_t claim_diagnostic_version() noexcept { return in_use_.claim_version(); }
+  // Model choice (ModelChooser): a MEM set it switched to becomes the set in use, with its
+  // version; while another model is in use, no MEM refit is started (off: MEM refits stop).
+  std::int32_t adopt_own_mem(const MemParams& params) noexcept { return in_use_.adopt_own(params); }
+  void set_mem_refits(bool on) noexcept { mem_refits_ = on; }
+  bool mem_refits() const noexcept { return mem_refits_; }
 
   // Health, for HX_STATUS.
   bool stale(std::int64_t now_us) const noexcept;  // no sample for longer than stale_after_s
@@ -105,6 +110,7 @@ class ReidentCore {
   std::int64_t last_sample_us_ = -1;
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;
+  bool mem_refits_ = true;
 };
 
 }  // namespace hystloop

@@ -20,9 +20,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "params_stale",
     "params_invalid",
     "command_versions_dropped",
-    // One per FitStatus, in its order ("ok" is never counted as a refusal).
-    "refits_rejected_ok",
-    "refits_rejected_invalid_options",
+    // One per refusal reason, in FitStatus's order from kFirstRefusal.
     "refits_rejected_size_mismatch",
     "refits_rejected_non_finite_data",
     "refits_rejected_constant_input",
@@ -42,7 +40,7 @@ std::string_view counter_name(std::size_t index) noexcept {
 
 std::uint64_t ReidentCounters::rejected_total() const noexcept {
   std::uint64_t n = 0;
-  for (std::size_t s = 0; s < kFitStatusCount; ++s) n += at(index(ReidentCounter::refits_rejected_first) + s);
+  for (std::size_t s = 0; s < kRefusalCount; ++s) n += at(index(ReidentCounter::refits_rejected_first) + s);
   return n;
 }
 

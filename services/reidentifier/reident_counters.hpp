@@ -29,12 +29,16 @@ enum class ReidentCounter : std::uint8_t {
   params_stale,          // valid sets not newer than the set in use
   params_invalid,        // valid = false sets
   command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
-  refits_rejected_first  // + static_cast<int>(FitStatus) for each refusal reason
+  refits_rejected_first  // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };
 
-inline constexpr std::size_t kFitStatusCount = static_cast<std::size_t>(FitStatus::poisoned_window) + 1;
+// A refit's refusals start at size_mismatch: `ok` is no refusal, and `invalid_options` cannot
+// happen online (the options were validated at start), so neither has a counter that never moves.
+inline constexpr FitStatus kFirstRefusal = FitStatus::size_mismatch;
+inline constexpr std::size_t kRefusalCount =
+    static_cast<std::size_t>(FitStatus::poisoned_window) - static_cast<std::size_t>(kFirstRefusal) + 1;
 inline constexpr std::size_t kReidentCounterCount =
-    static_cast<std::size_t>(ReidentCounter::refits_rejected_first) + kFitStatusCount;
+    static_cast<std::size_t>(ReidentCounter::refits_rejected_first) + kRefusalCount;
 
 // "samples_fed", ..., "refits_rejected_<fit status>" (index by counter).
 std::string_view counter_name(std::size_t index) noexcept;
@@ -42,6 +46,7 @@ std::string_view counter_name(std::size_t index) noexcept;
 class ReidentCounters {
  public:
   void add(ReidentCounter c, std::uint64_t n = 1) noexcept { values_[index(c)] += n; }
+  // ok / invalid_options (a caller's bug, not a refit's outcome) count as solver_failure.
   void add_rejected(FitStatus s) noexcept { values_[rejected_index(s)] += 1; }
   void set(ReidentCounter c, std::uint64_t total) noexcept { values_[index(c)] = total; }  // mirrored totals
   // Since start.
@@ -52,7 +57,9 @@ class ReidentCounters {
 
   static constexpr std::size_t index(ReidentCounter c) noexcept { return static_cast<std::size_t>(c); }
   static constexpr std::size_t rejected_index(FitStatus s) noexcept {
-    return index(ReidentCounter::refits_rejected_first) + static_cast<std::size_t>(s);
+    if (static_cast<int>(s) < static_cast<int>(kFirstRefusal)) s = FitStatus::solver_failure;
+    return index(ReidentCounter::refits_rejected_first) + static_cast<std::size_t>(s) -
+           static_cast<std::size_t>(kFirstRefusal);
   }
 
  private:

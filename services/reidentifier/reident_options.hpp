@@ -1,27 +1,36 @@
 #pragma once
 // The re-identifier's settings. The initial parameter set is read from `mem.c1/c2/c3`, the
 // keys the compensator reads and hystloop-identify writes (mem: {c1, c2, c3}), so one YAML
-// snippet configures both; the rest is the `reident:` section (each key also --set reident.KEY=V):
+// snippet configures both; the rest is the `reidentifier:` section (each key also --set reidentifier.KEY=V):
 //
-//   reident.rate_hz                   tick rate of HX_SENSOR [Hz], converts s -> samples (10000)
-//   reident.refit_period_s            time between refits [s] (1)
-//   reident.window_s                  data fitted per refit [s] (2)
-//   reident.capacity_s                samples kept in the estimator's ring [s] (>= window_s; 10)
-//   reident.holdout_branches          most recent complete branches held out of the fit (1)
-//   reident.min_relative_improvement  held-out RMS must drop by this fraction vs the set in use (0.02)
-//   reident.max_residual_rms_m        bound on the fit residual [m] (20e-9)
-//   reident.max_solver_time_s         time bound of the nonlinear refinement [s] (0.05)
-//   reident.reversal_dead_band_V      reversals of u smaller than this are not branches [V] (servo jitter; 0)
-//   reident.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
-//   reident.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
-//   reident.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
-//   reident.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2 s)
+//   reidentifier.rate_hz                   tick rate of HX_SENSOR [Hz], converts s -> samples (10000)
+//   reidentifier.refit_period_s            time between refits [s] (1)
+//   reidentifier.window_s                  data fitted per refit [s] (2)
+//   reidentifier.capacity_s                samples kept in the estimator's ring [s] (>= window_s; 10)
+//   reidentifier.holdout_branches          most recent complete branches held out of the fit (1)
+//   reidentifier.min_relative_improvement  held-out RMS must drop by this fraction vs the set in use (0.02)
+//   reidentifier.max_residual_rms_m        bound on the fit residual [m] (20e-9)
+//   reidentifier.max_solver_time_s         time bound of the nonlinear refinement [s] (0.05)
+//   reidentifier.reversal_dead_band_V      reversals of u smaller than this are not branches [V] (servo jitter; 0)
+//   reidentifier.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
+//   reidentifier.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
+//   reidentifier.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
+//   reidentifier.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2 s)
+//   reidentifier.models                    online model choice (issue 11): "off" (MEM refits only, as before),
+//                                     "auto" (MEM, PI, Katalenic, linear) or a list "mem,pi,linear" (off)
+//   reidentifier.model_margin              a different model must beat the one in use by this fraction of its
+//                                     held-out RMS (0.10; OnlineSelectorOptions::margin)
+//   reidentifier.model_period_s            time between model selections [s] (5; each fits every candidate)
+//   reidentifier.model_decimation          fit every n-th sample of the window (10: 1 kHz of a 10 kHz window)
+//   reidentifier.pin_model                 "none" (automatic), or mem|pi|katalenic|linear: no automatic change;
+//                                     a kind not in use is fitted and switched to once (hystloop-ctl pin-model)
 
 #include <cstdint>
 
 #include "core/config.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "models/mem.hpp"
+#include "reidentifier/model_chooser.hpp"
 
 namespace hystloop {
 
@@ -36,9 +45,10 @@ struct ReidentOptions {
   std::int64_t degraded_after_poisoned = 3;
   std::int64_t lcm_queue = 2000;
   OnlineMemOptions estimator{};  // window/capacity in samples, gates, fit time bound
+  ModelChoiceOptions models{};   // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model
 };
 
-// Reads and checks mem.{c1,c2,c3} and reident.*. Unknown reident.* keys are refused ("did
+// Reads and checks mem.{c1,c2,c3} and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are refused ("did
 // you mean"); other sections belong to the processes sharing the file (the compensator
 // checks the rest of mem.*). Throws ConfigError naming the field.
 ReidentOptions read_reident_options(const Config& config);

@@ -8,6 +8,7 @@
 
 #include "core/process.hpp"
 #include "runtime/io_loop.hpp"
+#include "runtime/model_params_message.hpp"
 
 namespace hystloop {
 
@@ -18,6 +19,13 @@ std::int64_t steady_ns() noexcept {
 
 namespace {
 std::int64_t steady_us() noexcept { return steady_ns() / 1000; }
+
+ModelParamSet initial_model(const ReidentOptions& options) {
+  ModelParamSet set;
+  set.kind = ModelKind::mem;  // the compensator's default, configured from the same mem.* keys
+  set.mem = options.initial;
+  return set;
+}
 }  // namespace
 
 namespace {
@@ -54,10 +62,15 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       own_source_(std::string(kProcessName) + "@" + host_name()),
       core_(std::make_unique<ReidentCore>(options, own_source_, true, refusal_logger())),
       params_out_(lcm, names.params),
+      chooser_(std::make_unique<ModelChooser>(options.models, initial_model(options), core_->estimator().make_window())),
+      model_out_(lcm, names.model),
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {
   out_.source = own_source_;
   out_.publisher_id = core_->in_use().own_publisher_id();
+  model_msg_.source = own_source_;
+  model_msg_.publisher_id = core_->in_use().own_publisher_id();
+  reserve_storage(model_msg_);
   Subscription<sensor_block_t>::Options sensor_options;
   sensor_options.queue_capacity = static_cast<int>(options.lcm_queue);
   sensor_options.on_reject = [this](RejectReason reason) {
@@ -113,11 +126,11 @@ void ReidentService::on_params(const mem_params_t& msg) {
 
 CounterSet::Entries ReidentService::counter_entries() {
   const ReidentCounters& c = core_->counters();
-  const std::size_t ok_index = ReidentCounters::rejected_index(FitStatus::ok);
   CounterSet::Entries entries;
-  entries.reserve(kReidentCounterCount + 1);
-  for (std::size_t i = 0; i < kReidentCounterCount; ++i) {
-    if (i != ok_index) entries.emplace_back(std::string(counter_name(i)), c.at(i));
+  entries.reserve(kReidentCounterCount + ModelChooser::kCounters + 1);
+  for (std::size_t i = 0; i < kReidentCounterCount; ++i) entries.emplace_back(std::string(counter_name(i)), c.at(i));
+  for (std::size_t i = 0; i < ModelChooser::kCounters; ++i) {
+    entries.emplace_back(ModelChooser::counter_name(i), chooser_->count(static_cast<ModelChooser::Counter>(i)));
   }
   entries.emplace_back("refits_rejected", c.rejected_total());
   return entries;
@@ -125,7 +138,9 @@ CounterSet::Entries ReidentService::counter_entries() {
 
 void ReidentService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
-  if (msg.command == control_t::SHUTDOWN) {
+  if (msg.command == control_t::SET_MODE && msg.target == kProcessName) {
+    pin_model(msg);
+  } else if (msg.command == control_t::SHUTDOWN) {
     spdlog::info("shutdown requested (request {})", msg.request_id);  // once: the service stops
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
@@ -139,6 +154,7 @@ void ReidentService::on_control(const control_t& msg) {
     reported_.rebase("params_in", params_in_->counters());
     reported_.rebase("control", control_->counters());
     reported_.rebase("params_out", params_out_.counters());
+    reported_.rebase("model_out", model_out_.counters());
   }
 }
 
@@ -171,6 +187,43 @@ void ReidentService::publish_decision(const RefitDecision& d) {
   }
 }
 
+void ReidentService::publish_model(const ModelDecision& d) {
+  if (d.kind == ModelDecision::Kind::none) return;
+  set_model(model_msg_, d.params);
+  model_msg_.utime = wall_utime();
+  model_msg_.version = d.version;
+  const ModelScore* score = nullptr;
+  for (const ModelScore& r : d.proposal.ranking) {
+    if (r.kind == d.params.kind) score = &r;
+  }
+  model_msg_.residual_m = score != nullptr && std::isfinite(score->train_rms_m) ? score->train_rms_m : 0.0;
+  model_msg_.heldout_rms_m = score != nullptr && std::isfinite(score->holdout_rms_m) ? score->holdout_rms_m
+                                                                                      : std::nan("");
+  model_msg_.samples_used = static_cast<std::int64_t>(d.window_samples);
+  model_msg_.window_s = static_cast<double>(d.window_samples) / options_.rate_hz;
+  model_msg_.valid = true;
+  const bool sent = model_out_.publish(model_msg_);
+  spdlog::info("published {} {} version {}{} on the model channel: held-out RMS {:.3g} m vs {:.3g} m in use ({})",
+               d.kind == ModelDecision::Kind::change ? "model change to" : "parameters of", to_string(d.params.kind),
+               d.version, sent ? "" : " (PUBLISH FAILED)", model_msg_.heldout_rms_m, d.proposal.in_use_holdout_rms_m,
+               d.proposal.reason);
+}
+
+void ReidentService::pin_model(const control_t& msg) {
+  std::optional<ModelKind> kind;
+  switch (msg.mode) {
+    case command_block_t::MODE_OFF: break;  // automatic choice again
+    case command_block_t::MODE_LINEAR: kind = ModelKind::linear; break;
+    case command_block_t::MODE_MEM: kind = ModelKind::mem; break;
+    case command_block_t::MODE_PI: kind = ModelKind::pi; break;
+    case command_block_t::MODE_KATALENIC: kind = ModelKind::katalenic; break;
+    default: spdlog::warn("pin-model request {}: mode {} names no model; ignored", msg.request_id, msg.mode); return;
+  }
+  chooser_->pin(kind);
+  spdlog::info("model {} (request {}){}", kind ? "pinned to " + std::string(to_string(*kind)) : "choice automatic",
+               msg.request_id, chooser_->enabled() ? "" : "; note: reidentifier.models is off, no model choice runs");
+}
+
 void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   std::int8_t state = service_status_t::HEALTHY;
   std::string why;
@@ -197,6 +250,10 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
     why += fmt::format("; refit last {:.1f} ms, p50 {:.1f} ms, max {:.1f} ms", core_->last_refit_s() * 1e3,
                        refit.percentile(0.5) * 1e-6, static_cast<double>(refit.max_ns()) * 1e-6);
   }
+  if (chooser_->enabled()) {
+    why += fmt::format("; model {}{}", to_string(chooser_->in_use().kind),
+                       chooser_->pinned() ? fmt::format(" (pinned to {})", to_string(*chooser_->pinned())) : "");
+  }
   status_.begin(state, std::move(why));
   reported_.report(status_, counter_entries());
   status_.counter("params_version", static_cast<std::uint64_t>(in_use.version()));
@@ -213,6 +270,7 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   reported_.report(status_, "params_in", params_in_->counters());
   reported_.report(status_, "control", control_->counters());
   reported_.report(status_, "params_out", params_out_.counters());
+  reported_.report(status_, "model_out", model_out_.counters());
   status_.loop_timing(block_cost_);  // per-block handler cost
   block_cost_.reset();
   status_.publish(wall_utime());
@@ -221,6 +279,7 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
 void ReidentService::on_tick(std::int64_t /*wall_us*/) {
   const std::int64_t now = steady_us();
   publish_decision(core_->poll(now));
+  publish_model(chooser_->poll(*core_, now));
   if (now >= next_status_us_) {
     publish_status(now, false);
     next_status_us_ += 1'000'000;

@@ -8,11 +8,15 @@
 //   <rig>COMMAND -> ReidentCore::on_command_block: the parameter version the compensator applies,
 //                   by tick (versions seen there are numbered above; status params_version_applied)
 //   <rig>PARAMS  -> a newer valid set from someone else becomes the set in use; our echo ignored
-//   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to "reident" (or to all)
+//   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to "reidentifier" (or to all)
 //   every 10 ms  -> poll the core: publish an accepted candidate on <rig>PARAMS (valid = true,
 //                   residual_m = its held-out RMS); a refused one is counted, logged by the
 //                   worker, and published only with publish_invalid, as valid = false
-//   1 Hz         -> <rig>STATUS, process "reident"
+//   every 10 ms  -> with reidentifier.models on: poll the ModelChooser; a model change (or new parameters
+//                   of a model other than MEM) goes out on <rig>MODEL (model_params_t)
+//   <rig>CONTROL -> SET_MODE addressed to "reidentifier" pins the model (hystloop-ctl pin-model): the mode's
+//                   model (linear, mem, pi, katalenic), or MODE_OFF = automatic choice again
+//   1 Hz         -> <rig>STATUS, process "reidentifier"
 
 #include <cstdint>
 #include <memory>
@@ -23,11 +27,13 @@
 #include "core/latency_stats.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
+#include "reidentifier/model_chooser.hpp"
 #include "reidentifier/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_filter.hpp"
@@ -39,7 +45,7 @@ namespace hystloop {
 
 class ReidentService {
  public:
-  static constexpr const char* kProcessName = "reident";
+  static constexpr const char* kProcessName = "reidentifier";
 
   ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options);
   ~ReidentService();
@@ -53,6 +59,8 @@ class ReidentService {
   void on_control(const control_t& msg);
   void on_tick(std::int64_t now_us);
   void publish_decision(const RefitDecision& d);
+  void publish_model(const ModelDecision& d);
+  void pin_model(const control_t& msg);
   CounterSet::Entries counter_entries();  // the core's counters by name, cumulative
   void publish_status(std::int64_t now_us, bool stopping);
 
@@ -61,6 +69,9 @@ class ReidentService {
   std::string own_source_;
   std::unique_ptr<ReidentCore> core_;
   Publisher<mem_params_t> params_out_;
+  std::unique_ptr<ModelChooser> chooser_;
+  Publisher<model_params_t> model_out_;
+  model_params_t model_msg_{};
   StatusReporter status_;
   ControlFilter control_filter_;
   // Log lines triggered by messages: at most one a second per kind (the next says how many were not).

@@ -41,7 +41,7 @@ stop_within_1s() {
 case "$what" in
   cli)
     "$reident" --help >"$dir/help" || fail "--help exit status"
-    for w in --config --set --lcm-url --rig --publish-invalid reident.refit_period_s mem.; do
+    for w in --config --set --lcm-url --rig --publish-invalid reidentifier.refit_period_s mem.; do
       grep -q -- "$w" "$dir/help" || fail "--help does not mention $w"
     done
     check_bad() {  # expected-field args...
@@ -52,20 +52,20 @@ case "$what" in
       grep -qF -- "$field" "$dir/err" || fail "stderr does not name $field: $(cat "$dir/err")"
       echo "refused ($*): $(cat "$dir/err")"
     }
-    check_bad "reident.refit_period_s" --set reident.refit_period_s=-1
-    check_bad "reident.capacity_s" --set reident.window_s=5 --set reident.capacity_s=2
+    check_bad "reidentifier.refit_period_s" --set reidentifier.refit_period_s=-1
+    check_bad "reidentifier.capacity_s" --set reidentifier.window_s=5 --set reidentifier.capacity_s=2
     check_bad "mem.c1" --set mem.c1=0
-    printf 'reident:\n  window_sec: 2\n' >"$dir/typo.yaml"
-    check_bad "reident.window_sec" --config "$dir/typo.yaml"
+    printf 'reidentifier:\n  window_sec: 2\n' >"$dir/typo.yaml"
+    check_bad "reidentifier.window_sec" --config "$dir/typo.yaml"
     # Refused before LCM starts; and this runs inside tools/netns-run, so nothing could leave anyway.
     check_bad "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
-    check_bad "reident.lcm_queue" --set reident.lcm_queue=10
+    check_bad "reidentifier.lcm_queue" --set reidentifier.lcm_queue=10
     start
     sleep 1.5
     kill -0 "$pid" || fail "exited early: $(cat "$dir/stderr")"
     stop_within_1s
-    grep -q "reident: rate_hz 10000" "$dir/reident.log" || fail "configuration not logged at start"
-    # control_t SHUTDOWN addressed to "reident" stops it as SIGTERM does.
+    grep -q "reidentifier: rate_hz 10000" "$dir/reident.log" || fail "configuration not logged at start"
+    # control_t SHUTDOWN addressed to "reidentifier" stops it as SIGTERM does.
     start
     "$stream" shutdown --url "$url" || fail "could not send SHUTDOWN"
     for _ in $(seq 20); do alive "$pid" || break; sleep 0.05; done
@@ -86,7 +86,7 @@ case "$what" in
     stop_within_1s
     ;;
   garbage)
-    start --set reident.window_s=1 --set reident.refit_period_s=0.5
+    start --set reidentifier.window_s=1 --set reidentifier.refit_period_s=0.5
     "$stream" garbage --url "$url" --phase-s 2 || fail "stream check"
     stop_within_1s
     grep -q "refit refused (poisoned_window)" "$dir/reident.log" || fail "refusals not logged"

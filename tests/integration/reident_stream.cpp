@@ -3,7 +3,7 @@
 //
 //   reident_stream good    --url U [--duration-s 6] [--frequency-hz 1] [--tolerance 0.03] [--expect-invalid 1]
 //   reident_stream garbage --url U [--phase-s 2]
-//   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reident" (after its first status)
+//   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reidentifier" (after its first status)
 //
 // Both wait for the re-identifier's first HX_STATUS, then stream 10 kHz of real time as the
 // bridge and compensator do: one sensor_block_t of 10 ticks per millisecond, and command_block_t
@@ -13,7 +13,7 @@
 //           re-identifier's initial params; the commands say the compensator applies version 7
 //           (a set the re-identifier never heard on HX_PARAMS); then streams u = 250 sin(2 pi f t),
 //           y from the MEM model (common/models/mem.hpp) with gain 1.1 x the initial params + 1 nm
-//           noise. Passes if a valid HX_PARAMS from "reident@..." arrives with version >= 8 (above
+//           noise. Passes if a valid HX_PARAMS from "reidentifier@..." arrives with version >= 8 (above
 //           the applied 7) and c1, c2 within --tolerance of the truth, and the status shows the
 //           external set adopted and version 7 applied.
 //           With --expect-invalid 1 (re-identifier run with --publish-invalid), the later refused
@@ -135,7 +135,7 @@ class Stream {
       c.utime = 1;
       c.request_id = 4242;
       c.command = control_t::SHUTDOWN;
-      c.target = "reident";
+      c.target = "reidentifier";
       Publisher<control_t> control(*lcm_, names_.control);
       for (int i = 0; i < 3; ++i) control.publish(c);  // repeated, as over UDP: acted on once
       return 0;
@@ -145,7 +145,7 @@ class Stream {
 
  private:
   void on_params(const mem_params_t& m) {
-    if (m.source.rfind("reident@", 0) != 0) return;  // our own announcement
+    if (m.source.rfind("reidentifier@", 0) != 0) return;  // our own announcement
     if (!seen_.versions.insert(m.version).second) seen_.duplicate_version = true;
     if (m.valid) {
       ++seen_.valid_params;
@@ -158,7 +158,7 @@ class Stream {
     }
   }
   void on_status(const service_status_t& m) {
-    if (m.process != "reident") return;
+    if (m.process != "reidentifier") return;
     ++seen_.statuses;
     seen_.last_status = m;
     if (std::isfinite(m.loop_p50_us)) {

@@ -15,6 +15,7 @@
 #include "loop/compensator.hpp"
 #include "loop/simulated_stage.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
@@ -374,12 +375,7 @@ TEST(BridgeCore, NeverAppliesOutsideRangeOrSlew) {
 TEST(ActuatorLimits, RefusesBadValuesNamingTheField) {
   ActuatorLimits lim;
   lim.u_max_V = -300;
-  try {
-    lim.validate();
-    FAIL();
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "actuator.u_max_V");
-  }
+  EXPECT_EQ(testing::refused_field([&] { lim.validate(); }), "actuator.u_max_V");
   lim = {};
   lim.watchdog_s = 0;
   EXPECT_THROW(lim.validate(), ParameterError);

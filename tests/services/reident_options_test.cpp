@@ -32,7 +32,7 @@ TEST(ReidentOptions, ReadsTheSharedMemSnippetAndTheReidentSection) {
   const ReidentOptions o = read_reident_options(Config::from_string(
       "mem: {c1: 4.0e-9, c2: 2.0e-12, c3: 0.8}\n"
       "compensator: {anything: 1}\n"
-      "reident: {rate_hz: 5000, window_s: 1.5, capacity_s: 3, refit_period_s: 0.5, holdout_branches: 2,\n"
+      "reidentifier: {rate_hz: 5000, window_s: 1.5, capacity_s: 3, refit_period_s: 0.5, holdout_branches: 2,\n"
       "          min_relative_improvement: 0.05, max_residual_rms_m: 1.0e-8, max_solver_time_s: 0.02,\n"
       "          publish_invalid: true, stale_after_s: 2, degraded_after_poisoned: 5, lcm_queue: 5000}\n"));
   EXPECT_DOUBLE_EQ(o.initial.c1, 4.0e-9);
@@ -51,21 +51,21 @@ TEST(ReidentOptions, ReadsTheSharedMemSnippetAndTheReidentSection) {
 }
 
 TEST(ReidentOptions, RefusalsNameTheField) {
-  EXPECT_NE(refusal("reident: {refit_period_s: -1}").find("r.yaml: reident.refit_period_s:"), std::string::npos);
-  EXPECT_NE(refusal("reident: {window_s: 0.001}").find("reident.window_s: must hold at least 16"), std::string::npos);
-  EXPECT_NE(refusal("reident: {window_s: 5, capacity_s: 2}").find("reident.capacity_s: must be >= reident.window_s"),
+  EXPECT_NE(refusal("reidentifier: {refit_period_s: -1}").find("r.yaml: reidentifier.refit_period_s:"), std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {window_s: 0.001}").find("reidentifier.window_s: must hold at least 16"), std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {window_s: 5, capacity_s: 2}").find("reidentifier.capacity_s: must be >= reidentifier.window_s"),
             std::string::npos);
-  EXPECT_NE(refusal("reident: {holdout_branches: 0}").find("reident.holdout_branches"), std::string::npos);
-  EXPECT_NE(refusal("reident: {min_relative_improvement: 1.5}").find("reident.min_relative_improvement"),
+  EXPECT_NE(refusal("reidentifier: {holdout_branches: 0}").find("reidentifier.holdout_branches"), std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {min_relative_improvement: 1.5}").find("reidentifier.min_relative_improvement"),
             std::string::npos);
-  EXPECT_NE(refusal("reident: {lcm_queue: 10}").find("reident.lcm_queue"), std::string::npos);
-  EXPECT_NE(refusal("reident: {publish_invalid: maybe}").find("reident.publish_invalid"), std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {lcm_queue: 10}").find("reidentifier.lcm_queue"), std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {publish_invalid: maybe}").find("reidentifier.publish_invalid"), std::string::npos);
   EXPECT_NE(refusal("mem: {c1: -1.0e-9}").find("mem.c1: must be > 0"), std::string::npos);
   EXPECT_NE(refusal("mem: {c2: -1.0e-9}").find("mem.c2"), std::string::npos);
   EXPECT_NE(refusal("mem: {c3: 0}").find("mem.c3"), std::string::npos);
-  const std::string typo = refusal("reident: {refit_period: 2}");
-  EXPECT_NE(typo.find("reident.refit_period: unknown key"), std::string::npos) << typo;
-  EXPECT_NE(typo.find("reident.refit_period_s"), std::string::npos) << typo;
+  const std::string typo = refusal("reidentifier: {refit_period: 2}");
+  EXPECT_NE(typo.find("reidentifier.refit_period: unknown key"), std::string::npos) << typo;
+  EXPECT_NE(typo.find("reidentifier.refit_period_s"), std::string::npos) << typo;
 }
 
 TEST(ReidentOptions, TheDeployedDefaultsLoad) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <memory>
 
 #include "core/errors.hpp"
@@ -80,11 +82,19 @@ TEST(RefitWorker, TheThreadEvaluatesAndTellsTheCallback) {
 
 TEST(RefitWorker, StopsWhileAJobIsInFlight) {
   Fixture f;
-  auto worker = std::make_unique<RefitWorker>(f.options, f.estimator.make_window(), true);
+  std::atomic<int> told{0};
+  auto worker = std::make_unique<RefitWorker>(f.options, f.estimator.make_window(), true,
+                                              [&](const RefitResult&) { told.fetch_add(1); });
   f.estimator.snapshot(worker->job_window());
   ASSERT_TRUE(worker->submit(f.in_use, 1));
-  worker.reset();  // waits for the (time-bounded) evaluate, then joins: no hang, no crash
-  SUCCEED();
+  const auto t0 = std::chrono::steady_clock::now();
+  worker.reset();  // waits for the (time-bounded) evaluate, then joins
+  const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The job in flight was finished, not dropped and not run twice...
+  EXPECT_EQ(told.load(), 1);
+  // ... within the fit's time bound (max_solver_time_s plus the search: well under a second on
+  // an idle machine; 10 s so that only a hang or an unbounded fit fails on a loaded one).
+  EXPECT_LT(stop_s, 10.0);
 }
 
 TEST(RefitWorker, OwnerSideAllocatesNothing) {

@@ -9,11 +9,11 @@
 #include <limits>
 #include <vector>
 
-#include "compensator_rig.hpp"
+#include "loop/compensator_rig.hpp"
 #include "core/errors.hpp"
 #include "loop/compensator.hpp"
 #include "loop/experiment.hpp"
-#include "loop/loop_simulation.hpp"
+#include "sim/loop_simulation.hpp"
 
 namespace hystloop {
 namespace {

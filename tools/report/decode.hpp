@@ -10,6 +10,7 @@
 
 #include "lcm/message_checks.hpp"
 #include "lcm/message_storage.hpp"
+#include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"
 
 namespace hystloop::report {
@@ -26,15 +27,16 @@ template <class T>
 bool decode_checked(const lcm::LogEvent& event, T& msg) noexcept {
   if (!has_fingerprint_of<T>(event)) return false;
   const auto size = static_cast<std::size_t>(event.datalen);
-  if (walk_wire_layout(wire_layout_of<T>(), event.data, size) < 0) return false;
+  const std::int64_t body = lcm_body_size(wire_layout_of<T>(), event.data, size);  // a signed message's trailer ignored
+  if (body < 0) return false;
   clear_arrays(msg);
   int used = -1;
   try {
-    used = msg.decode(event.data, 0, event.datalen);
+    used = msg.decode(event.data, 0, static_cast<int>(body));
   } catch (...) {
     return false;
   }
-  return used == event.datalen && check_message(msg) == Verdict::kOk;
+  return used == static_cast<int>(body) && check_message(msg) == Verdict::kOk;
 }
 
 }  // namespace hystloop::report

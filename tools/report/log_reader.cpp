@@ -1,13 +1,20 @@
 #include "log_reader.hpp"
 
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "decode.hpp"
 #include "event_file.hpp"
 #include "lcm/blocks.hpp"
+#include "models/model_set.hpp"
 
 namespace hystloop::report {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}  // namespace
 
 std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>& files,
                                         const std::function<void(const lcm::LogEvent&)>& visit) {
@@ -52,6 +59,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
   sensor_block_t sensor;
   command_block_t command;
   mem_params_t params;
+  model_params_t model;
   service_status_t status;
   control_t control;
   run.files = for_each_event(files, [&](const lcm::LogEvent& event) {
@@ -76,7 +84,15 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
       for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version); });
     } else if (event.channel == channels.params) {
       if (!decode_checked(event, params)) return void(++run.undecodable);
-      run.params.push_back({t, params.version, params.c1, params.c2, params.c3, params.residual_m, params.valid != 0});
+      run.params.push_back({t, params.version, params.c1, params.c2, params.c3, params.residual_m, params.valid != 0,
+                            "mem", params.residual_m, false});
+    } else if (event.channel == channels.model) {
+      if (!decode_checked(event, model)) return void(++run.undecodable);
+      const bool mem = model.kind == model_params_t::KIND_MEM;
+      const std::optional<ModelKind> kind = model_kind_from_int(model.kind);
+      run.params.push_back({t, model.version, mem ? model.mem_c1 : kNaN, mem ? model.mem_c2 : kNaN,
+                            mem ? model.mem_c3 : kNaN, model.residual_m, model.valid != 0,
+                            kind ? std::string(to_string(*kind)) : "unknown", model.heldout_rms_m, true});
     } else if (event.channel == channels.status) {
       if (!decode_checked(event, status)) return void(++run.undecodable);
       StatusRecord record{t, status.process, status.state, status.late, status.rejected, {}, status.utime,

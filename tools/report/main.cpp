@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "csv_export.hpp"
 #include "lcm/channels.hpp"
@@ -148,14 +149,7 @@ int main(int argc, char** argv) {
   app.add_option("--gnuplot", o.plots.gnuplot, "gnuplot executable")->capture_default_str();
   app.add_option("--plot-max-points", o.plots.max_points, "Decimate the plotted ticks to at most this many")
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return 2;
-  }
+  if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   try {
     return run(o);
   } catch (const ParameterError& e) {

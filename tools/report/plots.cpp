@@ -84,6 +84,38 @@ Histogram run_ahead_histogram(const ReportMetrics& m) {
 
 }  // namespace
 
+namespace {
+// convergence.png (issue 11): the published parameters over time (c1 and the held-out RMS of each
+// set; a model change labelled with its model) above the per-second tracking RMS, with every swap
+// (the second in which the version the compensator applies changed) marked by a vertical line.
+std::string convergence_plot(const ReportMetrics& m) {
+  std::ostringstream gp;
+  gp << "\nset output 'convergence.png'\nset multiplot layout 2,1 title 'Re-identification: parameters and "
+        "tracking error (dashed: a swap at the compensator)'\n";
+  std::int32_t version = m.per_second.front().params_version;
+  int arrow = 0;
+  std::ostringstream arrows;
+  for (const auto& bin : m.per_second) {
+    if (bin.params_version != version) {
+      arrows << "set arrow " << ++arrow << " from " << num(bin.t_s) << ", graph 0 to " << num(bin.t_s)
+             << ", graph 1 nohead dt 2 lc rgb 'red'\n";
+      version = bin.params_version;
+    }
+  }
+  for (const auto& p : m.params_history) {
+    if (p.model_change) gp << "set label '" << p.model << "' at " << num(p.t_s) << ", graph 0.9\n";
+  }
+  gp << arrows.str() << "set xlabel 't [s]'\nset ylabel 'c1 [nm/V]'\nset y2label 'held-out RMS [nm]'\n"
+     << "set y2tics\nset ytics nomirror\n"
+     << "plot 'params.dat' using 1:($8 == 1 ? $3 : NaN) with linespoints pt 7 title 'c1 (MEM sets)', "
+     << "'params.dat' using 1:($8 == 1 ? $7 : NaN) axes x1y2 with points pt 5 title 'held-out RMS of the set'\n"
+     << "unset label\nunset y2tics\nunset y2label\nset ytics mirror\nset ylabel 'RMS error [nm]'\n"
+     << "plot 'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n"
+     << "unset arrow\nunset multiplot\n";
+  return gp.str();
+}
+}  // namespace
+
 std::filesystem::path find_executable(const std::string& name) {
   if (name.empty()) return {};
   if (name.find('/') != std::string::npos) return ::access(name.c_str(), X_OK) == 0 ? std::filesystem::path(name) : "";
@@ -128,6 +160,19 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     close_checked(out, path);
     result.data_files.push_back(path);
   }
+  if (!m.params_history.empty()) {
+    const auto path = dir / "params.dat";
+    auto out = open_for_writing(path);
+    out << "# t_s version c1_nm_per_V c2 c3 residual_nm heldout_rms_nm valid model_change model   (one published "
+           "set per row; c1..c3 NaN unless the model is MEM)\n";
+    for (const auto& p : m.params_history) {
+      out << num(p.t_s) << ' ' << p.version << ' ' << num(p.c1 * 1e9) << ' ' << num(p.c2) << ' ' << num(p.c3) << ' '
+          << num(p.residual_m * 1e9) << ' ' << num(p.heldout_rms_m * 1e9) << ' ' << (p.valid ? 1 : 0) << ' '
+          << (p.model_change ? 1 : 0) << ' ' << p.model << '\n';
+    }
+    close_checked(out, path);
+    result.data_files.push_back(path);
+  }
   const Histogram hist = run_ahead_histogram(m);
   {
     const auto path = dir / "run_ahead_hist.dat";
@@ -164,6 +209,10 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
        << "set xlabel 't [s]'\nset ylabel 'e [nm]'\n"
        << "plot 'track.dat' using 1:5 with lines lw 1 title 'e', "
        << "'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n";
+  }
+  if (!m.params_history.empty() && !m.per_second.empty()) {
+    images.push_back("convergence.png");
+    gp << convergence_plot(m);
   }
   if (have_run_ahead) {
     images.push_back("run_ahead_histogram.png");

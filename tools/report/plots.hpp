@@ -5,6 +5,8 @@
 //   hysteresis_u_y.png     applied voltage u -> measured y (the stage's hysteresis loop)
 //   hysteresis_yref_y.png  reference y_ref -> measured y (as the MEM paper's Fig. 11)
 //   tracking_error.png     e = y_ref - y over time [nm], with the per-second RMS
+//   convergence.png        the published parameter sets over time above the per-second RMS, every
+//                          swap marked (params.dat: one row per set)
 //   run_ahead_histogram.png  run-ahead margin of the command blocks [ticks]
 // A plot whose data is empty is left out of the script.
 

@@ -41,14 +41,18 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
     if (t >= lo) {
       const bool seen = std::any_of(m.params_history.begin(), m.params_history.end(),
                                     [&](const ParamsPoint& h) { return h.version == p.version && h.valid == p.valid; });
-      if (!seen) m.params_history.push_back({t, p.version, p.c1, p.c2, p.c3, p.residual_m, p.valid});
+      if (!seen) {
+        m.params_history.push_back(
+            {t, p.version, p.c1, p.c2, p.c3, p.residual_m, p.valid, p.model, p.heldout_rms_m, p.model_channel});
+      }
     }
+    if (p.model != "mem") continue;  // params_initial/final are MEM sets
     if (p.valid && t <= start) initial = &p;
   }
   if (initial == nullptr) {
     for (const auto& p : run.params) {
       const double t = t_of(p.recv_utime);
-      if (p.valid && t >= lo && t <= hi) {
+      if (p.valid && p.model == "mem" && t >= lo && t <= hi) {
         initial = &p;
         break;
       }
@@ -59,7 +63,7 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
   MemParams current = *m.params_initial;
   for (const auto& p : run.params) {
     const double t = t_of(p.recv_utime);
-    if (!p.valid || &p == initial || t <= start || t < lo || t > hi) continue;
+    if (!p.valid || p.model != "mem" || &p == initial || t <= start || t < lo || t > hi) continue;
     if (p.version != current.version) ++m.params_updates;
     current = MemParams{p.version, p.c1, p.c2, p.c3};
   }

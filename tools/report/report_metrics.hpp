@@ -50,11 +50,15 @@ struct MemParams {
   double c1 = 0.0, c2 = 0.0, c3 = 0.0;
 };
 
+// One published parameter set (HX_PARAMS or HX_MODEL) in the range.
 struct ParamsPoint {
   double t_s = 0.0;
   std::int32_t version = 0;
-  double c1 = 0.0, c2 = 0.0, c3 = 0.0, residual_m = 0.0;
+  double c1 = 0.0, c2 = 0.0, c3 = 0.0, residual_m = 0.0;  // c1..c3 NaN unless the model is MEM
   bool valid = false;
+  std::string model = "mem";
+  double heldout_rms_m = 0.0;  // NaN: not given
+  bool model_change = false;   // from HX_MODEL: the feedforward switched to this model
 };
 
 struct ReportMetrics {

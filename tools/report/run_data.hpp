@@ -68,12 +68,16 @@ class CommandVersions {
   std::vector<VersionRun> runs_;  // increasing, disjoint
 };
 
+// A parameter set: HX_PARAMS (MEM) or HX_MODEL (any model; c1..c3 only when it is MEM).
 struct ParamsRecord {
   std::int64_t recv_utime = 0;
   std::int32_t version = 0;
   double c1 = 0.0, c2 = 0.0, c3 = 0.0;
   double residual_m = 0.0;
   bool valid = false;
+  std::string model = "mem";   // ModelKind's name
+  double heldout_rms_m = 0.0;  // NaN: not given (HX_PARAMS' residual_m is its held-out RMS)
+  bool model_channel = false;  // from HX_MODEL: a model change (the feedforward switched to it)
 };
 
 struct StatusRecord {

@@ -20,12 +20,13 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/message_storage.hpp"
-#include "mini_json.hpp"
+#include <nlohmann/json.hpp>
 
 namespace fs = std::filesystem;
 using namespace hystloop;
@@ -105,6 +106,21 @@ mem_params_t params(std::int32_t version, double c1, bool valid) {
   return p;
 }
 
+// A model change to a linear model on HX_MODEL (issue 11).
+model_params_t linear_model(std::int32_t version) {
+  model_params_t m{};
+  m.format_version = model_params_t::FORMAT_VERSION;
+  m.utime = kT0;
+  m.version = version;
+  m.kind = model_params_t::KIND_LINEAR;
+  m.linear_gain = 6.3e-9;
+  m.residual_m = 4e-9;
+  m.heldout_rms_m = 5e-9;
+  m.valid = true;
+  m.source = "test";
+  return m;
+}
+
 service_status_t status(const std::string& process, std::int64_t t, std::vector<std::pair<std::string, std::int64_t>> c) {
   service_status_t s{};
   s.utime = t;
@@ -182,6 +198,7 @@ LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
   events.push_back(event(kT0 + 3'001'000, "HX_PARAMS", params(2, 1.1e-7, true)));  // a repeat
   events.push_back(event(kT0 + 5'000'000, "HX_PARAMS", params(3, 9e-7, false)));   // diagnostic only
   events.push_back(event(kT0 + 7'000'000, "HX_PARAMS", params(4, 1.2e-7, true)));
+  events.push_back(event(kT0 + 9'000'000, "HX_MODEL", linear_model(5)));
   for (std::int64_t s = 1; s <= 12; ++s) {
     const std::int64_t t = kT0 + s * 1'000'000 - 100;
     std::vector<std::pair<std::string, std::int64_t>> bridge{{"ticks", s * 1000},
@@ -338,96 +355,111 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
                              " --csv HX_SENSOR --csv COMMAND --csv HX_STATUS",
                          dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
+  const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
   const Expected x = expected(-1e9, 1e9);
 
-  EXPECT_EQ(j["samples"].num(), static_cast<double>(x.samples));
-  EXPECT_EQ(j["samples"].num(), static_cast<double>(kTicks - kGapLen));
-  EXPECT_NEAR(j["duration_s"].num(), static_cast<double>(kTicks - 1) * 1e-3, 1e-9);
-  EXPECT_EQ(j["tracking_samples"].num(), static_cast<double>(x.tracking));
-  EXPECT_NEAR(j["rms_error_m"].num(), x.rms, kRel * x.rms);
-  EXPECT_NEAR(j["max_abs_error_m"].num(), 200e-9, 1e-18);
-  EXPECT_NEAR(j["max_abs_error_m"].num(), x.max_abs, 1e-18);
-  EXPECT_NEAR(j["rms_error_first_5s_m"].num(), x.rms_first, kRel * x.rms_first);
-  EXPECT_NEAR(j["rms_error_last_5s_m"].num(), x.rms_last, kRel * x.rms_last);
+  EXPECT_EQ(j.at("samples").get<double>(), static_cast<double>(x.samples));
+  EXPECT_EQ(j.at("samples").get<double>(), static_cast<double>(kTicks - kGapLen));
+  EXPECT_NEAR(j.at("duration_s").get<double>(), static_cast<double>(kTicks - 1) * 1e-3, 1e-9);
+  EXPECT_EQ(j.at("tracking_samples").get<double>(), static_cast<double>(x.tracking));
+  EXPECT_NEAR(j.at("rms_error_m").get<double>(), x.rms, kRel * x.rms);
+  EXPECT_NEAR(j.at("max_abs_error_m").get<double>(), 200e-9, 1e-18);
+  EXPECT_NEAR(j.at("max_abs_error_m").get<double>(), x.max_abs, 1e-18);
+  EXPECT_NEAR(j.at("rms_error_first_5s_m").get<double>(), x.rms_first, kRel * x.rms_first);
+  EXPECT_NEAR(j.at("rms_error_last_5s_m").get<double>(), x.rms_last, kRel * x.rms_last);
   EXPECT_GT(x.rms_first, 2.0 * x.rms_last);  // the generator's pattern: the test can tell them apart
 
-  const auto& per_second = j["per_second"].array;
+  const auto& per_second = j.at("per_second");
   ASSERT_EQ(per_second.size(), 12u);
   for (std::size_t s = 0; s < per_second.size(); ++s) {
     const auto& bin = per_second[s];
-    EXPECT_EQ(bin["t_s"].num(), static_cast<double>(s));
+    EXPECT_EQ(bin.at("t_s").get<double>(), static_cast<double>(s));
     const auto it = x.bins.find(static_cast<std::int64_t>(s));
     if (it == x.bins.end()) {
-      EXPECT_TRUE(bin["rms_error_m"].is_null()) << s;
+      EXPECT_TRUE(bin.at("rms_error_m").is_null()) << s;
     } else {
       const double want = std::sqrt(it->second.first / static_cast<double>(it->second.second));
-      EXPECT_NEAR(bin["rms_error_m"].num(), want, kRel * want) << s;
+      EXPECT_NEAR(bin.at("rms_error_m").get<double>(), want, kRel * want) << s;
     }
-    EXPECT_EQ(bin["params_version"].num(), version_in_use(static_cast<std::int64_t>(s) * 1000 + 999)) << s;
+    EXPECT_EQ(bin.at("params_version").get<double>(), version_in_use(static_cast<std::int64_t>(s) * 1000 + 999)) << s;
   }
 
-  EXPECT_EQ(j["armed_samples"].num(), static_cast<double>(x.armed));
-  EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
-  EXPECT_NEAR(j["late_command_fraction"].num(), static_cast<double>(x.late) / static_cast<double>(x.armed), 1e-15);
+  EXPECT_EQ(j.at("armed_samples").get<double>(), static_cast<double>(x.armed));
+  EXPECT_EQ(j.at("late_samples").get<double>(), static_cast<double>(x.late));
+  EXPECT_NEAR(j.at("late_command_fraction").get<double>(), static_cast<double>(x.late) / static_cast<double>(x.armed), 1e-15);
 
-  EXPECT_EQ(j["late_tick_fraction"].num(), j["late_command_fraction"].num());
-  EXPECT_GT(j["late_samples"].num(), 40.0);  // the test can tell armed from all ticks
-  EXPECT_LT(j["late_samples"].num(), 48.0);
+  EXPECT_EQ(j.at("late_tick_fraction").get<double>(), j.at("late_command_fraction").get<double>());
+  EXPECT_GT(j.at("late_samples").get<double>(), 40.0);  // the test can tell armed from all ticks
+  EXPECT_LT(j.at("late_samples").get<double>(), 48.0);
 
-  EXPECT_EQ(j["tick_period_s"].num(), 1e-3);
-  EXPECT_EQ(j["sensor_blocks"].num(), static_cast<double>(x.blocks));
-  EXPECT_EQ(j["buffer_min_depth_ticks"].num(), 2.0);  // the safe blocks' 0 does not count
-  EXPECT_EQ(j["buffer_min_depth_ticks"].num(), x.buffer_min);
+  EXPECT_EQ(j.at("tick_period_s").get<double>(), 1e-3);
+  EXPECT_EQ(j.at("sensor_blocks").get<double>(), static_cast<double>(x.blocks));
+  EXPECT_EQ(j.at("buffer_min_depth_ticks").get<double>(), 2.0);  // the safe blocks' 0 does not count
+  EXPECT_EQ(j.at("buffer_min_depth_ticks").get<double>(), x.buffer_min);
 
-  EXPECT_EQ(j["run_ahead_blocks"].num(), static_cast<double>(x.run_ahead.size()));
-  EXPECT_EQ(j["run_ahead_min_ticks"].num(), 20.0);
-  EXPECT_EQ(j["run_ahead_p01_ticks"].num(), rank(x.run_ahead, 0.01));
-  EXPECT_EQ(j["run_ahead_p50_ticks"].num(), rank(x.run_ahead, 0.50));
-  EXPECT_EQ(j["run_ahead_max_ticks"].num(), 24.0);
+  EXPECT_EQ(j.at("run_ahead_blocks").get<double>(), static_cast<double>(x.run_ahead.size()));
+  EXPECT_EQ(j.at("run_ahead_min_ticks").get<double>(), 20.0);
+  EXPECT_EQ(j.at("run_ahead_p01_ticks").get<double>(), rank(x.run_ahead, 0.01));
+  EXPECT_EQ(j.at("run_ahead_p50_ticks").get<double>(), rank(x.run_ahead, 0.50));
+  EXPECT_EQ(j.at("run_ahead_max_ticks").get<double>(), 24.0);
 
   // No watchdog_trips counter: the armed -> safe transitions, less the one DISARM explains.
   EXPECT_EQ(x.trips, 1);
-  EXPECT_EQ(j["watchdog_trips"].num(), static_cast<double>(x.trips));
-  EXPECT_NE(j["watchdog_trips_source"].string.find("transitions"), std::string::npos);
+  EXPECT_EQ(j.at("watchdog_trips").get<double>(), static_cast<double>(x.trips));
+  EXPECT_NE(j.at("watchdog_trips_source").get<std::string>().find("transitions"), std::string::npos);
 
   for (const auto& [channel, times] : truth.times) {
     const double n = static_cast<double>(std::count_if(times.begin(), times.end(), [&](std::int64_t t) {
       return t >= kT0 + std::llround(x.first_t * 1e6) && t <= kT0 + std::llround(x.last_t * 1e6);
     }));
-    EXPECT_NEAR(j["messages_per_s"][channel].num(), n / (x.last_t - x.first_t), 1e-9) << channel;
+    EXPECT_NEAR(j.at("messages_per_s")[channel].get<double>(), n / (x.last_t - x.first_t), 1e-9) << channel;
   }
-  EXPECT_NEAR(j["messages_per_s"]["HX_SENSOR"].num(), 100.0, 0.1);  // 1 kHz in blocks of 10
-  EXPECT_NEAR(j["cpu_fraction"]["bridge"].num(), 0.25, 1e-12);
-  EXPECT_NEAR(j["cpu_fraction"]["compensator"].num(), 0.1, 1e-12);
-  EXPECT_TRUE(j["cpu_fraction"]["logger"].is_null());  // it reports no CPU time
+  EXPECT_NEAR(j.at("messages_per_s").at("HX_SENSOR").get<double>(), 100.0, 0.1);  // 1 kHz in blocks of 10
+  EXPECT_NEAR(j.at("cpu_fraction").at("bridge").get<double>(), 0.25, 1e-12);
+  EXPECT_NEAR(j.at("cpu_fraction").at("compensator").get<double>(), 0.1, 1e-12);
+  EXPECT_TRUE(j.at("cpu_fraction").at("logger").is_null());  // it reports no CPU time
 
-  EXPECT_EQ(j["commands_rejected"].num(), 12 + 2 + 1);  // not the control endpoint's 5, not 'rejected' (77)
-  EXPECT_EQ(j["logger_gaps"].num(), 1.0);
-  EXPECT_NE(j["logger_gaps_source"].string.find("sensor.gaps"), std::string::npos);
-  EXPECT_EQ(j["seq_gaps"].num(), 1.0);
-  EXPECT_EQ(j["missing_samples"].num(), static_cast<double>(kGapLen));
+  EXPECT_EQ(j.at("commands_rejected").get<double>(), 12 + 2 + 1);  // not the control endpoint's 5, not 'rejected' (77)
+  EXPECT_EQ(j.at("logger_gaps").get<double>(), 1.0);
+  EXPECT_NE(j.at("logger_gaps_source").get<std::string>().find("sensor.gaps"), std::string::npos);
+  EXPECT_EQ(j.at("seq_gaps").get<double>(), 1.0);
+  EXPECT_EQ(j.at("missing_samples").get<double>(), static_cast<double>(kGapLen));
 
-  const auto& history = j["params_history"].array;
-  ASSERT_EQ(history.size(), 4u);  // v1, v2 (its repeat folded), v3 (invalid), v4
+  const auto& history = j.at("params_history");
+  ASSERT_EQ(history.size(), 5u);  // v1, v2 (its repeat folded), v3 (invalid), v4, v5 (HX_MODEL)
   const double want_t[] = {-0.5, 3.0, 5.0, 7.0};
   const int want_v[] = {1, 2, 3, 4};
   for (std::size_t i = 0; i < 4; ++i) {
-    EXPECT_NEAR(history[i]["t_s"].num(), want_t[i], 1e-9);
-    EXPECT_EQ(history[i]["version"].num(), want_v[i]);
-    EXPECT_EQ(history[i]["valid"].boolean, want_v[i] != 3);
-    EXPECT_NEAR(history[i]["c2"].num(), 2e-9 * want_v[i], 1e-24);
-    EXPECT_NEAR(history[i]["residual_m"].num(), 1e-9 * want_v[i], 1e-24);
+    EXPECT_NEAR(history[i].at("t_s").get<double>(), want_t[i], 1e-9);
+    EXPECT_EQ(history[i].at("version").get<double>(), want_v[i]);
+    EXPECT_EQ(history[i].at("valid").get<bool>(), want_v[i] != 3);
+    EXPECT_NEAR(history[i].at("c2").get<double>(), 2e-9 * want_v[i], 1e-24);
+    EXPECT_NEAR(history[i].at("residual_m").get<double>(), 1e-9 * want_v[i], 1e-24);
+    EXPECT_EQ(history[i].at("model").get<std::string>(), "mem");
+    EXPECT_NEAR(history[i].at("heldout_rms_m").get<double>(), 1e-9 * want_v[i], 1e-24);  // mem_params_t's residual
+    EXPECT_FALSE(history[i].at("model_change").get<bool>());
   }
-  EXPECT_EQ(j["params_initial"]["version"].num(), 1);
-  EXPECT_EQ(j["params_initial"]["c1"].num(), 1e-7);
-  EXPECT_EQ(j["params_final"]["version"].num(), 4);
-  EXPECT_EQ(j["params_final"]["c1"].num(), 1.2e-7);
-  EXPECT_NEAR(j["params_final"]["c3"].num(), 0.9, 1e-15);
-  EXPECT_EQ(j["params_updates"].num(), 2);  // v2 and v4; the invalid v3 is no update
+  const auto& change = history[4];  // a model change: kind and figures, no MEM parameters
+  EXPECT_NEAR(change.at("t_s").get<double>(), 9.0, 1e-9);
+  EXPECT_EQ(change.at("version").get<double>(), 5);
+  EXPECT_EQ(change.at("model").get<std::string>(), "linear");
+  EXPECT_TRUE(change.at("model_change").get<bool>());
+  EXPECT_TRUE(change.at("c1").is_null());
+  EXPECT_EQ(change.at("residual_m").get<double>(), 4e-9);
+  EXPECT_EQ(change.at("heldout_rms_m").get<double>(), 5e-9);
+  // rms_per_second_m: the per-second bins' RMS as a plain series.
+  const auto& rms = j.at("rms_per_second_m");
+  ASSERT_EQ(rms.size(), per_second.size());
+  for (std::size_t s = 0; s < rms.size(); ++s) EXPECT_EQ(rms[s], per_second[s].at("rms_error_m")) << s;
+  EXPECT_EQ(j.at("params_initial").at("version").get<double>(), 1);
+  EXPECT_EQ(j.at("params_initial").at("c1").get<double>(), 1e-7);
+  EXPECT_EQ(j.at("params_final").at("version").get<double>(), 4);
+  EXPECT_EQ(j.at("params_final").at("c1").get<double>(), 1.2e-7);
+  EXPECT_NEAR(j.at("params_final").at("c3").get<double>(), 0.9, 1e-15);
+  EXPECT_EQ(j.at("params_updates").get<double>(), 2);  // v2 and v4; the invalid v3 is no update
 
-  for (const auto& [channel, n] : counts) EXPECT_EQ(j["channels"][channel].num(), static_cast<double>(n)) << channel;
-  EXPECT_EQ(j["undecodable_events"].num(), 0);
+  for (const auto& [channel, n] : counts) EXPECT_EQ(j.at("channels")[channel].get<double>(), static_cast<double>(n)) << channel;
+  EXPECT_EQ(j.at("undecodable_events").get<double>(), 0);
 
   // CSV: header of decoded fields with units, one row per tick of the block channels.
   const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
@@ -469,27 +501,27 @@ TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
                          dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
-  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
+  const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
   const Expected x = expected(3.0, 9.0);
-  EXPECT_EQ(j["samples"].num(), static_cast<double>(x.samples));
-  EXPECT_NEAR(j["rms_error_m"].num(), x.rms, kRel * x.rms);
-  EXPECT_NEAR(j["rms_error_first_5s_m"].num(), x.rms_first, kRel * x.rms_first);
-  EXPECT_NEAR(j["rms_error_last_5s_m"].num(), x.rms_last, kRel * x.rms_last);
-  EXPECT_EQ(j["late_samples"].num(), static_cast<double>(x.late));
-  EXPECT_EQ(j["armed_samples"].num(), static_cast<double>(x.armed));
-  EXPECT_EQ(j["sensor_blocks"].num(), static_cast<double>(x.blocks));
-  EXPECT_EQ(j["run_ahead_blocks"].num(), static_cast<double>(x.run_ahead.size()));
-  EXPECT_EQ(j["range"]["from_s"].num(), 3.0);
-  EXPECT_EQ(j["range"]["to_s"].num(), 9.0);
+  EXPECT_EQ(j.at("samples").get<double>(), static_cast<double>(x.samples));
+  EXPECT_NEAR(j.at("rms_error_m").get<double>(), x.rms, kRel * x.rms);
+  EXPECT_NEAR(j.at("rms_error_first_5s_m").get<double>(), x.rms_first, kRel * x.rms_first);
+  EXPECT_NEAR(j.at("rms_error_last_5s_m").get<double>(), x.rms_last, kRel * x.rms_last);
+  EXPECT_EQ(j.at("late_samples").get<double>(), static_cast<double>(x.late));
+  EXPECT_EQ(j.at("armed_samples").get<double>(), static_cast<double>(x.armed));
+  EXPECT_EQ(j.at("sensor_blocks").get<double>(), static_cast<double>(x.blocks));
+  EXPECT_EQ(j.at("run_ahead_blocks").get<double>(), static_cast<double>(x.run_ahead.size()));
+  EXPECT_EQ(j.at("range").at("from_s").get<double>(), 3.0);
+  EXPECT_EQ(j.at("range").at("to_s").get<double>(), 9.0);
   // Parameters in force at the start (v2), updated once (v4) inside the range.
-  EXPECT_EQ(j["params_initial"]["version"].num(), 2);
-  EXPECT_EQ(j["params_final"]["version"].num(), 4);
-  EXPECT_EQ(j["params_updates"].num(), 1);
+  EXPECT_EQ(j.at("params_initial").at("version").get<double>(), 2);
+  EXPECT_EQ(j.at("params_final").at("version").get<double>(), 4);
+  EXPECT_EQ(j.at("params_updates").get<double>(), 1);
   // No logger status: gaps come from the sensor's seq.
-  EXPECT_EQ(j["logger_gaps"].num(), 1.0);
-  EXPECT_NE(j["logger_gaps_source"].string.find("sensor seq"), std::string::npos);
+  EXPECT_EQ(j.at("logger_gaps").get<double>(), 1.0);
+  EXPECT_NE(j.at("logger_gaps_source").get<std::string>().find("sensor seq"), std::string::npos);
   // The bridge counts its watchdog trips: its counter is the figure.
-  EXPECT_EQ(j["watchdog_trips"].num(), 3.0);
+  EXPECT_EQ(j.at("watchdog_trips").get<double>(), 3.0);
   const std::string sensor = slurp(dir_ / "out" / "HX_SENSOR.csv");
   EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), x.samples + 1);
   EXPECT_FALSE(fs::exists(dir_ / "out" / "plots.gp"));
@@ -513,12 +545,12 @@ TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
                              dir_);
   ASSERT_EQ(whole.exit_code, 0);
   ASSERT_EQ(split.exit_code, 0) << split.err;
-  const auto ja = mini_json::parse(slurp(dir_ / "a" / "summary.json"));
-  const auto jb = mini_json::parse(slurp(dir_ / "b" / "summary.json"));
-  EXPECT_EQ(ja["samples"].num(), jb["samples"].num());
-  EXPECT_EQ(ja["rms_error_m"].num(), jb["rms_error_m"].num());
-  EXPECT_EQ(ja["run_ahead_p50_ticks"].num(), jb["run_ahead_p50_ticks"].num());
-  EXPECT_EQ(ja["buffer_min_depth_ticks"].num(), jb["buffer_min_depth_ticks"].num());
+  const auto ja = nlohmann::json::parse(slurp(dir_ / "a" / "summary.json"));
+  const auto jb = nlohmann::json::parse(slurp(dir_ / "b" / "summary.json"));
+  EXPECT_EQ(ja.at("samples").get<double>(), jb.at("samples").get<double>());
+  EXPECT_EQ(ja.at("rms_error_m").get<double>(), jb.at("rms_error_m").get<double>());
+  EXPECT_EQ(ja.at("run_ahead_p50_ticks").get<double>(), jb.at("run_ahead_p50_ticks").get<double>());
+  EXPECT_EQ(ja.at("buffer_min_depth_ticks").get<double>(), jb.at("buffer_min_depth_ticks").get<double>());
 }
 
 TEST_F(ReportToolTest, MissingGnuplotIsAWarningNotAFailure) {
@@ -580,12 +612,12 @@ TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
   }
   const ToolRun r = run_tool((dir_ / "bad.lcmlog").string() + " --out " + (dir_ / "out").string() + " --no-plots", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = mini_json::parse(slurp(dir_ / "out" / "summary.json"));
-  EXPECT_EQ(j["samples"].num(), 1);
-  EXPECT_EQ(j["undecodable_events"].num(), 2);
-  EXPECT_TRUE(j["rms_error_m"].is_null());
-  EXPECT_TRUE(j["run_ahead_p50_ticks"].is_null());
-  EXPECT_TRUE(j["cpu_fraction"].object.empty());
+  const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(j.at("samples").get<double>(), 1);
+  EXPECT_EQ(j.at("undecodable_events").get<double>(), 2);
+  EXPECT_TRUE(j.at("rms_error_m").is_null());
+  EXPECT_TRUE(j.at("run_ahead_p50_ticks").is_null());
+  EXPECT_TRUE(j.at("cpu_fraction").empty());
 }
 
 namespace {
@@ -627,8 +659,8 @@ TEST_F(ReportToolTest, DamagedLogsAreNamedAndNothingDecodableExitsOne) {
   // ... and reading goes on after them (liblcm's reader stopped there, dropping the rest).
   const ToolRun clean = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean0").string() + " --no-plots", dir_);
   ASSERT_EQ(clean.exit_code, 0) << clean.err;
-  EXPECT_EQ(mini_json::parse(slurp(dir_ / "torn" / "summary.json"))["samples"].num(),
-            mini_json::parse(slurp(dir_ / "clean0" / "summary.json"))["samples"].num());
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "torn" / "summary.json")).at("samples").get<double>(),
+            nlohmann::json::parse(slurp(dir_ / "clean0" / "summary.json")).at("samples").get<double>());
 
   // A clean log: no warning at all.
   r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean").string() + " --no-plots", dir_);

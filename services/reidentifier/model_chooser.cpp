@@ -1,0 +1,122 @@
+#include "reidentifier/model_chooser.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+#include "ident/online_mem_estimator.hpp"
+#include "reidentifier/reident_core.hpp"
+
+namespace hystloop {
+
+const char* ModelChooser::counter_name(std::size_t i) noexcept {
+  static constexpr const char* kNames[kCounters] = {"model_selections", "model_changes", "model_refits",
+                                                    "model_kept",       "model_failed",  "model_poisoned",
+                                                    "model_refits_left_to_mem"};
+  return i < kCounters ? kNames[i] : "model_unknown";
+}
+
+ModelChooser::ModelChooser(const ModelChoiceOptions& options, const ModelParamSet& initial, MemWindow window,
+                           bool start_thread)
+    : options_(options),
+      in_use_(initial),
+      window_(std::move(window)),
+      slot_([this] { evaluate_job(); }, options.enabled && start_thread) {
+  options_.selector.validate();
+  in_use_.validate();
+}
+
+void ModelChooser::evaluate_job() {
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    result_ = job_poisoned_ ? ModelProposal{} : propose_model(window_.u, window_.y, job_in_use_, job_options_);
+    if (job_poisoned_) result_.reason = "window poisoned (non-finite sample or dropout)";
+  } catch (const std::exception& e) {
+    result_ = ModelProposal{};
+    result_.reason = e.what();
+  }
+  duration_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  spdlog::debug("model selection: {} ({:.0f} ms)", result_.reason, duration_s_ * 1e3);
+}
+
+namespace {
+// The set a pinned kind starts from when it is not in use: a valid set of that kind (the
+// selector refits it on the window and proposes the refit when it beats this one).
+ModelParamSet start_of(ModelKind kind, const MemParams& mem) {
+  ModelParamSet s;
+  s.kind = kind;
+  s.mem = mem;
+  if (kind == ModelKind::pi) s.pi = pi_params_from_mem(mem, 15, 250.0);
+  if (kind == ModelKind::linear) s.linear = linear_params_from_mem(mem, 250.0);
+  return s;
+}
+}  // namespace
+
+ModelDecision ModelChooser::collect(ReidentCore& core) {
+  ModelDecision d;
+  const ModelProposal& p = result_;
+  last_duration_s_ = duration_s_;
+  last_reason_ = p.reason;  // the I/O thread's copy (allocates only while it grows; 0.2 Hz)
+  if (job_poisoned_) {
+    ++counters_[poisoned];
+    return d;
+  }
+  if (p.status != FitStatus::ok) {
+    ++counters_[failed];
+    return d;
+  }
+  ++counters_[selections];
+  const bool pinned_elsewhere = options_.pinned && *options_.pinned != in_use_.kind;
+  if (!p.proposes() && !pinned_elsewhere) {
+    ++counters_[kept];
+    return d;
+  }
+  // Pinned to a kind not in use: the user asked for it, so it is switched to whether or not it
+  // wins; its refit when that beat the start set on the held-out branch, else the start set.
+  const ModelParamSet& set = p.proposes() ? p.params : job_in_use_;
+  const bool change = p.kind == ProposalKind::model_change || set.kind != in_use_.kind;
+  if (!change && set.kind == ModelKind::mem) {
+    ++counters_[left_to_mem];  // the MEM refit publishes MEM's parameters on HX_PARAMS
+    return d;
+  }
+  // A proposal made against a set that changed meanwhile (HX_PARAMS from elsewhere) is still
+  // judged on this window: the compensator swaps only at a reversal, so the newest wins anyway.
+  d.kind = change ? ModelDecision::Kind::change : ModelDecision::Kind::refit;
+  d.params = set;
+  d.proposal = p;
+  d.window_samples = window_.u.size();
+  d.version = set.kind == ModelKind::mem ? core.adopt_own_mem(set.mem) : core.claim_diagnostic_version();
+  ++counters_[change ? changes : refits];
+  in_use_ = set;
+  core.set_mem_refits(in_use_.kind == ModelKind::mem);
+  return d;
+}
+
+ModelDecision ModelChooser::poll(ReidentCore& core, std::int64_t now_us) {
+  if (!options_.enabled) return {};
+  ModelDecision d;
+  if (slot_.done()) {
+    d = collect(core);
+    slot_.release();
+  }
+  const std::uint64_t fed = core.estimator().samples_fed();
+  const std::size_t window = core.options().estimator.window_samples;
+  if (slot_.idle() && now_us >= next_us_ && fed >= window && fed != fed_at_last_) {
+    core.estimator().snapshot(window_);  // allocation-free: window_ came from make_window()
+    job_poisoned_ = window_.poison != PoisonKind::none;
+    if (in_use_.kind == ModelKind::mem) in_use_.mem = core.in_use().params();  // MEM refits move it
+    const bool pinned_elsewhere = options_.pinned && *options_.pinned != in_use_.kind;
+    job_in_use_ = pinned_elsewhere ? start_of(*options_.pinned, core.in_use().params()) : in_use_;
+    job_options_ = options_.selector;
+    job_options_.pinned = options_.pinned.has_value();
+    fed_at_last_ = fed;
+    next_us_ = now_us + std::llround(options_.period_s * 1e6);
+    slot_.submit();
+  }
+  return d;
+}
+
+}  // namespace hystloop
