@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
@@ -170,7 +171,7 @@ int main(int argc, char** argv) {
   add_common(*sub, opt, false);
   auto* idle = sub->add_flag("--idle", opt.idle, "Open no LCM at all: the same wait loop on a file descriptor that stays quiet (baseline)");
   sub->get_option("--channel")->excludes(idle);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
   try {
     if (sub->parsed() && !opt.idle && opt.channel.empty()) {

@@ -1,4 +1,4 @@
-# hystloop_lcm_types(TARGET <name> PACKAGE <pkg> FILES <a.lcm>... [JAR <jar name>])
+# hystloop_lcm_types(TARGET <name> PACKAGE <pkg> FILES <a.lcm>... [JAR <jar name>] [WIRE_LAYOUTS])
 #
 # Generates code for LCM message definitions at build time, into the build tree only:
 #  - C++ headers (lcm-gen --cpp) in <binary dir>/cpp/<pkg>/<type>.hpp, exposed through the
@@ -9,11 +9,15 @@
 #    lcm.jar into <binary dir>/<jar name>.jar, so that lcm-spy decodes every channel
 #    (CLASSPATH=<jar>:/usr/share/java/lcm.jar lcm-spy). The jar's target is <name>_jar;
 #    its path is in that target's JAR_FILE property.
+#  - with WIRE_LAYOUTS: each type's wire layout for common/lcm/wire_layout.{hpp,cpp}, made by
+#    cmake/lcm_wire_layouts.py from the same .lcm files into <binary dir>/cpp/<pkg>/:
+#    wire_layout_decls.inc, wire_layout_defs.inc and wire_layout_samples.hpp (for tests). A type
+#    the walker cannot check stops the build with the file, line and reason.
 # Each output depends on its .lcm file (and on lcm-gen), so editing a type regenerates it.
 find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED DOC "LCM type generator (package liblcm-bin / lcm)")
 
 function(hystloop_lcm_types)
-  cmake_parse_arguments(ARG "" "TARGET;PACKAGE;JAR" "FILES" ${ARGN})
+  cmake_parse_arguments(ARG "WIRE_LAYOUTS" "TARGET;PACKAGE;JAR" "FILES" ${ARGN})
   if(NOT ARG_TARGET OR NOT ARG_PACKAGE OR NOT ARG_FILES)
     message(FATAL_ERROR "hystloop_lcm_types: TARGET, PACKAGE and FILES are required")
   endif()
@@ -53,6 +57,26 @@ function(hystloop_lcm_types)
       list(APPEND _java_sources ${_java})
     endif()
   endforeach()
+
+  if(ARG_WIRE_LAYOUTS)
+    find_package(Python3 3.8 REQUIRED COMPONENTS Interpreter)
+    set(_generator ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/lcm_wire_layouts.py)
+    set(_layouts_dir ${_cpp_dir}/${ARG_PACKAGE})
+    set(_lcm_paths)
+    foreach(_lcm IN LISTS ARG_FILES)
+      get_filename_component(_lcm ${_lcm} ABSOLUTE)
+      list(APPEND _lcm_paths ${_lcm})
+    endforeach()
+    set(_layouts ${_layouts_dir}/wire_layout_decls.inc ${_layouts_dir}/wire_layout_defs.inc
+                 ${_layouts_dir}/wire_layout_samples.hpp)
+    add_custom_command(
+      OUTPUT ${_layouts}
+      COMMAND ${Python3_EXECUTABLE} ${_generator} ${_layouts_dir} ${ARG_PACKAGE} ${_lcm_paths}
+      DEPENDS ${_lcm_paths} ${_generator}
+      COMMENT "wire layouts of ${ARG_PACKAGE} (cmake/lcm_wire_layouts.py)"
+      VERBATIM)
+    list(APPEND _headers ${_layouts})
+  endif()
 
   add_custom_target(${ARG_TARGET}_generate DEPENDS ${_headers})
   add_library(${ARG_TARGET} INTERFACE)

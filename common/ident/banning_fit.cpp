@@ -7,7 +7,6 @@
 #include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <complex>
 #include <cstdint>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "ident/ceres_budget.hpp"
 #include "ident/fit_checks.hpp"
 
 namespace hystloop {
@@ -149,11 +149,11 @@ struct MagnitudeResidual {
   }
 };
 
-ceres::Solver::Options solver_options(double time_s) {
+// The time budget is attached per solve (CeresTimeBudget), read from the fit's clock.
+ceres::Solver::Options solver_options() {
   ceres::Solver::Options o;
   o.linear_solver_type = ceres::DENSE_QR;
   o.max_num_iterations = 200;
-  o.max_solver_time_in_seconds = time_s;
   o.logging_type = ceres::SILENT;
   o.function_tolerance = 1e-14;
   o.parameter_tolerance = 1e-12;
@@ -163,12 +163,6 @@ ceres::Solver::Options solver_options(double time_s) {
 
 double ch_slope_closed(double a, double b, double alpha, double amp) {
   return a + (b - a) / alpha * std::tanh(alpha * amp) / amp;
-}
-
-BanningFitResult refuse(BanningFitResult r, FitStatus s, std::string why) {
-  r.status = s;
-  r.reason = std::move(why);
-  return r;
 }
 
 // Inverts (25) for h (paper order): ptp = 2 a h A + 2 (b - a)/alpha tanh(alpha A h), increasing in h.
@@ -183,22 +177,20 @@ double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp
   return 0.5 * (lo + hi);
 }
 
-}  // namespace
+FitCheck refusal(FitStatus status, std::string reason) { return {status, std::move(reason)}; }
 
-BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments, const BanningFitOptions& o) {
-  o.validate();
-  const auto t0 = std::chrono::steady_clock::now();
-  auto stamp = [&](BanningFitResult r) {
-    r.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
-  };
-  BanningFitResult res;
-  // 1. Features of every experiment.
+using PointRefs = std::vector<BanningPoint*>;
+
+// 1. Offset, amplitude and frequency of every experiment's input; loop features of the slow
+// ones, the first-harmonic magnitude of the fast ones. An experiment that is not a sine is
+// skipped with a note; one with bad samples refuses the whole fit.
+FitCheck measure_experiments(std::span<const BanningExperimentData> experiments, const BanningFitOptions& o,
+                             std::vector<BanningPoint>& points) {
   for (std::size_t i = 0; i < experiments.size(); ++i) {
     const auto& ex = experiments[i];
     BanningPoint pt;
     if (FitCheck c = check_fit_samples(ex.u, ex.y); !c.ok()) {
-      return stamp(refuse(res, c.status, "experiment " + std::to_string(i) + ": " + c.reason));
+      return refusal(c.status, "experiment " + std::to_string(i) + ": " + c.reason);
     }
     SineEstimate se;
     if (ex.frequency_Hz > 0.0) {
@@ -210,7 +202,7 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
     }
     if (!se.ok) {
       pt.note = "input is not a sine of at least one period";
-      res.points.push_back(pt);
+      points.push_back(pt);
       continue;
     }
     pt.offset_V = se.offset, pt.amplitude_V = se.amplitude, pt.frequency_Hz = se.frequency_Hz;
@@ -227,52 +219,54 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
         pt.used = true;
       }
     }
-    res.points.push_back(pt);
+    points.push_back(pt);
   }
-  // 2. a from the centres.
-  std::vector<const BanningPoint*> loops, mags;
-  for (const auto& p : res.points) {
-    if (p.used) (p.magnitude_experiment ? mags : loops).push_back(&p);
-  }
+  return {};
+}
+
+// 2. a: the least-squares line y_centre = a u_centre + const through the loop centres.
+FitCheck fit_centre_line(const PointRefs& loops, const BanningFitOptions& o, BanningFitResult& res) {
   double umin = 1e300, umax = -1e300;
   for (const auto* p : loops) umin = std::min(umin, p->features.u_centre), umax = std::max(umax, p->features.u_centre);
   if (loops.size() < 2 || umax - umin < o.min_offset_span_V) {
     std::ostringstream s;
     s << loops.size() << " usable loop experiments whose centres span " << (loops.empty() ? 0.0 : umax - umin)
       << " V; need two or more offsets spanning >= " << o.min_offset_span_V << " V to identify a";
-    return stamp(refuse(res, FitStatus::too_few_samples, s.str()));
+    return refusal(FitStatus::too_few_samples, s.str());
   }
-  {
-    Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d r = Eigen::Vector2d::Zero();
-    for (const auto* p : loops) {
-      const Eigen::Vector2d phi(p->features.u_centre, 1.0);
-      g += phi * phi.transpose();
-      r += phi * p->features.y_centre;
-    }
-    const Eigen::Vector2d c = g.ldlt().solve(r);
-    res.hysteresis.a = c[0];
-    double ss = 0.0;
-    for (const auto* p : loops) ss += std::pow(p->features.y_centre - c[0] * p->features.u_centre - c[1], 2);
-    res.centre_rms_m = std::sqrt(ss / static_cast<double>(loops.size()));
+  Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  for (const auto* p : loops) {
+    const Eigen::Vector2d phi(p->features.u_centre, 1.0);
+    g += phi * phi.transpose();
+    r += phi * p->features.y_centre;
   }
-  const double a = res.hysteresis.a;
-  // 3. b and alpha seeds.
+  const Eigen::Vector2d c = g.ldlt().solve(r);
+  res.hysteresis.a = c[0];
+  double ss = 0.0;
+  for (const auto* p : loops) ss += std::pow(p->features.y_centre - c[0] * p->features.u_centre - c[1], 2);
+  res.centre_rms_m = std::sqrt(ss / static_cast<double>(loops.size()));
+  return {};
+}
+
+// 3. Seeds: b from the mean small-loop slope (Theorem 2), alpha as the median of the
+// small-amplitude area formula 4/3 (a - b) alpha A^3 over the larger loops. x = {b [nm/V], alpha}.
+FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions& o, double x[2]) {
   double b0 = 0.0;
-  {
-    std::size_t n = 0;
-    for (const auto* p : loops) if (p->amplitude_V <= o.small_amplitude_max_V) b0 += p->features.slope, ++n;
-    if (n == 0) {  // no small loop: the smallest one
-      const auto* smallest = *std::min_element(loops.begin(), loops.end(),
-                                               [](auto* x, auto* y) { return x->amplitude_V < y->amplitude_V; });
-      b0 = smallest->features.slope, n = 1;
-    }
-    b0 /= static_cast<double>(n);
+  std::size_t n = 0;
+  for (const auto* p : loops) {
+    if (p->amplitude_V <= o.small_amplitude_max_V) b0 += p->features.slope, ++n;
   }
+  if (n == 0) {  // no small loop: the smallest one
+    b0 = (*std::min_element(loops.begin(), loops.end(), [](auto* l, auto* r) { return l->amplitude_V < r->amplitude_V; }))
+             ->features.slope;
+    n = 1;
+  }
+  b0 /= static_cast<double>(n);
   if (!(a > 0.0) || !(b0 > 0.0) || !(b0 < a)) {
     std::ostringstream s;
     s << "a = " << a << " m/V, small-loop slope b = " << b0 << " m/V: need 0 < b < a (a loop with area)";
-    return stamp(refuse(res, FitStatus::out_of_range, s.str()));
+    return refusal(FitStatus::out_of_range, s.str());
   }
   std::vector<double> alphas;
   for (const auto* p : loops) {
@@ -281,105 +275,133 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
     }
   }
   if (alphas.empty()) {
-    return stamp(refuse(res, FitStatus::too_few_samples,
-                        "no loop above small_amplitude_max_V with a positive area: alpha cannot be identified"));
+    return refusal(FitStatus::too_few_samples,
+                   "no loop above small_amplitude_max_V with a positive area: alpha cannot be identified");
   }
   std::nth_element(alphas.begin(), alphas.begin() + static_cast<std::ptrdiff_t>(alphas.size() / 2), alphas.end());
-  double x[2] = {b0 * 1e9, alphas[alphas.size() / 2]};
-  // 4. (b, alpha) jointly on the exact (21) and (24).
-  {
-    ceres::Problem problem;
-    for (const auto* p : loops) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SlopeResidual, 1, 2>(
-                                   new SlopeResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9}),
+  x[0] = b0 * 1e9, x[1] = alphas[alphas.size() / 2];
+  return {};
+}
+
+// 4. (b, alpha) jointly on the exact (21) for every slope and (24) for the larger areas.
+FitCheck refine_b_alpha(const PointRefs& loops, const BanningFitOptions& o, const FitClock& clock, double x[2],
+                        BanningFitResult& res) {
+  const double a = res.hysteresis.a;
+  ceres::Problem problem;
+  for (const auto* p : loops) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SlopeResidual, 1, 2>(
+                                 new SlopeResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9}),
+                             nullptr, x);
+    if (p->amplitude_V > o.small_amplitude_max_V) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AreaResidual, 1, 2>(
+                                   new AreaResidual{a * 1e9, p->amplitude_V, p->features.area * 1e9}),
                                nullptr, x);
-      if (p->amplitude_V > o.small_amplitude_max_V) {
-        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AreaResidual, 1, 2>(
-                                     new AreaResidual{a * 1e9, p->amplitude_V, p->features.area * 1e9}),
-                                 nullptr, x);
-      }
     }
-    problem.SetParameterLowerBound(x, 0, 1e-6);
-    problem.SetParameterLowerBound(x, 1, 1e-9);
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options(o.max_solver_time_s), &problem, &summary);
-    if (!summary.IsSolutionUsable()) return stamp(refuse(res, FitStatus::solver_failure, "Ceres (b, alpha): " + summary.message));
   }
+  problem.SetParameterLowerBound(x, 0, 1e-6);
+  problem.SetParameterLowerBound(x, 1, 1e-9);
+  ceres::Solver::Options so = solver_options();
+  detail::CeresTimeBudget budget(clock, o.max_solver_time_s);
+  budget.attach(so);
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return refusal(FitStatus::solver_failure, "Ceres (b, alpha): " + summary.message);
   res.hysteresis.b = x[0] * 1e-9;
   res.hysteresis.alpha = x[1];
   try {
     res.hysteresis.validate();
   } catch (const ParameterError& e) {
-    return stamp(refuse(res, FitStatus::out_of_range, std::string("hysteresis: ") + e.what()));
+    return refusal(FitStatus::out_of_range, std::string("hysteresis: ") + e.what());
   }
-  {
-    double ss = 0.0, sa = 0.0;
-    std::size_t na = 0;
-    for (const auto* p : loops) {
-      const double z = ch_slope_closed(a, res.hysteresis.b, res.hysteresis.alpha, p->amplitude_V);
-      ss += std::pow((z - p->features.slope) / p->features.slope, 2);
-      if (p->amplitude_V > o.small_amplitude_max_V) {
-        const double al = res.hysteresis.alpha, A = p->amplitude_V;
-        const double eps = 4.0 * (a - res.hysteresis.b) / al * (A - std::tanh(al * A) / al);
-        sa += std::pow((eps - p->features.area) / p->features.area, 2), ++na;
-      }
-    }
-    res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
-    res.area_rel_rms = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
-    if (!std::isfinite(res.slope_rel_rms) || !std::isfinite(res.area_rel_rms)) {
-      return stamp(refuse(res, FitStatus::solver_failure, "the slope or area residual is not finite: no usable solution"));
+  const double b = res.hysteresis.b, al = res.hysteresis.alpha;
+  double ss = 0.0, sa = 0.0;
+  std::size_t na = 0;
+  for (const auto* p : loops) {
+    const double A = p->amplitude_V;
+    ss += std::pow((ch_slope_closed(a, b, al, A) - p->features.slope) / p->features.slope, 2);
+    if (A > o.small_amplitude_max_V) {
+      const double eps = 4.0 * (a - b) / al * (A - std::tanh(al * A) / al);
+      sa += std::pow((eps - p->features.area) / p->features.area, 2), ++na;
     }
   }
-  // 5. k, c from the magnitudes.
-  if (mags.size() < 3) {
-    res.status = FitStatus::ok;
-    res.reason = mags.empty() ? "no magnitude experiments: stage (k, c) not identified"
-                              : "fewer than 3 magnitude experiments: stage (k, c) not identified";
-    return stamp(res);
+  res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
+  res.area_rel_rms = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
+  if (!std::isfinite(res.slope_rel_rms) || !std::isfinite(res.area_rel_rms)) {
+    return refusal(FitStatus::solver_failure, "the slope or area residual is not finite: no usable solution");
   }
-  double fs = experiments.front().sample_rate_Hz;
-  for (auto& p : res.points) {
-    if (!p.used || !p.magnitude_experiment) continue;
-    const double ptp = 2.0 * p.magnitude;
-    if (o.order == BanningOrder::kStageThenHysteresis) {
-      p.magnitude = invert_peak_to_peak(res.hysteresis, ptp, p.amplitude_V);
-    } else {  // hysteresis first: the stage sees a loop of slope (21) at the drive amplitude
-      p.magnitude = ptp / (2.0 * ch_slope_closed(a, res.hysteresis.b, res.hysteresis.alpha, p.amplitude_V) * p.amplitude_V);
-    }
-  }
+  return {};
+}
+
+// 5. k, c: each magnitude experiment's h(w) through (27) (in the chosen order), then the
+// stage's magnitude response fitted by Ceres, seeded at the peak.
+FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFitOptions& o, const FitClock& clock,
+                   BanningFitResult& res) {
+  const ColemanHodgdonParams& h = res.hysteresis;
   double peak_h = 0.0, peak_f = 0.0;
-  for (const auto& p : res.points) {
-    if (p.used && p.magnitude_experiment && p.magnitude > peak_h) peak_h = p.magnitude, peak_f = p.frequency_Hz;
+  for (auto* p : mags) {
+    const double ptp = 2.0 * p->magnitude;
+    if (o.order == BanningOrder::kStageThenHysteresis) {
+      p->magnitude = invert_peak_to_peak(h, ptp, p->amplitude_V);
+    } else {  // hysteresis first: the stage sees a loop of slope (21) at the drive amplitude
+      p->magnitude = ptp / (2.0 * ch_slope_closed(h.a, h.b, h.alpha, p->amplitude_V) * p->amplitude_V);
+    }
+    if (p->magnitude > peak_h) peak_h = p->magnitude, peak_f = p->frequency_Hz;
   }
   // Seed: resonance at the peak, damping from its height (h_peak ~ 1 / (2 zeta)).
   const double wp = 2.0 * std::numbers::pi * peak_f;
-  double k0 = wp * wp, c0 = peak_h > 1.2 ? wp / peak_h : wp;
-  double kc[2] = {std::log(k0), std::log(c0)};
+  double kc[2] = {std::log(wp * wp), std::log(peak_h > 1.2 ? wp / peak_h : wp)};
   ceres::Problem problem;
-  for (const auto& p : res.points) {
-    if (!p.used || !p.magnitude_experiment) continue;
+  for (const auto* p : mags) {
     problem.AddResidualBlock(new ceres::NumericDiffCostFunction<MagnitudeResidual, ceres::CENTRAL, 1, 2>(
-                                 new MagnitudeResidual{2.0 * std::numbers::pi * p.frequency_Hz, p.magnitude,
-                                                       o.zoh_magnitude ? 1.0 / fs : 0.0}),
+                                 new MagnitudeResidual{2.0 * std::numbers::pi * p->frequency_Hz, p->magnitude,
+                                                       o.zoh_magnitude ? 1.0 / sample_rate_Hz : 0.0}),
                              nullptr, kc);
   }
+  ceres::Solver::Options so = solver_options();
+  detail::CeresTimeBudget budget(clock, o.max_solver_time_s);
+  budget.attach(so);
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options(o.max_solver_time_s), &problem, &summary);
-  if (!summary.IsSolutionUsable()) return stamp(refuse(res, FitStatus::solver_failure, "Ceres (k, c): " + summary.message));
+  ceres::Solve(so, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return refusal(FitStatus::solver_failure, "Ceres (k, c): " + summary.message);
   res.stage.k = std::exp(kc[0]);
   res.stage.c = std::exp(kc[1]);
   try {
     res.stage.validate();
   } catch (const ParameterError& e) {
-    return stamp(refuse(res, FitStatus::out_of_range, std::string("stage: ") + e.what()));
+    return refusal(FitStatus::out_of_range, std::string("stage: ") + e.what());
   }
   res.magnitude_rel_rms = std::sqrt(2.0 * summary.final_cost / static_cast<double>(mags.size()));
   if (!std::isfinite(res.magnitude_rel_rms)) {
-    return stamp(refuse(res, FitStatus::solver_failure, "the magnitude residual is not finite: no usable solution"));
+    return refusal(FitStatus::solver_failure, "the magnitude residual is not finite: no usable solution");
+  }
+  return {};
+}
+
+}  // namespace
+
+BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments, const BanningFitOptions& o) {
+  o.validate();
+  const FitTimer timer(o.clock);
+  BanningFitResult res;
+  if (FitCheck c = measure_experiments(experiments, o, res.points); !c.ok()) return timer.finish(res, c);
+  PointRefs loops, mags;  // into res.points, which no longer grows
+  for (auto& p : res.points) {
+    if (p.used) (p.magnitude_experiment ? mags : loops).push_back(&p);
+  }
+  if (FitCheck c = fit_centre_line(loops, o, res); !c.ok()) return timer.finish(res, c);
+  double x[2] = {0.0, 0.0};
+  if (FitCheck c = seed_b_alpha(loops, res.hysteresis.a, o, x); !c.ok()) return timer.finish(res, c);
+  if (FitCheck c = refine_b_alpha(loops, o, timer.clock(), x, res); !c.ok()) return timer.finish(res, c);
+  if (mags.size() < 3) {
+    return timer.finish(res, FitStatus::ok,
+                        mags.empty() ? "no magnitude experiments: stage (k, c) not identified"
+                                     : "fewer than 3 magnitude experiments: stage (k, c) not identified");
+  }
+  if (FitCheck c = fit_stage(mags, experiments.front().sample_rate_Hz, o, timer.clock(), res); !c.ok()) {
+    return timer.finish(res, c);
   }
   res.stage_identified = true;
-  res.status = FitStatus::ok;
-  return stamp(res);
+  return timer.finish(res, FitStatus::ok);
 }
 
 }  // namespace hystloop

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "ident/fit_clock.hpp"
 #include "ident/fit_status.hpp"
 #include "models/banning_stage.hpp"
 #include "models/loop_features.hpp"
@@ -41,7 +42,8 @@ struct BanningFitOptions {
   BanningOrder order = BanningOrder::kHysteresisThenStage;  // how (27) is inverted
   bool zoh_magnitude = true;
   LoopFeatureOptions loop{};
-  double max_solver_time_s = 1.0;        // per Ceres solve
+  double max_solver_time_s = 1.0;        // per Ceres solve, read from `clock`
+  FitClock clock{};                      // empty = monotonic; fixed_fit_clock() for a reproducible fit
 
   void validate() const;  // throws ParameterError naming the field
 };

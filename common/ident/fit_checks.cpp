@@ -1,9 +1,12 @@
 #include "ident/fit_checks.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "ident/branches.hpp"
 
 namespace hystloop {
 namespace {
@@ -33,6 +36,36 @@ FitCheck check_fit_samples(std::span<const double> u, std::span<const double> y)
       return refused(FitStatus::out_of_range, s.str());
     }
   }
+  return {};
+}
+
+FitCheck check_fit_input(std::span<const double> u, std::span<const double> y, double min_input_range_V,
+                         double* u_min_V, double* u_max_V) {
+  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return c;
+  const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
+  if (!(*hi - *lo >= min_input_range_V) || *hi == *lo) {
+    std::ostringstream s;
+    s << "u spans " << (*hi - *lo) << " V (< " << min_input_range_V << " V): nothing to identify";
+    return refused(FitStatus::constant_input, s.str());
+  }
+  if (u_min_V != nullptr) *u_min_V = *lo;
+  if (u_max_V != nullptr) *u_max_V = *hi;
+  return {};
+}
+
+FitCheck check_after_second_reversal(std::span<const double> u, std::size_t min_samples, std::size_t* begin) {
+  const std::vector<std::size_t> rev = find_reversals(u);
+  if (rev.size() < 2) {
+    return refused(FitStatus::too_few_branches,
+                   std::to_string(rev.size()) + " reversals of u: need 2 (before the second the operators carry "
+                                                "their unknown initial state)");
+  }
+  const std::size_t scored = u.size() - rev[1];
+  if (scored < min_samples) {
+    return refused(FitStatus::too_few_samples, std::to_string(scored) + " samples after the second reversal (need " +
+                                                   std::to_string(min_samples) + ")");
+  }
+  *begin = rev[1];
   return {};
 }
 

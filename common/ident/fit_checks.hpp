@@ -8,6 +8,7 @@
 // The bounds equal kMaxAbsVoltage_V / kMaxAbsPosition_m of the message contract
 // (common/lcm/message_checks.hpp); ident has no LCM, so tools/identify asserts that they agree.
 
+#include <cstddef>
 #include <span>
 #include <string>
 
@@ -29,6 +30,18 @@ struct FitCheck {
 // size_mismatch (different lengths or empty), non_finite_data, or out_of_range naming the first
 // bad sample ("sample 12: u = 2.5e+302 V is beyond the sanity bound +-10000 V").
 FitCheck check_fit_samples(std::span<const double> u_V, std::span<const double> y_m);
+
+// The input check every fitter makes first: check_fit_samples, then constant_input when u spans
+// less than min_input_range_V (or nothing at all). Writes u's extremes to *u_min_V / *u_max_V
+// when given (valid when ok).
+FitCheck check_fit_input(std::span<const double> u_V, std::span<const double> y_m, double min_input_range_V,
+                         double* u_min_V = nullptr, double* u_max_V = nullptr);
+
+// For fitters that score only the samples after the second reversal of u (before it, the
+// operators still carry their unknown initial state): too_few_branches with fewer than two
+// reversals, too_few_samples with fewer than min_samples from there. Writes the first scored
+// index to *begin (valid when ok).
+FitCheck check_after_second_reversal(std::span<const double> u_V, std::size_t min_samples, std::size_t* begin);
 
 // solver_failure if the residual is not finite or negative; out_of_range if it exceeds y_span_m.
 FitCheck check_fit_residual(double residual_rms_m, double y_span_m);

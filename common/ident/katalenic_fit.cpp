@@ -4,13 +4,13 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
+#include "ident/ceres_budget.hpp"
 #include "ident/fit_checks.hpp"
 
 namespace hystloop {
@@ -84,36 +84,21 @@ double cost(const Problem& p, double k1, double k2) {
   return s;
 }
 
-KatalenicFitResult refuse(KatalenicFitResult r, FitStatus s, std::string why) {
-  r.status = s;
-  r.reason = std::move(why);
-  return r;
-}
-
 }  // namespace
 
 KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const double> y, const KatalenicFitOptions& o) {
   o.validate();
-  const auto t0 = std::chrono::steady_clock::now();
-  auto stamp = [&](KatalenicFitResult r) {
-    r.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
-  };
+  const FitTimer timer(o.clock);
   KatalenicFitResult res;
-  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return stamp(refuse(res, c.status, std::move(c.reason)));
-  const auto [ulo, uhi] = std::minmax_element(u.begin(), u.end());
-  const double half = 0.5 * (*uhi - *ulo);
-  if (!(2.0 * half >= o.min_input_range_V) || half == 0.0) return stamp(refuse(res, FitStatus::constant_input, "u does not move"));
-  const std::vector<std::size_t> rev = find_reversals(u);
-  if (rev.size() < 2) {
-    return stamp(refuse(res, FitStatus::too_few_branches,
-                        std::to_string(rev.size()) + " reversals: need 2 (the first branches carry the unknown initial state)"));
-  }
-  Problem p{u, y, rev[1], o.output_polynomial_degree, half, 1.0};
+  double ulo = 0.0, uhi = 0.0;
+  std::size_t begin = 0;
+  if (FitCheck c = check_fit_input(u, y, o.min_input_range_V, &ulo, &uhi); !c.ok()) return timer.finish(res, c);
+  if (FitCheck c = check_after_second_reversal(u, o.min_samples, &begin); !c.ok()) return timer.finish(res, c);
+  const double half = 0.5 * (uhi - ulo);
+  Problem p{u, y, begin, o.output_polynomial_degree, half, 1.0};
   const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
   p.y_scale = *yhi > *ylo ? 0.5 * (*yhi - *ylo) : 1.0;
   res.samples_used = u.size() - p.score_begin;
-  if (res.samples_used < o.min_samples) return stamp(refuse(res, FitStatus::too_few_samples, "too few samples after the second reversal"));
   // Grid: k1 as a fraction of the half span, k2 k1 (the transition's sharpness) from 0.3 to 10.
   double best_k1 = 0.1 * half, best_k2 = 1.0 / (0.1 * half), best = 1e300;
   for (double f1 : {0.03, 0.08, 0.2, 0.4}) {
@@ -132,11 +117,12 @@ KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const doub
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = o.max_solver_iterations;
-  so.max_solver_time_in_seconds = o.max_solver_time_s;
   so.logging_type = ceres::SILENT;
+  detail::CeresTimeBudget budget(timer.clock(), o.max_solver_time_s);
+  budget.attach(so);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
-  if (!summary.IsSolutionUsable()) return stamp(refuse(res, FitStatus::solver_failure, "Ceres: " + summary.message));
+  if (!summary.IsSolutionUsable()) return timer.finish(res, FitStatus::solver_failure, "Ceres: " + summary.message);
   res.params.k1 = std::exp(x[0]);
   res.params.k2 = std::exp(x[1]);
   res.params.k2_slope = 0.0;
@@ -160,9 +146,8 @@ KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const doub
   // A fit that is not a fit (k1 run off to 1e301, a NaN residual) is a refusal.
   FitCheck check = check_katalenic_params(res.params, 2.0 * half);
   if (check.ok()) check = check_fit_residual(res.residual_rms_m, *yhi - *ylo);
-  if (!check.ok()) return stamp(refuse(res, check.status, std::move(check.reason)));
-  res.status = FitStatus::ok;
-  return stamp(res);
+  if (!check.ok()) return timer.finish(res, check);
+  return timer.finish(res, FitStatus::ok);
 }
 
 }  // namespace hystloop

@@ -16,26 +16,14 @@ LinearParams to_linear_params(const LinearFitResult& fit) {
 
 LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y, double min_range) {
   LinearFitResult r;
-  if (u.size() != y.size() || u.size() < 2) {
-    r.status = FitStatus::size_mismatch;
-    r.reason = "u and y differ in length or have fewer than 2 samples";
-    return r;
-  }
-  if (FitCheck c = check_fit_samples(u, y); !c.ok()) {
+  // (A moving u has at least 2 samples.)
+  if (FitCheck c = check_fit_input(u, y, min_range); !c.ok()) {
     r.status = c.status;
     r.reason = std::move(c.reason);
     return r;
   }
-  double su = 0.0, sy = 0.0, umin = u[0], umax = u[0];
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    su += u[k], sy += y[k];
-    umin = std::min(umin, u[k]), umax = std::max(umax, u[k]);
-  }
-  if (!(umax - umin >= min_range) || umax == umin) {
-    r.status = FitStatus::constant_input;
-    r.reason = "u does not move";
-    return r;
-  }
+  double su = 0.0, sy = 0.0;
+  for (std::size_t k = 0; k < u.size(); ++k) su += u[k], sy += y[k];
   const double n = static_cast<double>(u.size()), mu = su / n, my = sy / n;
   double suu = 0.0, suy = 0.0;
   for (std::size_t k = 0; k < u.size(); ++k) suu += (u[k] - mu) * (u[k] - mu), suy += (u[k] - mu) * (y[k] - my);

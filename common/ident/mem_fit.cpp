@@ -3,13 +3,13 @@
 #include <boost/math/tools/minima.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
 
 #include "core/errors.hpp"
 #include "ident/fit_checks.hpp"
+#include "ident/fit_clock.hpp"
 #include "ident/mem_projection.hpp"
 #include "ident/mem_refine.hpp"
 
@@ -34,11 +34,6 @@ void MemFitOptions::validate() const {
   if (max_solver_iterations < 1) throw ParameterError("max_solver_iterations", "must be >= 1");
 }
 
-double mem_branch_increment(const MemParams& params, double p_V) noexcept {
-  const double e = params.c3 + 1.0;
-  return params.c1 * p_V + params.c2 * std::pow(p_V, e) / e;
-}
-
 double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m, std::span<const BranchSegment> branches,
                       const MemParams& params) {
   double ss = 0.0;
@@ -46,7 +41,7 @@ double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m, 
   for (const BranchSegment& b : branches) {
     double sum = 0.0, sum2 = 0.0;
     for (std::size_t k = b.begin; k < b.end; ++k) {
-      const double d = y_m[k] - b.direction * mem_branch_increment(params, std::abs(u_V[k] - b.origin_u));
+      const double d = y_m[k] - b.direction * params.branch_rise(std::abs(u_V[k] - b.origin_u));
       sum += d;
       sum2 += d * d;
     }
@@ -71,9 +66,7 @@ struct Scales {
 };
 
 MemFitResult refuse(MemFitResult r, FitStatus status, std::string reason) {
-  r.status = status;
-  r.reason = std::move(reason);
-  return r;
+  return with_status(std::move(r), status, std::move(reason));
 }
 
 IntegratedData build_integrated(std::span<const double> u, std::span<const double> y,
@@ -249,26 +242,17 @@ MemFitResult solve(const Data& coarse, const Data& data, const Scales& sc, const
 
 MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const MemFitOptions& o) {
   o.validate();
-  const auto t0 = std::chrono::steady_clock::now();
-  auto stamp = [&](MemFitResult r) {
-    r.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
-  };
+  const FitTimer timer(o.clock);
   MemFitResult result;
-  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return stamp(refuse(result, c.status, std::move(c.reason)));
-  const auto [umin, umax] = std::minmax_element(u.begin(), u.end());
-  if (*umax - *umin < std::max(o.min_input_range_V, 0.0) || *umax == *umin) {
-    std::ostringstream s;
-    s << "u spans " << (*umax - *umin) << " V (< " << o.min_input_range_V << " V): nothing to identify";
-    return stamp(refuse(result, FitStatus::constant_input, s.str()));
-  }
+  double umin = 0.0, umax = 0.0;
+  if (FitCheck c = check_fit_input(u, y, o.min_input_range_V, &umin, &umax); !c.ok()) return timer.finish(result, c);
   const std::vector<BranchSegment> branches = split_branches(u, o.reversal_dead_band_V);
   result.branches_used = branches.size();
   if (branches.size() < o.min_branches) {
     std::ostringstream s;
     s << branches.size() << " branches after the first reversal (need " << o.min_branches
       << "); the part before it is the skeleton curve and is not used";
-    return stamp(refuse(result, FitStatus::too_few_branches, s.str()));
+    return timer.finish(result, FitStatus::too_few_branches, s.str());
   }
   Scales sc;
   sc.u = 0.0;
@@ -280,7 +264,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
       ymax = std::max(ymax, y[k]);
     }
   }
-  if (!(sc.u > 0.0)) return stamp(refuse(result, FitStatus::constant_input, "u does not move after the first reversal"));
+  if (!(sc.u > 0.0)) return timer.finish(result, FitStatus::constant_input, "u does not move after the first reversal");
   sc.y = ymax > ymin ? 0.5 * (ymax - ymin) : 1.0;
   sc.y_span = ymax - ymin;
   result.noise_rms_m = o.noise_rms_m > 0.0 ? o.noise_rms_m : estimate_noise_rms(y);
@@ -292,14 +276,14 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     if (result.samples_used < o.min_samples) {
       std::ostringstream s;
       s << result.samples_used << " samples on branches (need " << o.min_samples << ")";
-      return stamp(refuse(result, FitStatus::too_few_samples, s.str()));
+      return timer.finish(result, FitStatus::too_few_samples, s.str());
     }
     IntegratedData coarse = build_integrated(u, y, branches, sc, kGridStride);
     coarse.c1_floor_fraction = o.min_c1_fraction;
     result = solve(coarse, data, sc, o, std::move(result));
   } else {
     // SNR of z = dy/du: |du| * slope / (sqrt(2) sigma_y); the slope is the loop's mean slope.
-    const double slope = (ymax - ymin) / (*umax - *umin);
+    const double slope = (ymax - ymin) / (umax - umin);
     const double min_du = slope > 0.0 ? o.min_snr * std::sqrt(2.0) * result.noise_rms_m / slope : 0.0;
     DerivativeData data =
         build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag));
@@ -309,7 +293,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
       std::ostringstream s;
       s << result.samples_used << " difference points reach SNR " << o.min_snr << " (need " << o.min_samples
         << "; |du| must be >= " << min_du << " V per " << o.derivative_lag << " samples)";
-      return stamp(refuse(result, FitStatus::too_few_samples, s.str()));
+      return timer.finish(result, FitStatus::too_few_samples, s.str());
     }
     DerivativeData coarse = build_derivative(u, y, branches, sc, min_du,
                                              static_cast<std::size_t>(o.derivative_lag), kGridStride);
@@ -325,7 +309,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     if (c.ok()) c = check_fit_residual(result.residual_rms_m, sc.y_span);
     if (!c.ok()) result = refuse(std::move(result), c.status, std::move(c.reason));
   }
-  return stamp(std::move(result));
+  return timer.stamp(std::move(result));
 }
 
 }  // namespace hystloop

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "ident/branches.hpp"
+#include "ident/fit_clock.hpp"
 #include "ident/fit_status.hpp"
 #include "models/mem.hpp"
 
@@ -48,8 +49,9 @@ struct MemFitOptions {
   RobustLoss robust_loss = RobustLoss::huber;
   double robust_scale_sigmas = 1.345;  // loss scale in robust sigmas of the projected residual
   bool refine_with_ceres = true;
-  double max_solver_time_s = 0.05;   // Ceres max_solver_time_in_seconds
+  double max_solver_time_s = 0.05;   // refinement budget, read from `clock` between rounds
   int max_solver_iterations = 50;
+  FitClock clock{};                  // empty = monotonic; fixed_fit_clock() for a reproducible fit
 
   // Throws ParameterError naming the field.
   void validate() const;
@@ -62,7 +64,7 @@ struct MemFitResult {
   std::size_t branches_used = 0;
   FitStatus status = FitStatus::solver_failure;
   std::string reason;
-  double solve_time_s = 0.0;     // wall time of the whole fit (instrumentation only)
+  double solve_time_s = 0.0;     // time of the whole fit by options.clock (instrumentation only)
   // The best MEM element lies on the domain's edge (c1 at its floor, or c2 = 0): the data are
   // not exactly MEM-shaped. The parameters are usable; expect a larger model error.
   bool constrained = false;
@@ -75,10 +77,7 @@ struct MemFitResult {
 // throws ParameterError only for invalid options.
 MemFitResult fit_mem(std::span<const double> u_V, std::span<const double> y_m, const MemFitOptions& options = {});
 
-// c1 p + c2 p^(c3+1)/(c3+1): the MEM branch increment at distance p [V] from the reversal.
-double mem_branch_increment(const MemParams& params, double p_V) noexcept;
-
-// RMS [m] of y - (y_b + s_b * increment) over the given branches, with y_b the least-squares
+// RMS [m] of y - (y_b + s_b * params.branch_rise(|u - u_b|)) over the given branches, with y_b the least-squares
 // offset of each branch: how well the parameters explain the branch shapes.
 double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m,
                       std::span<const BranchSegment> branches, const MemParams& params);

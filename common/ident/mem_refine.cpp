@@ -3,7 +3,6 @@
 #include <ceres/tiny_solver.h>
 
 #include <Eigen/Core>
-#include <chrono>
 
 #include <algorithm>
 #include <cmath>
@@ -111,7 +110,7 @@ std::vector<double> plain_residuals(const Cost& cost, const double* theta, std::
 
 template <class Data, class Cost>
 RefineOutcome irls(const Data& data, std::size_t n, const ScaledMem& start, const MemFitOptions& o, double scale) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const FitTimer timer(o.clock);
   RefineOutcome out;
   double theta[3] = {start.c1, start.c2, start.c3};
   std::vector<double> w(n, 1.0);
@@ -147,7 +146,7 @@ RefineOutcome irls(const Data& data, std::size_t n, const ScaledMem& start, cons
     for (int i = 0; i < 3; ++i) change = std::max(change, std::abs(theta[i] - before[i]) / std::max(std::abs(before[i]), 1e-12));
     if (change < 1e-9) break;
     // The time bound is checked between reweighting rounds (a round is a few ms).
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > o.max_solver_time_s) break;
+    if (timer.elapsed_s() > o.max_solver_time_s) break;
   }
   out.usable = true;
   out.params = {theta[0], theta[1], theta[2]};

@@ -2,13 +2,13 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
 #include "ident/fit_checks.hpp"
+#include "ident/fit_clock.hpp"
 #include "ident/nnls.hpp"
 
 namespace hystloop {
@@ -52,24 +52,15 @@ std::vector<double> predict_pi(const PiFitResult& fit, std::span<const double> u
 
 PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const PiFitOptions& o) {
   o.validate();
-  const auto t0 = std::chrono::steady_clock::now();
+  const FitTimer timer(o.clock);
   PiFitResult res;
-  auto done = [&](FitStatus s, std::string why) {
-    res.status = s;
-    res.reason = std::move(why);
-    res.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return res;
-  };
-  if (FitCheck c = check_fit_samples(u, y); !c.ok()) return done(c.status, std::move(c.reason));
-  const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
-  const double half = 0.5 * (*hi - *lo);
-  if (!(2.0 * half >= o.min_input_range_V) || half == 0.0) return done(FitStatus::constant_input, "u does not move");
-  const std::vector<std::size_t> rev = find_reversals(u);
-  if (rev.size() < 2) return done(FitStatus::too_few_branches, std::to_string(rev.size()) + " reversals: need 2 to wipe out the plays' initial state");
-  const std::size_t begin = rev[1];
+  double lo = 0.0, hi = 0.0;
+  std::size_t begin = 0;
+  if (FitCheck c = check_fit_input(u, y, o.min_input_range_V, &lo, &hi); !c.ok()) return timer.finish(res, c);
+  if (FitCheck c = check_after_second_reversal(u, o.min_samples, &begin); !c.ok()) return timer.finish(res, c);
+  const double half = 0.5 * (hi - lo);
   const auto m = static_cast<Eigen::Index>(u.size() - begin);
   res.samples_used = u.size() - begin;
-  if (res.samples_used < o.min_samples) return done(FitStatus::too_few_samples, "too few samples after the second reversal");
   const auto n = static_cast<Eigen::Index>(o.operators);
   // Centred columns: the free offset is eliminated, the weights stay non-negative.
   Eigen::MatrixXd a(m, n);
@@ -89,16 +80,16 @@ PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const P
   // Scale to O(1) (volts and metres differ by 1e9) for the active-set tolerances.
   const double ys = std::max(bc.cwiseAbs().maxCoeff(), 1e-300), us = std::max(half, 1e-300);
   const NnlsResult nn = nnls(ac / us, bc / ys);
-  if (!nn.converged) return done(FitStatus::solver_failure, "NNLS did not converge in " + std::to_string(nn.iterations) + " iterations");
+  if (!nn.converged) return timer.finish(res, FitStatus::solver_failure, "NNLS did not converge in " + std::to_string(nn.iterations) + " iterations");
   const Eigen::VectorXd w = nn.x * (ys / us);
   res.weights.assign(w.data(), w.data() + n);
   res.offset_m = bmean - amean.dot(w);
   res.residual_rms_m = std::sqrt((bc - ac * w).squaredNorm() / static_cast<double>(m));
-  if (!(w.sum() > 0.0)) return done(FitStatus::out_of_range, "all weights are zero: y does not follow u");
+  if (!(w.sum() > 0.0)) return timer.finish(res, FitStatus::out_of_range, "all weights are zero: y does not follow u");
   if (FitCheck c = check_fit_residual(res.residual_rms_m, 2.0 * bc.cwiseAbs().maxCoeff()); !c.ok()) {
-    return done(c.status, std::move(c.reason));
+    return timer.finish(res, c.status, std::move(c.reason));
   }
-  return done(FitStatus::ok, "");
+  return timer.finish(res, FitStatus::ok, "");
 }
 
 }  // namespace hystloop

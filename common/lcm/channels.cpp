@@ -31,6 +31,7 @@ ChannelNames::ChannelNames(std::string_view rig_prefix)
       trajectory(prefix + std::string(kTrajectorySuffix)),
       params(prefix + std::string(kParamsSuffix)),
       status(prefix + std::string(kStatusSuffix)),
-      control(prefix + std::string(kControlSuffix)) {}
+      control(prefix + std::string(kControlSuffix)),
+      model(prefix + std::string(kModelSuffix)) {}
 
 }  // namespace hystloop

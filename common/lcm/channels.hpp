@@ -15,11 +15,14 @@ inline constexpr std::string_view kDefaultRigPrefix = "HX_";
 // [A-Z0-9_], starts with a letter and ends with '_'.
 void validate_rig_prefix(std::string_view prefix);
 
-// The six channels of DESIGN.md, by suffix.
+// The channels of DESIGN.md, by suffix.
 inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_block_t, 10 kHz of ticks in blocks
 inline constexpr std::string_view kCommandSuffix = "COMMAND";        // command_block_t, one block per sensor block
 inline constexpr std::string_view kTrajectorySuffix = "TRAJECTORY";  // trajectory_t, on change
 inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_params_t, on refit
+// model_params_t, on a model change: any model (HX_PARAMS stays MEM-only, so its tools and logs
+// work unchanged; a channel carries one type).
+inline constexpr std::string_view kModelSuffix = "MODEL";
 inline constexpr std::string_view kStatusSuffix = "STATUS";          // service_status_t, 1 Hz per process
 inline constexpr std::string_view kControlSuffix = "CONTROL";        // control_t, on demand
 
@@ -29,13 +32,14 @@ struct ChannelSpec {
   std::string_view suffix;
   std::string_view type_name;
 };
-inline constexpr std::array<ChannelSpec, 6> kChannelSpecs{{
+inline constexpr std::array<ChannelSpec, 7> kChannelSpecs{{
     {kSensorSuffix, "hystloop.sensor_block_t"},
     {kCommandSuffix, "hystloop.command_block_t"},
     {kTrajectorySuffix, "hystloop.trajectory_t"},
     {kParamsSuffix, "hystloop.mem_params_t"},
     {kStatusSuffix, "hystloop.service_status_t"},
     {kControlSuffix, "hystloop.control_t"},
+    {kModelSuffix, "hystloop.model_params_t"},
 }};
 
 // The full names for one prefix, built once (publishing then never builds a string).
@@ -47,6 +51,7 @@ struct ChannelNames {
   std::string params;
   std::string status;
   std::string control;
+  std::string model;
 
   // Validates the prefix (throws ParameterError naming "rig.prefix").
   explicit ChannelNames(std::string_view rig_prefix = kDefaultRigPrefix);

@@ -32,7 +32,10 @@ int handle_pending(lcm::LCM& lcm, std::chrono::microseconds timeout, int max_mes
   const int ready = ppoll(&pfd, 1, &ts, nullptr);
   if (ready < 0) return errno == EINTR ? 0 : -1;  // a signal: let the caller look at its stop flag
   if (ready == 0) return 0;
+  return dispatch_pending(lcm, max_messages);
+}
 
+int dispatch_pending(lcm::LCM& lcm, int max_messages) noexcept {
   int handled = 0;
   while (handled < max_messages) {
     const int rc = lcm.handleTimeout(0);  // dispatches one message if one is ready, never waits

@@ -21,4 +21,9 @@ std::unique_ptr<lcm::LCM> open_lcm(std::string_view url, bool allow_network = fa
 // -1 if LCM reported an error. Microsecond resolution (ppoll on LCM's file descriptor).
 int handle_pending(lcm::LCM& lcm, std::chrono::microseconds timeout, int max_messages = 256) noexcept;
 
+// Dispatches what is pending, at most `max_messages`, never waiting: for a loop that waits on
+// LCM's file descriptor together with its own (the bridge's ppoll). Returns the number
+// dispatched or -1 if LCM reported an error.
+int dispatch_pending(lcm::LCM& lcm, int max_messages = 256) noexcept;
+
 }  // namespace hystloop

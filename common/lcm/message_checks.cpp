@@ -129,6 +129,77 @@ Verdict check_message(const mem_params_t& msg) noexcept {
   return f.verdict();
 }
 
+namespace {
+
+void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
+  switch (msg.kind) {
+    case model_params_t::KIND_MEM:
+      f.require(msg.mem_c1 > 0.0 && msg.mem_c1 <= 1.0);  // [m/V]
+      f.require(msg.mem_c2 >= 0.0);
+      f.require(msg.mem_c3 > 0.0 && msg.mem_c3 <= 50.0);  // as mem_params_t
+      break;
+    case model_params_t::KIND_PI:
+      f.require(msg.n_operators >= 1);
+      if (msg.n_operators >= 1 && arrays_consistent(msg)) {
+        f.require(msg.pi_thresholds_V[0] == 0.0 && msg.pi_weights[0] > 0.0);
+        for (std::size_t i = 1; i < msg.pi_thresholds_V.size(); ++i) {
+          f.require(msg.pi_thresholds_V[i] > msg.pi_thresholds_V[i - 1] &&
+                    msg.pi_thresholds_V[i] <= kMaxAbsVoltage_V);
+        }
+      }
+      break;
+    case model_params_t::KIND_LINEAR: f.require(msg.linear_gain != 0.0 && std::fabs(msg.linear_gain) <= 1.0); break;
+    case model_params_t::KIND_KATALENIC:
+      f.require(msg.kat_k1 > 0.0 && msg.kat_k2 > 0.0 && msg.kat_k2_domain_min < msg.kat_k2_domain_max);
+      f.require(msg.kat_in_shaping >= model_params_t::SHAPING_LINEAR && msg.kat_in_shaping <= model_params_t::SHAPING_TANH);
+      f.require(msg.kat_out_shaping >= model_params_t::SHAPING_LINEAR &&
+                msg.kat_out_shaping <= model_params_t::SHAPING_TANH);
+      break;
+    default: break;  // unknown: the receiver's own reason (check_message refuses it)
+  }
+}
+
+}  // namespace
+
+Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
+  f.text(msg.source);
+  for (const double v : {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1,
+                         msg.kat_k2, msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max,
+                         msg.kat_initial_offset}) {
+    f.finite(v);
+  }
+  const double in[] = {msg.kat_in_gain, msg.kat_in_offset, msg.kat_in_domain_min, msg.kat_in_domain_max,
+                       msg.kat_in_amplitude, msg.kat_in_scale};
+  const double out[] = {msg.kat_out_gain, msg.kat_out_offset, msg.kat_out_domain_min, msg.kat_out_domain_max,
+                        msg.kat_out_amplitude, msg.kat_out_scale};
+  for (const double v : in) f.finite(v);
+  for (const double v : out) f.finite(v);
+  for (const double v : msg.kat_in_coefficients) f.finite(v);
+  for (const double v : msg.kat_out_coefficients) f.finite(v);
+  const bool count_ok = msg.n_operators >= 0 && msg.n_operators <= model_params_t::MAX_OPERATORS &&
+                        arrays_consistent(msg);
+  f.require(count_ok);
+  if (count_ok) {
+    for (const double v : msg.pi_thresholds_V) f.finite(v);
+    for (const double v : msg.pi_weights) f.finite(v);
+  }
+  f.within(msg.residual_m, 0.0, kMaxAbsPosition_m);
+  f.nan_or_within(msg.heldout_rms_m, 0.0, kMaxAbsPosition_m);
+  f.within(msg.window_s, 0.0, kMaxDuration_s);
+  if (f.verdict() == Verdict::kOk) check_model_kind(f, msg);  // the ranges read finite numbers only
+  return f.verdict();
+}
+
+Verdict check_message(const model_params_t& msg) noexcept {
+  const Verdict envelope = check_model_params_envelope(msg);
+  if (envelope != Verdict::kOk) return envelope;
+  const bool known = msg.format_version == model_params_t::FORMAT_VERSION && msg.kind >= model_params_t::KIND_MEM &&
+                     msg.kind <= model_params_t::KIND_LINEAR;
+  return known ? Verdict::kOk : Verdict::kOutOfRange;
+}
+
 Verdict check_message(const service_status_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.pid > 0 && !msg.process.empty());

@@ -12,6 +12,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
@@ -41,6 +42,18 @@ Verdict check_message(const trajectory_t& msg) noexcept;
 // version >= 1. Validity (`valid`) is the consumer's decision, not a wire error; so is
 // publisher_id (any value names a publisher, 0 = unknown).
 Verdict check_message(const mem_params_t& msg) noexcept;
+// model_params_t: the envelope (check_model_params_envelope), format_version FORMAT_VERSION and a
+// known kind. What a Publisher sends and a receiver without its own reasons refuses.
+Verdict check_message(const model_params_t& msg) noexcept;
+// model_params_t without the two "not understood" fields: utime, samples and window >= 0,
+// version >= 1, every number finite (heldout_rms_m may be NaN = not ranked), n_operators
+// 0..MAX_OPERATORS with both arrays that long, no NUL in source; and for a known kind its
+// parameters' ranges: MEM as mem_params_t; PI n_operators >= 1, r_0 = 0, thresholds increasing,
+// w_0 > 0; linear gain != 0; Katalenic k1, k2 > 0 and known shaping kinds. A receiver that counts
+// an unknown kind or format by its own reason subscribes with this one (ModelParamSet::validate
+// then checks the rest, e.g. every cumulative PI weight > 0).
+Verdict check_model_params_envelope(const model_params_t& msg) noexcept;
+
 // service_status_t: non-empty process, pid > 0, known state, 0..MAX_COUNTERS counters >= 0
 // with matching array sizes, timings NaN (not measured) or finite >= 0.
 Verdict check_message(const service_status_t& msg) noexcept;

@@ -52,6 +52,22 @@ void reserve_storage(trajectory_t& msg) {
 
 void reserve_storage(mem_params_t& msg) { msg.source.reserve(kReservedStringChars); }
 
+void reserve_storage(model_params_t& msg) {
+  msg.source.reserve(kReservedStringChars);
+  msg.pi_thresholds_V.reserve(model_params_t::MAX_OPERATORS);
+  msg.pi_weights.reserve(model_params_t::MAX_OPERATORS);
+}
+
+void clear_arrays(model_params_t& msg) noexcept {
+  msg.pi_thresholds_V.clear();
+  msg.pi_weights.clear();
+}
+
+bool arrays_consistent(const model_params_t& msg) noexcept {
+  const auto n = static_cast<std::size_t>(msg.n_operators);
+  return msg.n_operators >= 0 && msg.pi_thresholds_V.size() == n && msg.pi_weights.size() == n;
+}
+
 void reserve_storage(service_status_t& msg) {
   msg.process.reserve(kReservedStringChars);
   msg.host.reserve(kReservedStringChars);

@@ -11,6 +11,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
@@ -23,6 +24,7 @@ void reserve_storage(sensor_block_t& msg);
 void reserve_storage(command_block_t& msg);
 void reserve_storage(trajectory_t& msg);
 void reserve_storage(mem_params_t& msg);
+void reserve_storage(model_params_t& msg);
 void reserve_storage(service_status_t& msg);
 void reserve_storage(control_t& msg);
 
@@ -32,6 +34,7 @@ void reserve_storage(control_t& msg);
 void clear_arrays(sensor_block_t& msg) noexcept;
 void clear_arrays(command_block_t& msg) noexcept;
 inline void clear_arrays(mem_params_t&) noexcept {}
+void clear_arrays(model_params_t& msg) noexcept;
 inline void clear_arrays(control_t&) noexcept {}
 void clear_arrays(trajectory_t& msg) noexcept;
 void clear_arrays(service_status_t& msg) noexcept;
@@ -42,6 +45,7 @@ void clear_arrays(service_status_t& msg) noexcept;
 bool arrays_consistent(const sensor_block_t& msg) noexcept;
 bool arrays_consistent(const command_block_t& msg) noexcept;
 inline bool arrays_consistent(const mem_params_t&) noexcept { return true; }
+bool arrays_consistent(const model_params_t& msg) noexcept;
 inline bool arrays_consistent(const control_t&) noexcept { return true; }
 bool arrays_consistent(const trajectory_t& msg) noexcept;
 bool arrays_consistent(const service_status_t& msg) noexcept;

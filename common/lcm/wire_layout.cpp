@@ -1,6 +1,7 @@
 #include "lcm/wire_layout.hpp"
 
-#include <array>
+// Each type's WireField list and its wire_layout(const T*), generated from lcmtypes/*.lcm.
+#include "hystloop/wire_layout_defs.inc"
 
 namespace hystloop {
 namespace {
@@ -15,37 +16,7 @@ std::int64_t read_be(const unsigned char* p, int bytes) noexcept {
   return static_cast<std::int64_t>(v);
 }
 
-// The fingerprints below are T::getHash() of the .lcm files as committed; the layout test
-// checks them, so a changed type fails loudly rather than being walked with a stale layout.
-constexpr std::array kSensor{F::kInt64,       F::kInt64,       F::kDouble,      F::kInt32,       F::kCount,
-                             F::kDoubleArray, F::kDoubleArray, F::kDoubleArray, F::kDoubleArray, F::kDoubleArray,
-                             F::kInt32Array};
-constexpr std::array kCommand{F::kInt64,       F::kInt64,       F::kInt64,      F::kCount,
-                              F::kDoubleArray, F::kDoubleArray, F::kInt32Array, F::kInt8Array};
-constexpr std::array kTrajectory{F::kInt64,  F::kInt64,  F::kInt8,  F::kDouble,      F::kDouble,      F::kDouble,
-                                 F::kDouble, F::kInt64,  F::kDouble, F::kCount, F::kDoubleArray, F::kDoubleArray};
-constexpr std::array kParams{F::kInt64, F::kInt32, F::kInt64, F::kDouble, F::kDouble, F::kDouble,
-                             F::kDouble, F::kInt64, F::kDouble, F::kInt8,   F::kString};
-constexpr std::array kStatus{F::kInt64,  F::kString, F::kString, F::kInt32,  F::kInt8,   F::kString,
-                             F::kInt64,  F::kCount,  F::kStringArray, F::kInt64Array, F::kDouble, F::kDouble,
-                             F::kDouble, F::kDouble, F::kDouble, F::kDouble, F::kInt64,  F::kInt64};
-constexpr std::array kControl{F::kInt64,  F::kInt64,  F::kInt8,   F::kString, F::kInt8,   F::kDouble, F::kDouble,
-                              F::kDouble, F::kString, F::kDouble, F::kDouble, F::kDouble, F::kDouble};
-
 }  // namespace
-
-WireLayout wire_layout(const sensor_block_t*) noexcept { return {5057741610172088436, kSensor, sensor_block_t::MAX_TICKS}; }
-WireLayout wire_layout(const command_block_t*) noexcept {
-  return {6289571984888529779, kCommand, command_block_t::MAX_TICKS};
-}
-WireLayout wire_layout(const trajectory_t*) noexcept {
-  return {-2105350467762901674, kTrajectory, trajectory_t::MAX_POINTS};
-}
-WireLayout wire_layout(const mem_params_t*) noexcept { return {-5100139363921340702, kParams, 0}; }
-WireLayout wire_layout(const service_status_t*) noexcept {
-  return {-2051245413666674676, kStatus, service_status_t::MAX_COUNTERS};
-}
-WireLayout wire_layout(const control_t*) noexcept { return {8443511174066765041, kControl, 0}; }
 
 std::int64_t wire_fingerprint(const void* data, std::size_t size) noexcept {
   if (data == nullptr || size < 8) return 0;

@@ -6,19 +6,14 @@
 // overflow) instead of failing. With the counts checked first, a corrupted buffer is a
 // counted rejection and nothing else.
 //
-// A layout is pinned to the type's fingerprint: when a .lcm file changes, layout_matches()
-// fails (and Subscription refuses to start) until the layout here is updated with it.
+// The layouts are not written by hand: cmake/lcm_wire_layouts.py generates them from
+// lcmtypes/*.lcm at build time (cmake/LcmTypes.cmake), with each type's own getHash() as the
+// fingerprint, so a changed .lcm file changes its layout with it; a type the walker cannot
+// check (a nested type, a count without its MAX_* bound, ...) stops the build.
 
 #include <cstddef>
 #include <cstdint>
 #include <span>
-
-#include "hystloop/command_block_t.hpp"
-#include "hystloop/control_t.hpp"
-#include "hystloop/mem_params_t.hpp"
-#include "hystloop/sensor_block_t.hpp"
-#include "hystloop/service_status_t.hpp"
-#include "hystloop/trajectory_t.hpp"
 
 namespace hystloop {
 
@@ -37,27 +32,22 @@ enum class WireField : std::uint8_t {
 };
 
 struct WireLayout {
-  std::int64_t fingerprint;  // T::getHash() this layout was written for
+  std::int64_t fingerprint;  // T::getHash() of the type this layout was generated from
   std::span<const WireField> fields;
-  std::int32_t max_count;    // bound on every kCount field
+  std::int32_t max_count;    // bound on every kCount field: the type's MAX_* constant (0 = no arrays)
 };
 
-WireLayout wire_layout(const sensor_block_t*) noexcept;
-WireLayout wire_layout(const command_block_t*) noexcept;
-WireLayout wire_layout(const trajectory_t*) noexcept;
-WireLayout wire_layout(const mem_params_t*) noexcept;
-WireLayout wire_layout(const service_status_t*) noexcept;
-WireLayout wire_layout(const control_t*) noexcept;
+}  // namespace hystloop
+
+// `WireLayout wire_layout(const T*) noexcept;` for every type of lcmtypes/, with its header
+// (generated into the build tree: <build>/lcmtypes/cpp/hystloop/).
+#include "hystloop/wire_layout_decls.inc"  // IWYU pragma: export
+
+namespace hystloop {
 
 template <class T>
 WireLayout wire_layout_of() noexcept {
   return wire_layout(static_cast<const T*>(nullptr));
-}
-
-// True if `T`'s generated fingerprint is the one its layout was written for.
-template <class T>
-bool layout_matches() noexcept {
-  return wire_layout_of<T>().fingerprint == T::getHash();
 }
 
 // Walks a whole encoded message (8-byte fingerprint first): every fixed field fits, every

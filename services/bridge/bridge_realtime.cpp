@@ -12,25 +12,16 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/clock.hpp"  // wall_utime: clock_gettime through the vDSO, no system call
 #include "core/periodic_timer.hpp"
 
 namespace hystloop {
-namespace {
-
-std::int64_t wall_utime_now() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);  // vDSO: no system call
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-}
-
-}  // namespace
-
 BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<StageBackend> backend)
     : settings_(settings),
       backend_(std::move(backend)),
       core_(settings.limits, settings.servo, settings.dt_s()),
-      dt_s_(settings.dt_s()),
-      auto_arm_pending_(settings.auto_arm) {
+      arming_(ArmingSettings{settings.auto_arm, settings.rearm_after_trip_s, settings.dt_s()}),
+      dt_s_(settings.dt_s()) {
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
 }
@@ -133,55 +124,22 @@ void BridgeRealtime::run() noexcept {
 void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
 
-  if (!stopping_ && safe_stop_.load(std::memory_order_acquire)) {
-    stopping_ = true;  // from this tick the core ramps to the safe voltage and is never armed again
+  if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
     stop_u_start_V_ = core_.last_applied_V();
-    core_.disarm();
-    auto_arm_pending_ = false;
-    tripped_ = false;
+    arming_.stop(core_);  // from this tick the core ramps to the safe voltage and is never armed again
   }
-  switch (arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel)) {
-    case ArmRequest::kArm:
-      if (stopping_) break;
-      core_.arm(k);
-      tripped_ = false;
-      break;
-    case ArmRequest::kDisarm:
-      core_.disarm();
-      auto_arm_pending_ = false;  // an explicit disarm ends the convenience
-      tripped_ = false;           // ... and an operator's disarm is never undone automatically
-      break;
-    case ArmRequest::kNone: break;
-  }
+  arming_.request(arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel), k, core_);
   while (const auto gains = gains_.try_pop()) core_.set_servo_gains(*gains);
   while (const auto command = commands_.try_pop()) {
     ++commands_processed_;
     commands_seen_ = true;
     core_.submit(*command);
   }
-  if (commands_seen_ && core_.buffer_depth() > 0 && !core_.armed() && !stopping_) {
-    if (auto_arm_pending_) {
-      core_.arm(k);
-      auto_arm_pending_ = false;
-      ++auto_arms_;
-    } else if (tripped_ && settings_.rearm_after_trip_s > 0.0 &&
-               static_cast<double>(k - last_trip_tick_) * dt_s_ >= settings_.rearm_after_trip_s) {
-      // Opt-in (actuator.rearm_after_trip_s > 0): after a watchdog trip, re-arm once commands
-      // are buffered again and the safe state has lasted that long. For soak runs; counted.
-      core_.arm(k);
-      tripped_ = false;
-      ++auto_arms_;
-    }
-  }
-  if (core_.armed()) auto_arm_pending_ = false;  // armed by HX_CONTROL: no auto-arm later
+  arming_.before_tick(k, commands_seen_, core_);
 
   const double u_before_V = core_.last_applied_V();
   const BridgeTick decided = core_.tick(k, y_last_m_);
-  if (core_.counters().watchdog_trips != trips_seen_) {
-    trips_seen_ = core_.counters().watchdog_trips;
-    last_trip_tick_ = k;
-    tripped_ = true;
-  }
+  arming_.after_tick(k, core_);
   if (core_.armed() && commands_seen_) {
     min_depth_period_ = min_depth_period_ < 0 ? decided.buffer_depth : std::min(min_depth_period_, decided.buffer_depth);
     min_depth_total_ = min_depth_total_ < 0 ? decided.buffer_depth : std::min(min_depth_total_, decided.buffer_depth);
@@ -190,10 +148,11 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const double step_s = dt_s_ * static_cast<double>(1 + skipped);
   const double t_s = static_cast<double>(k) * dt_s_;
   const StageReading reading = backend_->step(decided.u_applied_V, t_s, step_s);
+  if (reading.go_safe && core_.armed()) arming_.request(ArmRequest::kDisarm, k, core_);  // from the next tick
   y_last_m_ = reading.y_m;
   last_tick_ = k;
   bool reached_now = false;
-  if (stopping_ && !safe_reached_.load(std::memory_order_relaxed)) {
+  if (arming_.stopping() && !safe_reached_.load(std::memory_order_relaxed)) {
     if (decided.u_applied_V != u_before_V) ++stop_ramp_ticks_;
     if (!core_.armed() && decided.u_applied_V == settings_.limits.safe_u_V) {
       stop_reached_ns_ = monotonic_now_ns();
@@ -202,7 +161,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
     }
   }
 
-  const OutgoingTick out{SensorTick{wall_utime_now(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
+  const OutgoingTick out{SensorTick{wall_utime(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
                                     decided.y_ref_m, reading.y_m, decided.flags | reading.flags},
                          static_cast<std::int32_t>(std::min<std::int64_t>(decided.buffer_depth, INT32_MAX))};
   if (samples_.try_push(out)) {
@@ -223,9 +182,9 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;
-    r.auto_arms = auto_arms_;
+    r.auto_arms = arming_.auto_arms();
     r.last_tick = last_tick_;
-    r.last_trip_tick = last_trip_tick_;
+    r.last_trip_tick = arming_.last_trip_tick();
     r.min_depth_period = min_depth_period_;
     r.min_depth_total = min_depth_total_;
     r.buffer_depth = core_.buffer_depth();

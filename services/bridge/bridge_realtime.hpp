@@ -17,6 +17,7 @@
 #include "bridge/stage_backend.hpp"
 #include "core/process.hpp"
 #include "core/ticks.hpp"
+#include "loop/arming_policy.hpp"
 #include "loop/bridge_core.hpp"
 #include "loop/spsc_queue.hpp"
 
@@ -28,8 +29,6 @@ struct OutgoingTick {
   SensorTick tick;
   std::int32_t buffer_depth = 0;
 };
-
-enum class ArmRequest : std::uint8_t { kNone = 0, kArm = 1, kDisarm = 2 };
 
 // How the stop's ramp to actuator.safe_u_V went (BridgeRealtime::begin_safe_stop / stop).
 struct SafeStopResult {
@@ -51,7 +50,7 @@ class BridgeRealtime {
   BridgeRealtime(const BridgeRealtime&) = delete;
   BridgeRealtime& operator=(const BridgeRealtime&) = delete;
 
-  // Starts the thread (scheduling set-up happens on it; see setup_status()).
+  // Starts the thread (scheduling set-up happens on it; see priority_status()/affinity_status()).
   void start();
   // The first half of every stop: from its next tick the thread disarms BridgeCore, refuses to
   // arm again and lets it ramp to actuator.safe_u_V (BridgeCore's safe state: min(ramp, slew)),
@@ -84,6 +83,7 @@ class BridgeRealtime {
   BridgeSettings settings_;
   std::unique_ptr<StageBackend> backend_;
   BridgeCore core_;
+  ArmingPolicy arming_;  // RT thread
   double dt_s_;
   SpscQueue<CommandTick, kCommandQueue> commands_;
   SpscQueue<FeedbackGains, 8> gains_;
@@ -102,9 +102,6 @@ class BridgeRealtime {
   SetupStatus affinity_status_;
 
   // RT-thread state.
-  bool auto_arm_pending_ = false;
-  bool tripped_ = false;  // in the safe state because of the watchdog (not an operator)
-  bool stopping_ = false;                 // took the safe-stop request: never arms again
   double stop_u_start_V_ = 0.0;
   std::int64_t stop_ramp_ticks_ = 0;
   std::int64_t stop_reached_ns_ = 0;
@@ -112,10 +109,7 @@ class BridgeRealtime {
   std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;
-  std::uint64_t auto_arms_ = 0;
-  std::uint64_t trips_seen_ = 0;
   std::int64_t last_tick_ = -1;
-  std::int64_t last_trip_tick_ = -1;
   double y_last_m_ = 0.0;                 // the stage's last measured position
   std::int64_t min_depth_period_ = -1;    // lowest buffer depth at an armed tick this report period
   std::int64_t min_depth_total_ = -1;     // ... since start (after the first command)

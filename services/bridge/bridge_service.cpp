@@ -14,6 +14,7 @@
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
+#include "lcm/connection.hpp"
 #include "runtime/counter_baseline.hpp"
 
 namespace hystloop {
@@ -30,7 +31,7 @@ Subscription<command_block_t>::Options command_options(int capacity) {
 BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, const ChannelNames& channels)
     : settings_(settings),
       lcm_(lcm),
-      rt_(settings, make_stage_backend(settings.backend, settings.stage)),
+      rt_(settings, make_stage_backend(settings)),
       sensor_pub_(lcm, channels.sensor),
       commands_(lcm, channels.command,
                 [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
@@ -153,13 +154,7 @@ void BridgeService::serve(bool stopping) {
     [[maybe_unused]] const ssize_t n = ::read(rt_.wake_fd(), &count, sizeof count);
   }
   publish_samples(false);
-  if (fds[0].revents & POLLIN) {
-    for (int i = 0; i < 256; ++i) {
-      const int rc = lcm_.handleTimeout(0);
-      if (rc < 0) ++lcm_errors_;
-      if (rc <= 0) break;
-    }
-  }
+  if ((fds[0].revents & POLLIN) && dispatch_pending(lcm_) < 0) ++lcm_errors_;
   const auto now = clock::now();
   if ((now >= next_report_ || reset_pending_) && !awaiting_report_) {
     rt_.reports().request();
@@ -240,7 +235,7 @@ void BridgeService::log_safe_stop(const SafeStopResult& r) const {
 
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
   const BridgeCounters& k = rt.core;
-  const CounterSet::Entries now = {
+  CounterSet::Entries now = {
       {"ticks", k.ticks},
       {"applied", k.applied},
       {"late", k.late},
@@ -261,6 +256,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
       {"control_acted", control_acted_},
       {"control_refused", control_refused_},
   };
+  rt_.backend().append_counters(now);  // e.g. comedi: sensor_faults, sensor_fault_safe, comedi_read_errors
   if (reset_pending_) {
     counters_.rebase(now);
     reset_pending_ = false;
@@ -362,17 +358,22 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
       "{{\"ticks\": {}, \"armed_ticks\": {}, \"late_ticks\": {}, \"late_tick_fraction\": {:.9g}, "
       "\"watchdog_trips\": {}, \"buffer_min_depth_ticks\": {}, \"ticks_skipped\": {}, \"ticks_caught_up\": {}, "
       "\"stale\": {}, \"duplicates\": {}, \"rejected\": {}, \"samples_dropped\": {}, \"sensor_blocks\": {}, "
-      "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}}}, "
+      "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}, "
+      "\"count\": {}}}, \"applied\": {}, \"clamped\": {}, \"slew_limited\": {}, \"rejected_nonfinite\": {}, "
+      "\"rejected_future\": {}, \"command_blocks_rejected\": {}, "
       "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}, "
       "\"stop\": {{\"safe_reached\": {}, \"u_start_V\": {:.9g}, \"ramp_ticks\": {}, \"ramp_s\": {:.6g}, "
-      "\"wall_s\": {:.6g}, \"bound_s\": {:.6g}}}}}\n",
+      "\"wall_s\": {:.6g}, \"bound_s\": {:.6g}, \"safe_u_V\": {:.6g}}}}}\n",
       c.ticks, static_cast<std::uint64_t>(armed_ticks), c.late,
       armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0, c.watchdog_trips, rt.min_depth_total,
       rt.ticks_skipped, rt.ticks_caught_up, c.stale, c.duplicates, c.rejected_nonfinite + c.rejected_future,
       rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
-      latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, wall_s,
+      latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, latency_total_.count(),
+      c.applied, c.clamped, c.slew_limited, c.rejected_nonfinite, c.rejected_future,
+      commands_.counters().rejected_total(), wall_s,
       usage.user_cpu_s + usage.system_cpu_s, wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0,
-      safe.reached, safe.u_start_V, safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
+      safe.reached, safe.u_start_V, safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s,
+      settings_.limits.safe_u_V);
   std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");
   if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
     spdlog::error("could not write the summary to {}", summary_json_path_);

@@ -1,4 +1,4 @@
-// hystloop-bridge: the 10 kHz clock, the stage (simulated: Banning or Ramberg-Osgood), the
+// hystloop-bridge: the 10 kHz clock, the stage (simulated: Banning or Ramberg-Osgood; or a DAQ card through comedi), the
 // actuator limits and the watchdog. See services/bridge/README.md.
 #include <CLI/CLI.hpp>
 
@@ -8,10 +8,12 @@
 #include <spdlog/spdlog.h>
 
 #include "bridge/bridge_service.hpp"
+#include "bridge/probe_hardware.hpp"
 #include "core/logging.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/url.hpp"
+#include "runtime/rig_auth_config.hpp"
 #include "runtime/service_options.hpp"
 
 int main(int argc, char** argv) {
@@ -24,7 +26,7 @@ int main(int argc, char** argv) {
   add_service_options(app, options);
   std::string backend, noise, drift, seconds, summary_json;
   bool auto_arm = false;
-  app.add_option("--backend", backend, "Stage backend: sim (Banning stage) or ro (Ramberg-Osgood) [bridge.backend]");
+  app.add_option("--backend", backend, "Stage backend: sim (Banning stage), ro (Ramberg-Osgood) or comedi (a DAQ card: comedi.*) [bridge.backend]");
   app.add_option("--noise-rms-m", noise, "Sensor noise RMS [m] [bridge.noise_rms_m]");
   app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");
@@ -32,6 +34,19 @@ int main(int argc, char** argv) {
                  "At exit, write the run's figures (ticks, late, watchdog trips, lowest buffer depth, block-to-answer "
                  "latency, CPU) to this JSON file");
   app.add_flag("--auto-arm", auto_arm, "Arm as soon as commands flow (first arm only) [bridge.auto_arm]");
+  // Setting up a comedi card (bridge.backend: comedi): see services/bridge/README.md.
+  bool probe = false;
+  std::string device;
+  ProbeOptions probe_options;
+  app.add_flag("--probe-hardware", probe,
+               "List the comedi card (subdevices, channels, ranges, calibration) and exit; with --yes also drive a "
+               "slow, clamped triangle and report the sensor's gain and sign against the command");
+  app.add_option("--device", device, "Comedi device file [comedi.device]");
+  app.add_flag("--yes", probe_options.drive, "With --probe-hardware: really drive the output (the amplifier is enabled)");
+  app.add_option("--amplitude-V", probe_options.amplitude_V, "With --probe-hardware --yes: the triangle's amplitude at the card [V]")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--duration-s", probe_options.duration_s, "With --probe-hardware --yes: the triangle's duration [s]")
+      ->check(CLI::Range(0.05, 60.0));
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   // Flags are overrides of their config keys, so every value is validated in one place.
@@ -40,18 +55,27 @@ int main(int argc, char** argv) {
   if (!drift.empty()) options.overrides.push_back("bridge.drift_fraction=" + drift);
   if (!seconds.empty()) options.overrides.push_back("bridge.run_seconds=" + seconds);
   if (auto_arm) options.overrides.push_back("bridge.auto_arm=true");
+  if (!device.empty()) options.overrides.push_back("comedi.device=" + device);
+  if (probe) {  // the comedi.* keys of the config, whatever its backend
+    options.overrides.push_back("bridge.backend=comedi");
+    options.overrides.push_back("rt.ticks_per_wake=1");
+  }
 
   BridgeSettings settings;
   std::string url;
   try {
     init_logging("bridge", options.log_level,
                  options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
-    settings = load_bridge_settings(load_service_config(options));
+    const Config config = load_service_config(options);
+    settings = load_bridge_settings(config);
     url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
+    configure_rig_auth(config, url);
   } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
     return 2;
   }
+
+  if (probe) return probe_hardware(settings, probe_options, stdout);
 
   try {
     install_stop_handlers();

@@ -1,6 +1,6 @@
 #pragma once
 // The channels the logger records, each with its counters: a fixed table (no allocation:
-// names live in fixed arrays). The rig's six channels (common/lcm/channels.hpp) hold the
+// names live in fixed arrays). The rig's channels (common/lcm/channels.hpp) hold the
 // first kRigChannels slots from the start, so no other traffic can take their place; other
 // channels the subscription lets through get the remaining slots as they appear, and once
 // those are gone their messages are counted in UnknownChannels (bounded), not recorded.
@@ -33,7 +33,7 @@ struct ChannelSlot {
   std::array<char, kMaxName + 1> name{};
   std::size_t name_length = 0;
   SequenceKind kind = SequenceKind::kNone;
-  bool rig = false;  // one of the rig's six channels: reported one by one on HX_STATUS
+  bool rig = false;  // one of the rig's channels: reported one by one on HX_STATUS
 
   // Receiving thread.
   std::uint64_t received = 0;
@@ -57,7 +57,7 @@ struct ChannelSlot {
 class ChannelTable {
  public:
   static constexpr std::size_t kMaxChannels = 64;
-  static constexpr std::size_t kRigChannels = kChannelSpecs.size();  // slots 0..5, in kChannelSpecs' order
+  static constexpr std::size_t kRigChannels = kChannelSpecs.size();  // slots 0..kRigChannels-1, in kChannelSpecs' order
 
   // The rig's channels (its sensor and command blocks are checked for gaps), and the
   // SequenceGapDetector settings: a command channel's forward jump after

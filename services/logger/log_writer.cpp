@@ -4,16 +4,10 @@
 
 #include <chrono>
 
+#include "core/clock.hpp"
 #include "core/errors.hpp"
 
 namespace hystloop {
-
-namespace {
-double monotonic_s() noexcept {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 void ChannelWriteCounter::written(std::uint32_t tag, std::size_t payload_bytes) noexcept {
   ChannelSlot& slot = channels_[tag];

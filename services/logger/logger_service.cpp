@@ -8,21 +8,18 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/clock.hpp"
 #include "core/errors.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_storage.hpp"
+#include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
 
 namespace {
-double monotonic_s() noexcept {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-
 std::int64_t monotonic_ns() noexcept {
   using namespace std::chrono;
   return duration_cast<nanoseconds>(steady_clock::now().time_since_epoch()).count();
@@ -35,15 +32,16 @@ template <class Block>
 bool decode_block(Block& block, const void* data, std::size_t size) noexcept {
   if (size < 8 || size > static_cast<std::size_t>(INT_MAX)) return false;
   if (wire_fingerprint(data, size) != Block::getHash()) return false;
-  if (walk_wire_layout(wire_layout_of<Block>(), data, size) != static_cast<std::int64_t>(size)) return false;
+  const std::int64_t body = lcm_body_size(wire_layout_of<Block>(), data, size);  // a signed block's trailer ignored
+  if (body < 0) return false;
   clear_arrays(block);
   int used = -1;
   try {
-    used = block.decode(data, 0, static_cast<int>(size));
+    used = block.decode(data, 0, static_cast<int>(body));
   } catch (...) {  // cannot happen within the reserved storage; never let it reach LCM
     return false;
   }
-  return used == static_cast<int>(size) && block.n_ticks >= 1;
+  return used == static_cast<int>(body) && block.n_ticks >= 1;
 }
 
 std::string append(std::string detail, const std::string& what) {

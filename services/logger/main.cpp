@@ -17,6 +17,7 @@
 #include "lcm/url.hpp"
 #include "logger/logger_options.hpp"
 #include "logger/logger_service.hpp"
+#include "runtime/rig_auth_config.hpp"
 #include "runtime/service_options.hpp"
 
 namespace {
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
     options = read_logger_options(config);
     names = std::make_unique<ChannelNames>(service.rig_prefix);
     url = resolve_lcm_url_for_10khz(service.lcm_url, service.allow_network);
+    configure_rig_auth(config, url);
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
     return kExitBadConfiguration;

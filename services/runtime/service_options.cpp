@@ -1,6 +1,6 @@
 #include "runtime/service_options.hpp"
 
-#include <cstdio>
+#include "core/cli.hpp"
 
 namespace hystloop {
 
@@ -16,20 +16,7 @@ void add_service_options(CLI::App& app, ServiceOptions& options) {
   app.add_option("--log-file", options.log_file, "Also write the log to this file");
 }
 
-std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    const std::string program = std::filesystem::path(app.get_name()).filename().string();
-    std::fprintf(stderr, "%s: %s\n", program.c_str(), e.what());
-    return 2;
-  }
-  return std::nullopt;
-}
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) { return parse_cli(app, argc, argv); }
 
 Config load_service_config(const ServiceOptions& options) {
   Config config = options.config_file.empty() ? Config() : Config::load_file(options.config_file);

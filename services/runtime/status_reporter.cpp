@@ -11,11 +11,6 @@
 
 namespace hystloop {
 
-std::int64_t wall_utime() noexcept {
-  using namespace std::chrono;
-  return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
-}
-
 StatusReporter::StatusReporter(lcm::LCM& lcm, const std::string& channel, std::string process)
     : publisher_(lcm, channel) {
   status_.process = std::move(process);

@@ -9,6 +9,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/clock.hpp"  // wall_utime() for utime fields
 #include "core/latency_stats.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "lcm/publisher.hpp"
@@ -38,8 +39,5 @@ class StatusReporter {
   service_status_t status_{};
   Publisher<service_status_t> publisher_;
 };
-
-// Microseconds since the UNIX epoch (for utime fields).
-std::int64_t wall_utime() noexcept;
 
 }  // namespace hystloop

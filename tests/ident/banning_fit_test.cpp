@@ -40,6 +40,13 @@ BanningPlanOptions test_plan() {
 }
 const double kAlphaTolerance = kSanitized ? 0.04 : 0.02;
 
+// Options with a clock that does not run: the Ceres solves end on their tolerances, not on the
+// machine's load, so the figures below are the same on every run.
+BanningFitOptions fixed_clock(BanningFitOptions o = {}) {
+  o.clock = fixed_fit_clock();
+  return o;
+}
+
 struct Recorded {
   std::vector<BanningExperiment> plan;
   std::vector<std::vector<double>> y;
@@ -91,7 +98,7 @@ TEST(BanningFit, ZohMagnitudeMatchesTheSimulatedLinearStage) {
 TEST(BanningFit, RecoversTables1And2FromNoisySimulatedExperiments) {
   const BanningStageParams truth{};
   const Recorded rec = record(truth, test_plan(), 1e-9, 1000);
-  const BanningFitResult r = fit_banning(rec.data);
+  const BanningFitResult r = fit_banning(rec.data, fixed_clock());
   ASSERT_TRUE(r.ok()) << r.reason;
   ASSERT_TRUE(r.stage_identified) << r.reason;
   const auto& h = truth.hysteresis;
@@ -99,11 +106,15 @@ TEST(BanningFit, RecoversTables1And2FromNoisySimulatedExperiments) {
               r.hysteresis.a, rel(r.hysteresis.a, h.a), r.hysteresis.b, rel(r.hysteresis.b, h.b), r.hysteresis.alpha,
               rel(r.hysteresis.alpha, h.alpha), r.stage.k, rel(r.stage.k, truth.stage.k), r.stage.c,
               rel(r.stage.c, truth.stage.c), r.solve_time_s * 1e3);
-  EXPECT_LT(rel(r.hysteresis.a, h.a), 2e-3);
+  // a from the centre line is nearly noise-free (measured 1.7e-5): 1e-4 (~6x). c is the least
+  // determined, by the resonance's width (measured 8.3e-4): 3e-3 (~4x). The data are seeded and the
+  // fit's clock fixed, so these figures do not move between runs. (The sanitizer's lighter plan
+  // keeps the earlier, wider bounds: not measured here.)
+  EXPECT_LT(rel(r.hysteresis.a, h.a), kSanitized ? 2e-3 : 1e-4);
   EXPECT_LT(rel(r.hysteresis.b, h.b), 5e-3);
   EXPECT_LT(rel(r.hysteresis.alpha, h.alpha), kAlphaTolerance);
   EXPECT_LT(rel(r.stage.k, truth.stage.k), 5e-3);
-  EXPECT_LT(rel(r.stage.c, truth.stage.c), 0.03);
+  EXPECT_LT(rel(r.stage.c, truth.stage.c), kSanitized ? 0.03 : 3e-3);
   EXPECT_LT(r.slope_rel_rms, 0.01);
   EXPECT_LT(r.area_rel_rms, kSanitized ? 0.04 : 0.02);
 }
@@ -112,11 +123,11 @@ TEST(BanningFit, PaperOrderIsRecoveredToo) {
   BanningStageParams truth{};
   truth.order = BanningOrder::kStageThenHysteresis;
   const Recorded rec = record(truth, test_plan(), 1e-9, 2000);
-  BanningFitOptions o;
+  BanningFitOptions o = fixed_clock();
   o.order = BanningOrder::kStageThenHysteresis;
   const BanningFitResult r = fit_banning(rec.data, o);
   ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_LT(rel(r.hysteresis.a, truth.hysteresis.a), 2e-3);
+  EXPECT_LT(rel(r.hysteresis.a, truth.hysteresis.a), kSanitized ? 2e-3 : 5e-5);  // measured 6.9e-6: ~7x
   // The CH input is the stage output here, sampled at the step ends: a little looser.
   EXPECT_LT(rel(r.hysteresis.b, truth.hysteresis.b), 1e-2);
   EXPECT_LT(rel(r.hysteresis.alpha, truth.hysteresis.alpha), kAlphaTolerance + 0.01);

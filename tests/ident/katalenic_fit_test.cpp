@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -44,11 +45,19 @@ TEST(KatalenicFit, RecoversTheOperatorAndLinearShaping) {
   for (double& v : y) v += n(rng);
   KatalenicFitOptions o;
   o.max_solver_time_s = kSolverTime;
+  o.clock = fixed_fit_clock();  // Ceres ends on its tolerances, whatever the machine's load
   const KatalenicFitResult r = fit_katalenic(u, y, o);
   ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_NEAR(r.params.k1, truth.k1, 0.01 * truth.k1);
-  EXPECT_NEAR(r.params.k2, truth.k2, 0.02 * truth.k2);
-  EXPECT_NEAR(r.params.output_shaping.gain, truth.output_shaping.gain, 0.01 * truth.output_shaping.gain);
+  const double e_k1 = std::abs(r.params.k1 / truth.k1 - 1.0), e_k2 = std::abs(r.params.k2 / truth.k2 - 1.0);
+  const double e_gain = std::abs(r.params.output_shaping.gain / truth.output_shaping.gain - 1.0);
+  std::printf("rel. errors: k1 %.2e, k2 %.2e, gain %.2e\n", e_k1, e_k2, e_gain);
+  // Seeded 1 nm noise on a 20,000-sample loop (Release): measured k1 1.4e-4, k2 2.2e-4, gain
+  // 9.9e-6, the noise's share of one draw. Bounds ~5x above (a 1-2 % bound let a real bias pass);
+  // the sanitizer's 10,000 samples double the variance, hence the factor 1.5 there.
+  const double widen = kSamples < 20000 ? 1.5 : 1.0;
+  EXPECT_LT(e_k1, widen * 7e-4);
+  EXPECT_LT(e_k2, widen * 1e-3);
+  EXPECT_LT(e_gain, widen * 5e-5);
   EXPECT_NEAR(r.residual_rms_m, 1e-9, 0.1e-9);
 }
 

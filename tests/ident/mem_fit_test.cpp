@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -25,8 +26,11 @@ Errors errors(const MemParams& est, const MemParams& truth) {
   return {rel_err(est.c1, truth.c1), rel_err(est.c2, truth.c2), rel_err(est.c3, truth.c3)};
 }
 
+// A clock that does not run: the refinement stops on its iteration limits, not on the machine's
+// load, so the tight bounds below hold on a busy CI host too.
 MemFitOptions form(MemFitForm f) {
   MemFitOptions o;
+  o.clock = fixed_fit_clock();
   o.form = f;
   return o;
 }
@@ -44,13 +48,18 @@ TEST(MemFit, NoiseFreeIntegratedRecoversWithinOnePercent) {
   EXPECT_LT(r.residual_rms_m, 1e-13);
 }
 
-TEST(MemFit, NoiseFreeDerivativeRecoversWithinOnePercent) {
+TEST(MemFit, NoiseFreeDerivativeRecoversToTheSolversPrecision) {
   const MemParams truth = testdata::piezo_truth();
   const auto u = testdata::paper_identification_input();
   const auto y = testdata::mem_branches(u, truth);
   const MemFitResult r = fit_mem(u, y, form(MemFitForm::derivative));
   ASSERT_TRUE(r.ok()) << r.reason;
-  EXPECT_LT(errors(r.params, truth).worst(), 1e-2);
+  // The derivative model is the exact mean slope over each interval, so noise-free data carry no
+  // discretisation bias: the error is the solver's (measured worst 7.5e-9). 1e-7 is ~10x that,
+  // and fails on a bias of 1e-7 (a 1 % bound let any modelling error below 1 % pass).
+  const Errors e = errors(r.params, truth);
+  std::printf("derivative, noise-free: c1 %.2e c2 %.2e c3 %.2e (rel. errors)\n", e.c1, e.c2, e.c3);
+  EXPECT_LT(e.worst(), 1e-7);
 }
 
 // 1 nm RMS sensor noise (seeded). Tolerances from the measured spread over the seeds below.
@@ -91,7 +100,13 @@ TEST(MemFit, RandomTruthsAreRecoveredNoiseFree) {
     for (MemFitForm f : {MemFitForm::integrated, MemFitForm::derivative}) {
       const MemFitResult r = fit_mem(u, y, form(f));
       ASSERT_TRUE(r.ok()) << r.reason;
-      EXPECT_LT(errors(r.params, truth).worst(), 1e-2) << "case " << i << " c3 " << truth.c3;
+      // Noise-free: the solver's precision. Measured worst: derivative 2.1e-9; integrated 5.3e-8,
+      // except case 3 (c3 = 0.23: c2 p^1.23 is nearly collinear with c1 p and the branch offsets,
+      // so c2 is the least determined) at 8.9e-6. Bounds ~5-10x above, far below a real bias.
+      const double worst = errors(r.params, truth).worst();
+      const double bound = f == MemFitForm::derivative ? 2e-8 : (i == 3 ? 5e-5 : 5e-7);
+      std::printf("case %d form %d: worst rel. error %.2e (bound %.0e)\n", i, static_cast<int>(f), worst, bound);
+      EXPECT_LT(worst, bound) << "case " << i << " c3 " << truth.c3;
     }
   }
 }
@@ -211,7 +226,7 @@ TEST(MemFit, BranchIncrementAndRmsAgreeWithTheGenerator) {
   MemParams off = truth;
   off.c1 *= 1.01;
   EXPECT_GT(mem_branch_rms(u, y, branches, off), 1e-10);
-  EXPECT_DOUBLE_EQ(mem_branch_increment(truth, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(truth.branch_rise(0.0), 0.0);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 //   lcm_probe ping      --url U --prefix P --rounds N [--rate-hz R]      round-trip percentiles
 //
 // Round k sends fixtures::sensor_block(k) and command_block(k) (1..10 ticks each, so the
-// arrays' sizes vary); every 10th round (j = k / 10) also trajectory(j), params(j), status(j)
+// arrays' sizes vary); every 10th round (j = k / 10) also trajectory(j), params(j), model_params(j), status(j)
 // and control(j). A receiver recovers k or j from the message, and requires every expected
 // message exactly once, byte-identical to the fixture, with nothing rejected. Exit status
 // 0 = all intact, 1 = something missing or altered.
@@ -29,6 +29,7 @@
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_fixtures.hpp"
+#include "lcm/model_params_fixtures.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 
@@ -78,6 +79,7 @@ void emit_round(const ChannelNames& ch, std::int64_t k, Emit&& emit) {
     const std::int64_t j = k / 10;
     emit(ch.trajectory, fixtures::trajectory(j));
     emit(ch.params, fixtures::params(j));
+    emit(ch.model, fixtures::model_params(j));
     emit(ch.status, fixtures::status(j));
     emit(ch.control, fixtures::control(j));
   }
@@ -88,12 +90,14 @@ std::int64_t index_of(const sensor_block_t& m) { return m.seq / fixtures::kRound
 std::int64_t index_of(const command_block_t& m) { return m.sample_seq / fixtures::kRoundTicks; }
 std::int64_t index_of(const trajectory_t& m) { return m.version - 1; }
 std::int64_t index_of(const mem_params_t& m) { return m.version - 1; }
+std::int64_t index_of(const model_params_t& m) { return m.version - 1; }
 std::int64_t index_of(const service_status_t& m) { return m.pid - 4242; }
 std::int64_t index_of(const control_t& m) { return m.request_id - 100; }
 sensor_block_t fixture_for(const sensor_block_t*, std::int64_t i) { return fixtures::sensor_block(i); }
 command_block_t fixture_for(const command_block_t*, std::int64_t i) { return fixtures::command_block(i); }
 trajectory_t fixture_for(const trajectory_t*, std::int64_t i) { return fixtures::trajectory(i); }
 mem_params_t fixture_for(const mem_params_t*, std::int64_t i) { return fixtures::params(i); }
+model_params_t fixture_for(const model_params_t*, std::int64_t i) { return fixtures::model_params(i); }
 service_status_t fixture_for(const service_status_t*, std::int64_t i) { return fixtures::status(i); }
 control_t fixture_for(const control_t*, std::int64_t i) { return fixtures::control(i); }
 
@@ -130,23 +134,25 @@ class Expectation {
   std::int64_t duplicates_ = 0;
 };
 
-// All six expectations, fed either by Subscriptions or by a log file.
+// All seven expectations, fed either by Subscriptions or by a log file.
 struct Expectations {
   Expectations(const ChannelNames& ch, std::int64_t rounds)
       : sensor(ch.sensor, rounds),
         command(ch.command, rounds),
         trajectory(ch.trajectory, rare_rounds(rounds)),
         params(ch.params, rare_rounds(rounds)),
+        model(ch.model, rare_rounds(rounds)),
         status(ch.status, rare_rounds(rounds)),
         control(ch.control, rare_rounds(rounds)) {}
   bool complete() const {
     return sensor.complete() && command.complete() && trajectory.complete() && params.complete() &&
-           status.complete() && control.complete();
+           model.complete() && status.complete() && control.complete();
   }
   Expectation<sensor_block_t> sensor;
   Expectation<command_block_t> command;
   Expectation<trajectory_t> trajectory;
   Expectation<mem_params_t> params;
+  Expectation<model_params_t> model;
   Expectation<service_status_t> status;
   Expectation<control_t> control;
 };
@@ -158,6 +164,7 @@ int publish(const Options& o) {
   Publisher<command_block_t> command(*lcm, ch.command);
   Publisher<trajectory_t> trajectory(*lcm, ch.trajectory);
   Publisher<mem_params_t> params(*lcm, ch.params);
+  Publisher<model_params_t> model(*lcm, ch.model);
   Publisher<service_status_t> status(*lcm, ch.status);
   Publisher<control_t> control(*lcm, ch.control);
   std::uint64_t failed = 0;
@@ -168,6 +175,7 @@ int publish(const Options& o) {
     else if constexpr (std::is_same_v<T, command_block_t>) ok = command.publish(msg);
     else if constexpr (std::is_same_v<T, trajectory_t>) ok = trajectory.publish(msg);
     else if constexpr (std::is_same_v<T, mem_params_t>) ok = params.publish(msg);
+    else if constexpr (std::is_same_v<T, model_params_t>) ok = model.publish(msg);
     else if constexpr (std::is_same_v<T, service_status_t>) ok = status.publish(msg);
     else ok = control.publish(msg);
     (void)channel;
@@ -201,6 +209,7 @@ int subscribe(const Options& o) {
   Subscription<command_block_t> command(*lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
   Subscription<trajectory_t> trajectory(*lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(*lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
+  Subscription<model_params_t> model(*lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
   Subscription<service_status_t> status(*lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
   Subscription<control_t> control(*lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
   if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
@@ -217,6 +226,7 @@ int subscribe(const Options& o) {
   ok = expect.command.report(command.counters().rejected_total()) && ok;
   ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
   ok = expect.params.report(params.counters().rejected_total()) && ok;
+  ok = expect.model.report(model.counters().rejected_total()) && ok;
   ok = expect.status.report(status.counters().rejected_total()) && ok;
   ok = expect.control.report(control.counters().rejected_total()) && ok;
   return ok ? 0 : 1;
@@ -254,6 +264,7 @@ int check_log(const Options& o) {
   Subscription<command_block_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
   Subscription<trajectory_t> trajectory(lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
+  Subscription<model_params_t> model(lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
   Subscription<service_status_t> status(lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
   Subscription<control_t> control(lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
   std::int64_t other = 0;
@@ -263,6 +274,7 @@ int check_log(const Options& o) {
     else if (event->channel == ch.command) command.receive(event->data, size, event->timestamp);
     else if (event->channel == ch.trajectory) trajectory.receive(event->data, size, event->timestamp);
     else if (event->channel == ch.params) params.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.model) model.receive(event->data, size, event->timestamp);
     else if (event->channel == ch.status) status.receive(event->data, size, event->timestamp);
     else if (event->channel == ch.control) control.receive(event->data, size, event->timestamp);
     else if (o.ignore_prefix.empty() || event->channel.rfind(o.ignore_prefix, 0) != 0) ++other;
@@ -271,6 +283,7 @@ int check_log(const Options& o) {
   ok = expect.command.report(command.counters().rejected_total()) && ok;
   ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
   ok = expect.params.report(params.counters().rejected_total()) && ok;
+  ok = expect.model.report(model.counters().rejected_total()) && ok;
   ok = expect.status.report(status.counters().rejected_total()) && ok;
   ok = expect.control.report(control.counters().rejected_total()) && ok;
   if (other != 0) std::printf("%lld events on other channels\n", static_cast<long long>(other));

@@ -32,6 +32,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/cli.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
@@ -432,7 +433,7 @@ int main(int argc, char** argv) {
   sv->add_option("--process", process)->required();
   sv->add_option("--key", key)->required();
 
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
   try {
     if (*an) return analyze(dir, u_min, u_max, slew, ramp, dt, watchdog);
     if (*sv) return status_value(dir, process, key);

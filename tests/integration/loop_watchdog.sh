@@ -43,6 +43,8 @@ wait_log "$dir/compensator2.log" "channels:"
 sleep 0.6
 "$probe" control --command arm
 for _ in $(seq 100); do [ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ] && break; sleep 0.05; done
+# Tracking after the trip must come from this ARM (the bridge waits for one after a watchdog trip).
+[ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ] || fail "the bridge did not take the second ARM within 5 s"
 sleep 2.2
 kill -TERM $bpid $c2
 wait $bpid || fail "the bridge exited with $? on SIGTERM"
@@ -56,7 +58,9 @@ get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
 [ "$(get safe_entries)" -ge 1 ] || fail "the bridge never entered the safe state after the kill"
 [ "$(get max_planned_ahead_ticks)" -le "$horizon_ticks" ] || fail "a plan reached $(get max_planned_ahead_ticks) ticks ahead"
 [ "$(get last_run_ticks)" -ge 15000 ] || fail "tracking did not resume for long after re-arm ($(get last_run_ticks) ticks)"
-awk -v e="$(get tracking_rms_m)" 'BEGIN { exit !(e < 2e-7) }' || fail "tracking error $(get tracking_rms_m) m RMS after re-arm"
+# Measured 2.5-2.6 nm RMS after re-arm (3 runs, 2-core machine shared with builds); 10 nm is ~4x
+# that: room for a loaded host; the earlier 200 nm let a loop 80x worse than this one pass.
+awk -v e="$(get tracking_rms_m)" 'BEGIN { exit !(e < 1e-8) }' || fail "tracking error $(get tracking_rms_m) m RMS after re-arm"
 trips=$(grep -c "watchdog: no command" "$dir/bridge.log" || true)
 [ "$trips" -ge 1 ] || fail "the bridge did not log a watchdog trip"
 grep -q "re-arm via HX_CONTROL" "$dir/status.log" || fail "no SAFE status naming the watchdog"

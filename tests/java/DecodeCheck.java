@@ -48,7 +48,7 @@ public class DecodeCheck {
         }
       }
     }
-    if (byFingerprint.size() != 6) fail("expected 6 LCM types in the jar, found " + byFingerprint.size());
+    if (byFingerprint.size() != 7) fail("expected 7 LCM types in the jar, found " + byFingerprint.size());
 
     lcm.spy.LCMTypeDatabase spyTypes = new lcm.spy.LCMTypeDatabase();
     for (Map.Entry<Long, Class<?>> e : byFingerprint.entrySet()) {
@@ -105,6 +105,13 @@ public class DecodeCheck {
       } else if (msg instanceof hystloop.trajectory_t) {
         hystloop.trajectory_t t = (hystloop.trajectory_t) msg;
         if (t.n_points != 1 + (t.version - 1) % 6 || t.points_y_m.length != t.n_points) fail("trajectory points");
+      } else if (msg instanceof hystloop.model_params_t) {
+        hystloop.model_params_t m = (hystloop.model_params_t) msg;
+        if (m.kind != (m.version - 1) % 4) fail("model params kind " + m.kind + " at version " + m.version);
+        if (m.kind == hystloop.model_params_t.KIND_PI
+            && (m.pi_weights.length != m.n_operators || m.pi_thresholds_V.length != m.n_operators)) {
+          fail("PI arrays do not hold n_operators = " + m.n_operators);
+        }
       } else if (msg instanceof hystloop.mem_params_t) {
         hystloop.mem_params_t p = (hystloop.mem_params_t) msg;
         if (!p.source.equals("reident@lab-host-" + (p.version - 1))) fail("params source '" + p.source + "'");
@@ -117,6 +124,7 @@ public class DecodeCheck {
     expected.put("HX_COMMAND command_block_t", rounds);
     expected.put("HX_TRAJECTORY trajectory_t", rare);
     expected.put("HX_PARAMS mem_params_t", rare);
+    expected.put("HX_MODEL model_params_t", rare);
     expected.put("HX_STATUS service_status_t", rare);
     expected.put("HX_CONTROL control_t", rare);
     if (!counts.equals(expected)) fail("decoded " + counts + ", expected " + expected);

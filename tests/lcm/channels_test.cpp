@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
+#include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 
 namespace hystloop {
@@ -18,6 +19,7 @@ TEST(Channels, DefaultPrefixGivesTheDesignNames) {
   EXPECT_EQ(names.command, "HX_COMMAND");
   EXPECT_EQ(names.trajectory, "HX_TRAJECTORY");
   EXPECT_EQ(names.params, "HX_PARAMS");
+  EXPECT_EQ(names.model, "HX_MODEL");
   EXPECT_EQ(names.status, "HX_STATUS");
   EXPECT_EQ(names.control, "HX_CONTROL");
   EXPECT_EQ(names.all_channels_regex(), "HX_.*");
@@ -41,7 +43,8 @@ TEST(Channels, RefusesPrefixesThatAreNotLiteralRegexes) {
 }
 
 TEST(Channels, SpecsListEveryChannelOnce) {
-  EXPECT_EQ(kChannelSpecs.size(), 6u);
+  EXPECT_EQ(kChannelSpecs.size(), 7u);
+  EXPECT_EQ(kChannelSpecs[6].type_name, std::string("hystloop.") + model_params_t::getTypeName());
   EXPECT_EQ(kChannelSpecs[0].type_name, "hystloop.sensor_block_t");
   EXPECT_EQ(kChannelSpecs[1].type_name, "hystloop.command_block_t");
   EXPECT_EQ(kChannelSpecs[0].type_name, std::string("hystloop.") + sensor_block_t::getTypeName());

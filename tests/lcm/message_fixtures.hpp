@@ -108,7 +108,7 @@ inline mem_params_t params(std::int64_t k) {
   m.residual_m = 2.79e-8;
   m.samples_used = 20000 + k;
   m.window_s = 2.0;
-  m.valid = (k % 3 != 0);
+  m.valid = k % 3 != 0 ? 1 : 0;
   m.source = "reident@lab-host-" + std::to_string(k);
   return m;
 }

@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <tuple>
 
+#include "hystloop/wire_layout_samples.hpp"
 #include "lcm/message_fixtures.hpp"
 
 namespace hystloop {
@@ -24,14 +27,64 @@ void put_be32(std::vector<std::uint8_t>& bytes, std::size_t at, std::int32_t val
   for (int i = 0; i < 4; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(u >> (24 - 8 * i));
 }
 
-// If this fails, a .lcm file changed: update kXxx and the fingerprint in wire_layout.cpp.
-TEST(WireLayout, EveryLayoutIsPinnedToItsTypesFingerprint) {
-  EXPECT_TRUE(layout_matches<sensor_block_t>());
-  EXPECT_TRUE(layout_matches<command_block_t>());
-  EXPECT_TRUE(layout_matches<trajectory_t>());
-  EXPECT_TRUE(layout_matches<mem_params_t>());
-  EXPECT_TRUE(layout_matches<service_status_t>());
-  EXPECT_TRUE(layout_matches<control_t>());
+// The bound on the counts of each type with arrays, written here rather than taken from the
+// generated layout, so that a generator picking the wrong constant fails. A new type with arrays
+// fails the test below until its bound is added here.
+template <class T>
+constexpr std::int32_t kBound = 0;
+template <>
+constexpr std::int32_t kBound<sensor_block_t> = sensor_block_t::MAX_TICKS;
+template <>
+constexpr std::int32_t kBound<command_block_t> = command_block_t::MAX_TICKS;
+template <>
+constexpr std::int32_t kBound<trajectory_t> = trajectory_t::MAX_POINTS;
+template <>
+constexpr std::int32_t kBound<model_params_t> = model_params_t::MAX_OPERATORS;
+template <>
+constexpr std::int32_t kBound<service_status_t> = service_status_t::MAX_COUNTERS;
+
+// The generated layout of T (cmake/lcm_wire_layouts.py) against lcm-gen's own encoder: a message
+// with every count at 0, 1, 7 and the bound, each array that long, walks to exactly its encoded
+// size, and every truncation is refused; a count one past the bound, or negative, is refused.
+template <class T>
+void expect_generated_layout_agrees_with_encoding() {
+  SCOPED_TRACE(T::getTypeName());
+  const WireLayout layout = wire_layout_of<T>();
+  EXPECT_EQ(layout.fingerprint, T::getHash());
+  const bool has_count = std::ranges::find(layout.fields, WireField::kCount) != layout.fields.end();
+  EXPECT_EQ(has_count, kBound<T> > 0) << "a type with arrays: add its bound to kBound";
+  EXPECT_EQ(layout.max_count, kBound<T>);
+  for (const std::int32_t count : {0, 1, 7, kBound<T>}) {
+    if (count > kBound<T>) continue;
+    T msg{};
+    wire_samples::fill_wire_sample(msg, count);
+    const auto bytes = fixtures::encode(msg);
+    ASSERT_EQ(walk_wire_layout(layout, bytes.data(), bytes.size()), msg.getEncodedSize()) << count;
+    for (std::size_t n = 0; n < bytes.size() && count <= 7; ++n) {
+      EXPECT_EQ(walk_wire_layout(layout, bytes.data(), n), -1) << count << " cut at " << n;
+    }
+  }
+  if (!has_count) return;
+  for (const std::int32_t bad : {kBound<T> + 1, -1, -2147483647 - 1}) {
+    T msg{};
+    wire_samples::fill_wire_sample(msg, bad);
+    std::vector<std::uint8_t> bytes(1 << 16);  // not getEncodedSize(): a negative count shrinks it
+    const int size = msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    ASSERT_GT(size, 8) << bad;
+    EXPECT_EQ(walk_wire_layout(layout, bytes.data(), static_cast<std::size_t>(size)), -1) << bad;
+  }
+}
+
+template <class... T>
+void expect_generated_layouts_agree_with_encoding(std::tuple<T...>* /*types*/) {
+  (expect_generated_layout_agrees_with_encoding<T>(), ...);
+}
+
+// Every type of lcmtypes/ (WireTypes is generated from the same files: a new type is covered here
+// without editing this test).
+TEST(WireLayout, TheGeneratedLayoutOfEveryTypeAgreesWithItsEncoding) {
+  static_assert(std::tuple_size_v<wire_samples::WireTypes> >= 7);
+  expect_generated_layouts_agree_with_encoding(static_cast<wire_samples::WireTypes*>(nullptr));
 }
 
 TEST(WireLayout, WalkCoversExactlyTheEncodedBytesOfEveryType) {

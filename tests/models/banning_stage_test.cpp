@@ -132,7 +132,9 @@ double stationary_peak_to_peak(BanningOrder order, double& f, double amplitude) 
 // at any frequency including the resonance (observed 4e-5, tolerance 1e-4: the sampling bound
 // above). Estimate (27) h = (y_max - y_min) / (2 b A) is within (a - b) / b (alpha A h)^2 / 3 of h:
 // observed 0.23 % at A = 2 V (tolerance 0.3 %), but 3 % to 26 % at A = 40 V. The default order is
-// not covered by (25), yet (27) still estimates h to 0.03 % at A = 2 V (tolerance 1 %).
+// not covered by (25), yet (27) still estimates h to 0.03 % at A = 2 V (observed 2.8e-4 worst over
+// the frequencies; tolerance 1e-3, ~3.5x: the (alpha A h)^2 term at A = 2 V is of that order, so a
+// factor-of-a-few error in the estimate's bias fails).
 TEST(BanningStage, PaperOrderObeysRelation25AndEstimate27) {
   const BanningStageParams p;
   std::printf("  f [Hz]   h(w)   A [V] | pp sim [nm]  pp (25) [nm]   rel | h (27) paper order  rel | "
@@ -152,7 +154,7 @@ TEST(BanningStage, PaperOrderObeysRelation25AndEstimate27) {
       EXPECT_NEAR(pp, want, 1e-4 * want) << f << " Hz, " << amplitude << " V";
       if (amplitude <= 2.0) {
         EXPECT_NEAR(h27, h, 3e-3 * h) << f;
-        EXPECT_NEAR(h27_ch, h, 1e-2 * h) << f;
+        EXPECT_NEAR(h27_ch, h, 1e-3 * h) << f;
       }
     }
   }
@@ -161,7 +163,9 @@ TEST(BanningStage, PaperOrderObeysRelation25AndEstimate27) {
 // Discretisation: with the voltage held over each sample, the default order is exact, so one step
 // of 100 us equals 100 steps of 1 us (rounding only: 3e-14 of the peak). The paper's order has the
 // Hermite error at y_L's reversals: 2e-9 of the peak at 2 Hz, 5.5e-4 at 1 kHz (2.4e-2 if the CH
-// skipped the reversal's extreme); bounded here by 2e-3.
+// skipped the reversal's extreme). Bounded separately, ~5x and ~2x above what is reached (the
+// Hermite error scales with (f dt)^2, so one bound for both would let a 2 Hz error of 1e-3 pass):
+// 1e-8 at 2 Hz, 1e-3 at 1 kHz (a regression to skipping the extreme, 2.4e-2, fails).
 TEST(BanningStage, DiscretisationAgainstAFinerStep) {
   for (BanningOrder order : {BanningOrder::kHysteresisThenStage, BanningOrder::kStageThenHysteresis}) {
     for (double f : {2.0, 1000.0}) {
@@ -182,7 +186,8 @@ TEST(BanningStage, DiscretisationAgainstAFinerStep) {
       }
       std::printf("order %d, %6.0f Hz, A = 100 V: dt = 100 us vs 100 x 1 us: max |error| = %.3g m (%.2g of peak)\n",
                   static_cast<int>(order), f, worst, worst / peak);
-      EXPECT_LT(worst, (order == BanningOrder::kHysteresisThenStage ? 1e-12 : 2e-3) * peak);
+      const double paper_bound = f < 10.0 ? 1e-8 : 1e-3;
+      EXPECT_LT(worst, (order == BanningOrder::kHysteresisThenStage ? 1e-12 : paper_bound) * peak);
     }
   }
 }

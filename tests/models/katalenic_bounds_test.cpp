@@ -12,27 +12,14 @@
 
 #include "core/errors.hpp"
 #include "models/katalenic_operator.hpp"
+#include "support/smooth_signal.hpp"
 
 namespace hystloop {
 namespace {
 
+// A smooth input with many reversals (tests/support/smooth_signal.hpp): 3-25 cycles, centred on 0.
 std::vector<double> smooth_signal(std::mt19937_64& rng, double amplitude, std::size_t n) {
-  std::uniform_real_distribution<double> freq(3.0, 25.0), phase(0.0, 6.283185307179586), weight(0.1, 1.0);
-  double f[4], p[4], a[4], total = 0.0;
-  for (int i = 0; i < 4; ++i) {
-    f[i] = freq(rng);
-    p[i] = phase(rng);
-    a[i] = weight(rng);
-    total += a[i];
-  }
-  std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / static_cast<double>(n);
-    double v = 0.0;
-    for (int i = 0; i < 4; ++i) v += a[i] * std::sin(6.283185307179586 * f[i] * t + p[i]);
-    s[k] = amplitude * v / total;
-  }
-  return s;
+  return testing::smooth_signal(rng, amplitude, 0.0, n, {3.0, 25.0, 0.1});
 }
 
 // The paper's Example 1: RH(0.14, 0.1, 8, 5) gives Delta_b <= 0.13, and 0.182 after the output

@@ -9,28 +9,14 @@
 #include <random>
 #include <vector>
 
+#include "support/smooth_signal.hpp"
+
 namespace hystloop {
 namespace {
 
-// A smooth input with many reversals: a sum of sines with seeded random frequencies and phases.
+// A smooth input with many reversals (tests/support/smooth_signal.hpp), centred on 0.
 std::vector<double> smooth_signal(std::uint64_t seed, double amplitude, std::size_t n) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> freq(5.0, 40.0), phase(0.0, 6.283185307179586), weight(0.2, 1.0);
-  double f[4], p[4], a[4], total = 0.0;
-  for (int i = 0; i < 4; ++i) {
-    f[i] = freq(rng);
-    p[i] = phase(rng);
-    a[i] = weight(rng);
-    total += a[i];
-  }
-  std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / static_cast<double>(n);
-    double v = 0.0;
-    for (int i = 0; i < 4; ++i) v += a[i] * std::sin(6.283185307179586 * f[i] * t + p[i]);
-    s[k] = amplitude * v / total;
-  }
-  return s;
+  return testing::smooth_signal(seed, amplitude, 0.0, n);
 }
 
 int reversals(const std::vector<double>& s) {
@@ -98,6 +84,42 @@ TEST(KatalenicBranch, StartsAtZeroAndReachesTheAsymptote) {
       EXPECT_NEAR(katalenic_inverse_branch(k2, m_star, far), far + m_star, 1e-12 * far);
     }
   }
+}
+
+// Interior points of (2) and (4) derived by hand from the paper, where W has a closed form:
+//  (a) k2 = 1, M* = 2, v~ = 1 + ln 2: the argument of W in (2) is k2 M* e^{k2 (M* - v~)}
+//      = 2 e^{1 - ln 2} = e = 1 e^1, so W = 1 and u~ = v~ - M* + W / k2 = 1 + ln 2 - 2 + 1 = ln 2.
+//      (4) at u_d~ = ln 2: v~ = ln 2 + 2 (1 - e^{-ln 2}) = ln 2 + 1, the same point back.
+//  (b) k2 = 2, M* = 1, v~ = (1 + ln 2) / 2: argument 2 e^{2 (1 - v~)} = 2 e^{1 - ln 2} = e, W = 1,
+//      u~ = v~ - 1 + 1/2 = ln 2 / 2; (4): ln 2 / 2 + (1 - e^{-ln 2}) = (1 + ln 2) / 2.
+//  (c) k2 = 1/2, M* = 2, v~ = 2: argument 1 e^0 = 1, W(1) = Omega = 0.5671432904097838 (the omega
+//      constant, Omega e^Omega = 1), u~ = 2 - 2 + 2 Omega; (4): 2 Omega + 2 (1 - e^{-Omega})
+//      = 2 Omega + 2 - 2 Omega = 2, since e^{-Omega} = Omega.
+TEST(KatalenicBranch, InteriorPointsDerivedByHand) {
+  const double ln2 = std::log(2.0), omega = 0.5671432904097838;
+  EXPECT_NEAR(katalenic_direct_branch(1.0, 2.0, 1.0 + ln2), ln2, 1e-15);
+  EXPECT_NEAR(katalenic_inverse_branch(1.0, 2.0, ln2), 1.0 + ln2, 1e-15);
+  EXPECT_NEAR(katalenic_direct_branch(2.0, 1.0, 0.5 * (1.0 + ln2)), 0.5 * ln2, 1e-15);
+  EXPECT_NEAR(katalenic_inverse_branch(2.0, 1.0, 0.5 * ln2), 0.5 * (1.0 + ln2), 1e-15);
+  EXPECT_NEAR(katalenic_direct_branch(0.5, 2.0, 2.0), 2.0 * omega, 1e-15);
+  EXPECT_NEAR(katalenic_inverse_branch(0.5, 2.0, 2.0 * omega), 2.0, 1e-15);
+}
+
+// The same point (a) through the operators, with Definition 2.1's T and M: the direct operator
+// started at (v0, u0) = (0, 1), ascending, has M = u0 - v0 = 1 and M* = M + k1 = 2 (k1 = 1); at
+// v = 1 + ln 2 (v~ = 1 + ln 2) it gives u = u0 + u~ = 1 + ln 2. Descending from (0, -1) by symmetry
+// u = -(1 + ln 2). The inverse started at (u_d0, v0) = (0, -1), ascending, has M = v0 - u_d0 = -1
+// and M* = -M + k1 = 2; at u_d = ln 2 it gives v = v0 + v~ = -1 + 1 + ln 2 = ln 2.
+TEST(KatalenicOperatorPair, InteriorPointDerivedByHand) {
+  const double ln2 = std::log(2.0);
+  KatalenicDirectOperator up, down;
+  up.reset(0.0, 1.0, 1.0);
+  EXPECT_NEAR(up.apply(1.0 + ln2, 1.0, 1.0), 1.0 + ln2, 1e-15);
+  down.reset(0.0, -1.0, -1.0);
+  EXPECT_NEAR(down.apply(-(1.0 + ln2), 1.0, 1.0), -(1.0 + ln2), 1e-15);
+  KatalenicInverseOperator inv;
+  inv.reset(0.0, -1.0, 1.0);
+  EXPECT_NEAR(inv.apply(ln2, 1.0, 1.0), ln2, 1e-15);
 }
 
 TEST(KatalenicBranch, DirectAndInverseBranchesAreInverse) {

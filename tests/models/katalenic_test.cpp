@@ -12,31 +12,14 @@
 
 #include "core/errors.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/smooth_signal.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 
-std::vector<double> smooth_signal(std::uint64_t seed, double amplitude, double offset, std::size_t n) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> freq(5.0, 40.0), phase(0.0, kTwoPi), weight(0.2, 1.0);
-  double f[4], p[4], a[4], total = 0.0;
-  for (int i = 0; i < 4; ++i) {
-    f[i] = freq(rng);
-    p[i] = phase(rng);
-    a[i] = weight(rng);
-    total += a[i];
-  }
-  std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) / static_cast<double>(n);
-    double v = 0.0;
-    for (int i = 0; i < 4; ++i) v += a[i] * std::sin(kTwoPi * f[i] * t + p[i]);
-    s[k] = offset + amplitude * v / total;
-  }
-  return s;
-}
+using testing::smooth_signal;  // tests/support/smooth_signal.hpp
 
 int reversals(const std::vector<double>& s) {
   int count = 0;

@@ -177,6 +177,33 @@ TEST(MemParams, MessageNamesFieldAndValue) {
   }
 }
 
+// Theorem 4 against the paper's branch (3) itself, not against the map's formula. By hand:
+// y* = 1 um, u* = 50 V, alpha = 1, gamma = 2 make (3) on an ascending branch
+//   y - y_i = 2 y* (p / 2u*) (1 + p / 2u*) = 2e-8 p + 2e-10 p^2  [m, p in V],
+// so its slope is dy/dp = 2e-8 + 4e-10 p: M(p) = c1 + c2 p^c3 with c1 = 2e-8, c2 = 4e-10, c3 = 1
+// (at p = 25 V: 3e-8 m/V; at 150 V: 8e-8 m/V). For gamma = 2.2 the slope of (3) is taken by
+// central differences of (3) as printed, and the rise F(p) is (3) itself.
+TEST(RambergOsgood, Theorem4AgainstTheBranchEquation3) {
+  RambergOsgoodParams ro;
+  ro.y_star = 1e-6, ro.u_star = 50.0, ro.alpha = 1.0, ro.gamma = 2.0;
+  const MemParams m = ro.to_mem();
+  EXPECT_NEAR(m.slope(25.0), 3e-8, 1e-22);
+  EXPECT_NEAR(m.slope(150.0), 8e-8, 1e-22);
+  EXPECT_NEAR(m.branch_rise(100.0), 2e-6 + 2e-6, 1e-20);  // 2e-8 * 100 + 2e-10 * 100^2
+  const RambergOsgoodParams r = test_ro();
+  auto eq3 = [&](double p) {  // (3): (y - y_i) / 2y* = (p / 2u*) (1 + alpha |p / 2u*|^(gamma - 1))
+    const double x = p / (2.0 * r.u_star);
+    return 2.0 * r.y_star * x * (1.0 + r.alpha * std::pow(std::abs(x), r.gamma - 1.0));
+  };
+  const MemParams mr = r.to_mem();
+  for (double p : {3.0, 40.0, 170.0, 480.0}) {
+    const double h = 1e-3 * p;
+    const double slope = (eq3(p + h) - eq3(p - h)) / (2.0 * h);
+    EXPECT_NEAR(mr.slope(p), slope, 1e-7 * slope) << p;  // central difference: O(h^2) ~ 1e-7 relative
+    EXPECT_NEAR(mr.branch_rise(p), eq3(p), 1e-13 * eq3(p)) << p;
+  }
+}
+
 TEST(RambergOsgood, Theorem4ParameterMapAndBack) {
   const RambergOsgoodParams ro = test_ro();
   const MemParams m = ro.to_mem();
@@ -358,42 +385,43 @@ struct Composition {
   std::uint64_t reversals = 0;
 };
 
-// y_d -> MemInverse -> MemModel -> y; both start virgin (reset) at matching points.
+inline double step(MemModel& model, double u) { return model.forward(u); }
+inline double step(MemInverse& inverse, double y) { return inverse.inverse(y); }
+
+// x -> a -> b -> x': both start virgin (reset) at matching points, b at a's output. Records the
+// worst |x' - x| and the largest |x| (reversals are the caller's: it knows which one is the model).
+template <class A, class B, class Signal>
+Composition round_trip(A& a, B& b, Signal&& x_of, std::size_t n) {
+  const double x0 = x_of();
+  a.reset(x0);
+  b.reset(a.output());
+  Composition c;
+  c.worst = std::abs(b.output() - x0);
+  for (std::size_t k = 1; k < n; ++k) {
+    const double x = x_of();
+    c.worst = std::max(c.worst, std::abs(step(b, step(a, x)) - x));
+    c.scale = std::max(c.scale, std::abs(x));
+  }
+  return c;
+}
+
+// y_d -> MemInverse -> MemModel -> y.
 template <class Signal>
 Composition inverse_then_model(const MemParams& p, Signal&& y_d, std::size_t n) {
   MemInverse inv(p);
   MemModel model(p);
-  const double y0 = y_d();
-  inv.reset(y0);
-  model.reset(inv.output());
-  Composition c;
-  c.worst = std::abs(model.output() - y0);
-  for (std::size_t k = 1; k < n; ++k) {
-    const double y = y_d();
-    const double out = model.forward(inv.inverse(y));
-    c.worst = std::max(c.worst, std::abs(out - y));
-    c.scale = std::max(c.scale, std::abs(y));
-  }
+  Composition c = round_trip(inv, model, y_d, n);
   c.reversals = model.reversals();
   EXPECT_EQ(model.reversals(), inv.reversals());
   return c;
 }
 
+// u -> MemModel -> MemInverse -> u.
 template <class Signal>
 Composition model_then_inverse(const MemParams& p, Signal&& u_in, std::size_t n) {
   MemModel model(p);
   MemInverse inv(p);
-  const double u0 = u_in();
-  model.reset(u0);
-  inv.reset(model.output());
-  Composition c;
-  c.worst = std::abs(inv.output() - u0);
-  for (std::size_t k = 1; k < n; ++k) {
-    const double u = u_in();
-    const double back = inv.inverse(model.forward(u));
-    c.worst = std::max(c.worst, std::abs(back - u));
-    c.scale = std::max(c.scale, std::abs(u));
-  }
+  Composition c = round_trip(model, inv, u_in, n);
   c.reversals = model.reversals();
   return c;
 }

@@ -66,6 +66,7 @@ TEST(RecordRing, RefusesABadCapacity) {
   EXPECT_THROW(RecordRing(100), ParameterError);
   try {
     RecordRing ring(10);
+    ADD_FAILURE() << "RecordRing(10) did not throw";
   } catch (const ParameterError& e) {
     EXPECT_EQ(e.field(), "queue_bytes");
   }

@@ -44,8 +44,11 @@ TEST(LoggerSummary, TheJsonSaysTheDiskFaultAndTheUnknownChannels) {
                       "device)\", \"events_lost\": 17"),
             std::string::npos)
       << json;
-  EXPECT_NE(json.find("\"unknown_channels\": {\"messages\": 42, \"distinct\": 42, \"distinct_is_lower_bound\": false, "
-                      "\"first\": [\"HX_J58\""),
+  // 100 names offered; the table keeps kMaxChannels - kRigChannels of them, the rest are unknown.
+  const std::size_t kept = ChannelTable::kMaxChannels - ChannelTable::kRigChannels;
+  const std::string unknown = std::to_string(100 - kept);
+  EXPECT_NE(json.find("\"unknown_channels\": {\"messages\": " + unknown + ", \"distinct\": " + unknown +
+                      ", \"distinct_is_lower_bound\": false, \"first\": [\"HX_J" + std::to_string(kept) + "\""),
             std::string::npos)
       << json;
   const auto lines = summary_lines(s, channels);

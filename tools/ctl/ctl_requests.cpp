@@ -8,19 +8,12 @@
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "lcm/message_checks.hpp"
+#include "loop/compensator.hpp"
 #include "loop/params_admission.hpp"
 
 namespace hystloop::ctl {
 
 namespace {
-
-constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kModes{{
-    {"off", command_block_t::MODE_OFF},
-    {"linear", command_block_t::MODE_LINEAR},
-    {"mem", command_block_t::MODE_MEM},
-    {"pi", command_block_t::MODE_PI},
-    {"katalenic", command_block_t::MODE_KATALENIC},
-}};
 
 constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kShapes{{
     {"hold", trajectory_t::HOLD},
@@ -54,7 +47,10 @@ std::int64_t new_request_id(std::int64_t utime, int pid) noexcept {
   return (utime % 1'000'000'000'000'000) * 1000 + (pid % 1000) + 1;  // > 0, unique per us and pid
 }
 
-std::int8_t parse_mode(std::string_view name) { return lookup(kModes, "mode", name); }
+// The compensator's one table of mode names; FeedforwardMode is numbered as command_block_t::MODE_*.
+std::int8_t parse_mode(std::string_view name) {
+  return static_cast<std::int8_t>(parse_feedforward_mode(std::string(name), "mode"));
+}
 
 control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime) {
   control_t msg{};

@@ -1,10 +1,11 @@
 // hystloop-ctl: operate a running rig over LCM.
 //
-//   hystloop-ctl [--lcm-url URL] [--allow-network] [--rig PREFIX] SUBCOMMAND [options]
+//   hystloop-ctl [--lcm-url URL] [--allow-network] [--rig PREFIX] [--key-file FILE] SUBCOMMAND [options]
 //
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
 //   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd [--target bridge]
+//   pin-model mem|pi|katalenic|linear|auto           the re-identifier's model choice (ctl_pin_model.hpp)
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
@@ -12,6 +13,8 @@
 //              --blend S [--points-csv FILE]   |   trajectory --mem-paper
 //   params --c1 --c2 --c3 [--residual M] [--version N]
 //   watch [--seconds S]
+//   config-get FILE KEY.PATH [--default V]   a YAML value for scripts (ctl_config_get.hpp)
+//   keygen --out FILE [--force]              a new rig key, mode 0600 (README "Authenticated rig")
 //
 // Requests are sent 3 times a few ms apart with the same request id (UDP may drop one;
 // receivers act on an id once). Exit status: 0 done, 1 failed (not healthy in time, LCM
@@ -23,13 +26,19 @@
 
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/cli.hpp"
 #include "core/errors.hpp"
+#include "ctl_config_get.hpp"
 #include "ctl_link.hpp"
+#include "ctl_pin_model.hpp"
 #include "ctl_requests.hpp"
+#include "auth/rig_key.hpp"
+#include "lcm/rig_auth.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -144,6 +153,13 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", o.link.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
   app.add_flag("--allow-network", o.link.allow_network, "Accept an LCM URL whose packets can leave this host");
   app.add_option("--rig", o.link.rig, "Channel prefix of the rig")->capture_default_str();
+  std::string key_file, keygen_out;
+  bool keygen_force = false;
+  app.add_option("--key-file", key_file,
+                 "The rig key (auth.key_file of the services): sign requests, trajectories and parameters with it");
+  CLI::App* keygen = app.add_subcommand("keygen", "Write a new rig key (mode 0600) for auth.key_file (no LCM)");
+  keygen->add_option("--out", keygen_out, "Key file to create")->required();
+  keygen->add_flag("--force", keygen_force, "Replace an existing file (every host of the rig then needs the new key)");
 
   CLI::App* status = app.add_subcommand("status", "Print the latest HX_STATUS of each process, or wait until healthy");
   status->add_option("--wait-healthy", o.status.wait_healthy,
@@ -156,6 +172,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   status->add_flag("--counters", o.status.all_counters, "Also print every named counter");
 
+  ConfigGetOptions config_get_options;
+  CLI::App* config_get = app.add_subcommand("config-get", "Print a YAML file's value: a scalar, a list's elements or a "
+                                                          "map's keys, one per line (no LCM)");
+  config_get->add_option("file", config_get_options.file, "YAML file (e.g. deploy/rig.yaml)")->required();
+  config_get->add_option("key", config_get_options.key, "Dotted key path (e.g. hosts.stage-pc.services)")->required();
+  config_get->add_option("--default", config_get_options.default_value, "Print this when the key is absent");
+
   CLI::App* arm = control_subcommand(app, "arm", "Bridge: leave the safe state and apply commands", o);
   CLI::App* disarm = control_subcommand(app, "disarm", "Bridge: enter the safe state now", o);
   CLI::App* stop_exp = control_subcommand(app, "stop-experiment", "Compensator: stop the identification experiment", o);
@@ -166,6 +189,9 @@ int main(int argc, char** argv) {
 
   CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
   mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
+  std::string pin_model;
+  CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
+  pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
 
   CLI::App* gains = app.add_subcommand("gains", "Bridge: the servo's gains (normalised PID, all >= 0)");
   gains->add_option("--target", o.gains_target, "Process of the servo (the bridge)")->capture_default_str();
@@ -247,16 +273,18 @@ int main(int argc, char** argv) {
   watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
       ->capture_default_str();
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return 2;
-  }
+  if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
 
   try {
+    if (*config_get) return run_config_get(config_get_options);
+    if (*keygen) {
+      write_rig_key(keygen_out, generate_rig_key(), keygen_force);
+      std::printf("wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
+                  "auth.key_file in every service's config\n",
+                  keygen_out.c_str());
+      return 0;
+    }
+    if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
     if (*status) {
       if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
       CtlLink link(o.link);
@@ -267,6 +295,11 @@ int main(int argc, char** argv) {
     if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT");
     if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN");
     if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS");
+    if (*pin) {
+      const std::int8_t m = ctl::pin_model_mode(pin_model);
+      return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, ("PIN_MODEL " + pin_model).c_str(),
+                          [m](control_t& msg) { msg.mode = m; });
+    }
     if (*mode) {
       const std::int8_t m = parse_mode(o.mode);
       return send_control(o, control_t::SET_MODE, o.target, ("SET_MODE " + o.mode).c_str(),

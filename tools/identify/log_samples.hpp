@@ -30,6 +30,7 @@
 
 #include "ident/sample_csv.hpp"
 #include "lcm/message_storage.hpp"
+#include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"
 
 namespace hystloop {
@@ -89,10 +90,11 @@ bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
   if (event.datalen < 8) return false;
   const auto size = static_cast<std::size_t>(event.datalen);
   if (wire_fingerprint(event.data, size) != T::getHash()) return false;
-  if (walk_wire_layout(wire_layout_of<T>(), event.data, size) < 0) return false;
+  const std::int64_t body = lcm_body_size(wire_layout_of<T>(), event.data, size);  // a signed message's trailer ignored
+  if (body < 0) return false;
   clear_arrays(msg);
   try {
-    return msg.decode(event.data, 0, event.datalen) == event.datalen;
+    return msg.decode(event.data, 0, static_cast<int>(body)) == static_cast<int>(body);
   } catch (...) {
     return false;
   }

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "csv_columns.hpp"
 #include "model_registry.hpp"
@@ -175,11 +176,7 @@ int main(int argc, char** argv) {
   app.add_option("--param", args.params, "NAME=VALUE, repeatable; overrides the params file (names below)");
   app.add_option("--params-file", args.params_file, "YAML as hystloop-identify --out writes it (model: {name: value})");
   app.add_option("--out", args.out, "output CSV file (default: standard output)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   if (!args.forward && !args.inverse) return refuse("choose --forward (t,u -> y) or --inverse (t,y_ref -> u)");
   return run(args);
 }

@@ -60,7 +60,7 @@ struct CompareReport {
   bool divergence_after_loss = false;              // first divergence at/after the first lost sample
 
   CompareVerdict verdict() const noexcept;
-  int exit_code() const noexcept;  // 0 equal, 1 diverged, 3 transport loss
+  int exit_code() const noexcept;  // 0 equal, 1 diverged or transport loss (the verdict line tells which)
 };
 
 // `played_samples`: sensor ticks the replay played to the compensator; a tick the replay did

@@ -18,6 +18,7 @@
 #include <set>
 #include <string>
 
+#include "core/cli.hpp"
 #include "command_comparison.hpp"
 #include "core/errors.hpp"
 
@@ -34,7 +35,7 @@ int main(int argc, char** argv) {
   app.add_option("--tolerance-m", tolerance.position_m, "Accept |expected - got| up to this on y_ref_m [m] (0: bitwise)")
       ->capture_default_str();
   app.add_option("--rig", rig, "Channel prefix of the rig")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
   try {
     tolerance.validate();

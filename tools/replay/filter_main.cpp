@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "core/cli.hpp"
 #include "command_alteration.hpp"
 #include "replay_inputs.hpp"
 
@@ -46,7 +47,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->excludes(seq_opt);
   alter->add_option("--delta-V", delta_V, "Add this to u_ff_V [V] (default: flip its least significant bit)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
   try {
     const hystloop::ChannelNames channels(rig);

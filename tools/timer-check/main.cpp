@@ -11,6 +11,7 @@
 #include <exception>
 #include <optional>
 
+#include "core/cli.hpp"
 #include "core/logging.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
   app.add_option("--cpu", opt.cpu, "Pin to this CPU (non-fatal if refused)")->check(CLI::NonNegativeNumber);
   app.add_flag("--lock-memory", opt.lock_memory, "mlockall before running (non-fatal if refused)");
   app.add_flag("--check", opt.check, "Exit 1 unless every deadline is accounted for and the percentiles are ordered");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
   try {
     hystloop::init_logging("timer-check", "info");

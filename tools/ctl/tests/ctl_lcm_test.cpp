@@ -371,7 +371,7 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
       {{"params", "--c1", "1e-7", "--c2", "0", "--c3", "0"}, "c3:"},
       {{"params", "--c1", "1e-7", "--c2", "0"}, "--c3"},
       {{"params", "--c1", "abc", "--c2", "0", "--c3", "1"}, "--c1"},
-      {{"mode", "fast"}, "mode: must be one of off|linear|mem|pi|katalenic"},
+      {{"mode", "fast"}, "mode: unknown mode 'fast' (expected off, linear, mem, pi or katalenic)"},
       {{"gains", "--kp", "-0.1"}, "kp:"},
       {{"experiment", "--amplitude", "0", "--frequency", "1", "--duration", "1"}, "amplitude:"},
       {{"experiment", "--amplitude", "1", "--frequency", "1"}, "--duration"},

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -45,11 +46,12 @@ std::string slurp(const std::string& path) {
 
 class ModelTool : public ::testing::Test {
  protected:
+  // A fresh folder per test from mkdtemp: unique, and one level deep (a parameterised test's name
+  // holds a '/', which made a nested folder whose parent TearDown left behind).
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("hystloop_model_tool_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    std::string tmpl = (std::filesystem::temp_directory_path() / "hystloop_model_tool_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr) << "mkdtemp " << tmpl;
+    dir_ = tmpl;
   }
   void TearDown() override {
     std::error_code ec;

@@ -127,14 +127,14 @@ TEST(CompareCommands, PlayedButUnansweredSamplesAreTransportLosses) {
   EXPECT_EQ(r.lost_in_transport, 2u);
   EXPECT_EQ(r.missing_in_actual, 0u);
   EXPECT_EQ(r.first_lost_sample, 298);
-  EXPECT_EQ(r.exit_code(), 3);
+  EXPECT_EQ(r.exit_code(), 1);  // the verdict (transport loss) tells it from a divergence
   EXPECT_NE(format_report(r, {}).find("replay transport lost 2 commanded ticks"), std::string::npos) << format_report(r, {});
 
   // A divergence after the loss may be its consequence: still a transport verdict.
   a.by_seq[600].u_ff_V += 1.0;
   auto r2 = compare_commands(e, a, &played, {});
   EXPECT_TRUE(r2.divergence_after_loss);
-  EXPECT_EQ(r2.exit_code(), 3);
+  EXPECT_EQ(r2.exit_code(), 1);
   // One before it is the control law's.
   a.by_seq[100].u_ff_V += 1.0;
   r2 = compare_commands(e, a, &played, {});
@@ -399,7 +399,7 @@ TEST(ReplayInputs, TheRecordedCommandsCompareTickByTick) {
   const auto r = compare_commands(e, a, &played, {});
   EXPECT_EQ(r.lost_in_transport, 20u);
   EXPECT_EQ(r.first_lost_sample, 69);
-  EXPECT_EQ(r.exit_code(), 3);
+  EXPECT_EQ(r.exit_code(), 1);
 }
 
 TEST(ReplayInputs, ALogWithoutCommandsOrFileIsRefused) {

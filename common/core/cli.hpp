@@ -1,0 +1,39 @@
+#pragma once
+// The exit-code contract of every hystloop program, for its command line:
+//   0  ok (also --help / --help-all / --version: printed, nothing run)
+//   1  runtime failure
+//   2  usage error or refused input
+// CLI11's own codes (105 for a failed check, 106 for an extra argument, ...) and its
+// CLI11_PARSE macro are not used: parse_cli maps every parse error to 2, with the message on
+// stderr as "<program>: <message>". Use:
+//   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
+// Tested for every program by tests/integration/exit_codes.sh.
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace hystloop {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+
+// nullopt: parsed, go on; otherwise the code to exit with.
+inline std::optional<int> parse_cli(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const std::string program = std::filesystem::path(argc > 0 ? argv[0] : app.get_name()).filename().string();
+    std::fprintf(stderr, "%s: %s\nRun with --help for more information.\n", program.c_str(), e.what());
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+}  // namespace hystloop

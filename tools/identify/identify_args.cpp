@@ -1,0 +1,124 @@
+#include "identify_args.hpp"
+
+#include "log_samples.hpp"
+
+namespace hystloop {
+
+std::optional<ModelChoice> parse_model_choice(const std::string& name) {
+  ModelChoice c;
+  c.name = name;
+  if (name == "auto") return c;
+  if (name == "banning") {
+    c.mode = ModelChoice::Mode::banning;
+    return c;
+  }
+  const std::optional<ModelKind> kind = parse_model_kind(name);
+  if (!kind) return std::nullopt;
+  c.mode = ModelChoice::Mode::single;
+  c.kind = *kind;
+  return c;
+}
+
+void add_identify_options(CLI::App& app, IdentifyArgs& args) {
+  app.add_option("files", args.files,
+                 "CSV file(s) (for banning one per experiment, or one with an 'experiment' column), or LCM log file(s)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--model", args.model, "mem, banning, katalenic, pi, linear, or auto (fit all, rank on held-out data)")
+      ->check([](const std::string& v) { return parse_model_choice(v) ? std::string() : "unknown model '" + v + "'"; })
+      ->capture_default_str();
+  app.add_option("--form", args.form, "MEM data form: integrated branches or the paper's derivative")
+      ->check(CLI::IsMember({"integrated", "derivative"}))
+      ->capture_default_str();
+  app.add_option("--out", args.out, "write the YAML config snippet to this file");
+  app.add_option("--noise-rms-m", args.noise_rms_m, "sensor noise RMS [m]; 0 = estimate from the data")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--min-snr", args.min_snr, "MEM derivative form: keep points with at least this SNR")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--operators", args.operators, "PI: number of play operators")->check(CLI::Range(1, 32))->capture_default_str();
+  app.add_option("--katalenic-degree", args.katalenic_degree, "Katalenic: output shaping polynomial degree (1 = linear)")
+      ->check(CLI::Range(1, 7))
+      ->capture_default_str();
+  auto* logs = app.add_option_group("LCM logs", "reading HX_SENSOR from LCM event logs");
+  logs->add_flag("--log", args.log, "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
+  logs->add_option("--rig", args.rig, "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>PARAMS")
+      ->capture_default_str();
+  logs->add_option("--dt", args.dt_s, "tick period [s]: t = (seq - first seq) * dt")->capture_default_str();
+  logs->add_option("--time-from", args.time_from, "time base: seq (* --dt) or utime (the samples' timestamps)")
+      ->check(CLI::IsMember({"seq", "utime"}))
+      ->capture_default_str();
+  logs->add_option("--from", args.from_s, "fit only samples at t >= this [s after the record's first sample]");
+  logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
+  logs->add_option("--experiment", args.experiment,
+                   "fit only this experiment the loop ran (numbered from 0 as listed; e.g. the one hystloop-ctl "
+                   "experiment --mem-paper ran)");
+  logs->add_option("--compensator", args.compensator,
+                   "banning: process name of the compensator whose HX_CONTROL experiment requests count")
+      ->capture_default_str();
+  logs->add_option("--max-late", args.max_late,
+                   "banning: skip a frequency-response experiment if more than this fraction of its samples were "
+                   "not applied as commanded (late, saturated, slew-limited); hysteresis loops keep them")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  logs->add_option("--max-missing", args.max_missing,
+                   "banning: skip a hysteresis-loop experiment if more than this fraction of its ticks has no sample "
+                   "(a frequency-response experiment may miss none)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  auto* pub = app.add_option_group("publishing", "sending the fitted MEM set to a running compensator");
+  pub->add_flag("--publish", args.publish,
+                "after a successful MEM fit, publish mem_params_t on <rig>PARAMS (3 times, 10 ms apart)");
+  pub->add_option("--version", args.version,
+                  "parameter set version (default: 1 + the highest heard on <rig>PARAMS / <rig>COMMAND, at least 2)");
+  pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
+  pub->add_option("--lcm-url", args.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
+  pub->add_flag("--allow-network", args.allow_network, "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
+  pub->add_option("--key-file", args.key_file, "the rig key (auth.key_file of the services): sign the published set");
+  auto* bounds = app.add_option_group("bounds", "memory and progress of long fits");
+  bounds->add_option("--max-samples", args.max_samples,
+                     "refuse more samples than this (after --decimate): the fit holds its problem in memory, "
+                     "~150 (mem) to ~300 (auto) bytes per sample")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bounds->add_option("--decimate", args.decimate, "keep every K-th sample (rate-independent models lose little)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bounds->add_flag("--progress", args.progress,
+                   "print the running stage and its elapsed time to stderr every 2 s (default: when stderr is a "
+                   "terminal)");
+  bounds->add_option("--progress-period-s", args.progress_period_s, "period of the progress lines [s]")
+      ->check(CLI::Range(0.001, 3600.0))
+      ->capture_default_str();
+}
+
+std::optional<std::string> check_identify_args(IdentifyArgs& args) {
+  const std::optional<ModelChoice> choice = parse_model_choice(args.model);
+  if (!choice) return "--model " + args.model + ": unknown";
+  args.choice = *choice;
+  std::size_t log_names = 0;
+  for (const auto& f : args.files) log_names += looks_like_lcm_log(f) ? 1 : 0;
+  args.from_logs = args.log || log_names == args.files.size();
+  const bool range = args.from_s || args.to_s;
+  const bool banning = args.choice.mode == ModelChoice::Mode::banning;
+  if (!args.from_logs && log_names > 0) return "mixed inputs: give either CSV files or LCM logs (*.lcmlog)";
+  if (!args.from_logs && range) return "--from/--to select a range of an LCM log";
+  if (!args.from_logs && args.experiment) return "--experiment selects an experiment of an LCM log";
+  const bool mem = args.choice.mode == ModelChoice::Mode::single && args.choice.kind == ModelKind::mem;
+  if (args.publish && !mem) {
+    return "--publish sends MEM parameters (mem_params_t on HX_PARAMS): only with --model mem (got --model " +
+           args.model + ")";
+  }
+  if (args.experiment && range) return "--experiment selects its own samples: not with --from/--to";
+  if (args.from_logs && banning && range) {
+    return "--from/--to do not apply to --model banning on logs: the experiments are found by their requests "
+           "(HX_CONTROL) and commands";
+  }
+  if (!banning && !args.from_logs && args.files.size() != 1) {
+    return "--model " + args.model + " takes one file (got " + std::to_string(args.files.size()) + ")";
+  }
+  return std::nullopt;
+}
+
+}  // namespace hystloop

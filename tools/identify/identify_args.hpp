@@ -1,0 +1,70 @@
+#pragma once
+// hystloop-identify's command line: the options (add_identify_options), and every check of
+// their combination in one place (check_identify_args), made before any file is read.
+
+#include <CLI/CLI.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "models/model_set.hpp"
+#include "sample_budget.hpp"
+
+namespace hystloop {
+
+// What --model asks for: one model of the set (ModelKind), the Banning recipe (several
+// experiments, not a ModelKind), or every model of the set ranked on held-out data.
+struct ModelChoice {
+  enum class Mode { single, banning, automatic };
+  Mode mode = Mode::automatic;
+  ModelKind kind = ModelKind::mem;  // when mode == single
+  std::string name = "auto";        // as given
+};
+// "mem", "pi", "katalenic", "linear" (parse_model_kind), "banning" or "auto"; nullopt otherwise.
+std::optional<ModelChoice> parse_model_choice(const std::string& name);
+
+struct IdentifyArgs {
+  std::vector<std::string> files;
+  std::string model = "auto";
+  ModelChoice choice{};  // from `model`, by check_identify_args
+  std::string form = "integrated";
+  std::string out;
+  double noise_rms_m = 0.0;
+  double min_snr = 3.0;
+  std::size_t operators = 15;
+  int katalenic_degree = 1;
+  // LCM logs
+  bool log = false;
+  bool from_logs = false;  // by check_identify_args: --log, or every file named *.lcmlog
+  std::string rig = "HX_";
+  double dt_s = 1e-4;
+  std::string time_from = "seq";
+  std::optional<double> from_s, to_s;
+  std::string compensator = "compensator";
+  std::optional<std::size_t> experiment;
+  double max_late = 0.02;
+  double max_missing = 0.01;
+  // --publish
+  bool publish = false;
+  std::optional<std::int32_t> version;
+  double listen_s = 0.5;
+  std::string lcm_url;
+  bool allow_network = false;
+  std::string key_file;  // the rig key: sign the set (README "Authenticated rig")
+  // bounds
+  std::size_t max_samples = kDefaultMaxSamples;
+  std::size_t decimate = 1;
+  bool progress = false;
+  double progress_period_s = 2.0;
+};
+
+void add_identify_options(CLI::App& app, IdentifyArgs& args);
+
+// The combinations CLI11 cannot check (mixed inputs, log-only options on a CSV, --publish
+// without MEM, ...). Fills args.choice and args.from_logs; returns the reason for a usage error.
+std::optional<std::string> check_identify_args(IdentifyArgs& args);
+
+}  // namespace hystloop

@@ -1,0 +1,399 @@
+// hystloop-identify's work once its options are checked (identify_args.hpp): read the inputs
+// (CSV or LCM logs), fit the chosen model, print and emit the YAML snippet, publish a MEM set.
+#include "identify_run.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/cli.hpp"
+#include "core/clock.hpp"
+#include "core/errors.hpp"
+#include "fit_progress.hpp"
+#include "ident/banning_fit.hpp"
+#include "ident/fit_checks.hpp"
+#include "ident/model_selection.hpp"
+#include "ident/params_yaml.hpp"
+#include "ident/sample_csv.hpp"
+#include "lcm/message_checks.hpp"
+#include "lcm/rig_auth.hpp"
+#include "log_experiments.hpp"
+#include "log_samples.hpp"
+#include "params_publish.hpp"
+#include "sample_budget.hpp"
+
+namespace hystloop {
+namespace {
+
+// ident has no LCM: its sanity bounds are its own constants, kept equal to the contract's here.
+static_assert(kFitMaxAbsVoltage_V == kMaxAbsVoltage_V && kFitMaxAbsPosition_m == kMaxAbsPosition_m,
+              "ident/fit_checks.hpp and lcm/message_checks.hpp disagree on the sanity bounds");
+
+// Set by run_identify: reports the stage in progress on stderr (silent unless wanted).
+FitProgress* g_progress = nullptr;
+
+// Reports `label` as running until the scope ends.
+class ProgressStage {
+ public:
+  explicit ProgressStage(std::string label) {
+    if (g_progress != nullptr) g_progress->stage(std::move(label));
+  }
+  ~ProgressStage() {
+    if (g_progress != nullptr) g_progress->done();
+  }
+  ProgressStage(const ProgressStage&) = delete;
+  ProgressStage& operator=(const ProgressStage&) = delete;
+};
+
+std::string on_samples(const std::string& what, std::size_t n) { return what + " on " + std::to_string(n) + " samples"; }
+
+int refuse(FitStatus status, const std::string& reason) {
+  std::cerr << "hystloop-identify: no fit (" << to_string(status) << "): " << reason << "\n";
+  return 1;
+}
+
+int emit(const IdentifyArgs& args, const std::string& yaml) {
+  std::cout << "--- YAML\n" << yaml;
+  if (!args.out.empty()) {
+    std::ofstream f(args.out);
+    f << "# written by hystloop-identify\n" << yaml;
+    if (!f) {
+      std::cerr << "hystloop-identify: cannot write " << args.out << "\n";
+      return 2;
+    }
+    std::cout << "written to " << args.out << "\n";
+  }
+  return 0;
+}
+
+int publish_fit(ParamsLink& link, const IdentifyArgs& args, const MemFitResult& r, double window_s) {
+  std::int32_t version = 0;
+  if (args.version) {
+    version = *args.version;
+  } else {
+    const std::int32_t heard = link.highest_version_heard();
+    version = next_params_version(heard);
+    if (heard > 0) {
+      std::printf("version in use on %s: %d\n", link.channels().prefix.c_str(), heard);
+    } else {
+      std::printf("no parameter version heard on %s/%s in %.2g s\n", link.channels().params.c_str(),
+                  link.channels().command.c_str(), args.listen_s);
+    }
+  }
+  const mem_params_t msg = to_mem_params(r, window_s, version, wall_utime(), identify_source());
+  const int sent = link.publish(msg);
+  if (sent == 0) {
+    std::cerr << "hystloop-identify: the parameters were not published (refused by the mem_params_t contract check "
+                 "or by LCM)\n";
+    return kExitFailure;
+  }
+  std::printf("published MEM parameters v%d on %s (%d time(s)) via %s, source '%s'\n", version,
+              link.channels().params.c_str(), sent, link.url().c_str(), msg.source.c_str());
+  return 0;
+}
+
+int fit_mem_and_emit(const IdentifyArgs& args, const SampleTable& s, ParamsLink* link) {
+  MemFitOptions o;
+  o.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
+  o.noise_rms_m = args.noise_rms_m;
+  o.min_snr = args.min_snr;
+  MemFitResult r;
+  {
+    const ProgressStage stage(on_samples("fitting mem", s.u.size()));
+    r = fit_mem(s.u, s.y, o);
+  }
+  if (!r.ok()) {
+    if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
+    return refuse(r.status, r.reason);
+  }
+  std::printf("MEM (%s form): c1 = %.6g m/V, c2 = %.6g m/V^(1+c3), c3 = %.6g\n", args.form.c_str(), r.params.c1,
+              r.params.c2, r.params.c3);
+  std::printf("fit: residual %.4g nm RMS, noise %.4g nm, %zu samples, %zu branches, %.1f ms\n", r.residual_rms_m * 1e9,
+              r.noise_rms_m * 1e9, r.samples_used, r.branches_used, r.solve_time_s * 1e3);
+  const int written = emit(args, to_yaml(r.params));
+  if (written != 0 || link == nullptr) return written;
+  const double window_s = s.t.size() < 2 ? 0.0 : s.t.back() - s.t.front();
+  return publish_fit(*link, args, r, window_s);
+}
+
+int fit_pi_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+  PiFitOptions o;
+  o.operators = args.operators;
+  PiFitResult r;
+  {
+    const ProgressStage stage(on_samples("fitting pi", s.u.size()));
+    r = fit_pi(s.u, s.y, o);
+  }
+  if (!r.ok()) return refuse(r.status, r.reason);
+  std::printf("Prandtl-Ishlinskii: %zu plays, offset %.6g m\n", r.weights.size(), r.offset_m);
+  for (std::size_t i = 0; i < r.weights.size(); ++i) std::printf("  r = %8.3f V  w = %.6g m/V\n", r.thresholds_V[i], r.weights[i]);
+  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used, r.solve_time_s * 1e3);
+  try {
+    return emit(args, to_yaml(to_pi_params(r)));
+  } catch (const ParameterError& e) {
+    return refuse(FitStatus::out_of_range, e.what());
+  }
+}
+
+int fit_katalenic_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+  KatalenicFitOptions o;
+  o.output_polynomial_degree = args.katalenic_degree;
+  KatalenicFitResult r;
+  {
+    const ProgressStage stage(on_samples("fitting katalenic", s.u.size()));
+    r = fit_katalenic(s.u, s.y, o);
+  }
+  if (!r.ok()) return refuse(r.status, r.reason);
+  std::printf("Katalenic: k1 = %.6g V, k2 = %.6g 1/V, output gain %.6g m/V\n", r.params.k1, r.params.k2,
+              r.params.output_shaping.gain);
+  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used, r.solve_time_s * 1e3);
+  return emit(args, to_yaml(r.params));
+}
+
+int fit_linear_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+  const LinearFitResult r = fit_linear(s.u, s.y);
+  if (!r.ok()) return refuse(r.status, r.reason);
+  std::printf("linear: gain = %.6g m/V, offset = %.6g m\n", r.gain_m_per_V, r.offset_m);
+  std::printf("fit: residual %.4g nm RMS, %zu samples\n", r.residual_rms_m * 1e9, r.samples_used);
+  return emit(args, to_yaml(to_linear_params(r)));
+}
+
+int fit_single(const IdentifyArgs& args, ModelKind kind, const SampleTable& s, ParamsLink* link) {
+  switch (kind) {
+    case ModelKind::mem: return fit_mem_and_emit(args, s, link);
+    case ModelKind::pi: return fit_pi_and_emit(args, s);
+    case ModelKind::katalenic: return fit_katalenic_and_emit(args, s);
+    case ModelKind::linear: return fit_linear_and_emit(args, s);
+  }
+  return kExitFailure;
+}
+
+// Every model of the set fitted and ranked on held-out data; the best one emitted.
+int fit_auto_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+  ModelSelectionOptions o;
+  o.mem.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
+  o.mem.noise_rms_m = args.noise_rms_m;
+  o.pi.operators = args.operators;
+  o.katalenic.output_polynomial_degree = args.katalenic_degree;
+  ModelSelection sel;
+  {
+    const ProgressStage stage(on_samples("fitting and ranking every model (auto)", s.u.size()));
+    sel = select_model(s.u, s.y, o);
+  }
+  std::printf("rank  model       status           train [nm]  held-out [nm]  fit [ms]\n");
+  for (std::size_t i = 0; i < sel.ranking.size(); ++i) {
+    const auto& r = sel.ranking[i];
+    std::printf("%4zu  %-10s  %-15s  %10.4g  %13.4g  %8.1f%s%s\n", i + 1, std::string(to_string(r.kind)).c_str(),
+                std::string(to_string(r.status)).c_str(), r.train_rms_m * 1e9, r.holdout_rms_m * 1e9, r.fit_time_s * 1e3,
+                r.reason.empty() ? "" : "  ", r.reason.c_str());
+  }
+  if (!sel.ok()) return refuse(sel.status, sel.reason);
+  std::printf("held out from sample %zu of %zu; best: %s\n", sel.split_index, s.u.size(),
+              std::string(to_string(sel.ranking.front().kind)).c_str());
+  try {
+    switch (sel.ranking.front().kind) {
+      case ModelKind::mem: return emit(args, to_yaml(sel.mem.params));
+      case ModelKind::pi: return emit(args, to_yaml(to_pi_params(sel.pi)));
+      case ModelKind::katalenic: return emit(args, to_yaml(sel.katalenic.params));
+      case ModelKind::linear: return emit(args, to_yaml(to_linear_params(sel.linear)));
+    }
+  } catch (const ParameterError& e) {
+    return refuse(FitStatus::out_of_range, e.what());
+  }
+  return 1;
+}
+
+int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExperimentData>& data);
+
+int fit_banning_files(const IdentifyArgs& args, const std::vector<SampleTable>& tables) {
+  std::vector<SampleTable> groups;
+  for (const auto& t : tables) {
+    for (auto& g : split_experiments(t)) groups.push_back(std::move(g));
+  }
+  std::vector<BanningExperimentData> data;
+  for (const auto& g : groups) {
+    const double fs = sample_rate_Hz(g.t);
+    if (!(fs > 0.0)) return refuse(FitStatus::size_mismatch, "an experiment's t does not increase: no sample rate");
+    data.push_back({g.u, g.y, fs});
+  }
+  return fit_banning_and_emit(args, data);
+}
+
+int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExperimentData>& data) {
+  BanningFitResult r;
+  {
+    const ProgressStage stage("fitting banning on " + std::to_string(data.size()) + " experiments");
+    r = fit_banning(data);
+  }
+  std::printf("experiment  offset [V]  amplitude [V]  frequency [Hz]  kind       feature\n");
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    const auto& p = r.points[i];
+    if (!p.used) {
+      std::printf("%10zu  skipped: %s\n", i, p.note.c_str());
+    } else if (p.magnitude_experiment) {
+      std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V, p.frequency_Hz, p.magnitude);
+    } else {
+      std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V\n", i,
+                  p.offset_V, p.amplitude_V, p.frequency_Hz, p.features.y_centre * 1e9, p.features.slope * 1e9,
+                  p.features.area * 1e9);
+    }
+  }
+  if (!r.ok()) return refuse(r.status, r.reason);
+  std::printf("Banning: a = %.6g m/V, b = %.6g m/V, alpha = %.6g 1/V\n", r.hysteresis.a, r.hysteresis.b, r.hysteresis.alpha);
+  if (r.stage_identified) {
+    std::printf("         k = %.6g 1/s^2, c = %.6g 1/s (f_n = %.1f Hz, zeta = %.4f)\n", r.stage.k, r.stage.c,
+                r.stage.natural_frequency() / (2.0 * 3.141592653589793), r.stage.damping_ratio());
+  } else {
+    std::printf("         stage not identified: %s\n", r.reason.c_str());
+  }
+  std::printf("fit: centre line %.4g nm RMS, slopes %.3g %% RMS, areas %.3g %% RMS, magnitudes %.3g %% RMS, %.1f ms\n",
+              r.centre_rms_m * 1e9, r.slope_rel_rms * 100.0, r.area_rel_rms * 100.0, r.magnitude_rel_rms * 100.0,
+              r.solve_time_s * 1e3);
+  return emit(args, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
+}
+
+LoggedExperiments read_experiments(const IdentifyArgs& args) {
+  ExperimentLogOptions o;
+  o.control_channel = channel_name(args.rig, kControlSuffix);
+  o.command_channel = channel_name(args.rig, kCommandSuffix);
+  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.compensator_process = args.compensator;
+  o.dt_s = args.dt_s;
+  o.max_not_as_commanded = args.max_late;
+  o.max_missing = args.max_missing;
+  o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
+  LoggedExperiments logged = read_logged_experiments(args.files, o);
+  std::cout << describe(logged);
+  return logged;
+}
+
+struct SampleBudgetError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
+// SampleLogError / SampleBudgetError.
+std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
+  const ProgressStage stage("reading " + std::to_string(args.files.size()) + " file(s)");
+  std::vector<SampleTable> tables;
+  if (!logs) {
+    // Counted first: an oversized CSV is refused before it takes memory.
+    std::size_t rows = 0;
+    for (const auto& f : args.files) rows += count_csv_rows(f);
+    if (auto why = over_sample_budget((rows + args.decimate - 1) / args.decimate, args.max_samples, args.decimate)) {
+      throw SampleBudgetError(*why);
+    }
+    for (const auto& f : args.files) tables.push_back(read_sample_csv(f));
+    return tables;
+  }
+  LogReadOptions o;
+  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.time_base = args.time_from == "utime" ? LogTimeBase::utime : LogTimeBase::seq;
+  o.dt_s = args.dt_s;
+  o.from_s = args.from_s;
+  o.to_s = args.to_s;
+  if (args.experiment) {
+    // One experiment the loop ran (e.g. hystloop-ctl experiment --mem-paper), as listed.
+    LoggedExperiments logged = read_experiments(args);
+    if (*args.experiment >= logged.experiments.size()) {
+      throw SampleLogError("--experiment " + std::to_string(*args.experiment) + ": the log holds " +
+                           std::to_string(logged.experiments.size()) + " experiment(s), numbered from 0");
+    }
+    LoggedExperiment& e = logged.experiments[*args.experiment];
+    // Late commands and skipped ticks do not spoil a rate-independent fit; these do.
+    std::string why;
+    if (!e.complete) why = e.problem;
+    if (e.safe_state > 0) why = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
+    if (e.sensor_fault > 0) why = std::to_string(e.sensor_fault) + " sample(s) flagged SENSOR_FAULT";
+    if (!why.empty()) throw SampleLogError("--experiment " + std::to_string(*args.experiment) + " cannot be used: " + why);
+    std::cout << "fitting experiment " << *args.experiment << ": " << e.samples.t.size()
+              << " samples (for this rate-independent fit, late commands and skipped ticks do no harm)\n";
+    tables.push_back(std::move(e.samples));
+    return tables;
+  }
+  LogSamples samples = read_sample_logs(args.files, o);
+  std::cout << describe(samples, o);
+  tables.push_back(std::move(samples.table));
+  return tables;
+}
+
+// --model banning on logs: the experiments the live loop ran (hystloop-ctl experiment
+// --banning-series), one table per measured experiment that can be used.
+int fit_banning_logs(const IdentifyArgs& args) {
+  const LoggedExperiments logged = read_experiments(args);
+  std::vector<BanningExperimentData> data;
+  for (const auto& e : logged.experiments) {
+    // The requested frequency is known: no need to estimate it from a u with held samples.
+    if (!e.spec.settle && e.usable()) data.push_back({e.samples.u, e.samples.y, 1.0 / args.dt_s, e.spec.frequency_hz});
+  }
+  if (data.empty()) {
+    return refuse(FitStatus::too_few_samples, "no usable measured experiment in the log (see the list above)");
+  }
+  return fit_banning_and_emit(args, data);
+}
+
+int usage_error(const std::string& message) {
+  std::cerr << "hystloop-identify: " << message << "\n";
+  return kExitUsage;
+}
+
+int fit_inputs(const IdentifyArgs& args) {
+  std::unique_ptr<ParamsLink> link;
+  if (args.publish) {
+    if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));
+    PublishOptions p;
+    p.lcm_url = args.lcm_url;
+    p.allow_network = args.allow_network;
+    p.rig = args.rig;
+    p.version = args.version;
+    p.listen_s = args.listen_s;
+    link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
+  } else {
+    validate_rig_prefix(args.rig);
+  }
+  if (args.from_logs && args.choice.mode == ModelChoice::Mode::banning) return fit_banning_logs(args);
+  std::vector<SampleTable> tables = read_inputs(args, args.from_logs);
+  std::size_t samples = 0;
+  for (auto& t : tables) {
+    decimate(t, args.decimate);
+    samples += t.u.size();
+  }
+  if (auto why = over_sample_budget(samples, args.max_samples, args.decimate)) return usage_error(*why);
+  switch (args.choice.mode) {
+    case ModelChoice::Mode::banning: return fit_banning_files(args, tables);
+    case ModelChoice::Mode::automatic: return fit_auto_and_emit(args, tables.front());
+    case ModelChoice::Mode::single: return fit_single(args, args.choice.kind, tables.front(), link.get());
+  }
+  return kExitFailure;
+}
+
+}  // namespace
+
+int run_identify(const IdentifyArgs& args) {
+  FitProgress progress(progress_wanted(args.progress) ? stderr : nullptr,
+                       std::chrono::milliseconds(static_cast<long>(args.progress_period_s * 1e3)));
+  g_progress = &progress;
+  struct Reset {
+    ~Reset() { g_progress = nullptr; }
+  } reset;
+  try {
+    return fit_inputs(args);
+  } catch (const CsvError& e) {
+    return usage_error(e.what());
+  } catch (const SampleLogError& e) {
+    return usage_error(e.what());
+  } catch (const SampleBudgetError& e) {
+    return usage_error(e.what());
+  } catch (const ParameterError& e) {
+    return usage_error(e.what());
+  } catch (const std::runtime_error& e) {  // LCM could not start
+    return usage_error(e.what());
+  }
+}
+
+}  // namespace hystloop
