@@ -81,7 +81,8 @@ void BM_Verify(benchmark::State& state) {
   MessageSigner signer(bench_key());
   const std::int64_t start = wall_utime();
   for (std::size_t i = 0; i < kBatch; ++i) {
-    signer.sign("HX_COMMAND", bytes.data(), body, start + static_cast<std::int64_t>(i), &trailers[i * kAuthTrailerBytes]);
+    signer.sign("HX_COMMAND", bytes.data(), body, start + static_cast<std::int64_t>(i),
+                &trailers[i * kAuthTrailerBytes]);
   }
   auto verifier = std::make_unique<MessageVerifier>(bench_key(), 3'600'000'000);
   std::size_t i = 0;

@@ -31,8 +31,8 @@ std::vector<double> input_signal() {
 
 void BM_BanningStageStep(benchmark::State& state) {
   hystloop::BanningStageParams p;
-  p.order = state.range(0) == 0 ? hystloop::BanningOrder::kHysteresisThenStage
-                                : hystloop::BanningOrder::kStageThenHysteresis;
+  p.order =
+      state.range(0) == 0 ? hystloop::BanningOrder::kHysteresisThenStage : hystloop::BanningOrder::kStageThenHysteresis;
   hystloop::BanningStage stage(p);
   const std::vector<double> u = input_signal();
   SampleTimer timer;

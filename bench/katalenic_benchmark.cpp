@@ -32,7 +32,8 @@ const char* shaping_name(int shaping) { return shaping == 0 ? "linear" : (shapin
 
 std::vector<double> sine(double amplitude, double offset) {
   std::vector<double> s(1000);  // 10 Hz at 10 kHz
-  for (std::size_t k = 0; k < s.size(); ++k) s[k] = offset + amplitude * std::sin(6.283185307179586 * static_cast<double>(k) / 1000.0);
+  for (std::size_t k = 0; k < s.size(); ++k)
+    s[k] = offset + amplitude * std::sin(6.283185307179586 * static_cast<double>(k) / 1000.0);
   return s;
 }
 

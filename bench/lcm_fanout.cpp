@@ -40,8 +40,8 @@ namespace {
 
 using hystloop::monotonic_now_ns;
 
-constexpr std::size_t kMaxChannelLength = 63;           // LCM's limit on a channel name
-constexpr std::int64_t kMaxWaitNs = 100'000'000;        // the wait loop wakes at least every 100 ms
+constexpr std::size_t kMaxChannelLength = 63;     // LCM's limit on a channel name
+constexpr std::int64_t kMaxWaitNs = 100'000'000;  // the wait loop wakes at least every 100 ms
 
 struct Options {
   std::string url;  // empty: $LCM_DEFAULT_URL, else hystloop's default (ttl=0)
@@ -65,8 +65,8 @@ double seconds_since(std::int64_t start_ns) noexcept {
 void check_channel(const std::string& channel) {
   if (channel.empty()) throw hystloop::ParameterError("channel", "must not be empty");
   if (channel.size() > kMaxChannelLength) {
-    throw hystloop::ParameterError("channel", "LCM allows at most 63 characters (got " +
-                                                  std::to_string(channel.size()) + ")");
+    throw hystloop::ParameterError("channel",
+                                   "LCM allows at most 63 characters (got " + std::to_string(channel.size()) + ")");
   }
 }
 
@@ -89,8 +89,8 @@ int publish(const Options& opt, std::int64_t start_ns) {
     }
     ++published;
   }
-  std::printf("{\"published\": %" PRIu64 ", \"skipped\": %" PRIu64 ", \"cpu_s\": %.6f, \"wall_s\": %.6f}\n",
-              published, timer.skipped_total(), cpu_seconds(), seconds_since(start_ns));
+  std::printf("{\"published\": %" PRIu64 ", \"skipped\": %" PRIu64 ", \"cpu_s\": %.6f, \"wall_s\": %.6f}\n", published,
+              timer.skipped_total(), cpu_seconds(), seconds_since(start_ns));
   return 0;
 }
 
@@ -139,8 +139,8 @@ int listen(const Options& opt, std::int64_t start_ns) {
       wait_idle(hystloop::stop_fd(), wait_ns);
     }
   }
-  std::printf("{\"received\": %" PRIu64 ", \"cpu_s\": %.6f, \"wall_s\": %.6f}\n", counter.received(),
-              cpu_seconds(), seconds_since(start_ns));
+  std::printf("{\"received\": %" PRIu64 ", \"cpu_s\": %.6f, \"wall_s\": %.6f}\n", counter.received(), cpu_seconds(),
+              seconds_since(start_ns));
   return 0;
 }
 
@@ -159,17 +159,21 @@ void add_common(CLI::App& cmd, Options& opt, bool channel_required) {
 int main(int argc, char** argv) {
   const std::int64_t start_ns = monotonic_now_ns();
   Options opt;
-  CLI::App app{"Measures the CPU a process spends on LCM multicast traffic: publish raw payloads, or listen and count."};
+  CLI::App app{
+      "Measures the CPU a process spends on LCM multicast traffic: publish raw payloads, or listen and count."};
   app.require_subcommand(1);
 
   CLI::App* pub = app.add_subcommand("publish", "Publish raw payloads of --bytes at --rate on a fixed deadline grid");
   add_common(*pub, opt, true);
-  pub->add_option("--rate", opt.rate_hz, "Messages per second [Hz]")->check(CLI::Range(0.1, 1e6))->capture_default_str();
+  pub->add_option("--rate", opt.rate_hz, "Messages per second [Hz]")
+      ->check(CLI::Range(0.1, 1e6))
+      ->capture_default_str();
   pub->add_option("--bytes", opt.bytes, "Payload size [bytes]")->check(CLI::Range(1, 1'000'000))->capture_default_str();
 
   CLI::App* sub = app.add_subcommand("listen", "Subscribe to --channel and count the messages dispatched to it");
   add_common(*sub, opt, false);
-  auto* idle = sub->add_flag("--idle", opt.idle, "Open no LCM at all: the same wait loop on a file descriptor that stays quiet (baseline)");
+  auto* idle = sub->add_flag("--idle", opt.idle,
+                             "Open no LCM at all: the same wait loop on a file descriptor that stays quiet (baseline)");
   sub->get_option("--channel")->excludes(idle);
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 

@@ -18,7 +18,8 @@ namespace {
 std::vector<double> cosine(double amplitude, double frequency_hz) {
   const auto n = static_cast<std::size_t>(std::lround(1e4 / frequency_hz));  // one period at 10 kHz
   std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) s[k] = -amplitude * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
+  for (std::size_t k = 0; k < n; ++k)
+    s[k] = -amplitude * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
   return s;
 }
 

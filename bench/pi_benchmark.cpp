@@ -18,7 +18,8 @@ namespace {
 std::vector<double> cosine(double amplitude, double frequency_hz) {
   const auto n = static_cast<std::size_t>(std::lround(1e4 / frequency_hz));
   std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) s[k] = -amplitude * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
+  for (std::size_t k = 0; k < n; ++k)
+    s[k] = -amplitude * std::cos(2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
   return s;
 }
 
@@ -41,7 +42,8 @@ void BM_Pi15Inverse(benchmark::State& state) {
 BENCHMARK(BM_Pi15Inverse)->Arg(1)->Arg(50);
 
 void BM_Pi32ForwardUntimed(benchmark::State& state) {
-  hystloop::PiModel model(hystloop::pi_params_from_mem(hystloop::MemParams::paper_like(), hystloop::kPiMaxOperators, 250.0));
+  hystloop::PiModel model(
+      hystloop::pi_params_from_mem(hystloop::MemParams::paper_like(), hystloop::kPiMaxOperators, 250.0));
   const auto u = cosine(250.0, 1.0);
   std::size_t i = 0;
   for (auto _ : state) {

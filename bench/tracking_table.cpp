@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   using namespace hystloop;
   if (argc > 1) {
     const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
-    std::printf("usage: tracking_table [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and docs/TRACKING.md.\n");
+    std::printf(
+        "usage: tracking_table [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and docs/TRACKING.md.\n");
     return help ? 0 : 2;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -76,8 +77,9 @@ int main(int argc, char** argv) {
                       {"MEM", FeedforwardMode::kMem, false, false, "27.9 nm"},
                       {"MEM, wrong parameters (c1 × 0.6, c2 × 1.8)", FeedforwardMode::kMem, false, true, "—"},
                       {"MEM, wrong + online re-identification", FeedforwardMode::kMem, true, true, "—"}};
-  std::printf("| feedforward | simulation: feedforward only (true / measured) | simulation: + PI feedback (true / measured) "
-              "| MEM paper, real actuator, feedforward only |\n| --- | --- | --- | --- |\n");
+  std::printf(
+      "| feedforward | simulation: feedforward only (true / measured) | simulation: + PI feedback (true / measured) "
+      "| MEM paper, real actuator, feedforward only |\n| --- | --- | --- | --- |\n");
   for (const Row& r : rows) {
     const MemParams& start = r.wrong_start ? wrong : id.mem;
     const TrackingStats ff = run_tracking(experiment, id, r.mode, false, r.reid, start).stats;
@@ -86,8 +88,9 @@ int main(int argc, char** argv) {
                 fb.rms_true_m * 1e9, fb.rms_measured_m * 1e9, r.paper);
     std::fflush(stdout);
   }
-  std::printf("\n| from MEM's wrong start | ff only | ff + re-identification | model at the end | servo | servo + "
-              "re-identification |\n| --- | --- | --- | --- | --- | --- |\n");
+  std::printf(
+      "\n| from MEM's wrong start | ff only | ff + re-identification | model at the end | servo | servo + "
+      "re-identification |\n| --- | --- | --- | --- | --- | --- |\n");
   TrackingExperiment twelve = experiment;
   twelve.track_s = 12.0;
   twelve.settle_s = 8.0;

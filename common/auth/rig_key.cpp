@@ -90,7 +90,8 @@ void write_rig_key(const std::filesystem::path& path, const RigKey& key, bool ov
   flags |= overwrite ? O_TRUNC : O_EXCL;
   const int fd = ::open(path.c_str(), flags, 0600);
   if (fd < 0) {
-    if (errno == EEXIST) refuse(field, path, "exists; pass --force to replace the rig's key (every host then needs the new one)");
+    if (errno == EEXIST)
+      refuse(field, path, "exists; pass --force to replace the rig's key (every host then needs the new one)");
     refuse(field, path, std::strerror(errno));
   }
   // An overwritten file keeps its mode: make it 0600 before the key goes in.

@@ -62,9 +62,8 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& source, co
 
 // Walks `parts` from `node`; nullopt when a key is absent (or its parent is an
 // empty section). Recursion, because assigning a YAML::Node would rewrite the tree.
-std::optional<YAML::Node> find_node(const Config& cfg, const YAML::Node& node,
-                                    const std::vector<std::string>& parts, std::size_t i,
-                                    std::string& walked) {
+std::optional<YAML::Node> find_node(const Config& cfg, const YAML::Node& node, const std::vector<std::string>& parts,
+                                    std::size_t i, std::string& walked) {
   if (i == parts.size()) return node;
   if (node.IsNull()) return std::nullopt;
   if (!node.IsMap()) cfg.fail(walked, "expected a map, got " + describe(node));
@@ -74,14 +73,13 @@ std::optional<YAML::Node> find_node(const Config& cfg, const YAML::Node& node,
   return find_node(cfg, child, parts, i + 1, walked);
 }
 
-void set_node(YAML::Node node, const std::vector<std::string>& parts,
-              std::size_t i, const YAML::Node& value, std::string& walked) {
+void set_node(YAML::Node node, const std::vector<std::string>& parts, std::size_t i, const YAML::Node& value,
+              std::string& walked) {
   if (!node.IsMap()) {
     if (!node.IsDefined() || node.IsNull()) {
       node = YAML::Node(YAML::NodeType::Map);  // assigns into the tree: creates the section
     } else {
-      throw ConfigError(kOverrideSource, walked,
-                        "cannot set a key inside it: it is " + describe(node) + ", not a map");
+      throw ConfigError(kOverrideSource, walked, "cannot set a key inside it: it is " + describe(node) + ", not a map");
     }
   }
   walked += walked.empty() ? parts[i] : "." + parts[i];
@@ -126,8 +124,7 @@ T convert_value(const Config& cfg, const YAML::Node& node, const std::string& fi
     T out;
     out.reserve(node.size());
     for (std::size_t i = 0; i < node.size(); ++i) {
-      out.push_back(convert_scalar<typename T::value_type>(cfg, node[i],
-                                                            field + "[" + std::to_string(i) + "]"));
+      out.push_back(convert_scalar<typename T::value_type>(cfg, node[i], field + "[" + std::to_string(i) + "]"));
     }
     return out;
   } else {
@@ -152,8 +149,7 @@ ConfigError::ConfigError(std::string source, std::string field, const std::strin
 
 const std::string& Config::Impl::source_for(std::string_view path) const {
   for (const auto& key : overridden) {
-    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key &&
-                        path[key.size()] == '.')) {
+    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key && path[key.size()] == '.')) {
       return kOverrideSource;
     }
   }
@@ -190,9 +186,9 @@ Config Config::from_string(std::string_view yaml_text, std::string source_name) 
   try {
     root = YAML::Load(std::string(yaml_text));
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(cfg.impl_->source, "",
-                      "line " + std::to_string(e.mark.line + 1) + ", column " +
-                          std::to_string(e.mark.column + 1) + ": " + e.msg);
+    throw ConfigError(
+        cfg.impl_->source, "",
+        "line " + std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   if (root.IsNull() || !root.IsDefined()) return cfg;  // empty file: empty map
   refuse_duplicate_keys(root, cfg.impl_->source, "");
@@ -283,12 +279,11 @@ double Config::get_non_negative(std::string_view path, double default_value) con
   return v;
 }
 
-std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t default_value,
-                                      std::int64_t lo, std::int64_t hi) const {
+std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t default_value, std::int64_t lo,
+                                      std::int64_t hi) const {
   const auto v = get<std::int64_t>(path, default_value);
   if (v < lo || v > hi) {
-    fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " +
-                   std::to_string(v) + ")");
+    fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
   }
   return v;
 }
@@ -296,8 +291,7 @@ std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t defaul
 void Config::apply_override(std::string_view assignment) {
   const std::size_t eq = assignment.find('=');
   if (eq == std::string_view::npos || eq == 0) {
-    throw ConfigError(kOverrideSource, "",
-                      "expected key=value, got '" + std::string(assignment) + "'");
+    throw ConfigError(kOverrideSource, "", "expected key=value, got '" + std::string(assignment) + "'");
   }
   const std::string key(assignment.substr(0, eq));
   const std::string text(assignment.substr(eq + 1));
@@ -327,7 +321,7 @@ std::string Config::dump() const {
   return out.c_str();
 }
 
-#define HYSTLOOP_CONFIG_INSTANTIATE(T)                                \
+#define HYSTLOOP_CONFIG_INSTANTIATE(T)                         \
   template T Config::get<T>(std::string_view, const T&) const; \
   template T Config::get<T>(std::string_view) const;
 HYSTLOOP_CONFIG_INSTANTIATE(bool)

@@ -48,13 +48,12 @@ class ConfigError : public ParameterError {
 // The value types get<T>() reads.
 template <class T>
 concept ConfigValue =
-    std::same_as<T, bool> || std::same_as<T, int> || std::same_as<T, std::int64_t> ||
-    std::same_as<T, double> || std::same_as<T, std::string> ||
-    std::same_as<T, std::vector<double>> || std::same_as<T, std::vector<std::string>>;
+    std::same_as<T, bool> || std::same_as<T, int> || std::same_as<T, std::int64_t> || std::same_as<T, double> ||
+    std::same_as<T, std::string> || std::same_as<T, std::vector<double>> || std::same_as<T, std::vector<std::string>>;
 
 class Config {
  public:
-  Config();  // empty tree, source "<empty>"
+  Config();                     // empty tree, source "<empty>"
   Config(const Config& other);  // deep copy: overriding a copy leaves the original alone
   Config& operator=(const Config& other);
   Config(Config&&) noexcept;
@@ -110,7 +109,7 @@ class Config {
   std::unique_ptr<Impl> impl_;
 };
 
-#define HYSTLOOP_CONFIG_EXTERN(T)                                            \
+#define HYSTLOOP_CONFIG_EXTERN(T)                                     \
   extern template T Config::get<T>(std::string_view, const T&) const; \
   extern template T Config::get<T>(std::string_view) const;
 HYSTLOOP_CONFIG_EXTERN(bool)

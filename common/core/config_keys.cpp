@@ -20,8 +20,7 @@ void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vect
 }
 
 bool starts_with_section(std::string_view key, std::string_view section) {
-  return key.size() > section.size() && key.substr(0, section.size()) == section &&
-         key[section.size()] == '.';
+  return key.size() > section.size() && key.substr(0, section.size()) == section && key[section.size()] == '.';
 }
 
 bool is_known(std::string_view key, const std::vector<std::string>& known) {
@@ -112,8 +111,8 @@ void Config::check_no_unknown_keys(const std::vector<std::string>& known) const 
     hints += near + "'";
     if (unknown.size() > 1) hints += " for '" + key + "'";
   }
-  const std::string reason = (unknown.size() == 1 ? "unknown key" : "unknown keys") +
-                             (hints.empty() ? std::string() : hints + "?");
+  const std::string reason =
+      (unknown.size() == 1 ? "unknown key" : "unknown keys") + (hints.empty() ? std::string() : hints + "?");
   throw ConfigError(impl_->source_for(unknown.front()), field, reason);
 }
 

@@ -36,9 +36,7 @@ void require_non_negative(std::string_view field, double value) {
 void require_in_range(std::string_view field, double value, double lo, double hi) {
   require_finite(field, value);
   if (value < lo || value > hi) {
-    throw ParameterError(std::string(field), "must be in [" + num(lo) + ", " +
-                                                 num(hi) + "] (got " +
-                                                 num(value) + ")");
+    throw ParameterError(std::string(field), "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(value) + ")");
   }
 }
 

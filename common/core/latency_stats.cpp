@@ -79,8 +79,7 @@ double LatencyStats::percentile(double q) const {
   require_in_range("q", q, 0.0, 1.0);
   if (count_ == 0) return 0.0;
   if (q <= 0.0) return static_cast<double>(min_);
-  const auto rank = std::max<std::uint64_t>(
-      1, static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(count_))));
+  const auto rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(count_))));
   if (rank >= count_) return static_cast<double>(max_);
   std::uint64_t seen = 0;
   for (std::size_t i = 0; i < kBucketCount; ++i) {

@@ -18,8 +18,8 @@ namespace hystloop {
 
 class LatencyStats {
  public:
-  static constexpr int kSubBucketBits = 7;                     // 128 sub-buckets per octave
-  static constexpr int kMaxValueBits = 34;                     // values < 2^34 ns are binned exactly
+  static constexpr int kSubBucketBits = 7;  // 128 sub-buckets per octave
+  static constexpr int kMaxValueBits = 34;  // values < 2^34 ns are binned exactly
   static constexpr std::int64_t kMaxTrackableNs = (std::int64_t{1} << kMaxValueBits) - 1;
   static constexpr std::size_t kBucketCount =
       (std::size_t{1} << kSubBucketBits) * static_cast<std::size_t>(kMaxValueBits - kSubBucketBits + 1);

@@ -27,9 +27,8 @@ spdlog::level::level_enum parse_log_level(std::string_view text);
 // Creates the process logger (replacing one of the same name), makes it the
 // default, sets the level, and flushes at warn and above. Throws ParameterError
 // ("log_level" or "log_file") for a bad level or a file that cannot be opened.
-std::shared_ptr<spdlog::logger> init_logging(
-    std::string_view process_name, std::string_view level = "info",
-    const std::optional<std::filesystem::path>& log_file = std::nullopt);
+std::shared_ptr<spdlog::logger> init_logging(std::string_view process_name, std::string_view level = "info",
+                                             const std::optional<std::filesystem::path>& log_file = std::nullopt);
 
 // Flushes every logger (at the end of main, and before a deliberate abort).
 // Loggers stay usable afterwards.

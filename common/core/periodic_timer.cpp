@@ -70,8 +70,7 @@ void DeadlineSchedule::reanchor(std::int64_t next_deadline_ns) noexcept {
   first_ns_ = next_deadline_ns - static_cast<std::int64_t>(next_tick_) * period_ns_;
 }
 
-PeriodicTimer::PeriodicTimer(std::int64_t period_ns)
-    : PeriodicTimer(period_ns, monotonic_now_ns() + period_ns) {}
+PeriodicTimer::PeriodicTimer(std::int64_t period_ns) : PeriodicTimer(period_ns, monotonic_now_ns() + period_ns) {}
 
 PeriodicTimer::PeriodicTimer(std::int64_t period_ns, std::int64_t first_deadline_ns)
     : schedule_(first_deadline_ns, period_ns) {}
@@ -89,8 +88,6 @@ TickInfo PeriodicTimer::wait_next() noexcept {
   return info;
 }
 
-void PeriodicTimer::restart() noexcept {
-  schedule_.reanchor(monotonic_now_ns() + schedule_.period_ns());
-}
+void PeriodicTimer::restart() noexcept { schedule_.reanchor(monotonic_now_ns() + schedule_.period_ns()); }
 
 }  // namespace hystloop

@@ -56,9 +56,7 @@ SetupStatus refused(const std::string& what, int err) {
   return s;
 }
 
-double seconds(const timeval& tv) {
-  return static_cast<double>(tv.tv_sec) + 1e-6 * static_cast<double>(tv.tv_usec);
-}
+double seconds(const timeval& tv) { return static_cast<double>(tv.tv_sec) + 1e-6 * static_cast<double>(tv.tv_usec); }
 
 }  // namespace
 

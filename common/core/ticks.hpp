@@ -11,10 +11,10 @@ namespace hystloop {
 struct SensorTick {
   std::int64_t utime = 0;  // [us]
   std::int64_t seq = 0;
-  double u_V = 0.0;        // applied, after the clamp
-  double u_ff_V = 0.0;     // feedforward part
-  double u_fb_V = 0.0;     // servo part
-  double y_ref_m = 0.0;    // NaN = no reference
+  double u_V = 0.0;      // applied, after the clamp
+  double u_ff_V = 0.0;   // feedforward part
+  double u_fb_V = 0.0;   // servo part
+  double y_ref_m = 0.0;  // NaN = no reference
   double y_m = 0.0;
   std::int32_t flags = 0;
 };

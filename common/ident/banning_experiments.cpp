@@ -78,12 +78,12 @@ std::vector<BanningExperiment> plan_banning_experiments(const BanningPlanOptions
     return std::max<double>(o.settle_periods, std::ceil(o.settle_path_V / (4.0 * amplitude) - 1e-9));
   };
   for (double off : o.offsets_V) {
-    plan.push_back(sine_experiment(BanningExperimentKind::offset, off, o.offset_amplitude_V, fh,
-                                   o.settle_frequency_Hz, sp_for(o.offset_amplitude_V), mp, fs));
+    plan.push_back(sine_experiment(BanningExperimentKind::offset, off, o.offset_amplitude_V, fh, o.settle_frequency_Hz,
+                                   sp_for(o.offset_amplitude_V), mp, fs));
   }
   for (double a : o.small_amplitudes_V) {
-    plan.push_back(sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a),
-                                   mp, fs));
+    plan.push_back(
+        sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a), mp, fs));
   }
   for (double a : o.amplitudes_V) {
     plan.push_back(

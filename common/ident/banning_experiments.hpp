@@ -40,7 +40,7 @@ struct BanningPlanOptions {
   std::vector<double> frequencies_Hz{20.0,   100.0,  300.0,  600.0,  900.0,  1200.0, 1400.0, 1550.0,
                                      1650.0, 1700.0, 1750.0, 1800.0, 1900.0, 2100.0, 2400.0, 2800.0};
   double frequency_amplitude_V = 2.0;
-  double frequency_settle_s = 0.03;   // the stage decays as e^{-c t / 2}: 30 ms is e^{-30}
+  double frequency_settle_s = 0.03;  // the stage decays as e^{-c t / 2}: 30 ms is e^{-30}
   double frequency_measure_s = 0.1;
 
   void validate() const;  // throws ParameterError naming the field
@@ -50,7 +50,7 @@ struct BanningExperiment {
   BanningExperimentKind kind = BanningExperimentKind::offset;
   double offset_V = 0.0;
   double amplitude_V = 0.0;
-  double frequency_Hz = 0.0;      // of the measured part
+  double frequency_Hz = 0.0;  // of the measured part
   double sample_rate_Hz = 1e4;
   std::vector<double> u;          // the whole input [V], settling included
   std::size_t measure_begin = 0;  // first sample of the stationary, measured part

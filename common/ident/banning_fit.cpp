@@ -80,8 +80,8 @@ SineEstimate estimate_sine(std::span<const double> u, double fs, bool refine_fre
     return e;
   }
   std::uintmax_t iterations = 60;
-  const auto best = boost::math::tools::brent_find_minima(
-      [&](double f) { return sine_fit(u, f, fs).rss; }, f0 * (1.0 - 2e-3), f0 * (1.0 + 2e-3), 40, iterations);
+  const auto best = boost::math::tools::brent_find_minima([&](double f) { return sine_fit(u, f, fs).rss; },
+                                                          f0 * (1.0 - 2e-3), f0 * (1.0 + 2e-3), 40, iterations);
   const SineFit fit = sine_fit(u, best.first, fs);
   e.frequency_Hz = best.first;
   e.offset = fit.offset;
@@ -90,9 +90,7 @@ SineEstimate estimate_sine(std::span<const double> u, double fs, bool refine_fre
   return e;
 }
 
-double first_harmonic_amplitude(std::span<const double> y, double f, double fs) {
-  return sine_fit(y, f, fs).amplitude;
-}
+double first_harmonic_amplitude(std::span<const double> y, double f, double fs) { return sine_fit(y, f, fs).amplitude; }
 
 double stage_magnitude_model(double k, double c, double omega, double T) noexcept {
   if (!(T > 0.0)) return k / std::hypot(k - omega * omega, c * omega);
@@ -167,7 +165,9 @@ double ch_slope_closed(double a, double b, double alpha, double amp) {
 
 // Inverts (25) for h (paper order): ptp = 2 a h A + 2 (b - a)/alpha tanh(alpha A h), increasing in h.
 double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp) {
-  auto f = [&](double h) { return 2.0 * p.a * h * amp + 2.0 * (p.b - p.a) / p.alpha * std::tanh(p.alpha * amp * h) - ptp; };
+  auto f = [&](double h) {
+    return 2.0 * p.a * h * amp + 2.0 * (p.b - p.a) / p.alpha * std::tanh(p.alpha * amp * h) - ptp;
+  };
   double lo = 0.0, hi = 1.0;
   while (f(hi) < 0.0 && hi < 1e6) hi *= 2.0;
   for (int i = 0; i < 100; ++i) {
@@ -258,8 +258,9 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
     if (p->amplitude_V <= o.small_amplitude_max_V) b0 += p->features.slope, ++n;
   }
   if (n == 0) {  // no small loop: the smallest one
-    b0 = (*std::min_element(loops.begin(), loops.end(), [](auto* l, auto* r) { return l->amplitude_V < r->amplitude_V; }))
-             ->features.slope;
+    b0 = (*std::min_element(loops.begin(), loops.end(), [](auto* l, auto* r) {
+           return l->amplitude_V < r->amplitude_V;
+         }))->features.slope;
     n = 1;
   }
   b0 /= static_cast<double>(n);
@@ -352,10 +353,10 @@ FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFi
   double kc[2] = {std::log(wp * wp), std::log(peak_h > 1.2 ? wp / peak_h : wp)};
   ceres::Problem problem;
   for (const auto* p : mags) {
-    problem.AddResidualBlock(new ceres::NumericDiffCostFunction<MagnitudeResidual, ceres::CENTRAL, 1, 2>(
-                                 new MagnitudeResidual{2.0 * std::numbers::pi * p->frequency_Hz, p->magnitude,
-                                                       o.zoh_magnitude ? 1.0 / sample_rate_Hz : 0.0}),
-                             nullptr, kc);
+    problem.AddResidualBlock(
+        new ceres::NumericDiffCostFunction<MagnitudeResidual, ceres::CENTRAL, 1, 2>(new MagnitudeResidual{
+            2.0 * std::numbers::pi * p->frequency_Hz, p->magnitude, o.zoh_magnitude ? 1.0 / sample_rate_Hz : 0.0}),
+        nullptr, kc);
   }
   ceres::Solver::Options so = solver_options();
   detail::CeresTimeBudget budget(clock, o.max_solver_time_s);

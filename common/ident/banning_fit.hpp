@@ -36,14 +36,14 @@ struct BanningExperimentData {
 };
 
 struct BanningFitOptions {
-  double frequency_threshold_Hz = 10.0;  // slower: hysteresis loop experiment; faster: magnitude
-  double small_amplitude_max_V = 5.0;    // slopes up to here seed b; areas are used above it
-  double min_offset_span_V = 1.0;        // the centres must span this much to give a
+  double frequency_threshold_Hz = 10.0;                     // slower: hysteresis loop experiment; faster: magnitude
+  double small_amplitude_max_V = 5.0;                       // slopes up to here seed b; areas are used above it
+  double min_offset_span_V = 1.0;                           // the centres must span this much to give a
   BanningOrder order = BanningOrder::kHysteresisThenStage;  // how (27) is inverted
   bool zoh_magnitude = true;
   LoopFeatureOptions loop{};
-  double max_solver_time_s = 1.0;        // per Ceres solve, read from `clock`
-  FitClock clock{};                      // empty = monotonic; fixed_fit_clock() for a reproducible fit
+  double max_solver_time_s = 1.0;  // per Ceres solve, read from `clock`
+  FitClock clock{};                // empty = monotonic; fixed_fit_clock() for a reproducible fit
 
   void validate() const;  // throws ParameterError naming the field
 };
@@ -54,9 +54,9 @@ struct BanningPoint {
   double frequency_Hz = 0.0;
   bool magnitude_experiment = false;
   bool used = false;
-  std::string note;          // why an experiment was skipped
-  LoopFeatures features{};   // loop experiments
-  double magnitude = 0.0;    // h(w) [-], magnitude experiments
+  std::string note;         // why an experiment was skipped
+  LoopFeatures features{};  // loop experiments
+  double magnitude = 0.0;   // h(w) [-], magnitude experiments
 };
 
 struct BanningFitResult {
@@ -66,10 +66,10 @@ struct BanningFitResult {
   FitStatus status = FitStatus::solver_failure;
   std::string reason;
   std::vector<BanningPoint> points;
-  double centre_rms_m = 0.0;      // of the centre line fit
-  double slope_rel_rms = 0.0;     // (21) against the measured slopes
-  double area_rel_rms = 0.0;      // (24) against the measured areas
-  double magnitude_rel_rms = 0.0; // magnitude model against h(w)
+  double centre_rms_m = 0.0;       // of the centre line fit
+  double slope_rel_rms = 0.0;      // (21) against the measured slopes
+  double area_rel_rms = 0.0;       // (24) against the measured areas
+  double magnitude_rel_rms = 0.0;  // magnitude model against h(w)
   double solve_time_s = 0.0;
   bool ok() const noexcept { return status == FitStatus::ok; }
 };

@@ -14,14 +14,20 @@ std::vector<std::size_t> find_reversals(std::span<const double> u, double dead_b
   for (std::size_t k = 1; k < u.size(); ++k) {
     const double x = u[k];
     if (direction == 0) {
-      if (x - u[extremum] > band) direction = +1, extremum = k;
-      else if (u[extremum] - x > band) direction = -1, extremum = k;
+      if (x - u[extremum] > band)
+        direction = +1, extremum = k;
+      else if (u[extremum] - x > band)
+        direction = -1, extremum = k;
     } else if (direction > 0) {
-      if (x > u[extremum]) extremum = k;
-      else if (u[extremum] - x > band) reversals.push_back(extremum), direction = -1, extremum = k;
+      if (x > u[extremum])
+        extremum = k;
+      else if (u[extremum] - x > band)
+        reversals.push_back(extremum), direction = -1, extremum = k;
     } else {
-      if (x < u[extremum]) extremum = k;
-      else if (x - u[extremum] > band) reversals.push_back(extremum), direction = +1, extremum = k;
+      if (x < u[extremum])
+        extremum = k;
+      else if (x - u[extremum] > band)
+        reversals.push_back(extremum), direction = +1, extremum = k;
     }
   }
   return reversals;

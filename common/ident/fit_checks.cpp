@@ -56,9 +56,9 @@ FitCheck check_fit_input(std::span<const double> u, std::span<const double> y, d
 FitCheck check_after_second_reversal(std::span<const double> u, std::size_t min_samples, std::size_t* begin) {
   const std::vector<std::size_t> rev = find_reversals(u);
   if (rev.size() < 2) {
-    return refused(FitStatus::too_few_branches,
-                   std::to_string(rev.size()) + " reversals of u: need 2 (before the second the operators carry "
-                                                "their unknown initial state)");
+    return refused(FitStatus::too_few_branches, std::to_string(rev.size()) +
+                                                    " reversals of u: need 2 (before the second the operators carry "
+                                                    "their unknown initial state)");
   }
   const std::size_t scored = u.size() - rev[1];
   if (scored < min_samples) {

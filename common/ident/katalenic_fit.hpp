@@ -21,9 +21,9 @@ struct KatalenicFitOptions {
   int output_polynomial_degree = 1;  // 1: linear shaping; 2..7: polynomial psi_out(z)
   double min_input_range_V = 1e-3;
   std::size_t min_samples = 50;
-  double max_solver_time_s = 2.0;   // Ceres' budget, read from `clock`
+  double max_solver_time_s = 2.0;  // Ceres' budget, read from `clock`
   int max_solver_iterations = 50;
-  FitClock clock{};                  // empty = monotonic; fixed_fit_clock() for a reproducible fit
+  FitClock clock{};       // empty = monotonic; fixed_fit_clock() for a reproducible fit
   void validate() const;  // throws ParameterError naming the field
 };
 

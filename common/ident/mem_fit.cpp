@@ -54,14 +54,14 @@ double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m, 
 
 namespace {
 
-using detail::IntegratedData;
 using detail::DerivativeData;
+using detail::IntegratedData;
 using detail::LinearPart;
 using detail::ScaledMem;
 
 struct Scales {
-  double u = 1.0;  // U [V]: largest p
-  double y = 1.0;  // Y [m]: half the output range
+  double u = 1.0;       // U [V]: largest p
+  double y = 1.0;       // Y [m]: half the output range
   double y_span = 0.0;  // [m] output range on the branches
 };
 
@@ -130,8 +130,8 @@ double search_c3(const Data& coarse, const Data& data, const MemFitOptions& o) {
   const double lo = grid[best == 0 ? 0 : best - 1];
   const double hi = grid[std::min(best + 1, grid.size() - 1)];
   std::uintmax_t iterations = 100;
-  const auto r = boost::math::tools::brent_find_minima(
-      [&](double c3) { return data.project(c3).residual_ss; }, lo, hi, o.brent_bits, iterations);
+  const auto r = boost::math::tools::brent_find_minima([&](double c3) { return data.project(c3).residual_ss; }, lo, hi,
+                                                       o.brent_bits, iterations);
   return r.first;
 }
 
@@ -175,9 +175,12 @@ MemParams unscale(const ScaledMem& m, const Scales& sc) {
 // The physical range, with a sentence for the refusal ("" when fine).
 std::string range_problem(const MemParams& p, const MemFitOptions& o) {
   std::ostringstream s;
-  if (!(p.c1 > 0.0)) s << "c1 = " << p.c1 << " m/V: must be > 0 (the stage does not move with u)";
-  else if (p.c2 < 0.0) s << "c2 = " << p.c2 << ": must be >= 0 (the loop bends the wrong way for MEM)";
-  else if (!(p.c3 > 0.0) || p.c3 > o.c3_max) s << "c3 = " << p.c3 << ": must be in (0, " << o.c3_max << "]";
+  if (!(p.c1 > 0.0))
+    s << "c1 = " << p.c1 << " m/V: must be > 0 (the stage does not move with u)";
+  else if (p.c2 < 0.0)
+    s << "c2 = " << p.c2 << ": must be >= 0 (the loop bends the wrong way for MEM)";
+  else if (!(p.c3 > 0.0) || p.c3 > o.c3_max)
+    s << "c3 = " << p.c3 << ": must be in (0, " << o.c3_max << "]";
   else if (p.c2 > 0.0 && (p.c3 >= o.c3_max * (1.0 - 1e-6) || p.c3 <= o.c3_min * (1.0 + 1e-6)))
     s << "c3 = " << p.c3 << " sits on the search bound [" << o.c3_min << ", " << o.c3_max
       << "]: the data do not determine it";
@@ -285,8 +288,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     // SNR of z = dy/du: |du| * slope / (sqrt(2) sigma_y); the slope is the loop's mean slope.
     const double slope = (ymax - ymin) / (umax - umin);
     const double min_du = slope > 0.0 ? o.min_snr * std::sqrt(2.0) * result.noise_rms_m / slope : 0.0;
-    DerivativeData data =
-        build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag));
+    DerivativeData data = build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag));
     data.c1_floor_fraction = o.min_c1_fraction;
     result.samples_used = data.z.size();
     if (result.samples_used < o.min_samples) {
@@ -295,8 +297,8 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
         << "; |du| must be >= " << min_du << " V per " << o.derivative_lag << " samples)";
       return timer.finish(result, FitStatus::too_few_samples, s.str());
     }
-    DerivativeData coarse = build_derivative(u, y, branches, sc, min_du,
-                                             static_cast<std::size_t>(o.derivative_lag), kGridStride);
+    DerivativeData coarse =
+        build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag), kGridStride);
     coarse.c1_floor_fraction = o.min_c1_fraction;
     result = solve(coarse, data, sc, o, std::move(result));
   }

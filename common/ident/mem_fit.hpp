@@ -31,17 +31,17 @@ enum class RobustLoss { none, huber, cauchy };
 
 struct MemFitOptions {
   MemFitForm form = MemFitForm::integrated;
-  double c3_min = 0.05;              // search interval of the nonlinear parameter
-  double c3_max = 5.0;               // also the physical upper limit: an optimum at it is refused
-  int c3_grid_points = 12;           // coarse log grid that brackets the global minimum
-  int brent_bits = 30;               // Brent precision in bits on the bracket
-  double min_snr = 3.0;              // derivative form: keep points with SNR >= this
-  int derivative_lag = 1;            // derivative form: difference over this many samples
-  double noise_rms_m = 0.0;          // sensor noise; 0 = estimate from the data (third difference)
+  double c3_min = 0.05;      // search interval of the nonlinear parameter
+  double c3_max = 5.0;       // also the physical upper limit: an optimum at it is refused
+  int c3_grid_points = 12;   // coarse log grid that brackets the global minimum
+  int brent_bits = 30;       // Brent precision in bits on the bracket
+  double min_snr = 3.0;      // derivative form: keep points with SNR >= this
+  int derivative_lag = 1;    // derivative form: difference over this many samples
+  double noise_rms_m = 0.0;  // sensor noise; 0 = estimate from the data (third difference)
   double reversal_dead_band_V = 0.0;
-  std::size_t min_branches = 2;      // complete branches after the first reversal
-  std::size_t min_samples = 50;      // usable samples (points, in the derivative form)
-  double min_input_range_V = 1e-3;   // below this u is "constant"
+  std::size_t min_branches = 2;     // complete branches after the first reversal
+  std::size_t min_samples = 50;     // usable samples (points, in the derivative form)
+  double min_input_range_V = 1e-3;  // below this u is "constant"
   // c1 (the slope right after a reversal) >= this x the data's mean slope. A MEM element
   // fitted to a stage whose slope saturates (Coleman-Hodgdon) otherwise drifts to c1 -> 0,
   // c3 -> 0, and its inverse would jump the voltage at every reversal. 0 = only c1 >= 0.
@@ -49,9 +49,9 @@ struct MemFitOptions {
   RobustLoss robust_loss = RobustLoss::huber;
   double robust_scale_sigmas = 1.345;  // loss scale in robust sigmas of the projected residual
   bool refine_with_ceres = true;
-  double max_solver_time_s = 0.05;   // refinement budget, read from `clock` between rounds
+  double max_solver_time_s = 0.05;  // refinement budget, read from `clock` between rounds
   int max_solver_iterations = 50;
-  FitClock clock{};                  // empty = monotonic; fixed_fit_clock() for a reproducible fit
+  FitClock clock{};  // empty = monotonic; fixed_fit_clock() for a reproducible fit
 
   // Throws ParameterError naming the field.
   void validate() const;
@@ -64,12 +64,12 @@ struct MemFitResult {
   std::size_t branches_used = 0;
   FitStatus status = FitStatus::solver_failure;
   std::string reason;
-  double solve_time_s = 0.0;     // time of the whole fit by options.clock (instrumentation only)
+  double solve_time_s = 0.0;  // time of the whole fit by options.clock (instrumentation only)
   // The best MEM element lies on the domain's edge (c1 at its floor, or c2 = 0): the data are
   // not exactly MEM-shaped. The parameters are usable; expect a larger model error.
   bool constrained = false;
-  double noise_rms_m = 0.0;      // noise level used (given or estimated)
-  double projected_c3 = 0.0;     // c3 from the variable-projection search, before Ceres
+  double noise_rms_m = 0.0;   // noise level used (given or estimated)
+  double projected_c3 = 0.0;  // c3 from the variable-projection search, before Ceres
   bool ok() const noexcept { return status == FitStatus::ok; }
 };
 
@@ -79,7 +79,7 @@ MemFitResult fit_mem(std::span<const double> u_V, std::span<const double> y_m, c
 
 // RMS [m] of y - (y_b + s_b * params.branch_rise(|u - u_b|)) over the given branches, with y_b the least-squares
 // offset of each branch: how well the parameters explain the branch shapes.
-double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m,
-                      std::span<const BranchSegment> branches, const MemParams& params);
+double mem_branch_rms(std::span<const double> u_V, std::span<const double> y_m, std::span<const BranchSegment> branches,
+                      const MemParams& params);
 
 }  // namespace hystloop

@@ -31,7 +31,7 @@ LinearPart constrained_pair(double saa, double sab, double sbb, double say, doub
 
 // Integrated branch form: y~_k = o_b + s_k (c1~ p~_k + c2~ p~_k^(c3+1)/(c3+1)).
 struct IntegratedData {
-  std::vector<double> p, log_p, s, y;  // scaled, branch after branch
+  std::vector<double> p, log_p, s, y;    // scaled, branch after branch
   std::vector<std::size_t> group_begin;  // branch b is [group_begin[b], group_begin[b+1])
   // Sums that do not depend on c3 (per branch and centred).
   std::vector<double> sum_a, sum_y;

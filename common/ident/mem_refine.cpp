@@ -138,12 +138,14 @@ RefineOutcome irls(const Data& data, std::size_t n, const ScaledMem& start, cons
     const auto summary = solver.Solve(cost, &x);
     ++out.ceres_solves;
     if (!x.allFinite()) {
-      out.message = "non-finite parameters (TinySolver status " + std::to_string(static_cast<int>(summary.status)) + ")";
+      out.message =
+          "non-finite parameters (TinySolver status " + std::to_string(static_cast<int>(summary.status)) + ")";
       return out;
     }
     theta[0] = x[0], theta[1] = x[1], theta[2] = x[2];
     double change = 0.0;
-    for (int i = 0; i < 3; ++i) change = std::max(change, std::abs(theta[i] - before[i]) / std::max(std::abs(before[i]), 1e-12));
+    for (int i = 0; i < 3; ++i)
+      change = std::max(change, std::abs(theta[i] - before[i]) / std::max(std::abs(before[i]), 1e-12));
     if (change < 1e-9) break;
     // The time bound is checked between reweighting rounds (a round is a few ms).
     if (timer.elapsed_s() > o.max_solver_time_s) break;

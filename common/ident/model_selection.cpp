@@ -101,7 +101,8 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
         break;
       case ModelKind::linear:
         sel.linear = fit_linear(ut, yt, o.mem.min_input_range_V);
-        score.status = sel.linear.status, score.reason = sel.linear.reason, score.train_rms_m = sel.linear.residual_rms_m;
+        score.status = sel.linear.status, score.reason = sel.linear.reason,
+        score.train_rms_m = sel.linear.residual_rms_m;
         if (sel.linear.ok()) {
           pred.resize(u.size());
           for (std::size_t k = 0; k < u.size(); ++k) pred[k] = sel.linear.gain_m_per_V * u[k] + sel.linear.offset_m;

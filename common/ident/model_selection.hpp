@@ -21,7 +21,6 @@
 
 namespace hystloop {
 
-
 struct ModelSelectionOptions {
   double holdout_fraction = 0.3;  // the held-out part starts at the first reversal after 1 - this
   std::vector<ModelKind> candidates{ModelKind::mem, ModelKind::pi, ModelKind::katalenic, ModelKind::linear};
@@ -37,7 +36,7 @@ struct ModelScore {
   std::string reason;
   double train_rms_m = 0.0;    // fit residual as the fitter reports it
   double holdout_rms_m = 0.0;  // prediction error on the held-out part
-  double fit_time_s = 0.0;    // the fitter's solve_time_s (its options' clock); linear: 0, closed form
+  double fit_time_s = 0.0;     // the fitter's solve_time_s (its options' clock); linear: 0, closed form
 };
 
 struct ModelSelection {

@@ -11,7 +11,8 @@ namespace {
 // Least squares restricted to the passive set P: solves G_PP z_P = h_P, z = 0 elsewhere.
 Eigen::VectorXd solve_passive(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, const std::vector<bool>& passive) {
   std::vector<Eigen::Index> idx;
-  for (Eigen::Index i = 0; i < h.size(); ++i) if (passive[static_cast<std::size_t>(i)]) idx.push_back(i);
+  for (Eigen::Index i = 0; i < h.size(); ++i)
+    if (passive[static_cast<std::size_t>(i)]) idx.push_back(i);
   Eigen::VectorXd z = Eigen::VectorXd::Zero(h.size());
   if (idx.empty()) return z;
   const auto m = static_cast<Eigen::Index>(idx.size());
@@ -19,7 +20,8 @@ Eigen::VectorXd solve_passive(const Eigen::MatrixXd& g, const Eigen::VectorXd& h
   Eigen::VectorXd hp(m);
   for (Eigen::Index r = 0; r < m; ++r) {
     hp[r] = h[idx[static_cast<std::size_t>(r)]];
-    for (Eigen::Index c = 0; c < m; ++c) gp(r, c) = g(idx[static_cast<std::size_t>(r)], idx[static_cast<std::size_t>(c)]);
+    for (Eigen::Index c = 0; c < m; ++c)
+      gp(r, c) = g(idx[static_cast<std::size_t>(r)], idx[static_cast<std::size_t>(c)]);
   }
   const Eigen::VectorXd zp = gp.ldlt().solve(hp);
   for (Eigen::Index r = 0; r < m; ++r) z[idx[static_cast<std::size_t>(r)]] = zp[r];

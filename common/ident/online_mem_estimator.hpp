@@ -32,14 +32,14 @@
 namespace hystloop {
 
 struct OnlineMemOptions {
-  std::size_t capacity_samples = 200000;  // ring size: 20 s at 10 kHz, preallocated
-  std::size_t window_samples = 20000;     // refit window: 2 s at 10 kHz
-  std::size_t holdout_branches = 1;       // most recent complete branches kept out of the fit
-  double min_relative_improvement = 0.02; // held-out RMS must drop by this fraction
-  double max_residual_rms_m = 20e-9;      // validation bound on the fit residual (absolute) ...
-  double max_relative_residual = 0.05;    // ... and relative to the window's half output range
-  std::size_t stuck_samples = 50;         // y bit-identical this long while u moves: a dropout
-  MemFitOptions fit{};                    // fit.max_solver_time_s bounds the solver
+  std::size_t capacity_samples = 200000;   // ring size: 20 s at 10 kHz, preallocated
+  std::size_t window_samples = 20000;      // refit window: 2 s at 10 kHz
+  std::size_t holdout_branches = 1;        // most recent complete branches kept out of the fit
+  double min_relative_improvement = 0.02;  // held-out RMS must drop by this fraction
+  double max_residual_rms_m = 20e-9;       // validation bound on the fit residual (absolute) ...
+  double max_relative_residual = 0.05;     // ... and relative to the window's half output range
+  std::size_t stuck_samples = 50;          // y bit-identical this long while u moves: a dropout
+  MemFitOptions fit{};                     // fit.max_solver_time_s bounds the solver
 
   void validate() const;  // throws ParameterError naming the field
 };

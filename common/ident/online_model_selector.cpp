@@ -145,16 +145,16 @@ ModelProposal propose_model(std::span<const double> u_in, std::span<const double
     out.kind = ProposalKind::model_change;
     out.params = *best;
     why << ": beats the model in use by more than " << o.margin * 100.0 << " %";
-  } else if (own_refit &&
-             out.in_use_refit_holdout_rms_m < (1.0 - o.refit_improvement) * out.in_use_holdout_rms_m) {
+  } else if (own_refit && out.in_use_refit_holdout_rms_m < (1.0 - o.refit_improvement) * out.in_use_holdout_rms_m) {
     out.kind = ProposalKind::refit;
     out.params = *own_refit;
     why << (o.pinned ? " (pinned)" : "") << ": refit of the model in use, " << o.refit_improvement * 100.0
         << " % better";
   } else {
     why << (o.pinned ? " (pinned)" : "") << ": keep the set in use";
-    if (!best || (own && !own_refit)) why << " (a fit predicts the held-out part worse than "
-                                          << o.max_holdout_to_train << "x its residual: the window changed)";
+    if (!best || (own && !own_refit))
+      why << " (a fit predicts the held-out part worse than " << o.max_holdout_to_train
+          << "x its residual: the window changed)";
   }
   out.reason = why.str();
   return out;

@@ -41,8 +41,8 @@ struct OnlineSelectorOptions {
   // A candidate whose held-out RMS exceeds this multiple of its own fit residual was fitted to a
   // window that changed under it (a swap's transient, the loop moving): it is not proposed.
   double max_holdout_to_train = 2.0;
-  bool pinned = false;          // never propose a different model (parameters are still refitted)
-  std::size_t decimation = 1;   // fit every n-th sample of the window (>= 1; 10 kHz / 10 = 1 kHz)
+  bool pinned = false;                // never propose a different model (parameters are still refitted)
+  std::size_t decimation = 1;         // fit every n-th sample of the window (>= 1; 10 kHz / 10 = 1 kHz)
   ModelSelectionOptions selection{};  // candidates, held-out fraction, fitter options
 
   void validate() const;  // throws ParameterError naming the field
@@ -58,15 +58,15 @@ std::string_view to_string(ProposalKind kind) noexcept;
 
 struct ModelProposal {
   ProposalKind kind = ProposalKind::none;
-  ModelParamSet params{};      // the proposal (meaningful unless kind == none); validated
+  ModelParamSet params{};                        // the proposal (meaningful unless kind == none); validated
   FitStatus status = FitStatus::solver_failure;  // of the selection (ok: at least one model fitted)
-  std::string reason;          // why this decision, with the figures
+  std::string reason;                            // why this decision, with the figures
   ModelKind in_use = ModelKind::mem;
-  ModelKind winner = ModelKind::mem;    // best refitted candidate
-  double in_use_holdout_rms_m = 0.0;    // the set in use on the held-out samples
+  ModelKind winner = ModelKind::mem;        // best refitted candidate
+  double in_use_holdout_rms_m = 0.0;        // the set in use on the held-out samples
   double in_use_refit_holdout_rms_m = 0.0;  // the in-use kind refitted on this window (inf: not fitted)
   double winner_holdout_rms_m = 0.0;
-  std::vector<ModelScore> ranking;      // select_model's, best first
+  std::vector<ModelScore> ranking;  // select_model's, best first
   bool proposes() const noexcept { return kind != ProposalKind::none; }
 };
 

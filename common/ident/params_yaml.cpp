@@ -27,8 +27,8 @@ std::string shaping(const ShapingFunction& s) {
       break;
     }
     case ShapingKind::tanh:
-      o << "{kind: tanh, amplitude: " << num(s.amplitude) << ", scale: " << num(s.scale) << ", offset: " << num(s.offset)
-        << "}";
+      o << "{kind: tanh, amplitude: " << num(s.amplitude) << ", scale: " << num(s.scale)
+        << ", offset: " << num(s.offset) << "}";
       break;
   }
   return o.str();
@@ -56,17 +56,19 @@ std::string to_yaml(const LinearParams& p) {
 
 std::string to_yaml(const KatalenicParams& p) {
   std::ostringstream o;
-  o << "katalenic:\n  k1: " << num(p.k1) << "  # [V]\n  k2: " << num(p.k2) << "  # [1/V]\n  k2_slope: " << num(p.k2_slope)
-    << "\n  initial_offset: " << num(p.initial_offset) << "\n  input_shaping: " << shaping(p.input_shaping)
-    << "\n  output_shaping: " << shaping(p.output_shaping) << "\n";
+  o << "katalenic:\n  k1: " << num(p.k1) << "  # [V]\n  k2: " << num(p.k2)
+    << "  # [1/V]\n  k2_slope: " << num(p.k2_slope) << "\n  initial_offset: " << num(p.initial_offset)
+    << "\n  input_shaping: " << shaping(p.input_shaping) << "\n  output_shaping: " << shaping(p.output_shaping) << "\n";
   return o.str();
 }
 
 std::string to_yaml(const ColemanHodgdonParams& h, const SecondOrderStageParams* stage) {
   std::ostringstream o;
-  o << "banning:\n  hysteresis:\n    a: " << num(h.a) << "  # [m/V]\n    b: " << num(h.b) << "  # [m/V]\n    alpha: " << num(h.alpha)
-    << "  # [1/V]\n    s_max: " << num(h.s_max) << "  # [V] (not identified)\n";
-  if (stage != nullptr) o << "  stage:\n    k: " << num(stage->k) << "  # [1/s^2]\n    c: " << num(stage->c) << "  # [1/s]\n";
+  o << "banning:\n  hysteresis:\n    a: " << num(h.a) << "  # [m/V]\n    b: " << num(h.b)
+    << "  # [m/V]\n    alpha: " << num(h.alpha) << "  # [1/V]\n    s_max: " << num(h.s_max)
+    << "  # [V] (not identified)\n";
+  if (stage != nullptr)
+    o << "  stage:\n    k: " << num(stage->k) << "  # [1/s^2]\n    c: " << num(stage->c) << "  # [1/s]\n";
   return o.str();
 }
 

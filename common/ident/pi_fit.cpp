@@ -80,7 +80,9 @@ PiFitResult fit_pi(std::span<const double> u, std::span<const double> y, const P
   // Scale to O(1) (volts and metres differ by 1e9) for the active-set tolerances.
   const double ys = std::max(bc.cwiseAbs().maxCoeff(), 1e-300), us = std::max(half, 1e-300);
   const NnlsResult nn = nnls(ac / us, bc / ys);
-  if (!nn.converged) return timer.finish(res, FitStatus::solver_failure, "NNLS did not converge in " + std::to_string(nn.iterations) + " iterations");
+  if (!nn.converged)
+    return timer.finish(res, FitStatus::solver_failure,
+                        "NNLS did not converge in " + std::to_string(nn.iterations) + " iterations");
   const Eigen::VectorXd w = nn.x * (ys / us);
   res.weights.assign(w.data(), w.data() + n);
   res.offset_m = bmean - amean.dot(w);

@@ -20,7 +20,7 @@ struct PiFitOptions {
   std::size_t operators = 15;  // the paper's comparison used 15 play operators; <= kPiMaxOperators
   double min_input_range_V = 1e-3;
   std::size_t min_samples = 50;
-  FitClock clock{};  // solve_time_s only (NNLS has no time budget); empty = monotonic
+  FitClock clock{};       // solve_time_s only (NNLS has no time budget); empty = monotonic
   void validate() const;  // throws ParameterError naming the field
 };
 

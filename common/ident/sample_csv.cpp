@@ -54,10 +54,14 @@ SampleTable parse_sample_csv(std::istream& in, const std::string& name) {
       for (std::size_t i = 0; i < header.size(); ++i) {
         const std::string h = lower(header[i]);
         const int idx = static_cast<int>(i);
-        if (h == "t") ct = idx;
-        else if (h == "u") cu = idx;
-        else if (h == "y") cy = idx;
-        else if (h == "experiment") ce = idx;
+        if (h == "t")
+          ct = idx;
+        else if (h == "u")
+          cu = idx;
+        else if (h == "y")
+          cy = idx;
+        else if (h == "experiment")
+          ce = idx;
       }
       std::string missing;
       if (ct < 0) missing += " t";
@@ -69,7 +73,8 @@ SampleTable parse_sample_csv(std::istream& in, const std::string& name) {
       continue;
     }
     if (fields.size() != header.size()) {
-      throw CsvError(name, line_no, std::to_string(fields.size()) + " fields, the header has " + std::to_string(header.size()));
+      throw CsvError(name, line_no,
+                     std::to_string(fields.size()) + " fields, the header has " + std::to_string(header.size()));
     }
     auto number = [&](int col) {
       const std::string& f = fields[static_cast<std::size_t>(col)];

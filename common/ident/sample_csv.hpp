@@ -24,8 +24,8 @@ class CsvError : public std::runtime_error {
 };
 
 struct SampleTable {
-  std::vector<double> t, u, y;           // [s], [V], [m]
-  std::vector<std::string> experiment;   // empty unless the column exists
+  std::vector<double> t, u, y;          // [s], [V], [m]
+  std::vector<std::string> experiment;  // empty unless the column exists
 };
 
 SampleTable parse_sample_csv(std::istream& in, const std::string& name);

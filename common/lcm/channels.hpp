@@ -23,8 +23,8 @@ inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_para
 // model_params_t, on a model change: any model (HX_PARAMS stays MEM-only, so its tools and logs
 // work unchanged; a channel carries one type).
 inline constexpr std::string_view kModelSuffix = "MODEL";
-inline constexpr std::string_view kStatusSuffix = "STATUS";          // service_status_t, 1 Hz per process
-inline constexpr std::string_view kControlSuffix = "CONTROL";        // control_t, on demand
+inline constexpr std::string_view kStatusSuffix = "STATUS";    // service_status_t, 1 Hz per process
+inline constexpr std::string_view kControlSuffix = "CONTROL";  // control_t, on demand
 
 // Suffix and LCM type name ("hystloop.sensor_block_t") of every channel, e.g. for a
 // logger that records them all or a tool that lists them.

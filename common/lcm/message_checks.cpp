@@ -95,8 +95,8 @@ Verdict check_message(const trajectory_t& msg) noexcept {
   f.within(msg.offset_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   f.within(msg.phase_rad, -kHuge, kHuge);
   f.within(msg.blend_s, 0.0, kMaxDuration_s);
-  const bool periodic = msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE ||
-                        msg.shape == trajectory_t::TRIANGLE;
+  const bool periodic =
+      msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE || msg.shape == trajectory_t::TRIANGLE;
   f.within(msg.frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
   f.require(!periodic || msg.frequency_Hz > 0.0);
 
@@ -143,15 +143,15 @@ void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
       if (msg.n_operators >= 1 && arrays_consistent(msg)) {
         f.require(msg.pi_thresholds_V[0] == 0.0 && msg.pi_weights[0] > 0.0);
         for (std::size_t i = 1; i < msg.pi_thresholds_V.size(); ++i) {
-          f.require(msg.pi_thresholds_V[i] > msg.pi_thresholds_V[i - 1] &&
-                    msg.pi_thresholds_V[i] <= kMaxAbsVoltage_V);
+          f.require(msg.pi_thresholds_V[i] > msg.pi_thresholds_V[i - 1] && msg.pi_thresholds_V[i] <= kMaxAbsVoltage_V);
         }
       }
       break;
     case model_params_t::KIND_LINEAR: f.require(msg.linear_gain != 0.0 && std::fabs(msg.linear_gain) <= 1.0); break;
     case model_params_t::KIND_KATALENIC:
       f.require(msg.kat_k1 > 0.0 && msg.kat_k2 > 0.0 && msg.kat_k2_domain_min < msg.kat_k2_domain_max);
-      f.require(msg.kat_in_shaping >= model_params_t::SHAPING_LINEAR && msg.kat_in_shaping <= model_params_t::SHAPING_TANH);
+      f.require(msg.kat_in_shaping >= model_params_t::SHAPING_LINEAR &&
+                msg.kat_in_shaping <= model_params_t::SHAPING_TANH);
       f.require(msg.kat_out_shaping >= model_params_t::SHAPING_LINEAR &&
                 msg.kat_out_shaping <= model_params_t::SHAPING_TANH);
       break;
@@ -165,21 +165,21 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
   f.text(msg.source);
-  for (const double v : {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1,
-                         msg.kat_k2, msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max,
-                         msg.kat_initial_offset}) {
+  for (const double v :
+       {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1, msg.kat_k2,
+        msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max, msg.kat_initial_offset}) {
     f.finite(v);
   }
-  const double in[] = {msg.kat_in_gain, msg.kat_in_offset, msg.kat_in_domain_min, msg.kat_in_domain_max,
-                       msg.kat_in_amplitude, msg.kat_in_scale};
-  const double out[] = {msg.kat_out_gain, msg.kat_out_offset, msg.kat_out_domain_min, msg.kat_out_domain_max,
-                        msg.kat_out_amplitude, msg.kat_out_scale};
+  const double in[] = {msg.kat_in_gain,       msg.kat_in_offset,    msg.kat_in_domain_min,
+                       msg.kat_in_domain_max, msg.kat_in_amplitude, msg.kat_in_scale};
+  const double out[] = {msg.kat_out_gain,       msg.kat_out_offset,    msg.kat_out_domain_min,
+                        msg.kat_out_domain_max, msg.kat_out_amplitude, msg.kat_out_scale};
   for (const double v : in) f.finite(v);
   for (const double v : out) f.finite(v);
   for (const double v : msg.kat_in_coefficients) f.finite(v);
   for (const double v : msg.kat_out_coefficients) f.finite(v);
-  const bool count_ok = msg.n_operators >= 0 && msg.n_operators <= model_params_t::MAX_OPERATORS &&
-                        arrays_consistent(msg);
+  const bool count_ok =
+      msg.n_operators >= 0 && msg.n_operators <= model_params_t::MAX_OPERATORS && arrays_consistent(msg);
   f.require(count_ok);
   if (count_ok) {
     for (const double v : msg.pi_thresholds_V) f.finite(v);
@@ -215,8 +215,8 @@ Verdict check_message(const service_status_t& msg) noexcept {
   if (count_ok) {
     for (const std::int64_t value : msg.counter_values) f.require(value >= 0);
   }
-  for (const double t : {msg.loop_p50_us, msg.loop_p99_us, msg.loop_max_us, msg.latency_p50_us,
-                         msg.latency_p99_us, msg.latency_max_us}) {
+  for (const double t : {msg.loop_p50_us, msg.loop_p99_us, msg.loop_max_us, msg.latency_p50_us, msg.latency_p99_us,
+                         msg.latency_max_us}) {
     f.nan_or_within(t, 0.0, kHuge);
   }
   f.require(msg.late >= 0 && msg.rejected >= 0);

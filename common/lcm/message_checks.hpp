@@ -20,8 +20,8 @@
 
 namespace hystloop {
 
-inline constexpr double kMaxAbsVoltage_V = 1.0e4;   // no piezo amplifier goes near 10 kV
-inline constexpr double kMaxAbsPosition_m = 1.0;    // a nanopositioner moves micrometres
+inline constexpr double kMaxAbsVoltage_V = 1.0e4;  // no piezo amplifier goes near 10 kV
+inline constexpr double kMaxAbsPosition_m = 1.0;   // a nanopositioner moves micrometres
 inline constexpr double kMaxAbsFrequency_Hz = 1.0e5;
 inline constexpr double kMaxDuration_s = 86400.0;
 inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FAULT

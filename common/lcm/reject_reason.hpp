@@ -17,10 +17,10 @@ enum class RejectReason : std::uint8_t {
   kOutOfRange,     // a value outside the contract (negative seq, unknown enum, c3 <= 0, ...)
   kHandlerFailed,  // the message was valid but the handler threw
   // A keyed rig's authenticated channels (lcm/rig_auth.hpp):
-  kUnsigned,       // no authentication trailer
-  kBadMac,         // the MAC does not match: altered, moved from another channel, or another key
-  kReplayed,       // counter not above the last one accepted from its sender (a repeat or a replay)
-  kSkewed,         // counter further than auth.max_skew_s from this host's clock (a recording, or clocks apart)
+  kUnsigned,  // no authentication trailer
+  kBadMac,    // the MAC does not match: altered, moved from another channel, or another key
+  kReplayed,  // counter not above the last one accepted from its sender (a repeat or a replay)
+  kSkewed,    // counter further than auth.max_skew_s from this host's clock (a recording, or clocks apart)
 };
 inline constexpr std::size_t kRejectReasonCount = 10;
 

@@ -24,7 +24,7 @@ namespace hystloop {
 // Channels whose messages can move the stage or change what it does: signed on a keyed rig,
 // refused unsigned. HX_SENSOR and HX_STATUS are not (see README "Authenticated rig").
 inline constexpr std::array<std::string_view, 5> kAuthenticatedSuffixes{kCommandSuffix, kControlSuffix,
-                                                                       kTrajectorySuffix, kParamsSuffix, kModelSuffix};
+                                                                        kTrajectorySuffix, kParamsSuffix, kModelSuffix};
 
 // True if `channel` is <prefix><suffix> for one of kAuthenticatedSuffixes (the prefix ends in '_').
 bool is_authenticated_channel(std::string_view channel) noexcept;

@@ -41,7 +41,8 @@ bool add_endpoint_counters(service_status_t& status, std::string_view endpoint, 
   for (std::size_t i = 0; i < kRejectReasonCount; ++i) {
     const auto reason = static_cast<RejectReason>(i);
     ok = add_counter(status, joined(endpoint, "rejected_" + std::string(to_string(reason))),
-                     counters.rejected(reason)) && ok;
+                     counters.rejected(reason)) &&
+         ok;
   }
   status.rejected = saturate(static_cast<std::uint64_t>(status.rejected) + counters.rejected_total());
   return ok;

@@ -102,7 +102,8 @@ std::string checked_lcm_url(std::string_view url, bool allow_network) {
   }
   if (parsed.provider != "udpm") refuse(url, "provider must be udpm, memq, file or tcpq");
 
-  if (!is_ipv4_multicast_group(checked_port(url, parsed.network))) refuse(url, "udpm needs an IPv4 multicast group 224.0.0.0/4");
+  if (!is_ipv4_multicast_group(checked_port(url, parsed.network)))
+    refuse(url, "udpm needs an IPv4 multicast group 224.0.0.0/4");
   const std::string ttl_text = lcm_url_option(parsed, "ttl");
   int ttl = 0;
   if (!ttl_text.empty() && (!parse_int(ttl_text, ttl) || ttl < 0 || ttl > 255)) {

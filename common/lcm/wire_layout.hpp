@@ -18,7 +18,7 @@
 namespace hystloop {
 
 enum class WireField : std::uint8_t {
-  kInt8,         // also boolean
+  kInt8,  // also boolean
   kInt32,
   kInt64,
   kDouble,
@@ -34,7 +34,7 @@ enum class WireField : std::uint8_t {
 struct WireLayout {
   std::int64_t fingerprint;  // T::getHash() of the type this layout was generated from
   std::span<const WireField> fields;
-  std::int32_t max_count;    // bound on every kCount field: the type's MAX_* constant (0 = no arrays)
+  std::int32_t max_count;  // bound on every kCount field: the type's MAX_* constant (0 = no arrays)
 };
 
 }  // namespace hystloop

@@ -65,7 +65,8 @@ void BridgeCore::set_servo_gains(const FeedbackGains& gains) noexcept {
 
 BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
   ++counters_.ticks;
-  const double step_s = last_tick_ >= 0 ? dt_s_ * static_cast<double>(std::max<std::int64_t>(1, k - last_tick_)) : dt_s_;
+  const double step_s =
+      last_tick_ >= 0 ? dt_s_ * static_cast<double>(std::max<std::int64_t>(1, k - last_tick_)) : dt_s_;
   last_tick_ = k;
   BridgeTick out;
   const CommandTick* command = buffer_.take(k);
@@ -93,7 +94,8 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
     ++safe_ramp_ticks_;
     const double distance = limits_.safe_u_V - safe_ramp_from_V_;
     const double travelled = static_cast<double>(safe_ramp_ticks_) * limits_.safe_ramp_rate_V_per_s() * dt_s_;
-    u_applied_ = travelled >= std::abs(distance) ? limits_.safe_u_V : safe_ramp_from_V_ + std::copysign(travelled, distance);
+    u_applied_ =
+        travelled >= std::abs(distance) ? limits_.safe_u_V : safe_ramp_from_V_ + std::copysign(travelled, distance);
     out.u_applied_V = u_applied_;
     return out;
   }

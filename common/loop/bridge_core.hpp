@@ -35,7 +35,9 @@ struct ActuatorLimits {
 
   void validate() const;  // throws ParameterError naming the field
   // The rate the safe state ramps at: safe_ramp_V_per_s, never faster than the slew limit.
-  double safe_ramp_rate_V_per_s() const noexcept { return safe_ramp_V_per_s < slew_V_per_s ? safe_ramp_V_per_s : slew_V_per_s; }
+  double safe_ramp_rate_V_per_s() const noexcept {
+    return safe_ramp_V_per_s < slew_V_per_s ? safe_ramp_V_per_s : slew_V_per_s;
+  }
   // The longest ramp to safe_u_V: from the end of the range farthest from it [s].
   double longest_safe_ramp_s() const noexcept {
     const double far_V = u_max_V - safe_u_V > safe_u_V - u_min_V ? u_max_V - safe_u_V : safe_u_V - u_min_V;
@@ -45,26 +47,26 @@ struct ActuatorLimits {
 
 struct BridgeCounters {
   std::uint64_t ticks = 0;
-  std::uint64_t applied = 0;            // armed ticks that applied a command meant for them
-  std::uint64_t late = 0;               // armed ticks with no command for them (last feedforward held)
-  std::uint64_t stale = 0;              // commands that arrived after their tick had passed
-  std::uint64_t duplicates = 0;         // commands for a tick that had one already (the first stays)
+  std::uint64_t applied = 0;     // armed ticks that applied a command meant for them
+  std::uint64_t late = 0;        // armed ticks with no command for them (last feedforward held)
+  std::uint64_t stale = 0;       // commands that arrived after their tick had passed
+  std::uint64_t duplicates = 0;  // commands for a tick that had one already (the first stays)
   std::uint64_t rejected_nonfinite = 0;
-  std::uint64_t rejected_future = 0;    // seq too far ahead to buffer
+  std::uint64_t rejected_future = 0;  // seq too far ahead to buffer
   std::uint64_t clamped = 0;
   std::uint64_t slew_limited = 0;
   std::uint64_t watchdog_trips = 0;
-  std::uint64_t safe_ticks = 0;         // ticks in the safe state
+  std::uint64_t safe_ticks = 0;  // ticks in the safe state
 };
 
 struct BridgeTick {
   double u_applied_V = 0.0;
-  double u_ff_V = 0.0;                  // feedforward part (held when late; 0 in the safe state)
-  double u_fb_V = 0.0;                  // servo part (0 when off, held or without reference)
-  double y_ref_m = 0.0;                 // reference of the command in force; NaN = none
+  double u_ff_V = 0.0;   // feedforward part (held when late; 0 in the safe state)
+  double u_fb_V = 0.0;   // servo part (0 when off, held or without reference)
+  double y_ref_m = 0.0;  // reference of the command in force; NaN = none
   std::int32_t flags = 0;
-  std::int32_t params_version = 0;      // of the command in force (0 when none)
-  std::int64_t buffer_depth = 0;        // consecutive ticks buffered after this one
+  std::int32_t params_version = 0;  // of the command in force (0 when none)
+  std::int64_t buffer_depth = 0;    // consecutive ticks buffered after this one
 };
 
 class BridgeCore {
@@ -98,19 +100,19 @@ class BridgeCore {
  private:
   ActuatorLimits limits_;
   double dt_s_;
-  std::int64_t watchdog_ticks_;          // dry armed ticks allowed before the trip: floor(watchdog_s / dt)
+  std::int64_t watchdog_ticks_;  // dry armed ticks allowed before the trip: floor(watchdog_s / dt)
   CommandBuffer buffer_;
   FeedbackController servo_;
   std::int64_t last_supplied_tick_ = 0;  // last armed tick whose command was in the buffer (or the arm tick)
   std::int64_t last_tick_ = -1;
-  double u_applied_ = 0.0;               // last voltage applied (starts at the safe voltage)
-  CommandTick held_{};                   // command in force, held when one is late
-  double servo_ref_m_;                   // reference of the previous tick, for the servo's error (NaN: none)
+  double u_applied_ = 0.0;  // last voltage applied (starts at the safe voltage)
+  CommandTick held_{};      // command in force, held when one is late
+  double servo_ref_m_;      // reference of the previous tick, for the servo's error (NaN: none)
   bool armed_ = false;
-  bool command_since_arm_ = false;       // until then the servo neither acts nor forgets its held state
-  bool safe_ramp_active_ = false;        // in the safe state: ramping from safe_ramp_from_V_ (or there)
+  bool command_since_arm_ = false;  // until then the servo neither acts nor forgets its held state
+  bool safe_ramp_active_ = false;   // in the safe state: ramping from safe_ramp_from_V_ (or there)
   double safe_ramp_from_V_ = 0.0;
-  std::int64_t safe_ramp_ticks_ = 0;     // safe-state ticks since the ramp started
+  std::int64_t safe_ramp_ticks_ = 0;  // safe-state ticks since the ramp started
   BridgeCounters counters_;
 };
 

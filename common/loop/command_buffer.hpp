@@ -40,9 +40,7 @@ class CommandBuffer {
   void clear() noexcept;
 
  private:
-  static std::size_t slot_of(std::int64_t seq) noexcept {
-    return static_cast<std::size_t>(seq % kCapacityTicks);
-  }
+  static std::size_t slot_of(std::int64_t seq) noexcept { return static_cast<std::size_t>(seq % kCapacityTicks); }
   bool holds(std::int64_t seq) const noexcept { return slots_[slot_of(seq)].seq == seq; }
   void extend() noexcept;
 

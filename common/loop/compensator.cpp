@@ -68,8 +68,8 @@ void CompensatorConfig::validate() const {
   require_in_range("compensator.slew_fraction", slew_fraction, 1e-3, 1.0);
   require_positive("compensator.reanchor_u_rate_V_per_s", reanchor_u_rate_V_per_s);
   if (horizon_ticks < 1 || horizon_ticks > kMaxHorizonTicks) {
-    throw ParameterError("compensator.horizon_s", "must be 1 to " + std::to_string(kMaxHorizonTicks) +
-                                                      " ticks (got " + std::to_string(horizon_ticks) + ")");
+    throw ParameterError("compensator.horizon_s", "must be 1 to " + std::to_string(kMaxHorizonTicks) + " ticks (got " +
+                                                      std::to_string(horizon_ticks) + ")");
   }
 }
 
@@ -151,7 +151,6 @@ double Compensator::nominal_slope() const noexcept {
     default: return linear_.params().gain;
   }
 }
-
 
 namespace {
 // Model and inverse at the end of the monotone branch u_from -> u_to (from a virgin start at

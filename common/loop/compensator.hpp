@@ -84,7 +84,7 @@ struct CompensatorConfig {
   double reanchor_u_rate_V_per_s = 50.0;
 
   static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer
-  void validate() const;  // throws ParameterError naming the field
+  void validate() const;                                  // throws ParameterError naming the field
 };
 
 struct CompensatorInput {
@@ -95,14 +95,14 @@ struct CompensatorInput {
 
 struct CompensatorCounters {
   std::uint64_t samples = 0;
-  std::uint64_t out_of_order = 0;   // samples whose seq did not increase (ignored)
-  std::uint64_t gaps = 0;           // missing sample ticks
-  std::uint64_t planned = 0;        // command ticks planned
-  std::uint64_t ticks_behind = 0;   // ticks the bridge reached before they were planned (never sent)
+  std::uint64_t out_of_order = 0;  // samples whose seq did not increase (ignored)
+  std::uint64_t gaps = 0;          // missing sample ticks
+  std::uint64_t planned = 0;       // command ticks planned
+  std::uint64_t ticks_behind = 0;  // ticks the bridge reached before they were planned (never sent)
   std::uint64_t params_accepted = 0;
   std::uint64_t params_rejected = 0;
   std::uint64_t params_swapped = 0;
-  std::uint64_t reversals = 0;      // of the planned reference
+  std::uint64_t reversals = 0;          // of the planned reference
   std::uint64_t nonfinite_outputs = 0;  // model produced NaN/Inf: the last voltage was held
   std::uint64_t model_switches = 0;     // swaps that changed the model (offer_model)
   std::uint64_t reanchors = 0;          // swaps re-anchored at the measured position
@@ -136,7 +136,7 @@ class Compensator {
   // step in u) and re-anchored at the measured position as offer_mem_params' sets are. A later
   // offer replaces one still waiting. Not on the per-sample path (may be called between plans).
   void offer_model(const ModelParamSet& params, std::int32_t version);
-  void set_mode(FeedforwardMode mode);   // re-initialises that inverse where the plan is
+  void set_mode(FeedforwardMode mode);  // re-initialises that inverse where the plan is
   // Starts the experiment at the next planned tick, or queues it behind the running one.
   // Validated here (throws ParameterError; also when the queue is full).
   void start_experiment(const ExperimentSpec& spec);
@@ -184,7 +184,7 @@ class Compensator {
   PiInverse pi_;
   KatalenicInverse katalenic_;
   LinearInverse linear_;
-  PiModel pi_model_;            // forward models, to restart PI / Katalenic at a reversal
+  PiModel pi_model_;  // forward models, to restart PI / Katalenic at a reversal
   KatalenicModel katalenic_model_;
   struct Pending {
     ModelParamSet params;
@@ -193,7 +193,7 @@ class Compensator {
   std::optional<Pending> pending_;
   std::int32_t pending_version_ = 0;
   FeedforwardAnchor anchor_offset_;
-  double shift_m_ = 0.0;  // output offset in effect at the last planned tick
+  double shift_m_ = 0.0;     // output offset in effect at the last planned tick
   double u_prev_rev_ = 0.0;  // voltage (model coordinates) at the reversal before the last
   std::int32_t params_version_ = 0;
   ExperimentQueue experiments_;
@@ -205,10 +205,10 @@ class Compensator {
 
   std::int64_t last_seq_ = -1;
   std::int64_t next_tick_ = -1;
-  std::int64_t plan_end_ = -1;   // last tick the plan must reach
-  double last_ref_ = 0.0;        // last reference planned
-  double last_u_ = 0.0;          // last voltage planned
-  bool inverse_fresh_ = true;    // next reference initialises the inverse
+  std::int64_t plan_end_ = -1;  // last tick the plan must reach
+  double last_ref_ = 0.0;       // last reference planned
+  double last_u_ = 0.0;         // last voltage planned
+  bool inverse_fresh_ = true;   // next reference initialises the inverse
   // After an experiment: hold last_u_ until the sample of tick anchor_tick_ is observed.
   bool awaiting_anchor_ = false;
   std::int64_t anchor_tick_ = 0;

@@ -19,7 +19,8 @@ void ExperimentSpec::validate() const {
 ExperimentSpec make_experiment_spec(std::string_view kind, double amplitude_V, double offset_V, double frequency_hz,
                                     double duration_s) {
   if (kind != "sine" && kind != "settle") {
-    throw ParameterError("experiment", "'" + std::string(kind) + "' unknown (sine, or settle: a sine identification skips)");
+    throw ParameterError("experiment",
+                         "'" + std::string(kind) + "' unknown (sine, or settle: a sine identification skips)");
   }
   const ExperimentSpec spec{amplitude_V, offset_V, frequency_hz, duration_s, kind == "settle"};
   spec.validate();

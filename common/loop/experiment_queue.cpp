@@ -14,8 +14,8 @@ void ExperimentQueue::add(const ExperimentSpec& spec) {
     return;
   }
   if (queued_ == kCapacity) {
-    throw ParameterError("experiment", "queue full: " + std::to_string(kCapacity) +
-                                           " experiments already wait behind the running one");
+    throw ParameterError(
+        "experiment", "queue full: " + std::to_string(kCapacity) + " experiments already wait behind the running one");
   }
   waiting_[(head_ + queued_) % kCapacity] = spec;
   ++queued_;

@@ -12,13 +12,13 @@
 namespace hystloop {
 
 struct FeedbackGains {
-  double kp = 0.0;          // [-]
-  double ki = 0.0;          // [1/s]
-  double kd = 0.0;          // [s]
+  double kp = 0.0;                       // [-]
+  double ki = 0.0;                       // [1/s]
+  double kd = 0.0;                       // [s]
   double nominal_gain_m_per_V = 6.4e-9;  // stage's mean slope dy/du (Banning stage: ~1.6 um / 250 V)
   double u_min_V = -250.0;               // the range of u_ff + u_fb the actuator allows (for anti-windup)
   double u_max_V = 250.0;
-  double d_filter_hz = 1000.0;           // first-order low-pass on the derivative
+  double d_filter_hz = 1000.0;  // first-order low-pass on the derivative
 
   void validate() const;
   bool enabled() const noexcept { return kp != 0.0 || ki != 0.0 || kd != 0.0; }
@@ -40,9 +40,9 @@ class FeedbackController {
 
  private:
   FeedbackGains gains_;
-  double integral_ = 0.0;       // [m s]
+  double integral_ = 0.0;  // [m s]
   double prev_error_ = 0.0;
-  double d_state_ = 0.0;        // filtered derivative [m/s]
+  double d_state_ = 0.0;  // filtered derivative [m/s]
   bool has_prev_ = false;
 };
 

@@ -86,7 +86,8 @@ void FeedforwardAnchor::ramp_to(double y_target, double u_target, std::int64_t r
     const double need = std::min(std::ceil(du / per_tick), 1e7);
     return std::max<std::int64_t>(min_ramp_ticks_, std::isfinite(need) ? static_cast<std::int64_t>(need) : 0);
   };
-  y_ = Ramp{y_now, y_target, ramp_start, ticks(slope > 0.0 ? std::abs(y_target - y_now) / slope : 0.0, max_du_per_tick_)};
+  y_ = Ramp{y_now, y_target, ramp_start,
+            ticks(slope > 0.0 ? std::abs(y_target - y_now) / slope : 0.0, max_du_per_tick_)};
   u_ = Ramp{u_now, u_target, ramp_start, ticks(std::abs(u_target - u_now), max_u_offset_per_tick_)};
 }
 

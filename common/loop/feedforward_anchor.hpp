@@ -67,7 +67,7 @@ class FeedforwardAnchor {
   // [measure_ticks]: y_measured - y_model and u_applied - u_model at each measured tick
   std::vector<double> y_model_, u_model_, dy_, du_;
   bool measuring_ = false;
-  std::int64_t first_ = 0;       // first measured tick
+  std::int64_t first_ = 0;  // first measured tick
   std::int64_t have_planned_ = 0, have_observed_ = 0;
   double u_first_ = 0.0, y_first_ = 0.0, u_last_ = 0.0, y_last_ = 0.0;  // for the secant slope
   Ramp y_, u_;

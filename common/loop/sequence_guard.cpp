@@ -22,8 +22,8 @@ bool SequenceGuard::continues(std::int64_t next, std::int64_t seq) const noexcep
 SequenceGuard::Verdict SequenceGuard::check(std::int64_t seq, std::int64_t n_ticks, std::int64_t now_us) noexcept {
   // Saturating: a forged seq near the int64 ceiling must not overflow (the wire bounds seq >= 0 only).
   const std::int64_t n = std::max<std::int64_t>(n_ticks, 1);
-  const std::int64_t end = seq > std::numeric_limits<std::int64_t>::max() - n ? std::numeric_limits<std::int64_t>::max()
-                                                                                : seq + n;
+  const std::int64_t end =
+      seq > std::numeric_limits<std::int64_t>::max() - n ? std::numeric_limits<std::int64_t>::max() : seq + n;
   if (next_ < 0) {
     next_ = end;
     return Verdict::take;

@@ -33,10 +33,10 @@ class SequenceGuard {
   };
 
   struct Counters {
-    std::uint64_t held = 0;              // blocks held (not used) while a discontinuity was unconfirmed
-    std::uint64_t ignored = 0;           // discontinuities never confirmed
-    std::uint64_t jumps = 0;             // confirmed jumps ahead
-    std::uint64_t restarts = 0;          // confirmed restarts
+    std::uint64_t held = 0;      // blocks held (not used) while a discontinuity was unconfirmed
+    std::uint64_t ignored = 0;   // discontinuities never confirmed
+    std::uint64_t jumps = 0;     // confirmed jumps ahead
+    std::uint64_t restarts = 0;  // confirmed restarts
   };
 
   // max_step_ticks: how far from the next expected tick a block may start and still continue the
@@ -56,8 +56,8 @@ class SequenceGuard {
 
   std::int64_t max_step_;
   std::int64_t window_us_;
-  std::int64_t next_ = -1;       // the tick after the last block taken
-  int streak_ = 0;               // blocks of the candidate so far (0 = none)
+  std::int64_t next_ = -1;  // the tick after the last block taken
+  int streak_ = 0;          // blocks of the candidate so far (0 = none)
   std::int64_t candidate_next_ = 0;
   std::int64_t candidate_utime_ = 0;
   Counters counters_{};

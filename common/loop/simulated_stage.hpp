@@ -24,11 +24,11 @@ struct SimulatedStageConfig {
   PlantKind plant = PlantKind::kBanning;
   BanningStageParams banning{};
   MemParams ramberg_osgood{};
-  double noise_rms_m = 1e-9;         // white sensor noise, RMS [m]
-  std::uint64_t seed = 1;            // of the noise
-  double drift_fraction = 0.0;       // gain change at the end of the drift (0.1 = +10 %)
-  double drift_start_s = 0.0;        // loop time the drift starts [s]
-  double drift_duration_s = 60.0;    // it grows linearly over this long [s]
+  double noise_rms_m = 1e-9;       // white sensor noise, RMS [m]
+  std::uint64_t seed = 1;          // of the noise
+  double drift_fraction = 0.0;     // gain change at the end of the drift (0.1 = +10 %)
+  double drift_start_s = 0.0;      // loop time the drift starts [s]
+  double drift_duration_s = 60.0;  // it grows linearly over this long [s]
 
   void validate() const;  // throws ParameterError naming the field
 };

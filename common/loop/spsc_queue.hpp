@@ -69,9 +69,9 @@ class Mailbox {
   static constexpr unsigned kIndex = 3u;
   static constexpr unsigned kFresh = 4u;
   std::array<T, 3> slots_{};
-  unsigned back_ = 0;                 // writer's
+  unsigned back_ = 0;  // writer's
   alignas(64) std::atomic<unsigned> middle_{1};
-  alignas(64) unsigned front_ = 2;    // reader's
+  alignas(64) unsigned front_ = 2;  // reader's
 };
 
 }  // namespace hystloop

@@ -17,28 +17,25 @@ void TrajectorySpec::validate() const {
   require_non_negative("trajectory.blend_s", blend_s);
   require_finite("trajectory.hold_m", hold_m);
   switch (shape) {
-    case TrajectoryShape::kHold:
-      break;
+    case TrajectoryShape::kHold: break;
     case TrajectoryShape::kSine:
     case TrajectoryShape::kCosine:
-    case TrajectoryShape::kTriangle:
-      require_positive("trajectory.frequency_hz", frequency_hz);
-      break;
+    case TrajectoryShape::kTriangle: require_positive("trajectory.frequency_hz", frequency_hz); break;
     case TrajectoryShape::kPoints:
       if (n_points == 0 || n_points > kMaxPoints) {
-        throw ParameterError("trajectory.n_points",
-                             "must be in [1, " + std::to_string(kMaxPoints) + "] (got " + std::to_string(n_points) + ")");
+        throw ParameterError("trajectory.n_points", "must be in [1, " + std::to_string(kMaxPoints) + "] (got " +
+                                                        std::to_string(n_points) + ")");
       }
       for (std::size_t i = 0; i < n_points; ++i) {
         require_finite("trajectory.points_t_s", points_t_s[i]);
         require_finite("trajectory.points_y_m", points_y_m[i]);
         if (i > 0 && !(points_t_s[i] > points_t_s[i - 1])) {
-          throw ParameterError("trajectory.points_t_s", "times must increase strictly (index " + std::to_string(i) + ")");
+          throw ParameterError("trajectory.points_t_s",
+                               "times must increase strictly (index " + std::to_string(i) + ")");
         }
       }
       break;
-    default:
-      throw ParameterError("trajectory.shape", "unknown shape " + std::to_string(static_cast<int>(shape)));
+    default: throw ParameterError("trajectory.shape", "unknown shape " + std::to_string(static_cast<int>(shape)));
   }
 }
 
@@ -46,12 +43,9 @@ double evaluate_shape(const TrajectorySpec& spec, double tau_s) noexcept {
   constexpr double kTwoPi = 2.0 * std::numbers::pi;
   const double phase = kTwoPi * spec.frequency_hz * tau_s + spec.phase_rad;
   switch (spec.shape) {
-    case TrajectoryShape::kHold:
-      return spec.offset_m;
-    case TrajectoryShape::kSine:
-      return spec.offset_m + spec.amplitude_m * std::sin(phase);
-    case TrajectoryShape::kCosine:
-      return spec.offset_m + spec.amplitude_m * std::cos(phase);
+    case TrajectoryShape::kHold: return spec.offset_m;
+    case TrajectoryShape::kSine: return spec.offset_m + spec.amplitude_m * std::sin(phase);
+    case TrajectoryShape::kCosine: return spec.offset_m + spec.amplitude_m * std::cos(phase);
     case TrajectoryShape::kTriangle: {
       // Same phase convention as sine: starts at 0 rising, peak at a quarter period.
       const double x = phase / kTwoPi - std::floor(phase / kTwoPi);  // [0, 1)

@@ -23,9 +23,9 @@ struct TrajectorySpec {
   double offset_m = 0.0;      // added to the shape, metres
   double frequency_hz = 1.0;  // for sine/cosine/triangle
   double phase_rad = 0.0;
-  double start_s = 0.0;       // loop time at which the shape's t = 0
-  double blend_s = 0.0;       // approach from hold_m, ending at start_s [s] (0 = none)
-  double hold_m = 0.0;        // where the reference was before this trajectory
+  double start_s = 0.0;  // loop time at which the shape's t = 0
+  double blend_s = 0.0;  // approach from hold_m, ending at start_s [s] (0 = none)
+  double hold_m = 0.0;   // where the reference was before this trajectory
   // kPoints: piecewise-linear through (t, y), t relative to start_s and increasing;
   // held at the last point afterwards.
   std::size_t n_points = 0;

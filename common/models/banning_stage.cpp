@@ -41,8 +41,7 @@ double hermite_extreme(double y0, double m0, double y1, double m1) noexcept {
   const double s = 0.5 * (lo + hi);
   const double s2 = s * s;
   const double s3 = s2 * s;
-  return (2.0 * s3 - 3.0 * s2 + 1.0) * y0 + (s3 - 2.0 * s2 + s) * m0 + (-2.0 * s3 + 3.0 * s2) * y1 +
-         (s3 - s2) * m1;
+  return (2.0 * s3 - 3.0 * s2 + 1.0) * y0 + (s3 - 2.0 * s2 + s) * m0 + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * m1;
 }
 }  // namespace
 

@@ -22,8 +22,8 @@ namespace hystloop {
 
 struct ColemanHodgdonParams {
   // Table 1 of the paper, converted to SI.
-  double a = 8.58e-9;   // [m/V] slope of f: the loop centre moves along w = a u (Theorem 3)
-  double b = 6.07e-9;   // [m/V] g inside +-s_max: the slope of small loops (Theorem 2)
+  double a = 8.58e-9;     // [m/V] slope of f: the loop centre moves along w = a u (Theorem 3)
+  double b = 6.07e-9;     // [m/V] g inside +-s_max: the slope of small loops (Theorem 2)
   double alpha = 0.0123;  // [1/V] rate at which a branch relaxes onto f after a reversal
   // [V] saturation of f and g, eqs. (19)-(20). The paper gives no value and assumes the input stays
   // inside (-s_max, s_max); 750 V covers its actuator's range (-750 V, +250 V) and, with margin,

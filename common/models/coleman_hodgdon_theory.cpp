@@ -14,9 +14,7 @@ bool in_domain(const ColemanHodgdonParams& p, double u_offset, double amplitude)
 }
 
 // (1 - e^{-2x}) / (1 + e^{-2x}) = tanh(x), the recurring factor of the proof.
-double t_of(const ColemanHodgdonParams& p, double amplitude) noexcept {
-  return std::tanh(p.alpha * amplitude);
-}
+double t_of(const ColemanHodgdonParams& p, double amplitude) noexcept { return std::tanh(p.alpha * amplitude); }
 
 // A - tanh(alpha A) / alpha without cancellation for small alpha A: (x - tanh x) / alpha.
 double a_minus_tanh(double alpha, double amplitude) noexcept {
@@ -123,8 +121,7 @@ LoopFeatures theorem3_features(const ColemanHodgdonParams& p, double u_offset, d
   return f;
 }
 
-LoopFeatures theorem3_small_amplitude(const ColemanHodgdonParams& p, double u_offset,
-                                      double amplitude) noexcept {
+LoopFeatures theorem3_small_amplitude(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept {
   LoopFeatures f = common_features(p, u_offset, amplitude);
   f.slope = in_domain(p, u_offset, amplitude) ? ch_slope_small(p) : kNaN;
   f.delta = ch_horizontal_aperture_small(p, amplitude);

@@ -21,11 +21,11 @@ namespace hystloop {
 double ch_left_turning_point(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept;
 double ch_right_turning_point(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept;
 
-double ch_slope(const ColemanHodgdonParams& p, double amplitude) noexcept;                    // (21) [m/V]
-double ch_horizontal_aperture(const ColemanHodgdonParams& p, double amplitude) noexcept;       // (22) [V]
+double ch_slope(const ColemanHodgdonParams& p, double amplitude) noexcept;                      // (21) [m/V]
+double ch_horizontal_aperture(const ColemanHodgdonParams& p, double amplitude) noexcept;        // (22) [V]
 double ch_horizontal_aperture_exact(const ColemanHodgdonParams& p, double amplitude) noexcept;  // [V]
-double ch_vertical_aperture(const ColemanHodgdonParams& p, double amplitude) noexcept;        // (23) [m]
-double ch_area(const ColemanHodgdonParams& p, double amplitude) noexcept;                     // (24) [m V]
+double ch_vertical_aperture(const ColemanHodgdonParams& p, double amplitude) noexcept;          // (23) [m]
+double ch_area(const ColemanHodgdonParams& p, double amplitude) noexcept;                       // (24) [m V]
 
 double ch_slope_small(const ColemanHodgdonParams& p) noexcept;                                  // b
 double ch_horizontal_aperture_small(const ColemanHodgdonParams& p, double amplitude) noexcept;  // alpha (a/b - 1) A^2
@@ -33,8 +33,7 @@ double ch_vertical_aperture_small(const ColemanHodgdonParams& p, double amplitud
 double ch_area_small(const ColemanHodgdonParams& p, double amplitude) noexcept;                 // 4/3 (a - b) alpha A^3
 
 LoopFeatures theorem3_features(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept;
-LoopFeatures theorem3_small_amplitude(const ColemanHodgdonParams& p, double u_offset,
-                                      double amplitude) noexcept;
+LoopFeatures theorem3_small_amplitude(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept;
 LoopFeatures exact_loop_features(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept;
 
 // |G(jw)| of (28)-(29): k / sqrt((k - w^2)^2 + (c w)^2), omega [rad/s].

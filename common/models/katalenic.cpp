@@ -33,8 +33,9 @@ void KatalenicParams::validate() const {
     require_finite("k2_domain_max", k2_domain_max);
     if (!(k2_domain_min < k2_domain_max)) throw ParameterError("k2_domain_max", "must be > k2_domain_min");
     if (!(k2_min() > 0.0)) {
-      throw ParameterError("k2_slope", "k2(x) = k2 + k2_slope * x must stay > 0 on [k2_domain_min, k2_domain_max] (min " +
-                                           describe(k2_min()) + ")");
+      throw ParameterError(
+          "k2_slope",
+          "k2(x) = k2 + k2_slope * x must stay > 0 on [k2_domain_min, k2_domain_max] (min " + describe(k2_min()) + ")");
     }
     if (!(std::abs(k2_slope) < max_k2_slope())) {
       throw ParameterError("k2_slope", "|k2_slope| must be < e * k2_min / (2 k1) = " + describe(max_k2_slope()) +

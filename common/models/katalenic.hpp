@@ -22,17 +22,17 @@ struct KatalenicParams {
   // Defaults: a piezo-like loop. With u = +-250 V periodic, the output swings 1.60 um and the
   // widest opening of the loop is 13 % of the stroke (tests/models/katalenic_test.cpp checks it).
   // The paper identifies no piezo (its examples are normalised), so these are chosen, not fitted.
-  double k1 = 40.0;   // [operator units] = V with the default psi_in; |z - x| <= k1
-  double k2 = 0.01;   // [1/operator unit]; at x = 0 when k2_slope != 0
+  double k1 = 40.0;  // [operator units] = V with the default psi_in; |z - x| <= k1
+  double k2 = 0.01;  // [1/operator unit]; at x = 0 when k2_slope != 0
   // Input-dependent k2 (Prop. 4.3): k2(x) = k2 + k2_slope * clamp(x, k2_domain_min, k2_domain_max).
   // The direct operator uses k2(x) of its input, the inverse k2(z) of its input (the paper's
   // approximate inverse; its error is bounded in katalenic_bounds.hpp).
-  double k2_slope = 0.0;         // [1/operator unit^2]
+  double k2_slope = 0.0;          // [1/operator unit^2]
   double k2_domain_min = -250.0;  // working interval L [operator units]
   double k2_domain_max = 250.0;
   // Initial condition: at reset the operator output is z0 = x0 + initial_offset (|.| <= k1);
   // 0 starts on the anhysteretic line z = x.
-  double initial_offset = 0.0;  // [operator units]
+  double initial_offset = 0.0;                                             // [operator units]
   ShapingFunction input_shaping = ShapingFunction::make_linear(1.0);       // V -> operator units
   ShapingFunction output_shaping = ShapingFunction::make_linear(3.79e-9);  // operator units -> m
 
@@ -61,8 +61,8 @@ class KatalenicModel {
   // moved to the band's edge (the only case where the output jumps).
   void set_params(const KatalenicParams& params);
 
-  double input() const noexcept { return u_; }   // last u [V]
-  double output() const noexcept { return y_; }  // last y [m]
+  double input() const noexcept { return u_; }                          // last u [V]
+  double output() const noexcept { return y_; }                         // last y [m]
   const KatalenicDirectOperator& core() const noexcept { return op_; }  // operator-unit state
 
  private:
@@ -75,9 +75,9 @@ class KatalenicModel {
 };
 
 struct KatalenicRates {
-  double u = 0.0;      // [V]
-  double u_dot = 0.0;  // [V/s]
-  double u_ddot = 0.0; // [V/s^2]
+  double u = 0.0;       // [V]
+  double u_dot = 0.0;   // [V/s]
+  double u_ddot = 0.0;  // [V/s^2]
 };
 
 class KatalenicInverse {

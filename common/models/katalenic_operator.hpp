@@ -55,7 +55,7 @@ class ReversalMemory {
   double alpha_tilde(double alpha) const noexcept { return direction_ * (alpha - alpha0_); }  // T, first part
   double beta_from_tilde(double beta_tilde) const noexcept { return beta0_ + direction_ * beta_tilde; }
   double m() const noexcept { return direction_ * (beta0_ - alpha0_); }  // M(alpha, beta)
-  double direction() const noexcept { return direction_; }  // +1 ascending, -1 descending
+  double direction() const noexcept { return direction_; }               // +1 ascending, -1 descending
   double last_alpha() const noexcept { return last_alpha_; }
   double last_beta() const noexcept { return last_beta_; }
   double alpha0() const noexcept { return alpha0_; }

@@ -84,9 +84,18 @@ void split_half(const std::vector<double>& b, std::vector<double>& left, std::ve
 // True when p' > 0 is proven on [a, b]; otherwise `where` is a point with p' <= 0 (or undecided).
 bool prove_positive(const std::vector<double>& b, double a, double w, int depth, double& where) {
   if (*std::min_element(b.begin(), b.end()) > 0.0) return true;
-  if (b.front() <= 0.0) { where = a; return false; }
-  if (b.back() <= 0.0) { where = a + w; return false; }
-  if (depth >= 48) { where = a + 0.5 * w; return false; }
+  if (b.front() <= 0.0) {
+    where = a;
+    return false;
+  }
+  if (b.back() <= 0.0) {
+    where = a + w;
+    return false;
+  }
+  if (depth >= 48) {
+    where = a + 0.5 * w;
+    return false;
+  }
   std::vector<double> left, right;
   split_half(b, left, right);
   return prove_positive(left, a, 0.5 * w, depth + 1, where) &&
@@ -100,9 +109,7 @@ double max_bernstein(const std::vector<double>& b, int depth) {
   return std::max(max_bernstein(left, depth - 1), max_bernstein(right, depth - 1));
 }
 
-std::string field_of(std::string_view field, const char* member) {
-  return std::string(field) + "." + member;
-}
+std::string field_of(std::string_view field, const char* member) { return std::string(field) + "." + member; }
 
 }  // namespace
 
@@ -127,8 +134,8 @@ ShapingFunction ShapingFunction::make_polynomial(std::initializer_list<double> c
   return s;
 }
 
-ShapingFunction ShapingFunction::make_odd_polynomial(std::initializer_list<double> odd_coefficients,
-                                                     double domain_min, double domain_max) {
+ShapingFunction ShapingFunction::make_odd_polynomial(std::initializer_list<double> odd_coefficients, double domain_min,
+                                                     double domain_max) {
   if (odd_coefficients.size() > kMaxCoefficients / 2) {
     throw ParameterError("coefficients", "at most 4 odd coefficients (degree 7)");
   }
@@ -189,10 +196,8 @@ void ShapingFunction::validate(std::string_view field) const {
 
 double ShapingFunction::apply(double x) const noexcept {
   switch (kind) {
-    case ShapingKind::linear:
-      return gain * x + offset;
-    case ShapingKind::tanh:
-      return offset + amplitude * std::tanh(x / scale);
+    case ShapingKind::linear: return gain * x + offset;
+    case ShapingKind::tanh: return offset + amplitude * std::tanh(x / scale);
     case ShapingKind::polynomial: {
       const double xc = std::clamp(x, domain_min, domain_max);
       double p = 0.0, dp = 0.0;
@@ -205,8 +210,7 @@ double ShapingFunction::apply(double x) const noexcept {
 
 double ShapingFunction::derivative(double x) const noexcept {
   switch (kind) {
-    case ShapingKind::linear:
-      return gain;
+    case ShapingKind::linear: return gain;
     case ShapingKind::tanh: {
       const double t = std::tanh(x / scale);
       return amplitude / scale * (1.0 - t * t);
@@ -222,29 +226,25 @@ double ShapingFunction::derivative(double x) const noexcept {
 
 double ShapingFunction::second_derivative(double x) const noexcept {
   switch (kind) {
-    case ShapingKind::linear:
-      return 0.0;
+    case ShapingKind::linear: return 0.0;
     case ShapingKind::tanh: {
       const double t = std::tanh(x / scale);
       return -2.0 * amplitude / (scale * scale) * t * (1.0 - t * t);
     }
-    case ShapingKind::polynomial:
-      return (x < domain_min || x > domain_max) ? 0.0 : horner_second(coefficients, x);
+    case ShapingKind::polynomial: return (x < domain_min || x > domain_max) ? 0.0 : horner_second(coefficients, x);
   }
   return 0.0;
 }
 
 double ShapingFunction::invert(double y, double hint) const noexcept {
   switch (kind) {
-    case ShapingKind::linear:
-      return (y - offset) / gain;
+    case ShapingKind::linear: return (y - offset) / gain;
     case ShapingKind::tanh: {
       constexpr double kLimit = 1.0 - 1e-12;
       const double r = std::clamp((y - offset) / amplitude, -kLimit, kLimit);
       return scale * std::atanh(r);
     }
-    case ShapingKind::polynomial:
-      break;
+    case ShapingKind::polynomial: break;
   }
   double pa = 0.0, da = 0.0, pb = 0.0, db = 0.0;
   horner(coefficients, domain_min, pa, da);
@@ -253,8 +253,8 @@ double ShapingFunction::invert(double y, double hint) const noexcept {
   if (y >= pb) return domain_max + (y - pb) / db;
   // Safeguarded Newton: p is strictly increasing on the bracket, so a Newton step that leaves
   // [lo, hi] is replaced by bisection; the iteration count is bounded for the real-time path.
-  const double tol = 4.0 * std::numeric_limits<double>::epsilon() *
-                     std::max({std::abs(domain_min), std::abs(domain_max), 1e-300});
+  const double tol =
+      4.0 * std::numeric_limits<double>::epsilon() * std::max({std::abs(domain_min), std::abs(domain_max), 1e-300});
   double lo = domain_min, hi = domain_max;
   double x = std::isfinite(hint) ? std::clamp(hint, lo, hi) : 0.5 * (lo + hi);
   for (int it = 0; it < 100; ++it) {
@@ -273,12 +273,9 @@ double ShapingFunction::invert(double y, double hint) const noexcept {
 
 double ShapingFunction::max_slope() const noexcept {
   switch (kind) {
-    case ShapingKind::linear:
-      return gain;
-    case ShapingKind::tanh:
-      return amplitude / scale;
-    case ShapingKind::polynomial:
-      break;
+    case ShapingKind::linear: return gain;
+    case ShapingKind::tanh: return amplitude / scale;
+    case ShapingKind::polynomial: break;
   }
   try {
     return max_bernstein(derivative_bernstein(coefficients, domain_min, domain_max), 6);

@@ -29,10 +29,10 @@ struct ShapingFunction {
   static constexpr double kTanhInverseLimit = 14.2;
 
   ShapingKind kind = ShapingKind::linear;
-  double gain = 1.0;       // linear: slope
-  double offset = 0.0;     // linear, tanh: value at x = 0
+  double gain = 1.0;                                    // linear: slope
+  double offset = 0.0;                                  // linear, tanh: value at x = 0
   std::array<double, kMaxCoefficients> coefficients{};  // polynomial: c[0] + c[1] x + ...
-  double domain_min = -1.0;  // polynomial: where monotonicity is proven
+  double domain_min = -1.0;                             // polynomial: where monotonicity is proven
   double domain_max = 1.0;
   double amplitude = 1.0;  // tanh: half the output range
   double scale = 1.0;      // tanh: input scale (x units)

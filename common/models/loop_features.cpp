@@ -81,11 +81,11 @@ struct Branch {
   double crossing(double level) const noexcept {
     double lo = -1.0;
     double hi = 1.0;
-    double flo = (*this)(lo) - level;
-    if (flo * ((*this)(hi) - level) > 0.0) return std::nan("");
+    double flo = (*this)(lo)-level;
+    if (flo * ((*this)(hi)-level) > 0.0) return std::nan("");
     for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
       const double mid = 0.5 * (lo + hi);
-      const double fmid = (*this)(mid) - level;
+      const double fmid = (*this)(mid)-level;
       if ((fmid < 0.0) == (flo < 0.0)) {
         lo = mid;
         flo = fmid;
@@ -100,8 +100,7 @@ struct Branch {
 // Indices where u reverses, confirmed by a retreat of more than `threshold`; the extremes at
 // either end of the data (confirmed or not) are included so every sample lies between two
 // boundaries of one direction.
-std::vector<std::size_t> reversal_boundaries(std::span<const double> u, double threshold,
-                                             std::size_t& confirmed) {
+std::vector<std::size_t> reversal_boundaries(std::span<const double> u, double threshold, std::size_t& confirmed) {
   std::vector<std::size_t> b{0};
   confirmed = 0;
   int dir = 0;
@@ -138,8 +137,8 @@ LoopFeatureResult extract_loop_features(std::span<const double> u, std::span<con
                                         const LoopFeatureOptions& options) {
   options.validate();
   if (u.size() != y.size()) {
-    throw ParameterError("y", "must have as many samples as u (" + std::to_string(u.size()) +
-                                  "), got " + std::to_string(y.size()));
+    throw ParameterError(
+        "y", "must have as many samples as u (" + std::to_string(u.size()) + "), got " + std::to_string(y.size()));
   }
   LoopFeatureResult r;
   for (std::size_t i = 0; i < u.size(); ++i) {

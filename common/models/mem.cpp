@@ -16,9 +16,7 @@ constexpr int kMaxNewtonSteps = 100;  // never reached from a factor-2 bound; a 
 double nan() noexcept { return std::numeric_limits<double>::quiet_NaN(); }
 
 // F(p) = c1 p + c2 p^(c3+1)/(c3+1) given pc3 = p^c3.
-double rise_from(const MemParams& c, double p, double pc3) noexcept {
-  return p * (c.c1 + c.c2 * pc3 / (c.c3 + 1.0));
-}
+double rise_from(const MemParams& c, double p, double pc3) noexcept { return p * (c.c1 + c.c2 * pc3 / (c.c3 + 1.0)); }
 
 // Bounds that need no guess: F(p) >= c1 p and F(p) >= c2 p^k / k, so the root of F(p) = rise
 // is below both; the smaller is within a factor 2 of the root (one term is >= rise / 2).
@@ -193,7 +191,8 @@ void MemModel::set_params(const MemParams& params) {
 
 // ---- MemInverse ----------------------------------------------------------------------------------
 
-MemInverse::MemInverse(const MemParams& params, double reversal_deadband) : params_(params), deadband_(reversal_deadband) {
+MemInverse::MemInverse(const MemParams& params, double reversal_deadband)
+    : params_(params), deadband_(reversal_deadband) {
   params_.validate();
   validate_deadband(reversal_deadband);
   reset(0.0);

@@ -48,10 +48,10 @@ struct MemParams {
   // makes M continuous at a reversal, M(0) = c1, and F convex). All finite.
   void validate() const;
 
-  double slope(double p) const noexcept;        // M(p) [m/V], p >= 0 [V]
-  double branch_rise(double p) const noexcept;  // F(p) [m], p >= 0 [V]
+  double slope(double p) const noexcept;          // M(p) [m/V], p >= 0 [V]
+  double branch_rise(double p) const noexcept;    // F(p) [m], p >= 0 [V]
   double branch_run(double rise) const noexcept;  // F^-1(rise) [V], rise >= 0 [m] (cold solve)
-  double skeleton(double u) const noexcept;     // y on the skeleton (2) [m] at u [V]
+  double skeleton(double u) const noexcept;       // y on the skeleton (2) [m] at u [V]
 };
 
 // Ramberg–Osgood parameters of (2)–(3).
@@ -70,8 +70,8 @@ struct RambergOsgoodParams {
   // The converse is not unique ((y*, u*, alpha) scale together): u* [V] is chosen by the caller.
   static RambergOsgoodParams from_mem(const MemParams& mem, double u_star);
 
-  double skeleton(double u) const noexcept;                                // (2) [m]
-  double branch(double u, double u_i, double y_i) const noexcept;          // (3) [m]
+  double skeleton(double u) const noexcept;                        // (2) [m]
+  double branch(double u, double u_i, double y_i) const noexcept;  // (3) [m]
 };
 
 // u [V] -> y [m].
@@ -94,8 +94,8 @@ class MemModel {
   void set_params(const MemParams& params);
   const MemParams& params() const noexcept { return params_; }
 
-  double input() const noexcept { return u_; }    // last u [V]
-  double output() const noexcept { return y_; }   // last y [m]
+  double input() const noexcept { return u_; }                   // last u [V]
+  double output() const noexcept { return y_; }                  // last y [m]
   double branch_origin_u() const noexcept { return u_origin_; }  // [V]
   double branch_origin_y() const noexcept { return y_origin_; }  // [m]
   bool on_skeleton() const noexcept { return scale_ != 1.0; }
@@ -167,7 +167,7 @@ class MemInverse {
   double u_ = 0.0;
   double y_at_u_ = 0.0;  // the model's output at u_ (the y_ref that produced it): next branching point
   double y_ref_ = 0.0;
-  int direction_ = 0;    // of u (= of y along a branch): +1, -1, 0 = not yet known
+  int direction_ = 0;  // of u (= of y along a branch): +1, -1, 0 = not yet known
   std::uint64_t reversals_ = 0;
   // Warm start: the last point where F, M and p^c3 were evaluated (see solve_run).
   bool warm_ = false;

@@ -20,7 +20,9 @@ namespace hystloop {
 
 // A parameter set: a value type that can check itself (throws ParameterError naming the field).
 template <class P>
-concept ModelParameters = std::copyable<P> && requires(const P& p) { p.validate(); };
+concept ModelParameters = std::copyable<P> && requires(const P& p) {
+  p.validate();
+};
 
 // The parameter type a model is built from, deduced from its params() accessor.
 template <class M>
@@ -28,24 +30,28 @@ using model_params_t = std::remove_cvref_t<decltype(std::declval<const M&>().par
 
 // u [V] -> y [m], sample by sample.
 template <class M>
-concept HysteresisForward =
-    ModelParameters<model_params_t<M>> && std::constructible_from<M, const model_params_t<M>&> &&
-    requires(M& m, const M& cm, double u) {
-      m.reset(u);
-      { m.forward(u) } noexcept -> std::same_as<double>;
-      { cm.params() } noexcept -> std::same_as<const model_params_t<M>&>;
-      m.set_params(cm.params());
-    };
+concept HysteresisForward = ModelParameters<model_params_t<M>> && std::constructible_from < M,
+        const model_params_t<M>
+& > &&requires(M& m, const M& cm, double u) {
+  m.reset(u);
+  { m.forward(u) }
+  noexcept->std::same_as<double>;
+  { cm.params() }
+  noexcept->std::same_as<const model_params_t<M>&>;
+  m.set_params(cm.params());
+};
 
 // y_ref [m] -> u [V], sample by sample (a feedforward compensator).
 template <class M>
-concept HysteresisInverse =
-    ModelParameters<model_params_t<M>> && std::constructible_from<M, const model_params_t<M>&> &&
-    requires(M& m, const M& cm, double y) {
-      m.reset(y);
-      { m.inverse(y) } noexcept -> std::same_as<double>;
-      { cm.params() } noexcept -> std::same_as<const model_params_t<M>&>;
-      m.set_params(cm.params());
-    };
+concept HysteresisInverse = ModelParameters<model_params_t<M>> && std::constructible_from < M,
+        const model_params_t<M>
+& > &&requires(M& m, const M& cm, double y) {
+  m.reset(y);
+  { m.inverse(y) }
+  noexcept->std::same_as<double>;
+  { cm.params() }
+  noexcept->std::same_as<const model_params_t<M>&>;
+  m.set_params(cm.params());
+};
 
 }  // namespace hystloop

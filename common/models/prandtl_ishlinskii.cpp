@@ -19,7 +19,8 @@ double play(double u, double r, double z) noexcept { return std::max(u - r, std:
 
 void PiParams::validate() const {
   if (count < 1 || count > kPiMaxOperators) {
-    throw ParameterError("count", "must be in [1, " + std::to_string(kPiMaxOperators) + "] (got " + std::to_string(count) + ")");
+    throw ParameterError("count",
+                         "must be in [1, " + std::to_string(kPiMaxOperators) + "] (got " + std::to_string(count) + ")");
   }
   if (thresholds[0] != 0.0) throw ParameterError("thresholds[0]", "must be 0 (the identity operator)");
   require_positive("weights[0]", weights[0]);
@@ -38,11 +39,13 @@ void PiParams::validate() const {
 }
 
 PiParams PiParams::with_even_thresholds(std::size_t count, double max_threshold) {
-  if (count < 1 || count > kPiMaxOperators) throw ParameterError("count", "must be in [1, " + std::to_string(kPiMaxOperators) + "]");
+  if (count < 1 || count > kPiMaxOperators)
+    throw ParameterError("count", "must be in [1, " + std::to_string(kPiMaxOperators) + "]");
   require_positive("max_threshold", max_threshold);
   PiParams p;
   p.count = count;
-  for (std::size_t i = 0; i < count; ++i) p.thresholds[i] = max_threshold * static_cast<double>(i) / static_cast<double>(count);
+  for (std::size_t i = 0; i < count; ++i)
+    p.thresholds[i] = max_threshold * static_cast<double>(i) / static_cast<double>(count);
   return p;
 }
 

@@ -55,8 +55,8 @@ class ReversalDetector {
     return Event::kNone;
   }
 
-  int direction() const noexcept { return direction_; }           // +1, -1, or 0 (not yet known)
-  double extremum() const noexcept { return extremum_; }          // furthest point in the direction
+  int direction() const noexcept { return direction_; }             // +1, -1, or 0 (not yet known)
+  double extremum() const noexcept { return extremum_; }            // furthest point in the direction
   double turning_point() const noexcept { return turning_point_; }  // last branching point
   double deadband() const noexcept { return deadband_; }
 

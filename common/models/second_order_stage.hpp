@@ -42,14 +42,14 @@ class SecondOrderStage {
   double step(double w, double dt) noexcept;
 
   const SecondOrderStageParams& params() const noexcept { return params_; }
-  double output() const noexcept { return x_(0); }    // y
-  double velocity() const noexcept;                   // dy/dt [unit/s]
+  double output() const noexcept { return x_(0); }  // y
+  double velocity() const noexcept;                 // dy/dt [unit/s]
 
  private:
   void discretise(double dt) noexcept;
 
   SecondOrderStageParams params_;
-  double omega_n_ = 0.0;                          // [rad/s]
+  double omega_n_ = 0.0;                         // [rad/s]
   Eigen::Vector2d x_ = Eigen::Vector2d::Zero();  // [y, v / omega_n]
   Eigen::Matrix2d phi_ = Eigen::Matrix2d::Identity();
   Eigen::Vector2d gamma_ = Eigen::Vector2d::Zero();

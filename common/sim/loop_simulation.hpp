@@ -20,8 +20,8 @@ struct LoopSimulationConfig {
   SimulatedStageConfig stage{};
   ActuatorLimits limits{};
   CompensatorConfig compensator{};
-  FeedbackGains servo{};   // the bridge's servo (all zero: feedforward only)
-  int block_ticks = 10;    // samples reach the compensator in blocks of this many ticks
+  FeedbackGains servo{};  // the bridge's servo (all zero: feedforward only)
+  int block_ticks = 10;   // samples reach the compensator in blocks of this many ticks
 };
 
 // One tick as the loop saw it.
@@ -73,7 +73,7 @@ class LoopSimulation {
   std::int64_t k_ = 0;
   bool keep_history_ = true;
   std::vector<LoopTick> history_;
-  std::vector<CommandTick> plan_;    // scratch for the compensator's plan
+  std::vector<CommandTick> plan_;  // scratch for the compensator's plan
   double y_last_m_ = 0.0;
 };
 

@@ -150,7 +150,8 @@ TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& mo
   run.final_mode = sim.compensator().mode();
   run.final_kind = sim.compensator().model_params().kind;
   run.counters = sim.compensator().counters();
-  for (double t = 0.0; t + 0.5 < e.track_s; t += 1.0) run.rms_per_second_m.push_back(rms_true(sim.history(), t, t + 1.0));
+  for (double t = 0.0; t + 0.5 < e.track_s; t += 1.0)
+    run.rms_per_second_m.push_back(rms_true(sim.history(), t, t + 1.0));
   judge_swaps(sim.history(), selector.margin, run);
   return run;
 }

@@ -21,8 +21,8 @@ struct TrackingExperiment {
   double settle_s = 4.0;    // the error is measured over [settle_s, track_s)
   double noise_rms_m = 1e-9;
   std::uint64_t seed = 7;
-  double kp = 0.1;          // feedback, when on (normalised, see loop/feedback.hpp)
-  double ki = 600.0;        // [1/s]
+  double kp = 0.1;    // feedback, when on (normalised, see loop/feedback.hpp)
+  double ki = 600.0;  // [1/s]
   PlantKind plant = PlantKind::kBanning;
   // The Ramberg-Osgood plant's truth. Not paper_like(): its +-250 V major loop spans 3.17 um, less
   // than the reference's 3.2 um, so the actuator's range would clip the feedforward. These span
@@ -53,9 +53,9 @@ struct TrackingOptions {
   FeedforwardMode mode = FeedforwardMode::kMem;
   bool feedback = false;
   Reidentify reidentify = Reidentify::off;
-  MemParams start_mem{};          // MEM's parameters at the start
-  double refit_every_s = 1.0;     // re-identification period [s]
-  double window_s = 4.0;          // the estimator's window [s] (4 s: eight branches of the 1 Hz reference)
+  MemParams start_mem{};       // MEM's parameters at the start
+  double refit_every_s = 1.0;  // re-identification period [s]
+  double window_s = 4.0;       // the estimator's window [s] (4 s: eight branches of the 1 Hz reference)
   // With Reidentify::select (pinned: no model change). Fits at 2 kHz: 10 kHz / 5 keeps MEM's c2 within
   // 0.4 % on the Ramberg-Osgood stage (10 kHz / 10: 1.2 %) at a fifth of the fitting time.
   OnlineSelectorOptions selector{.decimation = 5};
@@ -78,9 +78,9 @@ struct TrackingRun {
   FeedforwardMode final_mode = FeedforwardMode::kMem;
   std::vector<double> rms_per_second_m;  // true-position RMS over [i, i + 1) s (0: no reference)
   std::vector<SwapRecord> swaps;
-  int worse_swaps = 0;               // swaps with `worse`
-  int offers_refused = 0;            // offers the compensator refused (goal: 0)
-  double first_kind_time_s = -1.0;   // when the last model switch was planned (-1: none)
+  int worse_swaps = 0;              // swaps with `worse`
+  int offers_refused = 0;           // offers the compensator refused (goal: 0)
+  double first_kind_time_s = -1.0;  // when the last model switch was planned (-1: none)
   CompensatorCounters counters{};
 };
 

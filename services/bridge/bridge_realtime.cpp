@@ -59,7 +59,8 @@ SafeStopResult BridgeRealtime::stop() {
     begin_safe_stop();
     const std::int64_t deadline_ns =
         safe_stop_begin_ns_ + static_cast<std::int64_t>(settings_.stop_ramp_timeout_s * 1e9);
-    while (!safe_reached() && monotonic_now_ns() < deadline_ns) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (!safe_reached() && monotonic_now_ns() < deadline_ns)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     const std::int64_t waited_ns = monotonic_now_ns() - safe_stop_begin_ns_;
     stop_.store(true, std::memory_order_release);
     thread_.join();
@@ -102,7 +103,7 @@ void BridgeRealtime::run() noexcept {
   // the watchdog (seen on a fresh clone while another build ran: a 50 ms stall, 480 stale
   // commands). Hardware cannot go back in time: missed deadlines are skipped.
   const bool catch_up = backend_->simulated();
-  std::int64_t next = 0;  // the next tick to run
+  std::int64_t next = 0;                            // the next tick to run
   while (!stop_.load(std::memory_order_acquire)) {  // the I/O thread stops us after a last report
     const TickInfo info = timer.wait_next();
     const std::int64_t due = (static_cast<std::int64_t>(info.tick) + 1) * per_wake;  // ticks [0, due) are due
@@ -141,7 +142,8 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   const BridgeTick decided = core_.tick(k, y_last_m_);
   arming_.after_tick(k, core_);
   if (core_.armed() && commands_seen_) {
-    min_depth_period_ = min_depth_period_ < 0 ? decided.buffer_depth : std::min(min_depth_period_, decided.buffer_depth);
+    min_depth_period_ =
+        min_depth_period_ < 0 ? decided.buffer_depth : std::min(min_depth_period_, decided.buffer_depth);
     min_depth_total_ = min_depth_total_ < 0 ? decided.buffer_depth : std::min(min_depth_total_, decided.buffer_depth);
   }
   // After an overrun the stage has been holding the last voltage for the skipped ticks too.

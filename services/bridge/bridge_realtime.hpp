@@ -32,12 +32,12 @@ struct OutgoingTick {
 
 // How the stop's ramp to actuator.safe_u_V went (BridgeRealtime::begin_safe_stop / stop).
 struct SafeStopResult {
-  bool requested = false;     // begin_safe_stop() was called
-  bool reached = false;       // the ramp applied safe_u_V before the thread ended
-  double u_start_V = 0.0;     // applied when the real-time thread took the request
+  bool requested = false;       // begin_safe_stop() was called
+  bool reached = false;         // the ramp applied safe_u_V before the thread ended
+  double u_start_V = 0.0;       // applied when the real-time thread took the request
   std::int64_t ramp_ticks = 0;  // ticks that moved the voltage (0: it was already safe)
-  double ramp_s = 0.0;        // ramp_ticks * dt: loop time
-  double wall_s = 0.0;        // from the request to the tick that applied safe_u_V (or to the timeout)
+  double ramp_s = 0.0;          // ramp_ticks * dt: loop time
+  double wall_s = 0.0;          // from the request to the tick that applied safe_u_V (or to the timeout)
 };
 
 class BridgeRealtime {
@@ -110,9 +110,9 @@ class BridgeRealtime {
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;
   std::int64_t last_tick_ = -1;
-  double y_last_m_ = 0.0;                 // the stage's last measured position
-  std::int64_t min_depth_period_ = -1;    // lowest buffer depth at an armed tick this report period
-  std::int64_t min_depth_total_ = -1;     // ... since start (after the first command)
+  double y_last_m_ = 0.0;               // the stage's last measured position
+  std::int64_t min_depth_period_ = -1;  // lowest buffer depth at an armed tick this report period
+  std::int64_t min_depth_total_ = -1;   // ... since start (after the first command)
   bool commands_seen_ = false;
 };
 

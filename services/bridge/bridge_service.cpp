@@ -33,9 +33,9 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
       lcm_(lcm),
       rt_(settings, make_stage_backend(settings)),
       sensor_pub_(lcm, channels.sensor),
-      commands_(lcm, channels.command,
-                [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
-                command_options(settings.command_queue_capacity)),
+      commands_(
+          lcm, channels.command, [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
+          command_options(settings.command_queue_capacity)),
       control_(lcm, channels.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }),
       status_(lcm, channels.status, "bridge"),
       gains_(settings.servo) {
@@ -223,13 +223,15 @@ int BridgeService::run() {
 
 void BridgeService::log_safe_stop(const SafeStopResult& r) const {
   if (r.reached) {
-    spdlog::info("safe state reached: ramped from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s "
-                 "wall; bound {} s); the real-time thread has ended",
-                 r.u_start_V, settings_.limits.safe_u_V, r.ramp_ticks, r.ramp_s, r.wall_s, settings_.stop_ramp_timeout_s);
+    spdlog::info(
+        "safe state reached: ramped from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s "
+        "wall; bound {} s); the real-time thread has ended",
+        r.u_start_V, settings_.limits.safe_u_V, r.ramp_ticks, r.ramp_s, r.wall_s, settings_.stop_ramp_timeout_s);
   } else {
-    spdlog::error("the ramp to the safe {} V did not end within {} s (the longest ramp + margin; from {:.6g} V, "
-                  "{} ticks ramped); the backend was told to hold the safe voltage",
-                  settings_.limits.safe_u_V, settings_.stop_ramp_timeout_s, r.u_start_V, r.ramp_ticks);
+    spdlog::error(
+        "the ramp to the safe {} V did not end within {} s (the longest ramp + margin; from {:.6g} V, "
+        "{} ticks ramped); the backend was told to hold the safe voltage",
+        settings_.limits.safe_u_V, settings_.stop_ramp_timeout_s, r.u_start_V, r.ramp_ticks);
   }
 }
 
@@ -270,8 +272,9 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   previous_dropped_ = rt.samples_dropped;
   if (k.watchdog_trips != trips_reported_) {
     trips_reported_ = k.watchdog_trips;
-    safe_reason_ = fmt::format("watchdog: no command buffered for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
-                               settings_.limits.watchdog_s, rt.last_trip_tick);
+    safe_reason_ =
+        fmt::format("watchdog: no command buffered for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
+                    settings_.limits.watchdog_s, rt.last_trip_tick);
     spdlog::warn("{}", safe_reason_);
   }
 
@@ -306,7 +309,8 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   if (rt.min_depth_period >= 0) {
     status_.counter("buffer_min_depth_period_ticks", static_cast<std::uint64_t>(rt.min_depth_period));
   }
-  if (rt.min_depth_total >= 0) status_.counter("buffer_min_depth_ticks", static_cast<std::uint64_t>(rt.min_depth_total));
+  if (rt.min_depth_total >= 0)
+    status_.counter("buffer_min_depth_ticks", static_cast<std::uint64_t>(rt.min_depth_total));
   if (rt.lateness.count() > 0) {  // the timer's wake-up lateness this period
     status_.counter("timer_lateness_p50_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.5)));
     status_.counter("timer_lateness_p99_ns", static_cast<std::uint64_t>(rt.lateness.percentile(0.99)));
@@ -315,9 +319,10 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   counters_.report(status_, "command", commands_.counters());
   counters_.report(status_, "control", control_.counters());
   counters_.report(status_, "sensor", sensor_pub_.counters());
-  status_.add_rejected(static_cast<std::int64_t>(
-      counters_.since("rejected_nonfinite", k.rejected_nonfinite) + counters_.since("rejected_future", k.rejected_future) +
-      counters_.since("command_queue_full", command_queue_full_) + counters_.since("control_refused", control_refused_)));
+  status_.add_rejected(static_cast<std::int64_t>(counters_.since("rejected_nonfinite", k.rejected_nonfinite) +
+                                                 counters_.since("rejected_future", k.rejected_future) +
+                                                 counters_.since("command_queue_full", command_queue_full_) +
+                                                 counters_.since("control_refused", control_refused_)));
   status_.late(static_cast<std::int64_t>(counters_.since("late", k.late)));
   status_.loop_timing(rt.work);
   status_.latency(latency_);
@@ -328,24 +333,29 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
 void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
-  spdlog::info("summary: {} ticks ({} skipped, {} run late to catch up), {} commands applied, {} late ({:.3g} % of armed ticks), {} stale, "
-               "{} duplicate, {} clamped, {} slew-limited, {} watchdog trips, {} non-finite and {} too-far-ahead "
-               "rejected; lowest buffer depth {} ticks",
-               c.ticks, rt.ticks_skipped, rt.ticks_caught_up, c.applied, c.late, armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0,
-               c.stale, c.duplicates, c.clamped, c.slew_limited, c.watchdog_trips, c.rejected_nonfinite,
-               c.rejected_future, rt.min_depth_total);
+  spdlog::info(
+      "summary: {} ticks ({} skipped, {} run late to catch up), {} commands applied, {} late ({:.3g} % of armed "
+      "ticks), {} stale, "
+      "{} duplicate, {} clamped, {} slew-limited, {} watchdog trips, {} non-finite and {} too-far-ahead "
+      "rejected; lowest buffer depth {} ticks",
+      c.ticks, rt.ticks_skipped, rt.ticks_caught_up, c.applied, c.late,
+      armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0, c.stale, c.duplicates, c.clamped,
+      c.slew_limited, c.watchdog_trips, c.rejected_nonfinite, c.rejected_future, rt.min_depth_total);
   if (latency_total_.count() > 0) {
-    spdlog::info("summary: sensor block sent -> its answer received p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} commands",
-                 latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
-                 static_cast<double>(latency_total_.max_ns()) / 1e3, latency_total_.count());
+    spdlog::info(
+        "summary: sensor block sent -> its answer received p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} "
+        "commands",
+        latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
+        static_cast<double>(latency_total_.max_ns()) / 1e3, latency_total_.count());
   }
   spdlog::info("summary: {} sensor blocks published, {} command blocks received ({} rejected), {} dropped samples",
-               sensor_pub_.counters().published, commands_.counters().received,
-               commands_.counters().rejected_total(), rt.samples_dropped);
-  spdlog::info("summary: stop: {} from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s wall; "
-               "bound {} s)",
-               safe.reached ? "ramped" : "ramp NOT finished", safe.u_start_V, settings_.limits.safe_u_V,
-               safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
+               sensor_pub_.counters().published, commands_.counters().received, commands_.counters().rejected_total(),
+               rt.samples_dropped);
+  spdlog::info(
+      "summary: stop: {} from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s wall; "
+      "bound {} s)",
+      safe.reached ? "ramped" : "ramp NOT finished", safe.u_start_V, settings_.limits.safe_u_V, safe.ramp_ticks,
+      safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
 }
 
 void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult& safe) const {
@@ -370,10 +380,9 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
       rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
       latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, latency_total_.count(),
       c.applied, c.clamped, c.slew_limited, c.rejected_nonfinite, c.rejected_future,
-      commands_.counters().rejected_total(), wall_s,
-      usage.user_cpu_s + usage.system_cpu_s, wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0,
-      safe.reached, safe.u_start_V, safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s,
-      settings_.limits.safe_u_V);
+      commands_.counters().rejected_total(), wall_s, usage.user_cpu_s + usage.system_cpu_s,
+      wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0, safe.reached, safe.u_start_V,
+      safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s, settings_.limits.safe_u_V);
   std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");
   if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
     spdlog::error("could not write the summary to {}", summary_json_path_);

@@ -61,7 +61,7 @@ class BridgeService {
   ControlFilter filter_{"bridge"};
   StatusReporter status_;
   SendTimeRing sent_;
-  LatencyStats latency_;  // sensor block sent -> the command block answering it received, this period
+  LatencyStats latency_;        // sensor block sent -> the command block answering it received, this period
   LatencyStats latency_total_;  // since start, for the summary
 
   // I/O-thread counters (cumulative).

@@ -12,17 +12,45 @@
 
 namespace hystloop {
 const std::vector<std::string>& bridge_config_keys() {
-  static const std::vector<std::string> keys = {
-      "bridge.backend", "bridge.rate_hz", "bridge.noise_rms_m", "bridge.seed", "bridge.drift_fraction",
-      "bridge.drift_start_s", "bridge.drift_duration_s", "bridge.auto_arm", "actuator.rearm_after_trip_s", "bridge.degraded_late_fraction",
-      "bridge.run_seconds", "bridge.command_queue_capacity", "bridge.block_ticks",
-      "servo.kp", "servo.ki", "servo.kd", "servo.nominal_gain_m_per_V", "servo.d_filter_hz",
-      "actuator.u_min_V", "actuator.u_max_V", "actuator.slew_V_per_s", "actuator.safe_u_V",
-      "actuator.safe_ramp_V_per_s", "actuator.watchdog_s",
-      "rt.ticks_per_wake", "rt.priority", "rt.io_priority", "rt.lock_memory", "rt.cpu",
-      "banning.hysteresis.a", "banning.hysteresis.b", "banning.hysteresis.alpha", "banning.hysteresis.s_max",
-      "banning.stage.k", "banning.stage.c", "banning.order",
-      "ro.c1", "ro.c2", "ro.c3"};
+  static const std::vector<std::string> keys = {"bridge.backend",
+                                                "bridge.rate_hz",
+                                                "bridge.noise_rms_m",
+                                                "bridge.seed",
+                                                "bridge.drift_fraction",
+                                                "bridge.drift_start_s",
+                                                "bridge.drift_duration_s",
+                                                "bridge.auto_arm",
+                                                "actuator.rearm_after_trip_s",
+                                                "bridge.degraded_late_fraction",
+                                                "bridge.run_seconds",
+                                                "bridge.command_queue_capacity",
+                                                "bridge.block_ticks",
+                                                "servo.kp",
+                                                "servo.ki",
+                                                "servo.kd",
+                                                "servo.nominal_gain_m_per_V",
+                                                "servo.d_filter_hz",
+                                                "actuator.u_min_V",
+                                                "actuator.u_max_V",
+                                                "actuator.slew_V_per_s",
+                                                "actuator.safe_u_V",
+                                                "actuator.safe_ramp_V_per_s",
+                                                "actuator.watchdog_s",
+                                                "rt.ticks_per_wake",
+                                                "rt.priority",
+                                                "rt.io_priority",
+                                                "rt.lock_memory",
+                                                "rt.cpu",
+                                                "banning.hysteresis.a",
+                                                "banning.hysteresis.b",
+                                                "banning.hysteresis.alpha",
+                                                "banning.hysteresis.s_max",
+                                                "banning.stage.k",
+                                                "banning.stage.c",
+                                                "banning.order",
+                                                "ro.c1",
+                                                "ro.c2",
+                                                "ro.c3"};
   static const std::vector<std::string> all = [] {
     std::vector<std::string> k = keys;
     k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
@@ -107,7 +135,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
                                          "): a block is published when its last tick has run");
   }
   if (s.backend == "comedi" && s.rt.ticks_per_wake != 1) {
-    config.fail("rt.ticks_per_wake", "must be 1 with bridge.backend comedi: a card's output cannot run ticks back to back");
+    config.fail("rt.ticks_per_wake",
+                "must be 1 with bridge.backend comedi: a card's output cannot run ticks back to back");
   }
   s.rt.priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt.priority, 0, 99));
   s.rt.io_priority = static_cast<int>(config.get_int_in_range("rt.io_priority", s.rt.io_priority, 0, 99));
@@ -129,10 +158,11 @@ std::vector<std::string> describe(const BridgeSettings& s) {
       s.rate_hz, st.noise_rms_m, st.seed, st.drift_fraction, st.drift_duration_s, st.drift_start_s,
       s.auto_arm ? "auto-arm" : "arm via HX_CONTROL",
       s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
-  lines.push_back(fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s, "
-                              "stop: ramp to safe (at most {:.4g} s) within {} s",
-                              a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_rate_V_per_s(), a.watchdog_s,
-                              a.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
+  lines.push_back(
+      fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s, "
+                  "stop: ramp to safe (at most {:.4g} s) within {} s",
+                  a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_rate_V_per_s(), a.watchdog_s,
+                  a.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
   if (s.backend == "comedi") {
     lines.push_back(describe(s.comedi));
   } else if (s.backend == "sim") {

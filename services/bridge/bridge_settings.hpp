@@ -24,21 +24,21 @@ struct RtSettings {
 };
 
 struct BridgeSettings {
-  std::string backend = "sim";     // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
-  double rate_hz = 10000.0;        // the loop's clock
-  SimulatedStageConfig stage{};    // noise, seed, drift and the plants' parameters
-  ComediSettings comedi{};         // the comedi.* keys (used when backend is comedi)
+  std::string backend = "sim";   // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
+  double rate_hz = 10000.0;      // the loop's clock
+  SimulatedStageConfig stage{};  // noise, seed, drift and the plants' parameters
+  ComediSettings comedi{};       // the comedi.* keys (used when backend is comedi)
   ActuatorLimits limits{};
-  FeedbackGains servo{};           // the servo on y_ref - y (all gains 0 = feedforward only)
-  int block_ticks = 20;            // ticks per HX_SENSOR block: 500 messages/s (1 = a message per tick)
+  FeedbackGains servo{};  // the servo on y_ref - y (all gains 0 = feedforward only)
+  int block_ticks = 20;   // ticks per HX_SENSOR block: 500 messages/s (1 = a message per tick)
   RtSettings rt{};
-  bool auto_arm = false;           // arm as soon as commands flow (first arm only)
-  double rearm_after_trip_s = 0.0; // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
-  double stop_ramp_timeout_s = 0.75; // on every stop, the ramp to actuator.safe_u_V must end within this:
-                                     // the longest ramp + kStopRampMargin_s (set from the actuator's keys)
+  bool auto_arm = false;                 // arm as soon as commands flow (first arm only)
+  double rearm_after_trip_s = 0.0;       // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
+  double stop_ramp_timeout_s = 0.75;     // on every stop, the ramp to actuator.safe_u_V must end within this:
+                                         // the longest ramp + kStopRampMargin_s (set from the actuator's keys)
   double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
-  double run_seconds = 0.0;        // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
-  int command_queue_capacity = 256;  // LCM's queue for HX_COMMAND [blocks]
+  double run_seconds = 0.0;              // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
+  int command_queue_capacity = 256;      // LCM's queue for HX_COMMAND [blocks]
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
 };

@@ -74,8 +74,9 @@ ComediConverter::ComediConverter(comedi_t* device, unsigned subdevice, unsigned 
   range_ = *r;
   const int flags = comedi_get_subdevice_flags(device, subdevice);
   if (calibration != nullptr && flags >= 0 && (flags & SDF_SOFT_CALIBRATED) != 0) {
-    softcal_ = comedi_get_softcal_converter(subdevice, channel, range, COMEDI_TO_PHYSICAL, calibration, &to_phys_) == 0 &&
-               comedi_get_softcal_converter(subdevice, channel, range, COMEDI_FROM_PHYSICAL, calibration, &from_phys_) == 0;
+    softcal_ =
+        comedi_get_softcal_converter(subdevice, channel, range, COMEDI_TO_PHYSICAL, calibration, &to_phys_) == 0 &&
+        comedi_get_softcal_converter(subdevice, channel, range, COMEDI_FROM_PHYSICAL, calibration, &from_phys_) == 0;
   }
 }
 
@@ -171,8 +172,10 @@ void ComediBackend::check_against_card() {
     const int s = find_subdevice(dev, c.subdevice, type);
     const std::string p = std::string("comedi.") + prefix + ".";
     if (s < 0) fail(p + "subdevice", fmt::format("the card has no {} subdevice", kind));
-    if (s >= comedi_get_n_subdevices(dev)) fail(p + "subdevice", fmt::format("the card has {} subdevices", comedi_get_n_subdevices(dev)));
-    if (comedi_get_subdevice_type(dev, static_cast<unsigned>(s)) != type) fail(p + "subdevice", fmt::format("subdevice {} is not an {}", s, kind));
+    if (s >= comedi_get_n_subdevices(dev))
+      fail(p + "subdevice", fmt::format("the card has {} subdevices", comedi_get_n_subdevices(dev)));
+    if (comedi_get_subdevice_type(dev, static_cast<unsigned>(s)) != type)
+      fail(p + "subdevice", fmt::format("subdevice {} is not an {}", s, kind));
     const unsigned su = static_cast<unsigned>(s);
     const int n_channels = comedi_get_n_channels(dev, su);
     if (c.channel >= n_channels) fail(p + "channel", fmt::format("subdevice {} has {} channels", s, n_channels));
@@ -297,12 +300,13 @@ void ComediBackend::append_counters(std::vector<std::pair<std::string, std::uint
 }
 
 std::string ComediBackend::describe() const {
-  return fmt::format("comedi {} ({} / {}): ao subdevice {} channel {} {}; ai subdevice {} channel {} aref {} {}; "
-                     "calibration {}",
-                     settings_.device, comedi_get_driver_name(handle_.device), comedi_get_board_name(handle_.device),
-                     ao_subdevice_, settings_.ao.channel, dac_.describe(), ai_subdevice_, settings_.ai.channel,
-                     aref_name(settings_.ai.aref), adc_.describe(),
-                     handle_.calibration_path.empty() ? std::string("none (range tables)") : handle_.calibration_path);
+  return fmt::format(
+      "comedi {} ({} / {}): ao subdevice {} channel {} {}; ai subdevice {} channel {} aref {} {}; "
+      "calibration {}",
+      settings_.device, comedi_get_driver_name(handle_.device), comedi_get_board_name(handle_.device), ao_subdevice_,
+      settings_.ao.channel, dac_.describe(), ai_subdevice_, settings_.ai.channel, aref_name(settings_.ai.aref),
+      adc_.describe(),
+      handle_.calibration_path.empty() ? std::string("none (range tables)") : handle_.calibration_path);
 }
 
 }  // namespace hystloop

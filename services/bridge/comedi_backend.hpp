@@ -33,7 +33,7 @@ class ComediConverter {
                   const comedi_calibration_t* calibration);
   ComediConverter() = default;
 
-  double to_V(lsampl_t counts) const noexcept;    // NaN at the range table's ends (0, maxdata)
+  double to_V(lsampl_t counts) const noexcept;   // NaN at the range table's ends (0, maxdata)
   lsampl_t from_V(double volts) const noexcept;  // `volts` within [min_V, max_V]
   double min_V() const noexcept { return range_.min; }
   double max_V() const noexcept { return range_.max; }
@@ -64,14 +64,14 @@ struct ComediHandle {
 };
 
 struct ComediCounters {
-  std::atomic<std::uint64_t> transfers{0};     // comedi_do_insnlist calls of step()
-  std::atomic<std::uint64_t> write_errors{0};  // the write did not happen (rc < 1)
-  std::atomic<std::uint64_t> read_errors{0};   // the read did not happen (rc < 2)
-  std::atomic<std::uint64_t> saturated{0};     // read 0 or maxdata (or NaN): the sensor is out of range
-  std::atomic<std::uint64_t> sensor_faults{0}; // ticks flagged SENSOR_FAULT (read error or saturated)
-  std::atomic<std::uint64_t> fault_safe{0};    // times comedi.fault_limit faults in a row asked for the safe state
-  std::atomic<std::uint64_t> dac_clamped{0};   // card voltage clamped to the DAC's range (0 when the config is right)
-  std::atomic<std::uint64_t> safe_writes{0};   // hold_safe / start / emergency writes of the safe voltage
+  std::atomic<std::uint64_t> transfers{0};      // comedi_do_insnlist calls of step()
+  std::atomic<std::uint64_t> write_errors{0};   // the write did not happen (rc < 1)
+  std::atomic<std::uint64_t> read_errors{0};    // the read did not happen (rc < 2)
+  std::atomic<std::uint64_t> saturated{0};      // read 0 or maxdata (or NaN): the sensor is out of range
+  std::atomic<std::uint64_t> sensor_faults{0};  // ticks flagged SENSOR_FAULT (read error or saturated)
+  std::atomic<std::uint64_t> fault_safe{0};     // times comedi.fault_limit faults in a row asked for the safe state
+  std::atomic<std::uint64_t> dac_clamped{0};    // card voltage clamped to the DAC's range (0 when the config is right)
+  std::atomic<std::uint64_t> safe_writes{0};    // hold_safe / start / emergency writes of the safe voltage
 };
 
 class ComediBackend final : public StageBackend {

@@ -26,11 +26,20 @@ ComediChannelSettings load_channel(const Config& config, const std::string& pref
 }  // namespace
 
 const std::vector<std::string>& comedi_config_keys() {
-  static const std::vector<std::string> keys = {
-      "comedi.device", "comedi.ao.subdevice", "comedi.ao.channel", "comedi.ao.range", "comedi.ao.aref",
-      "comedi.ai.subdevice", "comedi.ai.channel", "comedi.ai.range", "comedi.ai.aref",
-      "comedi.amplifier_gain_V_per_V", "comedi.sensor.scale_m_per_V", "comedi.sensor.offset_m",
-      "comedi.fault_limit", "comedi.calibration"};
+  static const std::vector<std::string> keys = {"comedi.device",
+                                                "comedi.ao.subdevice",
+                                                "comedi.ao.channel",
+                                                "comedi.ao.range",
+                                                "comedi.ao.aref",
+                                                "comedi.ai.subdevice",
+                                                "comedi.ai.channel",
+                                                "comedi.ai.range",
+                                                "comedi.ai.aref",
+                                                "comedi.amplifier_gain_V_per_V",
+                                                "comedi.sensor.scale_m_per_V",
+                                                "comedi.sensor.offset_m",
+                                                "comedi.fault_limit",
+                                                "comedi.calibration"};
   return keys;
 }
 
@@ -61,10 +70,11 @@ std::string describe(const ComediSettings& s) {
                        c.subdevice < 0 ? std::string("auto") : std::to_string(c.subdevice), c.channel, c.range,
                        aref_name(c.aref));
   };
-  return fmt::format("comedi: {}, ao {} (x{} V/V to the piezo), ai {} ({:+.6g} m/V, offset {:.6g} m), go safe after {} "
-                     "faulted reads in a row, calibration {}",
-                     s.device, channel(s.ao), s.amplifier_gain_V_per_V, channel(s.ai), s.sensor_scale_m_per_V,
-                     s.sensor_offset_m, s.fault_limit, s.calibration);
+  return fmt::format(
+      "comedi: {}, ao {} (x{} V/V to the piezo), ai {} ({:+.6g} m/V, offset {:.6g} m), go safe after {} "
+      "faulted reads in a row, calibration {}",
+      s.device, channel(s.ao), s.amplifier_gain_V_per_V, channel(s.ai), s.sensor_scale_m_per_V, s.sensor_offset_m,
+      s.fault_limit, s.calibration);
 }
 
 }  // namespace hystloop

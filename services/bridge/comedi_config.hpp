@@ -16,12 +16,12 @@ namespace hystloop {
 struct ComediChannelSettings {
   int subdevice = -1;  // -1: the card's first analog output (ao) / analog input (ai) subdevice
   int channel = 0;
-  int range = 0;       // index into the subdevice's range table (see --probe-hardware)
-  int aref = 0;        // AREF_GROUND 0, AREF_COMMON 1, AREF_DIFF 2, AREF_OTHER 3 (ground | common | diff | other)
+  int range = 0;  // index into the subdevice's range table (see --probe-hardware)
+  int aref = 0;   // AREF_GROUND 0, AREF_COMMON 1, AREF_DIFF 2, AREF_OTHER 3 (ground | common | diff | other)
 };
 
 struct ComediSettings {
-  std::string source = "<defaults>";     // the config's file name, for messages found at open
+  std::string source = "<defaults>";  // the config's file name, for messages found at open
   std::string device = "/dev/comedi0";
   ComediChannelSettings ao{};            // -> the amplifier's input
   ComediChannelSettings ai{};            // <- the position sensor's output

@@ -1,5 +1,5 @@
-// hystloop-bridge: the 10 kHz clock, the stage (simulated: Banning or Ramberg-Osgood; or a DAQ card through comedi), the
-// actuator limits and the watchdog. See services/bridge/README.md.
+// hystloop-bridge: the 10 kHz clock, the stage (simulated: Banning or Ramberg-Osgood; or a DAQ card through comedi),
+// the actuator limits and the watchdog. See services/bridge/README.md.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -18,15 +18,18 @@
 
 int main(int argc, char** argv) {
   using namespace hystloop;
-  CLI::App app{"hystloop-bridge: owns the loop's clock. Buffers the feedforward and reference that HX_COMMAND sends "
-               "ahead of time, adds its servo (PI/PID on y_ref - y) at every tick, clamps, applies, samples the stage "
-               "and publishes HX_SENSOR in blocks. Starts in the safe state: arm it with an ARM request on HX_CONTROL "
-               "(or --auto-arm)."};
+  CLI::App app{
+      "hystloop-bridge: owns the loop's clock. Buffers the feedforward and reference that HX_COMMAND sends "
+      "ahead of time, adds its servo (PI/PID on y_ref - y) at every tick, clamps, applies, samples the stage "
+      "and publishes HX_SENSOR in blocks. Starts in the safe state: arm it with an ARM request on HX_CONTROL "
+      "(or --auto-arm)."};
   ServiceOptions options;
   add_service_options(app, options);
   std::string backend, noise, drift, seconds, summary_json;
   bool auto_arm = false;
-  app.add_option("--backend", backend, "Stage backend: sim (Banning stage), ro (Ramberg-Osgood) or comedi (a DAQ card: comedi.*) [bridge.backend]");
+  app.add_option(
+      "--backend", backend,
+      "Stage backend: sim (Banning stage), ro (Ramberg-Osgood) or comedi (a DAQ card: comedi.*) [bridge.backend]");
   app.add_option("--noise-rms-m", noise, "Sensor noise RMS [m] [bridge.noise_rms_m]");
   app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");
@@ -42,8 +45,10 @@ int main(int argc, char** argv) {
                "List the comedi card (subdevices, channels, ranges, calibration) and exit; with --yes also drive a "
                "slow, clamped triangle and report the sensor's gain and sign against the command");
   app.add_option("--device", device, "Comedi device file [comedi.device]");
-  app.add_flag("--yes", probe_options.drive, "With --probe-hardware: really drive the output (the amplifier is enabled)");
-  app.add_option("--amplitude-V", probe_options.amplitude_V, "With --probe-hardware --yes: the triangle's amplitude at the card [V]")
+  app.add_flag("--yes", probe_options.drive,
+               "With --probe-hardware: really drive the output (the amplifier is enabled)");
+  app.add_option("--amplitude-V", probe_options.amplitude_V,
+                 "With --probe-hardware --yes: the triangle's amplitude at the card [V]")
       ->check(CLI::Range(0.0, 10.0));
   app.add_option("--duration-s", probe_options.duration_s, "With --probe-hardware --yes: the triangle's duration [s]")
       ->check(CLI::Range(0.05, 60.0));

@@ -110,10 +110,11 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
   const double center_V = c.card_V(a.safe_u_V);
   const double lo_V = std::max({center_V - o.amplitude_V, c.card_V(a.u_min_V), backend.dac().min_V()});
   const double hi_V = std::min({center_V + o.amplitude_V, c.card_V(a.u_max_V), backend.dac().max_V()});
-  std::fprintf(out, "driving: triangle %.4g V -> %.4g V -> %.4g V -> %.4g V at the card (x%g: %.4g..%.4g V at the piezo), "
-               "%.3g s, %d steps\n", center_V, hi_V, lo_V, center_V, c.amplifier_gain_V_per_V,
-               lo_V * c.amplifier_gain_V_per_V, hi_V * c.amplifier_gain_V_per_V, o.duration_s,
-               static_cast<int>(o.duration_s * o.rate_hz));
+  std::fprintf(out,
+               "driving: triangle %.4g V -> %.4g V -> %.4g V -> %.4g V at the card (x%g: %.4g..%.4g V at the piezo), "
+               "%.3g s, %d steps\n",
+               center_V, hi_V, lo_V, center_V, c.amplifier_gain_V_per_V, lo_V * c.amplifier_gain_V_per_V,
+               hi_V * c.amplifier_gain_V_per_V, o.duration_s, static_cast<int>(o.duration_s * o.rate_hz));
   const int steps = std::max(4, static_cast<int>(o.duration_s * o.rate_hz));
   std::vector<double> command_V, sensor_V;
   command_V.reserve(static_cast<std::size_t>(steps));
@@ -140,17 +141,21 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
   std::fprintf(out, "measured: sensor %+.4g V per V at the card (offset %+.4g V, r %.4f) over %d samples, %d faulted\n",
                f.gain_V_per_V, f.offset_V, f.r, f.samples, f.faults);
   const double m_per_V = f.gain_V_per_V * c.sensor_scale_m_per_V / c.amplifier_gain_V_per_V;
-  std::fprintf(out, "  = %+.4g m per V at the piezo with comedi.sensor.scale_m_per_V %g and comedi.amplifier_gain_V_per_V %g "
-               "(servo.nominal_gain_m_per_V is %g)\n", m_per_V, c.sensor_scale_m_per_V, c.amplifier_gain_V_per_V,
-               settings.servo.nominal_gain_m_per_V);
+  std::fprintf(
+      out,
+      "  = %+.4g m per V at the piezo with comedi.sensor.scale_m_per_V %g and comedi.amplifier_gain_V_per_V %g "
+      "(servo.nominal_gain_m_per_V is %g)\n",
+      m_per_V, c.sensor_scale_m_per_V, c.amplifier_gain_V_per_V, settings.servo.nominal_gain_m_per_V);
   if (f.samples < 3 || std::abs(f.r) < 0.9) {
-    std::fprintf(out, "verdict: NO CLEAR RESPONSE (|r| < 0.9 or too few good reads): check the wiring, comedi.ai.* "
-                      "and the amplifier's enable before running the loop\n");
+    std::fprintf(out,
+                 "verdict: NO CLEAR RESPONSE (|r| < 0.9 or too few good reads): check the wiring, comedi.ai.* "
+                 "and the amplifier's enable before running the loop\n");
     return 1;
   }
   if (m_per_V < 0) {
-    std::fprintf(out, "verdict: SIGN REVERSED: the position falls as the command rises; swap the sensor's wiring or "
-                      "negate comedi.sensor.scale_m_per_V\n");
+    std::fprintf(out,
+                 "verdict: SIGN REVERSED: the position falls as the command rises; swap the sensor's wiring or "
+                 "negate comedi.sensor.scale_m_per_V\n");
     return 1;
   }
   std::fprintf(out, "verdict: sign OK (position rises with the command)\n");

@@ -15,10 +15,10 @@
 namespace hystloop {
 
 struct ProbeOptions {
-  bool drive = false;          // --yes
-  double amplitude_V = 1.0;    // at the card's output [V]
-  double duration_s = 1.0;     // one triangle: safe -> +A -> -A -> safe
-  double rate_hz = 1000.0;     // steps of the triangle
+  bool drive = false;        // --yes
+  double amplitude_V = 1.0;  // at the card's output [V]
+  double duration_s = 1.0;   // one triangle: safe -> +A -> -A -> safe
+  double rate_hz = 1000.0;   // steps of the triangle
 };
 
 // Writes the report to `out`. Returns 0, 1 (the card could not be opened / a read failed) or 2
@@ -29,7 +29,7 @@ int probe_hardware(const BridgeSettings& settings, const ProbeOptions& options, 
 struct ProbeFit {
   double gain_V_per_V = 0.0;  // slope (sign: + when the sensor rises with the command)
   double offset_V = 0.0;
-  double r = 0.0;             // correlation coefficient
+  double r = 0.0;  // correlation coefficient
   int samples = 0;
   int faults = 0;
 };

@@ -27,10 +27,10 @@ struct RtReport {
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue
   std::uint64_t auto_arms = 0;
   std::int64_t last_tick = -1;
-  std::int64_t last_trip_tick = -1;      // tick of the last watchdog trip
-  std::int64_t min_depth_period = -1;    // lowest buffer depth at an armed tick this period (-1: none)
-  std::int64_t min_depth_total = -1;     // ... since the first command arrived
-  std::int64_t buffer_depth = 0;         // now
+  std::int64_t last_trip_tick = -1;    // tick of the last watchdog trip
+  std::int64_t min_depth_period = -1;  // lowest buffer depth at an armed tick this period (-1: none)
+  std::int64_t min_depth_total = -1;   // ... since the first command arrived
+  std::int64_t buffer_depth = 0;       // now
   double u_applied_V = 0.0;
   double gain_scale = 1.0;
   bool armed = false;

@@ -15,10 +15,10 @@
 namespace hystloop {
 
 struct StageReading {
-  double y_m = 0.0;         // measured position [m]
-  std::int32_t flags = 0;   // sample_flags bits the backend adds (kSimulated, a sensor fault, ...)
-  bool go_safe = false;     // the backend asks for the safe state (e.g. its sensor failed too often in a row):
-                            // the bridge disarms as for DISARM (ramp to actuator.safe_u_V; re-arm via ARM)
+  double y_m = 0.0;        // measured position [m]
+  std::int32_t flags = 0;  // sample_flags bits the backend adds (kSimulated, a sensor fault, ...)
+  bool go_safe = false;    // the backend asks for the safe state (e.g. its sensor failed too often in a row):
+                           // the bridge disarms as for DISARM (ramp to actuator.safe_u_V; re-arm via ARM)
 };
 
 class StageBackend {

@@ -26,19 +26,20 @@ bool CompensatorService::admit(const ParamsHeader& h) {
   if (!h.valid) {
     ++counters_.params_invalid;
     if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::invalid)) {
-      spdlog::warn("{} parameters v{} from '{}' (publisher {:x}) are marked invalid; not used (further invalid "
-                   "sets from this publisher are counted, params_invalid, not logged){}",
-                   h.what, h.version, escape_wire(h.source), from, suppressed_note(g));
+      spdlog::warn(
+          "{} parameters v{} from '{}' (publisher {:x}) are marked invalid; not used (further invalid "
+          "sets from this publisher are counted, params_invalid, not logged){}",
+          h.what, h.version, escape_wire(h.source), from, suppressed_note(g));
     }
     return false;
   }
   if (!admission_.is_new(h.publisher_id, h.version)) {
     ++counters_.params_stale;
     if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale)) {
-      spdlog::info("{} parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
-                   "(further stale sets from this publisher are counted, params_stale, not logged){}",
-                   h.what, h.version, escape_wire(h.source), from, admission_.last_version(h.publisher_id),
-                   suppressed_note(g));
+      spdlog::info(
+          "{} parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
+          "(further stale sets from this publisher are counted, params_stale, not logged){}",
+          h.what, h.version, escape_wire(h.source), from, admission_.last_version(h.publisher_id), suppressed_note(g));
     }
     return false;
   }
@@ -55,18 +56,19 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
     }
     admission_.accept(h.publisher_id, h.version);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_now_ns())) {
-      spdlog::info("{} parameters v{} from '{}' (publisher {:x}) accepted ({}; residual {:.3g} m); swapped in at the "
-                   "next reversal{}",
-                   h.what, h.version, escape_wire(h.source), from, describe_model(set), h.residual_m,
-                   suppressed_note(g));
+      spdlog::info(
+          "{} parameters v{} from '{}' (publisher {:x}) accepted ({}; residual {:.3g} m); swapped in at the "
+          "next reversal{}",
+          h.what, h.version, escape_wire(h.source), from, describe_model(set), h.residual_m, suppressed_note(g));
     }
   } catch (const ParameterError& e) {
     ++counters_.params_refused;
     if (!admission_.first_refusal(h.publisher_id, ParamsRefusal::refused)) return;
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsRefused, monotonic_now_ns())) {
-      spdlog::warn("{} parameters v{} from '{}' (publisher {:x}) refused: {} (further refusals from this publisher "
-                   "are counted, params_rejected, not logged){}",
-                   h.what, h.version, escape_wire(h.source), from, e.what(), suppressed_note(g));
+      spdlog::warn(
+          "{} parameters v{} from '{}' (publisher {:x}) refused: {} (further refusals from this publisher "
+          "are counted, params_rejected, not logged){}",
+          h.what, h.version, escape_wire(h.source), from, e.what(), suppressed_note(g));
     }
   }
 }
@@ -87,11 +89,12 @@ void CompensatorService::on_model(const model_params_t& msg) {
     std::uint64_t& count = format_known ? counters_.model_unknown_kind : counters_.model_unknown_format;
     ++count;
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogModelUnknown, monotonic_now_ns())) {
-      spdlog::warn("model parameters v{} from '{}' (publisher {:x}) refused: {} {} is not one this build knows "
-                   "(counted, {}){}",
-                   msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(msg.publisher_id),
-                   format_known ? "kind" : "format version", format_known ? msg.kind : msg.format_version,
-                   format_known ? "model_unknown_kind" : "model_unknown_format", suppressed_note(g));
+      spdlog::warn(
+          "model parameters v{} from '{}' (publisher {:x}) refused: {} {} is not one this build knows "
+          "(counted, {}){}",
+          msg.version, escape_wire(msg.source), static_cast<std::uint64_t>(msg.publisher_id),
+          format_known ? "kind" : "format version", format_known ? msg.kind : msg.format_version,
+          format_known ? "model_unknown_kind" : "model_unknown_format", suppressed_note(g));
     }
     return;
   }
@@ -104,10 +107,8 @@ std::string describe_model(const ModelParamSet& set) {
     case ModelKind::pi:
       return fmt::format("PI, {} operators to {:.4g} V, w0 {:.6g}", set.pi.count,
                          set.pi.count > 0 ? set.pi.thresholds[set.pi.count - 1] : 0.0, set.pi.weights[0]);
-    case ModelKind::katalenic:
-      return fmt::format("Katalenic k1 {:.6g}, k2 {:.6g}", set.katalenic.k1, set.katalenic.k2);
-    case ModelKind::linear:
-      return fmt::format("linear gain {:.6g}, offset {:.4g}", set.linear.gain, set.linear.offset);
+    case ModelKind::katalenic: return fmt::format("Katalenic k1 {:.6g}, k2 {:.6g}", set.katalenic.k1, set.katalenic.k2);
+    case ModelKind::linear: return fmt::format("linear gain {:.6g}, offset {:.4g}", set.linear.gain, set.linear.offset);
   }
   return "unknown";
 }

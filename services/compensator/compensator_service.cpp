@@ -61,12 +61,13 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       lcm_(lcm),
       compensator_(std::in_place, settings.control),
       command_pub_(lcm, channels.command),
-      samples_(lcm, channels.sensor, [this](const sensor_block_t& m, std::int64_t t) { on_sensor(m, t); },
-               queue_of<sensor_block_t>(settings.sample_queue_capacity)),
+      samples_(
+          lcm, channels.sensor, [this](const sensor_block_t& m, std::int64_t t) { on_sensor(m, t); },
+          queue_of<sensor_block_t>(settings.sample_queue_capacity)),
       trajectories_(lcm, channels.trajectory, [this](const trajectory_t& m, std::int64_t) { on_trajectory(m); }),
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
-      models_(lcm, channels.model, [this](const model_params_t& m, std::int64_t) { on_model(m); },
-              model_envelope()),
+      models_(
+          lcm, channels.model, [this](const model_params_t& m, std::int64_t) { on_model(m); }, model_envelope()),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
       status_(lcm, channels.status, "compensator"),
       // A block within the horizon of the next expected tick continues the stream (lost blocks
@@ -189,17 +190,17 @@ void CompensatorService::on_control(const control_t& msg) {
         }
         break;
       case control_t::START_EXPERIMENT: {
-        const ExperimentSpec e = make_experiment_spec(msg.experiment, msg.experiment_amplitude_V,
-                                                      msg.experiment_offset_V, msg.experiment_frequency_Hz,
-                                                      msg.experiment_duration_s);
+        const ExperimentSpec e =
+            make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,
+                                 msg.experiment_frequency_Hz, msg.experiment_duration_s);
         const bool queued = compensator_->experiment_running();
         compensator_->start_experiment(e);
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
-                       e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
-                       queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting"
-                              : "started",
-                       msg.request_id, suppressed_note(g));
+          spdlog::info(
+              "experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
+              e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
+              queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting" : "started",
+              msg.request_id, suppressed_note(g));
         }
         break;
       }
@@ -294,19 +295,21 @@ CounterSet::Entries CompensatorService::collect_counters() const {
 void CompensatorService::log_sequence_events() {
   const SequenceGuard::Counters& g = guard_.counters();
   if (g.restarts != restarts_logged_) {
-    spdlog::warn("bridge restart: sensor ticks went back from {} to {} (confirmed by {} blocks): control law restarted "
-                 "({} restarts in all)",
-                 seq_before_, seq_after_, SequenceGuard::kConfirmBlocks, g.restarts);
+    spdlog::warn(
+        "bridge restart: sensor ticks went back from {} to {} (confirmed by {} blocks): control law restarted "
+        "({} restarts in all)",
+        seq_before_, seq_after_, SequenceGuard::kConfirmBlocks, g.restarts);
   }
   if (g.jumps != jumps_logged_) {
     spdlog::warn("sensor ticks jumped ahead from {} to {} (confirmed by {} blocks; {} jumps in all)", seq_before_,
                  seq_after_, SequenceGuard::kConfirmBlocks, g.jumps);
   }
   if (g.ignored != ignored_logged_) {
-    spdlog::warn("{} jump(s) or restart(s) of the sensor ticks not believed since the last report: not confirmed "
-                 "by the blocks that followed (a forged or corrupted block?); sensor_jumps_ignored {}, "
-                 "sensor_blocks_held {} in all",
-                 g.ignored - ignored_logged_, g.ignored, g.held);
+    spdlog::warn(
+        "{} jump(s) or restart(s) of the sensor ticks not believed since the last report: not confirmed "
+        "by the blocks that followed (a forged or corrupted block?); sensor_jumps_ignored {}, "
+        "sensor_blocks_held {} in all",
+        g.ignored - ignored_logged_, g.ignored, g.held);
   }
   restarts_logged_ = g.restarts;
   jumps_logged_ = g.jumps;
@@ -335,10 +338,10 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
     detail = "no samples from the bridge this period; ";
   }
   const MemParams& m = c.mem_params();
-  detail += fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
-                        to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(),
-                        m.c1, m.c2, m.c3, c.config().horizon_ticks,
-                        c.experiment_running() ? ", experiment running" : "");
+  detail +=
+      fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
+                  to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(), m.c1,
+                  m.c2, m.c3, c.config().horizon_ticks, c.experiment_running() ? ", experiment running" : "");
   status_.begin(state, detail);
   reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;
@@ -349,7 +352,8 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
     }
   }
   if (c.next_tick() >= 0) {
-    status_.counter("plan_ahead_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
+    status_.counter("plan_ahead_ticks",
+                    static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
   }
   reported_.report(status_, "sensor", samples_.counters());
   reported_.report(status_, "trajectory", trajectories_.counters());
@@ -385,11 +389,12 @@ int CompensatorService::run() {
   spdlog::info("stopping{}", stop_signal() ? fmt::format(" on signal {}", stop_signal()) : std::string());
   report(wall_utime(), true);
   const CompensatorCounters& c = compensator_->counters();
-  spdlog::info("summary: {} samples, {} command ticks published in {} blocks, {} ticks planned too late, {} gaps, "
-               "{} out of order, params {} accepted / {} refused / {} swapped, {} invalid sets ignored",
-               c.samples, counters_.command_ticks_published, counters_.command_blocks_published, c.ticks_behind, c.gaps,
-               c.out_of_order, c.params_accepted,
-               c.params_rejected + counters_.params_refused, c.params_swapped, counters_.params_invalid);
+  spdlog::info(
+      "summary: {} samples, {} command ticks published in {} blocks, {} ticks planned too late, {} gaps, "
+      "{} out of order, params {} accepted / {} refused / {} swapped, {} invalid sets ignored",
+      c.samples, counters_.command_ticks_published, counters_.command_blocks_published, c.ticks_behind, c.gaps,
+      c.out_of_order, c.params_accepted, c.params_rejected + counters_.params_refused, c.params_swapped,
+      counters_.params_invalid);
   if (latency_total_.count() > 0) {
     spdlog::info("summary: sensor block received -> its answer published p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us",
                  latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,

@@ -58,18 +58,18 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
 struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;
   std::uint64_t command_ticks_published = 0;
-  std::uint64_t params_invalid = 0;      // valid = false: diagnostic sets, never used
-  std::uint64_t params_stale = 0;        // version not above the last one accepted from the same publisher
-  std::uint64_t params_refused = 0;      // failed the compensator's own validation
+  std::uint64_t params_invalid = 0;        // valid = false: diagnostic sets, never used
+  std::uint64_t params_stale = 0;          // version not above the last one accepted from the same publisher
+  std::uint64_t params_refused = 0;        // failed the compensator's own validation
   std::uint64_t model_unknown_kind = 0;    // HX_MODEL: a kind this build does not know
   std::uint64_t model_unknown_format = 0;  // HX_MODEL: another format_version
-  std::uint64_t trajectories = 0;        // applied
-  std::uint64_t trajectory_repeats = 0;  // same version again (UDP repeats)
+  std::uint64_t trajectories = 0;          // applied
+  std::uint64_t trajectory_repeats = 0;    // same version again (UDP repeats)
   std::uint64_t trajectory_refused = 0;
   std::uint64_t trajectory_late_start = 0;  // start time already past: started now instead
   std::uint64_t control_acted = 0;
   std::uint64_t control_refused = 0;
-  std::uint64_t bridge_restarts = 0;     // sample seq went back (confirmed): the control law was restarted
+  std::uint64_t bridge_restarts = 0;  // sample seq went back (confirmed): the control law was restarted
   // On HX_STATUS besides: the SequenceGuard's sensor_blocks_held (not used while a jump or a
   // restart was unconfirmed), sensor_jumps_ignored (never confirmed: a forged or corrupted
   // block) and sensor_jumps (confirmed jumps ahead).
@@ -121,16 +121,24 @@ class CompensatorService {
   void log_sequence_events();
   // Log-line reasons (LogLimiter): each at most once a second, the next saying how many were suppressed.
   // kLogParamsInvalid + ParamsRefusal: one reason each (invalid, stale, refused).
-  enum LogReason : std::size_t { kLogTrajectory, kLogTrajectoryRefused, kLogParamsAccepted, kLogControl,
-                                 kLogControlRefused, kLogParamsInvalid, kLogParamsStale, kLogParamsRefused,
-                                 kLogModelUnknown };
+  enum LogReason : std::size_t {
+    kLogTrajectory,
+    kLogTrajectoryRefused,
+    kLogParamsAccepted,
+    kLogControl,
+    kLogControlRefused,
+    kLogParamsInvalid,
+    kLogParamsStale,
+    kLogParamsRefused,
+    kLogModelUnknown
+  };
   CounterSet::Entries collect_counters() const;
 
   CompensatorSettings settings_;
   lcm::LCM& lcm_;
   std::optional<Compensator> compensator_;
   Publisher<command_block_t> command_pub_;
-  command_block_t command_{};                       // storage reserved
+  command_block_t command_{};  // storage reserved
   std::array<CommandTick, command_block_t::MAX_TICKS> plan_{};
   Subscription<sensor_block_t> samples_;
   Subscription<trajectory_t> trajectories_;
@@ -147,7 +155,7 @@ class CompensatorService {
   std::int64_t pending_start_utime_ = 0;
   std::int64_t trajectory_version_ = 0;
   ParamsAdmission admission_;  // the last version accepted, per publisher
-  SequenceGuard guard_;         // sensor seq: a jump or a restart is believed once confirmed
+  SequenceGuard guard_;        // sensor seq: a jump or a restart is believed once confirmed
   std::uint64_t restarts_logged_ = 0;
   std::uint64_t jumps_logged_ = 0;
   std::uint64_t ignored_logged_ = 0;
@@ -157,8 +165,8 @@ class CompensatorService {
 
   CompensatorServiceCounters counters_;
   CompensatorCounters retired_{};  // counted by control laws a bridge restart replaced
-  LatencyStats latency_;  // sensor block received (LCM's receive time) -> its answer published [ns]
-  LatencyStats work_;     // handler work per sensor block [ns]
+  LatencyStats latency_;           // sensor block received (LCM's receive time) -> its answer published [ns]
+  LatencyStats work_;              // handler work per sensor block [ns]
   LatencyStats latency_total_;
   std::uint64_t blocks_in_period_ = 0;
   std::uint64_t swaps_reported_ = 0;

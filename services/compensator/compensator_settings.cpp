@@ -54,17 +54,39 @@ ShapingFunction read_shaping(const Config& config, const std::string& prefix, co
 }  // namespace
 
 const std::vector<std::string>& compensator_config_keys() {
-  static const std::vector<std::string> keys = {
-      "compensator.mode", "compensator.horizon_s", "compensator.dt_s", "compensator.run_seconds",
-      "compensator.sample_queue_capacity", "rt.priority", "rt.lock_memory",
-      "mem.c1", "mem.c2", "mem.c3",
-      "pi.count", "pi.thresholds", "pi.weights", "pi.range_V",
-      "linear.gain", "linear.offset",
-      "katalenic.k1", "katalenic.k2", "katalenic.k2_slope", "katalenic.k2_domain_min", "katalenic.k2_domain_max",
-      "katalenic.initial_offset", "katalenic.input_shaping.*", "katalenic.output_shaping.*",
+  static const std::vector<std::string> keys = {"compensator.mode",
+                                                "compensator.horizon_s",
+                                                "compensator.dt_s",
+                                                "compensator.run_seconds",
+                                                "compensator.sample_queue_capacity",
+                                                "rt.priority",
+                                                "rt.lock_memory",
+                                                "mem.c1",
+                                                "mem.c2",
+                                                "mem.c3",
+                                                "pi.count",
+                                                "pi.thresholds",
+                                                "pi.weights",
+                                                "pi.range_V",
+                                                "linear.gain",
+                                                "linear.offset",
+                                                "katalenic.k1",
+                                                "katalenic.k2",
+                                                "katalenic.k2_slope",
+                                                "katalenic.k2_domain_min",
+                                                "katalenic.k2_domain_max",
+                                                "katalenic.initial_offset",
+                                                "katalenic.input_shaping.*",
+                                                "katalenic.output_shaping.*",
 
-      "trajectory.shape", "trajectory.amplitude_m", "trajectory.offset_m", "trajectory.frequency_hz",
-      "trajectory.phase_rad", "trajectory.blend_s", "trajectory.points_t_s", "trajectory.points_y_m"};
+                                                "trajectory.shape",
+                                                "trajectory.amplitude_m",
+                                                "trajectory.offset_m",
+                                                "trajectory.frequency_hz",
+                                                "trajectory.phase_rad",
+                                                "trajectory.blend_s",
+                                                "trajectory.points_t_s",
+                                                "trajectory.points_y_m"};
   return keys;
 }
 
@@ -72,13 +94,15 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   // Keys of earlier versions say where their setting went.
   for (const std::string& key : config.keys()) {
     if (key.rfind("feedback.", 0) == 0) {
-      config.fail(key, "the servo runs in the bridge now, beside the sensor: set servo.kp, servo.ki, servo.kd in "
-                       "the bridge's config (deploy/config/bridge.yaml) or at run time with `hystloop-ctl gains`");
+      config.fail(key,
+                  "the servo runs in the bridge now, beside the sensor: set servo.kp, servo.ki, servo.kd in "
+                  "the bridge's config (deploy/config/bridge.yaml) or at run time with `hystloop-ctl gains`");
     }
   }
   if (config.has("compensator.lead_ticks")) {
-    config.fail("compensator.lead_ticks", "replaced by compensator.horizon_s: commands are planned that far ahead "
-                                          "of the bridge's clock");
+    config.fail("compensator.lead_ticks",
+                "replaced by compensator.horizon_s: commands are planned that far ahead "
+                "of the bridge's clock");
   }
   std::vector<std::string> known = compensator_config_keys();
   known.insert(known.end(), rig_auth_config_keys().begin(), rig_auth_config_keys().end());  // read by main
@@ -89,8 +113,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   validate_config_section(config, "", [&] { c.mode = parse_feedforward_mode(mode, "compensator.mode"); });
   c.dt_s = config.get_in_range("compensator.dt_s", c.dt_s, 1e-6, 1.0);
   s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
-  s.sample_queue_capacity =
-      static_cast<int>(config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 16, 100000));
+  s.sample_queue_capacity = static_cast<int>(
+      config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 16, 100000));
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
@@ -103,8 +127,10 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   if (config.has("pi.thresholds") || config.has("pi.weights")) {
     const auto r = config.get<std::vector<double>>("pi.thresholds");
     const auto w = config.get<std::vector<double>>("pi.weights");
-    if (r.empty() || r.size() > kPiMaxOperators) config.fail("pi.thresholds", fmt::format("needs 1..{} values", kPiMaxOperators));
-    if (w.size() != r.size()) config.fail("pi.weights", fmt::format("needs as many values as pi.thresholds ({})", r.size()));
+    if (r.empty() || r.size() > kPiMaxOperators)
+      config.fail("pi.thresholds", fmt::format("needs 1..{} values", kPiMaxOperators));
+    if (w.size() != r.size())
+      config.fail("pi.weights", fmt::format("needs as many values as pi.thresholds ({})", r.size()));
     const auto count = config.get_int_in_range("pi.count", static_cast<std::int64_t>(r.size()), 1,
                                                static_cast<std::int64_t>(kPiMaxOperators));
     if (static_cast<std::size_t>(count) != r.size()) config.fail("pi.count", "must equal the number of pi.thresholds");
@@ -117,7 +143,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   } else {
     const auto count = config.get_int_in_range("pi.count", 15, 1, static_cast<std::int64_t>(kPiMaxOperators));
     const double range = config.get_positive("pi.range_V", 250.0);
-    validate_config_section(config, "pi.", [&] { c.pi = pi_params_from_mem(c.mem, static_cast<std::size_t>(count), range); });
+    validate_config_section(config, "pi.",
+                            [&] { c.pi = pi_params_from_mem(c.mem, static_cast<std::size_t>(count), range); });
   }
   validate_config_section(config, "pi.", [&] { c.pi.validate(); });
 
@@ -136,8 +163,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   k.output_shaping = read_shaping(config, "katalenic.output_shaping", k.output_shaping);
   validate_config_section(config, "katalenic.", [&] { k.validate(); });
 
-  const double horizon_s = config.get_in_range("compensator.horizon_s", static_cast<double>(c.horizon_ticks) * c.dt_s,
-                                               2.0 * c.dt_s, static_cast<double>(CompensatorConfig::kMaxHorizonTicks) * c.dt_s);
+  const double horizon_s =
+      config.get_in_range("compensator.horizon_s", static_cast<double>(c.horizon_ticks) * c.dt_s, 2.0 * c.dt_s,
+                          static_cast<double>(CompensatorConfig::kMaxHorizonTicks) * c.dt_s);
   c.horizon_ticks = static_cast<std::int64_t>(std::llround(horizon_s / c.dt_s));
   validate_config_section(config, "", [&] { c.validate(); });
 
@@ -187,7 +215,8 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
                               c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
                               s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
   lines.push_back(fmt::format("mem: c1 {:.6g} m/V, c2 {:.6g} m/V^(1+c3), c3 {:.6g}", c.mem.c1, c.mem.c2, c.mem.c3));
-  lines.push_back(fmt::format("pi: {} plays up to {:.4g} V", c.pi.count, c.pi.count ? c.pi.thresholds[c.pi.count - 1] : 0.0));
+  lines.push_back(
+      fmt::format("pi: {} plays up to {:.4g} V", c.pi.count, c.pi.count ? c.pi.thresholds[c.pi.count - 1] : 0.0));
   lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
   lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
                               c.katalenic.k2_slope));

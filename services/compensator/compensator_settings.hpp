@@ -16,12 +16,12 @@
 namespace hystloop {
 
 struct CompensatorSettings {
-  CompensatorConfig control{};   // mode, models, horizon, dt
-  TrajectorySpec trajectory{};   // the initial reference (default: hold at 0), started with the first sample
-  double run_seconds = 0.0;      // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
+  CompensatorConfig control{};      // mode, models, horizon, dt
+  TrajectorySpec trajectory{};      // the initial reference (default: hold at 0), started with the first sample
+  double run_seconds = 0.0;         // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
   int sample_queue_capacity = 256;  // LCM's queue for HX_SENSOR [blocks]
-  int rt_priority = 0;           // SCHED_FIFO priority 1..99 of the (only) thread; 0 = normal scheduling
-  bool lock_memory = false;      // mlockall at start
+  int rt_priority = 0;              // SCHED_FIFO priority 1..99 of the (only) thread; 0 = normal scheduling
+  bool lock_memory = false;         // mlockall at start
 };
 
 const std::vector<std::string>& compensator_config_keys();

@@ -17,11 +17,12 @@
 
 int main(int argc, char** argv) {
   using namespace hystloop;
-  CLI::App app{"hystloop-compensator: turns the reference (HX_TRAJECTORY) into the feedforward voltage that makes "
-               "the stage follow it, through the inverse of the selected hysteresis model, one step per tick; answers "
-               "each HX_SENSOR block with the commands (HX_COMMAND) for compensator.horizon_s ahead of the bridge's "
-               "clock; swaps in new MEM parameters (HX_PARAMS) at reversals; mode and experiments change through "
-               "HX_CONTROL (the servo's gains are the bridge's)."};
+  CLI::App app{
+      "hystloop-compensator: turns the reference (HX_TRAJECTORY) into the feedforward voltage that makes "
+      "the stage follow it, through the inverse of the selected hysteresis model, one step per tick; answers "
+      "each HX_SENSOR block with the commands (HX_COMMAND) for compensator.horizon_s ahead of the bridge's "
+      "clock; swaps in new MEM parameters (HX_PARAMS) at reversals; mode and experiments change through "
+      "HX_CONTROL (the servo's gains are the bridge's)."};
   ServiceOptions options;
   add_service_options(app, options);
   std::vector<std::filesystem::path> params_files;

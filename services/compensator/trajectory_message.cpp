@@ -22,8 +22,8 @@ TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
   if (msg.n_points < 0 || static_cast<std::size_t>(msg.n_points) > TrajectorySpec::kMaxPoints ||
       msg.points_t_s.size() != static_cast<std::size_t>(msg.n_points) ||
       msg.points_y_m.size() != static_cast<std::size_t>(msg.n_points)) {
-    throw ParameterError("trajectory.n_points", "must be 0.." + std::to_string(TrajectorySpec::kMaxPoints) +
-                                                    " and match the point arrays");
+    throw ParameterError("trajectory.n_points",
+                         "must be 0.." + std::to_string(TrajectorySpec::kMaxPoints) + " and match the point arrays");
   }
   spec.n_points = static_cast<std::size_t>(msg.n_points);
   for (std::size_t i = 0; i < spec.n_points; ++i) {
@@ -34,7 +34,8 @@ TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
   return spec;
 }
 
-double loop_time_of_utime(std::int64_t utime, std::int64_t sample_utime, std::int64_t sample_seq, double dt_s) noexcept {
+double loop_time_of_utime(std::int64_t utime, std::int64_t sample_utime, std::int64_t sample_seq,
+                          double dt_s) noexcept {
   return static_cast<double>(sample_seq) * dt_s + static_cast<double>(utime - sample_utime) * 1e-6;
 }
 

@@ -40,7 +40,7 @@ struct ChannelSlot {
   std::uint64_t bytes_received = 0;
   std::uint64_t dropped_queue_full = 0;  // the disk thread fell behind: the ring was full
   std::uint64_t dropped_oversize = 0;    // larger than the ring's largest record
-  std::uint64_t undecodable = 0;         // kind != kNone but not a valid block of that type: recorded, ticks not checked
+  std::uint64_t undecodable = 0;  // kind != kNone but not a valid block of that type: recorded, ticks not checked
   SequenceGapDetector sequence;
 
   // Disk thread.

@@ -17,9 +17,9 @@ class LogFileIo {
   // Bytes written (possibly fewer than `size`), or -errno.
   virtual ssize_t write(int fd, const void* data, std::size_t size) noexcept = 0;
   virtual int truncate(int fd, std::uint64_t size) noexcept = 0;  // 0 or -errno
-  virtual int fsync(int fd) noexcept = 0;                          // 0 or -errno
-  virtual int close(int fd) noexcept = 0;                          // 0 or -errno; fd released either way
-  virtual int remove(const char* path) noexcept = 0;               // 0 or -errno
+  virtual int fsync(int fd) noexcept = 0;                         // 0 or -errno
+  virtual int close(int fd) noexcept = 0;                         // 0 or -errno; fd released either way
+  virtual int remove(const char* path) noexcept = 0;              // 0 or -errno
 };
 
 // The real calls (open(O_CREAT|O_EXCL), write, ftruncate, fsync, close, unlink).

@@ -70,9 +70,8 @@ LogFileSet::LogFileSet(std::filesystem::path dir, std::string file_prefix, Rotat
   if (ec) throw std::runtime_error("cannot create the log directory " + dir.string() + ": " + ec.message());
   const std::string name = recording_name(file_prefix, start_time);
   base_ = dir / name;
-  for (int n = 1; std::filesystem::exists(numbered(base_, 0)) ||
-                  std::filesystem::exists(base_.string() + ".summary.json");
-       ++n) {
+  for (int n = 1;
+       std::filesystem::exists(numbered(base_, 0)) || std::filesystem::exists(base_.string() + ".summary.json"); ++n) {
     base_ = dir / (name + "-" + std::to_string(n));
   }
   files_.reserve(256);
@@ -277,7 +276,8 @@ bool LogFileSet::write(const char* channel, std::size_t channel_length, const vo
   std::memcpy(at + kEventHeaderBytes, channel, channel_length);
   if (size > 0) std::memcpy(at + kEventHeaderBytes + channel_length, data, size);
   buffer_used_ += bytes;
-  buffered_[buffered_count_++] = Buffered{static_cast<std::uint32_t>(buffer_used_), tag, static_cast<std::uint32_t>(size)};
+  buffered_[buffered_count_++] =
+      Buffered{static_cast<std::uint32_t>(buffer_used_), tag, static_cast<std::uint32_t>(size)};
   ++file_events_taken_;
   file_bytes_taken_ += bytes;
   return true;

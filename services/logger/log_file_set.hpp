@@ -51,10 +51,10 @@ enum class DiskOp : std::uint8_t { kNone, kCreate, kWrite, kTruncate, kFsync, kC
 
 // A snapshot of the disk faults of a recording.
 struct DiskFaults {
-  std::uint64_t errors = 0;              // failed calls (a short write counts as a failed write)
-  std::uint64_t events_lost = 0;         // events not written because of them (also those refused while waiting to retry)
-  std::uint64_t files_truncated = 0;     // files cut back to their last complete event
-  std::uint64_t files_removed = 0;       // files left without any complete event, removed
+  std::uint64_t errors = 0;           // failed calls (a short write counts as a failed write)
+  std::uint64_t events_lost = 0;      // events not written because of them (also those refused while waiting to retry)
+  std::uint64_t files_truncated = 0;  // files cut back to their last complete event
+  std::uint64_t files_removed = 0;    // files left without any complete event, removed
   std::uint64_t unconfirmed_events = 0;  // in files whose fsync or close failed
   std::uint64_t recoveries = 0;          // times writing resumed in a new file after a fault
   int last_errno = 0;                    // of the last failed call; 0 for a short write
@@ -93,8 +93,8 @@ class LogFileSet {
   // Takes one event, rotating first if a limit says so. `now_s` is a monotonic time [s].
   // True if it was taken (its fate is told to the listener later); false if it was lost at
   // once (closed, or waiting to retry after a fault; the listener has been told).
-  bool write(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
-             std::int64_t utime, double now_s, std::uint32_t tag = 0) noexcept;
+  bool write(const char* channel, std::size_t channel_length, const void* data, std::size_t size, std::int64_t utime,
+             double now_s, std::uint32_t tag = 0) noexcept;
 
   // Hands the buffered events to the kernel (a crash then loses at most one flush interval).
   void flush() noexcept;

@@ -28,8 +28,8 @@ std::string yaml_single_quoted(const std::string& text) {
 std::string lcm_regex_error(const std::string& regex) {
   const std::string anchored = "^" + regex + "$";
   GError* error = nullptr;
-  GRegex* compiled = g_regex_new(anchored.c_str(), static_cast<GRegexCompileFlags>(0),
-                                 static_cast<GRegexMatchFlags>(0), &error);
+  GRegex* compiled =
+      g_regex_new(anchored.c_str(), static_cast<GRegexCompileFlags>(0), static_cast<GRegexMatchFlags>(0), &error);
   if (compiled != nullptr) g_regex_unref(compiled);
   if (error == nullptr) return {};
   std::string reason = error->message;
@@ -40,13 +40,17 @@ std::string lcm_regex_error(const std::string& regex) {
 constexpr std::array<FlagSpec, 11> kFlags{{
     {"--out-dir", "out_dir", "Directory of the log files (default logs)", "DIR", true},
     {"--file-prefix", "file_prefix", "Text prepended to every file name (default none)", "TEXT", true},
-    {"--max-file-mb", "max_file_mb", "Rotate before a file passes this size [10^6 bytes]; 0 = never (default 1024)", "MB"},
+    {"--max-file-mb", "max_file_mb", "Rotate before a file passes this size [10^6 bytes]; 0 = never (default 1024)",
+     "MB"},
     {"--max-file-s", "max_file_s", "Rotate a file once it is this old [s]; 0 = never (default 0)", "S"},
-    {"--summary", "summary", "Summary JSON written at close (default <out-dir>/<recording>.summary.json)", "FILE", true},
-    {"--channels", "channels", "Regular expression of the channels recorded (default the rig's, <rig>.*)", "REGEX", true},
+    {"--summary", "summary", "Summary JSON written at close (default <out-dir>/<recording>.summary.json)", "FILE",
+     true},
+    {"--channels", "channels", "Regular expression of the channels recorded (default the rig's, <rig>.*)", "REGEX",
+     true},
     {"--queue-mb", "queue_mb", "Buffer between receiving and disk [10^6 bytes] (default 64)", "MB"},
     {"--lcm-queue", "lcm_queue", "Messages LCM holds for the logger before dropping (default 20000)", "N"},
-    {"--flush-interval-s", "flush_interval_s", "How often buffered events are handed to the kernel [s] (default 0.2)", "S"},
+    {"--flush-interval-s", "flush_interval_s", "How often buffered events are handed to the kernel [s] (default 0.2)",
+     "S"},
     {"--restart-threshold", "restart_threshold",
      "A seq step back by more than this many ticks is a sender restart, not a late message (default 10000)", "N"},
     {"--command-resume-s", "command_resume_s",

@@ -4,7 +4,8 @@
 //
 //   --out-dir DIR             logger.out_dir            directory of the logs (default logs)
 //   --file-prefix TEXT        logger.file_prefix        prepended to every file name (default none)
-//   --max-file-mb MB          logger.max_file_mb        rotate before a file passes this size, 10^6 bytes (0 = never; default 1024)
+//   --max-file-mb MB          logger.max_file_mb        rotate before a file passes this size, 10^6 bytes (0 = never;
+//   default 1024)
 //   --max-file-s S            logger.max_file_s         rotate a file this old [s] (0 = never; default 0)
 //   --summary FILE            logger.summary            summary JSON (default <dir>/<recording>.summary.json;
 //                                                       a directory is refused at start)
@@ -14,7 +15,8 @@
 //   --flush-interval-s S      logger.flush_interval_s   how often buffered events reach the kernel (default 0.2)
 //   --restart-threshold N     logger.restart_threshold  seq step back (ticks) taken as a sender restart (default 10000)
 //   --command-resume-s S      logger.command_resume_s   HX_COMMAND silent this long, then a jump forward: a resume
-//                                                       (counted as skipped ticks), not a gap (0 = always a gap; default 0.1)
+//                                                       (counted as skipped ticks), not a gap (0 = always a gap;
+//                                                       default 0.1)
 
 #include <cstdint>
 #include <filesystem>

@@ -99,8 +99,7 @@ void LoggerService::on_raw(const lcm_recv_buf_t* rbuf, const char* channel, void
   static_cast<LoggerService*>(self)->receive(channel, rbuf->data, rbuf->data_size, rbuf->recv_utime);
 }
 
-void LoggerService::receive(const char* channel, const void* data, std::size_t size,
-                            std::int64_t recv_utime) noexcept {
+void LoggerService::receive(const char* channel, const void* data, std::size_t size, std::int64_t recv_utime) noexcept {
   const std::int64_t t0 = monotonic_ns();
   const auto index = channels_->find_or_add(channel);
   if (!index) return;  // counted by the table
@@ -165,7 +164,8 @@ std::string LoggerService::fault_detail(const DiskFaults& f) {
   const std::string file = escaped_for_log(files_->current_file().filename().string());
   if (!f.writing || f.errors > seen_faults_.errors) {
     detail = "FAULT: " + f.reason() + "; " + std::to_string(f.events_lost) + " events not written so far";
-    if (!f.writing) detail += ", retrying in a new file every " + fmt::format("{}", LogFileSet::kRetryInterval_s) + " s";
+    if (!f.writing)
+      detail += ", retrying in a new file every " + fmt::format("{}", LogFileSet::kRetryInterval_s) + " s";
   } else if (!seen_faults_.writing) {
     detail = "recovered from the disk fault: writing again to " + file + " after " + std::to_string(f.events_lost) +
              " events not written";
@@ -195,8 +195,9 @@ std::string LoggerService::unknown_channels_detail() {
   const double now_s = monotonic_s();
   if (u.distinct() > seen_unknown_names_ && now_s - unknown_logged_s_ >= 10.0) {
     spdlog::warn("{}{}", detail,
-                 unknown_log_suppressed_ > 0 ? " [" + std::to_string(unknown_log_suppressed_) + " similar warnings suppressed]"
-                                             : std::string());
+                 unknown_log_suppressed_ > 0
+                     ? " [" + std::to_string(unknown_log_suppressed_) + " similar warnings suppressed]"
+                     : std::string());
     unknown_logged_s_ = now_s;
     unknown_log_suppressed_ = 0;
   } else if (u.distinct() > seen_unknown_names_) {
@@ -229,7 +230,8 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     const Seen now{c.dropped(), q.gap_events(), q.missing(), q.overlaps() + q.duplicates(), q.resumes(), q.skipped()};
     Seen& before = seen_[i];
     const std::string on = " on " + std::string(c.name_view());
-    if (now.dropped > before.dropped) detail = append(detail, "dropped " + std::to_string(now.dropped - before.dropped) + on);
+    if (now.dropped > before.dropped)
+      detail = append(detail, "dropped " + std::to_string(now.dropped - before.dropped) + on);
     if (now.gap_events > before.gap_events) {
       detail = append(detail, std::to_string(now.gap_events - before.gap_events) + " gap(s), " +
                                   std::to_string(now.missing - before.missing) + " ticks missing" + on);
@@ -328,10 +330,11 @@ int LoggerService::run() {
     rc = 1;
   }
   if (summary.disk.errors > 0) {
-    spdlog::error("disk faults during the recording: {} failed call(s), last {}; {} events not written, {} unconfirmed "
-                  "(fsync/close failed), {} file(s) cut back to their last complete event, {} empty file(s) removed",
-                  summary.disk.errors, summary.disk.reason(), summary.disk.events_lost, summary.disk.unconfirmed_events,
-                  summary.disk.files_truncated, summary.disk.files_removed);
+    spdlog::error(
+        "disk faults during the recording: {} failed call(s), last {}; {} events not written, {} unconfirmed "
+        "(fsync/close failed), {} file(s) cut back to their last complete event, {} empty file(s) removed",
+        summary.disk.errors, summary.disk.reason(), summary.disk.events_lost, summary.disk.unconfirmed_events,
+        summary.disk.files_truncated, summary.disk.files_removed);
     rc = 1;
   }
   report(wall_utime(), service_status_t::STOPPING);
@@ -353,11 +356,11 @@ RecordingSummary LoggerService::finish() {
   s.stop_utime = wall_utime();
   s.duration_s = monotonic_s() - start_s_;
   const int signal = stop_signal();
-  s.stop_reason = shutdown_requested_  ? "control SHUTDOWN"
-                  : signal == SIGTERM  ? "SIGTERM"
-                  : signal == SIGINT   ? "SIGINT"
-                  : signal != 0        ? "signal " + std::to_string(signal)
-                                       : "stop request";
+  s.stop_reason = shutdown_requested_ ? "control SHUTDOWN"
+                  : signal == SIGTERM ? "SIGTERM"
+                  : signal == SIGINT  ? "SIGINT"
+                  : signal != 0       ? "signal " + std::to_string(signal)
+                                      : "stop request";
   s.files = files_->files();
   s.disk = files_->faults();
   s.unrecorded_channel = channels_->unrecorded_channels();

@@ -18,7 +18,8 @@ std::string json_string(std::string_view text) {
       case '\n': out += "\\n"; break;
       case '\t': out += "\\t"; break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) {  // keep the JSON valid UTF-8
+        if (static_cast<unsigned char>(c) < 0x20 ||
+            static_cast<unsigned char>(c) >= 0x7f) {  // keep the JSON valid UTF-8
           char escaped[8];
           std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
           out += escaped;
@@ -83,8 +84,8 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
     << ", \"distinct_is_lower_bound\": " << (u.distinct_is_lower_bound() ? "true" : "false") << ", \"first\": [";
   for (std::size_t i = 0; i < u.kept_count(); ++i) j << (i ? ", " : "") << json_string(u.kept_name(i));
   j << "]},\n";
-  j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes << ", \"high_water_bytes\": "
-    << s.queue_high_water_bytes << "},\n";
+  j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes
+    << ", \"high_water_bytes\": " << s.queue_high_water_bytes << "},\n";
   j << "  \"process\": {\"cpu_user_s\": " << s.cpu_user_s << ", \"cpu_system_s\": " << s.cpu_system_s
     << ", \"peak_rss_bytes\": " << s.peak_rss_bytes << "},\n  \"channels\": {";
   for (std::size_t i = 0; i < channels.size(); ++i) {
@@ -98,11 +99,11 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
       const SequenceGapDetector& q = c.sequence;
       j << ",\n      \"sequence\": {\"blocks\": " << q.observed() << ", \"ticks\": " << q.ticks()
         << ", \"first_seq\": " << q.first_seq() << ", \"last_seq\": " << q.last_seq()
-        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing() << ", \"resumes\": " << q.resumes()
-        << ", \"skipped\": " << q.skipped() << ", \"overlaps\": " << q.overlaps()
+        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing()
+        << ", \"resumes\": " << q.resumes() << ", \"skipped\": " << q.skipped() << ", \"overlaps\": " << q.overlaps()
         << ", \"overlap_ticks\": " << q.overlap_ticks() << ", \"duplicates\": " << q.duplicates()
-        << ", \"out_of_order\": " << q.out_of_order()
-        << ", \"restarts\": " << q.restarts() << ", \"undecodable\": " << c.undecodable << ", \"gaps\": [";
+        << ", \"out_of_order\": " << q.out_of_order() << ", \"restarts\": " << q.restarts()
+        << ", \"undecodable\": " << c.undecodable << ", \"gaps\": [";
       for (std::size_t g = 0; g < q.kept_gap_count(); ++g) {
         j << (g ? ", " : "") << "[" << q.kept_gaps()[g].first_missing << ", " << q.kept_gaps()[g].last_missing << "]";
       }
@@ -126,8 +127,8 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
        << s.unrecorded_channel << ")";
   lines.push_back(head.str());
   if (s.disk.errors > 0) {
-    lines.push_back("  DISK FAULT: " + std::to_string(s.disk.errors) + " failed call(s), last " + s.disk.reason() + "; " +
-                    std::to_string(s.disk.events_lost) + " events not written, " +
+    lines.push_back("  DISK FAULT: " + std::to_string(s.disk.errors) + " failed call(s), last " + s.disk.reason() +
+                    "; " + std::to_string(s.disk.events_lost) + " events not written, " +
                     std::to_string(s.disk.files_truncated) + " file(s) cut back to their last complete event, " +
                     std::to_string(s.disk.files_removed) + " empty file(s) removed, " +
                     std::to_string(s.disk.unconfirmed_events) + " events unconfirmed (fsync/close failed)");
@@ -143,8 +144,8 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
     std::ostringstream line;
-    line << "  " << escaped_for_log(c.name_view()) << ": received " << c.received << ", written " << c.written.load() << ", dropped "
-         << c.dropped();
+    line << "  " << escaped_for_log(c.name_view()) << ": received " << c.received << ", written " << c.written.load()
+         << ", dropped " << c.dropped();
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
       line << ", ticks " << q.first_seq() << ".." << q.last_seq() << ", gaps " << q.gap_events() << " (missing "

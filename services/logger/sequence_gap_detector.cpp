@@ -11,8 +11,8 @@ namespace {
 // Counters fed by what came off the wire (a forged seq can jump by 2^64 - 1 ticks): they
 // stop at the largest value instead of wrapping.
 void add_saturating(std::uint64_t& counter, std::uint64_t n) noexcept {
-  counter = n > std::numeric_limits<std::uint64_t>::max() - counter ? std::numeric_limits<std::uint64_t>::max()
-                                                                     : counter + n;
+  counter =
+      n > std::numeric_limits<std::uint64_t>::max() - counter ? std::numeric_limits<std::uint64_t>::max() : counter + n;
 }
 }  // namespace
 
@@ -30,8 +30,9 @@ SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, st
                                                           std::int64_t recv_utime) noexcept {
   const std::int64_t n = n_ticks < 1 ? 1 : n_ticks;
   // Last tick of the block, saturated at the largest tick number.
-  const std::int64_t last =
-      first > std::numeric_limits<std::int64_t>::max() - (n - 1) ? std::numeric_limits<std::int64_t>::max() : first + (n - 1);
+  const std::int64_t last = first > std::numeric_limits<std::int64_t>::max() - (n - 1)
+                                ? std::numeric_limits<std::int64_t>::max()
+                                : first + (n - 1);
   const std::int64_t silence_us = recv_utime - last_utime_;
   last_utime_ = recv_utime;
   add_saturating(ticks_, static_cast<std::uint64_t>(n));

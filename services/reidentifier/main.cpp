@@ -47,8 +47,9 @@ int main(int argc, char** argv) {
   ServiceOptions service;
   bool publish_invalid = false;
   add_service_options(app, service);
-  app.add_flag("--publish-invalid", publish_invalid,
-               "Also publish refused candidates, with valid = false, for diagnosis (= --set reidentifier.publish_invalid=true)");
+  app.add_flag(
+      "--publish-invalid", publish_invalid,
+      "Also publish refused candidates, with valid = false, for diagnosis (= --set reidentifier.publish_invalid=true)");
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   ReidentOptions options;

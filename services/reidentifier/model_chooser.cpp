@@ -13,9 +13,9 @@
 namespace hystloop {
 
 const char* ModelChooser::counter_name(std::size_t i) noexcept {
-  static constexpr const char* kNames[kCounters] = {"model_selections", "model_changes", "model_refits",
-                                                    "model_kept",       "model_failed",  "model_poisoned",
-                                                    "model_refits_left_to_mem"};
+  static constexpr const char* kNames[kCounters] = {
+      "model_selections", "model_changes",           "model_refits", "model_kept", "model_failed",
+      "model_poisoned",   "model_refits_left_to_mem"};
   return i < kCounters ? kNames[i] : "model_unknown";
 }
 

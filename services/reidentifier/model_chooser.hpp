@@ -14,8 +14,8 @@
 // use, only its parameters are refitted; pinned to another kind, the next selection fits that kind
 // and publishes it as the change (its refit, or its start set -- PI-15 / the chord matched to the
 // MEM in use -- when the refit does not beat that on the held-out branch), then stays. A selection
-// in flight when the service stops is waited for (its fits are time-bounded by their options). Versions come from the core (ParamsInUse): one
-// sequence over HX_PARAMS and HX_MODEL, as the compensator's admission expects.
+// in flight when the service stops is waited for (its fits are time-bounded by their options). Versions come from the
+// core (ParamsInUse): one sequence over HX_PARAMS and HX_MODEL, as the compensator's admission expects.
 //
 // Handoff through a JobSlot (job_slot.hpp), as RefitWorker's: whoever moves the slot's state owns
 // the job's data. start_thread = false: run_pending() runs the job on the caller (tests).
@@ -35,10 +35,10 @@ namespace hystloop {
 class ReidentCore;
 
 struct ModelChoiceOptions {
-  bool enabled = false;                 // reidentifier.models: off = MEM only, as before issue 11
-  double period_s = 5.0;                // reidentifier.model_period_s
-  std::optional<ModelKind> pinned;      // reidentifier.pin_model (none = automatic)
-  OnlineSelectorOptions selector{};     // margin (reidentifier.model_margin), candidates (reidentifier.models)
+  bool enabled = false;              // reidentifier.models: off = MEM only, as before issue 11
+  double period_s = 5.0;             // reidentifier.model_period_s
+  std::optional<ModelKind> pinned;   // reidentifier.pin_model (none = automatic)
+  OnlineSelectorOptions selector{};  // margin (reidentifier.model_margin), candidates (reidentifier.models)
 };
 
 struct ModelDecision {

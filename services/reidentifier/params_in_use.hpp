@@ -87,7 +87,7 @@ class ParamsInUse {
   std::int32_t own_published_ = 0;               // highest version we published
   std::uint64_t generation_ = 0;
   std::int64_t own_publisher_id_;
-  ParamsAdmission admission_;                    // the last version adopted, per publisher
+  ParamsAdmission admission_;  // the last version adopted, per publisher
   std::string own_source_;
   std::string source_ = "config";
   VersionTimeline applied_;

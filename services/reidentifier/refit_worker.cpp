@@ -7,8 +7,7 @@
 
 namespace hystloop {
 
-RefitWorker::RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread,
-                         OnEvaluated on_evaluated)
+RefitWorker::RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread, OnEvaluated on_evaluated)
     : options_(options),
       window_(std::move(window)),
       on_evaluated_(std::move(on_evaluated)),

@@ -21,7 +21,7 @@ namespace hystloop {
 
 struct RefitResult {
   MemRefitOutcome outcome;
-  double duration_s = 0.0;         // wall time of evaluate() (instrumentation)
+  double duration_s = 0.0;  // wall time of evaluate() (instrumentation)
   std::uint64_t window_first_seq = 0;
   std::size_t window_samples = 0;  // samples in the evaluated window
 };
@@ -33,7 +33,8 @@ class RefitWorker {
   using OnEvaluated = std::function<void(const RefitResult&)>;
 
   // `window` comes from OnlineMemEstimator::make_window() (its capacity is the job's).
-  RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread = true, OnEvaluated on_evaluated = {});
+  RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread = true,
+              OnEvaluated on_evaluated = {});
   ~RefitWorker() = default;  // the slot waits for a running evaluate (time-bounded), then joins
   RefitWorker(const RefitWorker&) = delete;
   RefitWorker& operator=(const RefitWorker&) = delete;

@@ -4,7 +4,6 @@
 #include <limits>
 #include <utility>
 
-
 namespace hystloop {
 
 ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread,
@@ -59,8 +58,8 @@ void ReidentCore::on_command_block(const command_block_t& block) noexcept {
   for_each_tick(block, [this](const CommandTick& tick) { in_use_.on_command(tick.seq, tick.params_version); });
 }
 
-ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id,
-                                   bool valid, std::string_view source) noexcept {
+ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
+                                   std::string_view source) noexcept {
   const ParamsOffer offer = in_use_.offer(params, version, publisher_id, valid, source);
   switch (offer) {
     case ParamsOffer::adopted: counters_.add(ReidentCounter::params_adopted); break;
@@ -80,7 +79,7 @@ RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
   const std::uint64_t fed = estimator_.samples_fed();
   if (mem_refits_ && worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
       fed != fed_at_last_snapshot_) {
-    estimator_.snapshot(worker_.job_window());  // no allocation: the worker's window is preallocated
+    estimator_.snapshot(worker_.job_window());               // no allocation: the worker's window is preallocated
     worker_.submit(in_use_.params(), in_use_.generation());  // "version": which set in use it was judged against
     counters_.add(ReidentCounter::refits_attempted);
     fed_at_last_snapshot_ = fed;
@@ -127,9 +126,7 @@ bool ReidentCore::stale(std::int64_t now_us) const noexcept {
   return last_sample_us_ < 0 || now_us - last_sample_us_ > stale_after_us_;
 }
 
-bool ReidentCore::poisoned() const noexcept {
-  return poisoned_streak_ >= options_.degraded_after_poisoned;
-}
+bool ReidentCore::poisoned() const noexcept { return poisoned_streak_ >= options_.degraded_after_poisoned; }
 
 double ReidentCore::seconds_since_sample(std::int64_t now_us) const noexcept {
   return last_sample_us_ < 0 ? std::numeric_limits<double>::infinity()

@@ -34,7 +34,7 @@ struct RefitDecision {
   enum class Kind : std::uint8_t { none, accepted, refused, superseded };
   Kind kind = Kind::none;
   FitStatus status = FitStatus::ok;
-  bool fitted = false;                   // a fit ran: `candidate` holds fitted parameters
+  bool fitted = false;  // a fit ran: `candidate` holds fitted parameters
   MemParams candidate{};
   std::int32_t version = 0;              // accepted: the version it is published with
   double holdout_rms_candidate_m = 0.0;  // held-out branch RMS of the candidate
@@ -78,13 +78,13 @@ class ReidentCore {
 
   // Health, for HX_STATUS.
   bool stale(std::int64_t now_us) const noexcept;  // no sample for longer than stale_after_s
-  bool poisoned() const noexcept;  // the last degraded_after_poisoned windows were all poisoned
+  bool poisoned() const noexcept;                  // the last degraded_after_poisoned windows were all poisoned
   std::int64_t poisoned_streak() const noexcept { return poisoned_streak_; }
   bool seen_samples() const noexcept { return last_sample_us_ >= 0; }
   double seconds_since_sample(std::int64_t now_us) const noexcept;
 
   const ReidentCounters& counters() noexcept;  // refreshes the estimator's mirrored totals
-  void reset_refit_time() noexcept;  // RESET_COUNTERS: the refit-time statistics start again
+  void reset_refit_time() noexcept;            // RESET_COUNTERS: the refit-time statistics start again
   const LatencyStats& refit_time() const noexcept { return refit_time_; }  // ns, since start
   double last_refit_s() const noexcept { return last_refit_s_; }
   const ParamsInUse& in_use() const noexcept { return in_use_; }

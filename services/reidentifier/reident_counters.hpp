@@ -23,13 +23,13 @@ enum class ReidentCounter : std::uint8_t {
   dropouts,              // y stuck while u moves: poisons the window
   refits_attempted,
   refits_accepted,
-  refits_superseded,     // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
-  params_adopted,        // sets from HX_PARAMS that became the set in use
-  params_echo,           // our own sets coming back
-  params_stale,          // valid sets not newer than the set in use
-  params_invalid,        // valid = false sets
+  refits_superseded,         // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
+  params_adopted,            // sets from HX_PARAMS that became the set in use
+  params_echo,               // our own sets coming back
+  params_stale,              // valid sets not newer than the set in use
+  params_invalid,            // valid = false sets
   command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
-  refits_rejected_first  // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
+  refits_rejected_first      // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };
 
 // A refit's refusals start at size_mismatch: `ok` is no refusal, and `invalid_options` cannot

@@ -12,12 +12,24 @@ namespace hystloop {
 
 namespace {
 constexpr const char* kReidentKeys[] = {
-    "reidentifier.rate_hz",          "reidentifier.refit_period_s",           "reidentifier.window_s",
-    "reidentifier.capacity_s",       "reidentifier.holdout_branches",         "reidentifier.min_relative_improvement",
-    "reidentifier.max_residual_rms_m", "reidentifier.max_solver_time_s", "reidentifier.reversal_dead_band_V",      "reidentifier.publish_invalid",
-    "reidentifier.stale_after_s",    "reidentifier.degraded_after_poisoned", "reidentifier.lcm_queue",
-    "reidentifier.models",           "reidentifier.model_margin",            "reidentifier.model_period_s",
-    "reidentifier.model_decimation", "reidentifier.pin_model",
+    "reidentifier.rate_hz",
+    "reidentifier.refit_period_s",
+    "reidentifier.window_s",
+    "reidentifier.capacity_s",
+    "reidentifier.holdout_branches",
+    "reidentifier.min_relative_improvement",
+    "reidentifier.max_residual_rms_m",
+    "reidentifier.max_solver_time_s",
+    "reidentifier.reversal_dead_band_V",
+    "reidentifier.publish_invalid",
+    "reidentifier.stale_after_s",
+    "reidentifier.degraded_after_poisoned",
+    "reidentifier.lcm_queue",
+    "reidentifier.models",
+    "reidentifier.model_margin",
+    "reidentifier.model_period_s",
+    "reidentifier.model_decimation",
+    "reidentifier.pin_model",
 };
 
 // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model.
@@ -31,8 +43,11 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
       const std::size_t comma = std::min(models.find(',', from), models.size());
       const std::string name = models.substr(from, comma - from);
       const std::optional<ModelKind> kind = parse_model_kind(name);
-      if (!kind) config.fail("reidentifier.models", "expected off, auto or a list of mem,pi,katalenic,linear (got \"" + name + "\")");
-      if (std::find(kinds.begin(), kinds.end(), *kind) != kinds.end()) config.fail("reidentifier.models", "lists " + name + " twice");
+      if (!kind)
+        config.fail("reidentifier.models",
+                    "expected off, auto or a list of mem,pi,katalenic,linear (got \"" + name + "\")");
+      if (std::find(kinds.begin(), kinds.end(), *kind) != kinds.end())
+        config.fail("reidentifier.models", "lists " + name + " twice");
       kinds.push_back(*kind);
       from = comma + 1;
     }
@@ -40,11 +55,13 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   }
   m.selector.margin = config.get_in_range("reidentifier.model_margin", m.selector.margin, 0.0, 0.9);
   m.period_s = config.get_in_range("reidentifier.model_period_s", m.period_s, 0.1, 3600.0);
-  m.selector.decimation = static_cast<std::size_t>(config.get_int_in_range("reidentifier.model_decimation", 10, 1, 1000));
+  m.selector.decimation =
+      static_cast<std::size_t>(config.get_int_in_range("reidentifier.model_decimation", 10, 1, 1000));
   const std::string pin = config.get<std::string>("reidentifier.pin_model", "none");
   if (pin != "none") {
     m.pinned = parse_model_kind(pin);
-    if (!m.pinned) config.fail("reidentifier.pin_model", "expected none, mem, pi, katalenic or linear (got \"" + pin + "\")");
+    if (!m.pinned)
+      config.fail("reidentifier.pin_model", "expected none, mem, pi, katalenic or linear (got \"" + pin + "\")");
   }
   validate_config_section(config, "reident.", [&] { m.selector.validate(); });
 }
@@ -77,24 +94,23 @@ ReidentOptions read_reident_options(const Config& config) {
   o.capacity_s = config.get_in_range("reidentifier.capacity_s", o.capacity_s, 1e-6, 3600.0);
   o.publish_invalid = config.get<bool>("reidentifier.publish_invalid", o.publish_invalid);
   o.stale_after_s = config.get_in_range("reidentifier.stale_after_s", o.stale_after_s, 0.001, 3600.0);
-  o.degraded_after_poisoned = config.get_int_in_range("reidentifier.degraded_after_poisoned", o.degraded_after_poisoned, 1,
-                                                      1000000);
+  o.degraded_after_poisoned =
+      config.get_int_in_range("reidentifier.degraded_after_poisoned", o.degraded_after_poisoned, 1, 1000000);
   o.lcm_queue = config.get_int_in_range("reidentifier.lcm_queue", o.lcm_queue, 100, 10000000);
 
   OnlineMemOptions& e = o.estimator;
   e.window_samples = samples_of(o.window_s, o.rate_hz);
   if (e.window_samples < 16) {
-    config.fail("reidentifier.window_s", "must hold at least 16 samples at reidentifier.rate_hz (got " +
-                                        std::to_string(e.window_samples) + ")");
+    config.fail("reidentifier.window_s",
+                "must hold at least 16 samples at reidentifier.rate_hz (got " + std::to_string(e.window_samples) + ")");
   }
   e.capacity_samples = samples_of(o.capacity_s, o.rate_hz);
   if (e.capacity_samples < e.window_samples) {
-    config.fail("reidentifier.capacity_s", "must be >= reidentifier.window_s (got " + std::to_string(o.capacity_s) + " s < " +
-                                          std::to_string(o.window_s) + " s)");
+    config.fail("reidentifier.capacity_s", "must be >= reidentifier.window_s (got " + std::to_string(o.capacity_s) +
+                                               " s < " + std::to_string(o.window_s) + " s)");
   }
   if (e.capacity_samples > 100'000'000) config.fail("reidentifier.capacity_s", "must hold at most 1e8 samples");
-  e.holdout_branches =
-      static_cast<std::size_t>(config.get_int_in_range("reidentifier.holdout_branches", 1, 1, 1000));
+  e.holdout_branches = static_cast<std::size_t>(config.get_int_in_range("reidentifier.holdout_branches", 1, 1, 1000));
   e.min_relative_improvement =
       config.get_in_range("reidentifier.min_relative_improvement", e.min_relative_improvement, 0.0, 0.99);
   e.max_residual_rms_m = config.get_in_range("reidentifier.max_residual_rms_m", e.max_residual_rms_m, 1e-15, 1.0);

@@ -15,8 +15,8 @@
 //   reidentifier.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
 //   reidentifier.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
 //   reidentifier.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
-//   reidentifier.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2 s)
-//   reidentifier.models                    online model choice (issue 11): "off" (MEM refits only, as before),
+//   reidentifier.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2
+//   s) reidentifier.models                    online model choice (issue 11): "off" (MEM refits only, as before),
 //                                     "auto" (MEM, PI, Katalenic, linear) or a list "mem,pi,linear" (off)
 //   reidentifier.model_margin              a different model must beat the one in use by this fraction of its
 //                                     held-out RMS (0.10; OnlineSelectorOptions::margin)
@@ -35,7 +35,7 @@
 namespace hystloop {
 
 struct ReidentOptions {
-  MemParams initial{};           // mem.c1, mem.c2, mem.c3
+  MemParams initial{};  // mem.c1, mem.c2, mem.c3
   double rate_hz = 10000.0;
   double refit_period_s = 1.0;
   double window_s = 2.0;
@@ -48,9 +48,9 @@ struct ReidentOptions {
   ModelChoiceOptions models{};   // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model
 };
 
-// Reads and checks mem.{c1,c2,c3} and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are refused ("did
-// you mean"); other sections belong to the processes sharing the file (the compensator
-// checks the rest of mem.*). Throws ConfigError naming the field.
+// Reads and checks mem.{c1,c2,c3} and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are
+// refused ("did you mean"); other sections belong to the processes sharing the file (the compensator checks the rest of
+// mem.*). Throws ConfigError naming the field.
 ReidentOptions read_reident_options(const Config& config);
 
 }  // namespace hystloop

@@ -33,8 +33,8 @@ namespace {
 // A steady plant is refused every period (no_improvement): a reason is logged at info when it
 // differs from the previous refusal's, or once a minute while it repeats; at debug otherwise.
 RefitWorker::OnEvaluated refusal_logger() {
-  return [last = FitStatus::ok, last_info_ns = std::int64_t{0}, repeats = std::uint64_t{0}](
-             const RefitResult& r) mutable {
+  return [last = FitStatus::ok, last_info_ns = std::int64_t{0},
+          repeats = std::uint64_t{0}](const RefitResult& r) mutable {
     if (r.outcome.accepted) {
       last = FitStatus::ok;
       return;
@@ -42,8 +42,8 @@ RefitWorker::OnEvaluated refusal_logger() {
     const std::int64_t now = steady_ns();
     const bool news = r.outcome.status != last || now - last_info_ns >= 60'000'000'000;
     const auto level = news ? spdlog::level::info : spdlog::level::debug;
-    spdlog::log(level, "refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms{}]", to_string(r.outcome.status),
-                r.outcome.reason, r.window_samples, r.window_first_seq, r.duration_s * 1e3,
+    spdlog::log(level, "refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms{}]",
+                to_string(r.outcome.status), r.outcome.reason, r.window_samples, r.window_first_seq, r.duration_s * 1e3,
                 news && repeats > 0 ? fmt::format("; {} repeats at debug level before this", repeats) : std::string());
     if (news) {
       last_info_ns = now;
@@ -62,7 +62,8 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       own_source_(std::string(kProcessName) + "@" + host_name()),
       core_(std::make_unique<ReidentCore>(options, own_source_, true, refusal_logger())),
       params_out_(lcm, names.params),
-      chooser_(std::make_unique<ModelChooser>(options.models, initial_model(options), core_->estimator().make_window())),
+      chooser_(
+          std::make_unique<ModelChooser>(options.models, initial_model(options), core_->estimator().make_window())),
       model_out_(lcm, names.model),
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {
@@ -88,8 +89,8 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       command_options);
   params_in_ = std::make_unique<Subscription<mem_params_t>>(
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
-  control_ = std::make_unique<Subscription<control_t>>(
-      lcm, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); });
+  control_ = std::make_unique<Subscription<control_t>>(lcm, names.control,
+                                                       [this](const control_t& msg, std::int64_t) { on_control(msg); });
 }
 
 ReidentService::~ReidentService() = default;
@@ -117,9 +118,10 @@ void ReidentService::on_params(const mem_params_t& msg) {
     }
   } else if (offer == ParamsOffer::invalid) {
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, steady_ns())) {
-      spdlog::info("params version {} from '{}' (publisher {:x}) not used: marked invalid or outside the model's "
-                   "domain{}",
-                   msg.version, escape_wire(msg.source), id, suppressed_note(g));
+      spdlog::info(
+          "params version {} from '{}' (publisher {:x}) not used: marked invalid or outside the model's "
+          "domain{}",
+          msg.version, escape_wire(msg.source), id, suppressed_note(g));
     }
   }
 }
@@ -197,8 +199,8 @@ void ReidentService::publish_model(const ModelDecision& d) {
     if (r.kind == d.params.kind) score = &r;
   }
   model_msg_.residual_m = score != nullptr && std::isfinite(score->train_rms_m) ? score->train_rms_m : 0.0;
-  model_msg_.heldout_rms_m = score != nullptr && std::isfinite(score->holdout_rms_m) ? score->holdout_rms_m
-                                                                                      : std::nan("");
+  model_msg_.heldout_rms_m =
+      score != nullptr && std::isfinite(score->holdout_rms_m) ? score->holdout_rms_m : std::nan("");
   model_msg_.samples_used = static_cast<std::int64_t>(d.window_samples);
   model_msg_.window_s = static_cast<double>(d.window_samples) / options_.rate_hz;
   model_msg_.valid = true;

@@ -12,8 +12,8 @@
 namespace hystloop {
 
 struct IoLoopOptions {
-  std::chrono::microseconds poll_timeout{1000};   // upper bound on one wait
-  std::chrono::milliseconds period{1000};         // how often on_period runs
+  std::chrono::microseconds poll_timeout{1000};  // upper bound on one wait
+  std::chrono::milliseconds period{1000};        // how often on_period runs
 };
 
 // Runs until stop_requested(). on_period is called every options.period (first after one

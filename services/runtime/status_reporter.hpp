@@ -24,7 +24,7 @@ class StatusReporter {
   // Starts a new report: clears counters and timings, keeps process/host/pid/start.
   void begin(std::int8_t state, std::string detail = {});
   void counter(std::string_view name, std::uint64_t value);
-  void endpoint(std::string_view name, const EndpointCounters& counters);   // adds to rejected
+  void endpoint(std::string_view name, const EndpointCounters& counters);  // adds to rejected
   void publisher(std::string_view name, const PublisherCounters& counters);
   void loop_timing(const LatencyStats& stats);  // per-iteration work
   void latency(const LatencyStats& stats);      // sample-to-command

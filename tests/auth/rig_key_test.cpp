@@ -76,8 +76,8 @@ TEST_F(RigKeyTest, FileOpenToGroupOrOthersIsRefusedNamingPathAndChmod) {
   const RigKey key = generate_rig_key();
   const fs::path p = dir_ / "rig.key";
   write_rig_key(p, key, false);
-  for (const fs::perms extra : {fs::perms::group_read, fs::perms::others_read, fs::perms::group_write,
-                                fs::perms::others_write}) {
+  for (const fs::perms extra :
+       {fs::perms::group_read, fs::perms::others_read, fs::perms::group_write, fs::perms::others_write}) {
     fs::permissions(p, fs::perms::owner_read | fs::perms::owner_write | extra);
     const std::string message = refusal(p);
     EXPECT_NE(message.find(p.string()), std::string::npos) << message;

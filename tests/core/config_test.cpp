@@ -109,11 +109,15 @@ TEST(Config, NonFiniteNumbersAreRefused) {
 
 TEST(Config, UnknownKeysAreListedWithSuggestions) {
   const Config cfg = Config::from_string("bridge: {u_maxV: 1, noise_rms_m: 1e-9}\n", "bridge.yaml");
-  EXPECT_EQ(error_of([&] { cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.noise_rms_m"}); }),
+  EXPECT_EQ(error_of([&] {
+              cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.noise_rms_m"});
+            }),
             "bridge.yaml: bridge.u_maxV: unknown key; did you mean 'bridge.u_max_V'?");
 
   const Config two = Config::from_string("bridge: {u_maxV: 1, colour: red}\ncompensater: {gain: 1}\n", "b.yaml");
-  EXPECT_EQ(error_of([&] { two.check_no_unknown_keys({"bridge.u_max_V", "compensator.gain"}); }),
+  EXPECT_EQ(error_of([&] {
+              two.check_no_unknown_keys({"bridge.u_max_V", "compensator.gain"});
+            }),
             "b.yaml: bridge.colour, bridge.u_maxV, compensater.gain: unknown keys; did you mean "
             "'bridge.u_max_V' for 'bridge.u_maxV', 'compensator.gain' for 'compensater.gain'?");
 
@@ -125,18 +129,17 @@ TEST(Config, UnknownKeysAreListedWithSuggestions) {
 
 TEST(Config, KnownKeysWildcardsAndEmptySectionsPass) {
   const Config cfg = Config::from_string(
-      "bridge: {u_max_V: 1, points: [{t: 0, y: 1}]}\nlogger: {dir: /tmp, rotate: {mb: 5}}\nstage:\n",
-      "x.yaml");
+      "bridge: {u_max_V: 1, points: [{t: 0, y: 1}]}\nlogger: {dir: /tmp, rotate: {mb: 5}}\nstage:\n", "x.yaml");
   EXPECT_NO_THROW(cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.points", "logger.*", "stage.model"}));
-  EXPECT_EQ(cfg.keys(), (std::vector<std::string>{"bridge.points", "bridge.u_max_V", "logger.dir",
-                                                  "logger.rotate.mb", "stage"}));
+  EXPECT_EQ(cfg.keys(),
+            (std::vector<std::string>{"bridge.points", "bridge.u_max_V", "logger.dir", "logger.rotate.mb", "stage"}));
   EXPECT_THROW(cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.points", "logger.dir"}), ConfigError);
 }
 
 TEST(Config, OverridesMergeOverTheFile) {
   Config cfg = Config::from_string(kBridge, "bridge.yaml");
-  cfg.apply_overrides({"bridge.u_max_V=90", "bridge.gains=[4, 5]", "compensator.mode=feedforward",
-                       "bridge.name=other"});
+  cfg.apply_overrides(
+      {"bridge.u_max_V=90", "bridge.gains=[4, 5]", "compensator.mode=feedforward", "bridge.name=other"});
   EXPECT_EQ(cfg.get<double>("bridge.u_max_V", 0.0), 90.0);
   EXPECT_EQ(cfg.get<std::vector<double>>("bridge.gains"), (std::vector<double>{4, 5}));
   EXPECT_EQ(cfg.get<std::string>("compensator.mode"), "feedforward");
@@ -153,20 +156,18 @@ TEST(Config, OverriddenValuesAreReportedAsComingFromTheCommandLine) {
   EXPECT_EQ(error_of([&] { (void)cfg.get_positive("bridge.u_max_V", 1.0); }),
             "--set: bridge.u_max_V: must be > 0 (got -5)");
   cfg.apply_override("bridge.typo=1");
-  EXPECT_EQ(error_of([&] { cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.noise_rms_m",
-                                                      "bridge.simulated", "bridge.name",
-                                                      "bridge.watchdog_ms", "bridge.gains",
-                                                      "stage.model"}); }),
+  EXPECT_EQ(error_of([&] {
+              cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.noise_rms_m", "bridge.simulated", "bridge.name",
+                                         "bridge.watchdog_ms", "bridge.gains", "stage.model"});
+            }),
             "--set: bridge.typo: unknown key");
 }
 
 TEST(Config, MalformedOverridesAreRefused) {
   Config cfg = Config::from_string(kBridge, "bridge.yaml");
-  EXPECT_EQ(error_of([&] { cfg.apply_override("bridge.u_max_V"); }),
-            "--set: expected key=value, got 'bridge.u_max_V'");
+  EXPECT_EQ(error_of([&] { cfg.apply_override("bridge.u_max_V"); }), "--set: expected key=value, got 'bridge.u_max_V'");
   EXPECT_EQ(error_of([&] { cfg.apply_override("=3"); }), "--set: expected key=value, got '=3'");
-  EXPECT_EQ(error_of([&] { cfg.apply_override("a..b=3"); }),
-            "--set: a..b: malformed key (empty part between dots)");
+  EXPECT_EQ(error_of([&] { cfg.apply_override("a..b=3"); }), "--set: a..b: malformed key (empty part between dots)");
   EXPECT_EQ(error_of([&] { cfg.apply_override("bridge.u_max_V.x=3"); }),
             "--set: bridge.u_max_V: cannot set a key inside it: it is '120', not a map");
   EXPECT_THROW(cfg.apply_override("a=[1, 2"), ConfigError);
@@ -209,8 +210,10 @@ TEST(Config, LoadsFilesAndReportsSyntaxErrorsWithALine) {
 // yaml-cpp keeps the first of two equal keys and answers with it: the second `u_max_V` of a file
 // edited in a hurry was silently ignored. Refused, naming the file, the key and both lines.
 TEST(Config, DuplicateKeysAreRefusedWithTheFileLineAndKey) {
-  EXPECT_EQ(error_of([] { (void)Config::from_string("bridge:\n  u_max_V: 120\n  noise_rms_m: 1e-9\n  u_max_V: 250\n",
-                                                   "bridge.yaml"); }),
+  EXPECT_EQ(error_of([] {
+              (void)Config::from_string("bridge:\n  u_max_V: 120\n  noise_rms_m: 1e-9\n  u_max_V: 250\n",
+                                        "bridge.yaml");
+            }),
             "bridge.yaml: bridge.u_max_V: duplicate key at line 4 (first at line 2): remove one of them");
   EXPECT_EQ(error_of([] { (void)Config::from_string("a: 1\nb: {c: 2}\na: 3\n", "top.yaml"); }),
             "top.yaml: a: duplicate key at line 3 (first at line 1): remove one of them");
@@ -218,13 +221,15 @@ TEST(Config, DuplicateKeysAreRefusedWithTheFileLineAndKey) {
   EXPECT_NE(error_of([] { (void)Config::from_string("s: [{k: 1, k: 2}]\n", "l.yaml"); }).find("s[0].k: duplicate key"),
             std::string::npos);
   Config cfg;
-  EXPECT_NE(error_of([&] { cfg.apply_override("bridge.gains={a: 1, a: 2}"); }).find("--set: bridge.gains.a: duplicate key"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { cfg.apply_override("bridge.gains={a: 1, a: 2}"); }).find("--set: bridge.gains.a: duplicate key"),
+      std::string::npos);
   // The same key in different sections is not a duplicate.
   const Config ok = Config::from_string("a: {x: 1}\nb: {x: 2}\n", "ok.yaml");
   EXPECT_EQ(ok.get<int>("b.x", 0), 2);
 
-  const auto file = std::filesystem::temp_directory_path() / ("hystloop_cfg_" + std::to_string(::getpid()) + "_dup.yaml");
+  const auto file =
+      std::filesystem::temp_directory_path() / ("hystloop_cfg_" + std::to_string(::getpid()) + "_dup.yaml");
   std::ofstream(file) << kBridge << "bridge:\n  u_max_V: 5\n";
   EXPECT_EQ(error_of([&] { (void)Config::load_file(file); }),
             file.string() + ": bridge: duplicate key at line 11 (first at line 2): remove one of them");

@@ -14,8 +14,7 @@ namespace hystloop {
 namespace {
 
 std::filesystem::path temp_path(const std::string& name) {
-  return std::filesystem::temp_directory_path() /
-         ("hystloop_logging_test_" + std::to_string(::getpid()) + "_" + name);
+  return std::filesystem::temp_directory_path() / ("hystloop_logging_test_" + std::to_string(::getpid()) + "_" + name);
 }
 
 std::string read_all(const std::filesystem::path& p) {
@@ -58,9 +57,7 @@ TEST(Logging, WritesTheProcessNameLevelAndPidToTheFile) {
   spdlog::trace("not shown at debug");
   flush_logging();
   const std::string text = read_all(file);
-  EXPECT_NE(text.find("bridge[" + std::to_string(::getpid()) + "] debug armed at 12.5 V"),
-            std::string::npos)
-      << text;
+  EXPECT_NE(text.find("bridge[" + std::to_string(::getpid()) + "] debug armed at 12.5 V"), std::string::npos) << text;
   EXPECT_EQ(text.find("not shown"), std::string::npos) << text;
   std::filesystem::remove(file);
 }

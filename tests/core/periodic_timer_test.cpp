@@ -177,8 +177,8 @@ TEST(PeriodicTimer, Keeps10kHzForOneSecondWithEveryTickAccountedFor) {
   RecordProperty("served", static_cast<int>(served));
   RecordProperty("skipped", static_cast<int>(skipped));
   std::printf("10 kHz for 1 s: served %llu, skipped %llu, lateness p50 %.1f us, p99 %.1f us, max %.1f us\n",
-              static_cast<unsigned long long>(served), static_cast<unsigned long long>(skipped),
-              s.p50_ns / 1e3, s.p99_ns / 1e3, s.max_ns / 1e3);
+              static_cast<unsigned long long>(served), static_cast<unsigned long long>(skipped), s.p50_ns / 1e3,
+              s.p99_ns / 1e3, s.max_ns / 1e3);
 }
 
 }  // namespace

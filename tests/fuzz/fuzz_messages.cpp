@@ -21,7 +21,8 @@ template <class T>
 void receive(const std::uint8_t* data, std::size_t size) {
   std::vector<std::uint8_t> buffer(8 + size);
   const std::int64_t hash = T::getHash();
-  for (int i = 0; i < 8; ++i) buffer[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(hash) >> (56 - 8 * i));
+  for (int i = 0; i < 8; ++i)
+    buffer[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(hash) >> (56 - 8 * i));
   if (size > 0) std::memcpy(buffer.data() + 8, data, size);
 
   const std::int64_t walked = walk_wire_layout(wire_layout_of<T>(), buffer.data(), buffer.size());

@@ -61,8 +61,8 @@ std::string refusal(const std::string& yaml) {
 }
 
 TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {
-  const BridgeSettings d = load_bridge_settings(
-      Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge-comedi.yaml"));
+  const BridgeSettings d =
+      load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge-comedi.yaml"));
   EXPECT_EQ(d.backend, "comedi");
   EXPECT_EQ(d.comedi.device, "/dev/comedi0");
   EXPECT_EQ(d.comedi.ai.aref, AREF_DIFF);
@@ -70,7 +70,8 @@ TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {
   EXPECT_EQ(d.rt.ticks_per_wake, 1);
   const std::string c = "bridge: {backend: comedi}\nrt: {ticks_per_wake: 1}\n";
   EXPECT_EQ(refusal(c), "accepted");
-  EXPECT_TRUE(contains(refusal(c + "comedi: {ai: {aref: floating}}"), "bridge.yaml: comedi.ai.aref")) << refusal(c + "comedi: {ai: {aref: floating}}");
+  EXPECT_TRUE(contains(refusal(c + "comedi: {ai: {aref: floating}}"), "bridge.yaml: comedi.ai.aref"))
+      << refusal(c + "comedi: {ai: {aref: floating}}");
   EXPECT_TRUE(contains(refusal(c + "comedi: {ao: {channel: -1}}"), "bridge.yaml: comedi.ao.channel"));
   EXPECT_TRUE(contains(refusal(c + "comedi: {ai: {subdevice: -2}}"), "bridge.yaml: comedi.ai.subdevice"));
   EXPECT_TRUE(contains(refusal(c + "comedi: {amplifier_gain_V_per_V: 0}"), "comedi.amplifier_gain_V_per_V"));
@@ -130,7 +131,7 @@ TEST_F(ComediBackendTest, ConvertsBothWaysThroughTheRangeTables) {
   for (const lsampl_t counts : {1u, 1000u, 32768u, 65534u}) {
     EXPECT_DOUBLE_EQ(b.position_m(counts), 1e-6 + 2e-7 * volts(counts, -5, 5)) << counts;
   }
-  EXPECT_TRUE(std::isnan(b.position_m(0)));         // the ends of the range: saturated
+  EXPECT_TRUE(std::isnan(b.position_m(0)));  // the ends of the range: saturated
   EXPECT_TRUE(std::isnan(b.position_m(kMaxdata)));
 }
 

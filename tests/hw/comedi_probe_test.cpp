@@ -27,8 +27,8 @@ struct BridgeRun {
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 BridgeRun run(const std::string& fake, const std::string& args, const std::string& wrap = "") {
-  const std::string log = ::testing::TempDir() + "/fake_comedi_" +
-                          ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".log";
+  const std::string log =
+      ::testing::TempDir() + "/fake_comedi_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".log";
   std::remove(log.c_str());
   const std::string bridge = std::string(HYSTLOOP_BRIDGE_EXE) + " --config " + kConfig + " " + args;
   const std::string cmd = "LD_LIBRARY_PATH=" HYSTLOOP_FAKE_LIBCOMEDI_DIR " HX_FAKE_COMEDI='" + fake +
@@ -76,8 +76,9 @@ TEST(ComediProbe, WithYesReportsTheSensorsGainAndSign) {
   EXPECT_TRUE(contains(r.out, "SIGN REVERSED")) << r.out;
   EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
   // Clamped to the actuator's range: +-2 V at the card asked, +-50 V / 25 allowed.
-  r = run("mirror_gain=1", "--probe-hardware --yes --duration-s 0.1 --amplitude-V 5 --set actuator.u_min_V=-50 "
-                           "--set actuator.u_max_V=50");
+  r = run("mirror_gain=1",
+          "--probe-hardware --yes --duration-s 0.1 --amplitude-V 5 --set actuator.u_min_V=-50 "
+          "--set actuator.u_max_V=50");
   EXPECT_TRUE(contains(r.out, "triangle 0 V -> 2 V -> -2 V -> 0 V")) << r.out;
 }
 
@@ -97,7 +98,7 @@ TEST(ComediProbe, ACardThatRefusesTheConfigExitsTwoWithTheOutputSafe) {
 TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
   const std::string netns = std::string(HYSTLOOP_SOURCE_DIR) + "/tools/netns-run";
   const BridgeRun r = run("", "--set rt.priority=0 --set rt.io_priority=0 --set rt.lock_memory=false --set rt.cpu=-1",
-                    netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
+                          netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
   EXPECT_EQ(r.rc, 0) << r.out;
   EXPECT_TRUE(contains(r.out, "the safe 0 V written (DAC code 32768)")) << r.out;
   EXPECT_TRUE(contains(r.out, "stopping on signal 15")) << r.out;

@@ -186,7 +186,8 @@ comedi_range* comedi_get_range(comedi_t*, unsigned int subdevice, unsigned int, 
 
 double comedi_to_phys(lsampl_t data, comedi_range* rng, lsampl_t maxdata) {
   if (rng == nullptr || maxdata == 0) return std::numeric_limits<double>::quiet_NaN();
-  if (data == 0 || data == maxdata) return std::numeric_limits<double>::quiet_NaN();  // COMEDI_OOR_NAN, comedilib's default
+  if (data == 0 || data == maxdata)
+    return std::numeric_limits<double>::quiet_NaN();  // COMEDI_OOR_NAN, comedilib's default
   return rng->min + (rng->max - rng->min) * static_cast<double>(data) / static_cast<double>(maxdata);
 }
 
@@ -252,8 +253,9 @@ comedi_calibration_t* comedi_parse_calibration_file(const char* path) {
 
 void comedi_cleanup_calibration(comedi_calibration_t*) {}
 
-int comedi_get_softcal_converter(unsigned subdevice, unsigned, unsigned range, enum comedi_conversion_direction direction,
-                                 const comedi_calibration_t* calibration, comedi_polynomial_t* polynomial) {
+int comedi_get_softcal_converter(unsigned subdevice, unsigned, unsigned range,
+                                 enum comedi_conversion_direction direction, const comedi_calibration_t* calibration,
+                                 comedi_polynomial_t* polynomial) {
   const comedi_range* r = range_of(subdevice, range);
   if (calibration != &g_calibration || r == nullptr || subdevice == kDio || polynomial == nullptr) return -1;
   // counts -> V: the range table's line with a 1 % gain error and a 2 mV offset; V -> counts its inverse.

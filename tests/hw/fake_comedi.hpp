@@ -36,16 +36,16 @@ struct InsnList {
 };
 
 struct ScriptedRead {
-  int rc = 2;          // what comedi_do_insnlist returns (2: both done; 1: the read failed; -1: the call failed)
-  lsampl_t counts = 0; // what the read returns
+  int rc = 2;           // what comedi_do_insnlist returns (2: both done; 1: the read failed; -1: the call failed)
+  lsampl_t counts = 0;  // what the read returns
 };
 
 struct State {
   bool open_fails = false;
-  bool calibration = false;       // the board has a calibration file with softcal polynomials
+  bool calibration = false;  // the board has a calibration file with softcal polynomials
   double mirror_gain = 1.0;
   double mirror_offset_V = 0.0;
-  std::vector<InsnList> lists;    // reserved: recording does not allocate up to its capacity
+  std::vector<InsnList> lists;      // reserved: recording does not allocate up to its capacity
   std::vector<ScriptedRead> reads;  // served first, in order, before mirroring
   std::size_t next_read = 0;
   int opens = 0;

@@ -68,7 +68,8 @@ Recorded record(const BanningStageParams& stage, const BanningPlanOptions& plan_
 
 TEST(BanningFit, SineEstimateReadsOffsetAmplitudeFrequency) {
   std::vector<double> u(1000);
-  for (std::size_t k = 0; k < u.size(); ++k) u[k] = 3.0 + 2.0 * std::sin(2.0 * std::numbers::pi * 2800.0 * static_cast<double>(k) / 1e4 + 0.3);
+  for (std::size_t k = 0; k < u.size(); ++k)
+    u[k] = 3.0 + 2.0 * std::sin(2.0 * std::numbers::pi * 2800.0 * static_cast<double>(k) / 1e4 + 0.3);
   const SineEstimate e = estimate_sine(u, 1e4);
   ASSERT_TRUE(e.ok);
   EXPECT_NEAR(e.frequency_Hz, 2800.0, 1e-3);
@@ -133,9 +134,10 @@ TEST(BanningFit, PaperOrderIsRecoveredToo) {
   EXPECT_LT(rel(r.hysteresis.alpha, truth.hysteresis.alpha), kAlphaTolerance + 0.01);
   EXPECT_LT(rel(r.stage.k, truth.stage.k), 5e-3);
   EXPECT_LT(rel(r.stage.c, truth.stage.c), 0.05);
-  std::printf("paper order: a %.2e b %.2e alpha %.2e k %.2e c %.2e (rel. errors)\n", rel(r.hysteresis.a, truth.hysteresis.a),
-              rel(r.hysteresis.b, truth.hysteresis.b), rel(r.hysteresis.alpha, truth.hysteresis.alpha),
-              rel(r.stage.k, truth.stage.k), rel(r.stage.c, truth.stage.c));
+  std::printf("paper order: a %.2e b %.2e alpha %.2e k %.2e c %.2e (rel. errors)\n",
+              rel(r.hysteresis.a, truth.hysteresis.a), rel(r.hysteresis.b, truth.hysteresis.b),
+              rel(r.hysteresis.alpha, truth.hysteresis.alpha), rel(r.stage.k, truth.stage.k),
+              rel(r.stage.c, truth.stage.c));
 }
 
 TEST(BanningFit, RefusalsSayWhy) {

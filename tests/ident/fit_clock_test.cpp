@@ -66,7 +66,8 @@ TEST(FitClock, AFixedClockMakesTheMemFitReproducible) {
   const auto u = sine(200.0, 10.0, 20000);
   std::vector<double> y(u.size());
   model.reset(0.0);
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]) + 1e-9 * std::sin(0.37 * static_cast<double>(k));
+  for (std::size_t k = 0; k < u.size(); ++k)
+    y[k] = model.forward(u[k]) + 1e-9 * std::sin(0.37 * static_cast<double>(k));
   MemFitOptions o;
   o.clock = fixed_fit_clock();
   const MemFitResult a = fit_mem(u, y, o), b = fit_mem(u, y, o);

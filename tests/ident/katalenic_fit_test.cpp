@@ -23,7 +23,8 @@ constexpr double kSolverTime = 2.0;
 
 std::vector<double> paper_input() {
   std::vector<double> u(kSamples);
-  for (std::size_t k = 0; k < u.size(); ++k) u[k] = 250.0 * std::sin(2.0 * std::numbers::pi * 10.0 * static_cast<double>(k) * 1e-4);
+  for (std::size_t k = 0; k < u.size(); ++k)
+    u[k] = 250.0 * std::sin(2.0 * std::numbers::pi * 10.0 * static_cast<double>(k) * 1e-4);
   return u;
 }
 

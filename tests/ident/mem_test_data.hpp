@@ -14,13 +14,13 @@
 namespace hystloop::testdata {
 
 // u = amplitude sin(2 pi f t), t = k / fs, k = 0 .. duration * fs - 1.
-inline std::vector<double> sine_input(double amplitude_V, double frequency_Hz, double sample_rate_Hz,
-                                      double duration_s, double offset_V = 0.0) {
+inline std::vector<double> sine_input(double amplitude_V, double frequency_Hz, double sample_rate_Hz, double duration_s,
+                                      double offset_V = 0.0) {
   const auto n = static_cast<std::size_t>(std::llround(duration_s * sample_rate_Hz));
   std::vector<double> u(n);
   for (std::size_t k = 0; k < n; ++k) {
-    u[k] = offset_V + amplitude_V * std::sin(2.0 * std::numbers::pi * frequency_Hz * static_cast<double>(k) /
-                                              sample_rate_Hz);
+    u[k] = offset_V +
+           amplitude_V * std::sin(2.0 * std::numbers::pi * frequency_Hz * static_cast<double>(k) / sample_rate_Hz);
   }
   return u;
 }

@@ -24,7 +24,8 @@ TEST(ModelSelection, MemDataRanksMemFirstAndLinearLast) {
   ASSERT_EQ(sel.ranking.size(), 4u);
   for (const auto& s : sel.ranking) {
     std::printf("%-10s %-8s train %.3g nm  held-out %.3g nm  %.1f ms\n", std::string(to_string(s.kind)).c_str(),
-                std::string(to_string(s.status)).c_str(), s.train_rms_m * 1e9, s.holdout_rms_m * 1e9, s.fit_time_s * 1e3);
+                std::string(to_string(s.status)).c_str(), s.train_rms_m * 1e9, s.holdout_rms_m * 1e9,
+                s.fit_time_s * 1e3);
   }
   EXPECT_EQ(sel.ranking.front().kind, ModelKind::mem);
   EXPECT_EQ(sel.ranking.back().kind, ModelKind::linear);

@@ -32,7 +32,8 @@ namespace {
 using namespace hystloop;
 
 int send_commands(lcm::LCM& lcm, const ChannelNames& ch, int count, const std::string& key_file) {
-  const std::shared_ptr<const RigAuth> auth = key_file.empty() ? nullptr : rig_auth_from_key_file(key_file, "--key-file");
+  const std::shared_ptr<const RigAuth> auth =
+      key_file.empty() ? nullptr : rig_auth_from_key_file(key_file, "--key-file");
   Publisher<command_block_t> pub(lcm, ch.command, default_message_check<command_block_t>(), auth);
   command_block_t block{};
   reserve_storage(block);
@@ -55,8 +56,9 @@ int capture(lcm::LCM& lcm, const std::string& channel, const std::string& out) {
       lcm.getUnderlyingLCM(), channel.c_str(),
       [](const lcm_recv_buf_t* rbuf, const char*, void* into) {
         auto* v = static_cast<std::vector<std::uint8_t>*>(into);
-        if (v->empty()) v->assign(static_cast<const std::uint8_t*>(rbuf->data),
-                                  static_cast<const std::uint8_t*>(rbuf->data) + rbuf->data_size);
+        if (v->empty())
+          v->assign(static_cast<const std::uint8_t*>(rbuf->data),
+                    static_cast<const std::uint8_t*>(rbuf->data) + rbuf->data_size);
       },
       &bytes);
   for (int i = 0; i < 100 && bytes.empty(); ++i) lcm.handleTimeout(50);
@@ -64,8 +66,8 @@ int capture(lcm::LCM& lcm, const std::string& channel, const std::string& out) {
     std::fprintf(stderr, "auth_probe: nothing on %s within 5 s\n", channel.c_str());
     return 1;
   }
-  std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                             static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(out, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   std::printf("captured %zu bytes of %s\n", bytes.size(), channel.c_str());
   return 0;
 }

@@ -55,15 +55,24 @@ Options parse(int argc, char** argv) {
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const std::string value = argv[i + 1];
-    if (key == "--url") o.url = value;
-    else if (key == "--prefix") o.prefix = value;
-    else if (key == "--file") o.file = value;
-    else if (key == "--ready-file") o.ready_file = value;
-    else if (key == "--ignore-prefix") o.ignore_prefix = value;
-    else if (key == "--rounds") o.rounds = std::stoll(value);
-    else if (key == "--rate-hz") o.rate_hz = std::stod(value);
-    else if (key == "--timeout-s") o.timeout_s = std::stod(value);
-    else throw std::invalid_argument("unknown option " + key);
+    if (key == "--url")
+      o.url = value;
+    else if (key == "--prefix")
+      o.prefix = value;
+    else if (key == "--file")
+      o.file = value;
+    else if (key == "--ready-file")
+      o.ready_file = value;
+    else if (key == "--ignore-prefix")
+      o.ignore_prefix = value;
+    else if (key == "--rounds")
+      o.rounds = std::stoll(value);
+    else if (key == "--rate-hz")
+      o.rate_hz = std::stod(value);
+    else if (key == "--timeout-s")
+      o.timeout_s = std::stod(value);
+    else
+      throw std::invalid_argument("unknown option " + key);
   }
   return o;
 }
@@ -145,8 +154,8 @@ struct Expectations {
         status(ch.status, rare_rounds(rounds)),
         control(ch.control, rare_rounds(rounds)) {}
   bool complete() const {
-    return sensor.complete() && command.complete() && trajectory.complete() && params.complete() &&
-           model.complete() && status.complete() && control.complete();
+    return sensor.complete() && command.complete() && trajectory.complete() && params.complete() && model.complete() &&
+           status.complete() && control.complete();
   }
   Expectation<sensor_block_t> sensor;
   Expectation<command_block_t> command;
@@ -171,20 +180,27 @@ int publish(const Options& o) {
   const auto emit = [&](const std::string& channel, const auto& msg) {
     using T = std::decay_t<decltype(msg)>;
     bool ok = false;
-    if constexpr (std::is_same_v<T, sensor_block_t>) ok = sensor.publish(msg);
-    else if constexpr (std::is_same_v<T, command_block_t>) ok = command.publish(msg);
-    else if constexpr (std::is_same_v<T, trajectory_t>) ok = trajectory.publish(msg);
-    else if constexpr (std::is_same_v<T, mem_params_t>) ok = params.publish(msg);
-    else if constexpr (std::is_same_v<T, model_params_t>) ok = model.publish(msg);
-    else if constexpr (std::is_same_v<T, service_status_t>) ok = status.publish(msg);
-    else ok = control.publish(msg);
+    if constexpr (std::is_same_v<T, sensor_block_t>)
+      ok = sensor.publish(msg);
+    else if constexpr (std::is_same_v<T, command_block_t>)
+      ok = command.publish(msg);
+    else if constexpr (std::is_same_v<T, trajectory_t>)
+      ok = trajectory.publish(msg);
+    else if constexpr (std::is_same_v<T, mem_params_t>)
+      ok = params.publish(msg);
+    else if constexpr (std::is_same_v<T, model_params_t>)
+      ok = model.publish(msg);
+    else if constexpr (std::is_same_v<T, service_status_t>)
+      ok = status.publish(msg);
+    else
+      ok = control.publish(msg);
     (void)channel;
     failed += ok ? 0 : 1;
   };
   // Paced, never bursting: after a stall the schedule starts again from now instead of sending the
   // missed rounds back to back (a burst overflows a receiver's 30-message LCM queue, e.g. lcm-logger's).
-  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(1.0 / o.rate_hz));
+  const auto period =
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(1.0 / o.rate_hz));
   auto next = std::chrono::steady_clock::now();
   for (std::int64_t k = 0; k < o.rounds; ++k) {
     std::this_thread::sleep_until(next);
@@ -205,9 +221,12 @@ int subscribe(const Options& o) {
   so.queue_capacity = queue;
   Subscription<command_block_t>::Options co;
   co.queue_capacity = queue;
-  Subscription<sensor_block_t> sensor(*lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
-  Subscription<command_block_t> command(*lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
-  Subscription<trajectory_t> trajectory(*lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
+  Subscription<sensor_block_t> sensor(
+      *lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
+  Subscription<command_block_t> command(
+      *lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
+  Subscription<trajectory_t> trajectory(*lcm, ch.trajectory,
+                                        [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(*lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
   Subscription<model_params_t> model(*lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
   Subscription<service_status_t> status(*lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
@@ -262,7 +281,8 @@ int check_log(const Options& o) {
   Expectations expect(ch, o.rounds);
   Subscription<sensor_block_t> sensor(lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); });
   Subscription<command_block_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
-  Subscription<trajectory_t> trajectory(lcm, ch.trajectory, [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
+  Subscription<trajectory_t> trajectory(lcm, ch.trajectory,
+                                        [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
   Subscription<mem_params_t> params(lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
   Subscription<model_params_t> model(lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
   Subscription<service_status_t> status(lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
@@ -270,14 +290,22 @@ int check_log(const Options& o) {
   std::int64_t other = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
     const auto size = static_cast<std::size_t>(event->datalen);
-    if (event->channel == ch.sensor) sensor.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.command) command.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.trajectory) trajectory.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.params) params.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.model) model.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.status) status.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.control) control.receive(event->data, size, event->timestamp);
-    else if (o.ignore_prefix.empty() || event->channel.rfind(o.ignore_prefix, 0) != 0) ++other;
+    if (event->channel == ch.sensor)
+      sensor.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.command)
+      command.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.trajectory)
+      trajectory.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.params)
+      params.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.model)
+      model.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.status)
+      status.receive(event->data, size, event->timestamp);
+    else if (event->channel == ch.control)
+      control.receive(event->data, size, event->timestamp);
+    else if (o.ignore_prefix.empty() || event->channel.rfind(o.ignore_prefix, 0) != 0)
+      ++other;
   }
   bool ok = expect.sensor.report(sensor.counters().rejected_total());
   ok = expect.command.report(command.counters().rejected_total()) && ok;
@@ -298,9 +326,12 @@ int echo(const Options& o) {
   std::int64_t answered = 0;
   Subscription<sensor_block_t>::Options so;
   so.queue_capacity = 1000;
-  Subscription<sensor_block_t> sensor(*lcm, ch.sensor, [&](const sensor_block_t& m, std::int64_t) {
-    answered += command.publish(fixtures::command_block(index_of(m))) ? 1 : 0;
-  }, so);
+  Subscription<sensor_block_t> sensor(
+      *lcm, ch.sensor,
+      [&](const sensor_block_t& m, std::int64_t) {
+        answered += command.publish(fixtures::command_block(index_of(m))) ? 1 : 0;
+      },
+      so);
   if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
   while (answered < o.rounds && std::chrono::steady_clock::now() < deadline) {
@@ -322,12 +353,16 @@ int ping(const Options& o) {
   rtt_us.reserve(sent.size());
   Subscription<command_block_t>::Options co;
   co.queue_capacity = 1000;
-  Subscription<command_block_t> command(*lcm, ch.command, [&](const command_block_t& m, std::int64_t) {
-    const std::int64_t k = index_of(m);
-    if (m.sample_seq >= 0 && k < o.rounds) {
-      rtt_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - sent[static_cast<std::size_t>(k)]).count());
-    }
-  }, co);
+  Subscription<command_block_t> command(
+      *lcm, ch.command,
+      [&](const command_block_t& m, std::int64_t) {
+        const std::int64_t k = index_of(m);
+        if (m.sample_seq >= 0 && k < o.rounds) {
+          rtt_us.push_back(
+              std::chrono::duration<double, std::micro>(Clock::now() - sent[static_cast<std::size_t>(k)]).count());
+        }
+      },
+      co);
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / o.rate_hz));
   const auto start = Clock::now();
   for (std::int64_t k = 0; k < o.rounds; ++k) {
@@ -344,7 +379,9 @@ int ping(const Options& o) {
   }
   if (rtt_us.empty()) return 1;
   std::sort(rtt_us.begin(), rtt_us.end());
-  const auto pct = [&](double p) { return rtt_us[static_cast<std::size_t>(p * static_cast<double>(rtt_us.size() - 1))]; };
+  const auto pct = [&](double p) {
+    return rtt_us[static_cast<std::size_t>(p * static_cast<double>(rtt_us.size() - 1))];
+  };
   std::printf("round trips %zu/%lld at %.0f Hz: p50 %.1f us  p99 %.1f us  max %.1f us\n", rtt_us.size(),
               static_cast<long long>(o.rounds), o.rate_hz, pct(0.5), pct(0.99), rtt_us.back());
   return static_cast<std::int64_t>(rtt_us.size()) == o.rounds ? 0 : 1;

@@ -71,19 +71,31 @@ Options parse(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
     const std::string value = argv[++i];
-    if (key == "--url") o.url = value;
-    else if (key == "--prefix") o.prefix = value;
-    else if (key == "--blocks") o.blocks = std::stoll(value);
-    else if (key == "--block-ticks") o.block_ticks = std::stoll(value);
-    else if (key == "--gap-at") o.gap_at = std::stoll(value);
-    else if (key == "--gap-len") o.gap_len = std::stoll(value);
-    else if (key == "--commands") o.commands = std::stoll(value);
-    else if (key == "--rate-hz") o.rate_hz = std::stod(value);
-    else if (key == "--wait-logger-s") o.wait_logger_s = std::stod(value);
-    else if (key == "--seconds") o.seconds = std::stod(value);
-    else throw std::invalid_argument("unknown option " + key);
+    if (key == "--url")
+      o.url = value;
+    else if (key == "--prefix")
+      o.prefix = value;
+    else if (key == "--blocks")
+      o.blocks = std::stoll(value);
+    else if (key == "--block-ticks")
+      o.block_ticks = std::stoll(value);
+    else if (key == "--gap-at")
+      o.gap_at = std::stoll(value);
+    else if (key == "--gap-len")
+      o.gap_len = std::stoll(value);
+    else if (key == "--commands")
+      o.commands = std::stoll(value);
+    else if (key == "--rate-hz")
+      o.rate_hz = std::stod(value);
+    else if (key == "--wait-logger-s")
+      o.wait_logger_s = std::stod(value);
+    else if (key == "--seconds")
+      o.seconds = std::stod(value);
+    else
+      throw std::invalid_argument("unknown option " + key);
   }
-  if (o.block_ticks < 1 || o.block_ticks > sensor_block_t::MAX_TICKS) throw std::invalid_argument("--block-ticks: 1..1000");
+  if (o.block_ticks < 1 || o.block_ticks > sensor_block_t::MAX_TICKS)
+    throw std::invalid_argument("--block-ticks: 1..1000");
   return o;
 }
 
@@ -109,7 +121,7 @@ std::vector<Event> expected_stream(const Options& o, const ChannelNames& ch) {
     }
     if (k < o.commands) {
       events.push_back({&ch.command, encoded(fixtures::command_ticks(seq + fixtures::kCommandLead, o.block_ticks,
-                                                                      seq + o.block_ticks - 1))});
+                                                                     seq + o.block_ticks - 1))});
     }
     if (k % 100 == 0) {
       events.push_back({&ch.trajectory, encoded(fixtures::trajectory(k / 100))});
@@ -156,8 +168,8 @@ int publish(const Options& o) {
     round = k + 1;
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("logger_probe: published %zu messages in %lld rounds over %.3f s (%.0f rounds/s), %d failed\n",
-              next, static_cast<long long>(round), elapsed, static_cast<double>(round) / elapsed, failures);
+  std::printf("logger_probe: published %zu messages in %lld rounds over %.3f s (%.0f rounds/s), %d failed\n", next,
+              static_cast<long long>(round), elapsed, static_cast<double>(round) / elapsed, failures);
   return failures == 0 ? 0 : 1;
 }
 
@@ -181,7 +193,8 @@ int check_log(const Options& o) {
     std::size_t events_in_file = 0;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       ++events_in_file;
-      if (ev->eventnum <= last_eventnum) fail(file + ": event numbers not increasing at " + std::to_string(ev->eventnum));
+      if (ev->eventnum <= last_eventnum)
+        fail(file + ": event numbers not increasing at " + std::to_string(ev->eventnum));
       if (ev->timestamp < last_timestamp) fail(file + ": timestamp goes back at event " + std::to_string(ev->eventnum));
       last_eventnum = ev->eventnum;
       last_timestamp = ev->timestamp;
@@ -206,8 +219,8 @@ int check_log(const Options& o) {
   if (next != expected.size()) {
     fail("found " + std::to_string(next) + " of " + std::to_string(expected.size()) + " published messages");
   }
-  std::printf("logger_probe check-log: %zu files, %zu of %zu messages intact and in order, %d errors\n",
-              o.files.size(), next, expected.size(), errors);
+  std::printf("logger_probe check-log: %zu files, %zu of %zu messages intact and in order, %d errors\n", o.files.size(),
+              next, expected.size(), errors);
   return errors == 0 ? 0 : 1;
 }
 
@@ -264,7 +277,8 @@ int watch_status(const Options& o) {
   auto lcm = open_lcm(o.url);
   Subscription<service_status_t> status(*lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
     if (m.process != "logger") return;
-    std::string line = "{\"state\": " + std::to_string(m.state) + ", \"detail\": " + json_text(m.detail) + ", \"counters\": {";
+    std::string line =
+        "{\"state\": " + std::to_string(m.state) + ", \"detail\": " + json_text(m.detail) + ", \"counters\": {";
     for (int i = 0; i < m.n_counters; ++i) {
       line += (i ? ", " : "") + json_text(m.counter_names[i]) + ": " + std::to_string(m.counter_values[i]);
     }

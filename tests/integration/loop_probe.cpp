@@ -1,7 +1,8 @@
 // The integration tests' hands and eyes on a running bridge + compensator (udpm inside
 // tools/netns-run):
 //
-//   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv, HX_COMMAND -> D/command.csv,
+//   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv,
+//   HX_COMMAND -> D/command.csv,
 //                                                HX_STATUS -> D/status.log (one line per report)
 //   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
 //                                reset_counters|shutdown [--target P] [--mode N] [--kp --ki --kd]
@@ -125,11 +126,14 @@ struct ControlArgs {
 };
 
 int control(lcm::LCM& lcm, const ChannelNames& ch, const ControlArgs& a) {
-  static const std::map<std::string, std::int8_t> commands = {
-      {"set_mode", control_t::SET_MODE},         {"set_gains", control_t::SET_GAINS},
-      {"arm", control_t::ARM},                   {"disarm", control_t::DISARM},
-      {"start_experiment", control_t::START_EXPERIMENT}, {"stop_experiment", control_t::STOP_EXPERIMENT},
-      {"reset_counters", control_t::RESET_COUNTERS}, {"shutdown", control_t::SHUTDOWN}};
+  static const std::map<std::string, std::int8_t> commands = {{"set_mode", control_t::SET_MODE},
+                                                              {"set_gains", control_t::SET_GAINS},
+                                                              {"arm", control_t::ARM},
+                                                              {"disarm", control_t::DISARM},
+                                                              {"start_experiment", control_t::START_EXPERIMENT},
+                                                              {"stop_experiment", control_t::STOP_EXPERIMENT},
+                                                              {"reset_counters", control_t::RESET_COUNTERS},
+                                                              {"shutdown", control_t::SHUTDOWN}};
   const auto it = commands.find(a.command);
   if (it == commands.end()) {
     std::fprintf(stderr, "loop_probe: unknown control command %s\n", a.command.c_str());
@@ -283,7 +287,8 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
     double u = 0, y = 0, y_ref = 0;
     int flags = 0;
     char ref_text[64] = {0};
-    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%d,%63[^,]", &seq, &utime, &u, &y, &flags, ref_text) != 6) continue;
+    if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%d,%63[^,]", &seq, &utime, &u, &y, &flags, ref_text) != 6)
+      continue;
     y_ref = std::strtod(ref_text, nullptr);  // "nan" (no reference) reads as NaN
     ++n;
     const bool consecutive = prev_seq >= 0 && seq == prev_seq + 1;
@@ -323,14 +328,15 @@ int analyze(const std::string& dir, double u_min, double u_max, double slew, dou
   const std::size_t n_track = run_errors.size() - half;
   std::printf("last_run_ticks=%zu\ntracking_rms_m=%.6g\n", run_errors.size(),
               n_track > 0 ? std::sqrt(sum2 / static_cast<double>(n_track)) : kNaN);
-  std::printf("samples=%lld\nseq_gaps=%lld\napplied=%lld\nout_of_range=%lld\nmax_step_V=%.6g\nallowed_step_V=%.6g\n"
-              "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n"
-              "late_ticks=%lld\nmax_planned_ahead_ticks=%lld\n",
-              static_cast<long long>(n), static_cast<long long>(gaps), static_cast<long long>(applied),
-              static_cast<long long>(out_of_range), max_du, max_step, static_cast<long long>(too_fast),
-              static_cast<long long>(trips), static_cast<long long>(worst_trip_ticks),
-              static_cast<long long>(watchdog_ticks), static_cast<long long>(slow_trips),
-              static_cast<long long>(late_ticks), static_cast<long long>(max_planned_ahead(dir)));
+  std::printf(
+      "samples=%lld\nseq_gaps=%lld\napplied=%lld\nout_of_range=%lld\nmax_step_V=%.6g\nallowed_step_V=%.6g\n"
+      "too_fast=%lld\nsafe_entries=%lld\nworst_trip_ticks=%lld\nwatchdog_ticks=%lld\nslow_trips=%lld\n"
+      "late_ticks=%lld\nmax_planned_ahead_ticks=%lld\n",
+      static_cast<long long>(n), static_cast<long long>(gaps), static_cast<long long>(applied),
+      static_cast<long long>(out_of_range), max_du, max_step, static_cast<long long>(too_fast),
+      static_cast<long long>(trips), static_cast<long long>(worst_trip_ticks), static_cast<long long>(watchdog_ticks),
+      static_cast<long long>(slow_trips), static_cast<long long>(late_ticks),
+      static_cast<long long>(max_planned_ahead(dir)));
   return (n > 0 && out_of_range == 0 && too_fast == 0 && slow_trips == 0) ? 0 : 1;
 }
 

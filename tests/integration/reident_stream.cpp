@@ -84,22 +84,31 @@ Options parse(int argc, char** argv) {
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const std::string value = argv[i + 1];
-    if (key == "--url") o.url = value;
-    else if (key == "--prefix") o.prefix = value;
-    else if (key == "--duration-s") o.duration_s = std::stod(value);
-    else if (key == "--phase-s") o.phase_s = std::stod(value);
-    else if (key == "--frequency-hz") o.frequency_hz = std::stod(value);
-    else if (key == "--tolerance") o.tolerance = std::stod(value);
-    else if (key == "--settle-s") o.settle_s = std::stod(value);
-    else if (key == "--expect-invalid") o.expect_invalid = value == "1";
-    else throw std::invalid_argument("unknown option " + key);
+    if (key == "--url")
+      o.url = value;
+    else if (key == "--prefix")
+      o.prefix = value;
+    else if (key == "--duration-s")
+      o.duration_s = std::stod(value);
+    else if (key == "--phase-s")
+      o.phase_s = std::stod(value);
+    else if (key == "--frequency-hz")
+      o.frequency_hz = std::stod(value);
+    else if (key == "--tolerance")
+      o.tolerance = std::stod(value);
+    else if (key == "--settle-s")
+      o.settle_s = std::stod(value);
+    else if (key == "--expect-invalid")
+      o.expect_invalid = value == "1";
+    else
+      throw std::invalid_argument("unknown option " + key);
   }
   return o;
 }
 
 struct Observed {
   int valid_params = 0, invalid_params = 0;
-  mem_params_t best{};  // last valid set from the re-identifier
+  mem_params_t best{};              // last valid set from the re-identifier
   std::set<std::int32_t> versions;  // of every set from the re-identifier
   bool duplicate_version = false;
   double first_valid_after_s = -1.0;
@@ -167,20 +176,21 @@ class Stream {
       seen_.feed_max_us = std::max(seen_.feed_max_us, m.loop_max_us);
     }
     seen_.counters.clear();
-    for (int i = 0; i < m.n_counters; ++i) seen_.counters[m.counter_names[static_cast<std::size_t>(i)]] =
-        m.counter_values[static_cast<std::size_t>(i)];
+    for (int i = 0; i < m.n_counters; ++i)
+      seen_.counters[m.counter_names[static_cast<std::size_t>(i)]] = m.counter_values[static_cast<std::size_t>(i)];
   }
   static double seconds_since(clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); }
 
   bool wait_for_status(double timeout_s) {
     const auto start = clock::now();
-    while (seen_.statuses == 0 && seconds_since(start) < timeout_s) handle_pending(*lcm_, std::chrono::milliseconds(10));
+    while (seen_.statuses == 0 && seconds_since(start) < timeout_s)
+      handle_pending(*lcm_, std::chrono::milliseconds(10));
     return seen_.statuses > 0;
   }
 
   static std::int64_t wall_us() {
-    return std::chrono::duration_cast<std::chrono::microseconds>(
-               std::chrono::system_clock::now().time_since_epoch()).count();
+    return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+        .count();
   }
 
   // Commands for the ticks not yet commanded, up to (excluding) `until`, in one block.
@@ -189,8 +199,11 @@ class Stream {
     begin_block(commands_, commanded_, wall_us(), seq_ - 1);
     constexpr double kNoReference = std::numeric_limits<double>::quiet_NaN();
     for (; commanded_ < until; ++commanded_) {
-      append_tick(commands_, CommandTick{.seq = commanded_, .u_ff_V = 0.0, .y_ref_m = kNoReference,
-                                         .params_version = params_version, .mode = command_block_t::MODE_MEM});
+      append_tick(commands_, CommandTick{.seq = commanded_,
+                                         .u_ff_V = 0.0,
+                                         .y_ref_m = kNoReference,
+                                         .params_version = params_version,
+                                         .mode = command_block_t::MODE_MEM});
     }
     command_pub_.publish(commands_);
   }
@@ -208,8 +221,9 @@ class Stream {
       for (std::int64_t i = 0; i < ticks; ++i) {
         double u = 0.0, y = 0.0;
         fill(k + i, u, y);
-        append_tick(block_, SensorTick{.u_V = u, .u_ff_V = u, .y_ref_m = kNoReference, .y_m = y,
-                                       .flags = sensor_block_t::SIMULATED});
+        append_tick(
+            block_,
+            SensorTick{.u_V = u, .u_ff_V = u, .y_ref_m = kNoReference, .y_m = y, .flags = sensor_block_t::SIMULATED});
       }
       sensor_.publish(block_);
       seq_ += ticks;
@@ -237,7 +251,8 @@ class Stream {
     const service_status_t& st = seen_.last_status;
     std::printf(
         "reident_stream: figures: refit p50 %.1f ms, max %.1f ms (%lld refits); per-block feed p50 %.3f us, "
-        "worst p99 %.3f us, max %.3f us (over the stream's reports); samples fed %lld, sensor rejected %lld, gaps %lld\n",
+        "worst p99 %.3f us, max %.3f us (over the stream's reports); samples fed %lld, sensor rejected %lld, gaps "
+        "%lld\n",
         static_cast<double>(counter("refit_p50_us")) * 1e-3, static_cast<double>(counter("refit_max_us")) * 1e-3,
         static_cast<long long>(counter("refits_attempted")), seen_.feed_p50_us, seen_.feed_p99_us, seen_.feed_max_us,
         static_cast<long long>(counter("samples_fed")), static_cast<long long>(counter("sensor.rejected_non_finite")),
@@ -281,13 +296,14 @@ class Stream {
     if (seen_.valid_params >= 1) {
       const mem_params_t& b = seen_.best;
       const double e1 = std::abs(b.c1 / truth.c1 - 1.0), e2 = std::abs(b.c2 / truth.c2 - 1.0);
-      std::printf("reident_stream: c1 error %.3f %%, c2 error %.3f %%, c3 %.4f (truth %.4f), version %d, first after "
-                  "%.2f s of stream\n",
-                  100 * e1, 100 * e2, b.c3, truth.c3, b.version, seen_.first_valid_after_s);
+      std::printf(
+          "reident_stream: c1 error %.3f %%, c2 error %.3f %%, c3 %.4f (truth %.4f), version %d, first after "
+          "%.2f s of stream\n",
+          100 * e1, 100 * e2, b.c3, truth.c3, b.version, seen_.first_valid_after_s);
       check(e1 <= o_.tolerance, "c1 off by " + std::to_string(100 * e1) + " %");
       check(e2 <= 3 * o_.tolerance, "c2 off by " + std::to_string(100 * e2) + " %");
-      check(b.version >= kAppliedVersion + 1, "version " + std::to_string(b.version) +
-                                                  " is not above the applied version 7 (nor the external set's 5)");
+      check(b.version >= kAppliedVersion + 1,
+            "version " + std::to_string(b.version) + " is not above the applied version 7 (nor the external set's 5)");
       check(std::isfinite(b.residual_m) && b.residual_m > 0 && b.residual_m < 20e-9, "residual_m out of range");
       check(b.samples_used > 0 && b.window_s > 0, "samples_used/window_s missing");
     }
@@ -348,8 +364,8 @@ class Stream {
     check(counter("seq_gaps") == 0, "refused blocks counted as a gap (or ticks lost)");
     check(counter("params_version") == 1, "the set in use changed");
     for (const auto& [name, value] : seen_.counters) {
-      if (name.rfind("refits_", 0) == 0 && value > 0) std::printf("reident_stream: %s = %lld\n", name.c_str(),
-                                                                  static_cast<long long>(value));
+      if (name.rfind("refits_", 0) == 0 && value > 0)
+        std::printf("reident_stream: %s = %lld\n", name.c_str(), static_cast<long long>(value));
     }
     return failures == 0 ? 0 : 1;
   }

@@ -30,8 +30,8 @@ using SensorArray = std::vector<double> sensor_block_t::*;
 using CommandArray = std::vector<double> command_block_t::*;
 
 TEST(MessageChecks, SensorBlockRejectsANonFiniteValueAtAnyTick) {
-  for (SensorArray field : {&sensor_block_t::u_V, &sensor_block_t::u_ff_V, &sensor_block_t::u_fb_V,
-                            &sensor_block_t::y_m}) {
+  for (SensorArray field :
+       {&sensor_block_t::u_V, &sensor_block_t::u_ff_V, &sensor_block_t::u_fb_V, &sensor_block_t::y_m}) {
     for (double bad : {kNaN, kInf, -kInf}) {
       for (std::size_t tick : {0u, 4u, 9u}) {
         auto m = fixtures::sensor_ticks(100, 10);
@@ -158,9 +158,9 @@ TEST(MessageChecks, CommandBlockModesVersionsAndSequence) {
   m = fixtures::command_ticks(200, 10, 150);
   m.utime = -1;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
-  for (const std::int8_t mode : {command_block_t::MODE_OFF, command_block_t::MODE_LINEAR, command_block_t::MODE_MEM,
-                                 command_block_t::MODE_PI, command_block_t::MODE_KATALENIC,
-                                 command_block_t::MODE_EXPERIMENT}) {
+  for (const std::int8_t mode :
+       {command_block_t::MODE_OFF, command_block_t::MODE_LINEAR, command_block_t::MODE_MEM, command_block_t::MODE_PI,
+        command_block_t::MODE_KATALENIC, command_block_t::MODE_EXPERIMENT}) {
     m = fixtures::command_ticks(200, 10, 150);
     m.mode[9] = mode;
     EXPECT_EQ(check_message(m), Verdict::kOk) << int{mode};
@@ -237,8 +237,8 @@ TEST(MessageChecks, Trajectory) {
 }
 
 TEST(MessageChecks, MemParams) {
-  for (double mem_params_t::*field : {&mem_params_t::c1, &mem_params_t::c2, &mem_params_t::c3,
-                                      &mem_params_t::residual_m, &mem_params_t::window_s}) {
+  for (double mem_params_t::*field :
+       {&mem_params_t::c1, &mem_params_t::c2, &mem_params_t::c3, &mem_params_t::residual_m, &mem_params_t::window_s}) {
     auto m = fixtures::params(2);
     m.*field = kNaN;
     EXPECT_EQ(check_message(m), Verdict::kNonFinite);

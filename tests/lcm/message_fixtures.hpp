@@ -26,7 +26,7 @@
 namespace hystloop::fixtures {
 
 inline constexpr std::int64_t kBaseUtime = 1'700'000'000'000'000;
-inline constexpr std::int64_t kRoundTicks = 10;     // ticks reserved per probe round
+inline constexpr std::int64_t kRoundTicks = 10;    // ticks reserved per probe round
 inline constexpr std::int64_t kCommandLead = 500;  // command_block(k) starts this many ticks after sensor_block(k)
 
 inline double dk(std::int64_t k) { return static_cast<double>(k); }

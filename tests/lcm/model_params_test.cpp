@@ -21,7 +21,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-
 TEST(ModelParamsMessage, WalkCoversExactlyTheEncodedBytesOfEveryKind) {
   for (std::int64_t k = 0; k < 40; ++k) {  // every kind, 1..32 operators
     const auto m = fixtures::model_params(k);
@@ -51,12 +50,31 @@ TEST(ModelParamsMessage, ACorruptedOperatorCountIsRefusedBeforeDecoding) {
 
 TEST(ModelParamsMessage, EveryNumberMustBeFinite) {
   using M = model_params_t;
-  for (double M::*field :
-       {&M::mem_c1, &M::mem_c2, &M::mem_c3, &M::linear_gain, &M::linear_offset_m, &M::kat_k1, &M::kat_k2,
-        &M::kat_k2_slope, &M::kat_k2_domain_min, &M::kat_k2_domain_max, &M::kat_initial_offset, &M::kat_in_gain,
-        &M::kat_in_offset, &M::kat_in_domain_min, &M::kat_in_domain_max, &M::kat_in_amplitude, &M::kat_in_scale,
-        &M::kat_out_gain, &M::kat_out_offset, &M::kat_out_domain_min, &M::kat_out_domain_max, &M::kat_out_amplitude,
-        &M::kat_out_scale, &M::residual_m, &M::window_s}) {
+  for (double M::*field : {&M::mem_c1,
+                           &M::mem_c2,
+                           &M::mem_c3,
+                           &M::linear_gain,
+                           &M::linear_offset_m,
+                           &M::kat_k1,
+                           &M::kat_k2,
+                           &M::kat_k2_slope,
+                           &M::kat_k2_domain_min,
+                           &M::kat_k2_domain_max,
+                           &M::kat_initial_offset,
+                           &M::kat_in_gain,
+                           &M::kat_in_offset,
+                           &M::kat_in_domain_min,
+                           &M::kat_in_domain_max,
+                           &M::kat_in_amplitude,
+                           &M::kat_in_scale,
+                           &M::kat_out_gain,
+                           &M::kat_out_offset,
+                           &M::kat_out_domain_min,
+                           &M::kat_out_domain_max,
+                           &M::kat_out_amplitude,
+                           &M::kat_out_scale,
+                           &M::residual_m,
+                           &M::window_s}) {
     for (std::int64_t k = 0; k < 4; ++k) {  // in the fields of its own kind and of the others
       for (const double bad : {kNaN, kInf}) {
         auto m = fixtures::model_params(k);

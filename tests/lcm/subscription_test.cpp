@@ -34,9 +34,8 @@ class SubscriptionTest : public ::testing::Test {
 
 TEST_F(SubscriptionTest, DeliversEachTypeIntactThroughLcm) {
   std::vector<std::int64_t> seqs;
-  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR", [&](const sensor_block_t& m, std::int64_t) {
-    seqs.push_back(m.seq);
-  });
+  Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR",
+                                      [&](const sensor_block_t& m, std::int64_t) { seqs.push_back(m.seq); });
   Subscription<trajectory_t> traj(lcm_, "HX_TRAJECTORY");
   Subscription<service_status_t> status(lcm_, "HX_STATUS");
   Publisher<sensor_block_t> pub_sensor(lcm_, "HX_SENSOR");

@@ -41,9 +41,9 @@ TEST(LcmUrl, TtlAboveZeroNeedsTheAllowFlag) {
 }
 
 TEST(LcmUrl, RefusesMalformedUrls) {
-  for (const char* bad : {"", "239.255.76.67:7667", "://x", "udpm://239.255.76.67:7667?ttl=abc",
-                          "udpm://239.255.76.67:7667?ttl=-1", "udpm://239.255.76.67:7667?ttl=256",
-                          "udpm://10.0.0.1:7667?ttl=0", "carrier-pigeon://x"}) {
+  for (const char* bad :
+       {"", "239.255.76.67:7667", "://x", "udpm://239.255.76.67:7667?ttl=abc", "udpm://239.255.76.67:7667?ttl=-1",
+        "udpm://239.255.76.67:7667?ttl=256", "udpm://10.0.0.1:7667?ttl=0", "carrier-pigeon://x"}) {
     expect_refused(bad, true);
   }
 }
@@ -51,9 +51,9 @@ TEST(LcmUrl, RefusesMalformedUrls) {
 // A bad port reached LCM, which failed at start-up (exit 1, "LCM could not start") without
 // naming it; refused here, naming the port, so that a service exits 2 with the reason.
 TEST(LcmUrl, BadPortIsRefusedNamingIt) {
-  for (const char* bad : {"udpm://239.255.76.67:99999?ttl=0", "udpm://239.255.76.67:0?ttl=0",
-                          "udpm://239.255.76.67:77x?ttl=0", "udpm://239.255.76.67:?ttl=0",
-                          "udpm://239.255.76.67:-1", "tcpq://lab-hub:70000"}) {
+  for (const char* bad :
+       {"udpm://239.255.76.67:99999?ttl=0", "udpm://239.255.76.67:0?ttl=0", "udpm://239.255.76.67:77x?ttl=0",
+        "udpm://239.255.76.67:?ttl=0", "udpm://239.255.76.67:-1", "tcpq://lab-hub:70000"}) {
     try {
       checked_lcm_url(bad, true);
       ADD_FAILURE() << "accepted " << bad;

@@ -17,8 +17,7 @@ namespace {
 template <class T>
 void expect_walk_matches_encoding(const T& msg) {
   const auto bytes = fixtures::encode(msg);
-  EXPECT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
-            static_cast<std::int64_t>(bytes.size()))
+  EXPECT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), static_cast<std::int64_t>(bytes.size()))
       << T::getTypeName();
 }
 
@@ -146,20 +145,19 @@ constexpr std::size_t kCommandCountOffset = 8 + 8 + 8 + 8;
 template <class T>
 void expect_bad_tick_counts_refused(std::vector<std::uint8_t> bytes, std::size_t offset, std::int32_t n_ticks) {
   ASSERT_EQ(bytes[offset + 3], static_cast<std::uint8_t>(n_ticks));  // the offset is right
-  ASSERT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
-            static_cast<std::int64_t>(bytes.size()));
+  ASSERT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), static_cast<std::int64_t>(bytes.size()));
   for (const std::int32_t bad : {-1, -2147483647 - 1, T::MAX_TICKS + 1, 1 << 28, 2147483647, n_ticks + 1}) {
     put_be32(bytes, offset, bad);
     EXPECT_LT(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), 0) << T::getTypeName() << " " << bad;
   }
   // Fewer ticks than the arrays hold: the walk ends early, so the sizes disagree.
   put_be32(bytes, offset, n_ticks - 1);
-  EXPECT_NE(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()),
-            static_cast<std::int64_t>(bytes.size()));
+  EXPECT_NE(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), static_cast<std::int64_t>(bytes.size()));
 }
 
 TEST(WireLayout, CorruptedTickCountsAreRefusedBeforeDecode) {
-  expect_bad_tick_counts_refused<sensor_block_t>(fixtures::encode(fixtures::sensor_ticks(40, 7)), kSensorCountOffset, 7);
+  expect_bad_tick_counts_refused<sensor_block_t>(fixtures::encode(fixtures::sensor_ticks(40, 7)), kSensorCountOffset,
+                                                 7);
   expect_bad_tick_counts_refused<command_block_t>(fixtures::encode(fixtures::command_ticks(40, 7, 30)),
                                                   kCommandCountOffset, 7);
 }

@@ -92,7 +92,7 @@ TEST(BridgeCore, RejectsNonFiniteCommandsButAcceptsANaNReference) {
   EXPECT_FALSE(b->submit(command(0, 1.0, kInf)));
   EXPECT_FALSE(b->submit(command(0, 1.0, -kInf)));
   EXPECT_EQ(b->counters().rejected_nonfinite, 5u);
-  EXPECT_EQ(b->buffer_depth(), 0);  // none of them took the tick's slot
+  EXPECT_EQ(b->buffer_depth(), 0);                // none of them took the tick's slot
   EXPECT_TRUE(b->submit(command(0, 1.0, kNaN)));  // NaN reference = none: the servo adds nothing
   const BridgeTick t = b->tick(0, 0.0);
   EXPECT_EQ(t.u_applied_V, 1.0);
@@ -325,10 +325,11 @@ TEST(BridgeCore, ADeadCompensatorStopsTheStageWithinHorizonPlusWatchdog) {
   ASSERT_GE(first_safe, 0) << "never reached the safe state";
   EXPECT_LE(first_safe, last_planned + watchdog_ticks + 1);
   EXPECT_GT(first_safe, last_planned + watchdog_ticks);  // not before the buffer is dry for watchdog_s
-  EXPECT_GT(std::abs(u_at_trip), 100.0);  // the test stops a stage that was really moving
+  EXPECT_GT(std::abs(u_at_trip), 100.0);                 // the test stops a stage that was really moving
   ASSERT_GE(safe_reached, 0);
-  EXPECT_LE(safe_reached - first_safe,
-            static_cast<std::int64_t>(std::ceil(std::abs(u_at_trip - lim.safe_u_V) / (lim.safe_ramp_V_per_s * kDt))) + 1);
+  EXPECT_LE(
+      safe_reached - first_safe,
+      static_cast<std::int64_t>(std::ceil(std::abs(u_at_trip - lim.safe_u_V) / (lim.safe_ramp_V_per_s * kDt))) + 1);
   EXPECT_EQ(bridge.counters().watchdog_trips, 1u);
   EXPECT_EQ(bridge.counters().stale, 0u);  // the first block plans from the tick after its samples
   EXPECT_EQ(bridge.counters().late, 10u + static_cast<std::uint64_t>(watchdog_ticks));  // before it, and the dry spell

@@ -65,8 +65,8 @@ TEST(BridgeServo, PiStepResponseConvergesWithoutSteadyError) {
   BridgeRig rig(patient_limits(), servo_gains(0.2, 300.0));
   run(rig, 100, 0.0, 0.0);
   const std::vector<double> e = run(rig, 3000, kFeedforward, kRef);
-  EXPECT_LT(std::abs(e.back()), 1e-13);                // no steady error: the integrator took the rest
-  EXPECT_LT(settle_ticks(e, 0.01 * kRef), 400u);       // within 1 % in 40 ms (crossover ~300 rad/s)
+  EXPECT_LT(std::abs(e.back()), 1e-13);           // no steady error: the integrator took the rest
+  EXPECT_LT(settle_ticks(e, 0.01 * kRef), 400u);  // within 1 % in 40 ms (crossover ~300 rad/s)
   const double overshoot = -*std::min_element(e.begin(), e.end());
   EXPECT_LT(overshoot, 0.2 * kRef);
   // Proportional alone leaves the error the feedforward and the disturbance left, divided by 1 + kp.
@@ -77,7 +77,7 @@ TEST(BridgeServo, PiStepResponseConvergesWithoutSteadyError) {
 
 struct WindupRun {
   double worst_request_beyond_range_V = -1e300;  // u_ff + u_fb beyond [u_min, u_max] while holding
-  std::size_t recovery_ticks = 0;             // to within 1 nm of the second reference
+  std::size_t recovery_ticks = 0;                // to within 1 nm of the second reference
 };
 
 // Holds y_hold for 0.5 s (out of reach when the test wants saturation), then asks for y_after.
@@ -117,7 +117,7 @@ TEST(BridgeServo, AntiWindupAtAnAsymmetricRange) {
   ActuatorLimits lim = patient_limits();
   lim.u_min_V = -30.0;
   lim.u_max_V = 150.0;
-  const WindupRun saturated = hold_then_step(lim, -1e-6, 0.5e-6);  // needs -102 V
+  const WindupRun saturated = hold_then_step(lim, -1e-6, 0.5e-6);       // needs -102 V
   const WindupRun unsaturated = hold_then_step(lim, -0.27e-6, 0.5e-6);  // -29 V: just inside
   EXPECT_LT(saturated.worst_request_beyond_range_V, 5.0) << "the integrator wound up beyond u_min";
   EXPECT_LE(saturated.recovery_ticks, unsaturated.recovery_ticks + 20);

@@ -20,11 +20,11 @@ using testing::command;
 using testing::kDt;
 
 struct StopRun {
-  double u_before_V = 0.0;     // applied at the last armed tick
-  std::int64_t ticks = 0;      // disarmed ticks until the safe voltage was applied (inclusive)
-  double max_step_V = 0.0;     // largest |du| over the ramp
-  bool flagged_safe = true;    // every ramp tick carried SAFE_STATE
-  bool stayed = true;          // and the voltage stayed there afterwards
+  double u_before_V = 0.0;   // applied at the last armed tick
+  std::int64_t ticks = 0;    // disarmed ticks until the safe voltage was applied (inclusive)
+  double max_step_V = 0.0;   // largest |du| over the ramp
+  bool flagged_safe = true;  // every ramp tick carried SAFE_STATE
+  bool stayed = true;        // and the voltage stayed there afterwards
 };
 
 // Drives an armed core to `u_V` (commands every tick: the slew limit takes it there), keeps

@@ -168,9 +168,9 @@ TEST(CommandBuffer, DepthAfterADrySpellAndSkippedTicks) {
   b->insert(command(30));
   EXPECT_EQ(b->depth(), 3);
   for (std::int64_t k = 25; k < 28; ++k) ASSERT_NE(b->take(k), nullptr);
-  EXPECT_EQ(b->depth(), 0);           // 28 missing
-  EXPECT_EQ(b->take(28), nullptr);    // late
-  EXPECT_EQ(b->depth(), 2);           // 29, 30
+  EXPECT_EQ(b->depth(), 0);         // 28 missing
+  EXPECT_EQ(b->take(28), nullptr);  // late
+  EXPECT_EQ(b->depth(), 2);         // 29, 30
 }
 
 TEST(CommandBuffer, ClearDropsWhatIsBufferedAndKeepsWhatWasTaken) {
@@ -181,7 +181,7 @@ TEST(CommandBuffer, ClearDropsWhatIsBufferedAndKeepsWhatWasTaken) {
   EXPECT_EQ(b->next_tick(), 1);
   EXPECT_EQ(b->depth(), 0);
   EXPECT_EQ(b->take(1), nullptr);
-  EXPECT_EQ(b->insert(command(1)), Insert::kStale);     // taken (late) already
+  EXPECT_EQ(b->insert(command(1)), Insert::kStale);         // taken (late) already
   EXPECT_EQ(b->insert(command(50, 0.5)), Insert::kStored);  // not a duplicate: the old one is gone
   EXPECT_EQ(b->depth(), 0);
   for (std::int64_t s = 2; s < 50; ++s) b->insert(command(s));

@@ -74,8 +74,7 @@ inline bool same_tick(const CommandTick& a, const CommandTick& b) {
 // The compensator in a loop: samples reach it one tick at a time, and it answers every
 // block_ticks samples, as the services do.
 struct CompensatorLoop {
-  explicit CompensatorLoop(const CompensatorConfig& config, int block_ticks = 10)
-      : comp(config), block(block_ticks) {}
+  explicit CompensatorLoop(const CompensatorConfig& config, int block_ticks = 10) : comp(config), block(block_ticks) {}
 
   // Runs n ticks; after observing tick k, on_sample(k) (optional) may act on the compensator.
   template <class OnSample>

@@ -149,7 +149,7 @@ TEST(Compensator, ATimedStartInThePastStartsNowAndReturnsFalse) {
     asap.observe({s, 0.0, 0.0});
   }
   late_plan.drain(late);
-  asap_plan.drain(asap);  // through 149: the next planned tick is 150 (t = 0.015 s)
+  asap_plan.drain(asap);                          // through 149: the next planned tick is 150 (t = 0.015 s)
   EXPECT_FALSE(late.set_trajectory(ref, 0.016));  // its approach would start at 0.011 s: passed
   EXPECT_TRUE(asap.set_trajectory(ref, kNaN));
   for (std::int64_t s = 100; s < 2000; ++s) {
@@ -162,8 +162,8 @@ TEST(Compensator, ATimedStartInThePastStartsNowAndReturnsFalse) {
   for (std::size_t i = 0; i < late_plan.ticks().size(); ++i) {
     ASSERT_TRUE(testing::same_tick(late_plan.ticks()[i], asap_plan.ticks()[i])) << late_plan.ticks()[i].seq;
   }
-  EXPECT_EQ(asap_plan.at(150).y_ref_m, 0.0);                   // the approach starts at the next planned tick
-  EXPECT_NEAR(asap_plan.at(200).y_ref_m, -1.6e-6, 1e-18);      // ... and reaches the shape after blend_s
+  EXPECT_EQ(asap_plan.at(150).y_ref_m, 0.0);               // the approach starts at the next planned tick
+  EXPECT_NEAR(asap_plan.at(200).y_ref_m, -1.6e-6, 1e-18);  // ... and reaches the shape after blend_s
 }
 
 TEST(Compensator, ATimedStartInTheFutureIsHonoured) {
@@ -322,7 +322,8 @@ TEST(Compensator, IsDeterministicAndIndependentOfHowThePlanIsChunked) {
     const Session s = scripted_session(chunk);
     ASSERT_EQ(s.ticks.size(), reference.ticks.size()) << "chunk " << chunk;
     for (std::size_t i = 0; i < s.ticks.size(); ++i) {
-      ASSERT_TRUE(testing::same_tick(s.ticks[i], reference.ticks[i])) << "chunk " << chunk << ", tick " << s.ticks[i].seq;
+      ASSERT_TRUE(testing::same_tick(s.ticks[i], reference.ticks[i]))
+          << "chunk " << chunk << ", tick " << s.ticks[i].seq;
     }
   }
 }

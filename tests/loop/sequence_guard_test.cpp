@@ -12,10 +12,10 @@ namespace hystloop {
 namespace {
 
 using V = SequenceGuard::Verdict;
-constexpr std::int64_t kStep = 500;      // ticks (the compensator's horizon)
+constexpr std::int64_t kStep = 500;        // ticks (the compensator's horizon)
 constexpr std::int64_t kWindow = 100'000;  // us
-constexpr std::int64_t kBlock = 20;      // ticks per block, one block every 2 ms
-constexpr std::int64_t kPeriod = 2'000;  // us
+constexpr std::int64_t kBlock = 20;        // ticks per block, one block every 2 ms
+constexpr std::int64_t kPeriod = 2'000;    // us
 
 TEST(SequenceGuard, TheFirstBlockAndItsSuccessorsAreTaken) {
   SequenceGuard g(kStep, kWindow);
@@ -113,7 +113,7 @@ TEST(SequenceGuard, RandomInterleavingsOfForgedBlocksNeverDisturbTheRealStream) 
     for (int i = 0; i < 400; ++i) {
       std::int64_t seq = s;
       if (rng() % 10 == 0) seq += kBlock * static_cast<std::int64_t>(1 + rng() % 5);  // lost blocks
-      if (rng() % 20 == 0 && seq >= 2 * kBlock) seq -= 2 * kBlock;                   // a late one
+      if (rng() % 20 == 0 && seq >= 2 * kBlock) seq -= 2 * kBlock;                    // a late one
       ASSERT_NE(g.check(seq, kBlock, t += kPeriod), V::hold) << "seed " << seed << " block " << i;
       s = std::max(s, seq) + kBlock;
       if (rng() % 7 == 0) {  // a forged run

@@ -29,9 +29,8 @@ TEST(SimulatedStageDrift, GainRampsLinearlyBetweenStartAndEnd) {
     for (double f : {0.1, -0.2}) {
       SimulatedStage s(drifting(plant, f));
       // (t, expected scale): before, at the start, a quarter, half, the end, long after.
-      const double points[][2] = {{0.0, 1.0},          {9.999, 1.0},         {10.0, 1.0},
-                                  {20.0, 1.0 + f / 4}, {30.0, 1.0 + f / 2},  {50.0, 1.0 + f},
-                                  {3600.0, 1.0 + f}};
+      const double points[][2] = {{0.0, 1.0},          {9.999, 1.0},    {10.0, 1.0},      {20.0, 1.0 + f / 4},
+                                  {30.0, 1.0 + f / 2}, {50.0, 1.0 + f}, {3600.0, 1.0 + f}};
       for (const auto& p : points) {
         s.step(1.0, p[0], 1e-4);
         EXPECT_NEAR(s.gain_scale(), p[1], 1e-12) << "plant " << static_cast<int>(plant) << " f " << f << " t " << p[0];

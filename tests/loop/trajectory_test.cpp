@@ -19,9 +19,9 @@ TEST(Trajectory, MemPaperReferenceIsEq24) {
 
 TEST(Trajectory, ApproachIsMonotoneFromHoldToTheShapeWithoutAStep) {
   const TrajectorySpec s = mem_paper_reference(1.0, 0.5, 0.3e-6);
-  EXPECT_EQ(evaluate(s, 0.2), 0.3e-6);                 // before the approach: hold
+  EXPECT_EQ(evaluate(s, 0.2), 0.3e-6);                           // before the approach: hold
   EXPECT_NEAR(evaluate(s, 0.75), (0.3e-6 - 1.6e-6) / 2, 1e-18);  // half way
-  EXPECT_NEAR(evaluate(s, 1.0), -1.6e-6, 1e-18);       // the shape's first value at start_s
+  EXPECT_NEAR(evaluate(s, 1.0), -1.6e-6, 1e-18);                 // the shape's first value at start_s
   EXPECT_NEAR(evaluate(s, 1.6), -1.6e-6 * std::cos(2 * std::numbers::pi * 0.6), 1e-18);
   double prev = evaluate(s, 0.4);
   for (double t = 0.5; t < 1.0; t += 1e-4) {

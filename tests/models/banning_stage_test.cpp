@@ -137,9 +137,11 @@ double stationary_peak_to_peak(BanningOrder order, double& f, double amplitude) 
 // factor-of-a-few error in the estimate's bias fails).
 TEST(BanningStage, PaperOrderObeysRelation25AndEstimate27) {
   const BanningStageParams p;
-  std::printf("  f [Hz]   h(w)   A [V] | pp sim [nm]  pp (25) [nm]   rel | h (27) paper order  rel | "
-              "h (27) CH-first  rel\n");
-  const std::vector<double> freqs = kSanitized ? std::vector<double>{1724.0} : std::vector<double>{200.0, 1000.0, 1500.0, 1724.0};
+  std::printf(
+      "  f [Hz]   h(w)   A [V] | pp sim [nm]  pp (25) [nm]   rel | h (27) paper order  rel | "
+      "h (27) CH-first  rel\n");
+  const std::vector<double> freqs =
+      kSanitized ? std::vector<double>{1724.0} : std::vector<double>{200.0, 1000.0, 1500.0, 1724.0};
   for (double f_nominal : freqs) {
     for (double amplitude : {2.0, 40.0}) {
       double f = f_nominal;
@@ -149,8 +151,8 @@ TEST(BanningStage, PaperOrderObeysRelation25AndEstimate27) {
       const double h27 = magnitude_from_peak_to_peak(pp, p.hysteresis.b, amplitude);
       const double pp_ch = stationary_peak_to_peak(BanningOrder::kHysteresisThenStage, f, amplitude);
       const double h27_ch = magnitude_from_peak_to_peak(pp_ch, p.hysteresis.b, amplitude);
-      std::printf("%8.0f %6.3f %6.1f | %11.3f %13.3f %+8.1e | %12.5f %+11.2e | %12.5f %+8.2e\n", f, h,
-                  amplitude, pp * 1e9, want * 1e9, pp / want - 1.0, h27, h27 / h - 1.0, h27_ch, h27_ch / h - 1.0);
+      std::printf("%8.0f %6.3f %6.1f | %11.3f %13.3f %+8.1e | %12.5f %+11.2e | %12.5f %+8.2e\n", f, h, amplitude,
+                  pp * 1e9, want * 1e9, pp / want - 1.0, h27, h27 / h - 1.0, h27_ch, h27_ch / h - 1.0);
       EXPECT_NEAR(pp, want, 1e-4 * want) << f << " Hz, " << amplitude << " V";
       if (amplitude <= 2.0) {
         EXPECT_NEAR(h27, h, 3e-3 * h) << f;
@@ -267,7 +269,8 @@ TEST(BanningStage, PropertyRandomParamsAndInputsStayFiniteAndBounded) {
     const double z = p.stage.damping_ratio();
     const double l1 = z < 1.0 ? 1.0 / (z * std::sqrt(1.0 - z * z)) : 1.0;
     const double ch_bound = p.hysteresis.a * p.hysteresis.s_max + p.hysteresis.b / p.hysteresis.alpha;
-    const double bound = stage.gain_scale() * (p.order == BanningOrder::kHysteresisThenStage ? l1 * ch_bound : ch_bound);
+    const double bound =
+        stage.gain_scale() * (p.order == BanningOrder::kHysteresisThenStage ? l1 * ch_bound : ch_bound);
     // Stage first: keep y_L inside +-s_max by driving within s_max / L1.
     const double u_max = p.order == BanningOrder::kHysteresisThenStage ? p.hysteresis.s_max : p.hysteresis.s_max / l1;
     double dt = 1e-4;

@@ -177,8 +177,8 @@ TEST(ColemanHodgdon, ClosedFormStepMatchesAFineRk4Reference) {
     w = got;
   }
   const double stroke = p.a * p.s_max;
-  std::printf("closed-form CH step vs RK4 (20000 substeps/piece): max |error| = %.3g m = %.3g of a*s_max\n",
-              worst, worst / stroke);
+  std::printf("closed-form CH step vs RK4 (20000 substeps/piece): max |error| = %.3g m = %.3g of a*s_max\n", worst,
+              worst / stroke);
   EXPECT_GT(crossings, 5);
   EXPECT_LT(worst, 1e-12 * stroke);
 }
@@ -214,8 +214,9 @@ TEST(ColemanHodgdon, Theorem3ClosedFormsMatchSimulatedLoops) {
     double amplitude;
   };
   const Case cases[] = {{0.0, 5.0}, {0.0, 25.0}, {-40.0, 50.0}, {30.0, 100.0}, {0.0, 150.0}, {-50.0, 200.0}};
-  std::printf("  u_off     A   alpha*A | delta sim [V]  exact [V]  (22) [V] (22)/exact-1  small-amp | "
-              "slope err  eta err   area err\n");
+  std::printf(
+      "  u_off     A   alpha*A | delta sim [V]  exact [V]  (22) [V] (22)/exact-1  small-amp | "
+      "slope err  eta err   area err\n");
   for (const Case& c : cases) {
     const Loop loop = stationary_loop(p, c.offset, c.amplitude, 4000);
     const LoopFeatureResult r = extract_loop_features(loop.u, loop.w);
@@ -236,10 +237,10 @@ TEST(ColemanHodgdon, Theorem3ClosedFormsMatchSimulatedLoops) {
     EXPECT_NEAR(got.delta, exact.delta, 1e-6 * exact.delta);
     EXPECT_NEAR(paper.delta, exact.delta, 0.02 * exact.delta);  // (22) is approximate
     EXPECT_GT(paper.delta, exact.delta);
-    std::printf("%7.1f %5.0f %8.4f | %12.6g %10.6g %10.6g %+11.3e %10.6g | %+9.1e %+9.1e %+9.1e\n",
-                c.offset, c.amplitude, p.alpha * c.amplitude, got.delta, exact.delta, paper.delta,
-                paper.delta / exact.delta - 1.0, small.delta, got.slope / paper.slope - 1.0,
-                got.eta / paper.eta - 1.0, got.area / paper.area - 1.0);
+    std::printf("%7.1f %5.0f %8.4f | %12.6g %10.6g %10.6g %+11.3e %10.6g | %+9.1e %+9.1e %+9.1e\n", c.offset,
+                c.amplitude, p.alpha * c.amplitude, got.delta, exact.delta, paper.delta,
+                paper.delta / exact.delta - 1.0, small.delta, got.slope / paper.slope - 1.0, got.eta / paper.eta - 1.0,
+                got.area / paper.area - 1.0);
   }
 }
 
@@ -257,8 +258,7 @@ TEST(ColemanHodgdon, DeltaClosedFormErrorPeaksNearAlphaAOfOne) {
       at = amplitude;
     }
   }
-  std::printf("(22) vs exact delta: worst %+.4f %% at A = %.1f V (alpha A = %.3f)\n", 100.0 * worst, at,
-              p.alpha * at);
+  std::printf("(22) vs exact delta: worst %+.4f %% at A = %.1f V (alpha A = %.3f)\n", 100.0 * worst, at, p.alpha * at);
   EXPECT_NEAR(worst, 0.0142, 0.0005);
   EXPECT_NEAR(p.alpha * at, 1.10, 0.05);
 }

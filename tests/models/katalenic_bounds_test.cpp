@@ -116,10 +116,10 @@ TEST(KatalenicBounds, Propositions32And33HoldForSampledMismatches) {
     // states for v and v + Delta_a) the bound is exceeded slightly: up to 0.30 % of Delta_a in
     // 9 of 5000 mismatches (KATALENIC_TRIALS=5000), always with k1* = k1 + dk1 and the error near
     // its asymptote |dk1|. Hence the 1 % allowance here; Prop. 3.2 holds to rounding.
-    EXPECT_LE(worst_b, bound * 1.01) << "trial " << trial << std::setprecision(17) << " worst " << worst_b
-                                     << " bound " << bound << " k1 " << m.family.k1 << " dk1 " << m.family.dk1
-                                     << " k2 " << m.family.k2 << " dk2 " << m.family.dk2 << " k1bar " << m.k1_bar
-                                     << " k2bar " << m.k2_bar;
+    EXPECT_LE(worst_b, bound * 1.01) << "trial " << trial << std::setprecision(17) << " worst " << worst_b << " bound "
+                                     << bound << " k1 " << m.family.k1 << " dk1 " << m.family.dk1 << " k2 "
+                                     << m.family.k2 << " dk2 " << m.family.dk2 << " k1bar " << m.k1_bar << " k2bar "
+                                     << m.k2_bar;
     tightest_a = std::max(tightest_a, worst_a / bound);
     tightest_b = std::max(tightest_b, worst_b / bound);
   }

@@ -53,9 +53,9 @@ TEST(LambertW, ContinuousAcrossLogDomainThreshold) {
   const double above = lambert_w0_of_exp(kLogDomainThreshold + delta);
   const double w = lambert_w0_of_exp(kLogDomainThreshold);
   EXPECT_NEAR(above - below, 2.0 * delta * w / (1.0 + w), 1e-12);
-  EXPECT_NEAR((lambert_w0_nothrow(std::exp(kLogDomainThreshold + 0.5)) - lambert_w0_of_exp(kLogDomainThreshold + 0.5)) /
-                  w,
-              0.0, 1e-15);
+  EXPECT_NEAR(
+      (lambert_w0_nothrow(std::exp(kLogDomainThreshold + 0.5)) - lambert_w0_of_exp(kLogDomainThreshold + 0.5)) / w, 0.0,
+      1e-15);
 }
 
 TEST(LambertW, Lemma31Inequalities) {
@@ -201,7 +201,8 @@ TEST(KatalenicOperatorPair, ExactInverseFromSoftToBacklashHard) {
     direct.reset(v[0] - 0.3, v[0]);
     inverse.reset(v[0], v[0] - 0.3);
     double worst_right = 0.0;
-    for (double z : v) worst_right = std::max(worst_right, std::abs(direct.apply(inverse.apply(z, k1, k2), k1, k2) - z));
+    for (double z : v)
+      worst_right = std::max(worst_right, std::abs(direct.apply(inverse.apply(z, k1, k2), k1, k2) - z));
     EXPECT_LT(worst_right, 1e-13) << "right inverse, k2 = " << k2;
     std::printf("k2 = %g: worst left %.3g, right %.3g (operator units, range 10)\n", k2, worst_left, worst_right);
   }

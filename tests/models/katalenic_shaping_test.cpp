@@ -94,7 +94,8 @@ TEST(ShapingFunction, MonotonicityIsProvenOrRefusedWithTheField) {
   EXPECT_EQ(field_of_error(ShapingFunction::make_polynomial({0.0, 1.0, -0.098}, -6.0, 6.0)),
             "output_shaping.coefficients");
   // Odd polynomial x^3 - x dips inside [-1, 1]; x^3 + x does not.
-  EXPECT_EQ(field_of_error(ShapingFunction::make_odd_polynomial({-1.0, 1.0}, -1.0, 1.0)), "output_shaping.coefficients");
+  EXPECT_EQ(field_of_error(ShapingFunction::make_odd_polynomial({-1.0, 1.0}, -1.0, 1.0)),
+            "output_shaping.coefficients");
   EXPECT_EQ(field_of_error(ShapingFunction::make_odd_polynomial({1.0, 1.0}, -1.0, 1.0)), "");
   // p' = (x - 0.3)^2 + 1e-6 > 0 everywhere (barely) ...
   EXPECT_EQ(field_of_error(ShapingFunction::make_polynomial({0.0, 0.09 + 1e-6, -0.3, 1.0 / 3.0}, -2.0, 2.0)), "");

@@ -86,8 +86,9 @@ TEST(KatalenicProposition41, ExactLeftAndRightInverse) {
       double worst_right = 0.0;
       for (double yk : y) worst_right = std::max(worst_right, std::abs(model.forward(inverse.inverse(yk)) - yk));
       EXPECT_LT(worst_right, 1e-17) << name << " seed " << seed;
-      if (seed == 1) std::printf("[%s] worst |u - H^-1 H u| = %.3g V, worst |y - H H^-1 y| = %.3g m\n", name.c_str(),
-                                 worst_left, worst_right);
+      if (seed == 1)
+        std::printf("[%s] worst |u - H^-1 H u| = %.3g V, worst |y - H H^-1 y| = %.3g m\n", name.c_str(), worst_left,
+                    worst_right);
     }
   }
 }
@@ -303,8 +304,16 @@ TEST(KatalenicParams, ValidationNamesTheField) {
   EXPECT_EQ(field_of([](KatalenicParams& p) { p.initial_offset = 41.0; }), "initial_offset");
   EXPECT_EQ(field_of([](KatalenicParams& p) { p.k2_slope = INFINITY; }), "k2_slope");
   EXPECT_EQ(field_of([](KatalenicParams& p) { p.k2_slope = 1e-4; }), "k2_slope");  // beyond e k2_min / (2 k1)
-  EXPECT_EQ(field_of([](KatalenicParams& p) { p.k2_slope = -1e-4; p.k2 = 0.02; }), "k2_slope");  // k2(250) < 0
-  EXPECT_EQ(field_of([](KatalenicParams& p) { p.k2_slope = 1e-6; p.k2_domain_min = 1.0; p.k2_domain_max = 0.0; }),
+  EXPECT_EQ(field_of([](KatalenicParams& p) {
+              p.k2_slope = -1e-4;
+              p.k2 = 0.02;
+            }),
+            "k2_slope");  // k2(250) < 0
+  EXPECT_EQ(field_of([](KatalenicParams& p) {
+              p.k2_slope = 1e-6;
+              p.k2_domain_min = 1.0;
+              p.k2_domain_max = 0.0;
+            }),
             "k2_domain_max");
   EXPECT_EQ(field_of([](KatalenicParams& p) { p.input_shaping = ShapingFunction::make_linear(0.0); }),
             "input_shaping.gain");

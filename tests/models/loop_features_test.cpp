@@ -86,9 +86,10 @@ TEST(LoopFeatures, PhaseAndLengthDoNotMatter) {
   const Synthetic s;
   const Samples ref = s.sample(1.0, 0.0, 2000);
   const LoopFeatures want = extract_loop_features(ref.u, ref.y).features;
-  const std::vector<double> lengths = kSanitized ? std::vector<double>{1.0, 2.37} : std::vector<double>{1.0, 1.3, 2.37, 5.0};
-  const std::vector<double> phases = kSanitized ? std::vector<double>{0.5 * kPi, 4.5}
-                                                : std::vector<double>{0.0, 0.5 * kPi, 2.0, kPi, 4.5};
+  const std::vector<double> lengths =
+      kSanitized ? std::vector<double>{1.0, 2.37} : std::vector<double>{1.0, 1.3, 2.37, 5.0};
+  const std::vector<double> phases =
+      kSanitized ? std::vector<double>{0.5 * kPi, 4.5} : std::vector<double>{0.0, 0.5 * kPi, 2.0, kPi, 4.5};
   for (double periods : lengths) {
     for (double phase : phases) {
       const Samples d = s.sample(periods, phase, 2000);
@@ -147,9 +148,10 @@ TEST(LoopFeatures, NoisyColemanHodgdonLoopStaysClose) {
     e_area = std::max(e_area, std::abs(f.area / exact.area - 1.0));
     rms = std::max(rms, r.residual_rms);
   }
-  std::printf("noisy CH loop (A = 100 V, 5 periods, 2 nm / 0.01 V rms), worst of 20 seeds: centre %.3g nm, "
-              "slope %.3g rel, eta %.3g nm, delta %.3g V, area %.3g rel, fit rms %.3g nm\n",
-              e_centre * 1e9, e_slope, e_eta * 1e9, e_delta, e_area, rms * 1e9);
+  std::printf(
+      "noisy CH loop (A = 100 V, 5 periods, 2 nm / 0.01 V rms), worst of 20 seeds: centre %.3g nm, "
+      "slope %.3g rel, eta %.3g nm, delta %.3g V, area %.3g rel, fit rms %.3g nm\n",
+      e_centre * 1e9, e_slope, e_eta * 1e9, e_delta, e_area, rms * 1e9);
   EXPECT_LT(e_centre, 0.3e-9);
   EXPECT_LT(e_slope, 4e-4);
   EXPECT_LT(e_eta, 0.5e-9);

@@ -34,11 +34,14 @@ constexpr std::size_t kLong = 1'000'000;
 #endif
 
 // The paper's input (1), sampled at 10 kHz.
-double paper_input(double t) { return t <= 7.0 / 4.0 ? 250.0 * std::sin(2.0 * kPi * t) : 125.0 * std::sin(2.0 * kPi * t) - 125.0; }
+double paper_input(double t) {
+  return t <= 7.0 / 4.0 ? 250.0 * std::sin(2.0 * kPi * t) : 125.0 * std::sin(2.0 * kPi * t) - 125.0;
+}
 
 std::vector<double> paper_input_samples(double t_end, double dt = 1e-4) {
   std::vector<double> u;
-  for (std::size_t k = 0; static_cast<double>(k) * dt <= t_end + 1e-12; ++k) u.push_back(paper_input(static_cast<double>(k) * dt));
+  for (std::size_t k = 0; static_cast<double>(k) * dt <= t_end + 1e-12; ++k)
+    u.push_back(paper_input(static_cast<double>(k) * dt));
   return u;
 }
 
@@ -46,7 +49,8 @@ std::vector<double> paper_input_samples(double t_end, double dt = 1e-4) {
 // (each next level may continue the direction or reverse it), with random holds in between.
 class SmoothRandomSignal {
  public:
-  SmoothRandomSignal(std::uint64_t seed, double lo, double hi) : rng_(seed), lo_(lo), hi_(hi), from_(0.5 * (lo + hi)), to_(from_) {}
+  SmoothRandomSignal(std::uint64_t seed, double lo, double hi)
+      : rng_(seed), lo_(lo), hi_(hi), from_(0.5 * (lo + hi)), to_(from_) {}
 
   double next() {
     if (hold_left_ > 0) {
@@ -236,7 +240,8 @@ TEST(RambergOsgood, SlopesOfSkeletonAndBranchAreM) {
   const MemParams m = ro.to_mem();
   for (double p : {1.0, 10.0, 73.0, 250.0, 499.0}) {
     const double h = 1e-3;
-    const double branch_slope = (ro.branch(-250.0 + p + h, -250.0, 0.0) - ro.branch(-250.0 + p - h, -250.0, 0.0)) / (2 * h);
+    const double branch_slope =
+        (ro.branch(-250.0 + p + h, -250.0, 0.0) - ro.branch(-250.0 + p - h, -250.0, 0.0)) / (2 * h);
     EXPECT_NEAR(branch_slope, m.slope(p), 1e-7 * m.slope(p)) << p;
     const double u = 0.5 * p;
     const double skeleton_slope = (ro.skeleton(u + h) - ro.skeleton(u - h)) / (2 * h);
@@ -428,7 +433,8 @@ Composition model_then_inverse(const MemParams& p, Signal&& u_in, std::size_t n)
 
 TEST(MemTheorem10, RandomSmoothReferenceWithHolds) {
   SmoothRandomSignal sig(20240601, -1.6e-6, 1.6e-6);
-  const Composition c = inverse_then_model(MemParams::paper_like(), [&] { return sig.next(); }, kLong);
+  const Composition c = inverse_then_model(
+      MemParams::paper_like(), [&] { return sig.next(); }, kLong);
   EXPECT_LT(c.worst / c.scale, 1e-12) << c.worst;
   EXPECT_GT(c.reversals, kLong / 500);  // thousands over 10^6 samples
   std::printf("[ info ] inverse->model: %zu samples, %llu reversals, max error %.3g m (%.3g of stroke)\n", kLong,
@@ -437,7 +443,8 @@ TEST(MemTheorem10, RandomSmoothReferenceWithHolds) {
 
 TEST(MemTheorem10, ReverseCompositionRandomSmoothInputWithHolds) {
   SmoothRandomSignal sig(777, -250.0, 250.0);
-  const Composition c = model_then_inverse(MemParams::paper_like(), [&] { return sig.next(); }, kLong);
+  const Composition c = model_then_inverse(
+      MemParams::paper_like(), [&] { return sig.next(); }, kLong);
   EXPECT_LT(c.worst / c.scale, 1e-12) << c.worst;
   EXPECT_GT(c.reversals, kLong / 500);
 }
@@ -476,7 +483,8 @@ TEST(MemTheorem10, PaperReference24) {
 TEST(MemTheorem10, PaperInput1InverseRecoversInput) {
   const std::vector<double> u = paper_input_samples(3.0);
   std::size_t k = 0;
-  const Composition c = model_then_inverse(test_ro().to_mem(), [&] { return u[k++]; }, u.size());
+  const Composition c = model_then_inverse(
+      test_ro().to_mem(), [&] { return u[k++]; }, u.size());
   EXPECT_LT(c.worst / 250.0, 1e-13);
   EXPECT_EQ(c.reversals, 6u);
 }
@@ -496,10 +504,12 @@ TEST(MemTheorem10, RandomParametersBothCompositions) {
     ASSERT_NO_THROW(p.validate());
     const double stroke = p.branch_rise(500.0) / 2.0;
     SmoothRandomSignal ys(1000 + static_cast<std::uint64_t>(trial), -stroke, stroke);
-    const Composition a = inverse_then_model(p, [&] { return ys.next(); }, n);
+    const Composition a = inverse_then_model(
+        p, [&] { return ys.next(); }, n);
     EXPECT_LT(a.worst / a.scale, 1e-12) << "trial " << trial << " c1 " << p.c1 << " c2 " << p.c2 << " c3 " << p.c3;
     SmoothRandomSignal us(2000 + static_cast<std::uint64_t>(trial), -250.0, 250.0);
-    const Composition b = model_then_inverse(p, [&] { return us.next(); }, n);
+    const Composition b = model_then_inverse(
+        p, [&] { return us.next(); }, n);
     EXPECT_LT(b.worst / b.scale, 1e-12) << "trial " << trial << " c1 " << p.c1 << " c2 " << p.c2 << " c3 " << p.c3;
   }
 }
@@ -561,7 +571,8 @@ TEST(MemSetParams, ModelOutputContinuousMidBranchAndOnSkeleton) {
     EXPECT_EQ(model.params().c1, other.c1);
     EXPECT_NEAR(model.forward(model.input()), y, 1e-21);
     const double u = model.input() + (on_branch ? -0.1 : 0.1);
-    EXPECT_NEAR(model.forward(u), y + (on_branch ? -1.0 : 1.0) * 0.1 * model.params().slope(on_branch ? 150.0 : 400.0), 1e-13);
+    EXPECT_NEAR(model.forward(u), y + (on_branch ? -1.0 : 1.0) * 0.1 * model.params().slope(on_branch ? 150.0 : 400.0),
+                1e-13);
     EXPECT_EQ(model.on_skeleton(), !on_branch);
   }
   EXPECT_THROW(MemModel().set_params(MemParams{0.0, 1.0, 1.0}), ParameterError);
@@ -656,7 +667,7 @@ TEST(MemInverse, ContinueBranchPicksUpAStageMeasuredOnItsBranch) {
     for (double u = 0.0; u > -320.0; u -= 1.0) plant.forward(u);  // down to the branching point
     plant.forward(-320.0);
     double u_now = -320.0;
-    for (; u_now < -223.0; u_now += 0.7) plant.forward(u_now);     // up its branch: the last input
+    for (; u_now < -223.0; u_now += 0.7) plant.forward(u_now);  // up its branch: the last input
     const double y_now = plant.output();
     const double u_last = plant.input();
     MemInverse inverse;

@@ -72,8 +72,8 @@ double zoh_gain(const SecondOrderStageParams& p, double omega, double dt) {
   const double th = wd * dt;
   const std::complex<double> z = std::polar(1.0, omega * dt);
   const std::complex<double> den = z * z - 2.0 * r * std::cos(th) * z + r * r;
-  const std::complex<double> s = z / (z - 1.0) - z * (z - r * std::cos(th)) / den -
-                                 (sigma / wd) * z * r * std::sin(th) / den;
+  const std::complex<double> s =
+      z / (z - 1.0) - z * (z - r * std::cos(th)) / den - (sigma / wd) * z * r * std::sin(th) / den;
   return std::abs((1.0 - 1.0 / z) * s);
 }
 
@@ -178,7 +178,7 @@ TEST(SecondOrderStage, FrequencyResponseMatchesTheSecondOrderClosedForm) {
     EXPECT_NEAR(fine, g, 1e-3 * g) << f;
     EXPECT_NEAR(coarse, gd, 1e-8 * gd) << f;
   }
-  EXPECT_NEAR(stage_magnitude(p, 0.0), 1.0, 1e-15);           // unit DC gain
+  EXPECT_NEAR(stage_magnitude(p, 0.0), 1.0, 1e-15);             // unit DC gain
   EXPECT_NEAR(stage_magnitude(p, std::sqrt(p.k)), 5.33, 0.01);  // 1 / (2 zeta) at omega_n
 }
 

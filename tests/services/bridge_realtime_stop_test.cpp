@@ -22,7 +22,7 @@ constexpr double kDt = 1e-4;
 // What the backend saw. Written on the real-time thread (step, the first hold_safe) and the
 // test's thread (the later hold_safe calls, after the join); read after the join.
 struct Record {
-  std::vector<double> u_V;             // every step's voltage
+  std::vector<double> u_V;  // every step's voltage
   std::atomic<double> last_u_V{0.0};
   std::atomic<int> holds{0};
   std::size_t steps_at_first_hold = 0;

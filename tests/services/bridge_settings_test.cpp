@@ -60,10 +60,10 @@ TEST(BridgeSettings, DefaultsAreTheIssues) {
 }
 
 TEST(BridgeSettings, TheServoTakesItsGainsFromServoKeysAndItsLimitFromTheActuatorsRange) {
-  const BridgeSettings s = load_bridge_settings(Config::from_string(
-      "servo: {kp: 0.2, ki: 300, kd: 1.0e-5, nominal_gain_m_per_V: 6.0e-9, d_filter_hz: 500}\n"
-      "actuator: {u_min_V: -100, u_max_V: 200}",
-      "bridge.yaml"));
+  const BridgeSettings s = load_bridge_settings(
+      Config::from_string("servo: {kp: 0.2, ki: 300, kd: 1.0e-5, nominal_gain_m_per_V: 6.0e-9, d_filter_hz: 500}\n"
+                          "actuator: {u_min_V: -100, u_max_V: 200}",
+                          "bridge.yaml"));
   EXPECT_EQ(s.servo.kp, 0.2);
   EXPECT_EQ(s.servo.ki, 300.0);
   EXPECT_EQ(s.servo.kd, 1e-5);
@@ -73,7 +73,8 @@ TEST(BridgeSettings, TheServoTakesItsGainsFromServoKeysAndItsLimitFromTheActuato
   EXPECT_EQ(s.servo.u_max_V, 200.0);
   EXPECT_TRUE(s.servo.enabled());
   const auto lines = describe(s);
-  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return contains(l, "servo: kp 0.2"); }));
+  EXPECT_TRUE(
+      std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return contains(l, "servo: kp 0.2"); }));
 }
 
 TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
@@ -172,14 +173,15 @@ TEST(BridgeSettings, TheStopRampBoundFollowsTheActuator) {
   const BridgeSettings d = load_bridge_settings(Config::load_file(kConfigDir + "bridge.yaml"));
   EXPECT_DOUBLE_EQ(d.limits.longest_safe_ramp_s(), 0.25);  // 250 V at 1e3 V/s
   EXPECT_DOUBLE_EQ(d.stop_ramp_timeout_s, 0.25 + kStopRampMargin_s);
-  const BridgeSettings slow = load_bridge_settings(
-      Config::from_string("actuator: {safe_u_V: -50, safe_ramp_V_per_s: 100}", "bridge.yaml"));
+  const BridgeSettings slow =
+      load_bridge_settings(Config::from_string("actuator: {safe_u_V: -50, safe_ramp_V_per_s: 100}", "bridge.yaml"));
   EXPECT_DOUBLE_EQ(slow.stop_ramp_timeout_s, 300.0 / 100.0 + kStopRampMargin_s);  // from +250 V
   const BridgeSettings slew = load_bridge_settings(
       Config::from_string("actuator: {safe_ramp_V_per_s: 1.0e6, slew_V_per_s: 1.0e4}", "bridge.yaml"));
   EXPECT_DOUBLE_EQ(slew.stop_ramp_timeout_s, 250.0 / 1e4 + kStopRampMargin_s);  // never faster than the slew
   bool said = false;
-  for (const std::string& line : describe(d)) said = said || contains(line, "stop: ramp to safe (at most 0.25 s) within 0.75 s");
+  for (const std::string& line : describe(d))
+    said = said || contains(line, "stop: ramp to safe (at most 0.25 s) within 0.75 s");
   EXPECT_TRUE(said);
 }
 
@@ -206,7 +208,7 @@ TEST(StageBackend, SimulatorsStepAndFlagThemselves) {
     for (int k = 0; k < 2000; ++k) r = backend->step(100.0, k * 1e-4, 1e-4);
     EXPECT_GT(r.y_m, 3e-7) << name;  // ~0.6 um at 100 V
     EXPECT_LT(r.y_m, 1.2e-6) << name;
-    EXPECT_EQ(r.flags, 4);           // SIMULATED
+    EXPECT_EQ(r.flags, 4);  // SIMULATED
   }
   EXPECT_THROW(make_stage_backend("daq", s.stage), ParameterError);
 }

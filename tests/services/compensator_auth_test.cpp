@@ -22,7 +22,8 @@ namespace {
 
 std::shared_ptr<const RigAuth> rig(unsigned char seed) {
   auto auth = std::make_shared<RigAuth>();
-  for (std::size_t i = 0; i < auth->key.bytes.size(); ++i) auth->key.bytes[i] = static_cast<unsigned char>(static_cast<std::size_t>(seed) * 3 + i);
+  for (std::size_t i = 0; i < auth->key.bytes.size(); ++i)
+    auth->key.bytes[i] = static_cast<unsigned char>(static_cast<std::size_t>(seed) * 3 + i);
   return auth;
 }
 
@@ -68,9 +69,9 @@ struct KeyedRig {
   ProcessAuth installed{key};
   std::unique_ptr<lcm::LCM> lcm = open_lcm("memq://");
   ChannelNames channels{};
-  CompensatorService service{
-      load_compensator_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml")),
-      *lcm, channels};
+  CompensatorService service{load_compensator_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) +
+                                                                         "/deploy/config/compensator.yaml")),
+                             *lcm, channels};
   std::vector<std::vector<std::uint8_t>> command_bytes;
   std::vector<std::vector<std::uint8_t>> control_bytes;
 

@@ -19,8 +19,8 @@ namespace {
 constexpr std::int64_t kPublisher = 0x7e1d'0002;
 
 CompensatorSettings cosine_settings() {
-  CompensatorSettings s =
-      load_compensator_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml"));
+  CompensatorSettings s = load_compensator_settings(
+      Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml"));
   s.control.horizon_ticks = 300;
   s.trajectory.shape = TrajectoryShape::kCosine;  // -1.6 um cos(2 pi t): a reversal near tick 510
   s.trajectory.amplitude_m = -1.6e-6;

@@ -44,9 +44,7 @@ std::int64_t utime_of(std::int64_t tick) { return kBaseUtime + tick * 100; }
 
 const std::string kConfigDir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
 
-CompensatorSettings deployed() {
-  return load_compensator_settings(Config::load_file(kConfigDir + "compensator.yaml"));
-}
+CompensatorSettings deployed() { return load_compensator_settings(Config::load_file(kConfigDir + "compensator.yaml")); }
 
 // The deployed settings (MEM, holding at 0) with a horizon of kHorizon ticks.
 CompensatorSettings holding() {
@@ -99,8 +97,8 @@ struct Harness {
   std::unique_ptr<lcm::LCM> lcm = open_lcm("memq://");
   ChannelNames channels{};
   CompensatorService service;
-  std::vector<BlockSeen> blocks;   // every command block published, in order
-  std::vector<CommandTick> ticks;  // their ticks, in order
+  std::vector<BlockSeen> blocks;               // every command block published, in order
+  std::vector<CommandTick> ticks;              // their ticks, in order
   std::map<std::int64_t, std::size_t> latest;  // tick -> its last entry in `ticks`
   Subscription<command_block_t> commands;
   sensor_block_t sensor{};
@@ -194,10 +192,10 @@ TEST(CompensatorService, AnswersEachSensorBlockWithTheTicksNotYetSentThroughTheH
   struct Step {
     std::int64_t seq, n;
   };
-  const Step steps[] = {{6000, 1},  {6001, 1},  {6002, 1}, {6003, 7},   {6010, 25},  {6035, 10},
-                        {6065, 10},  // 20 ticks lost: 30 ticks answered
-                        {6065, 10},  // the same block again: nothing new to send
-                        {6050, 10},  // an old one: nothing either
+  const Step steps[] = {{6000, 1},   {6001, 1},  {6002, 1},  {6003, 7},
+                        {6010, 25},  {6035, 10}, {6065, 10},  // 20 ticks lost: 30 ticks answered
+                        {6065, 10},                           // the same block again: nothing new to send
+                        {6050, 10},                           // an old one: nothing either
                         {6075, 250}, {6325, 10}};
   for (const Step& s : steps) {
     const std::size_t b = h.blocks.size();
@@ -276,7 +274,7 @@ TEST(CompensatorService, AFirstBlockCountsNoTicksBehind) {
 // message into a queue entry), which the counter does not see.
 TEST(CompensatorService, TheSensorBlockPathDoesNotAllocate) {
   Harness h;
-  h.run(0, 1000);  // warm-up: the first answer (a whole horizon) sizes the publisher's buffer
+  h.run(0, 1000);                          // warm-up: the first answer (a whole horizon) sizes the publisher's buffer
   h.service.on_params(params(2, 5.5e-9));  // swapped in at the reversal near tick 5510, below
   std::vector<sensor_block_t> blocks;
   for (std::int64_t seq = 1000; seq < 7000; seq += 10) {
@@ -440,7 +438,7 @@ TEST(CompensatorService, AForgedSensorBlockFarAheadIsIgnoredAndTheRealBlocksAreA
   h.run(0, 1000);
   const std::size_t from_block = h.blocks.size();
   const std::int64_t sent = h.sent_through();
-  h.send(1000 + 900);  // forged
+  h.send(1000 + 900);                      // forged
   EXPECT_EQ(h.blocks.size(), from_block);  // not answered
   EXPECT_EQ(h.service.compensator().last_seq(), 999);
   h.send(1000);
@@ -666,7 +664,8 @@ TEST(CompensatorService, ControlRequests) {
   }
   for (std::int64_t k = 320; k < 530; ++k) {  // started at the first tick not sent
     EXPECT_NEAR(h.tick(k).u_ff_V, 100.0 * std::sin(2.0 * std::numbers::pi * 10.0 * static_cast<double>(k - 320) * kDt),
-                1e-9) << k;
+                1e-9)
+        << k;
   }
 
   h.service.on_control(request(5, control_t::STOP_EXPERIMENT));  // ends at the first tick not sent (530)
@@ -682,7 +681,7 @@ TEST(CompensatorService, ControlRequests) {
     ASSERT_EQ(h.tick(tracking).mode, command_block_t::MODE_PI) << tracking;
     ++tracking;
   }
-  EXPECT_GT(tracking, 539);                // not before the sample of tick 530 (in the block 530..539)
+  EXPECT_GT(tracking, 539);                 // not before the sample of tick 530 (in the block 530..539)
   EXPECT_LE(tracking, 539 + kHorizon + 1);  // planned with the answer to that block
   for (std::int64_t k = tracking; k <= h.sent_through(); ++k) ASSERT_TRUE(std::isfinite(h.tick(k).y_ref_m)) << k;
 
@@ -826,7 +825,8 @@ TEST(CompensatorSettings, TheHorizonIsGivenInSecondsAndPlannedInTicks) {
   };
   EXPECT_EQ(load("compensator: {horizon_s: 0.25}").horizon_ticks, 2500);
   EXPECT_EQ(load("compensator: {horizon_s: 0.03, dt_s: 2.0e-4}").horizon_ticks, 150);
-  EXPECT_TRUE(contains(settings_refusal("compensator: {horizon_s: 0.0001}"), "compensator.yaml: compensator.horizon_s"));
+  EXPECT_TRUE(
+      contains(settings_refusal("compensator: {horizon_s: 0.0001}"), "compensator.yaml: compensator.horizon_s"));
   EXPECT_TRUE(contains(settings_refusal("compensator: {horizon_s: 1.0}"), "compensator.yaml: compensator.horizon_s"));
   const CompensatorSettings demo = load_compensator_settings(Config::load_file(kConfigDir + "demo/compensator.yaml"));
   EXPECT_EQ(demo.control.horizon_ticks, ticks_in("demo/compensator.yaml"));

@@ -45,7 +45,8 @@ class SmallDisk final : public LogFileIo {
     struct stat st {};
     ::fstat(fd, &st);
     const int rc = posix_log_file_io().truncate(fd, size);
-    if (rc == 0 && static_cast<std::uint64_t>(st.st_size) > size) free_ += static_cast<std::uint64_t>(st.st_size) - size;
+    if (rc == 0 && static_cast<std::uint64_t>(st.st_size) > size)
+      free_ += static_cast<std::uint64_t>(st.st_size) - size;
     return rc;
   }
   int fsync(int fd) noexcept override { return fsync_error != 0 ? -fsync_error : posix_log_file_io().fsync(fd); }

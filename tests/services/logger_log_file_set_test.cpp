@@ -105,7 +105,7 @@ TEST_F(LogFileSetTest, ASecondRecordingWithTheSameStartGetsItsOwnName) {
   EXPECT_EQ(b.current_file().string(), first.string() + "-1.000.lcmlog");
   b.close();
   EXPECT_FALSE(b.write("HX_A", 4, "ab", 2, 1, 0.0));  // closed: nothing reopens
-  EXPECT_EQ(b.file_count(), 0u);  // it never held an event: removed at close, no empty file left
+  EXPECT_EQ(b.file_count(), 0u);                      // it never held an event: removed at close, no empty file left
   EXPECT_FALSE(fs::exists(first.string() + "-1.000.lcmlog"));
 }
 

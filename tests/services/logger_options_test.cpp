@@ -68,8 +68,8 @@ TEST(LoggerOptions, ASummaryPathThatIsADirectoryIsRefusedAtOnce) {
 
 // Issue 12: a bad --channels regex was found only when LCM refused it (exit 1, not 2).
 TEST(LoggerOptions, AChannelRegexLcmCannotCompileIsRefused) {
-  EXPECT_NE(error_of(Config::from_string("logger:\n  channels: 'HX_(['\n")).find(
-                "logger.channels: not a regular expression LCM accepts"),
+  EXPECT_NE(error_of(Config::from_string("logger:\n  channels: 'HX_(['\n"))
+                .find("logger.channels: not a regular expression LCM accepts"),
             std::string::npos);
   EXPECT_EQ(error_of(Config::from_string("logger:\n  channels: 'HX_(SENSOR|COMMAND)|OTHER_.*'\n")), "");
 }

@@ -80,9 +80,8 @@ TEST(RecordRing, WrapsWithoutSplittingAndPushAllocatesNothing) {
   for (std::uint64_t id = 0; id < 5000; ++id) payloads.push_back(payload(id, rng() % 300));
   for (int round = 0; round < 2000 && next_read < payloads.size(); ++round) {
     const hystloop::testing::AllocationCounter allocations;
-    while (next_id < payloads.size() &&
-           ring.try_push(static_cast<std::uint32_t>(next_id), 0, payloads[next_id].data(), payloads[next_id].size()) ==
-               Push::kOk) {
+    while (next_id < payloads.size() && ring.try_push(static_cast<std::uint32_t>(next_id), 0, payloads[next_id].data(),
+                                                      payloads[next_id].size()) == Push::kOk) {
       ++next_id;
     }
     EXPECT_EQ(allocations.allocations(), 0u);

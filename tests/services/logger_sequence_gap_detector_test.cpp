@@ -54,7 +54,7 @@ TEST(SequenceGapDetector, DuplicateOverlappingAndLateBlocksAreCountedNotGaps) {
   EXPECT_EQ(d.observe(20, 10), Outcome::kDuplicate);  // the last block again
   EXPECT_EQ(d.observe(25, 10), Outcome::kOverlap);    // 25..29 again, 30..34 new
   EXPECT_EQ(d.last_seq(), 34);
-  EXPECT_EQ(d.observe(40, 10), Outcome::kGap);         // 35..39 missing
+  EXPECT_EQ(d.observe(40, 10), Outcome::kGap);        // 35..39 missing
   EXPECT_EQ(d.observe(35, 5), Outcome::kOutOfOrder);  // late: the gap stays counted
   EXPECT_EQ(d.observe(12, 3), Outcome::kOutOfOrder);  // inside an old block
   EXPECT_EQ(d.observe(50, 10), Outcome::kInOrder);    // last was kept at 49
@@ -70,8 +70,8 @@ TEST(SequenceGapDetector, DuplicateOverlappingAndLateBlocksAreCountedNotGaps) {
 TEST(SequenceGapDetector, LargeStepBackIsARestart) {
   SequenceGapDetector d(100);
   for (std::int64_t first = 0; first <= 500; first += 10) d.observe(first, 10);  // up to 509
-  EXPECT_EQ(d.observe(409, 10), Outcome::kOutOfOrder);  // 100 back: still "late"
-  EXPECT_EQ(d.observe(408, 10), Outcome::kRestart);     // 101 back: a restart
+  EXPECT_EQ(d.observe(409, 10), Outcome::kOutOfOrder);                           // 100 back: still "late"
+  EXPECT_EQ(d.observe(408, 10), Outcome::kRestart);                              // 101 back: a restart
   EXPECT_EQ(d.observe(418, 10), Outcome::kInOrder);
   EXPECT_EQ(d.observe(0, 10), Outcome::kRestart);
   EXPECT_EQ(d.observe(10, 10), Outcome::kInOrder);
@@ -86,8 +86,8 @@ TEST(SequenceGapDetector, AForwardJumpAfterSilenceIsAResumeWhenEnabled) {
   SequenceGapDetector d(10000, 50'000);
   d.observe(0, 10, 1'000'000);
   d.observe(10, 10, 1'001'000);
-  EXPECT_EQ(d.observe(500, 10, 1'101'000), Outcome::kResume);  // 100 ms silent: 20..499 skipped
-  EXPECT_EQ(d.observe(520, 10, 1'102'000), Outcome::kGap);     // 1 ms later: 510..519 lost
+  EXPECT_EQ(d.observe(500, 10, 1'101'000), Outcome::kResume);   // 100 ms silent: 20..499 skipped
+  EXPECT_EQ(d.observe(520, 10, 1'102'000), Outcome::kGap);      // 1 ms later: 510..519 lost
   EXPECT_EQ(d.observe(530, 10, 1'160'000), Outcome::kInOrder);  // silence without a jump: nothing
   EXPECT_EQ(d.resumes(), 1u);
   EXPECT_EQ(d.skipped(), 480u);
@@ -151,7 +151,7 @@ TEST(SequenceGapDetector, ForgedTicksSaturateTheCountersInsteadOfWrapping) {
   std::uint64_t last_missing = 0, last_skipped = 0;
   for (int i = 0; i < 4; ++i) {
     d.observe(kMin, 1, 0);
-    EXPECT_EQ(d.observe(kMax, 1, 0), Outcome::kGap);   // no silence: a gap of 2^64 - 2 ticks
+    EXPECT_EQ(d.observe(kMax, 1, 0), Outcome::kGap);  // no silence: a gap of 2^64 - 2 ticks
     EXPECT_GE(d.missing(), last_missing) << i;        // never goes down (no wrap)
     last_missing = d.missing();
     d.observe(kMin, 1, 0);
@@ -210,7 +210,8 @@ TEST(SequenceGapDetector, SeededRandomDroppedBlocksAreCountedExactly) {
       next += n;
     }
     std::size_t last_kept = 0;
-    for (std::size_t b = 0; b < stream.size(); ++b) if (stream[b].kept) last_kept = b;
+    for (std::size_t b = 0; b < stream.size(); ++b)
+      if (stream[b].kept) last_kept = b;
     std::uint64_t runs = 0, missing = 0;
     for (std::size_t b = 1; b <= last_kept; ++b) {
       if (stream[b].kept) continue;
@@ -220,7 +221,8 @@ TEST(SequenceGapDetector, SeededRandomDroppedBlocksAreCountedExactly) {
 
     SequenceGapDetector d;
     const hystloop::testing::AllocationCounter allocations;
-    for (const Block& b : stream) if (b.kept) d.observe(b.first, b.n);
+    for (const Block& b : stream)
+      if (b.kept) d.observe(b.first, b.n);
     EXPECT_EQ(allocations.allocations(), 0u);
     ASSERT_EQ(d.gap_events(), runs) << "trial " << trial;
     ASSERT_EQ(d.missing(), missing) << "trial " << trial;

@@ -154,7 +154,8 @@ TEST_F(LoggerServiceTest, RecordsEverythingCountsTheTickGapsAndReceivesWithoutAl
       EXPECT_EQ(status.state, service_status_t::DEGRADED);
       EXPECT_NE(status.detail.find("1 gap(s), 30 ticks missing on HX_SENSOR"), std::string::npos) << status.detail;
       EXPECT_NE(status.detail.find("1 gap(s), 10 ticks missing on HX_COMMAND"), std::string::npos) << status.detail;
-      EXPECT_NE(status.detail.find("1 overlapping/duplicate block(s) on HX_COMMAND"), std::string::npos) << status.detail;
+      EXPECT_NE(status.detail.find("1 overlapping/duplicate block(s) on HX_COMMAND"), std::string::npos)
+          << status.detail;
       std::map<std::string, std::int64_t> counters;
       for (int i = 0; i < status.n_counters; ++i) counters[status.counter_names[i]] = status.counter_values[i];
       EXPECT_EQ(counters["HX_SENSOR.received"], sent_blocks);

@@ -202,17 +202,17 @@ TEST(ReidentCore, SkipsFlaggedTicksAndCountsGapsAndRestarts) {
   rig.tick(1, kSafeState | kSimulated);
   rig.tick(2, kSensorFault);
   rig.tick(3, kSaturated | kLateCommand);
-  rig.tick(10);                             // 6 missing
-  rig.tick(12);                             // 1 missing
-  rig.core.on_refused_block(1, rig.now);    // 13 (NaN, refused on the wire) ...
-  rig.tick(14);                             // ... is no gap
-  rig.core.on_refused_block(1, rig.now);    // 15
-  rig.tick(17);                             // 16 missing
-  rig.core.on_refused_block(10, rig.now);   // 18 .. 27, a block the size of the bridge's
-  rig.tick(28);                             // no gap
-  rig.core.on_refused_block(10, rig.now);   // 29 .. 38
-  rig.tick(40);                             // 39 missing
-  rig.tick(0);                              // the bridge restarted
+  rig.tick(10);                            // 6 missing
+  rig.tick(12);                            // 1 missing
+  rig.core.on_refused_block(1, rig.now);   // 13 (NaN, refused on the wire) ...
+  rig.tick(14);                            // ... is no gap
+  rig.core.on_refused_block(1, rig.now);   // 15
+  rig.tick(17);                            // 16 missing
+  rig.core.on_refused_block(10, rig.now);  // 18 .. 27, a block the size of the bridge's
+  rig.tick(28);                            // no gap
+  rig.core.on_refused_block(10, rig.now);  // 29 .. 38
+  rig.tick(40);                            // 39 missing
+  rig.tick(0);                             // the bridge restarted
   const ReidentCounters& c = rig.core.counters();
   EXPECT_EQ(c.get(ReidentCounter::samples_fed), 13u);  // nine ticks and four poison markers
   EXPECT_EQ(c.get(ReidentCounter::non_finite), 4u);

@@ -51,9 +51,12 @@ TEST(ReidentOptions, ReadsTheSharedMemSnippetAndTheReidentSection) {
 }
 
 TEST(ReidentOptions, RefusalsNameTheField) {
-  EXPECT_NE(refusal("reidentifier: {refit_period_s: -1}").find("r.yaml: reidentifier.refit_period_s:"), std::string::npos);
-  EXPECT_NE(refusal("reidentifier: {window_s: 0.001}").find("reidentifier.window_s: must hold at least 16"), std::string::npos);
-  EXPECT_NE(refusal("reidentifier: {window_s: 5, capacity_s: 2}").find("reidentifier.capacity_s: must be >= reidentifier.window_s"),
+  EXPECT_NE(refusal("reidentifier: {refit_period_s: -1}").find("r.yaml: reidentifier.refit_period_s:"),
+            std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {window_s: 0.001}").find("reidentifier.window_s: must hold at least 16"),
+            std::string::npos);
+  EXPECT_NE(refusal("reidentifier: {window_s: 5, capacity_s: 2}")
+                .find("reidentifier.capacity_s: must be >= reidentifier.window_s"),
             std::string::npos);
   EXPECT_NE(refusal("reidentifier: {holdout_branches: 0}").find("reidentifier.holdout_branches"), std::string::npos);
   EXPECT_NE(refusal("reidentifier: {min_relative_improvement: 1.5}").find("reidentifier.min_relative_improvement"),

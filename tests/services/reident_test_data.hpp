@@ -62,11 +62,8 @@ inline command_block_t reserved_command_block() {
 
 // A bridge tick that applied u_V (all feedforward, no reference) and measured y_m.
 inline SensorTick sample_tick(double u_V, double y_m, std::int32_t flags = 0) {
-  return SensorTick{.u_V = u_V,
-                    .u_ff_V = u_V,
-                    .y_ref_m = std::numeric_limits<double>::quiet_NaN(),
-                    .y_m = y_m,
-                    .flags = flags};
+  return SensorTick{
+      .u_V = u_V, .u_ff_V = u_V, .y_ref_m = std::numeric_limits<double>::quiet_NaN(), .y_m = y_m, .flags = flags};
 }
 
 // Fills `b` with ticks seq .. seq + n - 1 of u/y from index `from` on.

@@ -36,9 +36,9 @@ TrajectorySpec cosine_reference() {
 }
 
 struct ExperimentRun {
-  std::int64_t first = 0;       // first experiment tick: the first not yet planned at the start
-  std::int64_t end = 0;         // first tick after it
-  std::int64_t resumed = 0;     // first tick planned after the end's sample was observed
+  std::int64_t first = 0;    // first experiment tick: the first not yet planned at the start
+  std::int64_t end = 0;      // first tick after it
+  std::int64_t resumed = 0;  // first tick planned after the end's sample was observed
 };
 
 // Tracks for 0.3 s, runs `e`, tracks again for `after_ticks`.
@@ -236,7 +236,7 @@ TEST(CompensatorExperiment, TrackingThroughTheLoopAfterAnExperimentStartsFromWhe
   EXPECT_FALSE(sim.compensator().experiment_running());
   const TrackingStats s = sim.tracking(2.0, 5.0);
   ASSERT_GT(s.n, 20000u);
-  EXPECT_LT(s.rms_true_m, 1e-11);  // rounding; a virgin-skeleton start would be off by nanometres
+  EXPECT_LT(s.rms_true_m, 1e-11);                // rounding; a virgin-skeleton start would be off by nanometres
   EXPECT_EQ(sim.bridge().counters().late, 10u);  // ticks 0-9, before the first block is answered
 }
 

@@ -196,8 +196,8 @@ TEST(Tracking, HEAVY(ReidentificationRepairsAWrongStartAndPicksTheBestModel)) {
   o.selector.pinned = false;
   const Case automatic = run_case(e, identified(), o);
   print_header("Banning stage, MEM from the wrong start", e);
-  std::printf("%-34s %9.2f nm (offline fit); PI-15 offline %.2f nm over [4, 8) s\n", "MEM", nm(offline_mem.stats.rms_true_m),
-              nm(offline_pi.stats.rms_true_m));
+  std::printf("%-34s %9.2f nm (offline fit); PI-15 offline %.2f nm over [4, 8) s\n", "MEM",
+              nm(offline_mem.stats.rms_true_m), nm(offline_pi.stats.rms_true_m));
   print_case("MEM estimator (paper's workflow)", paper);
   print_case("selector, MEM pinned", pinned);
   print_case("selector, automatic", automatic);
@@ -250,8 +250,9 @@ TEST(Tracking, HEAVY(ReidentificationFindsTheRambergOsgoodStageExactly)) {
       return run_tracking(e, id, none);
     }();
     const TrackingRun on = run_tracking(e, id, o);
-    std::printf("%-34s %9.2f nm %9.2f nm  c1 %.5g c2 %.5g c3 %.5g\n", r == Reidentify::mem ? "MEM estimator" : "selector",
-                nm(off.stats.rms_true_m), nm(on.stats.rms_true_m), on.final_mem.c1, on.final_mem.c2, on.final_mem.c3);
+    std::printf("%-34s %9.2f nm %9.2f nm  c1 %.5g c2 %.5g c3 %.5g\n",
+                r == Reidentify::mem ? "MEM estimator" : "selector", nm(off.stats.rms_true_m), nm(on.stats.rms_true_m),
+                on.final_mem.c1, on.final_mem.c2, on.final_mem.c3);
     // Within 10 s: one swap at 3.5 s brings c1, c2, c3 within 0.4 % (target 1 %) and 0.4-0.5 nm
     // of RMS with 1 nm of sensor noise (target 1.5 nm).
     EXPECT_EQ(on.final_kind, ModelKind::mem);

@@ -12,9 +12,9 @@
 namespace hystloop::testing {
 
 struct SmoothSignalShape {
-  double min_cycles = 5.0;   // per record
+  double min_cycles = 5.0;  // per record
   double max_cycles = 40.0;
-  double min_weight = 0.2;   // of each sine, relative (max 1)
+  double min_weight = 0.2;  // of each sine, relative (max 1)
 };
 
 inline std::vector<double> smooth_signal(std::mt19937_64& rng, double amplitude, double offset, std::size_t n,

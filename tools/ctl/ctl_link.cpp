@@ -59,7 +59,8 @@ int run_status(CtlLink& link, const StatusOptions& o) {
       if (verdict.healthy) break;
     }
   }
-  for (const auto& [name, report] : board.processes()) std::printf("%s\n", format_status(report, o.all_counters).c_str());
+  for (const auto& [name, report] : board.processes())
+    std::printf("%s\n", format_status(report, o.all_counters).c_str());
   std::fflush(stdout);
   if (waiting) {
     verdict = check_health(board, o.wait_healthy, o.accept_safe, o.accept_degraded);
@@ -99,10 +100,9 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
         line.params_in_use = command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
       },
       command_queue);
-  Subscription<mem_params_t> params(link.lcm(), link.channels().params,
-                                    [&](const mem_params_t& p, std::int64_t) {
-                                      if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
-                                    });
+  Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
+    if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
+  });
   Subscription<service_status_t> status(link.lcm(), link.channels().status,
                                         [&](const service_status_t& s, std::int64_t) {
                                           if (s.process != o.bridge_process) return;
@@ -166,12 +166,15 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
     if (!pump(listen_end)) return 1;
   }
   if (!mode) {
-    std::fprintf(stderr, "hystloop-ctl: no command on %s within 1 s: is the compensator running and the bridge "
-                         "sending samples? (hystloop-ctl status)\n", link.channels().command.c_str());
+    std::fprintf(stderr,
+                 "hystloop-ctl: no command on %s within 1 s: is the compensator running and the bridge "
+                 "sending samples? (hystloop-ctl status)\n",
+                 link.channels().command.c_str());
     return 1;
   }
   if (*mode == command_block_t::MODE_EXPERIMENT) {
-    std::fprintf(stderr, "hystloop-ctl: an experiment is running: wait for it to end, or hystloop-ctl stop-experiment\n");
+    std::fprintf(stderr,
+                 "hystloop-ctl: an experiment is running: wait for it to end, or hystloop-ctl stop-experiment\n");
     return 1;
   }
 
@@ -218,14 +221,17 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
     return 1;
   }
   if (!tracker.started()) {
-    std::fprintf(stderr, "hystloop-ctl: no experiment command within %g s of the requests: the compensator refused "
-                         "them or did not get them (see its log; hystloop-ctl status)\n", o.start_timeout_s);
+    std::fprintf(stderr,
+                 "hystloop-ctl: no experiment command within %g s of the requests: the compensator refused "
+                 "them or did not get them (see its log; hystloop-ctl status)\n",
+                 o.start_timeout_s);
     return 1;
   }
   if (tracker.ended_early()) {
-    std::fprintf(stderr, "hystloop-ctl: the series ended at tick %lld, before its end at tick %lld: stopped, or the "
-                         "compensator restarted\n", static_cast<long long>(last_seq.value_or(0)),
-                 static_cast<long long>(tracker.end_tick()));
+    std::fprintf(stderr,
+                 "hystloop-ctl: the series ended at tick %lld, before its end at tick %lld: stopped, or the "
+                 "compensator restarted\n",
+                 static_cast<long long>(last_seq.value_or(0)), static_cast<long long>(tracker.end_tick()));
     return 1;
   }
   if (!tracker.finished()) {
@@ -241,8 +247,9 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
 
 std::int32_t next_params_version(CtlLink& link, double listen_s) {
   std::int32_t highest = 0;
-  Subscription<mem_params_t> params(link.lcm(), link.channels().params,
-                                    [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
+  Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
+    highest = std::max(highest, p.version);
+  });
   Subscription<command_block_t>::Options queue;
   queue.queue_capacity = 4'000;
   Subscription<command_block_t> commands(

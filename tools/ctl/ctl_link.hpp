@@ -18,7 +18,7 @@
 namespace hystloop::ctl {
 
 struct LinkOptions {
-  std::string lcm_url;         // empty: $LCM_DEFAULT_URL, else the ttl=0 default
+  std::string lcm_url;  // empty: $LCM_DEFAULT_URL, else the ttl=0 default
   bool allow_network = false;
   std::string rig = "HX_";
 };
@@ -52,10 +52,10 @@ bool publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg, i
 }
 
 struct StatusOptions {
-  double listen_s = 1.5;                   // without --wait-healthy: how long to collect reports
-  std::vector<std::string> wait_healthy;   // processes that must report HEALTHY
-  std::vector<std::string> accept_safe;    // ... or SAFE, for these
-  bool accept_degraded = false;            // ... or DEGRADED, for all
+  double listen_s = 1.5;                  // without --wait-healthy: how long to collect reports
+  std::vector<std::string> wait_healthy;  // processes that must report HEALTHY
+  std::vector<std::string> accept_safe;   // ... or SAFE, for these
+  bool accept_degraded = false;           // ... or DEGRADED, for all
   double timeout_s = 10.0;
   bool all_counters = false;
 };
@@ -64,7 +64,7 @@ struct StatusOptions {
 int run_status(CtlLink& link, const StatusOptions& options);
 
 struct WatchOptions {
-  double seconds = 0.0;                 // 0: until SIGINT/SIGTERM
+  double seconds = 0.0;  // 0: until SIGINT/SIGTERM
   std::string bridge_process = "bridge";
 };
 

@@ -151,8 +151,8 @@ void read_points_csv(const std::filesystem::path& file, TrajectoryRequest& reque
     std::string rest;
     if (!(fields >> t >> y)) {
       if (request.points_t_s.empty() && number == 1) continue;  // a header line
-      throw ParameterError("points-csv", file.string() + " line " + std::to_string(number) +
-                                             ": expected two numbers t_s,y_m");
+      throw ParameterError("points-csv",
+                           file.string() + " line " + std::to_string(number) + ": expected two numbers t_s,y_m");
     }
     if (fields >> rest) {
       throw ParameterError("points-csv", file.string() + " line " + std::to_string(number) +
@@ -169,8 +169,8 @@ trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t vers
   msg.utime = utime;
   msg.version = version;
   msg.shape = lookup(kShapes, "shape", request.shape);
-  const bool periodic = msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE ||
-                        msg.shape == trajectory_t::TRIANGLE;
+  const bool periodic =
+      msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE || msg.shape == trajectory_t::TRIANGLE;
   msg.amplitude_m = request.amplitude_m;
   msg.offset_m = request.offset_m;
   msg.frequency_Hz = periodic ? request.frequency_Hz : 0.0;

@@ -26,9 +26,9 @@ std::int8_t parse_mode(std::string_view name);
 control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime);
 
 struct GainsRequest {
-  double kp = 0.0;  // [-]
-  double ki = 0.0;  // [1/s]
-  double kd = 0.0;  // [s]
+  double kp = 0.0;        // [-]
+  double ki = 0.0;        // [1/s]
+  double kd = 0.0;        // [s]
   void validate() const;  // finite, >= 0
 };
 
@@ -45,12 +45,12 @@ void apply(const GainsRequest& gains, control_t& msg);
 void apply(const ExperimentRequest& experiment, control_t& msg);
 
 struct TrajectoryRequest {
-  std::string shape;          // cosine|sine|triangle|hold|points
+  std::string shape;  // cosine|sine|triangle|hold|points
   double amplitude_m = 0.0;
   double frequency_Hz = 1.0;  // > 0 for the periodic shapes
   double offset_m = 0.0;
   double phase_rad = 0.0;
-  double blend_s = 1.0;       // fade-in from the previous reference, >= 0
+  double blend_s = 1.0;                        // fade-in from the previous reference, >= 0
   std::vector<double> points_t_s, points_y_m;  // points: >= 1, t >= 0 strictly increasing
   void validate() const;
 };
@@ -66,11 +66,11 @@ void read_points_csv(const std::filesystem::path& file, TrajectoryRequest& reque
 trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t version, std::int64_t utime);
 
 struct ParamsRequest {
-  double c1 = 0.0;          // [m/V], > 0 (and <= 1, the contract's sanity bound)
-  double c2 = 0.0;          // [m/V^(1+c3)], >= 0
-  double c3 = 0.0;          // [-], 0 < c3 <= 50
-  double residual_m = 0.0;  // >= 0
-  std::int32_t version = 0; // >= 1
+  double c1 = 0.0;           // [m/V], > 0 (and <= 1, the contract's sanity bound)
+  double c2 = 0.0;           // [m/V^(1+c3)], >= 0
+  double c3 = 0.0;           // [-], 0 < c3 <= 50
+  double residual_m = 0.0;   // >= 0
+  std::int32_t version = 0;  // >= 1
   void validate() const;
 };
 

@@ -35,21 +35,24 @@ std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {
   const std::vector<BanningExperiment> experiments = plan_banning_experiments(plan);
   for (std::size_t i = 0; i < experiments.size(); ++i) {
     const BanningExperiment& e = experiments[i];
-    const std::string head = std::string(to_string(e.kind)) + format(" experiment: offset %g V, amplitude %g V", e.offset_V,
-                                                                     e.amplitude_V, 0, 0);
+    const std::string head = std::string(to_string(e.kind)) +
+                             format(" experiment: offset %g V, amplitude %g V", e.offset_V, e.amplitude_V, 0, 0);
     if (e.settle_periods > 0) {
-      steps.push_back({i, head + format(": settling, %g periods at %g Hz (%.3g s)", e.settle_periods,
-                                        e.settle_frequency_Hz, e.settle_periods / e.settle_frequency_Hz, 0),
+      steps.push_back({i,
+                       head + format(": settling, %g periods at %g Hz (%.3g s)", e.settle_periods,
+                                     e.settle_frequency_Hz, e.settle_periods / e.settle_frequency_Hz, 0),
                        sine("settle", e.offset_V, e.amplitude_V, e.settle_frequency_Hz, e.settle_periods)});
     }
-    steps.push_back({i, head + format(": measuring %g periods at %g Hz (%.3g s)", e.measure_periods, e.frequency_Hz,
-                                      e.measure_periods / e.frequency_Hz, 0),
+    steps.push_back({i,
+                     head + format(": measuring %g periods at %g Hz (%.3g s)", e.measure_periods, e.frequency_Hz,
+                                   e.measure_periods / e.frequency_Hz, 0),
                      sine("sine", e.offset_V, e.amplitude_V, e.frequency_Hz, e.measure_periods)});
   }
   for (const auto& s : steps) s.request.validate();
   if (steps.size() > ExperimentQueue::kCapacity + 1) {
-    throw ParameterError("banning-series", std::to_string(steps.size()) + " experiments (settling included) exceed what "
-                                           "the compensator queues (" +
+    throw ParameterError("banning-series", std::to_string(steps.size()) +
+                                               " experiments (settling included) exceed what "
+                                               "the compensator queues (" +
                                                std::to_string(ExperimentQueue::kCapacity + 1) +
                                                "): give fewer offsets, amplitudes or frequencies");
   }

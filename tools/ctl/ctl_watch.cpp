@@ -44,7 +44,8 @@ std::string format_watch_line(const WatchLine& l) {
                 static_cast<unsigned long long>(l.second.samples));
   out += buf;
   out += l.params_in_use ? "  params v" + std::to_string(*l.params_in_use) : std::string("  params --");
-  if (l.params_latest && l.params_latest != l.params_in_use) out += " (v" + std::to_string(*l.params_latest) + " published)";
+  if (l.params_latest && l.params_latest != l.params_in_use)
+    out += " (v" + std::to_string(*l.params_latest) + " published)";
   if (l.late_total) {
     std::snprintf(buf, sizeof buf, "  late %lld (+%lld)", static_cast<long long>(*l.late_total),
                   static_cast<long long>(l.late_delta.value_or(0)));
@@ -52,7 +53,8 @@ std::string format_watch_line(const WatchLine& l) {
   } else {
     out += "  late --";
   }
-  out += l.second.buffer_min_ticks ? "  buf min " + std::to_string(*l.second.buffer_min_ticks) : std::string("  buf min --");
+  out += l.second.buffer_min_ticks ? "  buf min " + std::to_string(*l.second.buffer_min_ticks)
+                                   : std::string("  buf min --");
   out += l.bridge_state.empty() ? "  bridge --" : "  bridge " + l.bridge_state;
   return out;
 }

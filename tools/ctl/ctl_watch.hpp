@@ -30,11 +30,11 @@ struct WatchSecond {
 struct WatchLine {
   double elapsed_s = 0.0;
   WatchSecond second;
-  std::optional<std::int32_t> params_in_use;   // from the commands
-  std::optional<std::int32_t> params_latest;   // last HX_PARAMS version seen
-  std::optional<std::int64_t> late_total;      // bridge status
-  std::optional<std::int64_t> late_delta;      // since the previous bridge report
-  std::string bridge_state;                    // "" when no bridge status yet
+  std::optional<std::int32_t> params_in_use;  // from the commands
+  std::optional<std::int32_t> params_latest;  // last HX_PARAMS version seen
+  std::optional<std::int64_t> late_total;     // bridge status
+  std::optional<std::int64_t> late_delta;     // since the previous bridge report
+  std::string bridge_state;                   // "" when no bridge status yet
 };
 
 // " 12 s  rms   27.9 nm  max   80.1 nm  ticks 10000/10000  params v3  late 0 (+0)  buf min 212  bridge HEALTHY"

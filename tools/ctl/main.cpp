@@ -98,11 +98,12 @@ int send_trajectory(const Options& o) {
     std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().trajectory.c_str());
     return 1;
   }
-  std::printf("hystloop-ctl: sent trajectory %s amplitude %g m frequency %g Hz offset %g m blend %g s%s on %s "
-              "(version %lld)\n",
-              request.shape.c_str(), msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s,
-              msg.n_points > 0 ? (" with " + std::to_string(msg.n_points) + " points").c_str() : "",
-              link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
+  std::printf(
+      "hystloop-ctl: sent trajectory %s amplitude %g m frequency %g Hz offset %g m blend %g s%s on %s "
+      "(version %lld)\n",
+      request.shape.c_str(), msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s,
+      msg.n_points > 0 ? (" with " + std::to_string(msg.n_points) + " points").c_str() : "",
+      link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
   return 0;
 }
 
@@ -146,11 +147,13 @@ CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, 
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
-               "experiments, trajectories, parameters, live tracking error)"};
+  CLI::App app{
+      "hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
+      "experiments, trajectories, parameters, live tracking error)"};
   app.require_subcommand(1);
   app.fallthrough();
-  app.add_option("--lcm-url", o.link.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
+  app.add_option("--lcm-url", o.link.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
   app.add_flag("--allow-network", o.link.allow_network, "Accept an LCM URL whose packets can leave this host");
   app.add_option("--rig", o.link.rig, "Channel prefix of the rig")->capture_default_str();
   std::string key_file, keygen_out;
@@ -164,7 +167,8 @@ int main(int argc, char** argv) {
   CLI::App* status = app.add_subcommand("status", "Print the latest HX_STATUS of each process, or wait until healthy");
   status->add_option("--wait-healthy", o.status.wait_healthy,
                      "Exit 0 as soon as each of these processes reports HEALTHY; 1 after --timeout");
-  status->add_option("--accept-safe", o.status.accept_safe, "Also accept SAFE from this process (e.g. an unarmed bridge)");
+  status->add_option("--accept-safe", o.status.accept_safe,
+                     "Also accept SAFE from this process (e.g. an unarmed bridge)");
   status->add_flag("--accept-degraded", o.status.accept_degraded,
                    "Also accept DEGRADED (serving, with a complaint the status detail names)");
   status->add_option("--timeout", o.status.timeout_s, "How long --wait-healthy waits [s]")->capture_default_str();
@@ -173,8 +177,9 @@ int main(int argc, char** argv) {
   status->add_flag("--counters", o.status.all_counters, "Also print every named counter");
 
   ConfigGetOptions config_get_options;
-  CLI::App* config_get = app.add_subcommand("config-get", "Print a YAML file's value: a scalar, a list's elements or a "
-                                                          "map's keys, one per line (no LCM)");
+  CLI::App* config_get = app.add_subcommand("config-get",
+                                            "Print a YAML file's value: a scalar, a list's elements or a "
+                                            "map's keys, one per line (no LCM)");
   config_get->add_option("file", config_get_options.file, "YAML file (e.g. deploy/rig.yaml)")->required();
   config_get->add_option("key", config_get_options.key, "Dotted key path (e.g. hosts.stage-pc.services)")->required();
   config_get->add_option("--default", config_get_options.default_value, "Print this when the key is absent");
@@ -209,16 +214,19 @@ int main(int argc, char** argv) {
   auto* duration = experiment->add_option("--duration", o.experiment.duration_s,
                                           "Duration [s], > 0, rounded up to whole periods (--mem-paper: default 2)");
   auto* offset = experiment->add_option("--offset", o.experiment.offset_V, "Offset [V]")->capture_default_str();
-  auto* kind = experiment->add_option("--kind", o.experiment.kind,
-                                      "sine, or settle (the same sine, marked for identification to skip)")
+  auto* kind = experiment
+                   ->add_option("--kind", o.experiment.kind,
+                                "sine, or settle (the same sine, marked for identification to skip)")
                    ->capture_default_str();
-  auto* mem_paper_exp = experiment->add_flag("--mem-paper", o.experiment_mem_paper,
-                                             "The MEM paper's identification input u = 250 sin(20 pi t) V")
+  auto* mem_paper_exp = experiment
+                            ->add_flag("--mem-paper", o.experiment_mem_paper,
+                                       "The MEM paper's identification input u = 250 sin(20 pi t) V")
                             ->excludes(amplitude, frequency, offset, kind);
-  auto* series = experiment->add_flag("--banning-series", o.banning_series,
-                                      "Banning et al.'s series: offsets, small and large amplitudes (each settled "
-                                      "at --settle-frequency, then measured at --hysteresis-frequency), and the "
-                                      "frequency response; fit the log with hystloop-identify --model banning")
+  auto* series = experiment
+                     ->add_flag("--banning-series", o.banning_series,
+                                "Banning et al.'s series: offsets, small and large amplitudes (each settled "
+                                "at --settle-frequency, then measured at --hysteresis-frequency), and the "
+                                "frequency response; fit the log with hystloop-identify --model banning")
                      ->excludes(amplitude, frequency, duration, offset, kind, mem_paper_exp);
   auto plan_option = [&](const char* name, auto& value, const char* help) {
     experiment->add_option(name, value, help)->capture_default_str()->needs(series);
@@ -235,8 +243,11 @@ int main(int argc, char** argv) {
               "series: ... and at least this much input path, 4 x amplitude per cycle [V]");
   plan_option("--frequencies", o.plan.frequencies_Hz, "series: frequency-response points (k, c) [Hz]");
   plan_option("--frequency-amplitude", o.plan.frequency_amplitude_V, "series: their amplitude [V]");
-  experiment->add_flag("--list", o.series_list, "series: print the steps and their duration, send nothing")->needs(series);
-  experiment->add_flag("--no-wait", [&](std::int64_t) { o.series.wait = false; }, "series: send and return at once")
+  experiment->add_flag("--list", o.series_list, "series: print the steps and their duration, send nothing")
+      ->needs(series);
+  experiment
+      ->add_flag(
+          "--no-wait", [&](std::int64_t) { o.series.wait = false; }, "series: send and return at once")
       ->needs(series);
   experiment->add_option("--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")
       ->capture_default_str()
@@ -252,7 +263,8 @@ int main(int argc, char** argv) {
   trajectory->add_option("--phase", o.trajectory.phase_rad, "Phase [rad]")->capture_default_str();
   trajectory->add_option("--blend", o.trajectory.blend_s, "Fade-in from the current reference [s]")
       ->capture_default_str();
-  trajectory->add_option("--points-csv", o.points_csv, "points: CSV of t_s,y_m rows (times from the start, increasing)");
+  trajectory->add_option("--points-csv", o.points_csv,
+                         "points: CSV of t_s,y_m rows (times from the start, increasing)");
   trajectory->add_flag("--mem-paper", o.mem_paper, "The MEM paper's y_d = -1.6 um cos(2 pi t) (with --blend)")
       ->excludes("--shape");
 
@@ -267,8 +279,9 @@ int main(int argc, char** argv) {
   params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
       ->capture_default_str();
 
-  CLI::App* watch = app.add_subcommand("watch", "Print the tracking error (from HX_SENSOR), params version, late "
-                                                "commands and the bridge's lowest buffer depth once a second");
+  CLI::App* watch = app.add_subcommand("watch",
+                                       "Print the tracking error (from HX_SENSOR), params version, late "
+                                       "commands and the bridge's lowest buffer depth once a second");
   watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
   watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
       ->capture_default_str();
@@ -279,9 +292,10 @@ int main(int argc, char** argv) {
     if (*config_get) return run_config_get(config_get_options);
     if (*keygen) {
       write_rig_key(keygen_out, generate_rig_key(), keygen_force);
-      std::printf("wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
-                  "auth.key_file in every service's config\n",
-                  keygen_out.c_str());
+      std::printf(
+          "wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
+          "auth.key_file in every service's config\n",
+          keygen_out.c_str());
       return 0;
     }
     if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
@@ -316,8 +330,9 @@ int main(int argc, char** argv) {
       if (o.experiment_mem_paper) {
         o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
       } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
-        throw ParameterError("experiment", "give --amplitude, --frequency and --duration, or --mem-paper, or "
-                                           "--banning-series");
+        throw ParameterError("experiment",
+                             "give --amplitude, --frequency and --duration, or --mem-paper, or "
+                             "--banning-series");
       }
       o.experiment.validate();
       return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT",

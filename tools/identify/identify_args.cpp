@@ -37,12 +37,16 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   app.add_option("--min-snr", args.min_snr, "MEM derivative form: keep points with at least this SNR")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--operators", args.operators, "PI: number of play operators")->check(CLI::Range(1, 32))->capture_default_str();
-  app.add_option("--katalenic-degree", args.katalenic_degree, "Katalenic: output shaping polynomial degree (1 = linear)")
+  app.add_option("--operators", args.operators, "PI: number of play operators")
+      ->check(CLI::Range(1, 32))
+      ->capture_default_str();
+  app.add_option("--katalenic-degree", args.katalenic_degree,
+                 "Katalenic: output shaping polynomial degree (1 = linear)")
       ->check(CLI::Range(1, 7))
       ->capture_default_str();
   auto* logs = app.add_option_group("LCM logs", "reading HX_SENSOR from LCM event logs");
-  logs->add_flag("--log", args.log, "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
+  logs->add_flag("--log", args.log,
+                 "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
   logs->add_option("--rig", args.rig, "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>PARAMS")
       ->capture_default_str();
   logs->add_option("--dt", args.dt_s, "tick period [s]: t = (seq - first seq) * dt")->capture_default_str();
@@ -74,12 +78,14 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                   "parameter set version (default: 1 + the highest heard on <rig>PARAMS / <rig>COMMAND, at least 2)");
   pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
   pub->add_option("--lcm-url", args.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
-  pub->add_flag("--allow-network", args.allow_network, "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
+  pub->add_flag("--allow-network", args.allow_network,
+                "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
   pub->add_option("--key-file", args.key_file, "the rig key (auth.key_file of the services): sign the published set");
   auto* bounds = app.add_option_group("bounds", "memory and progress of long fits");
-  bounds->add_option("--max-samples", args.max_samples,
-                     "refuse more samples than this (after --decimate): the fit holds its problem in memory, "
-                     "~150 (mem) to ~300 (auto) bytes per sample")
+  bounds
+      ->add_option("--max-samples", args.max_samples,
+                   "refuse more samples than this (after --decimate): the fit holds its problem in memory, "
+                   "~150 (mem) to ~300 (auto) bytes per sample")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   bounds->add_option("--decimate", args.decimate, "keep every K-th sample (rate-independent models lose little)")

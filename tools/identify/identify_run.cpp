@@ -50,7 +50,9 @@ class ProgressStage {
   ProgressStage& operator=(const ProgressStage&) = delete;
 };
 
-std::string on_samples(const std::string& what, std::size_t n) { return what + " on " + std::to_string(n) + " samples"; }
+std::string on_samples(const std::string& what, std::size_t n) {
+  return what + " on " + std::to_string(n) + " samples";
+}
 
 int refuse(FitStatus status, const std::string& reason) {
   std::cerr << "hystloop-identify: no fit (" << to_string(status) << "): " << reason << "\n";
@@ -131,8 +133,10 @@ int fit_pi_and_emit(const IdentifyArgs& args, const SampleTable& s) {
   }
   if (!r.ok()) return refuse(r.status, r.reason);
   std::printf("Prandtl-Ishlinskii: %zu plays, offset %.6g m\n", r.weights.size(), r.offset_m);
-  for (std::size_t i = 0; i < r.weights.size(); ++i) std::printf("  r = %8.3f V  w = %.6g m/V\n", r.thresholds_V[i], r.weights[i]);
-  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used, r.solve_time_s * 1e3);
+  for (std::size_t i = 0; i < r.weights.size(); ++i)
+    std::printf("  r = %8.3f V  w = %.6g m/V\n", r.thresholds_V[i], r.weights[i]);
+  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
+              r.solve_time_s * 1e3);
   try {
     return emit(args, to_yaml(to_pi_params(r)));
   } catch (const ParameterError& e) {
@@ -151,7 +155,8 @@ int fit_katalenic_and_emit(const IdentifyArgs& args, const SampleTable& s) {
   if (!r.ok()) return refuse(r.status, r.reason);
   std::printf("Katalenic: k1 = %.6g V, k2 = %.6g 1/V, output gain %.6g m/V\n", r.params.k1, r.params.k2,
               r.params.output_shaping.gain);
-  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used, r.solve_time_s * 1e3);
+  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
+              r.solve_time_s * 1e3);
   return emit(args, to_yaml(r.params));
 }
 
@@ -189,8 +194,8 @@ int fit_auto_and_emit(const IdentifyArgs& args, const SampleTable& s) {
   for (std::size_t i = 0; i < sel.ranking.size(); ++i) {
     const auto& r = sel.ranking[i];
     std::printf("%4zu  %-10s  %-15s  %10.4g  %13.4g  %8.1f%s%s\n", i + 1, std::string(to_string(r.kind)).c_str(),
-                std::string(to_string(r.status)).c_str(), r.train_rms_m * 1e9, r.holdout_rms_m * 1e9, r.fit_time_s * 1e3,
-                r.reason.empty() ? "" : "  ", r.reason.c_str());
+                std::string(to_string(r.status)).c_str(), r.train_rms_m * 1e9, r.holdout_rms_m * 1e9,
+                r.fit_time_s * 1e3, r.reason.empty() ? "" : "  ", r.reason.c_str());
   }
   if (!sel.ok()) return refuse(sel.status, sel.reason);
   std::printf("held out from sample %zu of %zu; best: %s\n", sel.split_index, s.u.size(),
@@ -236,7 +241,8 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
     if (!p.used) {
       std::printf("%10zu  skipped: %s\n", i, p.note.c_str());
     } else if (p.magnitude_experiment) {
-      std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V, p.frequency_Hz, p.magnitude);
+      std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V, p.frequency_Hz,
+                  p.magnitude);
     } else {
       std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V\n", i,
                   p.offset_V, p.amplitude_V, p.frequency_Hz, p.features.y_centre * 1e9, p.features.slope * 1e9,
@@ -244,7 +250,8 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
     }
   }
   if (!r.ok()) return refuse(r.status, r.reason);
-  std::printf("Banning: a = %.6g m/V, b = %.6g m/V, alpha = %.6g 1/V\n", r.hysteresis.a, r.hysteresis.b, r.hysteresis.alpha);
+  std::printf("Banning: a = %.6g m/V, b = %.6g m/V, alpha = %.6g 1/V\n", r.hysteresis.a, r.hysteresis.b,
+              r.hysteresis.alpha);
   if (r.stage_identified) {
     std::printf("         k = %.6g 1/s^2, c = %.6g 1/s (f_n = %.1f Hz, zeta = %.4f)\n", r.stage.k, r.stage.c,
                 r.stage.natural_frequency() / (2.0 * 3.141592653589793), r.stage.damping_ratio());
@@ -308,9 +315,11 @@ std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
     // Late commands and skipped ticks do not spoil a rate-independent fit; these do.
     std::string why;
     if (!e.complete) why = e.problem;
-    if (e.safe_state > 0) why = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
+    if (e.safe_state > 0)
+      why = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
     if (e.sensor_fault > 0) why = std::to_string(e.sensor_fault) + " sample(s) flagged SENSOR_FAULT";
-    if (!why.empty()) throw SampleLogError("--experiment " + std::to_string(*args.experiment) + " cannot be used: " + why);
+    if (!why.empty())
+      throw SampleLogError("--experiment " + std::to_string(*args.experiment) + " cannot be used: " + why);
     std::cout << "fitting experiment " << *args.experiment << ": " << e.samples.t.size()
               << " samples (for this rate-independent fit, late commands and skipped ticks do no harm)\n";
     tables.push_back(std::move(e.samples));

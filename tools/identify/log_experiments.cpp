@@ -42,10 +42,10 @@ struct Sample {  // one sensor tick
 };
 
 struct Record {
-  std::vector<Request> starts;        // log order, distinct ids, valid
-  std::vector<std::int64_t> stops;    // log times of STOP_EXPERIMENT requests
-  std::vector<Command> commands;      // by seq, distinct
-  std::vector<Sample> samples;        // by seq, distinct
+  std::vector<Request> starts;      // log order, distinct ids, valid
+  std::vector<std::int64_t> stops;  // log times of STOP_EXPERIMENT requests
+  std::vector<Command> commands;    // by seq, distinct
+  std::vector<Sample> samples;      // by seq, distinct
 };
 
 std::string number(double v) {
@@ -91,10 +91,10 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
         }
         if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) continue;
         try {  // what the compensator accepts (CompensatorService::on_control)
-          r.starts.push_back({event->timestamp, control.request_id,
-                              make_experiment_spec(control.experiment, control.experiment_amplitude_V,
-                                                   control.experiment_offset_V, control.experiment_frequency_Hz,
-                                                   control.experiment_duration_s)});
+          r.starts.push_back(
+              {event->timestamp, control.request_id,
+               make_experiment_spec(control.experiment, control.experiment_amplitude_V, control.experiment_offset_V,
+                                    control.experiment_frequency_Hz, control.experiment_duration_s)});
         } catch (const ParameterError& e) {
           out.notes.push_back("request " + std::to_string(control.request_id) +
                               ": refused by the compensator's rules: " + e.what());
@@ -198,8 +198,10 @@ void collect_samples(const std::vector<Sample>& samples, const ExperimentLogOpti
   } else if (e.sensor_fault > 0) {
     e.problem = std::to_string(e.sensor_fault) + " sample(s) flagged SENSOR_FAULT";
   } else if (!loop && static_cast<double>(e.not_as_commanded) > o.max_not_as_commanded * ticks) {
-    e.problem = std::to_string(e.not_as_commanded) + " sample(s) not applied as commanded (late, saturated or "
-                "slew-limited), more than " + number(o.max_not_as_commanded * 100.0) + " %";
+    e.problem = std::to_string(e.not_as_commanded) +
+                " sample(s) not applied as commanded (late, saturated or "
+                "slew-limited), more than " +
+                number(o.max_not_as_commanded * 100.0) + " %";
   }
 }
 
@@ -257,8 +259,8 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
         e.problem = mismatch;
       } else if (const auto m = first_mismatch(r.commands, command_index, e.spec, start_s, e.begin_tick,
                                                std::min(e.end_tick, b.end_max), o.dt_s)) {
-        mismatch = "the commands differ from the requested sines from tick " + std::to_string(m->tick) +
-                   " (expected " + number(m->expected_V) + " V, commanded " + number(m->commanded_V) +
+        mismatch = "the commands differ from the requested sines from tick " + std::to_string(m->tick) + " (expected " +
+                   number(m->expected_V) + " V, commanded " + number(m->commanded_V) +
                    " V): a request is missing from the log";
         e.problem = mismatch;
       } else if (!e.complete) {

@@ -38,11 +38,11 @@ struct ExperimentLogOptions {
   std::string command_channel = "HX_COMMAND";
   std::string sensor_channel = "HX_SENSOR";
   std::string compensator_process = "compensator";  // requests addressed to it (or to everyone) count
-  double dt_s = 1e-4;                                // the rig's tick [s]
-  double max_not_as_commanded = 0.02;                // fraction of a fast experiment's samples, in [0, 1]
-  double max_missing = 0.01;                         // fraction of a slow experiment's ticks, in [0, 1]
-  double rate_independent_below_Hz = 10.0;           // BanningFitOptions::frequency_threshold_Hz
-  void validate() const;                             // throws ParameterError naming the field
+  double dt_s = 1e-4;                               // the rig's tick [s]
+  double max_not_as_commanded = 0.02;               // fraction of a fast experiment's samples, in [0, 1]
+  double max_missing = 0.01;                        // fraction of a slow experiment's ticks, in [0, 1]
+  double rate_independent_below_Hz = 10.0;          // BanningFitOptions::frequency_threshold_Hz
+  void validate() const;                            // throws ParameterError naming the field
 };
 
 struct LoggedExperiment {
@@ -50,13 +50,13 @@ struct LoggedExperiment {
   ExperimentSpec spec;          // as requested; spec.settle for "settle"
   std::int64_t begin_tick = 0;  // [begin, end): the command ticks of this experiment
   std::int64_t end_tick = 0;
-  bool complete = false;        // ran to its last period
-  std::size_t missing = 0;      // ticks without a sample in the log
-  std::size_t safe_state = 0;   // samples flagged SAFE_STATE
-  std::size_t sensor_fault = 0; // ... SENSOR_FAULT
+  bool complete = false;             // ran to its last period
+  std::size_t missing = 0;           // ticks without a sample in the log
+  std::size_t safe_state = 0;        // samples flagged SAFE_STATE
+  std::size_t sensor_fault = 0;      // ... SENSOR_FAULT
   std::size_t not_as_commanded = 0;  // ... LATE_COMMAND, SATURATED or SLEW_LIMITED
-  std::string problem;          // why it cannot be used; empty = usable
-  SampleTable samples;          // t = (seq - begin_tick) * dt [s], u = applied [V], y [m]
+  std::string problem;               // why it cannot be used; empty = usable
+  SampleTable samples;               // t = (seq - begin_tick) * dt [s], u = applied [V], y [m]
   bool usable() const noexcept { return problem.empty(); }
 };
 
@@ -64,8 +64,8 @@ struct LoggedExperiments {
   std::vector<LoggedExperiment> experiments;  // in the order they ran
   std::vector<std::string> notes;             // what else was found: dropped requests, unexplained ticks
   std::size_t files = 0;
-  std::size_t requests = 0;                   // distinct START_EXPERIMENT requests for the compensator
-  std::size_t blocks = 0;                     // runs of EXPERIMENT command ticks
+  std::size_t requests = 0;  // distinct START_EXPERIMENT requests for the compensator
+  std::size_t blocks = 0;    // runs of EXPERIMENT command ticks
 };
 
 // Reads the files in order as one record. Throws SampleLogError (log_samples.hpp) for a file

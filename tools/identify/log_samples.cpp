@@ -38,8 +38,8 @@ class RecordBuilder {
   void add(const std::string& file, std::int64_t eventnum, const sensor_block_t& block) {
     for_each_tick(block, [&](const SensorTick& s) {
       if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
-      throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) + "): " +
-                           (std::isfinite(s.u_V) ? "y_m" : "u_V") + " is not finite (u_V = " + number(s.u_V) +
+      throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) +
+                           "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") + " is not finite (u_V = " + number(s.u_V) +
                            ", y_m = " + number(s.y_m) + ")");
     });
     if (check_message(block) != Verdict::kOk) return void(++out_.undecodable);
@@ -66,9 +66,8 @@ class RecordBuilder {
       first_seq_ = s.seq;
       first_utime_ = s.utime;
     }
-    const double t = options_.time_base == LogTimeBase::seq
-                         ? static_cast<double>(s.seq - first_seq_) * options_.dt_s
-                         : static_cast<double>(s.utime - first_utime_) * 1e-6;
+    const double t = options_.time_base == LogTimeBase::seq ? static_cast<double>(s.seq - first_seq_) * options_.dt_s
+                                                            : static_cast<double>(s.utime - first_utime_) * 1e-6;
     const std::int64_t before = previous_seq_.value_or(s.seq - 1);
     previous_seq_ = s.seq;
     if ((options_.from_s && t < *options_.from_s) || (options_.to_s && t >= *options_.to_s)) {
@@ -116,9 +115,7 @@ void LogReadOptions::validate() const {
   }
 }
 
-bool looks_like_lcm_log(const std::string& path) {
-  return std::filesystem::path(path).extension() == ".lcmlog";
-}
+bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
 
 LogSamples read_sample_logs(const std::vector<std::string>& files, const LogReadOptions& options) {
   options.validate();

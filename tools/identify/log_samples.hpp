@@ -46,7 +46,7 @@ enum class LogTimeBase { seq, utime };
 struct LogReadOptions {
   std::string sensor_channel = "HX_SENSOR";  // rig prefix + "SENSOR"
   LogTimeBase time_base = LogTimeBase::seq;
-  double dt_s = 1e-4;                        // tick period with LogTimeBase::seq [s]
+  double dt_s = 1e-4;  // tick period with LogTimeBase::seq [s]
   // Time range [from, to) relative to the first sample of the record [s]; empty = open.
   std::optional<double> from_s;
   std::optional<double> to_s;
@@ -61,19 +61,19 @@ struct SeqGap {
 };
 
 struct LogSamples {
-  SampleTable table;                 // the samples kept (t relative to the record's first sample)
+  SampleTable table;  // the samples kept (t relative to the record's first sample)
   std::size_t files = 0;
-  std::size_t events = 0;            // events of any channel read
-  std::size_t sensor_events = 0;     // events (blocks) on the sensor channel
-  std::size_t sensor_ticks = 0;      // ticks of the blocks that decoded and met the contract
-  std::size_t outside_range = 0;     // valid ticks outside [from, to)
-  std::size_t safe_state = 0;        // skipped ticks: flagged SAFE_STATE
-  std::size_t sensor_fault = 0;      // skipped ticks: flagged SENSOR_FAULT (and not SAFE_STATE)
-  std::size_t duplicates = 0;        // skipped ticks: the same seq again
-  std::size_t undecodable = 0;       // skipped events: not a sensor_block_t, or out of contract
-  std::size_t gaps = 0;              // seq jumps among the samples in range
-  std::size_t missing = 0;           // ticks missing in those jumps
-  std::vector<SeqGap> first_gaps;    // the first few, for the report
+  std::size_t events = 0;                           // events of any channel read
+  std::size_t sensor_events = 0;                    // events (blocks) on the sensor channel
+  std::size_t sensor_ticks = 0;                     // ticks of the blocks that decoded and met the contract
+  std::size_t outside_range = 0;                    // valid ticks outside [from, to)
+  std::size_t safe_state = 0;                       // skipped ticks: flagged SAFE_STATE
+  std::size_t sensor_fault = 0;                     // skipped ticks: flagged SENSOR_FAULT (and not SAFE_STATE)
+  std::size_t duplicates = 0;                       // skipped ticks: the same seq again
+  std::size_t undecodable = 0;                      // skipped events: not a sensor_block_t, or out of contract
+  std::size_t gaps = 0;                             // seq jumps among the samples in range
+  std::size_t missing = 0;                          // ticks missing in those jumps
+  std::vector<SeqGap> first_gaps;                   // the first few, for the report
   std::optional<std::int64_t> first_seq, last_seq;  // of the samples kept
 
   double window_s() const noexcept { return table.t.size() < 2 ? 0.0 : table.t.back() - table.t.front(); }

@@ -28,8 +28,9 @@
 
 int main(int argc, char** argv) {
   using namespace hystloop;
-  CLI::App app{"Fit a hysteresis model to recorded samples: a CSV with a header row t,u,y (s, V, m), or LCM event logs "
-               "(*.lcmlog or --log: the rig's HX_SENSOR samples; rotated files in recording order)."};
+  CLI::App app{
+      "Fit a hysteresis model to recorded samples: a CSV with a header row t,u,y (s, V, m), or LCM event logs "
+      "(*.lcmlog or --log: the rig's HX_SENSOR samples; rotated files in recording order)."};
   IdentifyArgs args;
   add_identify_options(app, args);
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;

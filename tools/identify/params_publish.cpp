@@ -57,8 +57,8 @@ ParamsLink::ParamsLink(const PublishOptions& options)
 
 std::int32_t ParamsLink::highest_version_heard() {
   std::int32_t highest = 0;
-  Subscription<mem_params_t> params(*lcm_, channels_.params,
-                                    [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
+  Subscription<mem_params_t> params(
+      *lcm_, channels_.params, [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
   Subscription<command_block_t>::Options queue;
   queue.queue_capacity = 4'000;  // blocks of the whole listening time
   Subscription<command_block_t> commands(
@@ -68,8 +68,8 @@ std::int32_t ParamsLink::highest_version_heard() {
       },
       queue);
   using Clock = std::chrono::steady_clock;
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(options_.listen_s));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.listen_s));
   for (auto now = Clock::now(); now < deadline; now = Clock::now()) {
     const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now);
     if (handle_pending(*lcm_, std::min(left, std::chrono::microseconds(50'000)), 1024) < 0) break;

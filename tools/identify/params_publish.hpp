@@ -2,8 +2,8 @@
 // hystloop-identify --publish: a fitted MEM set sent on the rig's HX_PARAMS as mem_params_t,
 // so that a running compensator picks it up at its next reversal. Each run publishes with its
 // own publisher_id (process_publisher_id()): the compensator orders versions per publisher, so a
-// new run is never refused as stale, whatever versions others sent. The link is opened before the fit, so a refused URL or a
-// missing multicast route fails fast; the version is looked up after the fit, so it is fresh.
+// new run is never refused as stale, whatever versions others sent. The link is opened before the fit, so a refused URL
+// or a missing multicast route fails fast; the version is looked up after the fit, so it is fresh.
 
 #include <chrono>
 #include <cstdint>
@@ -20,12 +20,12 @@
 namespace hystloop {
 
 struct PublishOptions {
-  std::string lcm_url;                     // empty: $LCM_DEFAULT_URL, else the ttl=0 default
-  bool allow_network = false;              // needed for a URL whose packets leave the host
+  std::string lcm_url;         // empty: $LCM_DEFAULT_URL, else the ttl=0 default
+  bool allow_network = false;  // needed for a URL whose packets leave the host
   std::string rig = std::string(kDefaultRigPrefix);
-  std::optional<std::int32_t> version;     // empty: next_params_version(highest heard)
-  double listen_s = 0.5;                   // how long to listen for the version in use [s]
-  int repeats = 3;                         // UDP may drop one; receivers dedupe by version
+  std::optional<std::int32_t> version;  // empty: next_params_version(highest heard)
+  double listen_s = 0.5;                // how long to listen for the version in use [s]
+  int repeats = 3;                      // UDP may drop one; receivers dedupe by version
   std::chrono::milliseconds gap{10};
 
   // Throws ParameterError naming the field ("version", "listen_s", "repeats", "rig.prefix").

@@ -48,8 +48,8 @@ std::optional<std::string> over_sample_budget(std::size_t samples, std::size_t m
   return std::to_string(samples) + " samples" + (stride > 1 ? " after --decimate " + std::to_string(stride) : "") +
          " exceed --max-samples " + std::to_string(max_samples) +
          " (the fit holds its problem in memory, ~150-300 bytes per sample): fit a range (--from/--to on a log), "
-         "keep every K-th sample with --decimate " + std::to_string(suggest) +
-         ", or raise --max-samples if the memory is there";
+         "keep every K-th sample with --decimate " +
+         std::to_string(suggest) + ", or raise --max-samples if the memory is there";
 }
 
 }  // namespace hystloop

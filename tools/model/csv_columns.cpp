@@ -1,6 +1,5 @@
 #include "csv_columns.hpp"
 
-
 #include "param_table.hpp"
 
 namespace hystloop::model_tool {
@@ -69,8 +68,8 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
 
     if (header.empty()) {
       if (all_numbers(fields)) {
-        throw CsvError(file, line_no, "missing header row: expected column names '" + expected + "', got '" +
-                                          std::string(line) + "'");
+        throw CsvError(file, line_no,
+                       "missing header row: expected column names '" + expected + "', got '" + std::string(line) + "'");
       }
       for (const auto f : fields) header.push_back(unquote(f));
       for (std::size_t i = 0; i < header.size(); ++i) {
@@ -92,8 +91,9 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
         index[c] = found;
       }
       if (!missing.empty()) {
-        throw CsvError(file, line_no, "header '" + std::string(line) + "' lacks column " + missing + " (expected '" +
-                                          expected + "', SI units)");
+        throw CsvError(
+            file, line_no,
+            "header '" + std::string(line) + "' lacks column " + missing + " (expected '" + expected + "', SI units)");
       }
       for (const auto& h : header) {
         bool used = false;
@@ -105,8 +105,9 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
     }
 
     if (fields.size() != header.size()) {
-      throw CsvError(file, line_no, std::to_string(fields.size()) + " field" + (fields.size() == 1 ? "" : "s") +
-                                        ", the header has " + std::to_string(header.size()));
+      throw CsvError(file, line_no,
+                     std::to_string(fields.size()) + " field" + (fields.size() == 1 ? "" : "s") + ", the header has " +
+                         std::to_string(header.size()));
     }
     for (std::size_t c = 0; c < required.size(); ++c) {
       const std::string_view text = fields[index[c]];
@@ -121,8 +122,9 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
   }
   if (in.bad()) throw CsvError(file, line_no, "read error");
   if (header.empty()) {
-    throw CsvError(file, line_no == 0 ? 1 : line_no,
-                   std::string(saw_any ? "no header row" : "empty file") + ": expected a header row '" + expected + "'");
+    throw CsvError(
+        file, line_no == 0 ? 1 : line_no,
+        std::string(saw_any ? "no header row" : "empty file") + ": expected a header row '" + expected + "'");
   }
   if (table.rows() == 0) throw CsvError(file, table.header_line, "no data rows after the header");
   return table;
@@ -132,9 +134,9 @@ void require_increasing(const CsvColumns& table, std::size_t column, const std::
   const std::vector<double>& v = table.values[column];
   for (std::size_t k = 1; k < v.size(); ++k) {
     if (!(v[k] > v[k - 1])) {
-      throw CsvError(file, table.lines[k], "column '" + table.names[column] + "': must increase, got " +
-                                               format_number(v[k]) + " after " + format_number(v[k - 1]) +
-                                               " (line " + std::to_string(table.lines[k - 1]) + ")");
+      throw CsvError(file, table.lines[k],
+                     "column '" + table.names[column] + "': must increase, got " + format_number(v[k]) + " after " +
+                         format_number(v[k - 1]) + " (line " + std::to_string(table.lines[k - 1]) + ")");
     }
   }
 }

@@ -84,8 +84,8 @@ int run(Args& args) {
     std::vector<std::string> names;
     for (const ModelEntry* m : model_registry()) names.emplace_back(m->name());
     const std::string guess = closest_name(args.model, names);
-    return refuse("--model: unknown model '" + args.model + "'" + (guess.empty() ? "" : "; did you mean '" + guess + "'?") +
-                  " (models: " + model_names() + ")");
+    return refuse("--model: unknown model '" + args.model + "'" +
+                  (guess.empty() ? "" : "; did you mean '" + guess + "'?") + " (models: " + model_names() + ")");
   }
   if (args.inverse && !entry->has_inverse()) {
     return refuse("--inverse: model " + args.model +
@@ -122,8 +122,9 @@ int run(Args& args) {
       list += c;
       list += '\'';
     }
-    std::cerr << kTool << ": " << name << ":" << table.header_line << ": ignoring column" << (table.ignored.size() > 1 ? "s " : " ")
-              << list << " (reads '" << columns[0] << "," << columns[1] << "')\n";
+    std::cerr << kTool << ": " << name << ":" << table.header_line << ": ignoring column"
+              << (table.ignored.size() > 1 ? "s " : " ") << list << " (reads '" << columns[0] << "," << columns[1]
+              << "')\n";
   }
 
   const std::vector<double>& t = table.values[0];
@@ -159,7 +160,8 @@ int run(Args& args) {
 int main(int argc, char** argv) {
   CLI::App app{
       "Run a hysteresis model over a CSV file (header row, comma separated, SI units).\n"
-      "--forward reads columns t,u [s, V] and writes t,u,y [m]; --inverse reads t,y_ref [s, m] and writes t,y_ref,u [V].\n"
+      "--forward reads columns t,u [s, V] and writes t,u,y [m]; --inverse reads t,y_ref [s, m] and writes t,y_ref,u "
+      "[V].\n"
       "The first row sets the initial state (the model's reset at that point); other columns are ignored."};
   app.footer(models_help() +
              "\nExamples:\n"

@@ -33,9 +33,9 @@ struct MemDescriptor {
 // PI is given either by its operators (weights, optionally thresholds) or by a size and range,
 // with weights then matched to the default MEM (pi_params_from_mem): the project's PI baseline.
 struct PiSettings {
-  std::size_t n = 15;       // operators
+  std::size_t n = 15;  // operators
   bool n_given = false;
-  double u_max = 250.0;     // [V] input amplitude the even thresholds span: r_i = i u_max / n
+  double u_max = 250.0;            // [V] input amplitude the even thresholds span: r_i = i u_max / n
   std::vector<double> thresholds;  // [V]
   std::vector<double> weights;     // [m/V]
 };

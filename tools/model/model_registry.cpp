@@ -14,8 +14,10 @@ namespace {
 template <class M>
 concept SteppedStage = requires(M& m, const M& cm, double u, double dt) {
   m.reset(u);
-  { m.step(u, dt) } noexcept -> std::same_as<double>;
-  { cm.output() } noexcept -> std::same_as<double>;
+  { m.step(u, dt) }
+  noexcept->std::same_as<double>;
+  { cm.output() }
+  noexcept->std::same_as<double>;
 };
 
 template <class D>
@@ -129,9 +131,12 @@ std::string models_help() {
       std::snprintf(line, sizeof line, "    %-28s %-12s default %-22s %s", name.c_str(), unit.c_str(),
                     p.default_text.c_str(), p.description.c_str());
       out += line;
-      if (p.kind == "list") out += " (comma-separated list)";
-      else if (p.kind == "integer") out += " (integer)";
-      else if (p.kind != "number") out += " (one of " + p.kind + ")";
+      if (p.kind == "list")
+        out += " (comma-separated list)";
+      else if (p.kind == "integer")
+        out += " (integer)";
+      else if (p.kind != "number")
+        out += " (one of " + p.kind + ")";
       out += "\n";
     }
   }

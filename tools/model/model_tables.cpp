@@ -13,10 +13,13 @@ namespace hystloop::model_tool {
 
 std::span<const ParamSpec<MemParams>> MemDescriptor::table() {
   static const ParamSpec<MemParams> rows[] = {
-      number<MemParams>("c1", "m/V", "slope right after a reversal, M(0) = c1", [](auto& p) -> auto& { return p.c1; }),
-      number<MemParams>("c2", "m/V^(1+c3)", "growth of the slope with the distance p from the reversal",
-                        [](auto& p) -> auto& { return p.c2; }),
-      number<MemParams>("c3", "-", "exponent of that growth, M(p) = c1 + c2 p^c3", [](auto& p) -> auto& { return p.c3; }),
+      number<MemParams>(
+          "c1", "m/V", "slope right after a reversal, M(0) = c1", [](auto& p) -> auto& { return p.c1; }),
+      number<MemParams>(
+          "c2", "m/V^(1+c3)", "growth of the slope with the distance p from the reversal",
+          [](auto& p) -> auto& { return p.c2; }),
+      number<MemParams>(
+          "c3", "-", "exponent of that growth, M(p) = c1 + c2 p^c3", [](auto& p) -> auto& { return p.c3; }),
   };
   return rows;
 }
@@ -25,9 +28,11 @@ std::span<const ParamSpec<MemParams>> MemDescriptor::table() {
 
 std::span<const ParamSpec<LinearParams>> LinearDescriptor::table() {
   static const ParamSpec<LinearParams> rows[] = {
-      number<LinearParams>("gain", "m/V", "slope (default: chord of the default MEM's +-250 V loop)",
-                           [](auto& p) -> auto& { return p.gain; }),
-      number<LinearParams>("offset", "m", "output at u = 0", [](auto& p) -> auto& { return p.offset; }),
+      number<LinearParams>(
+          "gain", "m/V", "slope (default: chord of the default MEM's +-250 V loop)",
+          [](auto& p) -> auto& { return p.gain; }),
+      number<LinearParams>(
+          "offset", "m", "output at u = 0", [](auto& p) -> auto& { return p.offset; }),
   };
   return rows;
 }
@@ -39,15 +44,15 @@ static_assert(kPiMaxOperators == 32, "the help text of n says 1..32");
 std::span<const ParamSpec<PiSettings>> PiDescriptor::table() {
   static const ParamSpec<PiSettings> rows[] = {
       custom<PiSettings>(
-          "n", "-", "number of play operators (1..32)",
-          ValueKind::count,
+          "n", "-", "number of play operators (1..32)", ValueKind::count,
           [](PiSettings& s, const ParsedValue& v) {
             s.n = v.count;
             s.n_given = true;
           },
           [](const PiSettings& s) { return std::to_string(s.n); }, {}, "count"),
-      number<PiSettings>("u_max", "V", "input amplitude the even thresholds span (r_i = i*u_max/n)",
-                         [](auto& s) -> auto& { return s.u_max; }),
+      number<PiSettings>(
+          "u_max", "V", "input amplitude the even thresholds span (r_i = i*u_max/n)",
+          [](auto& s) -> auto& { return s.u_max; }),
       custom<PiSettings>(
           "thresholds", "V", "r_0 = 0 < r_1 < ... (needs weights)", ValueKind::list,
           [](PiSettings& s, const ParsedValue& v) { s.thresholds = v.list; },
@@ -55,7 +60,9 @@ std::span<const ParamSpec<PiSettings>> PiDescriptor::table() {
       custom<PiSettings>(
           "weights", "m/V", "w_0 > 0, cumulative sums > 0", ValueKind::list,
           [](PiSettings& s, const ParsedValue& v) { s.weights = v.list; },
-          [](const PiSettings& s) { return s.weights.empty() ? std::string("matched to mem") : format_list(s.weights); }),
+          [](const PiSettings& s) {
+            return s.weights.empty() ? std::string("matched to mem") : format_list(s.weights);
+          }),
   };
   return rows;
 }
@@ -64,10 +71,12 @@ PiParams PiDescriptor::build(const PiSettings& s) {
   const std::string max_text = std::to_string(kPiMaxOperators);
   if (s.weights.empty()) {
     if (!s.thresholds.empty()) {
-      throw ParameterError("thresholds", "given without weights: give weights=w0,w1,... as well (weights are matched "
-                                         "to the MEM only for even thresholds)");
+      throw ParameterError("thresholds",
+                           "given without weights: give weights=w0,w1,... as well (weights are matched "
+                           "to the MEM only for even thresholds)");
     }
-    if (s.n < 1 || s.n > kPiMaxOperators) throw ParameterError("n", "must be in [1, " + max_text + "] (got " + std::to_string(s.n) + ")");
+    if (s.n < 1 || s.n > kPiMaxOperators)
+      throw ParameterError("n", "must be in [1, " + max_text + "] (got " + std::to_string(s.n) + ")");
     require_positive("u_max", s.u_max);
     return pi_params_from_mem(MemParams::paper_like(), s.n, s.u_max);
   }
@@ -99,14 +108,21 @@ PiParams PiDescriptor::build(const PiSettings& s) {
 std::span<const ParamSpec<BanningStageParams>> BanningDescriptor::table() {
   using P = BanningStageParams;
   static const ParamSpec<P> rows[] = {
-      number<P>("hysteresis.a", "m/V", "slope of f: loop centres lie on w = a u",
-                [](auto& p) -> auto& { return p.hysteresis.a; }),
-      number<P>("hysteresis.b", "m/V", "slope of small loops, a/2 <= b <= a", [](auto& p) -> auto& { return p.hysteresis.b; }),
-      number<P>("hysteresis.alpha", "1/V", "relaxation rate onto f after a reversal",
-                [](auto& p) -> auto& { return p.hysteresis.alpha; }),
-      number<P>("hysteresis.s_max", "V", "saturation of f and g", [](auto& p) -> auto& { return p.hysteresis.s_max; }),
-      number<P>("stage.k", "1/s^2", "stiffness, omega_n^2", [](auto& p) -> auto& { return p.stage.k; }),
-      number<P>("stage.c", "1/s", "damping, 2 zeta omega_n", [](auto& p) -> auto& { return p.stage.c; }),
+      number<P>(
+          "hysteresis.a", "m/V", "slope of f: loop centres lie on w = a u",
+          [](auto& p) -> auto& { return p.hysteresis.a; }),
+      number<P>(
+          "hysteresis.b", "m/V", "slope of small loops, a/2 <= b <= a",
+          [](auto& p) -> auto& { return p.hysteresis.b; }),
+      number<P>(
+          "hysteresis.alpha", "1/V", "relaxation rate onto f after a reversal",
+          [](auto& p) -> auto& { return p.hysteresis.alpha; }),
+      number<P>(
+          "hysteresis.s_max", "V", "saturation of f and g", [](auto& p) -> auto& { return p.hysteresis.s_max; }),
+      number<P>(
+          "stage.k", "1/s^2", "stiffness, omega_n^2", [](auto& p) -> auto& { return p.stage.k; }),
+      number<P>(
+          "stage.c", "1/s", "damping, 2 zeta omega_n", [](auto& p) -> auto& { return p.stage.c; }),
       custom<P>(
           "order", "-", "which comes first: hysteresis (the bridge's) or the stage (the paper's)", ValueKind::choice,
           [](P& p, const ParsedValue& v) {

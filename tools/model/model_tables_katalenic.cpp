@@ -22,19 +22,17 @@ struct ShapingNames {
 constexpr ShapingNames kInputNames{"input_shaping.kind",         "input_shaping.gain",       "input_shaping.offset",
                                    "input_shaping.coefficients", "input_shaping.domain_min", "input_shaping.domain_max",
                                    "input_shaping.amplitude",    "input_shaping.scale"};
-constexpr ShapingNames kOutputNames{"output_shaping.kind",         "output_shaping.gain",
-                                    "output_shaping.offset",       "output_shaping.coefficients",
-                                    "output_shaping.domain_min",   "output_shaping.domain_max",
-                                    "output_shaping.amplitude",    "output_shaping.scale"};
+constexpr ShapingNames kOutputNames{
+    "output_shaping.kind",       "output_shaping.gain",       "output_shaping.offset",    "output_shaping.coefficients",
+    "output_shaping.domain_min", "output_shaping.domain_max", "output_shaping.amplitude", "output_shaping.scale"};
 
 // Sel: captureless generic lambda returning the ShapingFunction inside P.
 template <class Sel>
 void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, std::string_view map) {
   rows.push_back(custom<P>(
-      n.kind, "-", map == "in" ? "input map V -> operator units" : "output map operator units -> m",
-      ValueKind::choice,
+      n.kind, "-", map == "in" ? "input map V -> operator units" : "output map operator units -> m", ValueKind::choice,
       [](P& p, const ParsedValue& v) {
-        Sel{}(p).kind = v.choice == "tanh" ? ShapingKind::tanh
+        Sel{}(p).kind = v.choice == "tanh"         ? ShapingKind::tanh
                         : v.choice == "polynomial" ? ShapingKind::polynomial
                                                    : ShapingKind::linear;
       },
@@ -48,9 +46,10 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
       },
       "linear|polynomial|tanh"));
   const std::string_view unit = map == "in" ? "x/V" : "m/x";
-  rows.push_back(number<P>(n.gain, unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
-  rows.push_back(number<P>(n.offset, map == "in" ? "x" : "m", "linear, tanh: value at 0",
-                           [](auto& p) -> auto& { return Sel{}(p).offset; }));
+  rows.push_back(number<P>(
+      n.gain, unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
+  rows.push_back(number<P>(
+      n.offset, map == "in" ? "x" : "m", "linear, tanh: value at 0", [](auto& p) -> auto& { return Sel{}(p).offset; }));
   rows.push_back(custom<P>(
       n.coefficients, "-", "polynomial: c0,c1,...,c7 (units of the map)", ValueKind::list,
       [](P& p, const ParsedValue& v) {
@@ -68,26 +67,35 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
         while (k > 1 && c[k - 1] == 0.0) --k;
         return format_list(std::span<const double>(c.data(), k));
       }));
-  rows.push_back(number<P>(n.domain_min, map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
-                           [](auto& p) -> auto& { return Sel{}(p).domain_min; }));
-  rows.push_back(number<P>(n.domain_max, map == "in" ? "V" : "x", "polynomial: upper end of that domain",
-                           [](auto& p) -> auto& { return Sel{}(p).domain_max; }));
-  rows.push_back(number<P>(n.amplitude, map == "in" ? "x" : "m", "tanh: half the output range",
-                           [](auto& p) -> auto& { return Sel{}(p).amplitude; }));
-  rows.push_back(number<P>(n.scale, map == "in" ? "V" : "x", "tanh: input scale",
-                           [](auto& p) -> auto& { return Sel{}(p).scale; }));
+  rows.push_back(number<P>(
+      n.domain_min, map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
+      [](auto& p) -> auto& { return Sel{}(p).domain_min; }));
+  rows.push_back(number<P>(
+      n.domain_max, map == "in" ? "V" : "x", "polynomial: upper end of that domain",
+      [](auto& p) -> auto& { return Sel{}(p).domain_max; }));
+  rows.push_back(number<P>(
+      n.amplitude, map == "in" ? "x" : "m", "tanh: half the output range",
+      [](auto& p) -> auto& { return Sel{}(p).amplitude; }));
+  rows.push_back(number<P>(
+      n.scale, map == "in" ? "V" : "x", "tanh: input scale", [](auto& p) -> auto& { return Sel{}(p).scale; }));
 }
 
 std::vector<ParamSpec<P>> make_rows() {
   std::vector<ParamSpec<P>> rows = {
-      number<P>("k1", "x", "half-width of the backlash band |z - x| <= k1", [](auto& p) -> auto& { return p.k1; }),
-      number<P>("k2", "1/x", "rate of the transition to the asymptotes", [](auto& p) -> auto& { return p.k2; }),
-      number<P>("k2_slope", "1/x^2", "k2(x) = k2 + k2_slope*clamp(x, k2_domain_min, k2_domain_max)",
-                [](auto& p) -> auto& { return p.k2_slope; }),
-      number<P>("k2_domain_min", "x", "working interval of that schedule, lower end",
-                [](auto& p) -> auto& { return p.k2_domain_min; }),
-      number<P>("k2_domain_max", "x", "working interval, upper end", [](auto& p) -> auto& { return p.k2_domain_max; }),
-      number<P>("initial_offset", "x", "z - x at reset, |.| <= k1", [](auto& p) -> auto& { return p.initial_offset; }),
+      number<P>(
+          "k1", "x", "half-width of the backlash band |z - x| <= k1", [](auto& p) -> auto& { return p.k1; }),
+      number<P>(
+          "k2", "1/x", "rate of the transition to the asymptotes", [](auto& p) -> auto& { return p.k2; }),
+      number<P>(
+          "k2_slope", "1/x^2", "k2(x) = k2 + k2_slope*clamp(x, k2_domain_min, k2_domain_max)",
+          [](auto& p) -> auto& { return p.k2_slope; }),
+      number<P>(
+          "k2_domain_min", "x", "working interval of that schedule, lower end",
+          [](auto& p) -> auto& { return p.k2_domain_min; }),
+      number<P>(
+          "k2_domain_max", "x", "working interval, upper end", [](auto& p) -> auto& { return p.k2_domain_max; }),
+      number<P>(
+          "initial_offset", "x", "z - x at reset, |.| <= k1", [](auto& p) -> auto& { return p.initial_offset; }),
   };
   add_shaping_rows<decltype([](auto& p) -> auto& { return p.input_shaping; })>(rows, kInputNames, "in");
   add_shaping_rows<decltype([](auto& p) -> auto& { return p.output_shaping; })>(rows, kOutputNames, "out");

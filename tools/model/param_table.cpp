@@ -21,9 +21,10 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
     for (std::size_t j = 1; j <= b.size(); ++j) {
-      std::size_t best = std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1,
-                                   d[(i - 1) * w + j - 1] + (a[i - 1] == b[j - 1] ? 0U : 1U)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) best = std::min(best, d[(i - 2) * w + j - 2] + 1);
+      std::size_t best = std::min(
+          {d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + (a[i - 1] == b[j - 1] ? 0U : 1U)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        best = std::min(best, d[(i - 2) * w + j - 2] + 1);
       d[i * w + j] = best;
     }
   }
@@ -94,7 +95,8 @@ std::vector<double> parse_list(const Assignment& a) {
     double v = 0.0;
     std::string why;
     if (!parse_finite_double(item, v, &why)) {
-      throw AssignmentError(a, "entry " + std::to_string(index) + ": " + why + ", got '" + std::string(trim(item)) + "'");
+      throw AssignmentError(a,
+                            "entry " + std::to_string(index) + ": " + why + ", got '" + std::string(trim(item)) + "'");
     }
     out.push_back(v);
     ++index;

@@ -51,11 +51,11 @@ class AssignmentError : public ParameterError {
 template <class S>
 struct ParamSpec {
   std::string_view name;
-  std::string_view alias;        // accepted as well ("" if none): e.g. the key hystloop-identify writes
-  std::string_view unit;         // "m/V", "-" for dimensionless
+  std::string_view alias;  // accepted as well ("" if none): e.g. the key hystloop-identify writes
+  std::string_view unit;   // "m/V", "-" for dimensionless
   std::string_view description;
   ValueKind kind = ValueKind::number;
-  std::string_view choices;      // ValueKind::choice: "a|b|c"
+  std::string_view choices;  // ValueKind::choice: "a|b|c"
   void (*set)(S&, const ParsedValue&) = nullptr;
   std::string (*show)(const S&) = nullptr;  // the current value as text (help shows S{}'s)
 };
@@ -84,7 +84,7 @@ Assignment split_assignment(const std::string& text, const std::string& origin_p
 // The closest of `candidates` to `name` if it is close enough to be a likely typo, else "".
 std::string closest_name(std::string_view name, std::span<const std::string> candidates);
 
-std::string format_number(double v);                  // shortest round-trip text
+std::string format_number(double v);                 // shortest round-trip text
 std::string format_list(std::span<const double> v);  // "a,b,c"
 
 template <class S>

@@ -13,13 +13,12 @@ void flatten(const YAML::Node& node, const std::string& key, const std::string& 
              std::vector<Assignment>& out) {
   const std::string origin = path + ": " + model + "." + key;
   switch (node.Type()) {
-    case YAML::NodeType::Scalar:
-      out.push_back({key, node.Scalar(), origin});
-      return;
+    case YAML::NodeType::Scalar: out.push_back({key, node.Scalar(), origin}); return;
     case YAML::NodeType::Sequence: {
       std::string joined;
       for (std::size_t i = 0; i < node.size(); ++i) {
-        if (!node[i].IsScalar()) throw ParamsFileError(origin + ": list entry " + std::to_string(i) + " is not a value");
+        if (!node[i].IsScalar())
+          throw ParamsFileError(origin + ": list entry " + std::to_string(i) + " is not a value");
         if (i > 0) joined += ',';
         joined += node[i].Scalar();
       }
@@ -33,8 +32,7 @@ void flatten(const YAML::Node& node, const std::string& key, const std::string& 
       }
       return;
     case YAML::NodeType::Null:
-    case YAML::NodeType::Undefined:
-      throw ParamsFileError(origin + ": no value");
+    case YAML::NodeType::Undefined: throw ParamsFileError(origin + ": no value");
   }
 }
 

@@ -28,7 +28,8 @@ AlterationResult write_altered_log(const std::filesystem::path& log, const std::
       std::optional<std::int64_t> target;
       for_each_tick(msg, [&](const CommandTick& t) {
         const bool first_time = seen.insert(t.seq).second;
-        const bool wanted = alteration.nth ? static_cast<std::int64_t>(seen.size()) == *alteration.nth : t.seq == alteration.seq;
+        const bool wanted =
+            alteration.nth ? static_cast<std::int64_t>(seen.size()) == *alteration.nth : t.seq == alteration.seq;
         if (!target && first_time && wanted) target = t.seq;
       });
       if (target) {

@@ -137,29 +137,36 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
   if (tolerance.voltage_V == 0.0 && tolerance.position_m == 0.0) {
     add("comparison: exact (doubles bitwise equal; mode and params_version equal)\n");
   } else {
-    std::snprintf(line, sizeof line, "comparison: |expected - got| <= %.6g V (u_ff_V), <= %.6g m (y_ref_m); mode and params_version equal\n",
-                  tolerance.voltage_V, tolerance.position_m);
+    std::snprintf(
+        line, sizeof line,
+        "comparison: |expected - got| <= %.6g V (u_ff_V), <= %.6g m (y_ref_m); mode and params_version equal\n",
+        tolerance.voltage_V, tolerance.position_m);
     add(line);
   }
   if (r.first_divergence) {
     const Divergence& d = *r.first_divergence;
     std::snprintf(line, sizeof line,
-                  "FIRST DIVERGENCE at tick %lld (answering sample %lld): %s expected %.17g got %.17g (difference %.3g; %d of %d fields differ at this tick)\n",
-                  static_cast<long long>(d.seq), static_cast<long long>(d.sample_seq), d.field.c_str(), d.expected, d.got,
-                  d.got - d.expected, d.fields_differing, kComparedFields);
+                  "FIRST DIVERGENCE at tick %lld (answering sample %lld): %s expected %.17g got %.17g (difference "
+                  "%.3g; %d of %d fields differ at this tick)\n",
+                  static_cast<long long>(d.seq), static_cast<long long>(d.sample_seq), d.field.c_str(), d.expected,
+                  d.got, d.got - d.expected, d.fields_differing, kComparedFields);
     add(line);
   }
   if (r.first_missing_seq) {
-    std::snprintf(line, sizeof line, "FIRST MISSING: tick %lld was commanded by the original, not by the replay (its sample was not played)\n",
-                  static_cast<long long>(*r.first_missing_seq));
+    std::snprintf(
+        line, sizeof line,
+        "FIRST MISSING: tick %lld was commanded by the original, not by the replay (its sample was not played)\n",
+        static_cast<long long>(*r.first_missing_seq));
     add(line);
   }
   if (r.lost_in_transport > 0) {
     std::snprintf(line, sizeof line,
-                  "replay transport lost %llu commanded ticks (first planned at sample %lld): the sample was played, the command never logged; not counted as divergence\n",
+                  "replay transport lost %llu commanded ticks (first planned at sample %lld): the sample was played, "
+                  "the command never logged; not counted as divergence\n",
                   static_cast<unsigned long long>(r.lost_in_transport), static_cast<long long>(*r.first_lost_sample));
     add(line);
-    if (r.divergence_after_loss) add("the first divergence comes after the first lost sample and may be its consequence: replay again\n");
+    if (r.divergence_after_loss)
+      add("the first divergence comes after the first lost sample and may be its consequence: replay again\n");
   }
   std::snprintf(line, sizeof line,
                 "summary: original commanded %llu ticks; compared %llu (ticks %lld..%lld): %llu equal, %llu differing; "
@@ -167,7 +174,8 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
                 static_cast<unsigned long long>(r.expected_ticks), static_cast<unsigned long long>(r.compared),
                 static_cast<long long>(r.first_seq.value_or(-1)), static_cast<long long>(r.last_seq.value_or(-1)),
                 static_cast<unsigned long long>(r.equal), static_cast<unsigned long long>(r.differing),
-                static_cast<unsigned long long>(r.missing_in_actual), static_cast<unsigned long long>(r.lost_in_transport),
+                static_cast<unsigned long long>(r.missing_in_actual),
+                static_cast<unsigned long long>(r.lost_in_transport),
                 static_cast<unsigned long long>(r.missing_in_expected));
   add(line);
   if (r.compared == 0) add("nothing was compared: the replay answered none of the original's ticks\n");

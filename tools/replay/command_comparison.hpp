@@ -34,7 +34,7 @@ struct Divergence {
   std::string field;            // "u_ff_V", "y_ref_m", "mode", "params_version"
   double expected = 0.0;
   double got = 0.0;
-  int fields_differing = 0;     // how many of the kComparedFields fields differ at this tick
+  int fields_differing = 0;  // how many of the kComparedFields fields differ at this tick
 };
 
 enum class CompareVerdict {
@@ -45,8 +45,8 @@ enum class CompareVerdict {
 const char* to_string(CompareVerdict verdict) noexcept;
 
 struct CompareReport {
-  std::uint64_t expected_ticks = 0;       // ticks the original commanded
-  std::uint64_t compared = 0;             // of those, ticks the replay also commanded
+  std::uint64_t expected_ticks = 0;  // ticks the original commanded
+  std::uint64_t compared = 0;        // of those, ticks the replay also commanded
   std::uint64_t equal = 0;
   std::uint64_t differing = 0;
   std::uint64_t lost_in_transport = 0;    // original ticks whose sample was played but that the replay did not command
@@ -57,7 +57,7 @@ struct CompareReport {
   std::optional<Divergence> first_divergence;
   std::optional<std::int64_t> first_lost_sample;  // sample seq
   std::optional<std::int64_t> first_missing_seq;  // command seq
-  bool divergence_after_loss = false;              // first divergence at/after the first lost sample
+  bool divergence_after_loss = false;             // first divergence at/after the first lost sample
 
   CompareVerdict verdict() const noexcept;
   int exit_code() const noexcept;  // 0 equal, 1 diverged or transport loss (the verdict line tells which)

@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
                  "The inputs log that was played (its samples tell a transport loss from a missing command)");
   app.add_option("--tolerance-V", tolerance.voltage_V, "Accept |expected - got| up to this on u_ff_V [V] (0: bitwise)")
       ->capture_default_str();
-  app.add_option("--tolerance-m", tolerance.position_m, "Accept |expected - got| up to this on y_ref_m [m] (0: bitwise)")
+  app.add_option("--tolerance-m", tolerance.position_m,
+                 "Accept |expected - got| up to this on y_ref_m [m] (0: bitwise)")
       ->capture_default_str();
   app.add_option("--rig", rig, "Channel prefix of the rig")->capture_default_str();
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
@@ -45,14 +46,17 @@ int main(int argc, char** argv) {
     std::optional<std::set<std::int64_t>> played;
     if (!inputs_log.empty()) played = hystloop::replay::read_sample_seqs(inputs_log, channels);
     if (expected.by_seq.empty()) {
-      std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(), channels.command.c_str());
+      std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(),
+                   channels.command.c_str());
       return 2;
     }
     const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
     if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
-      std::printf("note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu undecodable blocks\n",
-                  static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
-                  static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
+      std::printf(
+          "note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu "
+          "undecodable blocks\n",
+          static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
+          static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
     }
     std::fputs(hystloop::replay::format_report(report, tolerance).c_str(), stdout);
     return report.exit_code();

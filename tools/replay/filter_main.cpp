@@ -27,13 +27,15 @@ int main(int argc, char** argv) {
   app.add_option("--rig", rig, "Channel prefix of the rig")->capture_default_str();
 
   hystloop::replay::ReplayInputOptions input_options;
-  CLI::App* inputs = app.add_subcommand("inputs", "Write the recorded compensator's inputs, from its first answered sample");
+  CLI::App* inputs =
+      app.add_subcommand("inputs", "Write the recorded compensator's inputs, from its first answered sample");
   inputs->add_option("log", log, "Recorded LCM event log")->required();
   inputs->add_option("out", out, "Inputs-only log to write")->required();
   inputs->add_flag("--only-answered", input_options.only_answered,
                    "Also leave out sensor blocks the recorded compensator did not answer (gaps it saw)");
-  inputs->add_option("--compensator-process", input_options.compensator_process,
-                     "Process name of the compensator in HX_STATUS (its start time bounds the warm-up)")
+  inputs
+      ->add_option("--compensator-process", input_options.compensator_process,
+                   "Process name of the compensator in HX_STATUS (its start time bounds the warm-up)")
       ->capture_default_str();
 
   hystloop::replay::CommandAlteration alteration;
@@ -60,7 +62,8 @@ int main(int argc, char** argv) {
       alteration.seq = seq.value_or(0);
       alteration.delta_V = delta_V;
       const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
-      std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V, r.new_u_ff_V);
+      std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V,
+                  r.new_u_ff_V);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());

@@ -24,7 +24,8 @@ LogStart read_log_start(const std::filesystem::path& log, const ChannelNames& ch
   report::for_each_event({log}, [&](const lcm::LogEvent& event) {
     if (!s.first_event_utime) s.first_event_utime = event.timestamp;
     if (s.compensator_start_utime || event.channel != channels.status) return;
-    if (report::decode_checked(event, status) && status.process == process) s.compensator_start_utime = status.start_utime;
+    if (report::decode_checked(event, status) && status.process == process)
+      s.compensator_start_utime = status.start_utime;
   });
   return s;
 }
@@ -57,7 +58,9 @@ ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const
                                          const ChannelNames& channels, const ReplayInputOptions& options) {
   ReplayInputSelection sel;
   const std::set<std::int64_t> answered = read_commands(log, channels).answered_samples;
-  if (answered.empty()) throw std::runtime_error(log.string() + ": no " + channels.command + " command block answering a sample: nothing to replay against");
+  if (answered.empty())
+    throw std::runtime_error(log.string() + ": no " + channels.command +
+                             " command block answering a sample: nothing to replay against");
   sel.first_answered_sample = *answered.begin();
   const LogStart start = read_log_start(log, channels, options.compensator_process);
   sel.compensator_start_utime = start.compensator_start_utime;
@@ -82,7 +85,8 @@ ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const
       sel.ticks_written += static_cast<std::uint64_t>(block.n_ticks);
     } else if (is_other_input(event.channel, channels)) {
       if (!other_input_decodes(event, channels)) return void(++sel.undecodable);
-      const bool running = started || (start.compensator_start_utime && event.timestamp >= *start.compensator_start_utime);
+      const bool running =
+          started || (start.compensator_start_utime && event.timestamp >= *start.compensator_start_utime);
       if (!running) return void(++sel.other_inputs_skipped);
       ++sel.other_inputs_written;
     } else {
@@ -104,19 +108,24 @@ std::string describe(const ReplayInputSelection& s) {
   out += line;
   if (s.blocks_before_start > 0) {
     std::snprintf(line, sizeof line,
-                  "warm-up: the recorded compensator started after the log did; the replay starts with the block of sample %lld (%llu earlier sensor blocks left out)\n",
+                  "warm-up: the recorded compensator started after the log did; the replay starts with the block of "
+                  "sample %lld (%llu earlier sensor blocks left out)\n",
                   ll(s.first_answered_sample), ull(s.blocks_before_start));
     out += line;
   }
   if (s.log_starts_after_compensator) {
-    out += "warning: the log begins after the recorded compensator started: inputs it received before are not in the log, the replay may diverge\n";
+    out +=
+        "warning: the log begins after the recorded compensator started: inputs it received before are not in the log, "
+        "the replay may diverge\n";
   }
   std::snprintf(line, sizeof line,
-                "replay inputs: %llu sensor blocks (%llu ticks), %llu trajectory/params/control messages (%llu logged before the compensator ran, left out)\n",
+                "replay inputs: %llu sensor blocks (%llu ticks), %llu trajectory/params/control messages (%llu logged "
+                "before the compensator ran, left out)\n",
                 ull(s.blocks_written), ull(s.ticks_written), ull(s.other_inputs_written), ull(s.other_inputs_skipped));
   out += line;
   if (s.blocks_unanswered > 0) {
-    std::snprintf(line, sizeof line, "the recorded compensator did not answer %llu sensor blocks after its first (%llu left out)\n",
+    std::snprintf(line, sizeof line,
+                  "the recorded compensator did not answer %llu sensor blocks after its first (%llu left out)\n",
                   ull(s.blocks_unanswered), ull(s.blocks_unanswered_dropped));
     out += line;
   }

@@ -29,15 +29,15 @@ struct ReplayInputSelection {
   std::optional<std::int64_t> first_log_sample;       // first tick of the log's first sensor block
   std::optional<std::int64_t> first_answered_sample;  // lowest sample_seq (>= 0) among the logged command blocks
   std::optional<std::int64_t> compensator_start_utime;
-  bool log_starts_after_compensator = false;  // inputs before the log began are unknown
-  std::uint64_t blocks_written = 0;        // sensor blocks
-  std::uint64_t ticks_written = 0;         // their ticks
-  std::uint64_t blocks_before_start = 0;   // sensor blocks before the first answered one (warm-up), left out
-  std::uint64_t blocks_unanswered = 0;     // later sensor blocks no command block of the original answered
+  bool log_starts_after_compensator = false;    // inputs before the log began are unknown
+  std::uint64_t blocks_written = 0;             // sensor blocks
+  std::uint64_t ticks_written = 0;              // their ticks
+  std::uint64_t blocks_before_start = 0;        // sensor blocks before the first answered one (warm-up), left out
+  std::uint64_t blocks_unanswered = 0;          // later sensor blocks no command block of the original answered
   std::uint64_t blocks_unanswered_dropped = 0;  // of those, left out (only_answered)
-  std::uint64_t other_inputs_written = 0;  // trajectory, params, control
-  std::uint64_t other_inputs_skipped = 0;  // logged before the compensator ran
-  std::uint64_t undecodable = 0;           // input events that failed to decode or check (left out)
+  std::uint64_t other_inputs_written = 0;       // trajectory, params, control
+  std::uint64_t other_inputs_skipped = 0;       // logged before the compensator ran
+  std::uint64_t undecodable = 0;                // input events that failed to decode or check (left out)
 };
 
 // Writes the inputs of `log` to `out` (an LCM event log, original timestamps kept).

@@ -115,8 +115,19 @@ class RowDecoder {
         std::size_t i = 0;
         for_each_tick(m, [&](const SensorTick& k) {
           const double t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
-          Fields(out).i(m.utime).i(m.seq).d(m.dt_s).i(m.buffer_depth_ticks).i(k.utime).i(k.seq).d(k.u_V).d(k.u_ff_V)
-              .d(k.u_fb_V).d(k.y_ref_m).d(k.y_m).i(k.flags);
+          Fields(out)
+              .i(m.utime)
+              .i(m.seq)
+              .d(m.dt_s)
+              .i(m.buffer_depth_ticks)
+              .i(k.utime)
+              .i(k.seq)
+              .d(k.u_V)
+              .d(k.u_ff_V)
+              .d(k.u_fb_V)
+              .d(k.y_ref_m)
+              .d(k.y_m)
+              .i(k.flags);
           emit(t, out);
         });
         return true;
@@ -125,7 +136,14 @@ class RowDecoder {
         const auto& m = command_;
         if (!decode_checked(e, command_)) return false;
         for_each_tick(m, [&](const CommandTick& k) {
-          Fields(out).i(m.utime).i(m.seq).i(m.sample_seq).i(k.seq).d(k.u_ff_V).d(k.y_ref_m).i(k.params_version)
+          Fields(out)
+              .i(m.utime)
+              .i(m.seq)
+              .i(m.sample_seq)
+              .i(k.seq)
+              .d(k.u_ff_V)
+              .d(k.y_ref_m)
+              .i(k.params_version)
               .i(k.mode);
           emit(t_of(e.timestamp), out);
         });
@@ -144,16 +162,35 @@ class RowDecoder {
       case Kind::kTrajectory: {
         const auto& m = trajectory_;
         if (!decode_checked(e, trajectory_)) return false;
-        Fields(out).i(m.utime).i(m.version).i(m.shape).d(m.amplitude_m).d(m.offset_m).d(m.frequency_Hz)
-            .d(m.phase_rad).i(m.start_utime).d(m.blend_s).i(m.n_points).raw(joined(m.points_t_s))
+        Fields(out)
+            .i(m.utime)
+            .i(m.version)
+            .i(m.shape)
+            .d(m.amplitude_m)
+            .d(m.offset_m)
+            .d(m.frequency_Hz)
+            .d(m.phase_rad)
+            .i(m.start_utime)
+            .d(m.blend_s)
+            .i(m.n_points)
+            .raw(joined(m.points_t_s))
             .raw(joined(m.points_y_m));
         return true;
       }
       case Kind::kParams: {
         const auto& m = params_;
         if (!decode_checked(e, params_)) return false;
-        Fields(out).i(m.utime).i(m.version).d(m.c1).d(m.c2).d(m.c3).d(m.residual_m).i(m.samples_used).d(m.window_s)
-            .i(m.valid ? 1 : 0).s(m.source);
+        Fields(out)
+            .i(m.utime)
+            .i(m.version)
+            .d(m.c1)
+            .d(m.c2)
+            .d(m.c3)
+            .d(m.residual_m)
+            .i(m.samples_used)
+            .d(m.window_s)
+            .i(m.valid ? 1 : 0)
+            .s(m.source);
         return true;
       }
       case Kind::kStatus: {
@@ -166,22 +203,45 @@ class RowDecoder {
           counters += '=';
           counters += std::to_string(m.counter_values[k]);
         }
-        Fields(out).i(m.utime).s(m.process).s(m.host).i(m.pid).i(m.state).s(m.detail).i(m.start_utime)
-            .d(m.loop_p50_us).d(m.loop_p99_us).d(m.loop_max_us).d(m.latency_p50_us).d(m.latency_p99_us)
-            .d(m.latency_max_us).i(m.late).i(m.rejected).s(counters);
+        Fields(out)
+            .i(m.utime)
+            .s(m.process)
+            .s(m.host)
+            .i(m.pid)
+            .i(m.state)
+            .s(m.detail)
+            .i(m.start_utime)
+            .d(m.loop_p50_us)
+            .d(m.loop_p99_us)
+            .d(m.loop_max_us)
+            .d(m.latency_p50_us)
+            .d(m.latency_p99_us)
+            .d(m.latency_max_us)
+            .i(m.late)
+            .i(m.rejected)
+            .s(counters);
         return true;
       }
       case Kind::kControl: {
         const auto& m = control_;
         if (!decode_checked(e, control_)) return false;
-        Fields(out).i(m.utime).i(m.request_id).i(m.command).s(m.target).i(m.mode).d(m.kp).d(m.ki).d(m.kd)
-            .s(m.experiment).d(m.experiment_amplitude_V).d(m.experiment_offset_V).d(m.experiment_frequency_Hz)
+        Fields(out)
+            .i(m.utime)
+            .i(m.request_id)
+            .i(m.command)
+            .s(m.target)
+            .i(m.mode)
+            .d(m.kp)
+            .d(m.ki)
+            .d(m.kd)
+            .s(m.experiment)
+            .d(m.experiment_amplitude_V)
+            .d(m.experiment_offset_V)
+            .d(m.experiment_frequency_Hz)
             .d(m.experiment_duration_s);
         return true;
       }
-      default:
-        Fields(out).i(e.datalen);
-        return true;
+      default: Fields(out).i(e.datalen); return true;
     }
   }
 
@@ -205,16 +265,16 @@ struct ChannelWriter {
 std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel) {
   std::string name = channel;
   for (char& c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-                    c == '.' || c == '-';
+    const bool ok =
+        (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
     if (!ok) c = '_';
   }
   return dir / (name + ".csv");
 }
 
-std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs, const std::vector<std::string>& channels,
-                                  std::int64_t t0_utime, double lower_s, double upper_s,
-                                  const std::filesystem::path& dir) {
+std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs,
+                                  const std::vector<std::string>& channels, std::int64_t t0_utime, double lower_s,
+                                  double upper_s, const std::filesystem::path& dir) {
   std::vector<std::unique_ptr<ChannelWriter>> writers;
   for (const auto& channel : channels) {
     auto writer = std::make_unique<ChannelWriter>();

@@ -16,9 +16,9 @@ namespace hystloop::report {
 struct CsvExport {
   std::string channel;
   std::filesystem::path file;
-  std::string type_name;   // "hystloop.sensor_block_t", or "unknown" (rows carry only times and size)
-  std::size_t rows = 0;    // rows written (ticks of a block channel)
-  std::size_t skipped = 0; // events that did not decode
+  std::string type_name;    // "hystloop.sensor_block_t", or "unknown" (rows carry only times and size)
+  std::size_t rows = 0;     // rows written (ticks of a block channel)
+  std::size_t skipped = 0;  // events that did not decode
 };
 
 // File name for a channel: DIR/<channel>.csv, characters outside [A-Za-z0-9_.-] replaced by '_'.
@@ -26,8 +26,8 @@ std::filesystem::path csv_path(const std::filesystem::path& dir, const std::stri
 
 // One pass over the logs, writing each channel's rows with lower_s <= t_s <= upper_s
 // (t_s relative to t0_utime). Throws std::runtime_error if a file cannot be written.
-std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs, const std::vector<std::string>& channels,
-                                  std::int64_t t0_utime, double lower_s, double upper_s,
-                                  const std::filesystem::path& dir);
+std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs,
+                                  const std::vector<std::string>& channels, std::int64_t t0_utime, double lower_s,
+                                  double upper_s, const std::filesystem::path& dir);
 
 }  // namespace hystloop::report

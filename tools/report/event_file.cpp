@@ -8,7 +8,7 @@ namespace hystloop::report {
 namespace {
 
 constexpr std::uint32_t kSync = 0xEDA1DA01u;
-constexpr std::uint64_t kHeaderBytes = 28;  // sync, event number, timestamp, two lengths
+constexpr std::uint64_t kHeaderBytes = 28;      // sync, event number, timestamp, two lengths
 constexpr std::int32_t kMaxChannelBytes = 999;  // as liblcm's reader
 
 std::uint64_t be(const std::uint8_t* p, int n) {
@@ -57,8 +57,8 @@ const lcm::LogEvent* EventFileReader::next() {
     const auto data_len = static_cast<std::int32_t>(be(header + 20, 4));
     const std::uint64_t end = start + kHeaderBytes + static_cast<std::uint64_t>(channel_len > 0 ? channel_len : 0) +
                               static_cast<std::uint64_t>(data_len > 0 ? data_len : 0);
-    const bool fits = whole_header && channel_len > 0 && channel_len <= kMaxChannelBytes && data_len >= 0 &&
-                      end <= scan_.bytes;
+    const bool fits =
+        whole_header && channel_len > 0 && channel_len <= kMaxChannelBytes && data_len >= 0 && end <= scan_.bytes;
     if (fits) {
       channel_.resize(static_cast<std::size_t>(channel_len));
       data_.resize(static_cast<std::size_t>(data_len));

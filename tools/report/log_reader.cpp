@@ -49,8 +49,8 @@ std::vector<std::string> describe_scan_problems(const std::vector<LogFileScan>& 
 }
 
 std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept {
-  const double back_us = static_cast<double>(static_cast<std::int64_t>(n_ticks) - 1 - static_cast<std::int64_t>(i)) *
-                         dt_s * 1e6;
+  const double back_us =
+      static_cast<double>(static_cast<std::int64_t>(n_ticks) - 1 - static_cast<std::int64_t>(i)) * dt_s * 1e6;
   return block_recv_utime - static_cast<std::int64_t>(std::llround(back_us));
 }
 
@@ -73,8 +73,8 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
       bool armed = true;
       std::size_t i = 0;
       for_each_tick(sensor, [&](const SensorTick& k) {
-        run.samples.push_back({tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m,
-                               k.flags});
+        run.samples.push_back(
+            {tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m, k.flags});
         armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
       });
       run.sensor_blocks.push_back({t, sensor.seq, sensor.n_ticks, sensor.dt_s, sensor.buffer_depth_ticks, armed});
@@ -95,8 +95,8 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
                             kind ? std::string(to_string(*kind)) : "unknown", model.heldout_rms_m, true});
     } else if (event.channel == channels.status) {
       if (!decode_checked(event, status)) return void(++run.undecodable);
-      StatusRecord record{t, status.process, status.state, status.late, status.rejected, {}, status.utime,
-                          status.start_utime};
+      StatusRecord record{t,  status.process, status.state,      status.late, status.rejected,
+                          {}, status.utime,   status.start_utime};
       for (std::size_t i = 0; i < status.counter_names.size(); ++i) {
         record.counters.emplace_back(status.counter_names[i], status.counter_values[i]);
       }

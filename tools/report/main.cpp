@@ -57,7 +57,8 @@ std::string resolve_channel(const std::string& name, const RunData& run, const s
   if (run.channel_counts.count(prefix + name) != 0) return prefix + name;
   std::string known;
   for (const auto& [channel, count] : run.channel_counts) known += (known.empty() ? "" : ", ") + channel;
-  throw ParameterError("--csv", "no channel '" + name + "' in the log (channels: " + (known.empty() ? "none" : known) + ")");
+  throw ParameterError("--csv",
+                       "no channel '" + name + "' in the log (channels: " + (known.empty() ? "none" : known) + ")");
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -83,8 +84,10 @@ int run(const Options& o) {
     std::fprintf(stderr, "hystloop-report: warning: %s\n", problem.c_str());
   }
   if (data.undecodable > 0) {
-    std::fprintf(stderr, "hystloop-report: warning: %llu event(s) on the rig's channels did not decode or broke the "
-                 "message contract; they are left out\n", static_cast<unsigned long long>(data.undecodable));
+    std::fprintf(stderr,
+                 "hystloop-report: warning: %llu event(s) on the rig's channels did not decode or broke the "
+                 "message contract; they are left out\n",
+                 static_cast<unsigned long long>(data.undecodable));
   }
   if (data.events == data.undecodable) {
     std::fprintf(stderr, "hystloop-report: nothing decodable in %zu log file(s): no report written\n", o.logs.size());
@@ -129,9 +132,10 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"hystloop-report: tracking error, late ticks, buffer depth, run-ahead margin, watchdog trips, CPU, message "
-               "rates, parameter history and plots of a recorded run, from LCM event logs (times are the log's receive "
-               "timestamps, relative to the first sensor tick)"};
+  CLI::App app{
+      "hystloop-report: tracking error, late ticks, buffer depth, run-ahead margin, watchdog trips, CPU, message "
+      "rates, parameter history and plots of a recorded run, from LCM event logs (times are the log's receive "
+      "timestamps, relative to the first sensor tick)"};
   app.add_option("logs", o.logs, "LCM event log file(s); rotated files in recording order")
       ->required()
       ->check(CLI::ExistingFile);
@@ -142,8 +146,10 @@ int main(int argc, char** argv) {
   app.add_option("--skip-initial", o.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
       ->capture_default_str();
   app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();
-  app.add_option("--bridge-process", o.bridge_process, "Process name of the bridge in HX_STATUS")->capture_default_str();
-  app.add_option("--logger-process", o.logger_process, "Process name of the logger in HX_STATUS")->capture_default_str();
+  app.add_option("--bridge-process", o.bridge_process, "Process name of the bridge in HX_STATUS")
+      ->capture_default_str();
+  app.add_option("--logger-process", o.logger_process, "Process name of the logger in HX_STATUS")
+      ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "Print nothing but warnings and errors");
   app.add_flag("--no-plots", o.no_plots, "Write no plots");
   app.add_option("--gnuplot", o.plots.gnuplot, "gnuplot executable")->capture_default_str();

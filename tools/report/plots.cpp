@@ -140,7 +140,8 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     const auto path = dir / "track.dat";
     auto out = open_for_writing(path);
     out << "# t_s u_V y_um y_ref_um e_nm   (e = y_ref - y; NaN: no reference for the tick)\n";
-    const std::size_t step = std::max<std::size_t>(1, (ticks.size() + options.max_points - 1) / std::max<std::size_t>(options.max_points, 1));
+    const std::size_t step = std::max<std::size_t>(
+        1, (ticks.size() + options.max_points - 1) / std::max<std::size_t>(options.max_points, 1));
     for (std::size_t i = 0; i < ticks.size(); i += step) {
       const auto& p = ticks[i];
       out << num(p.t_s) << ' ' << num(p.u_V) << ' ' << num(p.y_m * 1e6) << ' ' << num(p.y_ref_m * 1e6) << ' '
@@ -154,8 +155,8 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     auto out = open_for_writing(path);
     out << "# t_s rms_error_nm params_version   (t_s = start of the second)\n";
     for (const auto& bin : m.per_second) {
-      out << num(bin.t_s) << ' ' << num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")) << ' ' << bin.params_version
-          << '\n';
+      out << num(bin.t_s) << ' ' << num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")) << ' '
+          << bin.params_version << '\n';
     }
     close_checked(out, path);
     result.data_files.push_back(path);
@@ -202,7 +203,8 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     gp << "\nset output 'hysteresis_yref_y.png'\n"
        << "set title 'Reference y_ref -> measured position y (cf. the MEM paper, Fig. 11)'\n"
        << "set xlabel 'y_ref [um]'\nset ylabel 'y [um]'\nset size ratio -1\n"
-       << "plot 'track.dat' using 4:3 with lines lw 1 title 'y(y_ref)', x with lines dt 2 lc rgb 'gray' title 'y = y_ref'\n"
+       << "plot 'track.dat' using 4:3 with lines lw 1 title 'y(y_ref)', x with lines dt 2 lc rgb 'gray' title 'y = "
+          "y_ref'\n"
        << "set size noratio\n";
     images.push_back("tracking_error.png");
     gp << "\nset output 'tracking_error.png'\nset title 'Tracking error e = y_ref - y'\n"
@@ -236,8 +238,8 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
 
   const auto exe = find_executable(options.gnuplot);
   if (exe.empty()) {
-    result.warning = "gnuplot not found ('" + options.gnuplot + "'): plots skipped (data and plots.gp are in " +
-                     dir.string() + ")";
+    result.warning =
+        "gnuplot not found ('" + options.gnuplot + "'): plots skipped (data and plots.gp are in " + dir.string() + ")";
     return result;
   }
   if (images.empty()) {

@@ -20,8 +20,8 @@
 namespace hystloop::report {
 
 struct PlotOptions {
-  std::string gnuplot = "gnuplot";    // executable, searched in PATH unless it contains '/'
-  std::size_t max_points = 200'000;   // track.dat is decimated to at most this many rows
+  std::string gnuplot = "gnuplot";   // executable, searched in PATH unless it contains '/'
+  std::size_t max_points = 200'000;  // track.dat is decimated to at most this many rows
 };
 
 struct PlotResult {

@@ -241,10 +241,10 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   fill_blocks(run, lo, hi, t0, m);
   fill_message_rates(run, t0, m);
 
-  const std::int64_t upper_utime =
-      std::isfinite(hi) ? t0 + static_cast<std::int64_t>(std::floor(hi * 1e6)) : std::numeric_limits<std::int64_t>::max();
-  const std::int64_t lower_utime =
-      std::isfinite(lo) ? t0 + static_cast<std::int64_t>(std::ceil(lo * 1e6)) : std::numeric_limits<std::int64_t>::min();
+  const std::int64_t upper_utime = std::isfinite(hi) ? t0 + static_cast<std::int64_t>(std::floor(hi * 1e6))
+                                                     : std::numeric_limits<std::int64_t>::max();
+  const std::int64_t lower_utime = std::isfinite(lo) ? t0 + static_cast<std::int64_t>(std::ceil(lo * 1e6))
+                                                     : std::numeric_limits<std::int64_t>::min();
   fill_commands_rejected(run, options, upper_utime, m);
   fill_logger_gaps(run, options, upper_utime, m);
   fill_watchdog_trips(run, options, upper_utime, safe_transitions, m);

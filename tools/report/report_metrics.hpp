@@ -25,9 +25,9 @@
 namespace hystloop::report {
 
 struct ReportOptions {
-  std::optional<double> from_s;   // keep t_s >= from_s (+ skip_initial_s)
-  std::optional<double> to_s;     // keep t_s <= to_s
-  double skip_initial_s = 0.0;    // warm-up excluded at the start of the range, >= 0
+  std::optional<double> from_s;  // keep t_s >= from_s (+ skip_initial_s)
+  std::optional<double> to_s;    // keep t_s <= to_s
+  double skip_initial_s = 0.0;   // warm-up excluded at the start of the range, >= 0
   std::string bridge_process = "bridge";
   std::string logger_process = "logger";
 
@@ -39,10 +39,10 @@ struct ReportOptions {
 };
 
 struct SecondBin {
-  double t_s = 0.0;                  // start of the one-second bin
+  double t_s = 0.0;  // start of the one-second bin
   std::size_t tracking_samples = 0;
   std::optional<double> rms_error_m;
-  std::int32_t params_version = 0;   // of the last command applied in the bin (carried forward)
+  std::int32_t params_version = 0;  // of the last command applied in the bin (carried forward)
 };
 
 struct MemParams {
@@ -62,8 +62,8 @@ struct ParamsPoint {
 };
 
 struct ReportMetrics {
-  std::size_t samples = 0;           // sensor samples in the range
-  double duration_s = 0.0;           // last minus first sample time in the range
+  std::size_t samples = 0;  // sensor samples in the range
+  double duration_s = 0.0;  // last minus first sample time in the range
   std::optional<double> first_sample_t_s, last_sample_t_s;
 
   std::size_t tracking_samples = 0;
@@ -71,11 +71,11 @@ struct ReportMetrics {
   std::optional<double> rms_error_first_5s_m, rms_error_last_5s_m;
   std::vector<SecondBin> per_second;
 
-  std::size_t armed_samples = 0;     // ticks without SAFE_STATE
-  std::size_t late_samples = 0;      // armed ticks with LATE_COMMAND
+  std::size_t armed_samples = 0;                // ticks without SAFE_STATE
+  std::size_t late_samples = 0;                 // armed ticks with LATE_COMMAND
   std::optional<double> late_command_fraction;  // late / armed ticks (summary: also late_tick_fraction)
 
-  std::size_t sensor_blocks = 0;     // HX_SENSOR blocks in the range
+  std::size_t sensor_blocks = 0;  // HX_SENSOR blocks in the range
   std::size_t armed_blocks = 0;
   std::optional<std::int32_t> buffer_min_depth_ticks;  // lowest buffer_depth_ticks of an armed block
   std::optional<double> tick_period_s;                 // dt_s of the first sensor block in the range

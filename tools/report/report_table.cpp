@@ -32,26 +32,28 @@ std::string params(const std::optional<MemParams>& p) {
 std::string format_table(const ReportMetrics& m) {
   std::string out;
   auto row = [&out](const char* name, const std::string& value) { out += fmt("  %-22s %s\n", name, value.c_str()); };
-  row("duration", fmt("%.2f s, %zu ticks, %llu events", m.duration_s, m.samples,
-                      static_cast<unsigned long long>(m.events)));
+  row("duration",
+      fmt("%.2f s, %zu ticks, %llu events", m.duration_s, m.samples, static_cast<unsigned long long>(m.events)));
   row("tracking RMS error", nm(m.rms_error_m) + fmt("  (%zu ticks with a reference)", m.tracking_samples));
   row("  first / last 5 s", nm(m.rms_error_first_5s_m) + " / " + nm(m.rms_error_last_5s_m));
   row("  max |error|", nm(m.max_abs_error_m));
-  row("late commands", m.late_command_fraction ? fmt("%.4f %%  (%zu of %zu armed ticks)", *m.late_command_fraction * 100.0,
-                                                     m.late_samples, m.armed_samples)
+  row("late commands", m.late_command_fraction ? fmt("%.4f %%  (%zu of %zu armed ticks)",
+                                                     *m.late_command_fraction * 100.0, m.late_samples, m.armed_samples)
                                                : std::string("--  (no armed ticks)"));
   row("buffer min depth", m.buffer_min_depth_ticks
-                               ? fmt("%d ticks  (%zu armed of %zu sensor blocks)", *m.buffer_min_depth_ticks,
-                                     m.armed_blocks, m.sensor_blocks)
-                               : fmt("--  (%zu armed of %zu sensor blocks)", m.armed_blocks, m.sensor_blocks));
+                              ? fmt("%d ticks  (%zu armed of %zu sensor blocks)", *m.buffer_min_depth_ticks,
+                                    m.armed_blocks, m.sensor_blocks)
+                              : fmt("--  (%zu armed of %zu sensor blocks)", m.armed_blocks, m.sensor_blocks));
   row("run-ahead min/p1/p50", ticks(m.run_ahead_min_ticks) + " / " + ticks(m.run_ahead_p01_ticks) + " / " +
-                                  ticks(m.run_ahead_p50_ticks) + fmt(" ticks  (n = %zu command blocks)",
-                                                                     m.run_ahead_ticks.size()));
-  row("watchdog trips", (m.watchdog_trips ? fmt("%lld", static_cast<long long>(*m.watchdog_trips)) : std::string("--")) +
-                            "  (" + m.watchdog_trips_source + ")");
+                                  ticks(m.run_ahead_p50_ticks) +
+                                  fmt(" ticks  (n = %zu command blocks)", m.run_ahead_ticks.size()));
+  row("watchdog trips",
+      (m.watchdog_trips ? fmt("%lld", static_cast<long long>(*m.watchdog_trips)) : std::string("--")) + "  (" +
+          m.watchdog_trips_source + ")");
   std::string cpu;
   for (const auto& [process, fraction] : m.cpu_fraction) {
-    cpu += (cpu.empty() ? "" : ", ") + process + " " + (fraction ? fmt("%.1f %%", *fraction * 100.0) : std::string("--"));
+    cpu +=
+        (cpu.empty() ? "" : ", ") + process + " " + (fraction ? fmt("%.1f %%", *fraction * 100.0) : std::string("--"));
   }
   row("cpu", cpu.empty() ? std::string("--  (no status)") : cpu);
   row("commands rejected", m.commands_rejected ? fmt("%lld", static_cast<long long>(*m.commands_rejected)) + "  (" +

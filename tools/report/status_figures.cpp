@@ -25,7 +25,8 @@ bool is_command_reject_counter(std::string_view name) {
   const std::string_view l = leaf(name);
   const std::string_view e = endpoint(name);
   const bool reject = l.starts_with("rejected") || l == "stale";
-  const bool commands = e.empty() || e.find("command") != std::string_view::npos || e.find("cmd") != std::string_view::npos;
+  const bool commands =
+      e.empty() || e.find("command") != std::string_view::npos || e.find("cmd") != std::string_view::npos;
   return reject && commands;
 }
 
@@ -72,8 +73,7 @@ void fill_logger_gaps(const RunData& run, const ReportOptions& options, std::int
   if (const StatusRecord* logger = last_status(run, options.logger_process, upper_utime)) {
     // Most specific name first: "gaps", then "*gaps", then anything with "gap".
     const std::array<bool (*)(std::string_view), 3> tiers{
-        [](std::string_view l) { return l == "gaps"; },
-        [](std::string_view l) { return l.ends_with("gaps"); },
+        [](std::string_view l) { return l == "gaps"; }, [](std::string_view l) { return l.ends_with("gaps"); },
         [](std::string_view l) { return l.find("gap") != std::string_view::npos; }};
     for (const auto& matches : tiers) {
       std::int64_t sum = 0;
@@ -104,15 +104,17 @@ void fill_watchdog_trips(const RunData& run, const ReportOptions& options, std::
     }
   }
   m.watchdog_trips = transitions;
-  m.watchdog_trips_source = "sensor ticks: armed -> SAFE_STATE transitions not preceded by a DISARM/SHUTDOWN request "
-                            "(no watchdog_trips counter from '" + options.bridge_process + "')";
+  m.watchdog_trips_source =
+      "sensor ticks: armed -> SAFE_STATE transitions not preceded by a DISARM/SHUTDOWN request "
+      "(no watchdog_trips counter from '" +
+      options.bridge_process + "')";
 }
 
 void fill_cpu_fraction(const RunData& run, std::int64_t lower_utime, std::int64_t upper_utime, ReportMetrics& m) {
   struct Accumulator {
     const StatusRecord* first = nullptr;  // of the current segment
     const StatusRecord* last = nullptr;
-    std::int64_t cpu_us = 0;              // of the closed segments
+    std::int64_t cpu_us = 0;  // of the closed segments
     std::int64_t wall_us = 0;
     void close() {
       if (first != nullptr && last != first) {

@@ -59,8 +59,8 @@ Result run(const Options& opt) {
 // With --check: the result is consistent (not: fast). Exit code 1 otherwise.
 bool consistent(const Result& r, std::uint64_t wanted) {
   const auto& l = r.lateness;
-  return r.served + r.skipped == r.deadlines && r.deadlines >= wanted && l.count == r.served &&
-         l.min_ns >= 0 && l.p50_ns <= l.p99_ns && l.p99_ns <= l.p999_ns && l.p999_ns <= l.max_ns;
+  return r.served + r.skipped == r.deadlines && r.deadlines >= wanted && l.count == r.served && l.min_ns >= 0 &&
+         l.p50_ns <= l.p99_ns && l.p99_ns <= l.p999_ns && l.p999_ns <= l.max_ns;
 }
 
 }  // namespace
@@ -91,10 +91,11 @@ int main(int argc, char** argv) {
     const auto usage = hystloop::read_resource_usage();
 
     std::printf("rate %.0f Hz (period %" PRId64 " ns), %.3f s\n", opt.rate_hz, period, r.elapsed_s);
-    std::printf("deadlines %" PRIu64 ": served %" PRIu64 ", skipped %" PRIu64 " (%.3f %%)\n", r.deadlines,
-                r.served, r.skipped, r.deadlines ? 100.0 * static_cast<double>(r.skipped) / static_cast<double>(r.deadlines) : 0.0);
-    std::printf("lateness [us]: p50 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  mean %.1f\n", l.p50_ns / 1e3,
-                l.p99_ns / 1e3, l.p999_ns / 1e3, l.max_ns / 1e3, l.mean_ns / 1e3);
+    std::printf("deadlines %" PRIu64 ": served %" PRIu64 ", skipped %" PRIu64 " (%.3f %%)\n", r.deadlines, r.served,
+                r.skipped,
+                r.deadlines ? 100.0 * static_cast<double>(r.skipped) / static_cast<double>(r.deadlines) : 0.0);
+    std::printf("lateness [us]: p50 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  mean %.1f\n", l.p50_ns / 1e3, l.p99_ns / 1e3,
+                l.p999_ns / 1e3, l.max_ns / 1e3, l.mean_ns / 1e3);
     std::printf("worst overrun: %.1f us after the first deadline it missed\n",
                 static_cast<double>(r.worst_overdue_ns) / 1e3);
     std::printf("cpu %.3f s user + %.3f s system, peak rss %.1f MiB, involuntary switches %" PRId64 "\n",

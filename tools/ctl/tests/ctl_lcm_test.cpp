@@ -151,21 +151,30 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
       {{"shutdown"}, control_t::SHUTDOWN, "", {}},
       {{"reset-counters", "bridge"}, control_t::RESET_COUNTERS, "bridge", {}},
       {{"stop-experiment"}, control_t::STOP_EXPERIMENT, "", {}},
-      {{"mode", "mem"}, control_t::SET_MODE, "",
+      {{"mode", "mem"},
+       control_t::SET_MODE,
+       "",
        [](const control_t& c) { EXPECT_EQ(c.mode, command_block_t::MODE_MEM); }},
-      {{"mode", "pi", "--target", "compensator"}, control_t::SET_MODE, "compensator",
+      {{"mode", "pi", "--target", "compensator"},
+       control_t::SET_MODE,
+       "compensator",
        [](const control_t& c) { EXPECT_EQ(c.mode, command_block_t::MODE_PI); }},
-      {{"gains", "--kp", "0.5", "--ki", "20", "--kd", "1e-5"}, control_t::SET_GAINS, "bridge",  // the servo's home
+      {{"gains", "--kp", "0.5", "--ki", "20", "--kd", "1e-5"},
+       control_t::SET_GAINS,
+       "bridge",  // the servo's home
        [](const control_t& c) {
          EXPECT_EQ(c.kp, 0.5);
          EXPECT_EQ(c.ki, 20.0);
          EXPECT_EQ(c.kd, 1e-5);
        }},
-      {{"gains", "--kp", "0.1", "--target", "bridge2"}, control_t::SET_GAINS, "bridge2",
+      {{"gains", "--kp", "0.1", "--target", "bridge2"},
+       control_t::SET_GAINS,
+       "bridge2",
        [](const control_t& c) { EXPECT_EQ(c.kp, 0.1); }},
       {{"experiment", "--amplitude", "50", "--frequency", "2", "--duration", "10", "--offset", "-5", "--kind",
         "triangle"},
-       control_t::START_EXPERIMENT, "",
+       control_t::START_EXPERIMENT,
+       "",
        [](const control_t& c) {
          EXPECT_EQ(c.experiment, "triangle");
          EXPECT_EQ(c.experiment_amplitude_V, 50.0);
@@ -235,7 +244,8 @@ TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
 TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
   std::vector<mem_params_t> got;
   Subscription<mem_params_t> sub(*lcm_, ch_.params, [&](const mem_params_t& p, std::int64_t) { got.push_back(p); });
-  Result r = run_ctl(with_url({"params", "--c1", "1.2e-7", "--c2", "3e-9", "--c3", "0.8", "--version", "7"}), lcm_.get());
+  Result r =
+      run_ctl(with_url({"params", "--c1", "1.2e-7", "--c2", "3e-9", "--c3", "0.8", "--version", "7"}), lcm_.get());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(got.size(), 3u);
   EXPECT_EQ(got[0].version, 7);
@@ -281,9 +291,9 @@ TEST_F(CtlLcmTest, WaitHealthyReturnsAsSoonAsEveryoneIsHealthy) {
     status.publish(status_of("compensator", service_status_t::HEALTHY));
   };
   const auto start = std::chrono::steady_clock::now();
-  Result r = run_ctl(with_url({"status", "--wait-healthy", "bridge", "compensator", "--accept-safe", "bridge",
-                               "--timeout", "10"}),
-                     lcm_.get(), play_rig);
+  Result r = run_ctl(
+      with_url({"status", "--wait-healthy", "bridge", "compensator", "--accept-safe", "bridge", "--timeout", "10"}),
+      lcm_.get(), play_rig);
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_LT(took, 5.0);
@@ -399,11 +409,18 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
 }
 
 TEST(CtlArguments, HelpEverywhere) {
-  const std::vector<std::pair<std::string, std::string>> subcommands{
-      {"status", "--wait-healthy"}, {"arm", "--target"},         {"disarm", "--target"},
-      {"shutdown", "process"},      {"reset-counters", "process"}, {"mode", "katalenic"},
-      {"gains", "--kd"},            {"experiment", "--duration"}, {"stop-experiment", "--target"},
-      {"trajectory", "--mem-paper"}, {"params", "--c3"},          {"watch", "--seconds"}};
+  const std::vector<std::pair<std::string, std::string>> subcommands{{"status", "--wait-healthy"},
+                                                                     {"arm", "--target"},
+                                                                     {"disarm", "--target"},
+                                                                     {"shutdown", "process"},
+                                                                     {"reset-counters", "process"},
+                                                                     {"mode", "katalenic"},
+                                                                     {"gains", "--kd"},
+                                                                     {"experiment", "--duration"},
+                                                                     {"stop-experiment", "--target"},
+                                                                     {"trajectory", "--mem-paper"},
+                                                                     {"params", "--c3"},
+                                                                     {"watch", "--seconds"}};
   Result r = run_ctl({"--help"});
   EXPECT_EQ(r.exit_code, 0);
   for (const auto& [name, option] : subcommands) {

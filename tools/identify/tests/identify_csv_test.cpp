@@ -32,7 +32,8 @@ void write_csv(const std::string& file, const std::vector<double>& u, const std:
   std::FILE* f = std::fopen(file.c_str(), "w");
   ASSERT_NE(f, nullptr);
   std::fprintf(f, "t,u,y\n");
-  for (std::size_t k = 0; k < u.size(); ++k) std::fprintf(f, "%.9g,%.17g,%.17g\n", static_cast<double>(k) / fs, u[k], y[k]);
+  for (std::size_t k = 0; k < u.size(); ++k)
+    std::fprintf(f, "%.9g,%.17g,%.17g\n", static_cast<double>(k) / fs, u[k], y[k]);
   std::fclose(f);
 }
 
@@ -124,7 +125,8 @@ TEST_F(IdentifyTool, BanningFromOneFileWithAnExperimentColumn) {
   const YAML::Node doc = YAML::LoadFile(path("banning.yaml"));
   EXPECT_NEAR(doc["banning"]["hysteresis"]["a"].as<double>(), truth.hysteresis.a, 0.005 * truth.hysteresis.a);
   EXPECT_NEAR(doc["banning"]["hysteresis"]["b"].as<double>(), truth.hysteresis.b, 0.01 * truth.hysteresis.b);
-  EXPECT_NEAR(doc["banning"]["hysteresis"]["alpha"].as<double>(), truth.hysteresis.alpha, 0.04 * truth.hysteresis.alpha);
+  EXPECT_NEAR(doc["banning"]["hysteresis"]["alpha"].as<double>(), truth.hysteresis.alpha,
+              0.04 * truth.hysteresis.alpha);
   EXPECT_NEAR(doc["banning"]["stage"]["k"].as<double>(), truth.stage.k, 0.01 * truth.stage.k);
   EXPECT_NEAR(doc["banning"]["stage"]["c"].as<double>(), truth.stage.c, 0.05 * truth.stage.c);
 }
@@ -169,8 +171,8 @@ TEST_F(IdentifyTool, MoreSamplesThanTheBoundAreRefusedWithAHint) {
   EXPECT_NE(r.output.find("--decimate 4"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("c1 = "), std::string::npos) << r.output;  // refused before any fit
   // Decimated to the bound, the rate-independent MEM still fits.
-  const ToolRun d = run_tool(path("mem.csv") + " --model mem --max-samples 5000 --decimate 4 --out " +
-                             path("params.yaml"));
+  const ToolRun d =
+      run_tool(path("mem.csv") + " --model mem --max-samples 5000 --decimate 4 --out " + path("params.yaml"));
   ASSERT_EQ(d.exit_code, 0) << d.output;
   EXPECT_NEAR(YAML::LoadFile(path("params.yaml"))["mem"]["c1"].as<double>(), truth.c1, 0.02 * truth.c1);
 }

@@ -166,8 +166,8 @@ TEST_F(IdentifyLog, RepeatedTicksAreSkippedAndCounted) {
 TEST_F(IdentifyLog, NonFiniteValueIsRefusedNamingFileEventAndSeq) {
   for (const bool in_u : {false, true}) {
     auto record = mem_record(truth_);
-    (in_u ? record[1234].u_V : record[1234].y_m) = in_u ? std::numeric_limits<double>::infinity()
-                                                        : std::numeric_limits<double>::quiet_NaN();
+    (in_u ? record[1234].u_V : record[1234].y_m) =
+        in_u ? std::numeric_limits<double>::infinity() : std::numeric_limits<double>::quiet_NaN();
     write_log(path("nan.lcmlog"), record);
     try {
       read_sample_logs({path("nan.lcmlog")}, {});
@@ -284,7 +284,6 @@ TEST_F(IdentifyLog, ToolRecoversMemFromRotatedLogsAndReportsSkipsAndTheGap) {
   EXPECT_NEAR(yaml_value(path("p.yaml"), "c2"), truth_.c2, 0.01 * truth_.c2) << r.output;
   EXPECT_NEAR(yaml_value(path("p.yaml"), "c3"), truth_.c3, 0.01 * truth_.c3) << r.output;
 }
-
 
 TEST_F(IdentifyLog, ToolFitsOnlyTheTimeRange) {
   write_log(path("run.lcmlog"), with_faults(mem_record(truth_, 0.5e-9)));

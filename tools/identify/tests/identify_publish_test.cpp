@@ -93,9 +93,10 @@ class IdentifyPublish : public ::testing::Test {
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     lcm_ = open_lcm(kUrl);
-    params_ = std::make_unique<Subscription<mem_params_t>>(*lcm_, ch_.params, [this](const mem_params_t& m, std::int64_t) {
-      if (m.source.rfind("hystloop-identify@", 0) == 0) received_.push_back(m);
-    });
+    params_ =
+        std::make_unique<Subscription<mem_params_t>>(*lcm_, ch_.params, [this](const mem_params_t& m, std::int64_t) {
+          if (m.source.rfind("hystloop-identify@", 0) == 0) received_.push_back(m);
+        });
   }
   void TearDown() override {
     std::error_code ec;
@@ -186,7 +187,8 @@ TEST_F(IdentifyPublish, VersionSupersedesTheSetInUse) {
   received_.clear();
   write_log(path("rig3.lcmlog"), mem_record(truth_), 0, kTicks, false, "RIG3_SENSOR");
   std::vector<mem_params_t> rig3;
-  Subscription<mem_params_t> rig3_params(*lcm_, "RIG3_PARAMS", [&](const mem_params_t& m, std::int64_t) { rig3.push_back(m); });
+  Subscription<mem_params_t> rig3_params(*lcm_, "RIG3_PARAMS",
+                                         [&](const mem_params_t& m, std::int64_t) { rig3.push_back(m); });
   const Result v = run_tool(args(path("rig3.lcmlog"), {"--version", "42", "--rig", "RIG3_"}), *lcm_);
   ASSERT_EQ(v.exit_code, 0) << v.out;
   EXPECT_NE(v.out.find("published MEM parameters v42 on RIG3_PARAMS"), std::string::npos) << v.out;
@@ -210,9 +212,9 @@ TEST_F(IdentifyPublish, AUrlThatCouldLeaveTheHostIsRefusedBeforeTheFit) {
     }
   }
   for (const std::string input : {"run.lcmlog", "run.csv"}) {
-    const Result r = run_tool({path(input), "--model", "mem", "--publish", "--lcm-url",
-                               "udpm://239.255.76.67:7667?ttl=1", "--listen-s", "0"},
-                              *lcm_);
+    const Result r = run_tool(
+        {path(input), "--model", "mem", "--publish", "--lcm-url", "udpm://239.255.76.67:7667?ttl=1", "--listen-s", "0"},
+        *lcm_);
     EXPECT_EQ(r.exit_code, 2) << input << ": " << r.out;
     EXPECT_NE(r.out.find("lcm.url"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("MEM ("), std::string::npos) << "fitted before the URL was checked: " << r.out;

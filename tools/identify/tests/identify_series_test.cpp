@@ -57,7 +57,7 @@ struct Faults {
   std::int64_t stop_at_tick = -1;             // STOP_EXPERIMENT at this tick
   std::int64_t drop_samples_from = -1;        // ticks [from, from + count) not recorded
   std::int64_t drop_samples_count = 0;
-  std::int64_t late_from = -1;                // ticks [from, from + count) flagged LATE_COMMAND
+  std::int64_t late_from = -1;  // ticks [from, from + count) flagged LATE_COMMAND
   std::int64_t late_count = 0;
 };
 
@@ -200,7 +200,8 @@ TEST_F(IdentifySeries, EveryExperimentIsFoundAtTheTicksTheCompensatorRanIt) {
     double worst = 0.0;
     for (std::size_t k = 0; k < e.samples.u.size(); ++k) {
       const double t = static_cast<double>(e.begin_tick + static_cast<std::int64_t>(k)) * 1e-4 - start_s;
-      const double expected = e.spec.offset_V + e.spec.amplitude_V * std::sin(2.0 * std::numbers::pi * e.spec.frequency_hz * t);
+      const double expected =
+          e.spec.offset_V + e.spec.amplitude_V * std::sin(2.0 * std::numbers::pi * e.spec.frequency_hz * t);
       worst = std::max(worst, std::abs(e.samples.u[k] - expected));
     }
     EXPECT_LT(worst, 1e-9) << i;
@@ -246,8 +247,8 @@ TEST_F(IdentifySeries, MissingSamplesSpoilAFrequencyExperimentButNotALoop) {
   // Find the experiments' ticks from a clean recording first.
   const Recording rec = record_series(path("clean.lcmlog"), steps_, {}, seconds_);
   const auto schedule = experiment_schedule(rec.first_experiment_tick, rec.specs, 1e-4);
-  const std::size_t loop = 1;                 // offset -60 V, measured at 5 Hz: 4000 ticks
-  const std::size_t fast = steps_.size() - 1; // 2400 Hz, measured
+  const std::size_t loop = 1;                  // offset -60 V, measured at 5 Hz: 4000 ticks
+  const std::size_t fast = steps_.size() - 1;  // 2400 Hz, measured
   Faults loop_gap;
   loop_gap.drop_samples_from = schedule[loop].begin + 1000;
   loop_gap.drop_samples_count = 5;
@@ -311,9 +312,8 @@ TEST_F(IdentifySeries, ToolFitsTheStageFromTheLog) {
   const auto r = testing::run_tool(std::string(HYSTLOOP_IDENTIFY_EXE) + " --model banning " + path("run.lcmlog") +
                                    " --out " + path("b.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find(std::to_string(steps_.size()) + " experiment(s) ran (" +
-                          std::to_string(steps_.size() / 2) + " measured, " + std::to_string(steps_.size() / 2) +
-                          " usable)"),
+  EXPECT_NE(r.output.find(std::to_string(steps_.size()) + " experiment(s) ran (" + std::to_string(steps_.size() / 2) +
+                          " measured, " + std::to_string(steps_.size() / 2) + " usable)"),
             std::string::npos)
       << r.output;
   const YAML::Node b = YAML::LoadFile(path("b.yaml"))["banning"];
@@ -341,7 +341,8 @@ TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
       << r.output;
   double gain = 0.0, offset = 0.0;
   ASSERT_EQ(std::sscanf(r.output.substr(r.output.find("linear: gain = ")).c_str(),
-                        "linear: gain = %lf m/V, offset = %lf m", &gain, &offset), 2)
+                        "linear: gain = %lf m/V, offset = %lf m", &gain, &offset),
+            2)
       << r.output;
   const double a = BanningStageParams{}.hysteresis.a;
   EXPECT_NEAR(offset + gain * 60.0, a * 60.0, 0.005 * a * 60.0) << r.output;

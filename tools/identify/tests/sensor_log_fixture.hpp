@@ -23,15 +23,15 @@
 
 namespace hystloop::testlog {
 
-constexpr std::int64_t kFirstSeq = 1000;                  // a record rarely starts at tick 0
+constexpr std::int64_t kFirstSeq = 1000;                     // a record rarely starts at tick 0
 constexpr std::int64_t kFirstUtime = 1'700'000'000'000'000;  // [us]
-constexpr std::size_t kTicks = 20'000;                     // 2 s at 10 kHz
-constexpr std::size_t kBlockTicks = 10;                    // ticks per HX_SENSOR block
+constexpr std::size_t kTicks = 20'000;                       // 2 s at 10 kHz
+constexpr std::size_t kBlockTicks = 10;                      // ticks per HX_SENSOR block
 
 // Planted faults, as tick offsets from kFirstSeq.
-constexpr std::size_t kSafeBegin = 5000, kSafeCount = 10;    // SAFE_STATE (t = 0.5 s)
-constexpr std::size_t kFaultBegin = 7000, kFaultCount = 3;   // SENSOR_FAULT (t = 0.7 s)
-constexpr std::size_t kGapBegin = 12'000, kGapCount = 50;    // never recorded (t = 1.2 s)
+constexpr std::size_t kSafeBegin = 5000, kSafeCount = 10;   // SAFE_STATE (t = 0.5 s)
+constexpr std::size_t kFaultBegin = 7000, kFaultCount = 3;  // SENSOR_FAULT (t = 0.7 s)
+constexpr std::size_t kGapBegin = 12'000, kGapCount = 50;   // never recorded (t = 1.2 s)
 
 // Every tick of the record, before faults are planted.
 inline std::vector<SensorTick> mem_record(const MemParams& truth, double noise_rms_m = 0.0, std::uint64_t seed = 7) {
@@ -90,7 +90,7 @@ std::vector<std::uint8_t> encoded(const T& msg) {
 
 // The blocks ticks [begin, end) are sent in: runs of consecutive seq, at most kBlockTicks each.
 inline std::vector<std::pair<std::size_t, std::size_t>> block_ranges(const std::vector<SensorTick>& ticks,
-                                                                    std::size_t begin, std::size_t end) {
+                                                                     std::size_t begin, std::size_t end) {
   std::vector<std::pair<std::size_t, std::size_t>> ranges;
   for (std::size_t first = begin; first < end;) {
     std::size_t last = first + 1;
@@ -115,9 +115,8 @@ inline sensor_block_t make_block(const std::vector<SensorTick>& ticks, std::size
 // reader must ignore or count: another rig's sensor channel (a one-tick block with every
 // 1000th tick), a params message, and (with `corrupt`) one mem_params_t and one truncated block
 // on the sensor channel itself.
-inline void write_log(const std::string& path, const std::vector<SensorTick>& ticks, std::size_t begin,
-                      std::size_t end, bool corrupt = false, const std::string& sensor_channel = "HX_SENSOR",
-                      double dt_s = 1e-4) {
+inline void write_log(const std::string& path, const std::vector<SensorTick>& ticks, std::size_t begin, std::size_t end,
+                      bool corrupt = false, const std::string& sensor_channel = "HX_SENSOR", double dt_s = 1e-4) {
   lcm::LogFile log(path, "w");
   ASSERT_TRUE(log.good()) << path;
   std::int64_t eventnum = 0;

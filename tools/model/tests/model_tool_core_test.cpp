@@ -62,7 +62,9 @@ TEST(StrictNumber, AcceptsCNotationOnly) {
 }
 
 TEST(CsvColumnsRead, ReadsRequestedColumnsInAnyOrderAndListsTheOthers) {
-  const CsvColumns c = read("\xEF\xBB\xBF# recorded\r\n" "y, u ,t\r\n\n1e-9, 2.5 , 0\r\n2e-9,-3,0.001\n# end\n");
+  const CsvColumns c = read(
+      "\xEF\xBB\xBF# recorded\r\n"
+      "y, u ,t\r\n\n1e-9, 2.5 , 0\r\n2e-9,-3,0.001\n# end\n");
   ASSERT_EQ(c.rows(), 2u);
   EXPECT_EQ(c.values[0], (std::vector<double>{0.0, 0.001}));
   EXPECT_EQ(c.values[1], (std::vector<double>{2.5, -3.0}));
@@ -261,9 +263,8 @@ TEST(ModelRegistry, HelpListsEveryModelParameterUnitAndDefault) {
 class ParamsFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("hystloop_model_core_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = std::filesystem::temp_directory_path() / ("hystloop_model_core_" + std::to_string(::getpid()) + "_" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override {
@@ -287,11 +288,12 @@ class ParamsFileTest : public ::testing::Test {
 };
 
 TEST_F(ParamsFileTest, FlattensNestedMapsAndListsIntoAssignments) {
-  const std::string p = write("p.yaml",
-                              "# written by hystloop-identify\n"
-                              "bridge: {u_max_V: 250}\n"
-                              "katalenic:\n  k1: 30  # [V]\n  output_shaping: {kind: polynomial, coefficients: [0, 3e-9, "
-                              "0, 1e-15], domain_min: -300, domain_max: 300}\n");
+  const std::string p =
+      write("p.yaml",
+            "# written by hystloop-identify\n"
+            "bridge: {u_max_V: 250}\n"
+            "katalenic:\n  k1: 30  # [V]\n  output_shaping: {kind: polynomial, coefficients: [0, 3e-9, "
+            "0, 1e-15], domain_min: -300, domain_max: 300}\n");
   const ParamsFile f = read_params_file(p, "");
   EXPECT_EQ(f.model, "katalenic");
   ASSERT_EQ(f.assignments.size(), 5u);
@@ -304,7 +306,8 @@ TEST_F(ParamsFileTest, FlattensNestedMapsAndListsIntoAssignments) {
 }
 
 TEST_F(ParamsFileTest, RefusesWithTheFileAndKey) {
-  EXPECT_EQ(error((dir_ / "missing.yaml").string(), "mem"), (dir_ / "missing.yaml").string() + ": cannot open the parameters file");
+  EXPECT_EQ(error((dir_ / "missing.yaml").string(), "mem"),
+            (dir_ / "missing.yaml").string() + ": cannot open the parameters file");
   const std::string two = write("two.yaml", "mem: {c1: 5e-9}\npi: {n: 3}\n");
   EXPECT_EQ(error(two, ""), two + ": several model sections (mem, pi): choose one with --model");
   EXPECT_EQ(read_params_file(two, "pi").model, "pi");

@@ -163,7 +163,8 @@ INSTANTIATE_TEST_SUITE_P(
     Models, ModelToolRoundTrip,
     ::testing::Values(RoundTripCase{"mem", "--param c1=4.5e-9 --param c2=2e-12 --param c3=1.1", 1e-11},
                       RoundTripCase{"pi", "--param n=12 --param u_max=260", 1e-11},
-                      RoundTripCase{"pi_weights", "--param weights=4e-9,1e-9,1e-9,5e-10,5e-10 --param u_max=250", 1e-11},
+                      RoundTripCase{"pi_weights", "--param weights=4e-9,1e-9,1e-9,5e-10,5e-10 --param u_max=250",
+                                    1e-11},
                       RoundTripCase{"katalenic", "--param k1=30 --param k2=0.02", 1e-11},
                       RoundTripCase{"linear", "--param gain=6e-9 --param offset=1e-7", 1e-11}),
     [](const auto& test) { return std::string(test.param.name); });
@@ -198,8 +199,9 @@ TEST_F(ModelTool, BanningForwardMatchesTheStageSteppedWithTheFilesTimes) {
     std::vector<double> y = {stage.output()};
     for (std::size_t k = 1; k < u.size(); ++k) y.push_back(stage.step(u[k], t[k] - t[k - 1]));
 
-    const ToolRun r = run("--model banning --param hysteresis.alpha=0.015 " +
-                          std::string(paper_order ? "--param order=stage_then_hysteresis " : "") + "--forward " + u_csv);
+    const ToolRun r =
+        run("--model banning --param hysteresis.alpha=0.015 " +
+            std::string(paper_order ? "--param order=stage_then_hysteresis " : "") + "--forward " + u_csv);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::vector<double> got = parse(r.out, {"t", "u", "y"}).values[2];
     ASSERT_EQ(got.size(), y.size());
@@ -282,7 +284,8 @@ TEST_F(ModelTool, EveryRefusalExitsWithTwoAndNamesWhere) {
       {"--model mem --forward {in}", "0,0\n0.001,10\n", "{in}:1: missing header row: expected column names 't,u'"},
       {"--model mem --forward {in}", "t,v\n0,0\n", "{in}:1: header 't,v' lacks column 'u'"},
       {"--model mem --inverse {in}", ok, "{in}:1: header 't,u' lacks column 'y_ref' (expected 't,y_ref'"},
-      {"--model mem --forward {in}", "t,u\n0,0\n0.001,inf\n", "{in}:3: column 'u': expected a finite number, got 'inf'"},
+      {"--model mem --forward {in}", "t,u\n0,0\n0.001,inf\n",
+       "{in}:3: column 'u': expected a finite number, got 'inf'"},
       {"--model mem --forward {in}", "t,u\n0,0\n0.001,1,2\n", "{in}:3: 3 fields, the header has 2"},
       {"--model mem --forward {in}", "t,u\n", "{in}:1: no data rows after the header"},
       {"--model banning --forward {in}", "t,u\n0,0\n0.001,1\n0.001,2\n",
@@ -368,8 +371,9 @@ TEST_F(ModelTool, HelpListsEveryModelAndParameterWithUnitAndDefault) {
       EXPECT_NE(line.find("default " + p.default_text), std::string::npos) << line;
     }
   }
-  for (const char* name : {"c1", "c2", "c3", "hysteresis.alpha", "stage.k", "k1", "k2", "output_shaping.gain", "n (or count)",
-                           "u_max", "weights", "thresholds", "gain", "offset", "--params-file", "--forward", "--inverse"}) {
+  for (const char* name :
+       {"c1", "c2", "c3", "hysteresis.alpha", "stage.k", "k1", "k2", "output_shaping.gain", "n (or count)", "u_max",
+        "weights", "thresholds", "gain", "offset", "--params-file", "--forward", "--inverse"}) {
     EXPECT_NE(r.out.find(name), std::string::npos) << name;
   }
 }

@@ -128,7 +128,8 @@ TEST(CompareCommands, PlayedButUnansweredSamplesAreTransportLosses) {
   EXPECT_EQ(r.missing_in_actual, 0u);
   EXPECT_EQ(r.first_lost_sample, 298);
   EXPECT_EQ(r.exit_code(), 1);  // the verdict (transport loss) tells it from a divergence
-  EXPECT_NE(format_report(r, {}).find("replay transport lost 2 commanded ticks"), std::string::npos) << format_report(r, {});
+  EXPECT_NE(format_report(r, {}).find("replay transport lost 2 commanded ticks"), std::string::npos)
+      << format_report(r, {});
 
   // A divergence after the loss may be its consequence: still a transport verdict.
   a.by_seq[600].u_ff_V += 1.0;
@@ -209,7 +210,8 @@ sensor_block_t sensor_msg(std::int64_t b) {
   sensor_block_t m{};
   begin_block(m, 10 * b, 1'000'000 + 1000 * b, 1e-4);
   for (std::int64_t t = 10 * b; t < 10 * b + 10; ++t) {
-    append_tick(m, SensorTick{0, t, 0.5 * static_cast<double>(t), 0.5 * static_cast<double>(t), 0.0, 1e-9, 1e-9 * static_cast<double>(t), 4});
+    append_tick(m, SensorTick{0, t, 0.5 * static_cast<double>(t), 0.5 * static_cast<double>(t), 0.0, 1e-9,
+                              1e-9 * static_cast<double>(t), 4});
   }
   return m;
 }
@@ -220,9 +222,9 @@ command_block_t command_msg(std::int64_t first, std::int64_t last, std::int64_t 
   begin_block(m, first, 1'000'000 + 100 * sample_seq, sample_seq);
   for (std::int64_t t = first; t <= last; ++t) {
     const bool no_reference = t % 7 == 0;
-    append_tick(m, CommandTick{t, 0.25 * static_cast<double>(t),
-                               no_reference ? std::numeric_limits<double>::quiet_NaN() : 1e-9, 1,
-                               no_reference ? command_block_t::MODE_EXPERIMENT : command_block_t::MODE_MEM});
+    append_tick(
+        m, CommandTick{t, 0.25 * static_cast<double>(t), no_reference ? std::numeric_limits<double>::quiet_NaN() : 1e-9,
+                       1, no_reference ? command_block_t::MODE_EXPERIMENT : command_block_t::MODE_MEM});
   }
   return m;
 }
@@ -305,7 +307,7 @@ TEST(RecordedCommands, BlocksAreTakenApartIntoTicksAndARepeatedTickKeepsItsFirst
   {
     LogWriter w(path);
     w.write(1, c.command, command_msg(100, 109, -1));  // before any sample: not an answer
-    auto overlap = command_msg(105, 119, 42);           // 105..109 again
+    auto overlap = command_msg(105, 119, 42);          // 105..109 again
     for (double& u : overlap.u_ff_V) u += 1.0;
     w.write(2, c.command, overlap);
     w.write(3, c.sensor, sensor_msg(1));  // not a command
@@ -437,7 +439,8 @@ TEST(CommandAlteration, ChangesExactlyOneTickAndTheComparisonNamesIt) {
   const auto r2 = write_altered_log(recorded, altered, c, {141, std::nullopt, 0.5});
   EXPECT_EQ(r2.new_u_ff_V, r2.old_u_ff_V + 0.5);
   EXPECT_EQ(compare_commands(e, read_commands(altered, c), nullptr, {}).first_divergence->seq, 141);
-  EXPECT_THROW(write_altered_log(recorded, altered, c, {5, std::nullopt, std::nullopt}), std::runtime_error);  // no tick 5
+  EXPECT_THROW(write_altered_log(recorded, altered, c, {5, std::nullopt, std::nullopt}),
+               std::runtime_error);  // no tick 5
   // The first block carries ticks 30..79: the 10th tick commanded is 39, the 60th is 89.
   EXPECT_EQ(write_altered_log(recorded, altered, c, {0, 10, std::nullopt}).seq, 39);
   EXPECT_EQ(write_altered_log(recorded, altered, c, {0, 60, std::nullopt}).seq, 89);

@@ -82,7 +82,8 @@ TEST(ComputeMetrics, RandomErrorsGiveTheirRms) {
     run.samples.push_back(tick(kT0 + k * 100, k, 2e-6, 2e-6 - e));
     run.command_versions.add(k, 3);
   }
-  for (std::int64_t b = 0; b < 500; ++b) run.command_blocks.push_back({kT0 + b * 1000, b * 10 + 305, b * 10 + 4 - b % 7, 10});
+  for (std::int64_t b = 0; b < 500; ++b)
+    run.command_blocks.push_back({kT0 + b * 1000, b * 10 + 305, b * 10 + 4 - b % 7, 10});
   const auto m = compute_metrics(run, {});
   EXPECT_NEAR(*m.rms_error_m, std::sqrt(sum / 5000.0), 1e-18);
   EXPECT_NEAR(*m.rms_error_m, 30e-9, 2e-9);
@@ -126,7 +127,7 @@ TEST(CommandVersions, FirstLoggedCommandForATickWinsAndRunsCoalesce) {
   CommandVersions v;
   for (std::int64_t k = 10; k < 20; ++k) v.add(k, 1);
   for (std::int64_t k = 15; k < 25; ++k) v.add(k, 2);  // 15..19 re-sent: ignored
-  v.add(30, 2);                                         // after a gap
+  v.add(30, 2);                                        // after a gap
   EXPECT_EQ(v.runs().size(), 3u);
   EXPECT_FALSE(v.at(9));
   EXPECT_EQ(*v.at(10), 1);
@@ -154,11 +155,12 @@ TEST(ComputeMetrics, LateFractionAndBufferDepthCountArmedTicksAndBlocksOnly) {
   RunData run = ramp_run(100, 100);
   for (std::int64_t k = 0; k < 100; ++k) {
     auto& s = run.samples[static_cast<std::size_t>(k)];
-    if (k < 20) s.flags |= 2;                // SAFE_STATE: not counted, late or not
-    if (k % 10 == 3) s.flags |= 16;          // LATE_COMMAND: ticks 3, 13 safe; 23 .. 93 armed
+    if (k < 20) s.flags |= 2;        // SAFE_STATE: not counted, late or not
+    if (k % 10 == 3) s.flags |= 16;  // LATE_COMMAND: ticks 3, 13 safe; 23 .. 93 armed
   }
   for (std::int64_t b = 0; b < 10; ++b) {
-    run.sensor_blocks.push_back({kT0 + b * 1000 + 900, b * 10, 10, 1e-4, static_cast<std::int32_t>(b == 1 ? 0 : 40 - b), b >= 2});
+    run.sensor_blocks.push_back(
+        {kT0 + b * 1000 + 900, b * 10, 10, 1e-4, static_cast<std::int32_t>(b == 1 ? 0 : 40 - b), b >= 2});
   }
   const auto m = compute_metrics(run, {});
   EXPECT_EQ(m.armed_samples, 80u);
@@ -175,10 +177,10 @@ TEST(ComputeMetrics, WatchdogTripsFromTheBridgeCounterElseFromTheTicks) {
   auto safe = [&](std::int64_t from, std::int64_t to) {
     for (std::int64_t k = from; k < to; ++k) run.samples[static_cast<std::size_t>(k)].flags |= 2;
   };
-  safe(0, 10);   // the start: not a trip
-  safe(30, 40);  // a trip
-  safe(60, 70);  // a DISARM: not a trip
-  safe(90, 100); // a trip
+  safe(0, 10);    // the start: not a trip
+  safe(30, 40);   // a trip
+  safe(60, 70);   // a DISARM: not a trip
+  safe(90, 100);  // a trip
   run.safe_requests.push_back({kT0 + 595'000, "bridge"});
   run.safe_requests.push_back({kT0 + 295'000, "compensator"});  // not for the bridge
   auto m = compute_metrics(run, {});
@@ -194,7 +196,8 @@ TEST(ComputeMetrics, CpuFractionPerProcessAddsItsSegments) {
   RunData run = ramp_run(10, 100);
   // bridge: 0.25 of a core for 2 s, then restarted (counters from 0) and 0.5 for 1 s.
   run.statuses.push_back(status(kT0, "bridge", {{"cpu_user_us", 1'000'000}, {"cpu_system_us", 0}}, 1));
-  run.statuses.push_back(status(kT0 + 2'000'000, "bridge", {{"cpu_user_us", 1'400'000}, {"cpu_system_us", 100'000}}, 1));
+  run.statuses.push_back(
+      status(kT0 + 2'000'000, "bridge", {{"cpu_user_us", 1'400'000}, {"cpu_system_us", 100'000}}, 1));
   run.statuses.push_back(status(kT0 + 3'000'000, "bridge", {{"cpu_user_us", 10}, {"cpu_system_us", 0}}, 2));
   run.statuses.push_back(status(kT0 + 4'000'000, "bridge", {{"cpu_user_us", 250'010}, {"cpu_system_us", 250'000}}, 2));
   run.statuses.push_back(status(kT0, "logger", {{"cpu_user_us", 0}}));  // no system time: no figure
@@ -227,7 +230,8 @@ TEST(ComputeMetrics, RejectedCommandsFallBackToTheStatusField) {
   run.statuses.push_back({kT0, "bridge", 1, 0, 9, {{"ticks", 10}, {"control.rejected_out_of_range", 4}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 9);  // no command reject counter: the 'rejected' field
-  run.statuses.push_back({kT0 + 10, "bridge", 1, 0, 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}, kT0, 0});
+  run.statuses.push_back(
+      {kT0 + 10, "bridge", 1, 0, 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 3);
   EXPECT_EQ(m.commands_rejected_counters.size(), 2u);

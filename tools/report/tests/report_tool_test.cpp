@@ -34,7 +34,7 @@ using namespace hystloop;
 namespace {
 
 constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // time of the first tick [us]
-constexpr std::int64_t kTicks = 12'000;               // 12 s at 1 kHz (the tool does not assume 10 kHz)
+constexpr std::int64_t kTicks = 12'000;              // 12 s at 1 kHz (the tool does not assume 10 kHz)
 constexpr std::int64_t kTickUs = 1000;
 constexpr std::int64_t kBlock = 10;                     // ticks per block
 constexpr std::int64_t kGapFirst = 5000, kGapLen = 10;  // ticks 5000..5009 (one block) never logged
@@ -43,9 +43,9 @@ constexpr std::int64_t kFirstArmed = 500;               // ticks before this car
 constexpr std::int64_t kTripFirst = 8000;               // 8000..8049: a watchdog trip
 constexpr std::int64_t kDisarmFirst = 10'000;           // 10000..10049: a DISARM (not a trip)
 constexpr std::int64_t kSafeLen = 50;
-constexpr std::int64_t kShallowBlock = 700;             // the armed block with the lowest buffer depth
-constexpr std::int64_t kResentFirst = 3990;             // a second command block for 3990..3999 (ignored)
-constexpr std::int64_t kLeadUs = 20'000;                // commands are sent 20 ms ahead of their tick
+constexpr std::int64_t kShallowBlock = 700;  // the armed block with the lowest buffer depth
+constexpr std::int64_t kResentFirst = 3990;  // a second command block for 3990..3999 (ignored)
+constexpr std::int64_t kLeadUs = 20'000;     // commands are sent 20 ms ahead of their tick
 
 bool logged(std::int64_t k) { return k < kGapFirst || k >= kGapFirst + kGapLen; }
 // The tick's time on the log's clock: its block arrives as its last tick is sampled.
@@ -77,8 +77,12 @@ bool block_armed(std::int64_t b) {
 std::int64_t command_sample_seq(std::int64_t c) { return std::max<std::int64_t>(-1, c * kBlock - 20 - c % 5); }
 std::int64_t command_recv(std::int64_t c) { return tick_utime(c * kBlock) - kLeadUs; }
 // CPU time of a process by its status number s (one a second): bridge 0.25 of a core, compensator 0.1.
-std::int64_t cpu_user(const std::string& process, std::int64_t s) { return s * (process == "bridge" ? 200'000 : 60'000); }
-std::int64_t cpu_system(const std::string& process, std::int64_t s) { return s * (process == "bridge" ? 50'000 : 40'000); }
+std::int64_t cpu_user(const std::string& process, std::int64_t s) {
+  return s * (process == "bridge" ? 200'000 : 60'000);
+}
+std::int64_t cpu_system(const std::string& process, std::int64_t s) {
+  return s * (process == "bridge" ? 50'000 : 40'000);
+}
 
 struct Event {
   std::int64_t t;
@@ -121,7 +125,8 @@ model_params_t linear_model(std::int32_t version) {
   return m;
 }
 
-service_status_t status(const std::string& process, std::int64_t t, std::vector<std::pair<std::string, std::int64_t>> c) {
+service_status_t status(const std::string& process, std::int64_t t,
+                        std::vector<std::pair<std::string, std::int64_t>> c) {
   service_status_t s{};
   s.utime = t;
   s.process = process;
@@ -146,7 +151,7 @@ struct LogOptions {
 };
 
 struct LogTruth {
-  std::map<std::string, std::size_t> counts;              // events per channel
+  std::map<std::string, std::size_t> counts;               // events per channel
   std::map<std::string, std::vector<std::int64_t>> times;  // their log times
 };
 
@@ -183,7 +188,8 @@ LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
     }
     events.push_back(event(recv, "HX_COMMAND", cb));
   };
-  for (std::int64_t c = 0; c < kTicks / kBlock; ++c) add_command_block(c * kBlock, command_recv(c), command_sample_seq(c), -1);
+  for (std::int64_t c = 0; c < kTicks / kBlock; ++c)
+    add_command_block(c * kBlock, command_recv(c), command_sample_seq(c), -1);
   add_command_block(kResentFirst, tick_utime(kResentFirst) - 1, -1, 99);  // a re-send: the first one counts
 
   control_t disarm{};
@@ -210,9 +216,10 @@ LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
                                                              {"cpu_system_us", cpu_system("bridge", s)}};
     if (o.watchdog_counter) bridge.emplace_back("watchdog_trips", 3);
     events.push_back(event(t, "HX_STATUS", status("bridge", t, bridge)));
-    events.push_back(event(t + 5, "HX_STATUS",
-                           status("compensator", t, {{"cpu_user_us", cpu_user("compensator", s)},
-                                                     {"cpu_system_us", cpu_system("compensator", s)}})));
+    events.push_back(
+        event(t + 5, "HX_STATUS",
+              status("compensator", t,
+                     {{"cpu_user_us", cpu_user("compensator", s)}, {"cpu_system_us", cpu_system("compensator", s)}})));
     if (o.logger_status) events.push_back(event(t + 10, "HX_STATUS", status("logger", t, {{"sensor.gaps", 1}})));
   }
   trajectory_t traj{};
@@ -352,8 +359,8 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
   const LogTruth truth = write_log(dir_ / "run.lcmlog");
   const auto& counts = truth.counts;
   const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
-                             " --csv HX_SENSOR --csv COMMAND --csv HX_STATUS",
-                         dir_);
+                                 " --csv HX_SENSOR --csv COMMAND --csv HX_STATUS",
+                             dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
   const Expected x = expected(-1e9, 1e9);
@@ -386,7 +393,8 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
 
   EXPECT_EQ(j.at("armed_samples").get<double>(), static_cast<double>(x.armed));
   EXPECT_EQ(j.at("late_samples").get<double>(), static_cast<double>(x.late));
-  EXPECT_NEAR(j.at("late_command_fraction").get<double>(), static_cast<double>(x.late) / static_cast<double>(x.armed), 1e-15);
+  EXPECT_NEAR(j.at("late_command_fraction").get<double>(), static_cast<double>(x.late) / static_cast<double>(x.armed),
+              1e-15);
 
   EXPECT_EQ(j.at("late_tick_fraction").get<double>(), j.at("late_command_fraction").get<double>());
   EXPECT_GT(j.at("late_samples").get<double>(), 40.0);  // the test can tell armed from all ticks
@@ -458,7 +466,8 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
   EXPECT_NEAR(j.at("params_final").at("c3").get<double>(), 0.9, 1e-15);
   EXPECT_EQ(j.at("params_updates").get<double>(), 2);  // v2 and v4; the invalid v3 is no update
 
-  for (const auto& [channel, n] : counts) EXPECT_EQ(j.at("channels")[channel].get<double>(), static_cast<double>(n)) << channel;
+  for (const auto& [channel, n] : counts)
+    EXPECT_EQ(j.at("channels")[channel].get<double>(), static_cast<double>(n)) << channel;
   EXPECT_EQ(j.at("undecodable_events").get<double>(), 0);
 
   // CSV: header of decoded fields with units, one row per tick of the block channels.
@@ -468,8 +477,8 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
             "y_m,flags");
   EXPECT_EQ(static_cast<std::size_t>(std::count(sensor.begin(), sensor.end(), '\n')), x.samples + 1);
   // Tick 1234 is dated on the report's axis, its block received with tick 1239.
-  const std::string row_1234 = "1.234," + std::to_string(tick_utime(1239)) + "," + std::to_string(tick_utime(1230) - 30) +
-                               ",1230,0.001,";
+  const std::string row_1234 =
+      "1.234," + std::to_string(tick_utime(1239)) + "," + std::to_string(tick_utime(1230) - 30) + ",1230,0.001,";
   EXPECT_NE(sensor.find("\n" + row_1234), std::string::npos) << row_1234;
   const std::string command = slurp(dir_ / "out" / "HX_COMMAND.csv");
   EXPECT_EQ(command.substr(0, command.find('\n')),
@@ -497,8 +506,8 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
 TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
   write_log(dir_ / "run.lcmlog", {.logger_status = false, .watchdog_counter = true});
   const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
-                             " --from 2 --to 9 --skip-initial 1 --no-plots --quiet --csv SENSOR",
-                         dir_);
+                                 " --from 2 --to 9 --skip-initial 1 --no-plots --quiet --csv SENSOR",
+                             dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
@@ -539,10 +548,11 @@ TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
       (n++ < 1500 ? a : b).writeEvent(&copy);
     }
   }
-  const ToolRun whole = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "a").string() + " --no-plots", dir_);
-  const ToolRun split = run_tool((dir_ / "run.00").string() + " " + (dir_ / "run.01").string() + " --out " +
-                                 (dir_ / "b").string() + " --no-plots",
-                             dir_);
+  const ToolRun whole =
+      run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "a").string() + " --no-plots", dir_);
+  const ToolRun split = run_tool(
+      (dir_ / "run.00").string() + " " + (dir_ / "run.01").string() + " --out " + (dir_ / "b").string() + " --no-plots",
+      dir_);
   ASSERT_EQ(whole.exit_code, 0);
   ASSERT_EQ(split.exit_code, 0) << split.err;
   const auto ja = nlohmann::json::parse(slurp(dir_ / "a" / "summary.json"));
@@ -555,9 +565,9 @@ TEST_F(ReportToolTest, RotatedFilesReadAsOneLog) {
 
 TEST_F(ReportToolTest, MissingGnuplotIsAWarningNotAFailure) {
   write_log(dir_ / "run.lcmlog");
-  const ToolRun r = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() +
-                             " --gnuplot /nonexistent/gnuplot --quiet",
-                         dir_);
+  const ToolRun r = run_tool(
+      (dir_ / "run.lcmlog").string() + " --out " + (dir_ / "out").string() + " --gnuplot /nonexistent/gnuplot --quiet",
+      dir_);
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.err.find("gnuplot not found"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "out" / "summary.json"));
@@ -610,7 +620,8 @@ TEST_F(ReportToolTest, CorruptEventsAreCountedNotFatal) {
     e.datalen = 5;  // truncated
     log.writeEvent(&e);
   }
-  const ToolRun r = run_tool((dir_ / "bad.lcmlog").string() + " --out " + (dir_ / "out").string() + " --no-plots", dir_);
+  const ToolRun r =
+      run_tool((dir_ / "bad.lcmlog").string() + " --out " + (dir_ / "out").string() + " --no-plots", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir_ / "out" / "summary.json"));
   EXPECT_EQ(j.at("samples").get<double>(), 1);
@@ -657,7 +668,8 @@ TEST_F(ReportToolTest, DamagedLogsAreNamedAndNothingDecodableExitsOne) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("torn.lcmlog: 13 bytes between events are not events"), std::string::npos) << r.err;
   // ... and reading goes on after them (liblcm's reader stopped there, dropping the rest).
-  const ToolRun clean = run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean0").string() + " --no-plots", dir_);
+  const ToolRun clean =
+      run_tool((dir_ / "run.lcmlog").string() + " --out " + (dir_ / "clean0").string() + " --no-plots", dir_);
   ASSERT_EQ(clean.exit_code, 0) << clean.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "torn" / "summary.json")).at("samples").get<double>(),
             nlohmann::json::parse(slurp(dir_ / "clean0" / "summary.json")).at("samples").get<double>());
