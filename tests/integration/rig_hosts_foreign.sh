@@ -21,7 +21,10 @@ foreign_counts() {
 }
 sleep 1.2  # a status report of each after `up`
 foreign_counts >"$out/foreign-before.txt"
-seq_before=$(tail -n 1 "$out/desk/sensor.csv" | cut -d, -f1)
+# The recorder is still writing sensor.csv: its last line may be incomplete, so every read below
+# drops it (a half-written row once read as "u moved" and a truncated seq as the start).
+complete_rows() { head -n -1 "$out/desk/sensor.csv"; }
+seq_before=$(complete_rows | tail -n 1 | cut -d, -f1)
 foreign() { in_ns desk "$ctl_exe" --lcm-url "$foreign_url" --allow-network --rig "$prefix" "$@" >/dev/null; }
 foreign arm
 foreign experiment --mem-paper --duration 2
@@ -50,7 +53,8 @@ for k in bridge.control.accepted compensator.control.accepted compensator.trajec
 done
 if [ "$(counter bridge state)" = 3 ]; then echo "ok:   the bridge stayed SAFE"
 else echo "FAIL: the bridge left SAFE (state $(counter bridge state))"; fail=1; fi
-moved=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s && $3 != 0' "$out/desk/sensor.csv" | wc -l)
-ticks=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s' "$out/desk/sensor.csv" | wc -l)
+complete_rows >"$out/foreign-sensor.csv"
+moved=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s && $3 != 0' "$out/foreign-sensor.csv" | wc -l)
+ticks=$(awk -F, -v s="$seq_before" 'NR > 1 && $1 > s' "$out/foreign-sensor.csv" | wc -l)
 if [ "$moved" = 0 ] && [ "$ticks" -gt 0 ]; then echo "ok:   u stayed 0 V over $ticks recorded ticks"
 else echo "FAIL: u moved on $moved of $ticks recorded ticks"; fail=1; fi
