@@ -157,6 +157,13 @@ void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
       break;
     default: break;  // unknown: the receiver's own reason (check_message refuses it)
   }
+  f.require(msg.stage_kind >= model_params_t::STAGE_UNCHANGED && msg.stage_kind <= model_params_t::STAGE_SECOND_ORDER);
+  f.require(msg.stage_order == model_params_t::ORDER_HYSTERESIS_THEN_STAGE ||
+            msg.stage_order == model_params_t::ORDER_STAGE_THEN_HYSTERESIS);
+  if (msg.stage_kind == model_params_t::STAGE_SECOND_ORDER) {
+    // k = omega_n^2 up to a 1 MHz resonance, c within what a physical stage damps.
+    f.require(msg.stage_k > 0.0 && msg.stage_k <= 4e13 && msg.stage_c > 0.0 && msg.stage_c <= 1e8);
+  }
 }
 
 }  // namespace
@@ -165,9 +172,9 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
   f.text(msg.source);
-  for (const double v :
-       {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1, msg.kat_k2,
-        msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max, msg.kat_initial_offset}) {
+  for (const double v : {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1,
+                         msg.kat_k2, msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max,
+                         msg.kat_initial_offset, msg.stage_k, msg.stage_c}) {
     f.finite(v);
   }
   const double in[] = {msg.kat_in_gain,       msg.kat_in_offset,    msg.kat_in_domain_min,
@@ -228,7 +235,8 @@ Verdict check_message(const control_t& msg) noexcept {
   f.require(msg.utime >= 0 && msg.request_id > 0);
   f.text(msg.target);
   f.text(msg.experiment);
-  f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::SHUTDOWN);
+  f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::SET_LEARNING);
+  f.require(msg.learning >= control_t::LEARNING_OFF && msg.learning <= control_t::LEARNING_RESET);
   f.require(is_command_mode(msg.mode));
   f.within(msg.kp, 0.0, kHuge);
   f.within(msg.ki, 0.0, kHuge);

@@ -41,7 +41,8 @@ void validate_prefixed(const Params& params, const char* prefix) {
 }
 }  // namespace
 
-void ModelParamSet::validate() const {
+void ModelParamSet::validate(double dt_s) const {
+  if (stage) stage->validate(dt_s);
   switch (kind) {
     case ModelKind::mem: return validate_prefixed(mem, "mem");
     case ModelKind::pi: return validate_prefixed(pi, "pi");

@@ -12,6 +12,7 @@
 #include "models/linear.hpp"
 #include "models/mem.hpp"
 #include "models/prandtl_ishlinskii.hpp"
+#include "models/stage_inverse.hpp"
 
 namespace hystloop {
 
@@ -32,9 +33,13 @@ struct ModelParamSet {
   PiParams pi{};
   KatalenicParams katalenic{};
   LinearParams linear{};
+  // The stage in series with the hysteresis, when the set says (nullopt: the receiver keeps the
+  // stage it has; a hysteresis refit says nothing of the stage).
+  std::optional<StageModel> stage;
 
-  // Validates the member `kind` names; throws ParameterError naming the field ("pi.weights[3]").
-  void validate() const;
+  // Validates the member `kind` names (and the stage, at tick dt_s); throws ParameterError naming
+  // the field ("pi.weights[3]", "stage.c").
+  void validate(double dt_s = 1e-4) const;
 };
 
 }  // namespace hystloop

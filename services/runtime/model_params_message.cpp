@@ -79,6 +79,19 @@ void set_model(model_params_t& msg, const ModelParamSet& set) {
   clear_parameters(msg);
   msg.format_version = model_params_t::FORMAT_VERSION;
   msg.kind = static_cast<std::int8_t>(set.kind);
+  msg.stage_kind = model_params_t::STAGE_UNCHANGED;
+  msg.stage_k = msg.stage_c = 0.0;
+  msg.stage_order = model_params_t::ORDER_HYSTERESIS_THEN_STAGE;
+  if (set.stage) {
+    msg.stage_kind = set.stage->has_dynamics() ? model_params_t::STAGE_SECOND_ORDER : model_params_t::STAGE_NONE;
+    if (set.stage->has_dynamics()) {
+      msg.stage_k = set.stage->second_order.k;
+      msg.stage_c = set.stage->second_order.c;
+    }
+    msg.stage_order = set.stage->order == BanningOrder::kStageThenHysteresis
+                          ? model_params_t::ORDER_STAGE_THEN_HYSTERESIS
+                          : model_params_t::ORDER_HYSTERESIS_THEN_STAGE;
+  }
   switch (set.kind) {
     case ModelKind::mem:
       msg.mem_c1 = set.mem.c1;
@@ -117,6 +130,18 @@ std::optional<ModelParamSet> model_from_message(const model_params_t& msg) {
   if (!kind) return std::nullopt;
   ModelParamSet set;
   set.kind = *kind;
+  if (msg.stage_kind == model_params_t::STAGE_NONE || msg.stage_kind == model_params_t::STAGE_SECOND_ORDER) {
+    StageModel stage;
+    if (msg.stage_kind == model_params_t::STAGE_SECOND_ORDER) {
+      stage.kind = StageModel::Kind::kSecondOrder;
+      stage.second_order = {msg.stage_k, msg.stage_c};
+    }
+    stage.order = msg.stage_order == model_params_t::ORDER_STAGE_THEN_HYSTERESIS ? BanningOrder::kStageThenHysteresis
+                                                                                 : BanningOrder::kHysteresisThenStage;
+    set.stage = stage;
+  } else if (msg.stage_kind != model_params_t::STAGE_UNCHANGED) {
+    return std::nullopt;
+  }
   switch (*kind) {
     case ModelKind::mem: set.mem = {msg.mem_c1, msg.mem_c2, msg.mem_c3}; break;
     case ModelKind::linear: set.linear = {msg.linear_gain, msg.linear_offset_m}; break;
