@@ -1,5 +1,7 @@
 #include "compensator/trajectory_message.hpp"
 
+#include <string>
+
 #include "core/errors.hpp"
 
 namespace hystloop {
@@ -19,6 +21,16 @@ TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
   spec.frequency_hz = msg.frequency_Hz > 0.0 ? msg.frequency_Hz : 1.0;  // ignored for HOLD and POINTS
   spec.phase_rad = msg.phase_rad;
   spec.blend_s = msg.blend_s;
+  // 0 on the wire asks the compensator for the shortest corner the limits allow; the spec carries
+  // it as 0 (sharp) until the compensator has chosen.
+  spec.corner_s = msg.shape == trajectory_t::TRIANGLE ? msg.corner_s : 0.0;
+  switch (msg.if_infeasible) {
+    case trajectory_t::REFUSE: spec.shape_if_infeasible = false; break;
+    case trajectory_t::SHAPE: spec.shape_if_infeasible = true; break;
+    default:
+      throw ParameterError("trajectory.if_infeasible",
+                           "must be REFUSE (0) or SHAPE (1) (got " + std::to_string(msg.if_infeasible) + ")");
+  }
   if (msg.n_points < 0 || static_cast<std::size_t>(msg.n_points) > TrajectorySpec::kMaxPoints ||
       msg.points_t_s.size() != static_cast<std::size_t>(msg.n_points) ||
       msg.points_y_m.size() != static_cast<std::size_t>(msg.n_points)) {

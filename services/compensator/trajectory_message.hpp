@@ -10,8 +10,10 @@
 
 namespace hystloop {
 
-// Shape, amplitude, offset, frequency, phase, blend and points; start_s and hold_m are left
-// to the caller. Throws ParameterError naming the field when the spec is unusable.
+// Shape, amplitude, offset, frequency, phase, blend, points, the triangle's corner_s (0 for the
+// other shapes; 0 for a triangle means "the shortest the limits allow": the caller chooses it) and
+// if_infeasible as spec.shape_if_infeasible; start_s and hold_m are left to the caller. Throws
+// ParameterError naming the field when the spec is unusable.
 TrajectorySpec trajectory_from_message(const trajectory_t& msg);
 
 // Loop time [s] of wall time `utime` [us], given that sample `sample_seq` was taken at
