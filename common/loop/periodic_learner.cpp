@@ -1,0 +1,291 @@
+#include "loop/periodic_learner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+namespace {
+
+constexpr std::int64_t kNoTick = std::numeric_limits<std::int64_t>::min();
+
+// The -6 dB frequency of the triangle of half-width m: where an m-tick mean's gain
+// sin(m x) / (m sin x), x = pi f dt, falls to 1/sqrt(2). It decreases monotonically on
+// (0, pi/m), so bisection finds it.
+double triangle_cutoff_hz(std::int64_t m, double dt_s) {
+  const double md = static_cast<double>(m);
+  double lo = 0.0, hi = std::numbers::pi / md;
+  for (int it = 0; it < 80; ++it) {
+    const double x = 0.5 * (lo + hi);
+    if (std::sin(md * x) / (md * std::sin(x)) > std::numbers::sqrt2 / 2.0) {
+      lo = x;
+    } else {
+      hi = x;
+    }
+  }
+  return 0.5 * (lo + hi) / (std::numbers::pi * dt_s);
+}
+
+std::int64_t floor_mod(std::int64_t a, std::int64_t n) noexcept {
+  const std::int64_t r = a % n;
+  return r < 0 ? r + n : r;
+}
+
+}  // namespace
+
+void LearningConfig::validate(double dt_s) const {
+  require_positive("compensator.dt_s", dt_s);
+  require_positive("learning.gain", gain);
+  require_in_range("learning.gain", gain, 0.0, 1.0);
+  require_positive("learning.max_correction_m", max_correction_m);
+  // 100 um is beyond any piezo nanopositioner's range: a larger bound is a unit mistake.
+  require_in_range("learning.max_correction_m", max_correction_m, 0.0, 1e-4);
+  // Ten seconds at 10 kHz is 100 000 ticks per table (four tables): the memory stays small.
+  require_in_range("learning.max_period_s", max_period_s, 2.0 * dt_s, 10.0);
+  // Above fs/4 no window of two or more taps is -6 dB that high: there would be no filter, and
+  // without one a plant delay of a tick makes the learning diverge near Nyquist.
+  require_in_range("learning.cutoff_hz", cutoff_hz, 1.0 / max_period_s, 0.25 / dt_s);
+  require_in_range("learning.fade_s", fade_s, dt_s, 10.0);
+}
+
+PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std::int64_t max_lag_ticks)
+    : dt_s_(dt_s),
+      gain_(config.gain),
+      applied_weight_(config.lag_compensated ? config.gain : 1.0),
+      max_correction_m_(config.max_correction_m),
+      max_period_(0),
+      window_(2),
+      fade_ticks_(1),
+      filter_cutoff_hz_(0.0),
+      lag_compensated_(config.lag_compensated),
+      enabled_(config.enabled) {
+  config.validate(dt_s);
+  require_in_range("learning.max_lag_ticks", static_cast<double>(max_lag_ticks), 0.0, 1e6);
+  max_period_ = static_cast<std::int64_t>(std::floor(config.max_period_s / dt_s + 1e-9));
+  fade_ticks_ = std::max<std::int64_t>(1, std::llround(config.fade_s / dt_s));
+  // The longest window whose -6 dB frequency is still at or above the cutoff: an M-tick mean's
+  // -3 dB is near 0.443 / (M dt); start there and correct for the discrete response.
+  std::int64_t m = std::max<std::int64_t>(2, static_cast<std::int64_t>(0.443 / (config.cutoff_hz * dt_s)));
+  m = std::min(m, max_period_);
+  while (m > 2 && triangle_cutoff_hz(m, dt_s) < config.cutoff_hz) --m;
+  while (m + 1 <= max_period_ && triangle_cutoff_hz(m + 1, dt_s) >= config.cutoff_hz) ++m;
+  window_ = m;
+  filter_cutoff_hz_ = triangle_cutoff_hz(m, dt_s);
+
+  // A sample's slot must still hold its tick when the sample arrives max_lag_ticks later.
+  const auto ring = static_cast<std::size_t>(max_lag_ticks + 1);
+  ring_k_.assign(ring, kNoTick);
+  ring_r_.assign(ring, 0.0);
+  ring_c_.assign(ring, 0.0);
+  for (auto* v : {&table_, &next_, &acc_, &tmp_}) v->assign(static_cast<std::size_t>(max_period_), 0.0);
+}
+
+double PeriodicLearner::filter_null_hz() const noexcept { return 1.0 / (static_cast<double>(window_) * dt_s_); }
+
+double PeriodicLearner::filter_norm_sq() const noexcept {
+  const double m = static_cast<double>(window_);
+  return (2.0 * m * m + 1.0) / (3.0 * m * m * m);
+}
+
+std::int64_t PeriodicLearner::phase(std::int64_t k) const noexcept { return floor_mod(k - table_k0_, table_n_); }
+
+std::size_t PeriodicLearner::slot(std::int64_t k) const noexcept {
+  return static_cast<std::size_t>(floor_mod(k, static_cast<std::int64_t>(ring_k_.size())));
+}
+
+void PeriodicLearner::restart(std::int64_t k0, std::int64_t period_ticks) noexcept {
+  has_target_ = period_ticks >= 2 && period_ticks <= max_period_;
+  k0_ = k0;
+  n_ = has_target_ ? period_ticks : 0;
+  begin_again();
+}
+
+void PeriodicLearner::stop() noexcept {
+  has_target_ = false;
+  n_ = 0;
+  begin_again();
+}
+
+void PeriodicLearner::set_enabled(bool on) noexcept {
+  if (on == enabled_) return;
+  enabled_ = on;
+  begin_again();
+}
+
+void PeriodicLearner::reset() noexcept { begin_again(); }
+
+void PeriodicLearner::begin_again() noexcept {
+  // Whatever was being observed or waiting belongs to what is being forgotten.
+  pending_ = false;
+  cur_open_ = false;
+  figures_.period_ticks = n_;
+  if (mode_ == Mode::kLearning && have_table_) {
+    // A table in use is faded out, never dropped: dropping it would step the reference.
+    mode_ = Mode::kFading;
+    scale_ = 1.0;
+    fade_left_ = fade_ticks_;
+  } else if (mode_ != Mode::kFading) {
+    start_learning(last_planned_ == kNoTick ? kNoTick : last_planned_ + 1);
+  }
+  // A fade under way goes on from where it is (no step) and starts the learning when it ends.
+  figures_.active = mode_ == Mode::kLearning;
+  figures_.fading = mode_ == Mode::kFading;
+}
+
+void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
+  have_table_ = false;
+  pending_ = false;
+  cur_open_ = false;
+  scale_ = 1.0;
+  table_rms_m_ = 0.0;
+  figures_.correction_rms_m = 0.0;
+  if (!enabled_ || !has_target_) {
+    mode_ = Mode::kIdle;
+  } else {
+    mode_ = Mode::kLearning;
+    table_k0_ = k0_;
+    table_n_ = n_;
+    table_m_ = std::min(window_, n_);
+    // The first period that starts at or after from_k: its every tick is planned by this learning.
+    learn_start_ = k0_;
+    if (from_k != kNoTick && from_k > k0_) learn_start_ = k0_ + (from_k - k0_ + n_ - 1) / n_ * n_;
+    expect_start_ = learn_start_;
+    last_observed_ = kNoTick;
+  }
+  figures_.active = mode_ == Mode::kLearning;
+  figures_.fading = false;
+}
+
+double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
+  last_planned_ = k;
+  if (mode_ == Mode::kFading) {
+    --fade_left_;
+    scale_ = static_cast<double>(fade_left_) / static_cast<double>(fade_ticks_);
+    if (fade_left_ <= 0) start_learning(k);
+  }
+  double c = 0.0;
+  if (mode_ == Mode::kLearning) {
+    if (k >= table_k0_) {
+      const std::int64_t i = phase(k);
+      if (pending_ && i == 0) {
+        // Only at a boundary: the table in use never changes inside a period.
+        std::swap(table_, next_);
+        have_table_ = true;
+        pending_ = false;
+        ++figures_.tables_adopted;
+        table_rms_m_ = pending_rms_m_;
+        figures_.correction_rms_m = table_rms_m_;
+      }
+      if (have_table_) c = table_[static_cast<std::size_t>(i)];
+    }
+  } else if (mode_ == Mode::kFading) {
+    c = scale_ * table_[static_cast<std::size_t>(phase(k))];
+    figures_.correction_rms_m = scale_ * table_rms_m_;
+  }
+  const std::size_t s = slot(k);
+  ring_k_[s] = k;
+  ring_r_[s] = r_k_m;
+  ring_c_[s] = c;
+  return c;
+}
+
+void PeriodicLearner::account_skipped(std::uint64_t n) noexcept {
+  figures_.periods_completed += n;
+  figures_.periods_skipped += n;
+}
+
+void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
+  if (mode_ != Mode::kLearning || k < learn_start_ || (last_observed_ != kNoTick && k <= last_observed_)) return;
+  last_observed_ = k;
+  const std::int64_t start = k - phase(k);
+  if (!cur_open_ || start != cur_start_) {
+    if (cur_open_) {
+      // The period before ended without its last tick.
+      account_skipped(1);
+      expect_start_ = cur_start_ + table_n_;
+    }
+    // Periods of which not a single sample arrived.
+    account_skipped(static_cast<std::uint64_t>((start - expect_start_) / table_n_));
+    cur_open_ = true;
+    cur_start_ = start;
+    cur_ok_ = k == start;
+    cur_sum_sq_ = 0.0;
+    cur_max_ = 0.0;
+  } else if (k != cur_next_) {
+    cur_ok_ = false;
+  }
+  cur_next_ = k + 1;
+
+  const std::size_t s = slot(k);
+  const double e = ring_r_[s] - y_m;
+  if (ring_k_[s] == k && std::isfinite(e) && std::isfinite(ring_c_[s])) {
+    // The part of the update that is this period's own: c_applied + gain*e, or its gain-weighted
+    // share gain*(c_applied + e) when lag-compensated (learn_from_period adds the rest).
+    acc_[static_cast<std::size_t>(k - start)] = applied_weight_ * ring_c_[s] + gain_ * e;
+    cur_sum_sq_ += e * e;
+    cur_max_ = std::max(cur_max_, std::abs(e));
+  } else {
+    // No sample, or its slot was planned over (later than max_lag_ticks): the period has a hole.
+    cur_ok_ = false;
+  }
+
+  if (k == start + table_n_ - 1) {
+    cur_open_ = false;
+    expect_start_ = start + table_n_;
+    if (cur_ok_) {
+      ++figures_.periods_completed;
+      ++figures_.periods_learned;
+      figures_.last_error_rms_m = std::sqrt(cur_sum_sq_ / static_cast<double>(table_n_));
+      figures_.last_error_max_m = cur_max_;
+      learn_from_period();
+    } else {
+      account_skipped(1);
+    }
+  }
+}
+
+void PeriodicLearner::learn_from_period() noexcept {
+  if (lag_compensated_ && (pending_ || have_table_)) {
+    // The new table replaces the newest one (waiting for a boundary, else in use), not the one
+    // applied when the error was measured: learning gain*ê on top of it, with ê = e - (c_newest -
+    // c_applied) the error c_newest would give if T = 1, is (1 - gain) c_newest + gain (c_applied
+    // + e). acc_ holds the second term; add the first (before the filter overwrites next_).
+    const std::vector<double>& newest = pending_ ? next_ : table_;
+    const double keep = 1.0 - gain_;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(table_n_); ++i) acc_[i] += keep * newest[i];
+  }
+  // Q = two running means over the circular period: tmp[i] = mean(acc[i-m+1 .. i]), then
+  // next[i] = mean(tmp[i .. i+m-1]). The looking-back and looking-ahead halves cancel each other's
+  // delay, so the result is the zero-phase triangle; 4 additions and 2 multiplications per phase.
+  const std::int64_t n = table_n_, m = table_m_;
+  const double inv_m = 1.0 / static_cast<double>(m);
+  double sum = 0.0;
+  for (std::int64_t j = 0; j < m; ++j) sum += acc_[static_cast<std::size_t>(floor_mod(-j, n))];
+  tmp_[0] = sum * inv_m;
+  for (std::int64_t i = 1, out = n - m + 1; i < n; ++i, ++out) {  // out = (i - m) mod n
+    if (out >= n) out -= n;
+    sum += acc_[static_cast<std::size_t>(i)] - acc_[static_cast<std::size_t>(out)];
+    tmp_[static_cast<std::size_t>(i)] = sum * inv_m;
+  }
+  sum = 0.0;
+  for (std::int64_t j = 0; j < m; ++j) sum += tmp_[static_cast<std::size_t>(j)];
+  double sum_sq = 0.0;
+  auto put = [&](std::int64_t i, double v) {
+    const double c = std::clamp(v, -max_correction_m_, max_correction_m_);
+    next_[static_cast<std::size_t>(i)] = c;
+    sum_sq += c * c;
+  };
+  put(0, sum * inv_m);
+  for (std::int64_t i = 1, in = m; i < n; ++i, ++in) {  // in = (i + m - 1) mod n
+    if (in >= n) in -= n;
+    sum += tmp_[static_cast<std::size_t>(in)] - tmp_[static_cast<std::size_t>(i - 1)];
+    put(i, sum * inv_m);
+  }
+  pending_rms_m_ = std::sqrt(sum_sq / static_cast<double>(n));
+  pending_ = true;
+}
+
+}  // namespace hystloop
