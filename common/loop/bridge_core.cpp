@@ -11,9 +11,11 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-FeedbackGains with_actuator_limit(FeedbackGains gains, const ActuatorLimits& limits) {
+// The servo's anti-windup range and notch design follow the actuator and the clock, whoever sets the gains.
+FeedbackGains with_actuator_limit(FeedbackGains gains, const ActuatorLimits& limits, double dt_s) {
   gains.u_min_V = limits.u_min_V;
   gains.u_max_V = limits.u_max_V;
+  gains.tick_rate_hz = 1.0 / dt_s;
   return gains;
 }
 
@@ -35,8 +37,9 @@ BridgeCore::BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo,
       // Whole ticks: k * dt compared with watchdog_s in floating point trips a tick early for
       // about a third of the values (0.0003 s = 3 ticks reads as 3.0000000000000004e-4).
       watchdog_ticks_(static_cast<std::int64_t>(std::floor(limits.watchdog_s / dt_s + 1e-9))),
-      servo_(with_actuator_limit(servo, limits)),
-      servo_ref_m_(kNaN) {
+      servo_(with_actuator_limit(servo, limits, dt_s)),
+      servo_ref_m_(kNaN),
+      ticks_per_second_(std::max<std::int64_t>(1, std::llround(1.0 / dt_s))) {
   u_applied_ = limits_.safe_u_V;
   held_.u_ff_V = limits_.safe_u_V;
   held_.y_ref_m = kNaN;
@@ -58,13 +61,22 @@ bool BridgeCore::submit(const CommandTick& command) noexcept {
 
 void BridgeCore::set_servo_gains(const FeedbackGains& gains) noexcept {
   try {
-    servo_.set_gains(with_actuator_limit(gains, limits_));
+    servo_.set_gains(with_actuator_limit(gains, limits_, dt_s_));
   } catch (...) {  // validated by the caller; an invalid set keeps the gains in force
   }
 }
 
+void BridgeCore::roll_clamp_window(std::int64_t k) noexcept {
+  const std::int64_t second = k / ticks_per_second_;
+  if (second == clamp_second_) return;
+  clamp_last_second_ = second == clamp_second_ + 1 ? clamp_this_second_ : ClampCounts{};
+  clamp_this_second_ = {};
+  clamp_second_ = second;
+}
+
 BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
   ++counters_.ticks;
+  roll_clamp_window(k);
   const double step_s =
       last_tick_ >= 0 ? dt_s_ * static_cast<double>(std::max<std::int64_t>(1, k - last_tick_)) : dt_s_;
   last_tick_ = k;
@@ -109,31 +121,43 @@ BridgeTick BridgeCore::tick(std::int64_t k, double y_measured_m) noexcept {
     ++counters_.late;
     out.flags |= sample_flags::kLateCommand;
   }
+  // What the clamps below will let through this tick: the range, and the slew limit's reach from
+  // the voltage applied last. The servo integrates only while its command stays inside.
+  const double max_step = limits_.slew_V_per_s * dt_s_;
+  const double allowed_lo_V = std::max(limits_.u_min_V, u_applied_ - max_step);
+  const double allowed_hi_V = std::min(limits_.u_max_V, u_applied_ + max_step);
   // The servo: the previous tick's reference against the position measured at its end.
   if (!command_since_arm_) {
     // Re-armed, no command yet: the servo keeps what it held through the safe state.
   } else if (!std::isfinite(held_.y_ref_m)) {
     servo_.reset();  // no reference (an experiment): nothing to track, nothing to remember
   } else if (std::isfinite(servo_ref_m_) && servo_.gains().enabled()) {
-    out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s);
+    out.u_fb_V = servo_.update(servo_ref_m_ - y_measured_m, held_.u_ff_V, step_s, allowed_lo_V, allowed_hi_V);
   }
   servo_ref_m_ = held_.y_ref_m;
   out.u_ff_V = held_.u_ff_V;
   out.y_ref_m = held_.y_ref_m;
   out.params_version = held_.params_version;
   const double target = held_.u_ff_V + out.u_fb_V;
-  const double max_step = limits_.slew_V_per_s * dt_s_;
 
   const double clamped = std::clamp(target, limits_.u_min_V, limits_.u_max_V);
-  if (clamped != target) {
+  const bool range_clamped = clamped != target;
+  double u = clamped;
+  const bool slew_clamped = std::abs(u - u_applied_) > max_step;
+  if (slew_clamped) u = u_applied_ + std::copysign(max_step, u - u_applied_);
+  if (range_clamped) {
     ++counters_.clamped;
+    ++clamp_this_second_.range;
     out.flags |= sample_flags::kSaturated;
   }
-  double u = clamped;
-  if (std::abs(u - u_applied_) > max_step) {
-    u = u_applied_ + std::copysign(max_step, u - u_applied_);
+  if (slew_clamped) {
     ++counters_.slew_limited;
+    ++clamp_this_second_.slew;
     out.flags |= sample_flags::kSlewLimited;
+  }
+  if (range_clamped || slew_clamped) {
+    ++counters_.clamped_either;
+    ++clamp_this_second_.either;
   }
   u_applied_ = u;
   out.u_applied_V = u;

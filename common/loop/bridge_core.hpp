@@ -3,7 +3,8 @@
 // tick k. The compensator sends its feedforward and reference ahead of time; they wait in a
 // jitter buffer indexed by tick (CommandBuffer). At tick k the core takes the command for k
 // (or holds the last one: a late tick), adds the servo's correction on y_ref - y, clamps to the
-// actuator's range and slew rate, and applies. It owns the safety rules of DESIGN.md: range and
+// actuator's range and slew rate, and applies. The servo is told the interval both clamps leave
+// this tick, so its anti-windup sees every clamp. It owns the safety rules of DESIGN.md: range and
 // slew clamp, non-finite and stale rejection, the watchdog on an empty buffer and the ramp to
 // the safe voltage. Time is an argument, so all of it is tested faster than real time.
 
@@ -53,10 +54,18 @@ struct BridgeCounters {
   std::uint64_t duplicates = 0;  // commands for a tick that had one already (the first stays)
   std::uint64_t rejected_nonfinite = 0;
   std::uint64_t rejected_future = 0;  // seq too far ahead to buffer
-  std::uint64_t clamped = 0;
-  std::uint64_t slew_limited = 0;
+  std::uint64_t clamped = 0;          // armed ticks whose command was clamped to the range
+  std::uint64_t slew_limited = 0;     // ... limited by the slew rate
+  std::uint64_t clamped_either = 0;   // ... by either (a tick clamped by both counts once)
   std::uint64_t watchdog_trips = 0;
   std::uint64_t safe_ticks = 0;  // ticks in the safe state
+};
+
+// Armed ticks clamped during one whole second of loop time (BridgeCore::clamped_last_second).
+struct ClampCounts {
+  std::uint64_t either = 0;  // by the range or the slew limit (once when by both)
+  std::uint64_t range = 0;
+  std::uint64_t slew = 0;
 };
 
 struct BridgeTick {
@@ -93,6 +102,10 @@ class BridgeCore {
   const FeedbackGains& servo_gains() const noexcept { return servo_.gains(); }
 
   const BridgeCounters& counters() const noexcept { return counters_; }
+  // The clamped ticks of the last whole second of loop time: ticks [(s - 1) n, s n) while tick k
+  // is in second s = floor(k / n), n = round(1 / dt) ticks per second (zero before the first).
+  const ClampCounts& clamped_last_second() const noexcept { return clamp_last_second_; }
+  const FeedbackController& servo() const noexcept { return servo_; }
   const ActuatorLimits& limits() const noexcept { return limits_; }
   double last_applied_V() const noexcept { return u_applied_; }
   std::int64_t buffer_depth() const noexcept { return buffer_.depth(); }
@@ -114,6 +127,12 @@ class BridgeCore {
   double safe_ramp_from_V_ = 0.0;
   std::int64_t safe_ramp_ticks_ = 0;  // safe-state ticks since the ramp started
   BridgeCounters counters_;
+  std::int64_t ticks_per_second_;  // round(1 / dt), at least 1
+  std::int64_t clamp_second_ = 0;  // the second of loop time clamp_this_second_ counts
+  ClampCounts clamp_this_second_{};
+  ClampCounts clamp_last_second_{};
+
+  void roll_clamp_window(std::int64_t k) noexcept;
 };
 
 }  // namespace hystloop

@@ -1,13 +1,20 @@
 #pragma once
 // PID on the tracking error, added to the feedforward voltage. Gains are normalised by
 // the stage's nominal gain so that they read in plain units whatever the stage:
-//   u_fb [V] = (kp * e + ki * integral(e) + kd * de/dt) / nominal_gain_m_per_V,   e = y_ref - y [m]
+//   u_fb [V] = N[(kp * e + ki * integral(e) + kd * de/dt) / nominal_gain_m_per_V],   e = y_ref - y [m]
 // kp [-], ki [1/s], kd [s]. With the feedforward linearising the stage to ~unit gain,
-// ki is roughly the loop's crossover in rad/s. Anti-windup: the integrator stops
-// growing in the direction in which the total command already saturates at u_min_V or
-// u_max_V (conditional integration), so a clamp never winds it up.
+// ki is roughly the loop's crossover in rad/s. N is an optional notch at the stage's
+// resonance (notch_filter.hpp), which otherwise caps the loop's bandwidth.
+//
+// Anti-windup: each tick the caller says which total command u_ff + u_fb it will let through
+// (the bridge: the actuator's range intersected with what the slew limit reaches from the last
+// applied voltage). The integrator grows toward an edge of that interval only as far as the
+// command stays inside it (conditional integration): it follows a clamped actuator instead of
+// running ahead of it, so neither clamp winds it up, and a command the clamp cuts never has a
+// grown integral behind it.
 
 #include "core/errors.hpp"
+#include "loop/notch_filter.hpp"
 
 namespace hystloop {
 
@@ -19,20 +26,43 @@ struct FeedbackGains {
   double u_min_V = -250.0;               // the range of u_ff + u_fb the actuator allows (for anti-windup)
   double u_max_V = 250.0;
   double d_filter_hz = 1000.0;  // first-order low-pass on the derivative
+  double notch_hz = 0.0;        // centre of the notch on the servo's output [Hz]; 0 = none
+  double notch_q = 2.0;         // its quality factor, centre / width [-] (checked only with a notch)
+  double tick_rate_hz = 1e4;    // the rate update() is called at: the notch is designed for it
+                                // (the bridge sets it from its clock, as it sets u_min_V/u_max_V)
 
+  // Throws ParameterError naming the field ("servo.notch_hz"): the notch needs
+  // 0 < notch_hz < 0.45 tick_rate_hz and notch_q in [0.1, 50].
   void validate() const;
   bool enabled() const noexcept { return kp != 0.0 || ki != 0.0 || kd != 0.0; }
+  bool has_notch() const noexcept { return notch_hz > 0.0; }
 };
+
+// The notch's limits (FeedbackGains::validate): below 0.45 of the tick rate the prewarped
+// design is still a notch and not a band-stop pressed against Nyquist.
+inline constexpr double kNotchMaxFractionOfRate = 0.45;
+inline constexpr double kNotchMinQ = 0.1;
+inline constexpr double kNotchMaxQ = 50.0;
+// How far short of an edge of the allowed interval the integrator stops, per volt of the edge
+// (plus 1 V): a nanovolt, far above the rounding of the command's sum, far below any DAC's step.
+inline constexpr double kBoundaryMargin_V = 1e-9;
 
 class FeedbackController {
  public:
   explicit FeedbackController(const FeedbackGains& gains = {});
 
-  // Voltage correction for error e [m] after dt [s], given the feedforward part u_ff [V]
-  // (needed for anti-windup). Allocation- and throw-free.
-  double update(double error_m, double u_ff_V, double dt_s) noexcept;
+  // Voltage correction for error e [m] after dt [s], given the feedforward part u_ff [V] and the
+  // interval [u_lo_V, u_hi_V] the total command u_ff + u_fb will be clamped to (anti-windup).
+  // Allocation- and throw-free. The notch steps once per call whatever dt (a skipped tick of the
+  // clock is a rare overrun; the filter is designed for tick_rate_hz).
+  double update(double error_m, double u_ff_V, double dt_s, double u_lo_V, double u_hi_V) noexcept;
+  // The same against the actuator's range alone ([u_min_V, u_max_V]).
+  double update(double error_m, double u_ff_V, double dt_s) noexcept {
+    return update(error_m, u_ff_V, dt_s, gains_.u_min_V, gains_.u_max_V);
+  }
 
-  // New gains; the integral is rescaled so that the output does not jump (bumpless).
+  // New gains; the integral is rescaled so that its part of the output does not jump, and a
+  // changed notch starts settled at the last output (bumpless).
   void set_gains(const FeedbackGains& gains);
   const FeedbackGains& gains() const noexcept { return gains_; }
   void reset() noexcept;
@@ -40,9 +70,11 @@ class FeedbackController {
 
  private:
   FeedbackGains gains_;
+  NotchFilter notch_;
   double integral_ = 0.0;  // [m s]
   double prev_error_ = 0.0;
-  double d_state_ = 0.0;  // filtered derivative [m/s]
+  double d_state_ = 0.0;   // filtered derivative [m/s]
+  double output_V_ = 0.0;  // the last correction returned
   bool has_prev_ = false;
 };
 

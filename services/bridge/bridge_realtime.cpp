@@ -190,6 +190,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
     r.min_depth_period = min_depth_period_;
     r.min_depth_total = min_depth_total_;
     r.buffer_depth = core_.buffer_depth();
+    r.clamped_last_second = core_.clamped_last_second();
     r.u_applied_V = core_.last_applied_V();
     r.gain_scale = backend_->gain_scale();
     r.armed = core_.armed();

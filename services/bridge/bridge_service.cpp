@@ -11,6 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "bridge/bridge_health.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
@@ -78,6 +79,9 @@ void BridgeService::on_control(const control_t& msg) {
       g.kp = msg.kp;
       g.ki = msg.ki;
       g.kd = msg.kd;
+      // A sender that knows no notch sends 0 and 0: no notch, which validates as such.
+      g.notch_hz = msg.notch_hz;
+      g.notch_q = msg.notch_q;
       try {
         g.validate();
       } catch (const std::exception& e) {
@@ -93,7 +97,9 @@ void BridgeService::on_control(const control_t& msg) {
       }
       ++control_acted_;
       gains_ = g;
-      spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s (request {})", g.kp, g.ki, g.kd, msg.request_id);
+      spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s, {} (request {})", g.kp, g.ki, g.kd,
+                   g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
+                   msg.request_id);
       return;
     }
     case control_t::RESET_COUNTERS:
@@ -247,6 +253,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
       {"rejected_future", k.rejected_future},
       {"clamped", k.clamped},
       {"slew_limited", k.slew_limited},
+      {"clamped_either", k.clamped_either},
       {"watchdog_trips", k.watchdog_trips},
       {"safe_ticks", k.safe_ticks},
       {"ticks_skipped", rt.ticks_skipped},
@@ -278,24 +285,19 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     spdlog::warn("{}", safe_reason_);
   }
 
-  std::int8_t state = service_status_t::HEALTHY;
-  std::string detail;
-  if (stopping) {
-    state = service_status_t::STOPPING;
-    detail = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed
-                 ? fmt::format("stopping: at the safe {} V", settings_.limits.safe_u_V)
-                 : fmt::format("stopping: ramping to the safe {} V", settings_.limits.safe_u_V);
-  } else if (!rt.armed) {
-    state = service_status_t::SAFE;
-    detail = safe_reason_;
-  } else if (late_fraction > settings_.degraded_late_fraction) {
-    state = service_status_t::DEGRADED;
-    detail = fmt::format("late fraction {:.3g} % > {:.3g} %", 100.0 * late_fraction,
-                         100.0 * settings_.degraded_late_fraction);
-  } else if (dropped > 0) {
-    state = service_status_t::DEGRADED;
-    detail = fmt::format("{} samples dropped: the I/O thread fell behind", dropped);
-  }
+  BridgeHealthInput health;
+  health.stopping = stopping;
+  health.armed = rt.armed;
+  health.at_safe_voltage = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed;
+  health.safe_u_V = settings_.limits.safe_u_V;
+  health.safe_reason = safe_reason_;
+  health.late_fraction = late_fraction;
+  health.degraded_late_fraction = settings_.degraded_late_fraction;
+  health.samples_dropped = dropped;
+  health.clamped_last_second = rt.clamped_last_second;
+  const BridgeHealth assessed = assess_bridge_health(health);
+  const std::int8_t state = assessed.state;
+  std::string detail = assessed.detail;
   if (rt.armed) safe_reason_ = "not armed";  // the next safe state says its own reason
   detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
                         detail.empty() ? "" : "; ", rt_.backend().name(), rt.u_applied_V, rt.gain_scale,
@@ -305,6 +307,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   counters_.report(status_, now);
   status_.counter("armed", rt.armed ? 1 : 0);
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
+  status_.counter("clamped_per_s", rt.clamped_last_second.either);
   status_.counter("buffer_depth_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, rt.buffer_depth)));
   if (rt.min_depth_period >= 0) {
     status_.counter("buffer_min_depth_period_ticks", static_cast<std::uint64_t>(rt.min_depth_period));
@@ -336,11 +339,12 @@ void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) 
   spdlog::info(
       "summary: {} ticks ({} skipped, {} run late to catch up), {} commands applied, {} late ({:.3g} % of armed "
       "ticks), {} stale, "
-      "{} duplicate, {} clamped, {} slew-limited, {} watchdog trips, {} non-finite and {} too-far-ahead "
+      "{} duplicate, {} clamped (range {}, slew {}), {} watchdog trips, {} non-finite and {} too-far-ahead "
       "rejected; lowest buffer depth {} ticks",
       c.ticks, rt.ticks_skipped, rt.ticks_caught_up, c.applied, c.late,
-      armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0, c.stale, c.duplicates, c.clamped,
-      c.slew_limited, c.watchdog_trips, c.rejected_nonfinite, c.rejected_future, rt.min_depth_total);
+      armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0, c.stale, c.duplicates,
+      c.clamped_either, c.clamped, c.slew_limited, c.watchdog_trips, c.rejected_nonfinite, c.rejected_future,
+      rt.min_depth_total);
   if (latency_total_.count() > 0) {
     spdlog::info(
         "summary: sensor block sent -> its answer received p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} "
@@ -369,7 +373,8 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
       "\"watchdog_trips\": {}, \"buffer_min_depth_ticks\": {}, \"ticks_skipped\": {}, \"ticks_caught_up\": {}, "
       "\"stale\": {}, \"duplicates\": {}, \"rejected\": {}, \"samples_dropped\": {}, \"sensor_blocks\": {}, "
       "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}, "
-      "\"count\": {}}}, \"applied\": {}, \"clamped\": {}, \"slew_limited\": {}, \"rejected_nonfinite\": {}, "
+      "\"count\": {}}}, \"applied\": {}, \"clamped\": {}, \"slew_limited\": {}, "
+      "\"clamped_ticks\": {{\"range\": {}, \"slew\": {}, \"either\": {}}}, \"rejected_nonfinite\": {}, "
       "\"rejected_future\": {}, \"command_blocks_rejected\": {}, "
       "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}, "
       "\"stop\": {{\"safe_reached\": {}, \"u_start_V\": {:.9g}, \"ramp_ticks\": {}, \"ramp_s\": {:.6g}, "
@@ -379,8 +384,8 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
       rt.ticks_skipped, rt.ticks_caught_up, c.stale, c.duplicates, c.rejected_nonfinite + c.rejected_future,
       rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
       latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, latency_total_.count(),
-      c.applied, c.clamped, c.slew_limited, c.rejected_nonfinite, c.rejected_future,
-      commands_.counters().rejected_total(), wall_s, usage.user_cpu_s + usage.system_cpu_s,
+      c.applied, c.clamped, c.slew_limited, c.clamped, c.slew_limited, c.clamped_either, c.rejected_nonfinite,
+      c.rejected_future, commands_.counters().rejected_total(), wall_s, usage.user_cpu_s + usage.system_cpu_s,
       wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0, safe.reached, safe.u_start_V,
       safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s, settings_.limits.safe_u_V);
   std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");

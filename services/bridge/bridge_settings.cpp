@@ -30,6 +30,8 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "servo.kd",
                                                 "servo.nominal_gain_m_per_V",
                                                 "servo.d_filter_hz",
+                                                "servo.notch_hz",
+                                                "servo.notch_q",
                                                 "actuator.u_min_V",
                                                 "actuator.u_max_V",
                                                 "actuator.slew_V_per_s",
@@ -125,9 +127,13 @@ BridgeSettings load_bridge_settings(const Config& config) {
   g.kd = config.get_non_negative("servo.kd", g.kd);
   g.nominal_gain_m_per_V = config.get_positive("servo.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
   g.d_filter_hz = config.get_positive("servo.d_filter_hz", g.d_filter_hz);
+  g.notch_hz = config.get_non_negative("servo.notch_hz", g.notch_hz);
+  // Checked here even without a notch: a Q the file gives is meant to be used.
+  g.notch_q = config.get_in_range("servo.notch_q", g.notch_q, kNotchMinQ, kNotchMaxQ);
   g.u_min_V = a.u_min_V;
   g.u_max_V = a.u_max_V;
-  validate_config_section(config, "servo.", [&] { g.validate(); });
+  g.tick_rate_hz = s.rate_hz;
+  validate_config_section(config, "", [&] { g.validate(); });  // its fields are named servo.*
 
   s.rt.ticks_per_wake = static_cast<int>(config.get_int_in_range("rt.ticks_per_wake", s.rt.ticks_per_wake, 1, 1000));
   if (s.rt.ticks_per_wake > s.block_ticks) {
@@ -172,8 +178,11 @@ std::vector<std::string> describe(const BridgeSettings& s) {
     lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
                                 st.ramberg_osgood.c3));
   }
-  lines.push_back(fmt::format("servo: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V{}", s.servo.kp,
+  lines.push_back(fmt::format("servo: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}", s.servo.kp,
                               s.servo.ki, s.servo.kd, s.servo.nominal_gain_m_per_V,
+                              s.servo.has_notch()
+                                  ? fmt::format("notch at {} Hz (Q {})", s.servo.notch_hz, s.servo.notch_q)
+                                  : std::string("no notch"),
                               s.servo.enabled() ? "" : " (off: feedforward only)"));
   lines.push_back(fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s)", s.block_ticks,
                               s.rate_hz / s.block_ticks));

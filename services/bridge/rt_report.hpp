@@ -31,6 +31,7 @@ struct RtReport {
   std::int64_t min_depth_period = -1;  // lowest buffer depth at an armed tick this period (-1: none)
   std::int64_t min_depth_total = -1;   // ... since the first command arrived
   std::int64_t buffer_depth = 0;       // now
+  ClampCounts clamped_last_second{};   // armed ticks clamped in the last whole second of loop time
   double u_applied_V = 0.0;
   double gain_scale = 1.0;
   bool armed = false;

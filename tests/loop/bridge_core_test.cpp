@@ -282,7 +282,9 @@ TEST(BridgeCore, ADeadCompensatorStopsTheStageWithinHorizonPlusWatchdog) {
   cc.mode = FeedforwardMode::kMem;
   cc.horizon_ticks = 300;
   Compensator comp(cc);
-  comp.set_trajectory(mem_paper_reference(0.05, 0.05), 0.05);
+  TrajectorySpec reference = mem_paper_reference(0.05, 0.05);
+  reference.shape_if_infeasible = true;  // the default MEM set needs a little more than +-250 V for it
+  comp.set_trajectory(reference, 0.05);
   SimulatedStage stage(SimulatedStageConfig{});
   std::vector<CommandTick> plan(64);
   constexpr std::int64_t kDies = 4500;  // at 0.45 s, near the reference's peak (~250 V)

@@ -3,6 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
+#include <numbers>
+
+#include "loop/notch_filter.hpp"
+#include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
@@ -58,7 +63,134 @@ TEST(Feedback, GainChangeIsBumpless) {
 TEST(Feedback, RefusesNegativeGains) {
   FeedbackGains g;
   g.ki = -1;
-  EXPECT_THROW(FeedbackController{g}, ParameterError);
+  EXPECT_EQ(testing::refused_field([&] { FeedbackController{g}; }), "servo.ki");
+}
+
+// The edge of the interval the caller allows, not only the actuator's range: the integral goes
+// up to the edge (a nanovolt short of it) and no further.
+TEST(Feedback, TheIntegratorStopsAtTheEdgeOfTheAllowedInterval) {
+  FeedbackGains g;
+  g.ki = 1000.0;
+  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackController c(g);
+  double u = 0.0;
+  for (int i = 0; i < 1000; ++i) u = c.update(1e-6, 10.0, 1e-4, -5.0, 12.0);  // +10 V per tick, 2 V allowed
+  EXPECT_NEAR(10.0 + u, 12.0, 1e-7);
+  EXPECT_LE(10.0 + u, 12.0);
+  // The other way: an error toward the low edge takes the integral down to it.
+  for (int i = 0; i < 1000; ++i) u = c.update(-1e-6, 10.0, 1e-4, -5.0, 12.0);
+  EXPECT_NEAR(10.0 + u, -5.0, 1e-7);
+  EXPECT_GE(10.0 + u, -5.0);
+  // Inside the interval it integrates as ever: 1000 * 1e-9 * 1e-4 / 1e-8 = 0.01 V per tick.
+  const double before = c.update(0.0, 0.0, 1e-4, -100.0, 100.0);
+  EXPECT_NEAR(c.update(1e-9, 0.0, 1e-4, -100.0, 100.0) - before, 0.01, 1e-12);
+}
+
+// A command the proportional part alone takes beyond the edge: the integral holds (it does not
+// grow toward the clamp, nor unwind: that is the error's business).
+TEST(Feedback, BeyondTheEdgeAlreadyTheIntegralHolds) {
+  FeedbackGains g;
+  g.kp = 1.0;
+  g.ki = 100.0;
+  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackController c(g);
+  for (int i = 0; i < 10; ++i) c.update(1e-9, 0.0, 1e-4);
+  const double held = c.integral_m_s();
+  for (int i = 0; i < 100; ++i) c.update(1e-6, 0.0, 1e-4, -1.0, 1.0);  // kp e / gain = 100 V > 1 V
+  EXPECT_EQ(c.integral_m_s(), held);
+}
+
+std::complex<double> response(const BiquadCoefficients& c, double f_hz, double rate_hz) {
+  const std::complex<double> z1 = std::polar(1.0, -2.0 * std::numbers::pi * f_hz / rate_hz);
+  return (c.b0 + c.b1 * z1 + c.b2 * z1 * z1) / (1.0 + c.a1 * z1 + c.a2 * z1 * z1);
+}
+
+// The bilinear transform with the centre prewarped: a zero exactly at f0, unit gain at DC and
+// Nyquist, and -3 dB where the transform takes the analogue band edges W (sqrt(1 + 1/4q^2) -+ 1/2q).
+TEST(Notch, DesignHasItsClosedForms) {
+  const double rate = 1e4;
+  for (const double f0 : {50.0, 1720.0, 4400.0}) {
+    for (const double q : {0.1, 0.7, 5.0, 50.0}) {
+      const BiquadCoefficients c = design_notch(f0, q, rate);
+      EXPECT_LT(std::abs(response(c, f0, rate)), 1e-10) << f0 << " " << q;
+      EXPECT_NEAR(std::abs(response(c, 0.0, rate)), 1.0, 1e-12);
+      EXPECT_NEAR(std::abs(response(c, rate / 2, rate)), 1.0, 1e-12);
+      const double w = 2.0 * rate * std::tan(std::numbers::pi * f0 / rate);
+      const double r = std::sqrt(1.0 + 1.0 / (4.0 * q * q));
+      for (const double edge : {w * (r - 0.5 / q), w * (r + 0.5 / q)}) {
+        const double f_edge = std::atan(edge / (2.0 * rate)) * rate / std::numbers::pi;
+        EXPECT_NEAR(std::abs(response(c, f_edge, rate)), std::sqrt(0.5), 1e-10) << f0 << " " << q;
+      }
+    }
+  }
+}
+
+TEST(Notch, StopsASineAtItsCentreAndPassesASlowOne) {
+  const double rate = 1e4, f0 = 1720.0;
+  for (const double f : {f0, 10.0}) {
+    NotchFilter n(design_notch(f0, 0.7, rate));
+    double peak = 0.0;
+    for (int i = 0; i < 20000; ++i) {
+      const double y = n.step(std::sin(2.0 * std::numbers::pi * f * i / rate));
+      if (i >= 10000) peak = std::max(peak, std::abs(y));
+    }
+    if (f == f0) {
+      EXPECT_LT(peak, 1e-9);
+    } else {
+      EXPECT_NEAR(peak, 1.0, 2e-3);
+    }
+  }
+}
+
+TEST(Notch, ServoOutputIsThePidThroughTheNotch) {
+  FeedbackGains g;
+  g.kp = 0.5;
+  g.nominal_gain_m_per_V = 1e-8;
+  g.notch_hz = 1720.0;
+  g.notch_q = 0.7;
+  FeedbackController c(g);
+  NotchFilter n(design_notch(1720.0, 0.7, 1e4));
+  for (int i = 0; i < 200; ++i) {
+    const double e = 1e-9 * std::sin(0.37 * i);
+    ASSERT_NEAR(c.update(e, 0.0, 1e-4), n.step(0.5 * e / 1e-8), 1e-15) << i;
+  }
+}
+
+// Switching the notch in, retuning it or out on a servo at rest changes nothing in its output.
+TEST(Notch, ANotchChangeIsBumpless) {
+  FeedbackGains g;
+  g.ki = 300.0;
+  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackController c(g);
+  for (int i = 0; i < 1000; ++i) c.update(1e-8, 0.0, 1e-4);
+  const double before = c.update(0.0, 0.0, 1e-4);
+  ASSERT_GT(before, 1.0);
+  for (const double f : {1720.0, 900.0, 0.0, 2500.0}) {
+    g.notch_hz = f;
+    c.set_gains(g);
+    for (int i = 0; i < 50; ++i) ASSERT_NEAR(c.update(0.0, 0.0, 1e-4), before, 1e-12) << f << " " << i;
+  }
+}
+
+TEST(Notch, RefusesANotchOutsideItsRangeNamingTheField) {
+  FeedbackGains g;  // 10 kHz: the notch must be below 4.5 kHz
+  g.notch_hz = 4500.0;
+  EXPECT_EQ(testing::refused_field([&] { g.validate(); }), "servo.notch_hz");
+  g.notch_hz = -1.0;
+  EXPECT_EQ(testing::refused_field([&] { g.validate(); }), "servo.notch_hz");
+  g.notch_hz = 4499.0;
+  EXPECT_NO_THROW(g.validate());
+  g.tick_rate_hz = 2000.0;  // the limit follows the clock
+  EXPECT_EQ(testing::refused_field([&] { g.validate(); }), "servo.notch_hz");
+  g.tick_rate_hz = 1e4;
+  g.notch_q = 0.09;
+  EXPECT_EQ(testing::refused_field([&] { g.validate(); }), "servo.notch_q");
+  g.notch_q = 51.0;
+  EXPECT_EQ(testing::refused_field([&] { g.validate(); }), "servo.notch_q");
+  // No notch, Q unused: what a SET_GAINS of a sender that knows no notch carries (0, 0).
+  g.notch_hz = 0.0;
+  g.notch_q = 0.0;
+  EXPECT_NO_THROW(g.validate());
 }
 
 }  // namespace

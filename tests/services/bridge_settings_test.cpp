@@ -72,9 +72,19 @@ TEST(BridgeSettings, TheServoTakesItsGainsFromServoKeysAndItsLimitFromTheActuato
   EXPECT_EQ(s.servo.u_min_V, -100.0);
   EXPECT_EQ(s.servo.u_max_V, 200.0);
   EXPECT_TRUE(s.servo.enabled());
+  EXPECT_FALSE(s.servo.has_notch());  // none unless asked for
   const auto lines = describe(s);
   EXPECT_TRUE(
       std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return contains(l, "servo: kp 0.2"); }));
+  // A notch, designed for the bridge's own clock.
+  const BridgeSettings n = load_bridge_settings(
+      Config::from_string("bridge: {rate_hz: 20000}\nservo: {ki: 300, notch_hz: 1500, notch_q: 3}", "bridge.yaml"));
+  EXPECT_EQ(n.servo.notch_hz, 1500.0);
+  EXPECT_EQ(n.servo.notch_q, 3.0);
+  EXPECT_EQ(n.servo.tick_rate_hz, 20000.0);
+  const auto notch_lines = describe(n);
+  EXPECT_TRUE(std::any_of(notch_lines.begin(), notch_lines.end(),
+                          [](const std::string& l) { return contains(l, "notch at 1500 Hz (Q 3)"); }));
 }
 
 TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
@@ -87,10 +97,13 @@ TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
   EXPECT_LE(s.rt.ticks_per_wake, s.block_ticks);
   EXPECT_EQ(s.command_queue_capacity, 256);
   EXPECT_EQ(s.servo.kp, 0.1);
-  EXPECT_EQ(s.servo.ki, 600.0);
+  EXPECT_EQ(s.servo.ki, 2000.0);  // with the notch at the resonance (bridge_servo_margins_test)
   EXPECT_EQ(s.servo.kd, 0.0);
   EXPECT_EQ(s.servo.nominal_gain_m_per_V, 6.3e-9);
   EXPECT_EQ(s.servo.d_filter_hz, 1000.0);
+  EXPECT_EQ(s.servo.notch_hz, 1720.0);
+  EXPECT_EQ(s.servo.notch_q, 0.7);
+  EXPECT_EQ(s.servo.tick_rate_hz, s.rate_hz);
   // Every key the bridge reads is documented there...
   for (const std::string& key : bridge_config_keys()) EXPECT_TRUE(c.has(key)) << key << " is not documented";
   // ... and every key listed is really read: a value of the wrong kind is refused by name.
@@ -152,6 +165,13 @@ TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_TRUE(contains(too_many, "bridge.yaml: rt.ticks_per_wake")) << too_many;
   EXPECT_TRUE(contains(too_many, "bridge.block_ticks")) << too_many;
   EXPECT_TRUE(contains(refusal("bridge: {block_ticks: 4}\nrt: {ticks_per_wake: 5}"), "rt.ticks_per_wake"));
+  // The notch: 0 or below 0.45 x the tick rate (which may come from another section), Q in [0.1, 50].
+  EXPECT_TRUE(contains(refusal("servo: {notch_hz: 4500}"), "bridge.yaml: servo.notch_hz"));
+  EXPECT_TRUE(contains(refusal("servo: {notch_hz: -1}"), "bridge.yaml: servo.notch_hz"));
+  EXPECT_TRUE(contains(refusal("bridge: {rate_hz: 2000}\nservo: {notch_hz: 1720}"), "bridge.yaml: servo.notch_hz"));
+  EXPECT_TRUE(contains(refusal("servo: {notch_hz: 1720, notch_q: 0.05}"), "bridge.yaml: servo.notch_q"));
+  EXPECT_TRUE(contains(refusal("servo: {notch_q: 60}"), "bridge.yaml: servo.notch_q"));
+  EXPECT_EQ(refusal("servo: {notch_hz: 4499, notch_q: 50}"), "accepted");
   // The servo's keys were feedback.* in the compensator: not a bridge key.
   EXPECT_TRUE(contains(refusal("feedback: {kp: 0.1}"), "feedback.kp"));
 

@@ -13,6 +13,8 @@ namespace {
 
 constexpr std::int32_t kSafeStateFlag = sensor_block_t::SAFE_STATE;
 constexpr std::int32_t kLateCommandFlag = sensor_block_t::LATE_COMMAND;
+constexpr std::int32_t kSaturatedFlag = sensor_block_t::SATURATED;
+constexpr std::int32_t kSlewLimitedFlag = sensor_block_t::SLEW_LIMITED;
 // A SAFE_STATE transition up to this long after a DISARM/SHUTDOWN request for the bridge is its
 // answer, not a watchdog trip (a tick is dated no earlier than it was sampled, but allow for the
 // request reaching the logger after the bridge).
@@ -163,6 +165,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     double sum_sq = 0.0;
     std::size_t n = 0;
     std::optional<std::int32_t> version;
+    std::size_t clamped = 0;
   };
   std::map<std::int64_t, BinSum> bins;
   std::vector<std::pair<double, double>> track;  // (t_s, e_m)
@@ -189,6 +192,13 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     prev = &s;
     BinSum& bin = bins[static_cast<std::int64_t>(std::floor(t))];
     if (const auto version = run.command_versions.at(s.seq)) bin.version = *version;
+    const bool range_clamped = (s.flags & kSaturatedFlag) != 0, slew_clamped = (s.flags & kSlewLimitedFlag) != 0;
+    m.clamped_range_samples += range_clamped ? 1 : 0;
+    m.clamped_slew_samples += slew_clamped ? 1 : 0;
+    if (range_clamped || slew_clamped) {
+      ++m.clamped_samples;
+      ++bin.clamped;
+    }
     if (!std::isfinite(s.y_ref_m)) continue;
     const double e = s.y_ref_m - s.y_m;
     bin.sum_sq += e * e;
@@ -228,6 +238,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
       if (const auto it = bins.find(second); it != bins.end()) {
         if (it->second.version) version = *it->second.version;
         out.tracking_samples = it->second.n;
+        out.clamped_samples = it->second.clamped;
         if (it->second.n > 0) out.rms_error_m = rms(it->second.sum_sq, it->second.n);
       }
       out.params_version = version;

@@ -43,6 +43,7 @@ struct SecondBin {
   std::size_t tracking_samples = 0;
   std::optional<double> rms_error_m;
   std::int32_t params_version = 0;  // of the last command applied in the bin (carried forward)
+  std::size_t clamped_samples = 0;  // ticks clamped by the range or the slew limit (once when by both)
 };
 
 struct MemParams {
@@ -74,6 +75,12 @@ struct ReportMetrics {
   std::size_t armed_samples = 0;                // ticks without SAFE_STATE
   std::size_t late_samples = 0;                 // armed ticks with LATE_COMMAND
   std::optional<double> late_command_fraction;  // late / armed ticks (summary: also late_tick_fraction)
+
+  // Ticks the bridge clamped, from their flags: SATURATED (to the range), SLEW_LIMITED, and
+  // either (a tick clamped by both counts once); per second in per_second.
+  std::size_t clamped_range_samples = 0;
+  std::size_t clamped_slew_samples = 0;
+  std::size_t clamped_samples = 0;
 
   std::size_t sensor_blocks = 0;  // HX_SENSOR blocks in the range
   std::size_t armed_blocks = 0;

@@ -1,5 +1,6 @@
 #include "report_table.hpp"
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 
@@ -40,6 +41,10 @@ std::string format_table(const ReportMetrics& m) {
   row("late commands", m.late_command_fraction ? fmt("%.4f %%  (%zu of %zu armed ticks)",
                                                      *m.late_command_fraction * 100.0, m.late_samples, m.armed_samples)
                                                : std::string("--  (no armed ticks)"));
+  std::size_t worst_second = 0;
+  for (const auto& bin : m.per_second) worst_second = std::max(worst_second, bin.clamped_samples);
+  row("clamped ticks", fmt("%zu  (range %zu, slew %zu; at most %zu in a second)", m.clamped_samples,
+                           m.clamped_range_samples, m.clamped_slew_samples, worst_second));
   row("buffer min depth", m.buffer_min_depth_ticks
                               ? fmt("%d ticks  (%zu armed of %zu sensor blocks)", *m.buffer_min_depth_ticks,
                                     m.armed_blocks, m.sensor_blocks)

@@ -84,15 +84,24 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   j["rms_error_last_5s_m"] = number_or_null(m.rms_error_last_5s_m);
   Json per_second = Json::array();
   Json rms_per_second = Json::array();  // the same bins' RMS alone: a plain series (issue 11)
+  Json clamped_per_second = Json::array();
   for (const auto& bin : m.per_second) {
     per_second.push_back(Json{{"t_s", bin.t_s},
                               {"rms_error_m", number_or_null(bin.rms_error_m)},
                               {"tracking_samples", bin.tracking_samples},
-                              {"params_version", bin.params_version}});
+                              {"params_version", bin.params_version},
+                              {"clamped_ticks", bin.clamped_samples}});
     rms_per_second.push_back(number_or_null(bin.rms_error_m));
+    clamped_per_second.push_back(bin.clamped_samples);
   }
   j["per_second"] = std::move(per_second);
   j["rms_per_second_m"] = std::move(rms_per_second);
+  j["clamped_definition"] =
+      "HX_SENSOR ticks flagged SATURATED (clamped to the actuator's range) or SLEW_LIMITED; either counts a tick "
+      "clamped by both once; clamped_per_second: either, per one-second bin of per_second";
+  j["clamped_ticks"] =
+      Json{{"range", m.clamped_range_samples}, {"slew", m.clamped_slew_samples}, {"either", m.clamped_samples}};
+  j["clamped_per_second"] = std::move(clamped_per_second);
 
   j["armed_samples"] = m.armed_samples;
   j["late_samples"] = m.late_samples;

@@ -172,6 +172,26 @@ TEST(ComputeMetrics, LateFractionAndBufferDepthCountArmedTicksAndBlocksOnly) {
   EXPECT_EQ(*m.tick_period_s, 1e-4);
 }
 
+// SATURATED = 1 (range), SLEW_LIMITED = 8; a tick flagged with both is one clamped tick.
+TEST(ComputeMetrics, ClampedTicksFromTheirFlagsInTotalAndPerSecond) {
+  RunData run = ramp_run(30, 100'000);                             // 10 ticks a second for 3 s
+  const std::int32_t flags[30] = {1, 8, 9, 0, 0, 0, 0, 0,  0, 0,   // second 0: 3 clamped (2 range, 2 slew)
+                                  0, 0, 0, 0, 0, 0, 0, 0,  0, 0,   // second 1: none
+                                  8, 8, 8, 8, 9, 1, 2, 16, 0, 0};  // second 2: 6 (2 range, 5 slew)
+  for (std::size_t k = 0; k < 30; ++k) run.samples[k].flags = flags[k];
+  const auto m = compute_metrics(run, {});
+  EXPECT_EQ(m.clamped_range_samples, 4u);
+  EXPECT_EQ(m.clamped_slew_samples, 7u);
+  EXPECT_EQ(m.clamped_samples, 9u);
+  ASSERT_EQ(m.per_second.size(), 3u);
+  EXPECT_EQ(m.per_second[0].clamped_samples, 3u);
+  EXPECT_EQ(m.per_second[1].clamped_samples, 0u);
+  EXPECT_EQ(m.per_second[2].clamped_samples, 6u);
+  ReportOptions from_one;  // the range selects the ticks counted
+  from_one.from_s = 1.0;
+  EXPECT_EQ(compute_metrics(run, from_one).clamped_samples, 6u);
+}
+
 TEST(ComputeMetrics, WatchdogTripsFromTheBridgeCounterElseFromTheTicks) {
   RunData run = ramp_run(100, 10'000);  // 10 ms apart
   auto safe = [&](std::int64_t from, std::int64_t to) {

@@ -64,6 +64,9 @@ bool safe(std::int64_t k) {
          (k >= kDisarmFirst && k < kDisarmFirst + kSafeLen);
 }
 bool late(std::int64_t k) { return k % 250 == 3; }
+// Armed ticks the bridge clamped: to the range, by the slew limit, both at k % 1200 == 7.
+bool range_clamped(std::int64_t k) { return !safe(k) && k % 400 == 7; }
+bool slew_clamped(std::int64_t k) { return !safe(k) && (k % 300 == 7 || k % 300 == 8); }
 std::int32_t version_in_use(std::int64_t k) { return k < 3200 ? 1 : (k < 7200 ? 2 : 4); }
 // Sensor block b: ticks b * kBlock ..; its buffer depth while armed.
 std::int32_t buffer_depth(std::int64_t b) { return b == kShallowBlock ? 2 : static_cast<std::int32_t>(30 + b % 17); }
@@ -173,7 +176,8 @@ LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
       t.y_ref_m = ref;
       t.y_m = (std::isfinite(ref) ? ref : 0.0) - error_of(k);
       t.flags = sensor_block_t::SIMULATED | (safe(k) ? sensor_block_t::SAFE_STATE : 0) |
-                (late(k) ? sensor_block_t::LATE_COMMAND : 0);
+                (late(k) ? sensor_block_t::LATE_COMMAND : 0) | (range_clamped(k) ? sensor_block_t::SATURATED : 0) |
+                (slew_clamped(k) ? sensor_block_t::SLEW_LIMITED : 0);
       append_tick(sb, t);
     }
     sb.buffer_depth_ticks = block_armed(b) ? buffer_depth(b) : 0;
@@ -280,6 +284,8 @@ struct Expected {
   std::int64_t trips = 0;
   std::vector<double> run_ahead;
   std::map<std::int64_t, std::pair<double, std::size_t>> bins;  // second -> (sum sq, n)
+  std::size_t clamped_range = 0, clamped_slew = 0, clamped_either = 0;
+  std::map<std::int64_t, std::size_t> clamped_bins;  // second -> ticks clamped by either
 };
 
 Expected expected(double lo, double hi) {
@@ -295,6 +301,9 @@ Expected expected(double lo, double hi) {
     if (x.first_t < 0) x.first_t = t;
     x.last_t = t;
     if (!safe(k)) ++x.armed, x.late += late(k) ? 1 : 0;
+    x.clamped_range += range_clamped(k) ? 1 : 0;
+    x.clamped_slew += slew_clamped(k) ? 1 : 0;
+    if (range_clamped(k) || slew_clamped(k)) ++x.clamped_either, ++x.clamped_bins[static_cast<std::int64_t>(t)];
     if (safe(k) && prev >= 0 && !safe(prev) && k != kDisarmFirst) ++x.trips;
     prev = k;
     if (k < kFirstReference) continue;
@@ -389,7 +398,17 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
       EXPECT_NEAR(bin.at("rms_error_m").get<double>(), want, kRel * want) << s;
     }
     EXPECT_EQ(bin.at("params_version").get<double>(), version_in_use(static_cast<std::int64_t>(s) * 1000 + 999)) << s;
+    const auto clamped = x.clamped_bins.find(static_cast<std::int64_t>(s));
+    const double want_clamped = clamped == x.clamped_bins.end() ? 0.0 : static_cast<double>(clamped->second);
+    EXPECT_EQ(bin.at("clamped_ticks").get<double>(), want_clamped) << s;
+    EXPECT_EQ(j.at("clamped_per_second").at(s).get<double>(), want_clamped) << s;
   }
+  EXPECT_EQ(j.at("clamped_per_second").size(), per_second.size());
+  const auto& clamped = j.at("clamped_ticks");
+  EXPECT_EQ(clamped.at("range").get<double>(), static_cast<double>(x.clamped_range));
+  EXPECT_EQ(clamped.at("slew").get<double>(), static_cast<double>(x.clamped_slew));
+  EXPECT_EQ(clamped.at("either").get<double>(), static_cast<double>(x.clamped_either));
+  EXPECT_LT(x.clamped_either, x.clamped_range + x.clamped_slew);  // some ticks are clamped by both
 
   EXPECT_EQ(j.at("armed_samples").get<double>(), static_cast<double>(x.armed));
   EXPECT_EQ(j.at("late_samples").get<double>(), static_cast<double>(x.late));
@@ -501,6 +520,12 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
   EXPECT_NE(r.out.find("tracking RMS error"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("run-ahead min/p1/p50"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("buffer min depth       2 ticks"), std::string::npos) << r.out;
+  std::size_t worst = 0;
+  for (const auto& [second, n] : x.clamped_bins) worst = std::max(worst, n);
+  const std::string clamped_row = "clamped ticks          " + std::to_string(x.clamped_either) + "  (range " +
+                                  std::to_string(x.clamped_range) + ", slew " + std::to_string(x.clamped_slew) +
+                                  "; at most " + std::to_string(worst) + " in a second)";
+  EXPECT_NE(r.out.find(clamped_row), std::string::npos) << clamped_row << "\n" << r.out;
 }
 
 TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
@@ -518,6 +543,8 @@ TEST_F(ReportToolTest, TimeRangeAndWarmUpSelectTheSamples) {
   EXPECT_NEAR(j.at("rms_error_last_5s_m").get<double>(), x.rms_last, kRel * x.rms_last);
   EXPECT_EQ(j.at("late_samples").get<double>(), static_cast<double>(x.late));
   EXPECT_EQ(j.at("armed_samples").get<double>(), static_cast<double>(x.armed));
+  EXPECT_EQ(j.at("clamped_ticks").at("either").get<double>(), static_cast<double>(x.clamped_either));
+  EXPECT_EQ(j.at("clamped_ticks").at("slew").get<double>(), static_cast<double>(x.clamped_slew));
   EXPECT_EQ(j.at("sensor_blocks").get<double>(), static_cast<double>(x.blocks));
   EXPECT_EQ(j.at("run_ahead_blocks").get<double>(), static_cast<double>(x.run_ahead.size()));
   EXPECT_EQ(j.at("range").at("from_s").get<double>(), 3.0);

@@ -1,0 +1,22 @@
+#include "loop/notch_filter.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace hystloop {
+
+BiquadCoefficients design_notch(double centre_hz, double q, double rate_hz) noexcept {
+  // s = (2 / T) (z - 1) / (z + 1) with K = W T / 2 = tan(pi f0 T), multiplied through by (z + 1)^2.
+  const double K = std::tan(std::numbers::pi * centre_hz / rate_hz);
+  const double K2 = K * K;
+  const double norm = 1.0 + K / q + K2;
+  BiquadCoefficients c;
+  c.b0 = (1.0 + K2) / norm;
+  c.b1 = 2.0 * (K2 - 1.0) / norm;
+  c.b2 = c.b0;
+  c.a1 = c.b1;
+  c.a2 = (1.0 - K / q + K2) / norm;
+  return c;
+}
+
+}  // namespace hystloop

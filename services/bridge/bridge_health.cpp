@@ -1,0 +1,43 @@
+#include "bridge/bridge_health.hpp"
+
+#include <spdlog/fmt/fmt.h>
+
+#include "hystloop/service_status_t.hpp"
+
+namespace hystloop {
+
+BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
+  BridgeHealth h;
+  h.state = service_status_t::HEALTHY;
+  if (in.stopping) {
+    h.state = service_status_t::STOPPING;
+    h.detail = in.at_safe_voltage ? fmt::format("stopping: at the safe {} V", in.safe_u_V)
+                                  : fmt::format("stopping: ramping to the safe {} V", in.safe_u_V);
+    return h;
+  }
+  if (!in.armed) {
+    h.state = service_status_t::SAFE;
+    h.detail = in.safe_reason;
+    return h;
+  }
+  const auto degraded = [&h](const std::string& reason) {
+    h.state = service_status_t::DEGRADED;
+    h.detail += (h.detail.empty() ? "" : "; ") + reason;
+  };
+  if (in.late_fraction > in.degraded_late_fraction) {
+    degraded(
+        fmt::format("late fraction {:.3g} % > {:.3g} %", 100.0 * in.late_fraction, 100.0 * in.degraded_late_fraction));
+  }
+  if (in.samples_dropped > 0) {
+    degraded(fmt::format("{} samples dropped: the I/O thread fell behind", in.samples_dropped));
+  }
+  // A clamped command is not what the compensator and the servo asked for: the rig tracks worse
+  // than its figures say, whatever else is well.
+  const ClampCounts& c = in.clamped_last_second;
+  if (c.either > 0) {
+    degraded(fmt::format("{} ticks clamped in the last second (range {}, slew {})", c.either, c.range, c.slew));
+  }
+  return h;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,34 @@
+#pragma once
+// The bridge's HX_STATUS state and detail from one report period's figures (BridgeService::report
+// gathers them): STOPPING while the stop ramps, SAFE while disarmed (with the reason), otherwise
+// DEGRADED for every reason that holds — commands late beyond bridge.degraded_late_fraction,
+// samples dropped, ticks clamped by the range or the slew limit in the last whole second — each
+// said in the detail, HEALTHY when none does. Plain data in and out, so it is tested alone.
+
+#include <cstdint>
+#include <string>
+
+#include "loop/bridge_core.hpp"
+
+namespace hystloop {
+
+struct BridgeHealthInput {
+  bool stopping = false;
+  bool armed = false;
+  bool at_safe_voltage = false;  // disarmed and at actuator.safe_u_V (while stopping)
+  double safe_u_V = 0.0;
+  std::string safe_reason;               // why the bridge is in the safe state
+  double late_fraction = 0.0;            // late / armed ticks of the report period
+  double degraded_late_fraction = 0.01;  // bridge.degraded_late_fraction
+  std::uint64_t samples_dropped = 0;     // this report period
+  ClampCounts clamped_last_second{};
+};
+
+struct BridgeHealth {
+  std::int8_t state = 0;  // service_status_t::HEALTHY, DEGRADED, SAFE or STOPPING
+  std::string detail;     // empty when HEALTHY
+};
+
+BridgeHealth assess_bridge_health(const BridgeHealthInput& in);
+
+}  // namespace hystloop

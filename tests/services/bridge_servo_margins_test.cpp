@@ -1,0 +1,70 @@
+// The servo's defaults in deploy/config/bridge.yaml keep the margins docs/TRACKING.md gives them
+// on Banning's stage (bench/servo_margins prints the table): the loop as the simulator runs it,
+// as a card that reads after writing runs it, and when the resonance or the stage's local slope
+// (the hysteresis moves it between 0.57 and 1.36 x the nominal gain) is not as assumed.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "bridge/bridge_settings.hpp"
+#include "loop/servo_loop_response.hpp"
+
+namespace hystloop {
+namespace {
+
+ServoLoopModel model_of(const BridgeSettings& s, double resonance_scale = 1.0, double slope = 1.0, int delay = 0) {
+  ServoLoopModel m;
+  m.stage = s.stage.banning.stage;
+  m.stage.k *= resonance_scale * resonance_scale;
+  m.stage.c *= resonance_scale;  // the same damping ratio
+  m.dt_s = s.dt_s();
+  m.slope_ratio = slope;
+  m.extra_delay_ticks = delay;
+  return m;
+}
+
+BridgeSettings deployed() {
+  return load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge.yaml"));
+}
+
+TEST(BridgeServoMargins, TheDefaultsKeepTheirMargins) {
+  const BridgeSettings s = deployed();
+  ASSERT_TRUE(s.servo.has_notch());
+  const ServoLoopResponse sim(s.servo, model_of(s));
+  const LoopMargins m = sim.margins();
+  ASSERT_TRUE(m.stable);
+  EXPECT_GE(m.gain_margin_dB, 12.0);      // 13.4 dB
+  EXPECT_GE(m.phase_margin_deg, 75.0);    // 80°
+  EXPECT_LE(sim.sensitivity(50.0), 0.2);  // 0.156: a third of the former defaults' 0.454
+  const LoopMargins card = ServoLoopResponse(s.servo, model_of(s, 1.0, 1.0, 1)).margins();
+  ASSERT_TRUE(card.stable);
+  EXPECT_GE(card.gain_margin_dB, 9.0);     // 9.7 dB
+  EXPECT_GE(card.phase_margin_deg, 60.0);  // 68°
+}
+
+TEST(BridgeServoMargins, TheDefaultsStayStableWhenTheStageIsNotAsAssumed) {
+  const BridgeSettings s = deployed();
+  for (const double resonance : {0.9, 1.0, 1.1}) {
+    for (const double slope : {0.57, 1.0, 1.36}) {
+      for (const int delay : {0, 1}) {
+        const LoopMargins m = ServoLoopResponse(s.servo, model_of(s, resonance, slope, delay)).margins();
+        ASSERT_TRUE(m.stable) << resonance << " " << slope << " " << delay;
+        EXPECT_GE(m.gain_margin_dB, 5.0) << resonance << " " << slope << " " << delay;  // 5.4 dB at worst
+        EXPECT_GE(m.phase_margin_deg, 45.0) << resonance << " " << slope << " " << delay;
+      }
+    }
+  }
+}
+
+// Without its notch the same ki is unstable: the notch is what lets the servo go this fast.
+TEST(BridgeServoMargins, TheDefaultKiNeedsTheNotch) {
+  const BridgeSettings s = deployed();
+  FeedbackGains plain = s.servo;
+  plain.notch_hz = 0.0;
+  EXPECT_FALSE(ServoLoopResponse(plain, model_of(s)).stable());
+  EXPECT_LT(largest_stable_ki(plain, model_of(s)), s.servo.ki);
+  EXPECT_GT(largest_stable_ki(s.servo, model_of(s, 1.0, 1.0, 1)), 2.5 * s.servo.ki);
+}
+
+}  // namespace
+}  // namespace hystloop
