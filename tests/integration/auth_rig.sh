@@ -37,7 +37,7 @@ sleep 0.3
 # The foreign publisher: no key.
 "$ctl" arm >/dev/null
 "$ctl" mode off >/dev/null
-"$ctl" trajectory --shape hold --offset 1e-7 >/dev/null
+"$ctl" trajectory --shape hold --offset 1e-7 --no-wait >/dev/null  # refused unsigned: no verdict to wait for
 "$ctl" params --c1 5e-9 --c2 1e-12 --c3 1.2 --version 9 >/dev/null
 "$authp" commands --count 10 >/dev/null
 # A signed block captured now and replayed at once: its counter was seen.

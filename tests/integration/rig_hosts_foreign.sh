@@ -28,7 +28,7 @@ seq_before=$(complete_rows | tail -n 1 | cut -d, -f1)
 foreign() { in_ns desk "$ctl_exe" --lcm-url "$foreign_url" --allow-network --rig "$prefix" "$@" >/dev/null; }
 foreign arm
 foreign experiment --mem-paper --duration 2
-foreign trajectory --mem-paper --blend 0.5
+foreign trajectory --mem-paper --blend 0.5 --no-wait  # refused unsigned: no verdict to wait for
 foreign params --c1 2e-9 --c2 2e-9 --c3 0.3 --version 1000
 in_ns desk timeout -s TERM 2 "$build/services/compensator/hystloop-compensator" --config "$cfg/compensator.yaml" \
   --lcm-url "$foreign_url" --allow-network --rig "$prefix" >"$out/foreign-compensator.log" 2>&1 || true

@@ -32,6 +32,13 @@ std::string state_name(std::int8_t state) {
   }
 }
 
+std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name) {
+  for (std::size_t i = 0; i < status.counter_names.size() && i < status.counter_values.size(); ++i) {
+    if (status.counter_names[i] == name) return status.counter_values[i];
+  }
+  return std::nullopt;
+}
+
 void StatusBoard::update(const service_status_t& status, std::int64_t recv_utime) {
   ProcessReport& report = processes_[status.process];
   report.status = status;

@@ -10,6 +10,7 @@
 #include "core/process.hpp"
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
+#include "ctl_verdict.hpp"
 #include "ctl_watch.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
@@ -105,11 +106,16 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   });
   Subscription<service_status_t> status(link.lcm(), link.channels().status,
                                         [&](const service_status_t& s, std::int64_t) {
+                                          if (s.process == o.compensator_process) {
+                                            line.learning_rms_nm = learning_rms_nm(s);
+                                            line.learning_periods = find_counter(s, "learning_periods");
+                                          }
                                           if (s.process != o.bridge_process) return;
                                           line.late_delta = s.late - late_before_report.value_or(s.late);
                                           late_before_report = s.late;
                                           line.late_total = s.late;
                                           line.bridge_state = state_name(s.state);
+                                          line.clamped_per_s = find_counter(s, "clamped_per_s");
                                         });
 
   const auto start = Clock::now();
@@ -133,6 +139,66 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
     if (now >= end) break;
   }
   return 0;
+}
+
+int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
+                       const VerdictOptions& o) {
+  // Listening before publishing: the compensator reports right after it decides.
+  TrajectoryVerdict verdict;
+  bool heard = false, has_counters = false;
+  Subscription<service_status_t> status(link.lcm(), link.channels().status,
+                                        [&](const service_status_t& s, std::int64_t) {
+                                          if (s.process != o.compensator_process) return;
+                                          heard = true;
+                                          const TrajectoryVerdict v = trajectory_verdict(s, msg.version);
+                                          has_counters = has_counters || v.has_counters;
+                                          if (verdict.outcome == TrajectoryOutcome::kPending) verdict = v;
+                                        });
+  if (!publish_repeated(link.lcm(), link.channels().trajectory, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().trajectory.c_str());
+    return 1;
+  }
+  std::printf("hystloop-ctl: sent trajectory %s on %s (version %lld)\n", description.c_str(),
+              link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
+  std::fflush(stdout);
+  if (!o.wait) return 0;
+  const auto deadline = after(o.timeout_s);
+  while (verdict.outcome == TrajectoryOutcome::kPending && Clock::now() < deadline) {
+    if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(50'000))) < 0) {
+      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
+      return 1;
+    }
+  }
+  const long long version = static_cast<long long>(msg.version);
+  const char* who = o.compensator_process.c_str();
+  switch (verdict.outcome) {
+    case TrajectoryOutcome::kAccepted:
+      std::printf("hystloop-ctl: %s accepted trajectory %lld%s%s\n", who, version, verdict.detail.empty() ? "" : ": ",
+                  verdict.detail.c_str());
+      return 0;
+    case TrajectoryOutcome::kShaped:
+      std::printf("hystloop-ctl: %s shaped trajectory %lld: %s\n", who, version,
+                  verdict.detail.empty() ? "(no detail given)" : verdict.detail.c_str());
+      return 0;
+    case TrajectoryOutcome::kRefused:
+      std::fprintf(stderr, "hystloop-ctl: %s refused trajectory %lld: %s\n", who, version,
+                   verdict.detail.empty() ? "(no reason given)" : verdict.detail.c_str());
+      return 1;
+    case TrajectoryOutcome::kSuperseded:
+      std::fprintf(stderr,
+                   "hystloop-ctl: %s decided on trajectory %lld, sent after %lld, before reporting on it (another "
+                   "sender?)\n",
+                   who, static_cast<long long>(verdict.later_version), version);
+      return 1;
+    case TrajectoryOutcome::kPending: break;
+  }
+  const std::string hint =
+      !heard ? " (no status from '" + o.compensator_process + "' on " + link.channels().status + ": is it running?)"
+      : !has_counters ? " ('" + o.compensator_process + "' reports no trajectory_version: a build without verdicts?)"
+                      : "";
+  std::fprintf(stderr, "hystloop-ctl: no compensator confirmed trajectory version %lld within %g s%s\n", version,
+               o.timeout_s, hint.c_str());
+  return 1;
 }
 
 int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& o) {

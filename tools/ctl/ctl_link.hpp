@@ -12,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "ctl_series.hpp"
+#include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 
@@ -66,6 +67,7 @@ int run_status(CtlLink& link, const StatusOptions& options);
 struct WatchOptions {
   double seconds = 0.0;  // 0: until SIGINT/SIGTERM
   std::string bridge_process = "bridge";
+  std::string compensator_process = "compensator";
 };
 
 // Prints a line per second; returns 0 (1 if LCM failed).
@@ -82,6 +84,19 @@ struct SeriesRunOptions {
 // prints each step as it starts. Refuses to start while an experiment runs or no commands flow.
 // On SIGINT/SIGTERM it sends STOP_EXPERIMENT. Returns 0 when the series ran to its end, 1 if not.
 int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& options);
+
+struct VerdictOptions {
+  bool wait = true;        // wait for the compensator's verdict (else: send and return)
+  double timeout_s = 3.0;  // how long
+  std::string compensator_process = "compensator";
+};
+
+// Publishes the trajectory (3 copies), prints "sent trajectory <description> ..." and, with wait, follows the
+// compensator's HX_STATUS until it reports on msg.version (ctl_verdict.hpp), printing the verdict. Returns 0 when it
+// was sent (no wait), accepted or shaped; 1 when it was refused, superseded, not confirmed within the timeout, or could
+// not be published.
+int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
+                       const VerdictOptions& options);
 
 // The highest parameter version seen on HX_PARAMS or in HX_COMMAND's ticks within listen_s, plus one
 // (1 when nothing was seen), so that a set sent by hand supersedes the one in use.

@@ -23,6 +23,12 @@ constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kShapes{{
     {"points", trajectory_t::POINTS},
 }};
 
+constexpr std::array<std::pair<std::string_view, std::int8_t>, 3> kLearning{{
+    {"on", control_t::LEARNING_ON},
+    {"off", control_t::LEARNING_OFF},
+    {"reset", control_t::LEARNING_RESET},
+}};
+
 template <std::size_t N>
 std::int8_t lookup(const std::array<std::pair<std::string_view, std::int8_t>, N>& table, std::string_view field,
                    std::string_view name) {
@@ -65,7 +71,16 @@ void GainsRequest::validate() const {
   require_non_negative("kp", kp);
   require_non_negative("ki", ki);
   require_non_negative("kd", kd);
+  require_in_range("notch-hz", notch_hz, 0.0, kMaxNotch_hz);
+  if (notch_hz > 0.0) {
+    if (notch_q == 0.0) throw ParameterError("notch-q", "give the notch's quality factor with --notch-hz");
+    require_in_range("notch-q", notch_q, kMinNotchQ, kMaxNotchQ);
+  } else if (notch_q != 0.0) {
+    throw ParameterError("notch-q", "only with a notch (--notch-hz > 0)");
+  }
 }
+
+std::int8_t parse_learning(std::string_view name) { return lookup(kLearning, "learning", name); }
 
 void ExperimentRequest::validate() const {
   if (kind.empty()) throw ParameterError("kind", "must not be empty");
@@ -83,6 +98,8 @@ void apply(const GainsRequest& gains, control_t& msg) {
   msg.kp = gains.kp;
   msg.ki = gains.ki;
   msg.kd = gains.kd;
+  msg.notch_hz = gains.notch_hz;
+  msg.notch_q = gains.notch_q;
 }
 
 void apply(const ExperimentRequest& experiment, control_t& msg) {
@@ -121,6 +138,12 @@ void TrajectoryRequest::validate() const {
   } else if (!points_t_s.empty()) {
     throw ParameterError("points-csv", "only for --shape points");
   }
+  require_non_negative("corner", corner_s);
+  if (s == trajectory_t::TRIANGLE && !(corner_s < 0.5 / frequency_Hz)) {
+    throw ParameterError("corner", "must be below half the period (" + str(0.5 / frequency_Hz) + " s at " +
+                                       str(frequency_Hz) + " Hz; got " + str(corner_s) + " s)");
+  }
+  if (s != trajectory_t::TRIANGLE && corner_s != 0.0) throw ParameterError("corner", "only for --shape triangle");
 }
 
 TrajectoryRequest mem_paper_trajectory(double blend_s) {
@@ -180,6 +203,8 @@ trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t vers
   msg.n_points = static_cast<std::int32_t>(request.points_t_s.size());
   msg.points_t_s = request.points_t_s;
   msg.points_y_m = request.points_y_m;
+  msg.corner_s = msg.shape == trajectory_t::TRIANGLE ? request.corner_s : 0.0;
+  msg.if_infeasible = request.shape_to_feasible ? trajectory_t::SHAPE : trajectory_t::REFUSE;
   if (check_message(msg) != Verdict::kOk) throw ParameterError("trajectory", "refused by the message contract");
   return msg;
 }

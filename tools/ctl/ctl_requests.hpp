@@ -26,10 +26,18 @@ std::int8_t parse_mode(std::string_view name);
 control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime);
 
 struct GainsRequest {
-  double kp = 0.0;        // [-]
-  double ki = 0.0;        // [1/s]
-  double kd = 0.0;        // [s]
-  void validate() const;  // finite, >= 0
+  double kp = 0.0;  // [-]
+  double ki = 0.0;  // [1/s]
+  double kd = 0.0;  // [s]
+  // The servo's notch at the stage's resonance: centre [Hz], 0 = none (a request without one
+  // removes it), else in (0, kMaxNotch_hz]; and its quality factor, in [kMinNotchQ, kMaxNotchQ]
+  // with a notch, 0 without.
+  double notch_hz = 0.0;
+  double notch_q = 0.0;
+  static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
+  static constexpr double kMinNotchQ = 0.1;
+  static constexpr double kMaxNotchQ = 50.0;
+  void validate() const;  // gains finite and >= 0; the notch as above ("notch-hz", "notch-q")
 };
 
 struct ExperimentRequest {
@@ -40,6 +48,9 @@ struct ExperimentRequest {
   double offset_V = 0.0;      // finite
   void validate() const;
 };
+
+// "on"|"off"|"reset" -> control_t::LEARNING_*; throws ParameterError("learning").
+std::int8_t parse_learning(std::string_view name);
 
 void apply(const GainsRequest& gains, control_t& msg);
 void apply(const ExperimentRequest& experiment, control_t& msg);
@@ -52,6 +63,8 @@ struct TrajectoryRequest {
   double phase_rad = 0.0;
   double blend_s = 1.0;                        // fade-in from the previous reference, >= 0
   std::vector<double> points_t_s, points_y_m;  // points: >= 1, t >= 0 strictly increasing
+  double corner_s = 0.0;  // triangle only: each corner's duration, below half the period; 0 = the compensator's choice
+  bool shape_to_feasible = false;  // if_infeasible SHAPE (else REFUSE)
   void validate() const;
 };
 

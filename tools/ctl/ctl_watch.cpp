@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ctl_health.hpp"
 #include "lcm/blocks.hpp"
 
 namespace hystloop::ctl {
@@ -27,6 +28,12 @@ void WatchSecond::add_sensor_block(const sensor_block_t& block) noexcept {
 std::optional<double> WatchSecond::rms_m() const noexcept {
   if (tracking == 0) return std::nullopt;
   return std::sqrt(sum_sq_m2 / static_cast<double>(tracking));
+}
+
+std::optional<double> learning_rms_nm(const service_status_t& compensator) {
+  if (const auto nm = find_counter(compensator, "learning_rms_nm")) return static_cast<double>(*nm);
+  if (const auto pm = find_counter(compensator, "learning_rms_pm")) return static_cast<double>(*pm) * 1e-3;
+  return std::nullopt;
 }
 
 std::string format_watch_line(const WatchLine& l) {
@@ -53,9 +60,19 @@ std::string format_watch_line(const WatchLine& l) {
   } else {
     out += "  late --";
   }
+  out += l.clamped_per_s ? "  clamped " + std::to_string(*l.clamped_per_s) + "/s" : std::string("  clamped --");
   out += l.second.buffer_min_ticks ? "  buf min " + std::to_string(*l.second.buffer_min_ticks)
                                    : std::string("  buf min --");
   out += l.bridge_state.empty() ? "  bridge --" : "  bridge " + l.bridge_state;
+  if (l.learning_rms_nm || l.learning_periods) {
+    if (l.learning_rms_nm) {
+      std::snprintf(buf, sizeof buf, "  learned %.1f nm", *l.learning_rms_nm);
+    } else {
+      std::snprintf(buf, sizeof buf, "  learned -- nm");
+    }
+    out += buf;
+    out += " (" + (l.learning_periods ? std::to_string(*l.learning_periods) : std::string("--")) + " periods)";
+  }
   return out;
 }
 

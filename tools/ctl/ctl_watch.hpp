@@ -8,6 +8,7 @@
 #include <string>
 
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/service_status_t.hpp"
 
 namespace hystloop::ctl {
 
@@ -35,9 +36,18 @@ struct WatchLine {
   std::optional<std::int64_t> late_total;     // bridge status
   std::optional<std::int64_t> late_delta;     // since the previous bridge report
   std::string bridge_state;                   // "" when no bridge status yet
+  std::optional<std::int64_t> clamped_per_s;  // bridge status: ticks clamped (range or slew) in its last second
+  // Compensator status, when it learns a periodic reference: RMS error of the last learned period
+  // [nm] and the periods learned.
+  std::optional<double> learning_rms_nm;
+  std::optional<std::int64_t> learning_periods;
 };
 
-// " 12 s  rms   27.9 nm  max   80.1 nm  ticks 10000/10000  params v3  late 0 (+0)  buf min 212  bridge HEALTHY"
+// The compensator's learning error [nm] from its counter learning_rms_nm, or learning_rms_pm (finer).
+std::optional<double> learning_rms_nm(const service_status_t& compensator);
+
+// " 12 s  rms   27.9 nm  max   80.1 nm  ticks 10000/10000  params v3  late 0 (+0)  clamped 0/s  buf min 212
+//  bridge HEALTHY" and, when the compensator reports learning, "  learned 12.3 nm (34 periods)"
 std::string format_watch_line(const WatchLine& line);
 
 }  // namespace hystloop::ctl

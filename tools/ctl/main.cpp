@@ -4,21 +4,25 @@
 //
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
-//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd [--target bridge]
+//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--target bridge]
+//   learn on|off|reset [--target compensator]        learning for periodic references (SET_LEARNING)
 //   pin-model mem|pi|katalenic|linear|auto           the re-identifier's model choice (ctl_pin_model.hpp)
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
 //   trajectory --shape cosine|sine|triangle|hold|points --amplitude M --frequency HZ --offset M
-//              --blend S [--points-csv FILE]   |   trajectory --mem-paper
+//              --blend S [--points-csv FILE] [--corner S] [--shape-to-feasible]   |   trajectory --mem-paper
+//              then waits for the compensator's verdict on HX_STATUS ([--timeout S] (3), [--no-wait],
+//              [--compensator P]): exit 0 accepted or shaped (printed how), 1 refused (its reason) or
+//              not confirmed in time
 //   params --c1 --c2 --c3 [--residual M] [--version N]
-//   watch [--seconds S]
+//   watch [--seconds S] [--bridge P] [--compensator P]   tracking error, late and clamped ticks, learning
 //   config-get FILE KEY.PATH [--default V]   a YAML value for scripts (ctl_config_get.hpp)
 //   keygen --out FILE [--force]              a new rig key, mode 0600 (README "Authenticated rig")
 //
 // Requests are sent 3 times a few ms apart with the same request id (UDP may drop one;
-// receivers act on an id once). Exit status: 0 done, 1 failed (not healthy in time, LCM
-// error), 2 bad arguments (the message names the option).
+// receivers act on an id once). Exit status: 0 done, 1 failed (not healthy in time, trajectory
+// refused or not confirmed, LCM error), 2 bad arguments (the message names the option).
 
 #include <CLI/CLI.hpp>
 
@@ -62,6 +66,9 @@ struct Options {
   TrajectoryRequest trajectory;
   std::string points_csv;
   bool mem_paper = false;
+  VerdictOptions verdict;
+  std::string learning;
+  std::string learn_target = "compensator";  // only the compensator learns
   ParamsRequest params;
   std::optional<std::int32_t> params_version;
   double params_listen_s = 1.5;
@@ -91,20 +98,21 @@ int send_trajectory(const Options& o) {
   TrajectoryRequest request = o.mem_paper ? mem_paper_trajectory(o.trajectory.blend_s) : o.trajectory;
   if (!o.mem_paper && request.shape.empty()) throw ParameterError("shape", "required (or --mem-paper)");
   if (!o.points_csv.empty()) read_points_csv(o.points_csv, request);
+  if (!(o.verdict.timeout_s > 0.0)) throw ParameterError("timeout", "must be > 0");
   const std::int64_t now = wall_utime();
   const trajectory_t msg = make_trajectory(request, now, now);  // version: wall time, increases per request
-  CtlLink link(o.link);
-  if (!publish_repeated(link.lcm(), link.channels().trajectory, msg)) {
-    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().trajectory.c_str());
-    return 1;
+  char text[256];
+  std::snprintf(text, sizeof text, "%s amplitude %g m frequency %g Hz offset %g m blend %g s", request.shape.c_str(),
+                msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s);
+  std::string description = text;
+  if (msg.n_points > 0) description += " with " + std::to_string(msg.n_points) + " points";
+  if (msg.shape == trajectory_t::TRIANGLE) {
+    std::snprintf(text, sizeof text, " corner %g s", msg.corner_s);
+    description += msg.corner_s > 0.0 ? text : " corner: the shortest feasible";
   }
-  std::printf(
-      "hystloop-ctl: sent trajectory %s amplitude %g m frequency %g Hz offset %g m blend %g s%s on %s "
-      "(version %lld)\n",
-      request.shape.c_str(), msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s,
-      msg.n_points > 0 ? (" with " + std::to_string(msg.n_points) + " points").c_str() : "",
-      link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
-  return 0;
+  if (msg.if_infeasible == trajectory_t::SHAPE) description += ", shaped if infeasible";
+  CtlLink link(o.link);
+  return publish_trajectory(link, msg, description, o.verdict);
 }
 
 int send_params(const Options& o) {
@@ -143,13 +151,11 @@ CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, 
   return sub;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   Options o;
   CLI::App app{
       "hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
-      "experiments, trajectories, parameters, live tracking error)"};
+      "learning, experiments, trajectories, parameters, live tracking error)"};
   app.require_subcommand(1);
   app.fallthrough();
   app.add_option("--lcm-url", o.link.lcm_url,
@@ -203,6 +209,16 @@ int main(int argc, char** argv) {
   gains->add_option("--kp", o.gains.kp, "Proportional gain [-]")->capture_default_str();
   gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();
   gains->add_option("--kd", o.gains.kd, "Derivative gain [s]")->capture_default_str();
+  gains
+      ->add_option("--notch-hz", o.gains.notch_hz,
+                   "Notch at the stage's resonance [Hz], in (0, 4500]; 0 = none (a request without it removes it)")
+      ->capture_default_str();
+  gains->add_option("--notch-q", o.gains.notch_q, "The notch's quality factor (centre / width), in [0.1, 50]");
+
+  CLI::App* learn = app.add_subcommand("learn", "Compensator: learning of the feedforward for periodic references");
+  learn->add_option("what", o.learning, "on, off (drops the correction, ramped out) or reset (starts again)")
+      ->required();
+  learn->add_option("--target", o.learn_target, "Process that learns (the compensator)")->capture_default_str();
 
   CLI::App* experiment = control_subcommand(
       app, "experiment",
@@ -267,6 +283,22 @@ int main(int argc, char** argv) {
                          "points: CSV of t_s,y_m rows (times from the start, increasing)");
   trajectory->add_flag("--mem-paper", o.mem_paper, "The MEM paper's y_d = -1.6 um cos(2 pi t) (with --blend)")
       ->excludes("--shape");
+  trajectory
+      ->add_option("--corner", o.trajectory.corner_s,
+                   "triangle: duration of each rounded corner [s], below half the period; 0 = the shortest the "
+                   "actuator's limits allow (the compensator chooses)")
+      ->capture_default_str();
+  trajectory->add_flag("--shape-to-feasible", o.trajectory.shape_to_feasible,
+                       "If the feedforward would leave the actuator's range or slew limit, let the compensator "
+                       "shape the trajectory (smaller amplitude, rounder corners) instead of refusing it");
+  auto* no_wait = trajectory->add_flag(
+      "--no-wait", [&](std::int64_t) { o.verdict.wait = false; },
+      "Send and return at once, without waiting for the compensator's verdict");
+  trajectory->add_option("--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
+      ->capture_default_str()
+      ->excludes(no_wait);
+  trajectory->add_option("--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS")
+      ->capture_default_str();
 
   CLI::App* params = app.add_subcommand("params", "Send a MEM parameter set (HX_PARAMS, valid, source hystloop-ctl)");
   params->add_option("--c1", o.params.c1, "Slope at a branch point [m/V], > 0")->required();
@@ -284,6 +316,8 @@ int main(int argc, char** argv) {
                                        "commands and the bridge's lowest buffer depth once a second");
   watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
   watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
+      ->capture_default_str();
+  watch->add_option("--compensator", o.watch.compensator_process, "Process name of the compensator in HX_STATUS")
       ->capture_default_str();
 
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
@@ -325,6 +359,12 @@ int main(int argc, char** argv) {
       return send_control(o, control_t::SET_GAINS, o.gains_target, "SET_GAINS",
                           [&](control_t& msg) { apply(o.gains, msg); });
     }
+    if (*learn) {
+      const std::int8_t l = parse_learning(o.learning);
+      if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
+      return send_control(o, control_t::SET_LEARNING, o.learn_target, ("SET_LEARNING " + o.learning).c_str(),
+                          [l](control_t& msg) { msg.learning = l; });
+    }
     if (*experiment) {
       if (o.banning_series) return run_banning_series(o);
       if (o.experiment_mem_paper) {
@@ -353,4 +393,18 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 2;
+}
+
+}  // namespace
+
+// Setting the options up can throw too (CLI11 refuses a malformed definition): nothing escapes.
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "hystloop-ctl: unknown error\n");
+  }
+  return 1;
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <numbers>
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
 #include "ctl_series.hpp"
+#include "ctl_verdict.hpp"
 #include "ctl_watch.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "lcm/blocks.hpp"
@@ -71,6 +73,64 @@ TEST(CtlRequests, GainsAndExperimentAreCheckedAndPassTheContract) {
   EXPECT_EQ(msg.experiment, "sine");
   x.duration_s = -2;
   EXPECT_EQ(field_of([&] { x.validate(); }), "duration");
+}
+
+TEST(CtlRequests, GainsCarryANotchWithinItsBounds) {
+  GainsRequest g{0.1, 600, 0, 1700.0, 4.0};
+  control_t msg = make_control(control_t::SET_GAINS, "bridge", 9, 1);
+  apply(g, msg);
+  EXPECT_EQ(msg.notch_hz, 1700.0);
+  EXPECT_EQ(msg.notch_q, 4.0);
+  EXPECT_EQ(check_message(msg), Verdict::kOk);
+  apply(GainsRequest{0.1, 600, 0}, msg);  // no notch: 0 removes it
+  EXPECT_EQ(msg.notch_hz, 0.0);
+  EXPECT_EQ(msg.notch_q, 0.0);
+  EXPECT_NO_THROW((GainsRequest{0, 0, 0, 4500.0, 0.1}.validate()));
+  EXPECT_NO_THROW((GainsRequest{0, 0, 0, 1e-3, 50.0}.validate()));
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 4500.1, 2.0}.validate(); }), "notch-hz");
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, -1.0, 2.0}.validate(); }), "notch-hz");
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, NAN, 2.0}.validate(); }), "notch-hz");
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.0}.validate(); }), "notch-q");  // not given
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.09}.validate(); }), "notch-q");
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 50.5}.validate(); }), "notch-q");
+  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 0.0, 3.0}.validate(); }), "notch-q");  // a Q without a notch
+}
+
+TEST(CtlRequests, LearningByName) {
+  EXPECT_EQ(parse_learning("on"), control_t::LEARNING_ON);
+  EXPECT_EQ(parse_learning("off"), control_t::LEARNING_OFF);
+  EXPECT_EQ(parse_learning("reset"), control_t::LEARNING_RESET);
+  try {
+    parse_learning("yes");
+    FAIL();
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "learning");
+    EXPECT_NE(std::string(e.what()).find("on|off|reset"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CtlRequests, TriangleCornerAndTheInfeasiblePolicy) {
+  TrajectoryRequest r;
+  r.shape = "triangle";
+  r.amplitude_m = 1e-6;
+  r.frequency_Hz = 10.0;
+  trajectory_t t = make_trajectory(r, 1, 1);
+  EXPECT_EQ(t.corner_s, 0.0);  // the compensator's choice
+  EXPECT_EQ(t.if_infeasible, trajectory_t::REFUSE);
+  r.corner_s = 0.004;
+  r.shape_to_feasible = true;
+  t = make_trajectory(r, 2, 2);
+  EXPECT_EQ(t.corner_s, 0.004);
+  EXPECT_EQ(t.if_infeasible, trajectory_t::SHAPE);
+  r.corner_s = 0.05;  // half the period
+  EXPECT_EQ(field_of([&] { r.validate(); }), "corner");
+  r.corner_s = -1e-3;
+  EXPECT_EQ(field_of([&] { r.validate(); }), "corner");
+  r.corner_s = 0.01;
+  r.shape = "sine";
+  EXPECT_EQ(field_of([&] { r.validate(); }), "corner");  // only for a triangle
+  r.corner_s = 0.0;
+  EXPECT_EQ(make_trajectory(r, 3, 3).if_infeasible, trajectory_t::SHAPE);  // any shape may be shaped
 }
 
 TEST(CtlRequests, MemPaperTrajectory) {
@@ -263,11 +323,76 @@ TEST(CtlWatch, LineIsTidy) {
   l.late_delta = 1;
   l.second.buffer_min_ticks = 212;
   l.bridge_state = "HEALTHY";
+  l.clamped_per_s = 14;
   EXPECT_EQ(format_watch_line(l),
             "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
-            "buf min 212  bridge HEALTHY");
+            "clamped 14/s  buf min 212  bridge HEALTHY");
+  l.learning_rms_nm = 9;
+  l.learning_periods = 31;
+  EXPECT_EQ(format_watch_line(l),
+            "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
+            "clamped 14/s  buf min 212  bridge HEALTHY  learned 9.0 nm (31 periods)");
+  service_status_t comp{};
+  comp.counter_names = {"learning_rms_pm", "learning_periods"};
+  comp.counter_values = {12345, 4};
+  EXPECT_EQ(learning_rms_nm(comp), std::optional<double>(12.345));
+  comp.counter_names[0] = "learning_rms_nm";
+  EXPECT_EQ(learning_rms_nm(comp), std::optional<double>(12345.0));
+  EXPECT_EQ(learning_rms_nm(service_status_t{}), std::nullopt);
   EXPECT_EQ(format_watch_line(WatchLine{}),
-            "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  buf min --  bridge --");
+            "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  clamped --  buf min --  "
+            "bridge --");
+}
+
+namespace {
+service_status_t compensator_report(std::int64_t accepted, std::int64_t refused, std::int64_t shaped,
+                                    const std::string& detail) {
+  service_status_t s{};
+  s.process = "compensator";
+  s.detail = detail;
+  s.counter_names = {"samples", "trajectory_version", "trajectory_refused_version", "trajectory_shaped_version"};
+  s.counter_values = {100, accepted, refused, shaped};
+  s.n_counters = 4;
+  return s;
+}
+}  // namespace
+
+TEST(CtlVerdict, CountersSayWhatBecameOfTheVersion) {
+  EXPECT_EQ(find_counter(compensator_report(7, 0, 0, ""), "trajectory_version"), std::optional<std::int64_t>(7));
+  EXPECT_EQ(find_counter(compensator_report(7, 0, 0, ""), "learning_periods"), std::nullopt);
+
+  TrajectoryVerdict v = trajectory_verdict(compensator_report(41, 0, 0, ""), 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kPending);  // still the previous one
+  EXPECT_TRUE(v.has_counters);
+  v = trajectory_verdict(compensator_report(42, 0, 0, ""), 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kAccepted);
+  EXPECT_EQ(v.detail, "");
+  v = trajectory_verdict(compensator_report(42, 0, 0, "trajectory 42 taken: corner 97 us (the shortest)"), 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kAccepted);
+  EXPECT_EQ(v.detail, "corner 97 us (the shortest)");
+  EXPECT_EQ(trajectory_verdict(compensator_report(42, 0, 0, "late commands"), 42).detail, "");  // not about it
+  v = trajectory_verdict(compensator_report(42, 0, 42, "trajectory 42 shaped: amplitude 1 um -> 0.51 um (slew)"), 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kShaped);
+  EXPECT_EQ(v.detail, "amplitude 1 um -> 0.51 um (slew)");
+  v = trajectory_verdict(compensator_report(41, 42, 0, "late commands; trajectory 42 refused: slew 9.8e4 V/s > 5e4"),
+                         42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kRefused);
+  EXPECT_EQ(v.detail, "slew 9.8e4 V/s > 5e4");
+  v = trajectory_verdict(compensator_report(41, 42, 0, "something else"), 42);  // no prefix: the whole detail
+  EXPECT_EQ(v.detail, "something else");
+  // An older shaped version does not make this one shaped.
+  EXPECT_EQ(trajectory_verdict(compensator_report(42, 0, 40, ""), 42).outcome, TrajectoryOutcome::kAccepted);
+  v = trajectory_verdict(compensator_report(43, 0, 0, ""), 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kSuperseded);
+  EXPECT_EQ(v.later_version, 43);
+  EXPECT_EQ(trajectory_verdict(compensator_report(41, 44, 0, ""), 42).outcome, TrajectoryOutcome::kSuperseded);
+  // A compensator without the counters never answers.
+  service_status_t old{};
+  old.process = "compensator";
+  v = trajectory_verdict(old, 42);
+  EXPECT_EQ(v.outcome, TrajectoryOutcome::kPending);
+  EXPECT_FALSE(v.has_counters);
+  EXPECT_EQ(verdict_reason("trajectory 5 refused: range", 6, "refused"), "trajectory 5 refused: range");
 }
 
 // Banning's series as requests: per planned experiment a settling sine then the measured one,

@@ -170,7 +170,29 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
       {{"gains", "--kp", "0.1", "--target", "bridge2"},
        control_t::SET_GAINS,
        "bridge2",
-       [](const control_t& c) { EXPECT_EQ(c.kp, 0.1); }},
+       [](const control_t& c) {
+         EXPECT_EQ(c.kp, 0.1);
+         EXPECT_EQ(c.notch_hz, 0.0);  // none: removes a notch
+       }},
+      {{"gains", "--kp", "0.2", "--notch-hz", "1720", "--notch-q", "3.5"},
+       control_t::SET_GAINS,
+       "bridge",
+       [](const control_t& c) {
+         EXPECT_EQ(c.notch_hz, 1720.0);
+         EXPECT_EQ(c.notch_q, 3.5);
+       }},
+      {{"learn", "on"},
+       control_t::SET_LEARNING,
+       "compensator",  // the one that learns
+       [](const control_t& c) { EXPECT_EQ(c.learning, control_t::LEARNING_ON); }},
+      {{"learn", "off", "--target", "compensator2"},
+       control_t::SET_LEARNING,
+       "compensator2",
+       [](const control_t& c) { EXPECT_EQ(c.learning, control_t::LEARNING_OFF); }},
+      {{"learn", "reset"},
+       control_t::SET_LEARNING,
+       "compensator",
+       [](const control_t& c) { EXPECT_EQ(c.learning, control_t::LEARNING_RESET); }},
       {{"experiment", "--amplitude", "50", "--frequency", "2", "--duration", "10", "--offset", "-5", "--kind",
         "triangle"},
        control_t::START_EXPERIMENT,
@@ -206,7 +228,7 @@ TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
   std::vector<trajectory_t> got;
   Subscription<trajectory_t> sub(*lcm_, ch_.trajectory, [&](const trajectory_t& t, std::int64_t) { got.push_back(t); });
 
-  Result r = run_ctl(with_url({"trajectory", "--mem-paper", "--blend", "0.5"}), lcm_.get());
+  Result r = run_ctl(with_url({"trajectory", "--mem-paper", "--blend", "0.5", "--no-wait"}), lcm_.get());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(got.size(), 3u);
   EXPECT_EQ(got[0].shape, trajectory_t::COSINE);
@@ -218,7 +240,7 @@ TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
 
   got.clear();
   r = run_ctl(with_url({"trajectory", "--shape", "triangle", "--amplitude", "2e-6", "--frequency", "5", "--offset",
-                        "1e-7", "--blend", "0"}),
+                        "1e-7", "--blend", "0", "--no-wait"}),
               lcm_.get());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(got.size(), 3u);
@@ -226,12 +248,25 @@ TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
   EXPECT_DOUBLE_EQ(got[0].amplitude_m, 2e-6);
   EXPECT_DOUBLE_EQ(got[0].frequency_Hz, 5.0);
   EXPECT_DOUBLE_EQ(got[0].offset_m, 1e-7);
+  EXPECT_EQ(got[0].corner_s, 0.0);  // the compensator chooses
+  EXPECT_EQ(got[0].if_infeasible, trajectory_t::REFUSE);
   EXPECT_GT(got[0].version, first_version);  // a new trajectory supersedes the last
+  EXPECT_NE(r.out.find("corner: the shortest feasible"), std::string::npos) << r.out;
+
+  got.clear();
+  r = run_ctl(with_url({"trajectory", "--shape", "triangle", "--amplitude", "1e-6", "--frequency", "10", "--corner",
+                        "0.004", "--shape-to-feasible", "--no-wait"}),
+              lcm_.get());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[0].corner_s, 0.004);
+  EXPECT_EQ(got[0].if_infeasible, trajectory_t::SHAPE);
+  EXPECT_NE(r.out.find("corner 0.004 s, shaped if infeasible"), std::string::npos) << r.out;
 
   const fs::path csv = fs::temp_directory_path() / ("ctl_points_" + std::to_string(::getpid()) + ".csv");
   std::ofstream(csv) << "t_s,y_m\n0,0\n0.25,1e-6\n0.5,-1e-6\n";
   got.clear();
-  r = run_ctl(with_url({"trajectory", "--shape", "points", "--points-csv", csv.string()}), lcm_.get());
+  r = run_ctl(with_url({"trajectory", "--shape", "points", "--points-csv", csv.string(), "--no-wait"}), lcm_.get());
   fs::remove(csv);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(got.size(), 3u);
@@ -239,6 +274,100 @@ TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
   ASSERT_EQ(got[0].n_points, 3);
   EXPECT_DOUBLE_EQ(got[0].points_t_s[1], 0.25);
   EXPECT_DOUBLE_EQ(got[0].points_y_m[2], -1e-6);
+}
+
+// ctl waits for the compensator's verdict on the version it sent: the test plays a compensator
+// that reports on HX_STATUS right after each trajectory, as the real one does.
+TEST_F(CtlLcmTest, TrajectoryWaitsForTheCompensatorsVerdict) {
+  Publisher<service_status_t> status(*lcm_, ch_.status);
+  enum class Answer { kAccept, kShape, kRefuse, kLater, kOldBuild, kSilent } answer = Answer::kAccept;
+  std::int64_t accepted = 0, refused = 0, shaped = 0;
+  std::string detail;
+  Subscription<trajectory_t> sub(*lcm_, ch_.trajectory, [&](const trajectory_t& t, std::int64_t) {
+    const std::string v = std::to_string(t.version);
+    switch (answer) {
+      case Answer::kAccept:
+        accepted = t.version;
+        detail = "trajectory " + v + " taken: as sent";
+        break;
+      case Answer::kShape:
+        accepted = shaped = t.version;
+        detail = "trajectory " + v + " shaped: amplitude 1e-06 m -> 5.09e-07 m (slew 9.8e4 V/s > 5e4 V/s)";
+        break;
+      case Answer::kRefuse:
+        refused = t.version;
+        detail = "trajectory " + v + " refused: slew 9.8e4 V/s > 5e4 V/s; at most 5.09e-07 m at 100 Hz";
+        break;
+      case Answer::kLater: accepted = t.version + 5; break;
+      case Answer::kOldBuild:
+      case Answer::kSilent: break;
+    }
+  });
+  int ticks = 0;
+  auto play_compensator = [&] {
+    if (answer == Answer::kSilent || ++ticks % 10 != 0) return;  // every ~20 ms
+    service_status_t s = status_of("compensator", service_status_t::HEALTHY);
+    s.detail = detail;
+    if (answer != Answer::kOldBuild) {
+      s.counter_names = {"trajectory_version", "trajectory_refused_version", "trajectory_shaped_version"};
+      s.counter_values = {accepted, refused, shaped};
+      s.n_counters = 3;
+    }
+    status.publish(s);
+  };
+  const std::vector<std::string> sine{"trajectory", "--shape", "sine", "--amplitude", "1e-6", "--frequency", "100"};
+  auto run = [&](Answer a, std::vector<std::string> extra = {}) {
+    answer = a;
+    std::vector<std::string> args = sine;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_ctl(with_url(args), lcm_.get(), play_compensator);
+  };
+
+  Result r = run(Answer::kAccept);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("compensator accepted trajectory " + std::to_string(accepted) + ": as sent"), std::string::npos)
+      << r.out;
+
+  r = run(Answer::kShape, {"--shape-to-feasible"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("shaped trajectory " + std::to_string(shaped) + ": amplitude 1e-06 m -> 5.09e-07 m"),
+            std::string::npos)
+      << r.out;
+
+  r = run(Answer::kRefuse);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refused trajectory " + std::to_string(refused) + ": slew 9.8e4 V/s > 5e4 V/s; at most"),
+            std::string::npos)
+      << r.err;
+
+  r = run(Answer::kLater);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("before reporting on it"), std::string::npos) << r.err;
+
+  // No verdict: bounded by --timeout, and the message says whether anyone answered at all.
+  auto start = std::chrono::steady_clock::now();
+  r = run(Answer::kSilent, {"--timeout", "0.5"});
+  double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no compensator confirmed trajectory version "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" within 0.5 s (no status from 'compensator'"), std::string::npos) << r.err;
+  EXPECT_GE(took, 0.45);
+  EXPECT_LT(took, 3.0);
+  r = run(Answer::kOldBuild, {"--timeout", "0.5"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("reports no trajectory_version"), std::string::npos) << r.err;
+  // The default is 3 s; --no-wait returns at once.
+  start = std::chrono::steady_clock::now();
+  r = run(Answer::kSilent);
+  took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(" within 3 s"), std::string::npos) << r.err;
+  EXPECT_GE(took, 2.9);
+  start = std::chrono::steady_clock::now();
+  r = run(Answer::kSilent, {"--no-wait"});
+  took = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(took, 1.0);
 }
 
 TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
@@ -331,7 +460,18 @@ TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfTheSensorTicks) {
     s.buffer_depth_ticks = 280 + static_cast<std::int32_t>(k % 7);
     samples.publish(s);
     commands.publish(c);
-    if (++ticks % 100 == 0) status.publish(status_of("bridge", service_status_t::HEALTHY, 7));
+    if (++ticks % 100 == 0) {
+      service_status_t b = status_of("bridge", service_status_t::HEALTHY, 7);
+      b.counter_names = {"ticks", "clamped_per_s"};
+      b.counter_values = {k, 12};
+      b.n_counters = 2;
+      status.publish(b);
+      service_status_t comp = status_of("compensator", service_status_t::HEALTHY);
+      comp.counter_names = {"learning_rms_pm", "learning_periods"};
+      comp.counter_values = {7240, 3};
+      comp.n_counters = 2;
+      status.publish(comp);
+    }
   };
   const Result r = run_ctl(with_url({"watch", "--seconds", "2.5"}), lcm_.get(), play_rig);
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -345,6 +485,8 @@ TEST_F(CtlLcmTest, WatchPrintsTheTrackingErrorOfTheSensorTicks) {
   EXPECT_NE(last.find("params v3"), std::string::npos) << last;
   EXPECT_NE(last.find("late 7"), std::string::npos) << last;
   EXPECT_NE(last.find("buf min 280 "), std::string::npos) << last;  // the lowest of 280 .. 286
+  EXPECT_NE(last.find("clamped 12/s"), std::string::npos) << last;
+  EXPECT_NE(last.find("learned 7.2 nm (3 periods)"), std::string::npos) << last;
 }
 
 // The series needs a running loop that is not in an experiment: both refusals name the cause.
@@ -393,6 +535,18 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
       {{"trajectory", "--shape", "sine", "--blend", "-1"}, "blend:"},
       {{"trajectory", "--shape", "points"}, "points-csv:"},
       {{"trajectory"}, "shape:"},
+      {{"trajectory", "--shape", "triangle", "--frequency", "10", "--corner", "0.05"},
+       "corner: must be below half the period (0.05 s at 10 Hz"},
+      {{"trajectory", "--shape", "triangle", "--corner", "-1"}, "corner:"},
+      {{"trajectory", "--shape", "cosine", "--corner", "0.01"}, "corner: only for --shape triangle"},
+      {{"trajectory", "--shape", "sine", "--timeout", "0"}, "timeout:"},
+      {{"trajectory", "--shape", "sine", "--timeout", "1", "--no-wait"}, "excludes"},
+      {{"gains", "--notch-hz", "5000", "--notch-q", "2"}, "notch-hz:"},
+      {{"gains", "--notch-hz", "1700"}, "notch-q:"},
+      {{"gains", "--notch-hz", "1700", "--notch-q", "0.05"}, "notch-q:"},
+      {{"gains", "--notch-q", "2"}, "notch-q: only with a notch"},
+      {{"learn", "maybe"}, "learning: must be one of on|off|reset"},
+      {{"learn"}, "what"},
       {{"status", "--wait-healthy", "bridge", "--timeout", "0"}, "timeout:"},
       {{"watch", "--seconds", "-1"}, "seconds:"},
       {{"frobnicate"}, "subcommand"},
@@ -415,12 +569,13 @@ TEST(CtlArguments, HelpEverywhere) {
                                                                      {"shutdown", "process"},
                                                                      {"reset-counters", "process"},
                                                                      {"mode", "katalenic"},
-                                                                     {"gains", "--kd"},
+                                                                     {"gains", "--notch-q"},
+                                                                     {"learn", "reset"},
                                                                      {"experiment", "--duration"},
                                                                      {"stop-experiment", "--target"},
-                                                                     {"trajectory", "--mem-paper"},
+                                                                     {"trajectory", "--shape-to-feasible"},
                                                                      {"params", "--c3"},
-                                                                     {"watch", "--seconds"}};
+                                                                     {"watch", "--compensator"}};
   Result r = run_ctl({"--help"});
   EXPECT_EQ(r.exit_code, 0);
   for (const auto& [name, option] : subcommands) {
