@@ -11,7 +11,14 @@
 // from MEM's deliberately wrong start: RMS over [8, 12) s of a 12 s run, and with the stage's
 // gain drifting +10 % over 30 s, over [20, 30) s of a 30 s run.
 //
+// Then the line-rate scans (sim/scan_experiment.hpp): triangles and sines at 10-200 Hz with the
+// models identified from a 10 Hz sine of the line's loops and the best of them (--model auto), without and
+// with the stage's inverse, then with learning; RMS and max against the true position over the
+// periods [20, 30) after the shape is entered, the bridge's clamped ticks and the periods until
+// every period is at most 1 nm RMS.
+//
 //   tracking_table            prints the tables (Markdown) and the identified MEM parameters
+//   tracking_table --scan     prints the scan table only
 //   tracking_table --help     this text
 
 #include <chrono>
@@ -19,6 +26,7 @@
 #include <cstring>
 #include <string>
 
+#include "sim/scan_experiment.hpp"
 #include "sim/tracking_experiment.hpp"
 
 namespace {
@@ -46,14 +54,53 @@ void reid_row(const char* name, const hystloop::TrackingExperiment& e, const hys
   std::fflush(stdout);
 }
 
+std::string cell(const hystloop::ScanRun& r) {
+  if (r.refused) return "refused";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%.2f / %.1f nm%s", r.stats.rms_true_m * 1e9, r.stats.max_abs_true_m * 1e9,
+                r.clamped_ticks > 0 ? (", " + std::to_string(r.clamped_ticks) + " clamped").c_str() : "");
+  return buf;
+}
+
+// The line-rate table of docs/TRACKING.md ("Scans at line rate").
+bool scan_table() {
+  using namespace hystloop;
+  const TrackingExperiment experiment;
+  std::printf(
+      "| reference | corner | model | servo, no stage inverse | + stage inverse | + learning, periods "
+      "[20, 30) | periods to <= 1 nm |\n| --- | --- | --- | --- | --- | --- | --- |\n");
+  bool all_taken = true;
+  for (const ScanReference& r : scan_references()) {
+    const IdentifiedModels id = identify_for_scan(experiment, r.amplitude_m);
+    if (id.ranking.empty()) return false;
+    ScanOptions o;
+    o.stage_inverse = false;
+    const ScanRun plain = run_scan(experiment, id, r, o);
+    o.stage_inverse = true;
+    const ScanRun inverse = run_scan(experiment, id, r, o);
+    o.learning = true;
+    const ScanRun learned = run_scan(experiment, id, r, o);
+    all_taken = all_taken && !inverse.refused && !learned.refused;
+    char corner[32] = "—";
+    if (r.shape == TrajectoryShape::kTriangle) std::snprintf(corner, sizeof corner, "%.2f ms", inverse.corner_s * 1e3);
+    std::printf("| %s | %s | %s | %s | %s | %s | %d |\n", r.name.c_str(), corner, to_string(inverse.mode),
+                cell(plain).c_str(), cell(inverse).c_str(), cell(learned).c_str(), learned.periods_to_converge);
+    if (inverse.refused) std::printf("\n(refused: %s)\n", inverse.reason.c_str());
+    std::fflush(stdout);
+  }
+  return all_taken;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace hystloop;
   if (argc > 1) {
     const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
+    if (std::strcmp(argv[1], "--scan") == 0) return scan_table() ? 0 : 1;
     std::printf(
-        "usage: tracking_table [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and docs/TRACKING.md.\n");
+        "usage: tracking_table [--scan] [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and "
+        "docs/TRACKING.md (--scan: the line-rate scan table only).\n");
     return help ? 0 : 2;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -113,8 +160,10 @@ int main(int argc, char** argv) {
   reid_row("gain +10 %/30 s, offline MEM start, MEM estimator, [20, 30) s", drift, id, o);
   o.reidentify = Reidentify::select;
   reid_row("gain +10 %/30 s, offline MEM start, automatic, [20, 30) s", drift, id, o);
+  std::printf("\n");
+  const bool scans = scan_table();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("\n(%.0f s of simulated loop at 10 kHz in %.1f s of wall time)\n",
               experiment.identify_s + 12 * experiment.track_s + 3 * 4 * 12.0 + 2 * 4 * 30.0, seconds);
-  return id.ok ? 0 : 1;
+  return id.ok && scans ? 0 : 1;
 }

@@ -8,6 +8,7 @@
 
 #include "ident/katalenic_fit.hpp"
 #include "ident/linear_fit.hpp"
+#include "ident/model_selection.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "ident/pi_fit.hpp"
 
@@ -24,15 +25,19 @@ LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e) {
 }
 
 IdentifiedModels identify_models_through_loop(const TrackingExperiment& e) {
-  constexpr double kLeadIn = 0.01;  // the first ticks hold 0 V while the compensator starts
-  LoopSimulation sim(tracking_loop_config(e));
   ExperimentSpec input;  // 250 V, 10 Hz: the MEM paper's identification input
   input.duration_s = e.identify_s;
+  return identify_models_through_loop(e, input);
+}
+
+IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input) {
+  constexpr double kLeadIn = 0.01;  // the first ticks hold 0 V while the compensator starts
+  LoopSimulation sim(tracking_loop_config(e));
   sim.compensator().start_experiment(input);
-  sim.run(e.identify_s + kLeadIn);
+  sim.run(input.duration_s + kLeadIn);
   std::vector<double> u, y;
   for (const LoopTick& t : sim.history()) {
-    if (t.t_s < kLeadIn || t.t_s > e.identify_s) continue;
+    if (t.t_s < kLeadIn || t.t_s > input.duration_s) continue;
     u.push_back(t.u_V);
     y.push_back(t.y_m);
   }
@@ -46,6 +51,10 @@ IdentifiedModels identify_models_through_loop(const TrackingExperiment& e) {
   if (pi.ok()) m.pi = to_pi_params(pi);
   m.katalenic = kat.params;
   if (lin.ok()) m.linear = to_linear_params(lin);
+  const ModelSelection selection = select_model(u, y);
+  for (const ModelScore& score : selection.ranking) {
+    if (score.status == FitStatus::ok) m.ranking.push_back(score.kind);
+  }
   return m;
 }
 

@@ -41,6 +41,8 @@ struct IdentifiedModels {
   KatalenicParams katalenic;
   LinearParams linear;
   bool ok = false;  // every fit succeeded
+  // The candidates ranked on the record's held-out branches, as hystloop-identify --model auto.
+  std::vector<ModelKind> ranking;
 };
 
 enum class Reidentify : std::uint8_t {
@@ -88,6 +90,9 @@ LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e);
 
 // Runs the identification input through the loop and fits MEM, PI-15, Katalenic and linear.
 IdentifiedModels identify_models_through_loop(const TrackingExperiment& e);
+// The same with another excitation (its duration_s is the record's length), e.g. one sized to
+// the loops a scan will make.
+IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input);
 
 // Tracks the MEM paper's reference for e.track_s; the error is measured over [e.settle_s, e.track_s).
 TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& models, const TrackingOptions& options);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <spdlog/spdlog.h>
 
@@ -30,6 +31,10 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
   a.reanchors += b.reanchors;
   a.reanchors_skipped += b.reanchors_skipped;
   a.u_clamped += b.u_clamped;
+  a.u_slew_clamped += b.u_slew_clamped;
+  a.trajectories_refused += b.trajectories_refused;
+  a.trajectories_shaped += b.trajectories_shaped;
+  a.stage_swaps += b.stage_swaps;
   return a;
 }
 
@@ -106,9 +111,16 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
       const TrajectorySpec spec = *pending_trajectory_;
       pending_trajectory_.reset();
       try {
-        apply_trajectory(spec, pending_start_utime_);
-      } catch (...) {
+        apply_trajectory(spec, pending_start_utime_, pending_version_);
+      } catch (const std::exception& e) {
         ++counters_.trajectory_refused;
+        decide_trajectory(pending_version_, e.what(), true, false);
+      }
+      if (verdict_due_) {
+        try {
+          report(wall_utime(), false, false);
+        } catch (...) {  // the periodic report says it a second later
+        }
       }
     }
   }
@@ -130,41 +142,65 @@ void CompensatorService::publish_plan() noexcept {
   }
 }
 
-void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime) {
+void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version) {
+  TrajectoryVerdict v;
   if (start_utime == 0) {
-    compensator_->set_trajectory(spec, kNaN);
+    v = compensator_->take_trajectory(spec, kNaN);
     pending_trajectory_.reset();  // a newer trajectory replaces one waiting for the first sample
   } else if (!have_sample_) {
     spec.validate();
     pending_trajectory_ = spec;
     pending_start_utime_ = start_utime;
+    pending_version_ = version;
     return;
   } else {
     Compensator& c = *compensator_;
     const double start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
-    if (!c.set_trajectory(spec, start_s)) ++counters_.trajectory_late_start;
+    v = c.take_trajectory(spec, start_s);
+    if (!v.started) ++counters_.trajectory_late_start;
   }
   ++counters_.trajectories;
+  decide_trajectory(version, v.note, false, v.shaped);
+}
+
+void CompensatorService::decide_trajectory(std::int64_t version, const std::string& verdict, bool refused,
+                                           bool shaped) {
+  if (version <= 0) return;  // the configured reference: nobody waits for it
+  if (refused) {
+    counters_.trajectory_refused_version = version;
+    verdict_ = fmt::format("trajectory {} refused: {}", version, escape_wire(verdict));
+  } else {
+    counters_.trajectory_version = version;
+    if (shaped) counters_.trajectory_shaped_version = version;
+    verdict_ = verdict.empty() ? std::string()
+                               : fmt::format("trajectory {} {}: {}", version, shaped ? "shaped" : "taken", verdict);
+  }
+  verdict_until_ns_ = monotonic_now_ns() + 10'000'000'000;  // 10 s in the status detail
+  verdict_due_ = true;                                      // answered at once, not at the next second
 }
 
 void CompensatorService::on_trajectory(const trajectory_t& msg) {
-  if (msg.version == trajectory_version_) {
+  if (msg.version == trajectory_version_ || msg.version == refused_version_) {  // UDP repeats: decided once
     ++counters_.trajectory_repeats;
     return;
   }
   try {
-    apply_trajectory(trajectory_from_message(msg), msg.start_utime);
+    apply_trajectory(trajectory_from_message(msg), msg.start_utime, msg.version);
     trajectory_version_ = msg.version;
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_now_ns())) {
       spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", msg.version,
                    msg.shape, msg.amplitude_m, msg.offset_m, msg.frequency_Hz, msg.blend_s, suppressed_note(g));
+      if (!verdict_.empty()) spdlog::info("{}", verdict_);
     }
   } catch (const std::exception& e) {
     ++counters_.trajectory_refused;
+    refused_version_ = msg.version;  // its repeats are the same refusal
+    decide_trajectory(msg.version, e.what(), true, false);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_now_ns())) {
       spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what()), suppressed_note(g));
     }
   }
+  if (verdict_due_) report(wall_utime(), false, false);
 }
 
 void CompensatorService::on_control(const control_t& msg) {
@@ -211,6 +247,19 @@ void CompensatorService::on_control(const control_t& msg) {
         }
         compensator_->stop_experiment();
         break;
+      case control_t::SET_LEARNING:
+        switch (msg.learning) {
+          case control_t::LEARNING_OFF: compensator_->set_learning(false); break;
+          case control_t::LEARNING_ON: compensator_->set_learning(true); break;
+          case control_t::LEARNING_RESET: compensator_->reset_learning(); break;
+          default: return refuse("learning " + std::to_string(msg.learning) + " is not off (0), on (1) or reset (2)");
+        }
+        if (const LogLimiter::Gate g = acted()) {
+          spdlog::info("learning {} (request {}){}",
+                       msg.learning == control_t::LEARNING_RESET ? "reset" : (msg.learning ? "on" : "off"),
+                       msg.request_id, suppressed_note(g));
+        }
+        break;
       case control_t::RESET_COUNTERS:
         reported_.rebase(collect_counters());
         reported_.rebase("sensor", samples_.counters());
@@ -247,7 +296,15 @@ void CompensatorService::restart_control_law() {
   Compensator next(config);
   next.take_params_from(old);
   retired_ += old.counters();
-  next.set_trajectory(reference, kNaN);
+  try {
+    next.set_trajectory(reference, kNaN);
+  } catch (const ParameterError& e) {
+    // Taken before, infeasible now (the parameters in use changed since): hold where the new
+    // control law starts rather than clamp; the operator sends it again, or a feasible one.
+    next.set_trajectory(TrajectorySpec{}, kNaN);
+    ++counters_.trajectory_refused;
+    spdlog::warn("after the bridge's restart the trajectory in force was not taken again: {}", escape_wire(e.what()));
+  }
   compensator_.emplace(std::move(next));
   have_sample_ = false;
   ++counters_.bridge_restarts;
@@ -277,6 +334,9 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"reanchors", c.reanchors},
           {"reanchors_skipped", c.reanchors_skipped},
           {"u_clamped", c.u_clamped},
+          {"u_slew_clamped", c.u_slew_clamped},
+          {"trajectories_shaped", c.trajectories_shaped},
+          {"stage_swaps", c.stage_swaps},
           {"trajectories", s.trajectories},
           {"trajectory_repeats", s.trajectory_repeats},
           {"trajectory_refused", s.trajectory_refused},
@@ -316,7 +376,8 @@ void CompensatorService::log_sequence_events() {
   ignored_logged_ = g.ignored;
 }
 
-void CompensatorService::report(std::int64_t utime, bool stopping) {
+void CompensatorService::report(std::int64_t utime, bool stopping, bool end_period) {
+  verdict_due_ = false;
   log_sequence_events();
   const auto counters = collect_counters();
   const Compensator& c = *compensator_;
@@ -337,6 +398,29 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
     state = service_status_t::DEGRADED;
     detail = "no samples from the bridge this period; ";
   }
+  const CompensatorCounters& now = c.counters();
+  const std::uint64_t clamped = (now.u_clamped - clamped_reported_) + (now.u_slew_clamped - slew_clamped_reported_);
+  if (end_period) {
+    clamped_in_period_ = clamped;
+    clamped_reported_ = now.u_clamped;
+    slew_clamped_reported_ = now.u_slew_clamped;
+  }
+  if (state == service_status_t::HEALTHY && clamped_in_period_ > 0) {
+    state = service_status_t::DEGRADED;
+    detail += fmt::format("feedforward clamped at the actuator's limits on {} ticks in the last second; ",
+                          clamped_in_period_);
+  }
+  if (!verdict_.empty() && monotonic_now_ns() < verdict_until_ns_) detail += verdict_ + "; ";
+  const LearnerFigures& learner = c.learner().figures();
+  if (learner.active) {
+    detail += fmt::format("learning a {}-tick period ({} periods learned, last {:.3g} nm RMS); ", learner.period_ticks,
+                          learner.periods_learned, learner.last_error_rms_m * 1e9);
+  }
+  if (c.stage().has_dynamics()) {
+    detail += fmt::format("stage {:.4g} Hz zeta {:.3g}; ",
+                          c.stage().second_order.natural_frequency() / (2.0 * std::numbers::pi),
+                          c.stage().second_order.damping_ratio());
+  }
   const MemParams& m = c.mem_params();
   detail +=
       fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
@@ -351,6 +435,15 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
       if (n == name) semantic_rejects += reported_.since(n, value);
     }
   }
+  status_.counter("trajectory_version",
+                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_version)));
+  status_.counter("trajectory_refused_version",
+                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_refused_version)));
+  status_.counter("trajectory_shaped_version",
+                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_shaped_version)));
+  status_.counter("learning_active", learner.active ? 1u : 0u);
+  status_.counter("learning_periods", learner.periods_learned);
+  status_.counter("learning_rms_pm", static_cast<std::uint64_t>(std::llround(learner.last_error_rms_m * 1e12)));
   if (c.next_tick() >= 0) {
     status_.counter("plan_ahead_ticks",
                     static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
@@ -365,6 +458,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping) {
   status_.loop_timing(work_);
   status_.latency(latency_);
   status_.publish(utime);
+  if (!end_period) return;
   latency_total_.merge(latency_);
   latency_.reset();
   work_.reset();

@@ -70,6 +70,11 @@ struct CompensatorServiceCounters {
   std::uint64_t control_acted = 0;
   std::uint64_t control_refused = 0;
   std::uint64_t bridge_restarts = 0;  // sample seq went back (confirmed): the control law was restarted
+  // The last trajectory_t.version taken (as given or shaped), refused, shaped: what
+  // hystloop-ctl trajectory waits for.
+  std::int64_t trajectory_version = 0;
+  std::int64_t trajectory_refused_version = 0;
+  std::int64_t trajectory_shaped_version = 0;
   // On HX_STATUS besides: the SequenceGuard's sensor_blocks_held (not used while a jump or a
   // restart was unconfirmed), sensor_jumps_ignored (never confirmed: a forged or corrupted
   // block) and sensor_jumps (confirmed jumps ahead).
@@ -94,7 +99,9 @@ class CompensatorService {
   // HX_MODEL: any model; the feedforward switches to it at the next reversal (compensator_params.cpp).
   void on_model(const model_params_t& msg);
   void on_control(const control_t& msg);
-  void report(std::int64_t utime, bool stopping);
+  // HX_STATUS; end_period false: an extra report between the periodic ones (a trajectory's
+  // verdict), which leaves the period's timing and sample counts running.
+  void report(std::int64_t utime, bool stopping, bool end_period = true);
 
   const Compensator& compensator() const noexcept { return *compensator_; }
   const CompensatorServiceCounters& counters() const noexcept { return counters_; }
@@ -103,7 +110,8 @@ class CompensatorService {
   const command_block_t& last_command() const noexcept { return command_; }
 
  private:
-  void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime);
+  void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version);
+  void decide_trajectory(std::int64_t version, const std::string& verdict, bool refused, bool shaped);
   // What HX_PARAMS and HX_MODEL sets share: admit() refuses a diagnostic or stale set (counted,
   // logged once per reason and publisher); offer() validates and offers an admitted one.
   struct ParamsHeader {
@@ -154,6 +162,14 @@ class CompensatorService {
   std::optional<TrajectorySpec> pending_trajectory_;  // a timed start that arrived before the first sample
   std::int64_t pending_start_utime_ = 0;
   std::int64_t trajectory_version_ = 0;
+  std::int64_t pending_version_ = 0;  // of pending_trajectory_
+  std::int64_t refused_version_ = 0;  // the last trajectory_t.version refused
+  // The last verdict on a trajectory, in HX_STATUS's detail for a while after it was decided.
+  std::string verdict_;
+  std::int64_t verdict_until_ns_ = 0;
+  bool verdict_due_ = false;
+  std::uint64_t clamped_reported_ = 0, slew_clamped_reported_ = 0;  // u_clamped, u_slew_clamped at the last report
+  std::uint64_t clamped_in_period_ = 0;
   ParamsAdmission admission_;  // the last version accepted, per publisher
   SequenceGuard guard_;        // sensor seq: a jump or a restart is believed once confirmed
   std::uint64_t restarts_logged_ = 0;

@@ -59,6 +59,21 @@ const std::vector<std::string>& compensator_config_keys() {
                                                 "compensator.dt_s",
                                                 "compensator.run_seconds",
                                                 "compensator.sample_queue_capacity",
+                                                "compensator.plan_slew_fraction",
+                                                "actuator.u_min_V",
+                                                "actuator.u_max_V",
+                                                "actuator.slew_V_per_s",
+                                                "stage.kind",
+                                                "stage.k",
+                                                "stage.c",
+                                                "stage.order",
+                                                "learning.enabled",
+                                                "learning.gain",
+                                                "learning.cutoff_hz",
+                                                "learning.max_correction_m",
+                                                "learning.max_period_s",
+                                                "learning.lag_compensated",
+                                                "learning.fade_s",
                                                 "rt.priority",
                                                 "rt.lock_memory",
                                                 "mem.c1",
@@ -85,6 +100,8 @@ const std::vector<std::string>& compensator_config_keys() {
                                                 "trajectory.frequency_hz",
                                                 "trajectory.phase_rad",
                                                 "trajectory.blend_s",
+                                                "trajectory.corner_s",
+                                                "trajectory.shape_if_infeasible",
                                                 "trajectory.points_t_s",
                                                 "trajectory.points_y_m"};
   return keys;
@@ -163,6 +180,44 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   k.output_shaping = read_shaping(config, "katalenic.output_shaping", k.output_shaping);
   validate_config_section(config, "katalenic.", [&] { k.validate(); });
 
+  // The actuator as the bridge limits it: the plan stays inside it (keep equal to the bridge's actuator.*).
+  c.u_min_V = config.get<double>("actuator.u_min_V", c.u_min_V);
+  c.u_max_V = config.get<double>("actuator.u_max_V", c.u_max_V);
+  c.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", c.slew_V_per_s);
+  c.plan_slew_fraction = config.get_in_range("compensator.plan_slew_fraction", c.plan_slew_fraction, 0.05, 1.0);
+
+  const std::string stage_kind = config.get<std::string>("stage.kind", "none");
+  if (stage_kind == "second_order") {
+    c.stage.kind = StageModel::Kind::kSecondOrder;
+  } else if (stage_kind != "none") {
+    config.fail("stage.kind", "must be none or second_order (got '" + stage_kind + "')");
+  } else {
+    for (const char* key : {"stage.k", "stage.c"}) {
+      if (config.has(key)) config.fail("stage.kind", std::string("is none: set it to second_order to use ") + key);
+    }
+  }
+  c.stage.second_order.k = config.get_positive("stage.k", c.stage.second_order.k);
+  c.stage.second_order.c = config.get_positive("stage.c", c.stage.second_order.c);
+  const std::string order = config.get<std::string>("stage.order", "hysteresis_then_stage");
+  if (order == "hysteresis_then_stage") {
+    c.stage.order = BanningOrder::kHysteresisThenStage;
+  } else if (order == "stage_then_hysteresis") {
+    c.stage.order = BanningOrder::kStageThenHysteresis;
+  } else {
+    config.fail("stage.order", "must be hysteresis_then_stage or stage_then_hysteresis (got '" + order + "')");
+  }
+  validate_config_section(config, "", [&] { c.stage.validate(c.dt_s); });
+
+  LearningConfig& l = c.learning;
+  l.enabled = config.get<bool>("learning.enabled", l.enabled);
+  l.gain = config.get_in_range("learning.gain", l.gain, 1e-3, 1.0);
+  l.cutoff_hz = config.get_positive("learning.cutoff_hz", l.cutoff_hz);
+  l.max_correction_m = config.get_positive("learning.max_correction_m", l.max_correction_m);
+  l.max_period_s = config.get_positive("learning.max_period_s", l.max_period_s);
+  l.lag_compensated = config.get<bool>("learning.lag_compensated", l.lag_compensated);
+  l.fade_s = config.get_positive("learning.fade_s", l.fade_s);
+  validate_config_section(config, "learning.", [&] { l.validate(c.dt_s); });
+
   const double horizon_s =
       config.get_in_range("compensator.horizon_s", static_cast<double>(c.horizon_ticks) * c.dt_s, 2.0 * c.dt_s,
                           static_cast<double>(CompensatorConfig::kMaxHorizonTicks) * c.dt_s);
@@ -176,6 +231,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   t.frequency_hz = config.get_in_range("trajectory.frequency_hz", 1.0, 1e-6, 1e4);
   t.phase_rad = config.get<double>("trajectory.phase_rad", 0.0);
   t.blend_s = config.get_in_range("trajectory.blend_s", 0.5, 0.0, 3600.0);
+  t.corner_s = config.get_non_negative("trajectory.corner_s", 0.0);
+  t.shape_if_infeasible = config.get<bool>("trajectory.shape_if_infeasible", false);
   const auto pt = config.get<std::vector<double>>("trajectory.points_t_s", {});
   const auto py = config.get<std::vector<double>>("trajectory.points_y_m", {});
   if (pt.size() != py.size()) config.fail("trajectory.points_y_m", "needs as many values as trajectory.points_t_s");
@@ -220,6 +277,21 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
   lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
                               c.katalenic.k2_slope));
+  lines.push_back(fmt::format("actuator: u in [{}, {}] V, slew {:.4g} V/s (the plan uses at most {:.0f} % of it)",
+                              c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction));
+  if (c.stage.has_dynamics()) {
+    lines.push_back(fmt::format(
+        "stage: second order k {:.6g} 1/s^2, c {:.6g} 1/s ({:.4g} Hz, zeta {:.3g}), {}, inverted",
+        c.stage.second_order.k, c.stage.second_order.c,
+        c.stage.second_order.natural_frequency() / (2.0 * 3.141592653589793), c.stage.second_order.damping_ratio(),
+        c.stage.order == BanningOrder::kHysteresisThenStage ? "hysteresis then stage" : "stage then hysteresis"));
+  } else {
+    lines.push_back("stage: none (the hysteresis inverse alone)");
+  }
+  lines.push_back(fmt::format("learning: {} (gain {}, filter {} Hz, |correction| <= {:.3g} m, periods up to {} s{})",
+                              c.learning.enabled ? "on for periodic references" : "off", c.learning.gain,
+                              c.learning.cutoff_hz, c.learning.max_correction_m, c.learning.max_period_s,
+                              c.learning.lag_compensated ? ", lag-compensated" : ""));
   lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
   static const char* shapes[] = {"hold", "sine", "cosine", "triangle", "points"};
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",

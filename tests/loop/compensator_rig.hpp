@@ -22,6 +22,13 @@ inline CompensatorConfig compensator_config(FeedforwardMode mode, std::int64_t h
   CompensatorConfig c;
   c.mode = mode;
   c.horizon_ticks = horizon_ticks;
+  // These rigs test when things take effect, with steps and short approaches that no real
+  // actuator could follow: an actuator without limits here (compensator_limits_test has them).
+  c.u_min_V = -1e6;
+  c.u_max_V = 1e6;
+  c.slew_V_per_s = 1e12;
+  // ... and the re-anchoring ramp as fast as with the real actuator's slew limit.
+  c.slew_fraction = CompensatorConfig{}.slew_fraction * CompensatorConfig{}.slew_V_per_s / c.slew_V_per_s;
   return c;
 }
 

@@ -50,6 +50,14 @@ CompensatorSettings deployed() { return load_compensator_settings(Config::load_f
 CompensatorSettings holding() {
   CompensatorSettings s = deployed();
   s.control.horizon_ticks = kHorizon;
+  // These harnesses test when things take effect, with steps no actuator could follow: without
+  // the actuator's limits (tests/loop/compensator_limits_test.cpp has them), the re-anchoring
+  // ramp as fast as with them.
+  const CompensatorConfig real = s.control;
+  s.control.u_min_V = -1e6;
+  s.control.u_max_V = 1e6;
+  s.control.slew_V_per_s = 1e12;
+  s.control.slew_fraction = real.slew_fraction * real.slew_V_per_s / s.control.slew_V_per_s;
   return s;
 }
 

@@ -1,0 +1,91 @@
+#include "sim/scan_experiment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+
+std::vector<ScanReference> scan_references() {
+  return {{"triangle 10 Hz 1 um", TrajectoryShape::kTriangle, 1e-6, 10.0},
+          {"triangle 50 Hz 1 um", TrajectoryShape::kTriangle, 1e-6, 50.0},
+          {"sine 10 Hz 1 um", TrajectoryShape::kSine, 1e-6, 10.0},
+          {"sine 50 Hz 1 um", TrajectoryShape::kSine, 1e-6, 50.0},
+          {"sine 100 Hz 0.5 um", TrajectoryShape::kSine, 0.5e-6, 100.0},
+          {"sine 200 Hz 0.25 um", TrajectoryShape::kSine, 0.25e-6, 200.0}};
+}
+
+IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude_m) {
+  ExperimentSpec input;
+  input.amplitude_V = 160.0 * std::abs(amplitude_m) / 1e-6;
+  input.frequency_hz = 10.0;
+  input.duration_s = 2.0;
+  return identify_models_through_loop(e, input);
+}
+
+ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, const ScanReference& r,
+                 const ScanOptions& o) {
+  LoopSimulationConfig c = tracking_loop_config(e);
+  c.compensator.mode = o.mode.value_or(models.ranking.empty() ? FeedforwardMode::kPi : mode_of(models.ranking.front()));
+  c.compensator.mem = models.mem;
+  c.compensator.pi = models.pi;
+  c.compensator.katalenic = models.katalenic;
+  c.compensator.linear = models.linear;
+  c.compensator.u_min_V = c.limits.u_min_V;
+  c.compensator.u_max_V = c.limits.u_max_V;
+  c.compensator.slew_V_per_s = c.limits.slew_V_per_s;
+  if (o.stage_inverse && e.plant == PlantKind::kBanning) {
+    c.compensator.stage.kind = StageModel::Kind::kSecondOrder;
+    c.compensator.stage.second_order = c.stage.banning.stage;
+    c.compensator.stage.order = c.stage.banning.order;
+  }
+  c.compensator.learning.enabled = o.learning;
+  if (o.servo) {
+    c.servo.kp = o.kp;
+    c.servo.ki = o.ki;
+    c.servo.notch_hz = o.notch_hz;
+    c.servo.notch_q = o.notch_q;
+    c.servo.nominal_gain_m_per_V = models.linear.gain;
+  }
+  LoopSimulation sim(c);
+  TrajectorySpec spec;
+  spec.shape = r.shape;
+  spec.amplitude_m = r.amplitude_m;
+  spec.frequency_hz = r.frequency_hz;
+  spec.blend_s = 0.2;
+  const double start_s = 0.3;
+  ScanRun run;
+  run.mode = c.compensator.mode;
+  sim.run(0.05);  // the first samples: the plan knows where the loop is
+  try {
+    const TrajectoryVerdict v = sim.compensator().take_trajectory(spec, start_s);
+    run.reason = v.note;
+    run.corner_s = v.spec.corner_s;
+  } catch (const ParameterError& err) {
+    run.refused = true;
+    run.reason = err.what();
+    return run;
+  }
+  const double period = 1.0 / r.frequency_hz;
+  const int measure = std::max(o.measure_periods, static_cast<int>(std::ceil(o.min_measure_s / period)));
+  const double from = start_s + o.settle_periods * period;
+  const double to = from + measure * period;
+  sim.run(to + 1e-9 - sim.now_s());
+  run.stats = sim.tracking(from, to);
+  run.counters = sim.compensator().counters();
+  const std::vector<LoopTick>& h = sim.history();
+  for (const LoopTick& t : h) {
+    if (t.t_s >= start_s - spec.blend_s && (t.flags & (sample_flags::kSaturated | sample_flags::kSlewLimited)))
+      ++run.clamped_ticks;
+  }
+  const int periods = static_cast<int>(std::floor((to - start_s) / period + 1e-9));
+  for (int p = 0; p < periods; ++p)
+    run.rms_per_period_m.push_back(sim.tracking(start_s + p * period, start_s + (p + 1) * period).rms_true_m);
+  for (int p = periods - 1; p >= 0 && run.rms_per_period_m[static_cast<std::size_t>(p)] <= 1e-9; --p)
+    run.periods_to_converge = p;
+  return run;
+}
+
+}  // namespace hystloop

@@ -1,0 +1,259 @@
+// The plan stays inside the actuator's limits: a trajectory whose feedforward would leave the
+// range or the slew limit is refused where it enters, naming the limit and what would fit, or
+// shaped when asked; a triangle's corners are rounded by the shortest time the limits allow; the
+// stage's inverse is part of the plan; learning follows the trajectory.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "loop/compensator.hpp"
+#include "loop/feasibility.hpp"
+#include "models/stage_inverse.hpp"
+
+namespace hystloop {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kGain = 6.34e-9;                              // LinearParams' default [m/V]
+const double kShare = CompensatorConfig{}.plan_slew_fraction;  // of the slew limit a plan may use
+
+CompensatorConfig linear_config(bool stage) {
+  CompensatorConfig c;
+  c.mode = FeedforwardMode::kLinear;
+  if (stage) c.stage.kind = StageModel::Kind::kSecondOrder;  // Banning's Table 2
+  return c;
+}
+
+TrajectorySpec sine(double amplitude_m, double frequency_hz) {
+  TrajectorySpec s;
+  s.shape = TrajectoryShape::kSine;
+  s.amplitude_m = amplitude_m;
+  s.frequency_hz = frequency_hz;
+  s.blend_s = 0.05;
+  return s;
+}
+
+TrajectorySpec triangle(double amplitude_m, double frequency_hz, double corner_s) {
+  TrajectorySpec s = sine(amplitude_m, frequency_hz);
+  s.shape = TrajectoryShape::kTriangle;
+  s.corner_s = corner_s;
+  return s;
+}
+
+// Plans `seconds` of loop time as a stage that follows perfectly would answer it (each sample
+// the tick's own voltage and reference: feedforward only, tracking exact), and returns the
+// largest tick-to-tick step of u_ff [V].
+double plan_for(Compensator& c, double seconds, std::vector<CommandTick>* ticks = nullptr) {
+  std::vector<CommandTick> out(64);
+  std::map<std::int64_t, CommandTick> planned;
+  double last = 0.0, worst = 0.0;
+  bool first = true;
+  const auto n = static_cast<std::int64_t>(std::llround(seconds / c.config().dt_s));
+  for (std::int64_t k = 0; k < n; ++k) {
+    const std::int64_t seq = std::max<std::int64_t>(c.last_seq() + 1, 0);
+    const auto it = planned.find(seq);
+    const bool tracked = it != planned.end() && std::isfinite(it->second.y_ref_m);
+    c.observe({seq, it != planned.end() ? it->second.u_ff_V : 0.0, tracked ? it->second.y_ref_m : 0.0});
+    while (const std::size_t m = c.plan(out)) {
+      for (std::size_t i = 0; i < m; ++i) {
+        if (!first) worst = std::max(worst, std::abs(out[i].u_ff_V - last));
+        first = false;
+        last = out[i].u_ff_V;
+        planned[out[i].seq] = out[i];
+        if (ticks) ticks->push_back(out[i]);
+      }
+    }
+  }
+  return worst;
+}
+
+TEST(CompensatorLimits, TheDryRunOfALinearPlanAgreesWithTheClosedForms) {
+  // The dry run is the plan itself; for a static gain (and Banning's stage, inverted exactly at
+  // the tick) the closed forms of loop/feasibility.hpp hold to the discretisation.
+  for (const bool stage : {false, true}) {
+    Compensator c(linear_config(stage));
+    LinearPlant plant{kGain, std::nullopt};
+    if (stage) plant.stage = SecondOrderStageParams{};
+    for (const double f : {10.0, 50.0, 100.0}) {
+      const PlanExtent e = c.dry_run(sine(0.5e-6, f), 0.1);
+      const VoltageNeed need = sine_need(plant, 0.5e-6, f, 0.0);
+      // The plan inverts the stage sampled at the tick, with its hold: its gain is 1 / |G(e^iwT)|,
+      // which differs from the continuous |k - w^2 + i c w| / k by the hold's sinc (0.3 % at 100 Hz).
+      const double discrete =
+          stage
+              ? 1.0 / (discretise_zoh(SecondOrderStageParams{}, 1e-4).magnitude(f, 1e-4) * stage_inverse_gain(plant, f))
+              : 1.0;
+      const double tol = stage ? 3e-3 : 1e-3;
+      EXPECT_NEAR(e.rate_max_V_per_s, need.rate_V_per_s * discrete, tol * need.rate_V_per_s) << f << " Hz, " << stage;
+      // The approach arrives with the sine's curvature, so the extremes are the periods'.
+      EXPECT_NEAR(e.u_max_V, need.u_max_V * discrete, 1e-3 * need.u_max_V) << f << " Hz, stage " << stage;
+      EXPECT_NEAR(e.u_min_V, need.u_min_V * discrete, 1e-3 * need.u_max_V) << f << " Hz, stage " << stage;
+    }
+    const double corner = 2e-3;
+    const PlanExtent e = c.dry_run(triangle(0.5e-6, 50.0, corner), 0.1);
+    const VoltageNeed need = triangle_need(plant, 0.5e-6, 50.0, corner, 0.0);
+    // The continuous closed form, against the discrete plan: within the hold's share.
+    EXPECT_NEAR(e.rate_max_V_per_s, need.rate_V_per_s, 1.5e-2 * need.rate_V_per_s) << "stage " << stage;
+    EXPECT_NEAR(e.u_max_V, need.u_max_V, 5e-3 * need.u_max_V) << "stage " << stage;
+  }
+}
+
+TEST(CompensatorLimits, ASineBeyondTheSlewLimitIsRefusedNamingTheLimitAndWhatWouldFit) {
+  Compensator c(linear_config(true));
+  // 1 um at 200 Hz needs 2 pi 200 1e-6 / 6.34e-9 = 2.0e5 V/s, four times the 5e4 V/s limit.
+  try {
+    c.take_trajectory(sine(1e-6, 200.0), kNaN);
+    FAIL() << "a 1 um 200 Hz sine was taken";
+  } catch (const ParameterError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("actuator.slew_V_per_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("largest feasible amplitude"), std::string::npos) << what;
+    EXPECT_NE(what.find("highest feasible frequency"), std::string::npos) << what;
+    EXPECT_NE(what.find("--shape-to-feasible"), std::string::npos) << what;
+  }
+  EXPECT_EQ(c.counters().trajectories_refused, 1u);
+  EXPECT_EQ(c.trajectory().shape, TrajectoryShape::kHold);  // the plan is unchanged
+  // What the closed form says fits does: kShare x 5e4 V/s at 200 Hz, through the stage's inverse.
+  FeedforwardLimits limits;
+  limits.fraction = kShare;
+  const double a = largest_sine_amplitude_m(LinearPlant{kGain, SecondOrderStageParams{}}, limits, 200.0, 0.0);
+  EXPECT_NEAR(a, kShare * 5e4 * kGain / (2.0 * std::numbers::pi * 200.0) / 0.9867, 1e-3 * a);  // M(200 Hz)
+  EXPECT_NO_THROW(c.take_trajectory(sine(0.99 * a, 200.0), kNaN));
+  EXPECT_THROW(c.take_trajectory(sine(1.02 * a, 200.0), kNaN), ParameterError);
+}
+
+TEST(CompensatorLimits, AnAmplitudeBeyondTheRangeIsRefusedNamingTheRange) {
+  Compensator c(linear_config(false));
+  try {
+    c.take_trajectory(sine(2e-6, 1.0), kNaN);  // 2 um / 6.34e-9 m/V = 315 V > 250 V
+    FAIL() << "a 2 um sine was taken";
+  } catch (const ParameterError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("actuator.u_min_V/u_max_V"), std::string::npos) << what;
+    EXPECT_EQ(what.find("highest feasible frequency"), std::string::npos) << what;  // no frequency helps
+  }
+}
+
+TEST(CompensatorLimits, AskedToShapeItScalesTheAmplitudeAndThePlanNeverClamps) {
+  Compensator c(linear_config(true));
+  TrajectorySpec s = sine(1e-6, 200.0);
+  s.shape_if_infeasible = true;
+  const TrajectoryVerdict v = c.take_trajectory(s, kNaN);
+  EXPECT_TRUE(v.shaped);
+  EXPECT_NE(v.note.find("scaled"), std::string::npos) << v.note;
+  EXPECT_LT(v.spec.amplitude_m, 0.26e-6);  // kShare x 5e4 V/s at 200 Hz through the stage's inverse
+  EXPECT_GT(v.spec.amplitude_m, 0.2e-6);
+  EXPECT_EQ(c.counters().trajectories_shaped, 1u);
+  const double worst = plan_for(c, 0.3);
+  EXPECT_LE(worst, kShare * 5e4 * 1e-4 + 1e-9);
+  EXPECT_EQ(c.counters().u_slew_clamped, 0u);
+  EXPECT_EQ(c.counters().u_clamped, 0u);
+}
+
+TEST(CompensatorLimits, ATriangleGetsTheShortestCornersTheLimitsAllow) {
+  // With the stage's inverse a sharp corner needs an unbounded voltage rate: the planner rounds
+  // it, never below two periods of the resonance, where the line still fits.
+  const double floor_s = 2.0 / (std::sqrt(SecondOrderStageParams{}.k) / (2.0 * std::numbers::pi));
+  for (const double f : {10.0, 50.0, 66.0}) {
+    Compensator c(linear_config(true));
+    const TrajectoryVerdict v = c.take_trajectory(triangle(1e-6, f, 0.0), kNaN);
+    EXPECT_NEAR(v.spec.corner_s, floor_s, 1e-12) << f;
+    EXPECT_NE(v.note.find("resonance"), std::string::npos) << v.note;
+    EXPECT_LE(v.extent.rate_max_V_per_s, kShare * 5e4) << f;
+    const double worst = plan_for(c, 0.2);  // the plan then never leaves the limits
+    EXPECT_LE(worst, kShare * 5e4 * 1e-4 + 1e-9) << f;
+    EXPECT_EQ(c.counters().u_slew_clamped, 0u) << f;
+  }
+  // At 90 Hz no corner fits 1 um (the straight line alone needs 5.7e4 V/s): refused, or shaped by
+  // the amplitude with the corners kept.
+  Compensator refused(linear_config(true));
+  EXPECT_THROW(refused.take_trajectory(triangle(1e-6, 90.0, 0.0), kNaN), ParameterError);
+  Compensator shaped(linear_config(true));
+  TrajectorySpec t = triangle(1e-6, 90.0, 0.0);
+  t.shape_if_infeasible = true;
+  const TrajectoryVerdict v = shaped.take_trajectory(t, kNaN);
+  EXPECT_TRUE(v.shaped);
+  EXPECT_LT(v.spec.amplitude_m, 0.9e-6);
+  EXPECT_GT(v.spec.amplitude_m, 0.6e-6);
+  EXPECT_LE(plan_for(shaped, 0.2), kShare * 5e4 * 1e-4 + 1e-9);
+  EXPECT_EQ(shaped.counters().u_slew_clamped, 0u);
+  // Without the stage's inverse a linear plant takes a sharp corner (the rate is v / g).
+  Compensator no_stage(linear_config(false));
+  EXPECT_EQ(no_stage.take_trajectory(triangle(1e-6, 50.0, 0.0), kNaN).spec.corner_s, 0.0);
+}
+
+TEST(CompensatorLimits, TheStageInverseIsPartOfThePlan) {
+  // Driven by the plan, the discrete stage reproduces the reference at every sample: u_ff through
+  // the linear model and then the stage, both exact, gives y = y_ref.
+  Compensator c(linear_config(true));
+  c.take_trajectory(sine(0.4e-6, 100.0), kNaN);
+  std::vector<CommandTick> ticks;
+  plan_for(c, 0.5, &ticks);
+  SecondOrderStage stage;
+  double worst = 0.0;
+  for (const CommandTick& t : ticks) {
+    const double y = stage.step(kGain * t.u_ff_V, 1e-4);
+    if (t.seq > 3000) worst = std::max(worst, std::abs(y - t.y_ref_m));
+  }
+  EXPECT_LT(worst, 1e-15);
+  EXPECT_TRUE(c.stage().has_dynamics());
+}
+
+TEST(CompensatorLimits, LearningFollowsTheTrajectory) {
+  CompensatorConfig config = linear_config(false);
+  Compensator c(config);
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  plan_for(c, 0.3);
+  EXPECT_TRUE(c.learner().figures().active);
+  EXPECT_EQ(c.learner().figures().period_ticks, 200);
+  c.take_trajectory(sine(0.4e-6, 100.0), kNaN);  // a new reference: learning starts again
+  plan_for(c, 0.3);
+  EXPECT_EQ(c.learner().figures().period_ticks, 100);
+  c.take_trajectory(sine(0.5e-6, 30.0), kNaN);  // 333.3 ticks: not a whole number, not learned
+  plan_for(c, 0.3);
+  EXPECT_FALSE(c.learner().figures().active);
+  c.take_trajectory(sine(0.5e-6, 5.0), kNaN);  // longer than learning.max_period_s (0.1 s)
+  plan_for(c, 0.5);
+  EXPECT_FALSE(c.learner().figures().active);
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  c.set_learning(false);
+  plan_for(c, 0.3);
+  EXPECT_FALSE(c.learner().figures().active);
+}
+
+TEST(CompensatorLimits, ParameterSetsCarryAStageThatIsValidatedAndSwappedAtAReversal) {
+  Compensator c(linear_config(false));
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.stage = StageModel{StageModel::Kind::kSecondOrder, SecondOrderStageParams{1.17e8, 1e-3}, {}};
+  EXPECT_THROW(c.offer_model(set, 2), ParameterError);  // an almost undamped stage: refused
+  set.stage->second_order.c = 2.03e3;
+  c.offer_model(set, 3);
+  EXPECT_FALSE(c.stage().has_dynamics());  // waits for a reversal
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  plan_for(c, 0.2);
+  EXPECT_TRUE(c.stage().has_dynamics());
+  EXPECT_EQ(c.params_version(), 3);
+}
+
+TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
+  CompensatorConfig c = linear_config(true);
+  c.stage.second_order.c = 1e-3;
+  EXPECT_THROW(Compensator{c}, ParameterError);
+  c = linear_config(true);
+  c.learning.gain = 1.5;
+  EXPECT_THROW(Compensator{c}, ParameterError);
+  c = linear_config(true);
+  c.plan_slew_fraction = 0.0;
+  EXPECT_THROW(Compensator{c}, ParameterError);
+}
+
+}  // namespace
+}  // namespace hystloop
