@@ -1,5 +1,6 @@
 #include "compensator/compensator_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <cstdio>
@@ -211,12 +212,13 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   LearningConfig& l = c.learning;
   l.enabled = config.get<bool>("learning.enabled", l.enabled);
   l.gain = config.get_in_range("learning.gain", l.gain, 1e-3, 1.0);
-  l.cutoff_hz = config.get_positive("learning.cutoff_hz", l.cutoff_hz);
+  // The default filter, never above a quarter of the tick rate (what the learner's filter can be).
+  l.cutoff_hz = config.get_positive("learning.cutoff_hz", std::min(l.cutoff_hz, 0.25 / c.dt_s));
   l.max_correction_m = config.get_positive("learning.max_correction_m", l.max_correction_m);
   l.max_period_s = config.get_positive("learning.max_period_s", l.max_period_s);
   l.lag_compensated = config.get<bool>("learning.lag_compensated", l.lag_compensated);
   l.fade_s = config.get_positive("learning.fade_s", l.fade_s);
-  validate_config_section(config, "learning.", [&] { l.validate(c.dt_s); });
+  validate_config_section(config, "", [&] { l.validate(c.dt_s); });  // its fields are named learning.*
 
   const double horizon_s =
       config.get_in_range("compensator.horizon_s", static_cast<double>(c.horizon_ticks) * c.dt_s, 2.0 * c.dt_s,

@@ -46,10 +46,12 @@ const std::string kConfigDir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/confi
 
 CompensatorSettings deployed() { return load_compensator_settings(Config::load_file(kConfigDir + "compensator.yaml")); }
 
-// The deployed settings (MEM, holding at 0) with a horizon of kHorizon ticks.
+// The deployed settings, in MEM mode (the MEM paper's workflow, whose parameter swaps these test),
+// holding at 0, with a horizon of kHorizon ticks.
 CompensatorSettings holding() {
   CompensatorSettings s = deployed();
   s.control.horizon_ticks = kHorizon;
+  s.control.mode = FeedforwardMode::kMem;
   // These harnesses test when things take effect, with steps no actuator could follow: without
   // the actuator's limits (tests/loop/compensator_limits_test.cpp has them), the re-anchoring
   // ramp as fast as with them.
@@ -849,6 +851,32 @@ TEST(TrajectoryMessage, MapsWallTimeToLoopTime) {
   t.version = 1;
   t.shape = 9;
   EXPECT_THROW(trajectory_from_message(t), ParameterError);
+}
+
+}  // namespace
+}  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+TEST(CompensatorSettings, TheStageTheLearningAndTheActuatorComeFromTheConfig) {
+  const CompensatorSettings deploy = deployed();
+  EXPECT_TRUE(deploy.control.stage.has_dynamics());  // the simulated stage's Table 2
+  EXPECT_DOUBLE_EQ(deploy.control.stage.second_order.k, 1.17e8);
+  EXPECT_DOUBLE_EQ(deploy.control.stage.second_order.c, 2.03e3);
+  EXPECT_TRUE(deploy.control.learning.enabled);
+  EXPECT_TRUE(deploy.control.learning.lag_compensated);
+  EXPECT_EQ(deploy.control.slew_V_per_s, 5.0e4);
+  EXPECT_EQ(deploy.control.mode, FeedforwardMode::kPi);
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: third_order}"), "stage.kind"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: second_order, c: 1.0e-3}"), "sampling zero"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {k: 1.0e8}"), "stage.kind"));  // k without a stage
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: second_order, order: backwards}"), "stage.order"));
+  EXPECT_TRUE(contains(settings_refusal("learning: {gain: 2.0}"), "learning.gain"));
+  EXPECT_TRUE(contains(settings_refusal("actuator: {slew_V_per_s: -1}"), "actuator.slew_V_per_s"));
+  EXPECT_TRUE(contains(settings_refusal("compensator: {plan_slew_fraction: 0}"), "compensator.plan_slew_fraction"));
+  const auto none = load_compensator_settings(Config::from_string("stage: {kind: none}", "compensator.yaml"));
+  EXPECT_FALSE(none.control.stage.has_dynamics());
 }
 
 }  // namespace

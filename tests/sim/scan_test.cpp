@@ -1,0 +1,64 @@
+// Scans at line rate on the simulated stage (sim/scan_experiment.hpp), in process: the references a
+// lab runs, with the stage's inverse and the model identified for the line's loops, without and
+// with learning, inside the actuator's limits. The figures are docs/TRACKING.md's
+// (bench/tracking_table --scan prints them).
+#include "sim/scan_experiment.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace hystloop {
+namespace {
+
+TEST(Scan, EveryLineRateTargetIsTrackedInsideTheLimits) {
+  const TrackingExperiment experiment;  // Banning's stage, 1 nm sensor noise
+  for (const ScanReference& r : scan_references()) {
+    const IdentifiedModels models = identify_for_scan(experiment, r.amplitude_m);
+    ASSERT_FALSE(models.ranking.empty()) << r.name;
+    ScanOptions o;
+    const ScanRun plain = run_scan(experiment, models, r, o);
+    ASSERT_FALSE(plain.refused) << r.name << ": " << plain.reason;
+    EXPECT_EQ(plain.clamped_ticks, 0u) << r.name;
+    EXPECT_EQ(plain.counters.u_slew_clamped + plain.counters.u_clamped, 0u) << r.name;
+    EXPECT_LE(plain.stats.rms_true_m, 2e-9) << r.name;  // with the stage's inverse, without learning
+    o.learning = true;
+    const ScanRun learned = run_scan(experiment, models, r, o);
+    ASSERT_FALSE(learned.refused) << r.name;
+    EXPECT_EQ(learned.clamped_ticks, 0u) << r.name;
+    EXPECT_LE(learned.stats.rms_true_m, 1e-9) << r.name;  // periods [20, 30)
+    EXPECT_LE(learned.stats.max_abs_true_m, 5e-9) << r.name;
+    EXPECT_GE(learned.periods_to_converge, 0) << r.name;
+    EXPECT_LE(learned.periods_to_converge, 20) << r.name;
+    if (r.shape == TrajectoryShape::kTriangle) {
+      EXPECT_GT(plain.corner_s, 0.0) << r.name;
+    }
+  }
+}
+
+TEST(Scan, TheStageInverseIsWhatMakesTheFastLinesTrack) {
+  // Without it a 50 Hz line is several times worse: the 1.72 kHz stage and the hold lag a third
+  // of a tick behind the plan.
+  const TrackingExperiment experiment;
+  const ScanReference line = scan_references()[3];  // sine 50 Hz 1 um
+  const IdentifiedModels models = identify_for_scan(experiment, line.amplitude_m);
+  ScanOptions o;
+  const ScanRun with = run_scan(experiment, models, line, o);
+  o.stage_inverse = false;
+  const ScanRun without = run_scan(experiment, models, line, o);
+  ASSERT_FALSE(with.refused || without.refused);
+  EXPECT_GT(without.stats.rms_true_m, 1.2 * with.stats.rms_true_m);
+}
+
+TEST(Scan, AnInfeasibleLineIsRefusedNamingTheSlewLimit) {
+  const TrackingExperiment experiment;
+  const IdentifiedModels models = identify_for_scan(experiment, 1e-6);
+  for (const double f : {100.0, 200.0}) {  // 1 um at 100 Hz needs ~1e5 V/s, twice the limit
+    const ScanRun run = run_scan(experiment, models, {"sine 1 um", TrajectoryShape::kSine, 1e-6, f}, ScanOptions{});
+    EXPECT_TRUE(run.refused) << f;
+    EXPECT_NE(run.reason.find("actuator.slew_V_per_s"), std::string::npos) << run.reason;
+  }
+}
+
+}  // namespace
+}  // namespace hystloop
