@@ -28,6 +28,7 @@ void BanningPlanOptions::validate() const {
   require_positive("hysteresis_frequency_Hz", hysteresis_frequency_Hz);
   if (measure_periods < 1) throw ParameterError("measure_periods", "must be >= 1");
   require_positive("settle_frequency_Hz", settle_frequency_Hz);
+  require_positive("slew_V_per_s", slew_V_per_s);
   if (settle_periods < 0) throw ParameterError("settle_periods", "must be >= 0");
   require_non_negative("settle_path_V", settle_path_V);
   for (double f : frequencies_Hz) require_in_range("frequencies_Hz", f, 1e-3, 0.45 * sample_rate_Hz);
@@ -77,19 +78,26 @@ std::vector<BanningExperiment> plan_banning_experiments(const BanningPlanOptions
   auto sp_for = [&](double amplitude) {
     return std::max<double>(o.settle_periods, std::ceil(o.settle_path_V / (4.0 * amplitude) - 1e-9));
   };
+  // The settling sine within 90 % of the slew limit: 2 pi f A <= 0.9 slew.
+  auto settle_f_for = [&](double amplitude) {
+    return std::min(o.settle_frequency_Hz, 0.9 * o.slew_V_per_s / (2.0 * std::numbers::pi * amplitude));
+  };
   for (double off : o.offsets_V) {
-    plan.push_back(sine_experiment(BanningExperimentKind::offset, off, o.offset_amplitude_V, fh, o.settle_frequency_Hz,
-                                   sp_for(o.offset_amplitude_V), mp, fs));
+    plan.push_back(sine_experiment(BanningExperimentKind::offset, off, o.offset_amplitude_V, fh,
+                                   settle_f_for(o.offset_amplitude_V), sp_for(o.offset_amplitude_V), mp, fs));
   }
   for (double a : o.small_amplitudes_V) {
     plan.push_back(
-        sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a), mp, fs));
+        sine_experiment(BanningExperimentKind::small_amplitude, 0.0, a, fh, settle_f_for(a), sp_for(a), mp, fs));
   }
   for (double a : o.amplitudes_V) {
-    plan.push_back(
-        sine_experiment(BanningExperimentKind::amplitude, 0.0, a, fh, o.settle_frequency_Hz, sp_for(a), mp, fs));
+    plan.push_back(sine_experiment(BanningExperimentKind::amplitude, 0.0, a, fh, settle_f_for(a), sp_for(a), mp, fs));
   }
   for (double f : o.frequencies_Hz) {
+    if (2.0 * std::numbers::pi * f * o.frequency_amplitude_V > o.slew_V_per_s) {
+      throw ParameterError("frequency_amplitude_V", "at " + std::to_string(f) + " Hz needs more than the slew limit " +
+                                                        std::to_string(o.slew_V_per_s) + " V/s");
+    }
     // Settle and measure at the drive frequency itself: the stage's transient needs
     // frequency_settle_s, the hysteresis (on a live stage, coming from the previous experiment's
     // loop) settle_periods.

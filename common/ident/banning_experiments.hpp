@@ -42,6 +42,9 @@ struct BanningPlanOptions {
   double frequency_amplitude_V = 2.0;
   double frequency_settle_s = 0.03;  // the stage decays as e^{-c t / 2}: 30 ms is e^{-30}
   double frequency_measure_s = 0.1;
+  // The actuator's slew limit (the bridge's actuator.slew_V_per_s): a settling sine runs slower
+  // where its amplitude would need more than 90 % of it (200 V at 50 Hz needs 6.3e4 V/s).
+  double slew_V_per_s = 5.0e4;
 
   void validate() const;  // throws ParameterError naming the field
 };

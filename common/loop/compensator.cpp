@@ -487,7 +487,27 @@ void Compensator::set_mode(FeedforwardMode mode) {
   }
 }
 
-void Compensator::start_experiment(const ExperimentSpec& spec) { experiments_.add(spec); }
+void Compensator::start_experiment(const ExperimentSpec& spec) {
+  spec.validate();
+  // An excitation is a voltage: it must fit the actuator as it is, not be clamped by the bridge.
+  if (spec.offset_V - spec.amplitude_V < config_.u_min_V || spec.offset_V + spec.amplitude_V > config_.u_max_V) {
+    throw ParameterError("experiment", "offset " + si(spec.offset_V, "V") + " +- amplitude " +
+                                           si(spec.amplitude_V, "V") + " leaves the actuator's range " +
+                                           si(config_.u_min_V, "V") + " to " + si(config_.u_max_V, "V") +
+                                           " (actuator.u_min_V/u_max_V)");
+  }
+  const double rate = 2.0 * std::numbers::pi * spec.frequency_hz * spec.amplitude_V;
+  if (rate > config_.plan_slew_fraction * config_.slew_V_per_s) {
+    throw ParameterError(
+        "experiment",
+        "a sine of " + si(spec.amplitude_V, "V") + " at " + si(spec.frequency_hz, "Hz") + " needs " + si(rate, "V/s") +
+            ", above " + si(100.0 * config_.plan_slew_fraction, "%") + " of the slew limit " +
+            si(config_.slew_V_per_s, "V/s") + " (actuator.slew_V_per_s): at most " +
+            si(config_.plan_slew_fraction * config_.slew_V_per_s / (2.0 * std::numbers::pi * spec.amplitude_V), "Hz") +
+            " at this amplitude");
+  }
+  experiments_.add(spec);
+}
 
 void Compensator::stop_experiment() noexcept { experiments_.stop(loop_time(std::max<std::int64_t>(next_tick_, 0))); }
 
@@ -603,9 +623,17 @@ CommandTick Compensator::plan_tick(std::int64_t k) noexcept {
     } else {
       experiment_u_.update(e.voltage_V);
     }
-    last_u_ = e.voltage_V;
+    // From where the plan is (the previous experiment's offset, or the tracking voltage) at the
+    // slew limit's admitted share: the bridge never has to clamp an excitation.
+    const double max_step = config_.plan_slew_fraction * config_.slew_V_per_s * config_.dt_s;
+    double u = e.voltage_V;
+    if (std::abs(u - last_u_) > max_step) {
+      u = last_u_ + std::copysign(max_step, u - last_u_);
+      ++counters_.experiment_ramped;
+    }
+    last_u_ = u;
     last_u_wanted_ = kNaN;
-    return {k, e.voltage_V, kNaN, params_version_, kExperimentMode};
+    return {k, u, kNaN, params_version_, kExperimentMode};
   }
   if (e.ended) {
     awaiting_anchor_ = true;

@@ -144,6 +144,7 @@ struct CompensatorCounters {
   std::uint64_t trajectories_refused = 0;  // infeasible (or invalid) trajectories not taken
   std::uint64_t trajectories_shaped = 0;   // taken after shaping to feasibility
   std::uint64_t stage_swaps = 0;           // stage models swapped in
+  std::uint64_t experiment_ramped = 0;     // experiment ticks ramped towards the excitation (a jump between two)
 };
 
 // What the feedforward of a trajectory needs, from a dry run of the plan.
@@ -206,7 +207,9 @@ class Compensator {
   void offer_model(const ModelParamSet& params, std::int32_t version);
   void set_mode(FeedforwardMode mode);  // re-initialises that inverse where the plan is
   // Starts the experiment at the next planned tick, or queues it behind the running one.
-  // Validated here (throws ParameterError; also when the queue is full).
+  // Validated here (throws ParameterError; also when the queue is full, and when the excitation
+  // leaves the actuator's range or plan_slew_fraction of its slew limit). A jump between two
+  // excitations (or from the tracking voltage) is ramped at that rate.
   void start_experiment(const ExperimentSpec& spec);
   // Ends the running experiment at the next planned tick and drops the queue.
   void stop_experiment() noexcept;

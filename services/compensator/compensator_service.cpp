@@ -35,6 +35,7 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
   a.trajectories_refused += b.trajectories_refused;
   a.trajectories_shaped += b.trajectories_shaped;
   a.stage_swaps += b.stage_swaps;
+  a.experiment_ramped += b.experiment_ramped;
   return a;
 }
 
@@ -337,6 +338,7 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"u_slew_clamped", c.u_slew_clamped},
           {"trajectories_shaped", c.trajectories_shaped},
           {"stage_swaps", c.stage_swaps},
+          {"experiment_ramped", c.experiment_ramped},
           {"trajectories", s.trajectories},
           {"trajectory_repeats", s.trajectory_repeats},
           {"trajectory_refused", s.trajectory_refused},

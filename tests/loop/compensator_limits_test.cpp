@@ -257,3 +257,45 @@ TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
 
 }  // namespace
 }  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
+  Compensator c(linear_config(false));
+  ExperimentSpec big;
+  big.amplitude_V = 300.0;
+  try {
+    c.start_experiment(big);
+    FAIL() << "a 300 V excitation was queued";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("actuator.u_min_V/u_max_V"), std::string::npos) << e.what();
+  }
+  ExperimentSpec fast;  // 200 V at 50 Hz needs 6.3e4 V/s
+  fast.amplitude_V = 200.0;
+  fast.frequency_hz = 50.0;
+  try {
+    c.start_experiment(fast);
+    FAIL() << "a 6.3e4 V/s excitation was queued";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("actuator.slew_V_per_s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at most 39.4 Hz"), std::string::npos) << e.what();
+  }
+  // Two excitations at different offsets, back to back: the jump between them is a ramp.
+  ExperimentSpec low, high;
+  low.offset_V = -100.0;
+  low.amplitude_V = 20.0;
+  low.frequency_hz = 50.0;
+  low.duration_s = 0.04;
+  high = low;
+  high.offset_V = 100.0;
+  c.start_experiment(low);
+  c.start_experiment(high);
+  std::vector<CommandTick> ticks;
+  const double worst = plan_for(c, 0.12, &ticks);
+  EXPECT_LE(worst, kShare * 5e4 * 1e-4 + 1e-9);
+  EXPECT_GT(c.counters().experiment_ramped, 38u);  // 200 V at 4.95 V per tick, and 100 V from 0 V
+}
+
+}  // namespace
+}  // namespace hystloop

@@ -222,6 +222,17 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   Subscription<command_block_t>::Options queue;
   queue.queue_capacity = 4'000;
   Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command, queue);
+  // The plan runs a horizon ahead of the stage: the series is done when the sample of its last
+  // tick has arrived, not when that tick was planned.
+  std::int64_t last_sample = -1;
+  Subscription<sensor_block_t>::Options sensor_queue;
+  sensor_queue.queue_capacity = 4'000;
+  Subscription<sensor_block_t> samples(
+      link.lcm(), link.channels().sensor,
+      [&](const sensor_block_t& b, std::int64_t) {
+        if (b.n_ticks > 0) last_sample = std::max<std::int64_t>(last_sample, b.seq + b.n_ticks - 1);
+      },
+      sensor_queue);
   auto pump = [&](Clock::time_point until_time) {
     return handle_pending(link.lcm(), std::min(until(until_time), std::chrono::microseconds(50'000)), 4096) >= 0;
   };
@@ -305,7 +316,19 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
                  total_s + o.start_timeout_s + 5.0);
     return 1;
   }
-  std::printf("hystloop-ctl: series done: %zu steps, ticks %lld .. %lld (%.1f s)\n", steps.size(),
+  const auto measured_deadline = after(2.0);
+  while (last_sample < tracker.end_tick() && Clock::now() < measured_deadline && !stop_requested()) {
+    if (!pump(measured_deadline)) return 1;
+  }
+  if (last_sample < tracker.end_tick()) {
+    std::fprintf(stderr,
+                 "hystloop-ctl: the series' last tick %lld was planned but its sample did not arrive within 2 s "
+                 "(last sample %lld on %s: is the bridge running?)\n",
+                 static_cast<long long>(tracker.end_tick()), static_cast<long long>(last_sample),
+                 link.channels().sensor.c_str());
+    return 1;
+  }
+  std::printf("hystloop-ctl: series done: %zu steps, ticks %lld .. %lld (%.1f s), measured\n", steps.size(),
               static_cast<long long>(tracker.first_tick().value_or(0)), static_cast<long long>(tracker.end_tick()),
               total_s);
   return 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -151,13 +152,23 @@ std::optional<Mismatch> first_mismatch(const std::vector<Command>& commands, std
                                        const ExperimentSpec& e, double start_s, std::int64_t begin, std::int64_t end,
                                        double dt_s) {
   while (index < commands.size() && commands[index].seq < begin) ++index;
+  // The compensator ramps to an excitation that starts away from where the plan is (another
+  // experiment's offset) within the slew limit: until the commands meet the sine, each moves from
+  // the previous one towards it.
+  bool ramping = true;
+  double previous = std::numeric_limits<double>::quiet_NaN();
   for (; index < commands.size() && commands[index].seq < end; ++index) {
     const Command& c = commands[index];
     // Loop time as the compensator computes it (Compensator::loop_time).
     const double expected = experiment_voltage(e, static_cast<double>(c.seq) * dt_s - start_s);
-    if (!c.experiment || !(std::abs(c.u_ff_V - expected) <= 1e-9 * (1.0 + std::abs(expected)))) {
-      return Mismatch{c.seq, expected, c.u_ff_V};
-    }
+    const double tolerance = 1e-9 * (1.0 + std::abs(expected));
+    const bool exact = c.experiment && std::abs(c.u_ff_V - expected) <= tolerance;
+    const bool towards = c.experiment && ramping &&
+                         (std::isnan(previous) || (c.u_ff_V >= std::min(previous, expected) - tolerance &&
+                                                   c.u_ff_V <= std::max(previous, expected) + tolerance));
+    if (!exact && !towards) return Mismatch{c.seq, expected, c.u_ff_V};
+    if (exact) ramping = false;
+    previous = c.u_ff_V;
   }
   return std::nullopt;
 }
