@@ -67,8 +67,13 @@ std::string to_yaml(const ColemanHodgdonParams& h, const SecondOrderStageParams*
   o << "banning:\n  hysteresis:\n    a: " << num(h.a) << "  # [m/V]\n    b: " << num(h.b)
     << "  # [m/V]\n    alpha: " << num(h.alpha) << "  # [1/V]\n    s_max: " << num(h.s_max)
     << "  # [V] (not identified)\n";
-  if (stage != nullptr)
+  if (stage != nullptr) {
     o << "  stage:\n    k: " << num(stage->k) << "  # [1/s^2]\n    c: " << num(stage->c) << "  # [1/s]\n";
+    // The same stage for the compensator, which inverts it (hystloop-compensator --params FILE
+    // reads this section and leaves the bridge's banning section to the bridge).
+    o << "stage:\n  kind: second_order\n  k: " << num(stage->k) << "  # [1/s^2]\n  c: " << num(stage->c)
+      << "  # [1/s]\n  order: hysteresis_then_stage\n";
+  }
   return o.str();
 }
 

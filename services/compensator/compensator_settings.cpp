@@ -251,6 +251,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
 void merge_params_file(Config& config, const std::filesystem::path& snippet) {
   const Config params = Config::load_file(snippet);
   for (const std::string& key : params.keys()) {
+    // hystloop-identify --model banning writes the bridge's simulated stage beside the
+    // compensator's stage section: that one is the bridge's.
+    if (key.rfind("banning.", 0) == 0) continue;
     std::string value;
     try {
       value = params.get<std::string>(key);

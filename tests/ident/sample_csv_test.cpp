@@ -82,6 +82,9 @@ TEST(ParamsYaml, KeysAreTheParameterNamesAndValuesRoundTrip) {
   const YAML::Node ban = YAML::Load(to_yaml(ColemanHodgdonParams{}, &stage));
   EXPECT_DOUBLE_EQ(ban["banning"]["hysteresis"]["alpha"].as<double>(), ColemanHodgdonParams{}.alpha);
   EXPECT_DOUBLE_EQ(ban["banning"]["stage"]["k"].as<double>(), stage.k);
+  // ... and the compensator's stage section, which it inverts.
+  EXPECT_EQ(ban["stage"]["kind"].as<std::string>(), "second_order");
+  EXPECT_DOUBLE_EQ(ban["stage"]["c"].as<double>(), stage.c);
   const YAML::Node kat = YAML::Load(to_yaml(KatalenicParams{}));
   EXPECT_DOUBLE_EQ(kat["katalenic"]["k1"].as<double>(), KatalenicParams{}.k1);
   EXPECT_EQ(kat["katalenic"]["output_shaping"]["kind"].as<std::string>(), "linear");

@@ -11,6 +11,8 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -877,6 +879,30 @@ TEST(CompensatorSettings, TheStageTheLearningAndTheActuatorComeFromTheConfig) {
   EXPECT_TRUE(contains(settings_refusal("compensator: {plan_slew_fraction: 0}"), "compensator.plan_slew_fraction"));
   const auto none = load_compensator_settings(Config::from_string("stage: {kind: none}", "compensator.yaml"));
   EXPECT_FALSE(none.control.stage.has_dynamics());
+}
+
+}  // namespace
+}  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+TEST(CompensatorSettings, TheBanningFitsStageIsTakenWithParams) {
+  // hystloop-identify --model banning --out FILE writes the bridge's banning section and the
+  // compensator's stage section: --params FILE takes the latter, leaves the former.
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "hystloop-banning-params.yaml";
+  {
+    std::ofstream out(file);
+    out << "banning:\n  hysteresis: {a: 8.6e-9, b: 6.1e-9, alpha: 0.0123, s_max: 750}\n  stage: {k: 1.2e8, c: 2.1e3}\n"
+        << "stage:\n  kind: second_order\n  k: 1.2e8\n  c: 2.1e3\n  order: hysteresis_then_stage\n";
+  }
+  Config config = Config::from_string("compensator: {mode: pi}", "compensator.yaml");
+  merge_params_file(config, file);
+  const CompensatorSettings s = load_compensator_settings(config);
+  EXPECT_TRUE(s.control.stage.has_dynamics());
+  EXPECT_DOUBLE_EQ(s.control.stage.second_order.k, 1.2e8);
+  EXPECT_DOUBLE_EQ(s.control.stage.second_order.c, 2.1e3);
+  std::filesystem::remove(file);
 }
 
 }  // namespace
