@@ -412,22 +412,22 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     detail += fmt::format("feedforward clamped at the actuator's limits on {} ticks in the last second; ",
                           clamped_in_period_);
   }
-  if (!verdict_.empty() && monotonic_now_ns() < verdict_until_ns_) detail += verdict_ + "; ";
-  const LearnerFigures& learner = c.learner().figures();
-  if (learner.active) {
-    detail += fmt::format("learning a {}-tick period ({} periods learned, last {:.3g} nm RMS); ", learner.period_ticks,
-                          learner.periods_learned, learner.last_error_rms_m * 1e9);
-  }
-  if (c.stage().has_dynamics()) {
-    detail += fmt::format("stage {:.4g} Hz zeta {:.3g}; ",
-                          c.stage().second_order.natural_frequency() / (2.0 * std::numbers::pi),
-                          c.stage().second_order.damping_ratio());
-  }
   const MemParams& m = c.mem_params();
   detail +=
       fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
                   to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(), m.c1,
                   m.c2, m.c3, c.config().horizon_ticks, c.experiment_running() ? ", experiment running" : "");
+  if (c.stage().has_dynamics()) {
+    detail += fmt::format("; stage {:.4g} Hz zeta {:.3g} inverted",
+                          c.stage().second_order.natural_frequency() / (2.0 * std::numbers::pi),
+                          c.stage().second_order.damping_ratio());
+  }
+  const LearnerFigures& learner = c.learner().figures();
+  if (learner.active) {
+    detail += fmt::format("; learning a {}-tick period ({} periods learned, last {:.3g} nm RMS)", learner.period_ticks,
+                          learner.periods_learned, learner.last_error_rms_m * 1e9);
+  }
+  if (!verdict_.empty() && monotonic_now_ns() < verdict_until_ns_) detail += "; " + verdict_;
   status_.begin(state, detail);
   reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;

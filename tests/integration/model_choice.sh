@@ -10,7 +10,8 @@
 source "$(dirname "$0")/loop_common.sh" "$@"
 reident="$4"; ctl="$5"
 start_recording
-"$compensator" "${compensator_args[@]}" >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
+# MEM from the start (the deployed compensator runs PI): the automatic choice then has a model to change.
+"$compensator" "${compensator_args[@]}" --set compensator.mode=mem >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
 "$bridge" "${bridge_args[@]}" --auto-arm >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 # The re-identifier logs to stdout (its --log-file is flushed late; the waits below read the log).
 "$reident" --config "$config/reidentifier.yaml" --set reidentifier.models=mem,pi,linear --set reidentifier.model_period_s=2 \
