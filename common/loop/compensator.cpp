@@ -187,6 +187,17 @@ TrajectoryVerdict Compensator::take_trajectory(TrajectorySpec spec, double start
 void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s) noexcept {
   TrajectorySpec spec = given;
   learner_restart_ = true;
+  // The reference in force moves (a periodic shape already entered, or its approach): the new
+  // approach fades it out instead of holding where it was.
+  bool moving = false;
+  if (!trajectory_starts_now_ && next_tick_ > 0 && counters_.planned > 0 && !in_experiment_ && !awaiting_anchor_) {
+    const double t = loop_time(next_tick_);
+    moving = evaluate(trajectory_, t) != evaluate(trajectory_, t - config_.dt_s);
+  }
+  if (moving) {
+    previous_trajectory_ = trajectory_;
+    from_moving_ = true;
+  }  // else a fade under way (into a hold) goes on into the new approach
   const bool timed = !std::isnan(start_s);
   if (timed && next_tick_ >= 0 && start_s - spec.blend_s < loop_time(next_tick_)) {
     trajectory_ = spec;
@@ -595,6 +606,7 @@ void Compensator::restart_reference(double t_s, double from_m) noexcept {
   trajectory_.start_s = trajectory_timed_ ? std::max(trajectory_.start_s, earliest) : earliest;
   trajectory_.hold_m = from_m;
   trajectory_starts_now_ = false;
+  from_moving_ = false;
   last_ref_ = from_m;
   last_w_ = from_m;
   reversals_.reset(from_m);
@@ -659,7 +671,23 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
     restart_learning(k);
     learner_restart_ = false;
   }
-  const double y_ref = evaluate(trajectory_, t);
+  double y_ref = evaluate(trajectory_, t);
+  if (from_moving_) {
+    // A new reference while the old one moves: the approach starts from the old one, faded out
+    // along a smoothstep (zero slope and curvature at both ends), so that neither its velocity
+    // nor its acceleration steps (a step the stage's inverse would turn into a voltage jump).
+    const double begin = trajectory_.start_s - trajectory_.blend_s;
+    const double length = trajectory_.blend_s + first_extreme_s(trajectory_);
+    const double s = length > 0.0 ? (t - begin) / length : 1.0;
+    if (s >= 1.0) {
+      from_moving_ = false;
+    } else if (s > 0.0) {
+      const double w = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+      y_ref = (1.0 - w) * evaluate(previous_trajectory_, t) + w * y_ref;
+    } else {
+      y_ref = evaluate(previous_trajectory_, t);
+    }
+  }
   if (reversals_.update(y_ref) == ReversalDetector::Event::kReversal) {
     ++counters_.reversals;
     if (pending_) swap_params(k);

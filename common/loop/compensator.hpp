@@ -256,8 +256,10 @@ class Compensator {
   CompensatorConfig config_;
   FeedforwardMode mode_;
   TrajectorySpec trajectory_{};
-  bool trajectory_starts_now_ = true;  // start_s is set at the next planned tick
-  bool trajectory_timed_ = false;      // start_s was given: an experiment's end does not move it
+  bool trajectory_starts_now_ = true;     // start_s is set at the next planned tick
+  bool trajectory_timed_ = false;         // start_s was given: an experiment's end does not move it
+  TrajectorySpec previous_trajectory_{};  // the reference a new one's approach fades out
+  bool from_moving_ = false;              // ... while that approach lasts
   MemInverse mem_;
   PiInverse pi_;
   KatalenicInverse katalenic_;

@@ -299,3 +299,31 @@ TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
 
 }  // namespace
 }  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+TEST(CompensatorLimits, ANewLineWhileTheOldMovesStartsFromItWithoutAStep) {
+  // The approach fades the moving reference out: holding where it was would stop a 50 Hz line
+  // dead, a step in velocity that the stage's inverse turns into a voltage jump (1.2e5 V/s).
+  Compensator c(linear_config(true));
+  c.take_trajectory(triangle(1e-6, 50.0, 0.0), kNaN);
+  std::vector<CommandTick> ticks;
+  plan_for(c, 0.4, &ticks);
+  const TrajectoryVerdict v = c.take_trajectory(sine(0.4e-6, 100.0), kNaN);
+  EXPECT_LE(v.extent.rate_max_V_per_s, kShare * 5e4);
+  const std::size_t from = ticks.size();
+  const double worst = plan_for(c, 0.5, &ticks);
+  EXPECT_LE(worst, kShare * 5e4 * 1e-4 + 1e-9);
+  EXPECT_EQ(c.counters().u_slew_clamped, 0u);
+  // From the switch on, the reference's velocity never steps: its change per tick stays that of
+  // the line's own corners (v pi / tau dt^2 = 5.7e-9 m per tick squared for these, 1.16 ms).
+  double worst_dv = 0.0;
+  for (std::size_t i = from + 2; i < ticks.size(); ++i) {
+    worst_dv = std::max(worst_dv, std::abs(ticks[i].y_ref_m - 2 * ticks[i - 1].y_ref_m + ticks[i - 2].y_ref_m));
+  }
+  EXPECT_LT(worst_dv, 6e-9);  // holding where it was: 2.1e-8 (the line's velocity in one tick)
+}
+
+}  // namespace
+}  // namespace hystloop
