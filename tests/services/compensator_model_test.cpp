@@ -22,7 +22,7 @@ CompensatorSettings cosine_settings() {
   CompensatorSettings s = load_compensator_settings(
       Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml"));
   s.control.horizon_ticks = 300;
-  s.control.mode = FeedforwardMode::kMem;  // the MEM paper's workflow: a model change from MEM
+  s.control.mode = FeedforwardMode::kMem;         // the MEM paper's workflow: a model change from MEM
   s.trajectory.shape = TrajectoryShape::kCosine;  // -1.6 um cos(2 pi t): a reversal near tick 510
   s.trajectory.amplitude_m = -1.6e-6;
   s.trajectory.blend_s = 0.05;
