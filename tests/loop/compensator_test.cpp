@@ -286,7 +286,8 @@ Session scripted_session(std::size_t chunk) {
   for (std::int64_t k = 0; k < 30000; ++k) {
     const double phase = 0.0007 * static_cast<double>(k);
     MemParams p;
-    p.c1 *= 1.0 + 0.1 * static_cast<double>(k / 7000);
+    const std::int64_t step = k / 7000;  // a new set every 0.7 s
+    p.c1 *= 1.0 + 0.1 * static_cast<double>(step);
     if (k % 7000 == 3500) comp.offer_mem_params(p, static_cast<std::int32_t>(k / 7000) + 2);
     if (k == 9000) comp.start_experiment(sine);
     if (k == 9001) comp.start_experiment(settle);

@@ -46,7 +46,7 @@ const char* update_name(bool lag_compensated) { return lag_compensated ? "lag-co
 // boundary the plan reaches after that.
 std::int64_t rig_chain(std::int64_t n) {
   switch (n) {
-    case 1000: return 2;
+    case 1000:
     case 700: return 2;
     case 400: return 3;
     case 200: return 4;

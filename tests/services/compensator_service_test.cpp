@@ -92,7 +92,7 @@ mem_params_t params(std::int32_t version, double c1, bool valid = true, std::int
   p.c1 = c1;
   p.c2 = 1.5e-12;
   p.c3 = 1.1;
-  p.valid = valid;
+  p.valid = valid ? 1 : 0;
   p.source = "test";
   return p;
 }

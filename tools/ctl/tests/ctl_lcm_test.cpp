@@ -68,6 +68,7 @@ Result run_ctl(const std::vector<std::string>& args, lcm::LCM* lcm = nullptr, co
   std::vector<std::string> all{HYSTLOOP_CTL_EXE};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(all.size() + 1);
   for (auto& a : all) argv.push_back(a.data());
   argv.push_back(nullptr);
   pid_t pid = 0;

@@ -108,7 +108,7 @@ mem_params_t params(std::int32_t version, double c1, bool valid) {
   p.c2 = 2e-9 * version;
   p.c3 = 0.5 + 0.1 * version;
   p.residual_m = 1e-9 * version;
-  p.valid = valid;
+  p.valid = valid ? 1 : 0;
   p.source = "test";
   return p;
 }
@@ -129,7 +129,7 @@ model_params_t linear_model(std::int32_t version) {
 }
 
 service_status_t status(const std::string& process, std::int64_t t,
-                        std::vector<std::pair<std::string, std::int64_t>> c) {
+                        const std::vector<std::pair<std::string, std::int64_t>>& c) {
   service_status_t s{};
   s.utime = t;
   s.process = process;
