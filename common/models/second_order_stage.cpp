@@ -27,17 +27,23 @@ void SecondOrderStage::reset(double y0) noexcept { x_ << y0, 0.0; }
 
 double SecondOrderStage::velocity() const noexcept { return x_(1) * omega_n_; }
 
-void SecondOrderStage::discretise(double dt) noexcept {
+ZohMatrices zoh_matrices(const SecondOrderStageParams& params, double dt) noexcept {
+  const double wn = params.natural_frequency();
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   // d/dt [y; v/wn] = [0 wn; -wn -c] [y; v/wn] + [0; wn] w
-  m(0, 1) = omega_n_;
-  m(1, 0) = -omega_n_;
-  m(1, 1) = -params_.c;
-  m(1, 2) = omega_n_;
+  m(0, 1) = wn;
+  m(1, 0) = -wn;
+  m(1, 1) = -params.c;
+  m(1, 2) = wn;
   m *= dt;
   const Eigen::Matrix3d e = m.exp();
-  phi_ = e.topLeftCorner<2, 2>();
-  gamma_ = e.topRightCorner<2, 1>();
+  return {e.topLeftCorner<2, 2>(), e.topRightCorner<2, 1>()};
+}
+
+void SecondOrderStage::discretise(double dt) noexcept {
+  const ZohMatrices z = zoh_matrices(params_, dt);
+  phi_ = z.phi;
+  gamma_ = z.gamma;
   dt_cached_ = dt;
 }
 

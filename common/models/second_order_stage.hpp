@@ -30,6 +30,14 @@ struct SecondOrderStageParams {
   double damping_ratio() const noexcept;      // zeta [-]
 };
 
+// The exact ZOH discretisation x+ = Phi x + Gamma w of the state [y, v / omega_n] at step dt [s]
+// (the exponential of the augmented matrix, every entry O(omega_n dt)). Validated by the caller.
+struct ZohMatrices {
+  Eigen::Matrix2d phi;
+  Eigen::Vector2d gamma;
+};
+ZohMatrices zoh_matrices(const SecondOrderStageParams& params, double dt) noexcept;
+
 class SecondOrderStage {
  public:
   explicit SecondOrderStage(const SecondOrderStageParams& params = {});  // validates

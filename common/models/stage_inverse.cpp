@@ -4,7 +4,8 @@
 #include <complex>
 #include <numbers>
 #include <string>
-#include <unsupported/Eigen/MatrixFunctions>
+
+#include <Eigen/LU>  // determinant
 
 #include "core/errors.hpp"
 
@@ -18,17 +19,9 @@ double DiscreteStage::magnitude(double f_hz, double dt_s) const noexcept {
 DiscreteStage discretise_zoh(const SecondOrderStageParams& stage, double dt_s) {
   stage.validate();
   require_in_range("dt_s", dt_s, 1e-7, 1.0);
-  // State [y, v / omega_n] as in SecondOrderStage: every entry of the exponent is O(omega_n dt).
-  const double wn = stage.natural_frequency();
-  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-  m(0, 1) = wn;
-  m(1, 0) = -wn;
-  m(1, 1) = -stage.c;
-  m(1, 2) = wn;
-  m *= dt_s;
-  const Eigen::Matrix3d e = m.exp();
-  const Eigen::Matrix2d phi = e.topLeftCorner<2, 2>();
-  const Eigen::Vector2d gamma = e.topRightCorner<2, 1>();
+  const ZohMatrices z = zoh_matrices(stage, dt_s);  // the matrices SecondOrderStage steps with
+  const Eigen::Matrix2d& phi = z.phi;
+  const Eigen::Vector2d& gamma = z.gamma;
   // G(z) = C (zI - Phi)^-1 Gamma with C = [1 0]: C adj(zI - Phi) = [z - Phi22, Phi12].
   DiscreteStage d;
   d.a1 = -phi.trace();

@@ -29,13 +29,7 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
                  const ScanOptions& o) {
   LoopSimulationConfig c = tracking_loop_config(e);
   c.compensator.mode = o.mode.value_or(models.ranking.empty() ? FeedforwardMode::kPi : mode_of(models.ranking.front()));
-  c.compensator.mem = models.mem;
-  c.compensator.pi = models.pi;
-  c.compensator.katalenic = models.katalenic;
-  c.compensator.linear = models.linear;
-  c.compensator.u_min_V = c.limits.u_min_V;
-  c.compensator.u_max_V = c.limits.u_max_V;
-  c.compensator.slew_V_per_s = c.limits.slew_V_per_s;
+  use_models(c, models, models.mem);
   if (o.stage_inverse && e.plant == PlantKind::kBanning) {
     c.compensator.stage.kind = StageModel::Kind::kSecondOrder;
     c.compensator.stage.second_order = c.stage.banning.stage;

@@ -24,6 +24,16 @@ LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e) {
   return c;
 }
 
+void use_models(LoopSimulationConfig& c, const IdentifiedModels& models, const MemParams& mem) {
+  c.compensator.mem = mem;
+  c.compensator.pi = models.pi;
+  c.compensator.katalenic = models.katalenic;
+  c.compensator.linear = models.linear;
+  c.compensator.u_min_V = c.limits.u_min_V;
+  c.compensator.u_max_V = c.limits.u_max_V;
+  c.compensator.slew_V_per_s = c.limits.slew_V_per_s;
+}
+
 IdentifiedModels identify_models_through_loop(const TrackingExperiment& e) {
   ExperimentSpec input;  // 250 V, 10 Hz: the MEM paper's identification input
   input.duration_s = e.identify_s;
@@ -94,13 +104,7 @@ TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& mo
   c.stage.drift_fraction = e.drift_fraction;
   c.stage.drift_duration_s = e.drift_duration_s;
   c.compensator.mode = o.mode;
-  c.compensator.mem = o.start_mem;
-  c.compensator.pi = models.pi;
-  c.compensator.katalenic = models.katalenic;
-  c.compensator.linear = models.linear;
-  c.compensator.u_min_V = c.limits.u_min_V;
-  c.compensator.u_max_V = c.limits.u_max_V;
-  c.compensator.slew_V_per_s = c.limits.slew_V_per_s;
+  use_models(c, models, o.start_mem);
   if (o.feedback) {
     c.servo.kp = e.kp;
     c.servo.ki = e.ki;

@@ -87,6 +87,8 @@ struct TrackingRun {
 };
 
 LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e);
+// The loop's compensator with these models (MEM's as given) and the bridge's actuator limits.
+void use_models(LoopSimulationConfig& c, const IdentifiedModels& models, const MemParams& mem);
 
 // Runs the identification input through the loop and fits MEM, PI-15, Katalenic and linear.
 IdentifiedModels identify_models_through_loop(const TrackingExperiment& e);
