@@ -169,7 +169,9 @@ void CompensatorService::decide_trajectory(std::int64_t version, const std::stri
   if (version <= 0) return;  // the configured reference: nobody waits for it
   if (refused) {
     counters_.trajectory_refused_version = version;
-    verdict_ = fmt::format("trajectory {} refused: {}", version, escape_wire(verdict));
+    // The compensator's own words (the limit, what would fit): whole, not cut like wire text.
+    constexpr std::size_t kVerdictChars = 600;
+    verdict_ = fmt::format("trajectory {} refused: {}", version, escape_wire(verdict, kVerdictChars));
   } else {
     counters_.trajectory_version = version;
     if (shaped) counters_.trajectory_shaped_version = version;
@@ -198,7 +200,7 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
     refused_version_ = msg.version;  // its repeats are the same refusal
     decide_trajectory(msg.version, e.what(), true, false);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_now_ns())) {
-      spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what()), suppressed_note(g));
+      spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
     }
   }
   if (verdict_due_) report(wall_utime(), false, false);

@@ -1,10 +1,12 @@
 // hystloop-report: the figures of a recorded run, from LCM event logs.
 //
 //   hystloop-report LOG... --out DIR [--csv CHANNEL]... [--from S] [--to S] [--skip-initial S]
-//                   [--rig PREFIX] [--quiet] [--no-plots] [--gnuplot PATH]
+//                   [--rig PREFIX] [--quiet] [--no-plots] [--gnuplot PATH] [--scan | --no-scan] [--scan-settle S]
 //
 // Writes DIR/summary.json, DIR/<channel>.csv for each --csv, and the plots (PNG via
 // gnuplot, with their data files and plots.gp); prints a table of the main figures.
+// A log of several periodic trajectories (deploy/hystloop scan), or --scan, also gets the scan
+// table (scan_report.hpp: scan.json, scan.md, scan_*.png), printed last.
 // A file that is empty, holds no event, bytes that are not events (skipped by the reader) or a
 // truncated last event is named in a warning on stderr; so are events on the rig's channels
 // that do not decode (summary.json: undecodable_events).
@@ -29,6 +31,7 @@
 #include "plots.hpp"
 #include "report_metrics.hpp"
 #include "report_table.hpp"
+#include "scan_report.hpp"
 #include "summary_json.hpp"
 
 namespace {
@@ -49,6 +52,7 @@ struct Options {
   PlotOptions plots;
   std::string bridge_process = "bridge";
   std::string logger_process = "logger";
+  ScanReportOptions scan;  // --scan, --no-scan, --scan-settle, --compensator-process
 };
 
 // A --csv argument names a channel as logged ("HX_SENSOR") or by its suffix ("SENSOR").
@@ -77,6 +81,7 @@ int run(const Options& o) {
   ro.bridge_process = o.bridge_process;
   ro.logger_process = o.logger_process;
   ro.validate();
+  o.scan.figures.validate();
   if (o.plots.max_points == 0) throw ParameterError("--plot-max-points", "must be > 0 (got 0)");
 
   const RunData data = read_logs(o.logs, channels);
@@ -125,12 +130,14 @@ int run(const Options& o) {
     for (const auto& image : plots.images) std::printf(", %s", image.filename().c_str());
     std::printf("\n");
   }
-  return 0;
+  ScanReportOptions scan = o.scan;
+  scan.quiet = o.quiet;
+  scan.no_plots = o.no_plots;
+  scan.plots = o.plots;
+  return write_scan_report(o.logs, data, channels, o.out, scan);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int report_main(int argc, char** argv) {
   Options o;
   CLI::App app{
       "hystloop-report: tracking error, late ticks, buffer depth, run-ahead margin, watchdog trips, CPU, message "
@@ -155,6 +162,16 @@ int main(int argc, char** argv) {
   app.add_option("--gnuplot", o.plots.gnuplot, "gnuplot executable")->capture_default_str();
   app.add_option("--plot-max-points", o.plots.max_points, "Decimate the plotted ticks to at most this many")
       ->capture_default_str();
+  auto* scan = app.add_flag("--scan", o.scan.force,
+                            "Write the scan table (scan.json, scan.md, scan_*.png: per periodic trajectory, learning "
+                            "off and on) even for a single periodic trajectory; the whole log, whatever --from/--to");
+  app.add_flag("--no-scan", o.scan.off, "Do not write the scan table (written by default for 2+ periodic trajectories)")
+      ->excludes(scan);
+  app.add_option("--scan-settle", o.scan.figures.settle_s,
+                 "Scan: skipped at each segment's start, after a trajectory's blend [s]")
+      ->capture_default_str();
+  app.add_option("--compensator-process", o.scan.compensator_process, "Process name of the compensator in HX_STATUS")
+      ->capture_default_str();
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   try {
     return run(o);
@@ -165,4 +182,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hystloop-report: %s\n", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+// Setting the options up can throw too (CLI11 refuses a malformed definition): nothing escapes.
+int main(int argc, char** argv) {
+  try {
+    return report_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "hystloop-report: unknown error\n");
+  }
+  return 1;
 }
