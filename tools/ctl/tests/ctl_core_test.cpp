@@ -1,5 +1,6 @@
 // hystloop-ctl's plain parts: request validation and conversion, the health verdict, the
 // watch arithmetic and its line, the series tracker.
+#include <limits>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -60,7 +61,7 @@ TEST(CtlRequests, RequestIdsArePositiveAndDiffer) {
 
 TEST(CtlRequests, GainsAndExperimentAreCheckedAndPassTheContract) {
   EXPECT_EQ(field_of([] { GainsRequest{-1, 0, 0}.validate(); }), "kp");
-  EXPECT_EQ(field_of([] { GainsRequest{0, NAN, 0}.validate(); }), "ki");
+  EXPECT_EQ(field_of([] { GainsRequest{0, std::numeric_limits<double>::quiet_NaN(), 0}.validate(); }), "ki");
   ExperimentRequest x;
   x.amplitude_V = 10;
   x.frequency_Hz = 0;
@@ -89,7 +90,10 @@ TEST(CtlRequests, GainsCarryANotchWithinItsBounds) {
   EXPECT_NO_THROW((GainsRequest{0, 0, 0, 1e-3, 50.0}.validate()));
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 4500.1, 2.0}.validate(); }), "notch-hz");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, -1.0, 2.0}.validate(); }), "notch-hz");
-  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, NAN, 2.0}.validate(); }), "notch-hz");
+  EXPECT_EQ(field_of([] {
+              GainsRequest{0, 0, 0, std::numeric_limits<double>::quiet_NaN(), 2.0}.validate();
+            }),
+            "notch-hz");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.0}.validate(); }), "notch-q");  // not given
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.09}.validate(); }), "notch-q");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 50.5}.validate(); }), "notch-q");
@@ -237,7 +241,7 @@ service_status_t report(const std::string& process, std::int8_t state, const std
   s.loop_p50_us = 1.5;
   s.loop_p99_us = 3.0;
   s.loop_max_us = 250.0;
-  s.latency_p50_us = s.latency_p99_us = s.latency_max_us = NAN;
+  s.latency_p50_us = s.latency_p99_us = s.latency_max_us = std::numeric_limits<double>::quiet_NaN();
   return s;
 }
 }  // namespace
