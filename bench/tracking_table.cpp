@@ -7,7 +7,7 @@
 // y_d = -1.6 um cos(2 pi t) tracked with each feedforward, without and with PI feedback
 // (kp 0.1, ki 600 1/s); RMS error over t in [4, 8) s against the true position.
 //
-// Then the re-identification table (issue 11), without and with re-identification side by side,
+// Then the re-identification table, without and with re-identification side by side,
 // from MEM's deliberately wrong start: RMS over [8, 12) s of a 12 s run, and with the stage's
 // gain drifting +10 % over 30 s, over [20, 30) s of a 30 s run.
 //

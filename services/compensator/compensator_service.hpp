@@ -6,7 +6,7 @@
 // deterministic function of the messages received, in order: no wall clock reaches the
 // control law (a sample's utime only maps a trajectory's start time to loop time).
 //
-// Issue 12 (nothing lost, nothing unsafe):
+// nothing lost, nothing unsafe:
 // - A sensor block far from the stream (further than the horizon from the next expected tick,
 //   ahead or behind) is held until SequenceGuard::kConfirmBlocks consecutive blocks confirm the
 //   new numbering (a bridge restart restarts the control law; a jump is followed); one forged or
@@ -15,7 +15,7 @@
 // - HX_PARAMS versions are ordered per publisher (ParamsAdmission): a set is stale only against
 //   the last one accepted from the same mem_params_t.publisher_id. Refusals are counted by reason
 //   (params_invalid, params_stale, params_rejected) and logged once per reason and publisher.
-// - HX_MODEL (model_params_t, issue 11) carries any model: admitted as HX_PARAMS is (one version
+// - HX_MODEL (model_params_t) carries any model: admitted as HX_PARAMS is (one version
 //   order per publisher over both channels), then Compensator::offer_model switches the
 //   feedforward at the next reversal; a kind or format this build does not know is counted
 //   (model_unknown_kind, model_unknown_format). model_switches and reanchors count the swaps.

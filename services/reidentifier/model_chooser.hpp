@@ -1,5 +1,5 @@
 #pragma once
-// The re-identifier's online model choice (issue 11, item 4), beside the MEM refit: every
+// The re-identifier's online model choice, beside the MEM refit: every
 // period_s it copies the estimator's window (on the I/O thread, no allocation) and hands it to its
 // own worker thread, which runs propose_model (common/ident/online_model_selector.hpp: fits MEM,
 // PI, Katalenic and linear, ranks them on the held-out branch, proposes a change only past the
@@ -35,7 +35,7 @@ namespace hystloop {
 class ReidentCore;
 
 struct ModelChoiceOptions {
-  bool enabled = false;              // reidentifier.models: off = MEM only, as before issue 11
+  bool enabled = false;              // reidentifier.models: off = MEM only, as before the model choice
   double period_s = 5.0;             // reidentifier.model_period_s
   std::optional<ModelKind> pinned;   // reidentifier.pin_model (none = automatic)
   OnlineSelectorOptions selector{};  // margin (reidentifier.model_margin), candidates (reidentifier.models)

@@ -16,7 +16,7 @@
 //   reidentifier.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
 //   reidentifier.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
 //   reidentifier.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2
-//   s) reidentifier.models                    online model choice (issue 11): "off" (MEM refits only, as before),
+//   s) reidentifier.models                    online model choice: "off" (MEM refits only, as before),
 //                                     "auto" (MEM, PI, Katalenic, linear) or a list "mem,pi,linear" (off)
 //   reidentifier.model_margin              a different model must beat the one in use by this fraction of its
 //                                     held-out RMS (0.10; OnlineSelectorOptions::margin)

@@ -11,7 +11,7 @@ check_loop_summary() {  # summary.json, rig prefix
   done
   summary_check "$s" "the logger reported every sensor gap in the log" '.logger_gaps >= .seq_gaps'
   summary_check "$s" "no sample tick missing" '.missing_samples == 0'
-  # The loop's contract (../shared/DESIGN.md, "Timing"): the compensator plans 50 ms ahead, so the
+  # The loop's contract (docs/ARCHITECTURE.md, "Where time comes from"): the compensator plans 50 ms ahead, so the
   # stalls of a shared machine (a few ms with SCHED_FIFO, tens without) cost nothing. Judged on
   # every run, with margins: the benchmark (bench/run-all) reports the figures themselves.
   summary_check "$s" "no watchdog trip with the 2 ms watchdog" '.watchdog_trips == 0'

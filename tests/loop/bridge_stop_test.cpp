@@ -1,4 +1,4 @@
-// The bridge's stop (issue 12, item 2): on every stop the bridge disarms BridgeCore and lets it
+// The bridge's stop: on every stop the bridge disarms BridgeCore and lets it
 // ramp to actuator.safe_u_V before the real-time thread ends. This is that path, with time as
 // an argument: from anywhere in the range, armed, the ramp reaches the safe voltage exactly within
 // ceil(|u - safe| / (rate * dt)) ticks, rate = min(safe_ramp, slew), and no tick steps further.

@@ -1,4 +1,4 @@
-// The bridge's stop on its real-time thread (issue 12, item 2): every stop ramps the actuator to
+// The bridge's stop on its real-time thread: every stop ramps the actuator to
 // actuator.safe_u_V before the thread ends, also when nobody asked (the destructor while an
 // exception unwinds), refuses to arm again once begun, tells the backend to hold_safe() after the
 // ramp and at the end, and gives up after bridge's stop_ramp_timeout_s. Real threads, real time,

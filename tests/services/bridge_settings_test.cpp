@@ -1,6 +1,6 @@
 // hystloop-bridge's configuration: defaults are the papers' and the issue's, every value is
 // validated where it enters and a refusal names the field; the servo, the block size and the
-// wake-up batching are the bridge's now (issue 10); every deployed config loads; the report
+// wake-up batching are the bridge's now; every deployed config loads; the report
 // handoff between the real-time and the I/O thread; the send-time ring behind the latency figures.
 #include <gtest/gtest.h>
 
@@ -186,7 +186,7 @@ TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_EQ(s.command_queue_capacity, 16);
 }
 
-// Every stop ramps to actuator.safe_u_V first (issue 12, item 2); how long it may take follows
+// Every stop ramps to actuator.safe_u_V first; how long it may take follows
 // from the actuator's keys: the longest ramp (from the range's end farthest from safe_u_V, at
 // min(safe_ramp, slew)) plus kStopRampMargin_s.
 TEST(BridgeSettings, TheStopRampBoundFollowsTheActuator) {

@@ -1,4 +1,4 @@
-// HX_MODEL in hystloop-compensator (issue 11): a set of any model goes through the admission path
+// HX_MODEL in hystloop-compensator: a set of any model goes through the admission path
 // of HX_PARAMS (valid, newer per publisher over both channels, validated again), then the
 // feedforward switches to that model at the next reversal; an unknown kind or format version is
 // refused and counted by its reason, also when it arrives over the wire.

@@ -416,7 +416,7 @@ TEST(CompensatorService, TakesOnlyValidNewerParameterSetsAndSwapsThemAtAReversal
   EXPECT_EQ(first_with_version(h, 3), h.ticks.size());  // the refused one never
 }
 
-// Issue 12: one set with the largest version from anyone (or a re-identifier's earlier run)
+// one set with the largest version from anyone (or a re-identifier's earlier run)
 // must not freeze the re-identifier out: versions are ordered per publisher only.
 TEST(CompensatorService, AHugeVersionFromOnePublisherDoesNotFreezeTheReidentifiersLaterSets) {
   Harness h;
@@ -443,7 +443,7 @@ TEST(CompensatorService, AHugeVersionFromOnePublisherDoesNotFreezeTheReidentifie
   h.service.report(wall_utime(), false);
 }
 
-// Issue 12: a forged sensor block 900 ticks ahead made the compensator skip ahead and drop the
+// a forged sensor block 900 ticks ahead made the compensator skip ahead and drop the
 // real blocks that followed (~50 ms without commands). It is held, then ignored.
 TEST(CompensatorService, AForgedSensorBlockFarAheadIsIgnoredAndTheRealBlocksAreAnswered) {
   Harness h;
@@ -468,7 +468,7 @@ TEST(CompensatorService, AForgedSensorBlockFarAheadIsIgnoredAndTheRealBlocksAreA
   EXPECT_EQ(h.service.sequence_counters().jumps, 0u);
 }
 
-// Issue 12: one 5,000 ticks behind silently restarted the control law and reset its counters.
+// one 5,000 ticks behind silently restarted the control law and reset its counters.
 TEST(CompensatorService, AForgedSensorBlockFarBehindDoesNotRestartTheControlLaw) {
   Harness h;
   h.run(50000, 1000);
@@ -487,7 +487,7 @@ TEST(CompensatorService, AForgedSensorBlockFarBehindDoesNotRestartTheControlLaw)
   EXPECT_EQ(h.sent_through(), 51999 + kHorizon);
 }
 
-// Issue 12: 5,804 log lines a minute under malformed input, with raw control bytes from the
+// 5,804 log lines a minute under malformed input, with raw control bytes from the
 // messages. Repeated warnings are rate-limited (the next line says how many were suppressed),
 // and text off the wire is escaped.
 TEST(CompensatorService, RepeatedWarningsAreRateLimitedAndWireTextIsEscaped) {

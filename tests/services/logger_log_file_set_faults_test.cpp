@@ -1,4 +1,4 @@
-// LogFileSet on a failing disk (issue 12: a full disk lost data silently). A LogFileIo that
+// LogFileSet on a failing disk (a full disk lost data silently). A LogFileIo that
 // passes the calls to the real ones but has a byte budget (a disk that fills up), can stop
 // writes short and fail fsync: every event must then be told written or lost, the files
 // must end at an event boundary (lcm::LogFile reads each to its end), no empty file may be

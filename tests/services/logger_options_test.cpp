@@ -57,7 +57,7 @@ TEST(LoggerOptions, BadValuesNameTheField) {
             std::string::npos);
 }
 
-// Issue 12: --summary DIR failed only at shutdown, after the whole recording.
+// --summary DIR failed only at shutdown, after the whole recording.
 TEST(LoggerOptions, ASummaryPathThatIsADirectoryIsRefusedAtOnce) {
   EXPECT_NE(error_of(Config::from_string("logger:\n  summary: /tmp\n")).find("logger.summary: '/tmp' is a directory"),
             std::string::npos);
@@ -66,7 +66,7 @@ TEST(LoggerOptions, ASummaryPathThatIsADirectoryIsRefusedAtOnce) {
   EXPECT_EQ(error_of(Config::from_string("logger:\n  summary: /nonexistent/dir/run.json\n")), "");
 }
 
-// Issue 12: a bad --channels regex was found only when LCM refused it (exit 1, not 2).
+// a bad --channels regex was found only when LCM refused it (exit 1, not 2).
 TEST(LoggerOptions, AChannelRegexLcmCannotCompileIsRefused) {
   EXPECT_NE(error_of(Config::from_string("logger:\n  channels: 'HX_(['\n"))
                 .find("logger.channels: not a regular expression LCM accepts"),

@@ -141,7 +141,7 @@ TEST(SequenceGapDetector, ExtremeValuesDoNotOverflow) {
   EXPECT_EQ(e.last_seq(), 0);
 }
 
-// Forged ticks (issue 12: a gap counter wrapped to 1.69e19): INT64_MAX after INT64_MIN, again
+// Forged ticks (a gap counter wrapped to 1.69e19): INT64_MAX after INT64_MIN, again
 // and again, saturates every counter instead of wrapping.
 TEST(SequenceGapDetector, ForgedTicksSaturateTheCountersInsteadOfWrapping) {
   constexpr auto kMin = std::numeric_limits<std::int64_t>::min();

@@ -229,7 +229,7 @@ TEST_F(LoggerServiceTest, AFullQueueDropsAndCountsEveryMessage) {
   EXPECT_EQ(slot.sequence.missing(), 0u);  // the network lost nothing: drops are the logger's own
 }
 
-// Issue 12: 64+ junk channel names sent before the rig starts filled the table and nothing of
+// 64+ junk channel names sent before the rig starts filled the table and nothing of
 // the rig was recorded. Now the rig's channels are recorded whatever came first, the junk is
 // counted (bounded), and its names reach HX_STATUS escaped.
 TEST_F(LoggerServiceTest, JunkChannelsSentFirstDoNotBlindTheLogger) {

@@ -1,4 +1,4 @@
-// The logger's summary file (issue 12): a summary that cannot be written leaves no stray
+// The logger's summary file: a summary that cannot be written leaves no stray
 // temporary file, and the JSON reports the disk faults and the channels without a slot.
 #include "logger/logger_summary.hpp"
 

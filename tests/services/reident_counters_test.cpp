@@ -1,5 +1,5 @@
 // The re-identifier's counters on HX_STATUS: one per refusal reason a refit can have, none that
-// can never move (issue 15: "refits_rejected_ok" and "refits_rejected_invalid_options" were).
+// can never move ("refits_rejected_ok" and "refits_rejected_invalid_options" were).
 #include "reidentifier/reident_counters.hpp"
 
 #include <gtest/gtest.h>

@@ -119,7 +119,7 @@ TEST(ParamsInUse, VersionsTheCompensatorAppliesAreNumberedAbove) {
   EXPECT_EQ(p.offer(kOther, 10, kOwn, true, "reident@a"), ParamsOffer::echo);
 }
 
-// Issue 12: versions are per publisher. One huge version from anyone is adopted (the compensator
+// versions are per publisher. One huge version from anyone is adopted (the compensator
 // takes it too) but neither freezes another publisher nor runs our numbering into its ceiling.
 TEST(ParamsInUse, AHugeVersionFreezesNoOneAndIsNotFollowed) {
   ParamsInUse p(kConfig, "reident@a", kOwn);

@@ -3,7 +3,7 @@
 // (250 V sin(20 pi t)) run through the loop, then track the MEM paper's reference (24)
 // y_d = -1.6 um cos(2 pi t) with each feedforward, with and without feedback, and with online
 // re-identification from deliberately wrong MEM parameters. Prints the table; asserts the
-// figures the product promises. The re-identification cases (issue 11: the swap that repairs,
+// figures the product promises. The re-identification cases (the swap that repairs,
 // the drift, the online model choice) print with and without re-identification side by side;
 // they run ~10 s in Release and are skipped under the sanitizers (too slow there; the
 // mechanisms they exercise have unit tests: compensator_swap_test, online_model_selector_test).
@@ -113,7 +113,7 @@ TEST(Tracking, EveryModeOnTheBanningStage) {
   EXPECT_LT(reid.second.stats.rms_true_m, table["MEM, wrong parameters"].second.stats.rms_true_m);
 }
 
-// --- Issue 11: re-identification that repairs the feedforward and picks the model online. ---
+// --- Re-identification that repairs the feedforward and picks the model online. ---
 
 #ifdef HYSTLOOP_TRACKING_SANITIZED
 #define HEAVY(name) DISABLED_##name

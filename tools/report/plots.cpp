@@ -85,7 +85,7 @@ Histogram run_ahead_histogram(const ReportMetrics& m) {
 }  // namespace
 
 namespace {
-// convergence.png (issue 11): the published parameters over time (c1 and the held-out RMS of each
+// convergence.png: the published parameters over time (c1 and the held-out RMS of each
 // set; a model change labelled with its model) above the per-second tracking RMS, with every swap
 // (the second in which the version the compensator applies changed) marked by a vertical line.
 std::string convergence_plot(const ReportMetrics& m) {

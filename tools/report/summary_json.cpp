@@ -83,7 +83,7 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   j["rms_error_first_5s_m"] = number_or_null(m.rms_error_first_5s_m);
   j["rms_error_last_5s_m"] = number_or_null(m.rms_error_last_5s_m);
   Json per_second = Json::array();
-  Json rms_per_second = Json::array();  // the same bins' RMS alone: a plain series (issue 11)
+  Json rms_per_second = Json::array();  // the same bins' RMS alone: a plain series
   Json clamped_per_second = Json::array();
   for (const auto& bin : m.per_second) {
     per_second.push_back(Json{{"t_s", bin.t_s},

@@ -113,7 +113,7 @@ mem_params_t params(std::int32_t version, double c1, bool valid) {
   return p;
 }
 
-// A model change to a linear model on HX_MODEL (issue 11).
+// A model change to a linear model on HX_MODEL.
 model_params_t linear_model(std::int32_t version) {
   model_params_t m{};
   m.format_version = model_params_t::FORMAT_VERSION;
