@@ -17,22 +17,26 @@ echo "== record with lcm-logger"
 rt=(); [ "$(id -u)" -eq 0 ] && command -v chrt >/dev/null && rt=(chrt -f 10)
 "${rt[@]}" lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*|WARMUP_.*' "$dir/run.lcmlog" &
 logger=$!
+# Warm-up sensor messages in the file so far (channel names are plain text in the log; none yet is
+# 0, not a failure: grep's status would end the script under pipefail).
+marks() { { grep -a -o 'WARMUP_SENSOR' "$dir/run.lcmlog" 2>/dev/null || true; } | wc -l; }
 # lcm-logger gives no ready signal: warm-up rounds on another prefix until its file shows them
-# (a fixed sleep lost the first rounds on a loaded machine; check-log counts these apart).
+# (a fixed sleep lost the first rounds on a loaded machine; a non-empty file is not enough either:
+# the first event can be in it before the round's sensor message; check-log counts these apart).
 for _ in $(seq 200); do
   "$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
-  [ -s "$dir/run.lcmlog" ] && break
+  [ "$(marks)" -gt 0 ] && break
   sleep 0.05
 done
-[ -s "$dir/run.lcmlog" ] || { echo "lcm-logger never recorded the warm-up messages" >&2; exit 1; }
+[ "$(marks)" -gt 0 ] || { echo "lcm-logger never recorded the warm-up messages" >&2; exit 1; }
 # 1000 rounds/s: about the loop's own message rate.
 "$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 1000
 # The same at the end: the logger handles its socket in order, so once a round sent after them
-# is in the file, so is every HX_ message (channel names are plain text in the log).
-marks() { grep -a -o 'WARMUP_SENSOR' "$dir/run.lcmlog" | wc -l; }
+# is in the file, so is every HX_ message.
 before=$(marks)
 "$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
 for _ in $(seq 200); do [ "$(marks)" -gt "$before" ] && break; sleep 0.05; done
+[ "$(marks)" -gt "$before" ] || { echo "lcm-logger never recorded the closing warm-up round" >&2; exit 1; }
 kill -INT "$logger"; wait "$logger" || true; logger=""
 
 echo "== read the log back"

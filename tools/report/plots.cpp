@@ -123,7 +123,7 @@ std::filesystem::path find_executable(const std::string& name) {
   std::stringstream dirs(path != nullptr ? path : "/usr/bin:/bin");
   std::string dir;
   while (std::getline(dirs, dir, ':')) {
-    const auto candidate = std::filesystem::path(dir.empty() ? "." : dir) / name;
+    auto candidate = std::filesystem::path(dir.empty() ? "." : dir) / name;
     if (::access(candidate.c_str(), X_OK) == 0) return candidate;
   }
   return {};
