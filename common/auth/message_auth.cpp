@@ -85,7 +85,8 @@ std::string_view to_string(AuthResult result) noexcept {
   return "unknown";
 }
 
-MessageVerifier::MessageVerifier(const RigKey& key, std::int64_t max_skew_us) : key_(key), max_skew_us_(max_skew_us) {
+MessageVerifier::MessageVerifier(const RigKey& key, std::int64_t max_skew_us, std::int64_t not_before_us)
+    : key_(key), max_skew_us_(max_skew_us), not_before_us_(not_before_us) {
   ensure_sodium();
   if (max_skew_us <= 0) throw std::invalid_argument("MessageVerifier: max_skew_us must be > 0");
 }
@@ -108,6 +109,7 @@ AuthResult MessageVerifier::verify(std::string_view channel, const unsigned char
   const auto counter = static_cast<std::int64_t>(raw_counter);
   // |counter - now| > max_skew, without overflow (both are >= 0 on any sane clock).
   if (counter < now_us - max_skew_us_ || counter - max_skew_us_ > now_us) return AuthResult::kSkewed;
+  if (counter < not_before_us_) return AuthResult::kReplayed;
 
   Sender* slot = nullptr;
   Sender* oldest = &senders_[0];

@@ -13,8 +13,11 @@
 // clock [us since the epoch], strictly increasing (max(last + 1, now)). A verifier keeps the
 // last counter of each sender and refuses a counter <= it; a counter further than max_skew from
 // the verifier's own wall clock is refused too, so a message recorded from a process that has
-// since stopped (a sender the verifier never saw or has forgotten) is refused as well. The
-// hosts of a rig therefore need synchronised clocks (chrony or PTP), to well within max_skew.
+// since stopped (a sender the verifier never saw or has forgotten) is refused as well. A
+// verifier also refuses every counter below the wall-clock time it was made (not_before): a
+// receiver that has just started remembers no sender, and without that bound a message captured
+// up to max_skew before it started (an ARM before the operator's DISARM, say) would pass once.
+// The hosts of a rig therefore need synchronised clocks (chrony or PTP), to well within max_skew.
 //
 // Time is an argument (now_us); nothing here allocates or throws after construction.
 
@@ -62,7 +65,7 @@ enum class AuthResult : std::uint8_t {
   kUnsigned,   // no trailer
   kMalformed,  // trailing bytes that are not a trailer (wrong size or magic)
   kBadMac,     // altered, another channel, or another key
-  kReplayed,   // counter not above the last one accepted from this sender
+  kReplayed,   // counter not above the last one accepted from this sender, or below not_before
   kSkewed,     // counter further than max_skew from the receiver's clock (too old, or from the future)
 };
 std::string_view to_string(AuthResult result) noexcept;
@@ -73,8 +76,9 @@ class MessageVerifier {
   // (its old messages are still refused once they are max_skew old).
   static constexpr std::size_t kMaxSenders = 32;
 
-  // max_skew_us > 0.
-  MessageVerifier(const RigKey& key, std::int64_t max_skew_us);
+  // max_skew_us > 0; not_before_us: counters below it are refused as replayed (the receiver's
+  // start, wall clock [us since the epoch]; 0 = no such bound).
+  MessageVerifier(const RigKey& key, std::int64_t max_skew_us, std::int64_t not_before_us = 0);
   ~MessageVerifier();
   MessageVerifier(const MessageVerifier&) = delete;
   MessageVerifier& operator=(const MessageVerifier&) = delete;
@@ -85,6 +89,7 @@ class MessageVerifier {
                     const unsigned char* trailer, std::size_t trailer_size, std::int64_t now_us) noexcept;
 
   std::int64_t max_skew_us() const noexcept { return max_skew_us_; }
+  std::int64_t not_before_us() const noexcept { return not_before_us_; }
   // Senders forgotten to make room for a new one.
   std::uint64_t evictions() const noexcept { return evictions_; }
 
@@ -96,6 +101,7 @@ class MessageVerifier {
 
   RigKey key_;
   std::int64_t max_skew_us_;
+  std::int64_t not_before_us_;
   std::array<Sender, kMaxSenders> senders_{};
   std::uint64_t evictions_ = 0;
 };

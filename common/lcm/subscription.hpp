@@ -34,6 +34,7 @@
 #include "lcm/message_checks.hpp"
 #include "lcm/message_storage.hpp"
 #include "auth/message_auth.hpp"
+#include "core/clock.hpp"
 #include "lcm/reject_reason.hpp"
 #include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"
@@ -67,7 +68,8 @@ class Subscription {
     if (subscription_ == nullptr) throw std::runtime_error("LCM could not subscribe to " + channel_);
     if (options_.queue_capacity > 0) lcm_subscription_set_queue_capacity(subscription_, options_.queue_capacity);
     if (options_.auth != nullptr && is_authenticated_channel(channel_)) {
-      verifier_.emplace(options_.auth->key, options_.auth->max_skew_us);
+      // Nothing signed before this receiver existed is taken (auth/message_auth.hpp: replay).
+      verifier_.emplace(options_.auth->key, options_.auth->max_skew_us, wall_utime());
     }
   }
 

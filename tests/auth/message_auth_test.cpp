@@ -168,5 +168,19 @@ TEST(MessageAuth, SenderIdsAreRandomAndNonZero) {
   EXPECT_NE(a.sender_id(), b.sender_id());
 }
 
+// A receiver that has just started has seen no sender: without not_before an ARM captured a
+// second before it started (before the operator's DISARM) would re-arm it once.
+TEST(MessageAuth, AReceiverRefusesWhatWasSignedBeforeItStarted) {
+  MessageSigner signer(key_of(1));
+  const Signed before = sign(signer, "HX_CONTROL", body(40), kNow - 1'000'000);  // 1 s before the start
+  const Signed after = sign(signer, "HX_CONTROL", body(40), kNow + 10);
+  MessageVerifier restarted(key_of(1), kSkew, kNow);
+  EXPECT_EQ(check(restarted, "HX_CONTROL", before, kNow + 20), AuthResult::kReplayed);
+  EXPECT_EQ(check(restarted, "HX_CONTROL", after, kNow + 20), AuthResult::kOk);
+  // Without the bound (0) the captured message would pass: the check above is what refuses it.
+  MessageVerifier unbounded(key_of(1), kSkew);
+  EXPECT_EQ(check(unbounded, "HX_CONTROL", before, kNow + 20), AuthResult::kOk);
+}
+
 }  // namespace
 }  // namespace hystloop

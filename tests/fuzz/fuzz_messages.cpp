@@ -2,13 +2,17 @@
 // length fields walked before decoding (common/lcm/wire_layout.hpp), lcm-gen's decode into a
 // reused, reserved message, the decoded size against the walked size, the value contract
 // (common/lcm/message_checks.hpp) — then a re-encode of what was accepted, which must decode
-// back to the same size. The first input byte picks the type; the rest follows its fingerprint.
+// back to the same size. What follows the walked encoding goes through a keyed rig's check
+// (common/auth/message_auth.hpp): no input can carry a trailer the verifier takes, since the
+// fuzzer does not know the key; one that did would be a hole in the MAC check or its framing.
+// The first input byte picks the type; the rest follows its fingerprint.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
 
+#include "auth/message_auth.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/wire_layout.hpp"
@@ -16,6 +20,16 @@
 namespace {
 
 using namespace hystloop;
+
+// A keyed receiver: a key the fuzzer never sees, every counter since the epoch within the skew.
+MessageVerifier& verifier() {
+  static MessageVerifier v = [] {
+    RigKey key;
+    for (std::size_t i = 0; i < key.bytes.size(); ++i) key.bytes[i] = static_cast<unsigned char>(0xA5 ^ (13 * i));
+    return MessageVerifier(key, INT64_MAX / 4, 1);
+  }();
+  return v;
+}
 
 template <class T>
 void receive(const std::uint8_t* data, std::size_t size) {
@@ -27,6 +41,11 @@ void receive(const std::uint8_t* data, std::size_t size) {
 
   const std::int64_t walked = walk_wire_layout(wire_layout_of<T>(), buffer.data(), buffer.size());
   if (walked < 0) return;  // refused before decoding: what a Subscription counts as decode_failed
+  const auto body = static_cast<std::size_t>(walked);
+  if (body < buffer.size() && verifier().verify("HX_SENSOR", buffer.data(), body, buffer.data() + body,
+                                                buffer.size() - body, 1'800'000'000'000'000) == AuthResult::kOk) {
+    std::abort();
+  }
   static T msg = [] {
     T m{};
     reserve_storage(m);

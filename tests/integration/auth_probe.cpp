@@ -5,6 +5,9 @@
 //   auth_probe capture --channel C --out FILE       the first message on channel C, raw (trailer and
 //                                                  all), written to FILE
 //   auth_probe replay --channel C --in FILE         publishes FILE's bytes on C as they are
+//   auth_probe sensor-jump --ahead N --count K      waits for a sensor block, then sends K unsigned
+//                                                  20-tick blocks back to back from N ticks after
+//                                                  it (what the sequence guard would confirm as a jump)
 // Common: --url URL (default udpm ttl=0), --prefix P (default HX_; channel C is the suffix).
 #include <CLI/CLI.hpp>
 
@@ -26,6 +29,7 @@
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/rig_auth.hpp"
+#include "lcm/wire_layout.hpp"
 
 namespace {
 
@@ -79,11 +83,50 @@ int replay(lcm::LCM& lcm, const std::string& channel, const std::string& in) {
   return lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())) == 0 ? 0 : 1;
 }
 
+int sensor_jump(lcm::LCM& lcm, const ChannelNames& ch, std::int64_t ahead, int count) {
+  std::int64_t next = -1;
+  lcm_subscribe(
+      lcm.getUnderlyingLCM(), ch.sensor.c_str(),
+      [](const lcm_recv_buf_t* rbuf, const char*, void* into) {
+        sensor_block_t b;
+        const std::int64_t body = lcm_body_size(wire_layout_of<sensor_block_t>(), rbuf->data, rbuf->data_size);
+        if (body > 0 && b.decode(rbuf->data, 0, static_cast<int>(body)) == body && b.n_ticks > 0) {
+          *static_cast<std::int64_t*>(into) = b.seq + b.n_ticks;
+        }
+      },
+      &next);
+  for (int i = 0; i < 100 && next < 0; ++i) lcm.handleTimeout(50);
+  if (next < 0) {
+    std::fprintf(stderr, "auth_probe: no sensor block within 5 s\n");
+    return 1;
+  }
+  Publisher<sensor_block_t> pub(lcm, ch.sensor, default_message_check<sensor_block_t>(), nullptr);
+  sensor_block_t block{};
+  reserve_storage(block);
+  for (int k = 0; k < count; ++k) {
+    const std::int64_t first = next + ahead + std::int64_t{20} * k;
+    begin_block(block, first, wall_utime(), 1e-4);
+    for (std::int64_t t = first; t < first + 20; ++t) {
+      SensorTick tick;
+      tick.utime = wall_utime();
+      tick.seq = t;
+      tick.y_ref_m = 0.0;
+      append_tick(block, tick);
+    }
+    if (!pub.publish(block)) return 1;
+  }
+  const long long first = next + ahead;
+  std::printf("sent %d unsigned sensor blocks from tick %lld (%lld ahead)\n", count, first,
+              static_cast<long long>(ahead));
+  return 0;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"auth_probe: foreign publisher and raw capture/replay for the authenticated-rig test"};
   app.require_subcommand(1);
   std::string url = "udpm://239.255.76.67:7667?ttl=0", prefix = "HX_", key_file, channel, file;
   int count = 10;
+  std::int64_t ahead = 5000;
   app.add_option("--url", url);
   app.add_option("--prefix", prefix);
   auto* cmd = app.add_subcommand("commands");
@@ -95,6 +138,9 @@ int run(int argc, char** argv) {
   auto* rep = app.add_subcommand("replay");
   rep->add_option("--channel", channel)->required();
   rep->add_option("--in", file)->required();
+  auto* jump = app.add_subcommand("sensor-jump");
+  jump->add_option("--ahead", ahead);
+  jump->add_option("--count", count);
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   try {
     const ChannelNames ch(prefix);
@@ -102,6 +148,7 @@ int run(int argc, char** argv) {
     if (*cmd) return send_commands(*lcm, ch, count, key_file);
     if (*cap) return capture(*lcm, prefix + channel, file);
     if (*rep) return replay(*lcm, prefix + channel, file);
+    if (*jump) return sensor_jump(*lcm, ch, ahead, count);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "auth_probe: %s\n", e.what());
     return 2;

@@ -5,6 +5,8 @@
 # command blocks, a trajectory and a parameter set: nothing acts, the stage stays in the safe
 # state, and every message is counted as refused on HX_STATUS. A signed command block captured
 # from the running rig and replayed (at once: replayed; after the skew window: skewed) is refused.
+# The sensor stream is signed too: three forged blocks 5000 ticks ahead (which the sequence guard
+# would confirm as a jump) and a replayed real block are refused before the guard sees them.
 # Inside tools/netns-run.
 #   auth_rig.sh <hystloop-bridge> <hystloop-compensator> <loop_probe> <auth_probe> <hystloop-ctl>
 source "$(dirname "$0")/loop_common.sh" "$1" "$2" "$3"
@@ -28,7 +30,7 @@ start_recording
 "$bridge" "${bridge_args[@]}" "${auth[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)   # not armed
 wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
-grep -q "auth: commands, control" "$dir/bridge.log" || fail "the bridge did not say it checks signatures"
+grep -q "auth: sensor blocks, commands, control" "$dir/bridge.log" || fail "the bridge did not say it checks signatures"
 sleep 1.0
 "$authp" capture --channel COMMAND --out "$dir/early.bin" >/dev/null || fail "no command block to capture"
 "$ctl" --key-file "$key" reset-counters >/dev/null   # signed: counts from here on
@@ -43,6 +45,10 @@ sleep 0.3
 # A signed block captured now and replayed at once: its counter was seen.
 "$authp" capture --channel COMMAND --out "$dir/now.bin" >/dev/null
 "$authp" replay --channel COMMAND --in "$dir/now.bin"
+# Forged sensor blocks far ahead, and a real one captured and replayed.
+"$authp" sensor-jump --ahead 5000 --count 3 >/dev/null || fail "could not send the forged sensor blocks"
+"$authp" capture --channel SENSOR --out "$dir/sensor.bin" >/dev/null || fail "no sensor block to capture"
+"$authp" replay --channel SENSOR --in "$dir/sensor.bin"
 # The one captured before the reset, now older than auth.max_skew_s (2 s): a recording.
 sleep_left=$(awk -v t="$(stat -c %Y "$dir/early.bin")" -v now="$(date +%s)" 'BEGIN { s = t + 3.2 - now; print (s > 0 ? s : 0) }')
 sleep "$sleep_left"
@@ -69,7 +75,30 @@ expect_value compensator trajectory.accepted 0
 expect_value compensator params.accepted 0
 expect_value compensator control_acted 1       # the signed reset-counters only
 expect_value compensator trajectories 0
+[ "$(value compensator sensor.rejected_unsigned)" -ge 3 ] || fail "compensator sensor.rejected_unsigned = $(value compensator sensor.rejected_unsigned)"
+[ "$(value compensator sensor.rejected_replayed)" -ge 1 ] || fail "compensator sensor.rejected_replayed = $(value compensator sensor.rejected_replayed)"
+expect_value compensator sensor_jumps 0
+expect_value compensator sensor_blocks_held 0   # refused before the sequence guard
+[ "$(value compensator sensor.accepted)" -gt 100 ] || fail "the compensator took few signed sensor blocks: $(value compensator sensor.accepted)"
 expect_value compensator params_accepted 0
 echo "bridge refused: command unsigned $(value bridge command.rejected_unsigned), replayed $(value bridge command.rejected_replayed)," \
      "skewed $(value bridge command.rejected_skewed), control unsigned $(value bridge control.rejected_unsigned)"
+# A restarted receiver: an ARM signed (and captured) before the bridge started, replayed within
+# the skew window (2 s: only the bridge's start lies between), is refused as replayed; the bridge
+# stays in the safe state.
+start_recording
+"$authp" capture --channel CONTROL --out "$dir/arm.bin" >"$dir/capture_arm.out" 2>&1 & cap=$!; pids+=($cap)
+sleep 0.3
+"$ctl" --key-file "$key" arm >/dev/null
+wait $cap || fail "no signed ARM captured"
+"$bridge" "${bridge_args[@]}" "${auth[@]}" --summary-json "$dir/bridge2.json" >"$dir/bridge2.log" 2>&1 & b2=$!; pids+=($b2)
+wait_log "$dir/bridge2.log" "started in the safe state"
+"$authp" replay --channel CONTROL --in "$dir/arm.bin"
+sleep 1.3   # a status report after it
+kill -TERM $b2; wait $b2 || fail "the restarted bridge exited with $?"
+stop_recording
+[ "$(value bridge control.rejected_replayed)" -ge 1 ] || fail "the restarted bridge did not refuse the ARM signed before it started (control.rejected_replayed $(value bridge control.rejected_replayed))"
+expect_value bridge control_acted 0
+[ "$(jq .armed_ticks "$dir/bridge2.json")" = 0 ] || fail "the restarted bridge armed on a replayed ARM"
+
 echo "auth_rig: ok"

@@ -31,7 +31,7 @@ std::shared_ptr<const RigAuth> rig(unsigned char seed) {
 template <class T>
 typename Subscription<T>::Options keyed(const std::shared_ptr<const RigAuth>& auth) {
   typename Subscription<T>::Options o;
-  o.auth = std::move(auth);
+  o.auth = auth;
   return o;
 }
 
@@ -62,10 +62,11 @@ class AuthenticatedEndpointTest : public ::testing::Test {
 };
 
 TEST(RigAuth, AuthenticatedChannelsAreTheOnesThatCanMoveTheStage) {
-  for (const char* c : {"HX_COMMAND", "HX_CONTROL", "HX_TRAJECTORY", "HX_PARAMS", "HX_MODEL", "RIG2_PARAMS"}) {
+  for (const char* c :
+       {"HX_COMMAND", "HX_CONTROL", "HX_TRAJECTORY", "HX_PARAMS", "HX_MODEL", "HX_SENSOR", "RIG2_PARAMS"}) {
     EXPECT_TRUE(is_authenticated_channel(c)) << c;
   }
-  for (const char* c : {"HX_SENSOR", "HX_STATUS", "COMMAND", "HX_COMMANDS", "HXCOMMAND", ""}) {
+  for (const char* c : {"HX_STATUS", "COMMAND", "HX_COMMANDS", "HXCOMMAND", "HX_SENSORS", ""}) {
     EXPECT_FALSE(is_authenticated_channel(c)) << c;
   }
 }
@@ -142,16 +143,56 @@ TEST_F(AuthenticatedEndpointTest, AMessageMovedToAnotherAuthenticatedChannelIsRe
 }
 
 TEST_F(AuthenticatedEndpointTest, UnauthenticatedChannelsAreNeitherSignedNorChecked) {
-  Subscription<sensor_block_t> sensor(*lcm_, "HX_SENSOR", {}, keyed<sensor_block_t>(key_));
-  Publisher<sensor_block_t> keyed_pub(*lcm_, "HX_SENSOR", default_message_check<sensor_block_t>(), key_);
-  Publisher<sensor_block_t> keyless_pub(*lcm_, "HX_SENSOR", default_message_check<sensor_block_t>(), nullptr);
-  EXPECT_FALSE(sensor.authenticated());
+  Subscription<service_status_t> status(*lcm_, "HX_STATUS", {}, keyed<service_status_t>(key_));
+  Publisher<service_status_t> keyed_pub(*lcm_, "HX_STATUS", default_message_check<service_status_t>(), key_);
+  Publisher<service_status_t> keyless_pub(*lcm_, "HX_STATUS", default_message_check<service_status_t>(), nullptr);
+  EXPECT_FALSE(status.authenticated());
   EXPECT_FALSE(keyed_pub.signs());
-  ASSERT_TRUE(keyed_pub.publish(fixtures::sensor_block(1)));
-  ASSERT_TRUE(keyless_pub.publish(fixtures::sensor_block(2)));
+  ASSERT_TRUE(keyed_pub.publish(fixtures::status(1)));
+  ASSERT_TRUE(keyless_pub.publish(fixtures::status(2)));
   drain();
-  EXPECT_EQ(sensor.counters().accepted, 2u);
-  EXPECT_EQ(recorded_.at(0).bytes, fixtures::encode(fixtures::sensor_block(1)));  // today's bytes
+  EXPECT_EQ(status.counters().accepted, 2u);
+  EXPECT_EQ(recorded_.at(0).bytes, fixtures::encode(fixtures::status(1)));  // today's bytes
+}
+
+// The compensator plans from the sensor blocks' tick numbers: on a keyed rig a forged or
+// replayed block is refused before its numbers reach the sequence guard.
+TEST_F(AuthenticatedEndpointTest, SensorBlocksAreSignedAndAForgedOrReplayedOneIsRefused) {
+  Subscription<sensor_block_t> sensor(*lcm_, "HX_SENSOR", {}, keyed<sensor_block_t>(key_));
+  Publisher<sensor_block_t> bridge(*lcm_, "HX_SENSOR", default_message_check<sensor_block_t>(), key_);
+  Publisher<sensor_block_t> forger(*lcm_, "HX_SENSOR", default_message_check<sensor_block_t>(), nullptr);
+  ASSERT_TRUE(sensor.authenticated());
+  ASSERT_TRUE(bridge.signs());
+  ASSERT_TRUE(bridge.publish(fixtures::sensor_block(1)));
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(forger.publish(fixtures::sensor_block(5000 + i)));  // 3 blocks ahead
+  drain();
+  replay("HX_SENSOR", recorded_.at(0).bytes);
+  drain();
+  EXPECT_EQ(sensor.counters().accepted, 1u);
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kUnsigned), 3u);
+  EXPECT_EQ(sensor.counters().rejected(RejectReason::kReplayed), 1u);
+}
+
+// A receiver made after a message was signed refuses it, though it never saw the sender and the
+// message is well within the skew: a captured ARM cannot re-arm a restarted bridge.
+TEST_F(AuthenticatedEndpointTest, ARestartedReceiverRefusesWhatWasSignedBeforeItStarted) {
+  Publisher<control_t> ctl(*lcm_, "HX_CONTROL", default_message_check<control_t>(), key_);
+  ASSERT_TRUE(ctl.publish(fixtures::control(1)));
+  drain();
+  ASSERT_EQ(recorded_.size(), 1u);
+  const std::vector<std::uint8_t> captured = recorded_[0].bytes;
+  // The verifier's bound is its construction's wall clock [us]: let it pass the counter (the
+  // signing time, at most `now` here).
+  const std::int64_t signed_by = wall_utime();
+  while (wall_utime() <= signed_by + 1) {
+  }
+  Subscription<control_t> restarted(*lcm_, "HX_CONTROL", {}, keyed<control_t>(key_));
+  restarted.receive(captured.data(), captured.size(), wall_utime());
+  EXPECT_EQ(restarted.counters().rejected(RejectReason::kReplayed), 1u);
+  EXPECT_EQ(restarted.counters().accepted, 0u);
+  ASSERT_TRUE(ctl.publish(fixtures::control(2)));  // the live sender goes on being heard
+  drain();
+  EXPECT_EQ(restarted.counters().accepted, 1u);
 }
 
 TEST_F(AuthenticatedEndpointTest, TrailingBytesThatAreNotATrailerAreSizeMismatch) {
