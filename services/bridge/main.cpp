@@ -16,7 +16,7 @@
 #include "runtime/rig_auth_config.hpp"
 #include "runtime/service_options.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   using namespace hystloop;
   CLI::App app{
       "hystloop-bridge: owns the loop's clock. Buffers the feedforward and reference that HX_COMMAND sends "
@@ -74,8 +74,8 @@ int main(int argc, char** argv) {
     const Config config = load_service_config(options);
     settings = load_bridge_settings(config);
     url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
-    configure_rig_auth(config, url);
-  } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
+    if (!probe) configure_rig_auth(config, url);  // the probe drives the card alone: no LCM
+  } catch (const std::exception& e) {             // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
     return 2;
   }
@@ -105,4 +105,10 @@ int main(int argc, char** argv) {
     flush_logging();
     return 1;
   }
+} catch (const std::exception& e) {  // CLI11's set-up, before the handlers below exist: nothing escapes main
+  std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
+  return 1;
+} catch (...) {
+  std::fprintf(stderr, "hystloop-bridge: unknown error\n");
+  return 1;
 }

@@ -96,7 +96,7 @@ TEST(ComediProbe, ACardThatRefusesTheConfigExitsTwoWithTheOutputSafe) {
 }
 
 TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
-  const std::string netns = std::string(HYSTLOOP_SOURCE_DIR) + "/tools/netns-run";
+  const std::string netns = std::string(HYSTLOOP_SOURCE_DIR) + "/tools/netns-run --keyless";
   const BridgeRun r = run("", "--set rt.priority=0 --set rt.io_priority=0 --set rt.lock_memory=false --set rt.cpu=-1",
                           netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
   EXPECT_EQ(r.rc, 0) << r.out;

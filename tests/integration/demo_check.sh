@@ -16,6 +16,14 @@ s="$out/summary.json"
 fail=0
 source "$(dirname "$0")/summary_checks.sh"
 check_loop_summary "$s" HXT_
+# Keyed by default: the deploy script made the rig key (0600) and every service checked with it.
+key="$out/run/rig.key"
+if [ -f "$key" ] && [ "$(stat -c %a "$key")" = 600 ]; then echo "ok:   rig key $key made, mode 600"
+else echo "FAIL: no rig key with mode 600 at $key"; fail=1; fi
+for svc in logger bridge compensator reidentifier; do
+  if grep -q "signed and checked with the rig key $key" "$out/run/$svc.log"; then echo "ok:   $svc keyed"
+  else echo "FAIL: $svc did not run keyed: $(grep -m1 'auth:' "$out/run/$svc.log")"; fail=1; fi
+done
 for f in hysteresis_u_y.png tracking_error.png; do
   [ -s "$out/$f" ] && echo "ok:   $f written" || { echo "FAIL: $f missing"; fail=1; }
 done

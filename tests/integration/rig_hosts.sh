@@ -68,7 +68,7 @@ echo "hosts: stage, control, desk on bridge $br (10.203.0.1-3/24)"
 cfg="$src/deploy/config/demo"
 ctl_exe="$(find "$build/tools/ctl" -maxdepth 1 -name hystloop-ctl -type f)"
 ctl_get() { "$ctl_exe" config-get "$@"; }
-# A keyed rig (rig.key_file) where hystloop-ctl has keygen (issue 14, "Authenticated rig").
+# A keyed rig (rig.key_file) where hystloop-ctl has keygen (docs/SECURITY.md).
 key_line=""
 if "$ctl_exe" keygen --help >/dev/null 2>&1; then
   "$ctl_exe" keygen --out "$out/rig.key" >/dev/null || die "keygen"

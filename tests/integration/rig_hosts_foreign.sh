@@ -30,8 +30,20 @@ foreign arm
 foreign experiment --mem-paper --duration 2
 foreign trajectory --mem-paper --blend 0.5 --no-wait  # refused unsigned: no verdict to wait for
 foreign params --c1 2e-9 --c2 2e-9 --c3 0.3 --version 1000
+# A keyless service on a host's network is refused unless that is chosen twice (auth.keyless and
+# auth.allow_keyless_network): the desk has a veth up, and ttl=0 would not keep the LAN out.
+set +e
+in_ns desk "$build/services/compensator/hystloop-compensator" --config "$cfg/compensator.yaml" \
+  --lcm-url "$foreign_url" --allow-network --rig "$prefix" --set auth.keyless=true --seconds 1 >"$out/keyless-refused.log" 2>&1
+rc=$?
+set -e
+if [ "$rc" = 2 ] && grep -q "auth.keyless: a keyless service on a network other hosts reach" "$out/keyless-refused.log"; then
+  echo "ok:   a keyless compensator on the desk's network is refused (exit 2, naming auth.allow_keyless_network)"
+else echo "FAIL: a keyless compensator on a host network: exit $rc, $(head -c 300 "$out/keyless-refused.log")"; fail=1; fi
+# The attacker chooses both.
 in_ns desk timeout -s TERM 2 "$build/services/compensator/hystloop-compensator" --config "$cfg/compensator.yaml" \
-  --lcm-url "$foreign_url" --allow-network --rig "$prefix" >"$out/foreign-compensator.log" 2>&1 || true
+  --lcm-url "$foreign_url" --allow-network --rig "$prefix" --set auth.keyless=true \
+  --set auth.allow_keyless_network=true >"$out/foreign-compensator.log" 2>&1 || true
 sleep 2.5  # the real compensator's report is the last again (the keyless one also reported as "compensator")
 foreign_counts >"$out/foreign-after.txt"
 value_in() { awk -F= -v k="$1" '$1 == k { print $2 }' "$2"; }

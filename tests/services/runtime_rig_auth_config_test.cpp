@@ -66,6 +66,58 @@ TEST_F(RigAuthConfigTest, SkewOutOfRangeIsRefused) {
   }
 }
 
+// A service without a key runs only by an explicit choice, and on a network other hosts reach
+// only by a second one: ttl=0 does not stop packets arriving from the LAN.
+TEST(RigAuthKeyless, NoKeyWithoutTheChoiceIsRefusedNamingTheFix) {
+  const Config c = Config::from_string("{}", "bridge.yaml");
+  try {
+    check_keyless_choice(c, false, "udpm://239.255.76.67:7667?ttl=0", {});
+    FAIL() << "a service without a key started without auth.keyless";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("bridge.yaml: auth.key_file: no rig key", 0), 0u) << what;
+    EXPECT_NE(what.find("hystloop-ctl keygen"), std::string::npos) << what;
+    EXPECT_NE(what.find("auth.keyless: true"), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(check_keyless_choice(c, true, "udpm://239.255.76.67:7667?ttl=0", {"eth0"}));  // keyed: anywhere
+}
+
+TEST(RigAuthKeyless, KeylessRunsInAPrivateNamespaceOnly) {
+  const Config keyless = Config::from_string("auth: {keyless: true}", "c.yaml");
+  EXPECT_NO_THROW(check_keyless_choice(keyless, false, "udpm://239.255.76.67:7667?ttl=0", {}));
+  EXPECT_NO_THROW(check_keyless_choice(keyless, false, "memq://", {"eth0"}));
+  try {
+    check_keyless_choice(keyless, false, "udpm://239.255.76.67:7667?ttl=0", {"eth0", "veth1"});
+    FAIL() << "keyless on a host network";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("c.yaml: auth.keyless: a keyless service on a network other hosts reach", 0), 0u) << what;
+    EXPECT_NE(what.find("eth0, veth1"), std::string::npos) << what;
+    EXPECT_NE(what.find("auth.allow_keyless_network"), std::string::npos) << what;
+  }
+  // A URL that leaves the host is shared whatever the interfaces say.
+  EXPECT_THROW(check_keyless_choice(keyless, false, "tcpq://hub:7700", {}), ConfigError);
+  const Config allowed = Config::from_string("auth: {keyless: true, allow_keyless_network: true}", "c.yaml");
+  EXPECT_NO_THROW(check_keyless_choice(allowed, false, "udpm://239.255.76.67:7667?ttl=1", {"eth0"}));
+  // Allowing the network is not the keyless choice itself.
+  EXPECT_THROW(check_keyless_choice(Config::from_string("auth: {allow_keyless_network: true}", "c.yaml"), false,
+                                    "udpm://239.255.76.67:7667?ttl=0", {}),
+               ConfigError);
+}
+
+TEST(RigAuthKeyless, TheEnvironmentsChoiceCountsOnlyWithoutAKeyAndNotOnAHostNetwork) {
+  const Config none = Config::from_string("{}", "c.yaml");
+  EXPECT_NO_THROW(check_keyless_choice(none, false, "udpm://239.255.76.67:7667?ttl=0", {}, true));
+  EXPECT_NO_THROW(check_keyless_choice(none, true, "udpm://239.255.76.67:7667?ttl=0", {"eth0"}, true));  // keyed
+  EXPECT_THROW(check_keyless_choice(none, false, "udpm://239.255.76.67:7667?ttl=0", {"eth0"}, true), ConfigError);
+}
+
+TEST(RigAuthKeyless, KeyAndKeylessTogetherIsRefused) {
+  EXPECT_THROW(check_keyless_choice(Config::from_string("auth: {keyless: true}", "c.yaml"), true,
+                                    "udpm://239.255.76.67:7667?ttl=0", {}),
+               ConfigError);
+}
+
 TEST(RigAuthConfig, UrlsThatLeaveTheHost) {
   EXPECT_FALSE(lcm_url_leaves_host("udpm://239.255.76.67:7667?ttl=0"));
   EXPECT_FALSE(lcm_url_leaves_host("udpm://239.255.76.67:7667"));
