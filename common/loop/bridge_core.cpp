@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "core/errors.hpp"
 
@@ -50,6 +51,10 @@ bool BridgeCore::submit(const CommandTick& command) noexcept {
     ++counters_.rejected_nonfinite;
     return false;
   }
+  if (command.seq - buffer_.next_tick() > max_lead_ticks_) {
+    ++counters_.rejected_future;
+    return false;
+  }
   switch (buffer_.insert(command)) {
     case CommandBuffer::Insert::kStored: return true;
     case CommandBuffer::Insert::kDuplicate: ++counters_.duplicates; return false;
@@ -57,6 +62,14 @@ bool BridgeCore::submit(const CommandTick& command) noexcept {
     case CommandBuffer::Insert::kTooFarAhead: ++counters_.rejected_future; return false;
   }
   return false;
+}
+
+void BridgeCore::set_max_lead_ticks(std::int64_t ticks) {
+  if (ticks < 1 || ticks > CommandBuffer::kCapacityTicks) {
+    throw ParameterError("bridge.max_lead_s", "must be between one tick and the command buffer's " +
+                                                  std::to_string(CommandBuffer::kCapacityTicks) + " ticks");
+  }
+  max_lead_ticks_ = ticks;
 }
 
 void BridgeCore::set_servo_gains(const FeedbackGains& gains) noexcept {

@@ -53,7 +53,7 @@ struct BridgeCounters {
   std::uint64_t stale = 0;       // commands that arrived after their tick had passed
   std::uint64_t duplicates = 0;  // commands for a tick that had one already (the first stays)
   std::uint64_t rejected_nonfinite = 0;
-  std::uint64_t rejected_future = 0;  // seq too far ahead to buffer
+  std::uint64_t rejected_future = 0;  // seq further ahead of the bridge's clock than max_lead_ticks
   std::uint64_t clamped = 0;          // armed ticks whose command was clamped to the range
   std::uint64_t slew_limited = 0;     // ... limited by the slew rate
   std::uint64_t clamped_either = 0;   // ... by either (a tick clamped by both counts once)
@@ -86,6 +86,12 @@ class BridgeCore {
   // A command received at any time before its tick. Returns false if refused (counted).
   bool submit(const CommandTick& command) noexcept;
 
+  // The bridge owns its clock: a command for a tick more than `ticks` after the next one it
+  // will take is refused (rejected_future), whatever the sensor stream the compensator planned
+  // from said. 1 .. CommandBuffer::kCapacityTicks (the default: only the buffer's size bounds it).
+  void set_max_lead_ticks(std::int64_t ticks);
+  std::int64_t max_lead_ticks() const noexcept { return max_lead_ticks_; }
+
   // Decides the voltage for tick k (k increases between calls; a skipped tick is simply not
   // called). y_measured_m is the stage's position sampled at the end of the previous tick;
   // the servo acts on that tick's reference minus it.
@@ -114,6 +120,7 @@ class BridgeCore {
   ActuatorLimits limits_;
   double dt_s_;
   std::int64_t watchdog_ticks_;  // dry armed ticks allowed before the trip: floor(watchdog_s / dt)
+  std::int64_t max_lead_ticks_ = CommandBuffer::kCapacityTicks;
   CommandBuffer buffer_;
   FeedbackController servo_;
   std::int64_t last_supplied_tick_ = 0;  // last armed tick whose command was in the buffer (or the arm tick)

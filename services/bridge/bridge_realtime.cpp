@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <ctime>
 #include <chrono>
 #include <system_error>
@@ -22,6 +23,7 @@ BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<S
       core_(settings.limits, settings.servo, settings.dt_s()),
       arming_(ArmingSettings{settings.auto_arm, settings.rearm_after_trip_s, settings.dt_s()}),
       dt_s_(settings.dt_s()) {
+  core_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
 }

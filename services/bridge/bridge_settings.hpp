@@ -39,6 +39,10 @@ struct BridgeSettings {
   double degraded_late_fraction = 0.01;  // status DEGRADED above this late fraction over a report period
   double run_seconds = 0.0;              // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
   int command_queue_capacity = 256;      // LCM's queue for HX_COMMAND [blocks]
+  // Commands for ticks further ahead of the bridge's own clock than this are refused: the
+  // compensator plans compensator.horizon_s (0.05) ahead of the last sample, which is behind the
+  // clock, so 10 ms of margin takes every honest plan and a forged sensor stream moves none.
+  double max_lead_s = 0.06;
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
 };

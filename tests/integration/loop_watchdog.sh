@@ -13,7 +13,7 @@ horizon_ticks=2000
 stop_s=0.05
 start_recording
 "$compensator" "${compensator_args[@]}" --set compensator.horizon_s=$horizon_s >"$dir/compensator1.log" 2>&1 & c1=$!; pids+=($c1)
-"$bridge" "${bridge_args[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
+"$bridge" "${bridge_args[@]}" --set bridge.max_lead_s=0.25 >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 wait_log "$dir/compensator1.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
 sleep 0.2

@@ -116,6 +116,23 @@ TEST(BridgeCore, RefusesStaleDuplicateAndFarFutureCommandsAndCountsThem) {
   EXPECT_EQ(b->tick(20, 0.0).u_applied_V, 1.0);
 }
 
+// A forged sensor stream 5000 ticks ahead makes the compensator plan for the forged future; the
+// bridge refuses those commands itself, from its own clock, and keeps the real ones.
+TEST(BridgeCore, CommandsFurtherAheadOfItsClockThanTheMaxLeadAreRefused) {
+  auto b = make_bridge();
+  b->set_max_lead_ticks(600);
+  b->arm(0);
+  for (std::int64_t k = 0; k < 100; ++k) b->tick(k, 0.0);  // next tick: 100
+  EXPECT_TRUE(b->submit(command(700, 1.0)));               // exactly the lead
+  EXPECT_FALSE(b->submit(command(701, 1.0)));
+  EXPECT_FALSE(b->submit(command(5100, 200.0)));
+  EXPECT_EQ(b->counters().rejected_future, 2u);
+  EXPECT_TRUE(b->submit(command(100, 1.0)));
+  EXPECT_THROW(b->set_max_lead_ticks(0), ParameterError);
+  EXPECT_THROW(b->set_max_lead_ticks(CommandBuffer::kCapacityTicks + 1), ParameterError);
+  EXPECT_EQ(b->max_lead_ticks(), 600);
+}
+
 // A late tick holds the last feedforward and reference, and the servo keeps acting on it.
 TEST(BridgeCore, LateTicksHoldTheLastCommandAndKeepTheServoRunning) {
   ActuatorLimits lim;

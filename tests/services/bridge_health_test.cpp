@@ -53,6 +53,20 @@ TEST(BridgeHealth, EveryReasonIsSaid) {
   EXPECT_EQ(assess_bridge_health(in).state, service_status_t::HEALTHY);
 }
 
+// Commands refused for ticks beyond bridge.max_lead_s: a horizon longer than the bridge takes, or
+// a sensor stream that did not come from this bridge; either way not a healthy rig.
+TEST(BridgeHealth, CommandsTooFarAheadOfTheClockAreDegraded) {
+  BridgeHealthInput in = armed();
+  in.commands_too_far_ahead = 40;
+  in.max_lead_s = 0.06;
+  const BridgeHealth h = assess_bridge_health(in);
+  EXPECT_EQ(h.state, service_status_t::DEGRADED);
+  EXPECT_NE(h.detail.find("40 commands refused for ticks more than 0.06 s ahead of the bridge's clock"),
+            std::string::npos)
+      << h.detail;
+  EXPECT_NE(h.detail.find("bridge.max_lead_s"), std::string::npos) << h.detail;
+}
+
 TEST(BridgeHealth, SafeAndStoppingSayTheirOwnReason) {
   BridgeHealthInput in = armed();
   in.clamped_last_second = {5, 5, 0};
