@@ -9,8 +9,6 @@
 namespace hystloop {
 namespace {
 
-constexpr std::int64_t kMaxTick = std::int64_t{1} << 53;  // 28,000 years at 10 kHz
-
 // Collects the findings of one message: any non-finite value outranks a range failure.
 class Findings {
  public:

@@ -1,5 +1,6 @@
 #include "loop/params_admission.hpp"
 
+#include <limits>
 #include <random>
 
 namespace hystloop {
@@ -37,7 +38,7 @@ ParamsAdmission::Row& ParamsAdmission::row(std::int64_t publisher) noexcept {
     }
     ++evictions_;
   }
-  rows_[i] = Row{publisher, 0, 0, use_clock_};
+  rows_[i] = Row{publisher, 0, 0, use_clock_, 0, 0, 0};
   return rows_[i];
 }
 
@@ -49,6 +50,28 @@ bool ParamsAdmission::is_new(std::int64_t publisher, std::int32_t version) const
 void ParamsAdmission::accept(std::int64_t publisher, std::int32_t version) noexcept {
   Row& r = row(publisher);
   if (version > r.version) r.version = version;
+  r.below = 0;  // its sets are taken again: not frozen out
+}
+
+bool ParamsAdmission::refuse_stale(std::int64_t publisher, std::int32_t version, std::int64_t now_ns) noexcept {
+  Row& r = row(publisher);
+  if (version >= r.version) return false;  // a repeat of the set accepted: harmless
+  // Quiet for longer than the window since the last one: a new run of refusals.
+  if (r.below > 0 && now_ns - r.below_ns > kFrozenWindowNs) r.below = 0;
+  if (r.below < std::numeric_limits<std::uint32_t>::max()) ++r.below;
+  r.below_version = version;
+  r.below_ns = now_ns;
+  return true;
+}
+
+std::size_t ParamsAdmission::frozen(std::int64_t now_ns, FrozenList& out) const noexcept {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < used_; ++i) {
+    const Row& r = rows_[i];
+    if (r.below < kFrozenRefusals || now_ns - r.below_ns > kFrozenWindowNs) continue;
+    out[n++] = Frozen{r.publisher, r.below_version, r.version, r.below};
+  }
+  return n;
 }
 
 bool ParamsAdmission::first_refusal(std::int64_t publisher, ParamsRefusal reason) noexcept {

@@ -85,21 +85,14 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
 
 void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
   const std::int64_t start_ns = monotonic_now_ns();
-  const std::int64_t before = compensator_->last_seq();
   // The block's own time, not the receive time: the commands stay a function of the messages.
-  switch (guard_.check(msg.seq, msg.n_ticks, msg.utime)) {
+  // discontinuities_ notes where a confirmed jump or restart went, for log_sequence_events().
+  switch (discontinuities_.check(guard_, msg.seq, msg.n_ticks, msg.utime)) {
     case SequenceGuard::Verdict::hold:  // a jump or a restart not confirmed yet: not used
       work_.add(monotonic_now_ns() - start_ns);
       return;
-    case SequenceGuard::Verdict::restart:
-      restart_control_law();
-      seq_before_ = before;
-      seq_after_ = msg.seq;
-      break;
+    case SequenceGuard::Verdict::restart: restart_control_law(); break;
     case SequenceGuard::Verdict::jump:
-      seq_before_ = before;
-      seq_after_ = msg.seq;
-      break;
     case SequenceGuard::Verdict::take: break;
   }
   const SensorTick last = sensor_tick(msg, msg.u_V.size() - 1);
@@ -330,6 +323,8 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"params_rejected", c.params_rejected + s.params_refused},
           {"params_invalid", s.params_invalid},
           {"params_stale", s.params_stale},
+          {"params_stale_repeat", s.params_stale_repeat},
+          {"params_stale_below", s.params_stale_below},
           {"params_swapped", c.params_swapped},
           {"model_switches", c.model_switches},
           {"model_unknown_kind", s.model_unknown_kind},
@@ -358,15 +353,20 @@ CounterSet::Entries CompensatorService::collect_counters() const {
 // Off the sensor path: what the SequenceGuard decided since the last report.
 void CompensatorService::log_sequence_events() {
   const SequenceGuard::Counters& g = guard_.counters();
+  constexpr int kHeld = SequenceGuard::kConfirmBlocks - 1;
   if (g.restarts != restarts_logged_) {
+    const Discontinuity& d = discontinuities_.last_restart();
     spdlog::warn(
-        "bridge restart: sensor ticks went back from {} to {} (confirmed by {} blocks): control law restarted "
-        "({} restarts in all)",
-        seq_before_, seq_after_, SequenceGuard::kConfirmBlocks, g.restarts);
+        "bridge restart: sensor ticks went back: tick {} was expected, the stream continues from tick {} "
+        "(confirmed by {} blocks, the first {} of them held): control law restarted ({} restarts in all)",
+        d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.restarts);
   }
   if (g.jumps != jumps_logged_) {
-    spdlog::warn("sensor ticks jumped ahead from {} to {} (confirmed by {} blocks; {} jumps in all)", seq_before_,
-                 seq_after_, SequenceGuard::kConfirmBlocks, g.jumps);
+    const Discontinuity& d = discontinuities_.last_jump();
+    spdlog::warn(
+        "sensor ticks jumped ahead: tick {} was expected, the stream continues from tick {} (confirmed by {} "
+        "blocks, the first {} of them held; {} jumps in all)",
+        d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.jumps);
   }
   if (g.ignored != ignored_logged_) {
     spdlog::warn(
@@ -413,6 +413,19 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     state = service_status_t::DEGRADED;
     detail += fmt::format("feedforward clamped at the actuator's limits on {} ticks in the last second; ",
                           clamped_in_period_);
+  }
+  ParamsAdmission::FrozenList frozen;
+  const std::size_t n_frozen = admission_.frozen(monotonic_now_ns(), frozen);
+  if (n_frozen > 0 && (state == service_status_t::HEALTHY || state == service_status_t::DEGRADED)) {
+    state = service_status_t::DEGRADED;
+    for (std::size_t i = 0; i < n_frozen; ++i) {
+      const ParamsAdmission::Frozen& f = frozen[i];
+      detail += fmt::format(
+          "parameter sets from publisher {:x} refused as stale: {} in a row below v{} accepted from it before, the "
+          "last v{}; none of its sets is used now (params v{} in use; params_stale_below); ",
+          static_cast<std::uint64_t>(f.publisher), f.refusals, f.accepted_version, f.refused_version,
+          c.params_version());
+    }
   }
   const MemParams& m = c.mem_params();
   detail +=

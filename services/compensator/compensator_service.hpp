@@ -14,7 +14,10 @@
 //   bridge_restarts, sensor_jumps, sensor_jumps_ignored, sensor_blocks_held; logged in report().
 // - HX_PARAMS versions are ordered per publisher (ParamsAdmission): a set is stale only against
 //   the last one accepted from the same mem_params_t.publisher_id. Refusals are counted by reason
-//   (params_invalid, params_stale, params_rejected) and logged once per reason and publisher.
+//   (params_invalid, params_stale = params_stale_repeat + params_stale_below, params_rejected) and
+//   logged once per reason and publisher. A publisher frozen out (its sets refused as stale below
+//   the version accepted from it, e.g. after a forged set with its id and a huge version:
+//   ParamsAdmission::frozen) makes HX_STATUS DEGRADED, naming it and both versions.
 // - HX_MODEL (model_params_t) carries any model: admitted as HX_PARAMS is (one version
 //   order per publisher over both channels), then Compensator::offer_model switches the
 //   feedforward at the next reversal; a kind or format this build does not know is counted
@@ -44,6 +47,7 @@
 #include "lcm/subscription.hpp"
 #include "loop/compensator.hpp"
 #include "loop/params_admission.hpp"
+#include "loop/sequence_discontinuities.hpp"
 #include "loop/sequence_guard.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
@@ -60,6 +64,8 @@ struct CompensatorServiceCounters {
   std::uint64_t command_ticks_published = 0;
   std::uint64_t params_invalid = 0;        // valid = false: diagnostic sets, never used
   std::uint64_t params_stale = 0;          // version not above the last one accepted from the same publisher
+  std::uint64_t params_stale_repeat = 0;   // ... the very version accepted (a repeat): harmless
+  std::uint64_t params_stale_below = 0;    // ... below it: the publisher may be frozen out
   std::uint64_t params_refused = 0;        // failed the compensator's own validation
   std::uint64_t model_unknown_kind = 0;    // HX_MODEL: a kind this build does not know
   std::uint64_t model_unknown_format = 0;  // HX_MODEL: another format_version
@@ -175,8 +181,7 @@ class CompensatorService {
   std::uint64_t restarts_logged_ = 0;
   std::uint64_t jumps_logged_ = 0;
   std::uint64_t ignored_logged_ = 0;
-  std::int64_t seq_before_ = -1;  // the last tick before the last confirmed jump or restart
-  std::int64_t seq_after_ = -1;   // the first block's after it
+  SequenceDiscontinuities discontinuities_;  // where the last confirmed jump and restart went
   LogLimiter log_limiter_;
 
   CompensatorServiceCounters counters_;

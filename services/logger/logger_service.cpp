@@ -5,12 +5,14 @@
 #include <csignal>
 #include <ctime>
 #include <string>
+#include <string_view>
 
 #include <spdlog/spdlog.h>
 
 #include "core/clock.hpp"
 #include "core/errors.hpp"
 #include "core/process.hpp"
+#include "core/saturating.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/rig_auth.hpp"
@@ -217,31 +219,40 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   std::uint64_t other_channels = 0, other_received = 0, other_written = 0, other_dropped = 0;
   for (std::size_t i = 0; i < channels_->size(); ++i) {
     const ChannelSlot& c = (*channels_)[i];
-    bytes_written += c.bytes_written.load(std::memory_order_relaxed);
-    dropped += c.dropped();
+    // Counts fed by the wire: every sum saturates rather than wrap to a plausible small number.
+    add_saturating(bytes_written, c.bytes_written.load(std::memory_order_relaxed));
+    add_saturating(dropped, c.dropped());
     if (!c.rig) {  // names off the wire: summed, never put in the detail one by one
       ++other_channels;
-      other_received += c.received;
-      other_written += c.written.load(std::memory_order_relaxed);
-      other_dropped += c.dropped();
+      add_saturating(other_received, c.received);
+      add_saturating(other_written, c.written.load(std::memory_order_relaxed));
+      add_saturating(other_dropped, c.dropped());
       continue;
     }
     const SequenceGapDetector& q = c.sequence;
-    const Seen now{c.dropped(), q.gap_events(), q.missing(), q.overlaps() + q.duplicates(), q.resumes(), q.skipped()};
+    const std::uint64_t overlaps = saturating_add(q.overlaps(), q.duplicates());
+    const Seen now{c.dropped(), q.gap_events(), q.missing(), overlaps, q.resumes(), q.skipped(), q.violations()};
     Seen& before = seen_[i];
-    const std::string on = " on " + std::string(c.name_view());
-    if (now.dropped > before.dropped)
-      detail = append(detail, "dropped " + std::to_string(now.dropped - before.dropped) + on);
+    const std::string_view name = c.name_view();
+    if (now.dropped > before.dropped) {
+      detail = append(detail, fmt::format("dropped {} on {}", now.dropped - before.dropped, name));
+    }
     if (now.gap_events > before.gap_events) {
-      detail = append(detail, std::to_string(now.gap_events - before.gap_events) + " gap(s), " +
-                                  std::to_string(now.missing - before.missing) + " ticks missing" + on);
+      detail = append(detail, fmt::format("{} gap(s), {} ticks missing on {}", now.gap_events - before.gap_events,
+                                          now.missing - before.missing, name));
     }
     if (now.overlaps > before.overlaps) {
-      detail = append(detail, std::to_string(now.overlaps - before.overlaps) + " overlapping/duplicate block(s)" + on);
+      detail =
+          append(detail, fmt::format("{} overlapping/duplicate block(s) on {}", now.overlaps - before.overlaps, name));
     }
     if (now.resumes > before.resumes) {
-      detail = append(detail, std::to_string(now.resumes - before.resumes) + " resume(s) after silence, " +
-                                  std::to_string(now.skipped - before.skipped) + " ticks skipped" + on);
+      detail = append(detail, fmt::format("{} resume(s) after silence, {} ticks skipped on {}",
+                                          now.resumes - before.resumes, now.skipped - before.skipped, name));
+    }
+    if (now.violations > before.violations) {
+      detail = append(detail, fmt::format("{} block(s) breaking the channel contract (seq or n_ticks out of range; "
+                                          "not checked for gaps) on {}",
+                                          now.violations - before.violations, name));
     }
     before = now;
   }
@@ -273,6 +284,10 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
       reporter_.counter(name + ".out_of_order", q.out_of_order());
       reporter_.counter(name + ".restarts", q.restarts());
       reporter_.counter(name + ".undecodable", c.undecodable);
+      for (std::size_t v = 0; v < SequenceGapDetector::kViolationKinds; ++v) {
+        const auto reason = static_cast<SequenceGapDetector::Violation>(v);
+        reporter_.counter(name + ".contract_" + SequenceGapDetector::to_string(reason), q.violations(reason));
+      }
       if (c.kind == SequenceKind::kCommand) {
         reporter_.counter(name + ".resumes", q.resumes());
         reporter_.counter(name + ".skipped", q.skipped());
@@ -286,7 +301,7 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   reporter_.counter("files", files_->file_count());
   reporter_.counter("bytes_written", bytes_written);
   reporter_.counter("events_written", write_counter_->events_written());
-  reporter_.counter("dropped", dropped + unrecorded);
+  reporter_.counter("dropped", saturating_add(dropped, unrecorded));
   reporter_.counter("disk_errors", faults.errors);
   reporter_.counter("disk_events_lost", faults.events_lost);
   reporter_.counter("disk_files_truncated", faults.files_truncated);

@@ -9,14 +9,15 @@
 //
 // HX_STATUS (process "logger") once a second, and at once when the disk fails or recovers:
 // per rig channel received/written/dropped, and for the two block channels gaps/missing
-// (ticks)/overlaps/duplicates/out_of_order/restarts (+ resumes/skipped for HX_COMMAND, see
-// SequenceGapDetector); other recorded channels summed under "other.*"; channels without a
-// slot as unrecorded_channel (messages) and unknown_channel_names; files, bytes, dropped and
-// the disk faults (disk_errors, disk_events_lost, ...; see LogFileSet). DEGRADED with a
-// detail when something was dropped, a gap, overlap or resume seen in the last period. A
-// disk fault is DEGRADED with a detail starting "FAULT: " and the reason ("FAULT: disk full
-// (write: No space left on device); ...") for as long as nothing can be written
-// (service_status_t has no FAULT state; DEGRADED + this prefix needs no type change).
+// (ticks)/overlaps/duplicates/out_of_order/restarts/contract_<reason> (+ resumes/skipped for
+// HX_COMMAND, see SequenceGapDetector); other recorded channels summed under "other.*";
+// channels without a slot as unrecorded_channel (messages) and unknown_channel_names; files,
+// bytes, dropped and the disk faults (disk_errors, disk_events_lost, ...; see LogFileSet).
+// DEGRADED with a detail when something was dropped, a gap, overlap, resume or contract
+// violation seen in the last period. A disk fault is DEGRADED with a detail starting "FAULT: "
+// and the reason ("FAULT: disk full (write: No space left on device); ...") for as long as
+// nothing can be written (service_status_t has no FAULT state; DEGRADED + this prefix needs no
+// type change).
 // On SIGINT/SIGTERM or a control_t SHUTDOWN for "logger": receive what LCM already holds,
 // stop receiving, write the queue out, close the file, write the summary (logger_summary.hpp).
 
@@ -103,6 +104,7 @@ class LoggerService {
     std::uint64_t overlaps = 0;  // overlapping and duplicate blocks
     std::uint64_t resumes = 0;
     std::uint64_t skipped = 0;
+    std::uint64_t violations = 0;  // blocks breaking the channel contract, all reasons
   };
   std::array<Seen, ChannelTable::kMaxChannels> seen_{};
   std::uint64_t seen_other_dropped_ = 0;

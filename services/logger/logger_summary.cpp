@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "core/saturating.hpp"
+
 namespace hystloop {
 
 namespace {
@@ -33,23 +35,27 @@ std::string json_string(std::string_view text) {
 
 struct Totals {
   std::uint64_t received = 0, written = 0, dropped = 0, bytes_written = 0, gap_events = 0, missing = 0, skipped = 0;
+  std::uint64_t contract_violations = 0;
   std::uint64_t queue_full = 0, oversize = 0, write_failed = 0;
 };
 
+// Each channel's counts saturate; so do their sums (two channels at 2^63 ticks missing must not
+// add up to a total of 0).
 Totals totals_of(const ChannelTable& channels) {
   Totals t;
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
-    t.received += c.received;
-    t.written += c.written.load();
-    t.dropped += c.dropped();
-    t.bytes_written += c.bytes_written.load();
-    t.gap_events += c.sequence.gap_events();
-    t.missing += c.sequence.missing();
-    t.skipped += c.sequence.skipped();
-    t.queue_full += c.dropped_queue_full;
-    t.oversize += c.dropped_oversize;
-    t.write_failed += c.write_failed.load();
+    add_saturating(t.received, c.received);
+    add_saturating(t.written, c.written.load());
+    add_saturating(t.dropped, c.dropped());
+    add_saturating(t.bytes_written, c.bytes_written.load());
+    add_saturating(t.gap_events, c.sequence.gap_events());
+    add_saturating(t.missing, c.sequence.missing());
+    add_saturating(t.skipped, c.sequence.skipped());
+    add_saturating(t.contract_violations, c.sequence.violations());
+    add_saturating(t.queue_full, c.dropped_queue_full);
+    add_saturating(t.oversize, c.dropped_oversize);
+    add_saturating(t.write_failed, c.write_failed.load());
   }
   return t;
 }
@@ -69,9 +75,10 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
       << ", \"bytes\": " << f.bytes << "}";
   }
   j << "\n  ],\n  \"totals\": {\"received\": " << t.received << ", \"written\": " << t.written
-    << ", \"dropped\": " << t.dropped + s.unrecorded_channel << ", \"bytes_written\": " << t.bytes_written
-    << ", \"gap_events\": " << t.gap_events << ", \"missing\": " << t.missing << ", \"skipped\": " << t.skipped
-    << "},\n";
+    << ", \"dropped\": " << saturating_add(t.dropped, s.unrecorded_channel)
+    << ", \"bytes_written\": " << t.bytes_written << ", \"gap_events\": " << t.gap_events
+    << ", \"missing\": " << t.missing << ", \"skipped\": " << t.skipped
+    << ", \"contract_violations\": " << t.contract_violations << "},\n";
   j << "  \"dropped\": {\"queue_full\": " << t.queue_full << ", \"oversize\": " << t.oversize
     << ", \"write_failed\": " << t.write_failed << ", \"unrecorded_channel\": " << s.unrecorded_channel << "},\n";
   const DiskFaults& d = s.disk;
@@ -103,7 +110,12 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
         << ", \"resumes\": " << q.resumes() << ", \"skipped\": " << q.skipped() << ", \"overlaps\": " << q.overlaps()
         << ", \"overlap_ticks\": " << q.overlap_ticks() << ", \"duplicates\": " << q.duplicates()
         << ", \"out_of_order\": " << q.out_of_order() << ", \"restarts\": " << q.restarts()
-        << ", \"undecodable\": " << c.undecodable << ", \"gaps\": [";
+        << ", \"undecodable\": " << c.undecodable << ", \"contract_violations\": {";
+      for (std::size_t v = 0; v < SequenceGapDetector::kViolationKinds; ++v) {
+        const auto reason = static_cast<SequenceGapDetector::Violation>(v);
+        j << (v ? ", " : "") << "\"" << SequenceGapDetector::to_string(reason) << "\": " << q.violations(reason);
+      }
+      j << "}, \"gaps\": [";
       for (std::size_t g = 0; g < q.kept_gap_count(); ++g) {
         j << (g ? ", " : "") << "[" << q.kept_gaps()[g].first_missing << ", " << q.kept_gaps()[g].last_missing << "]";
       }
@@ -122,8 +134,8 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
   head.precision(1);
   head << std::fixed << "recorded " << t.written << " of " << t.received << " messages (" << t.bytes_written
        << " payload bytes) in " << s.files.size() << " file(s) over " << s.duration_s << " s, stopped by "
-       << s.stop_reason << "; dropped " << t.dropped + s.unrecorded_channel << " (queue full " << t.queue_full
-       << ", oversize " << t.oversize << ", write failed " << t.write_failed << ", no channel slot "
+       << s.stop_reason << "; dropped " << saturating_add(t.dropped, s.unrecorded_channel) << " (queue full "
+       << t.queue_full << ", oversize " << t.oversize << ", write failed " << t.write_failed << ", no channel slot "
        << s.unrecorded_channel << ")";
   lines.push_back(head.str());
   if (s.disk.errors > 0) {
@@ -154,6 +166,14 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
       if (q.resumes() > 0) line << ", resumes " << q.resumes() << " (skipped " << q.skipped() << " ticks)";
       if (q.restarts() > 0) line << ", restarts " << q.restarts();
       if (c.undecodable > 0) line << ", undecodable " << c.undecodable;
+      if (q.violations() > 0) {
+        line << ", contract violations " << q.violations() << " (not checked for gaps:";
+        for (std::size_t v = 0; v < SequenceGapDetector::kViolationKinds; ++v) {
+          const auto reason = static_cast<SequenceGapDetector::Violation>(v);
+          line << " " << SequenceGapDetector::to_string(reason) << " " << q.violations(reason);
+        }
+        line << ")";
+      }
     }
     lines.push_back(line.str());
   }

@@ -5,7 +5,8 @@
 // JSON layout (counts are integers; times in us since the epoch; durations in s):
 //   { "recording", "start_utime", "stop_utime", "duration_s", "stop_reason",
 //     "files": [ {"path", "events", "bytes"} ],
-//     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing", "skipped" },
+//     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing", "skipped",
+//                 "contract_violations" },
 //     "dropped": { "queue_full", "oversize", "write_failed", "unrecorded_channel" },
 //     "disk": { "ok", "errors", "last_error", "events_lost", "files_truncated", "files_removed",
 //               "unconfirmed_events", "recoveries" },
@@ -17,9 +18,13 @@
 //                               ["sequence": { "blocks", "ticks", "first_seq", "last_seq", "gap_events", "missing",
 //                                              "resumes", "skipped", "overlaps", "overlap_ticks",
 //                                              "duplicates", "out_of_order", "restarts", "undecodable",
+//                                              "contract_violations": { "negative_seq", "seq_above_max",
+//                                                                       "tick_count" },
 //                                              "gaps": [[first_missing, last_missing], ...] }] } } }
 // Counts in "sequence" are of blocks, except ticks, missing, skipped and overlap_ticks (ticks);
-// first_seq/last_seq are tick numbers. "gaps" lists the first SequenceGapDetector::kKeptGaps
+// first_seq/last_seq are tick numbers; "contract_violations" counts blocks whose seq or n_ticks
+// the channel contract forbids, by reason (not checked for gaps: SequenceGapDetector). Every
+// count and total saturates at UINT64_MAX. "gaps" lists the first SequenceGapDetector::kKeptGaps
 // gaps of a channel; "sequence" is present for the channels checked for gaps (the rig's
 // sensor and command channels). "disk.ok" is false after any disk fault (LogFileSet): then
 // "events_lost" events were not written (also in dropped.write_failed) and the process exits 1.

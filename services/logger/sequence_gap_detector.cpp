@@ -1,20 +1,42 @@
 #include "logger/sequence_gap_detector.hpp"
 
-#include <limits>
+#include <optional>
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/saturating.hpp"
+#include "lcm/message_checks.hpp"
 
 namespace hystloop {
 
 namespace {
-// Counters fed by what came off the wire (a forged seq can jump by 2^64 - 1 ticks): they
-// stop at the largest value instead of wrapping.
-void add_saturating(std::uint64_t& counter, std::uint64_t n) noexcept {
-  counter =
-      n > std::numeric_limits<std::uint64_t>::max() - counter ? std::numeric_limits<std::uint64_t>::max() : counter + n;
+// Both block channels share one bound on the ticks per block.
+constexpr std::int64_t kMaxBlockTicks = sensor_block_t::MAX_TICKS;
+static_assert(kMaxBlockTicks == static_cast<std::int64_t>(command_block_t::MAX_TICKS));
+
+std::optional<SequenceGapDetector::Violation> contract_violation(std::int64_t first, std::int64_t n_ticks) noexcept {
+  using V = SequenceGapDetector::Violation;
+  if (first < 0) return V::kNegativeSeq;
+  if (first > kMaxTick) return V::kSeqAboveMax;
+  if (n_ticks < 1 || n_ticks > kMaxBlockTicks) return V::kTickCount;
+  return std::nullopt;
 }
 }  // namespace
+
+const char* SequenceGapDetector::to_string(Violation reason) noexcept {
+  switch (reason) {
+    case Violation::kNegativeSeq: return "negative_seq";
+    case Violation::kSeqAboveMax: return "seq_above_max";
+    case Violation::kTickCount: return "tick_count";
+  }
+  return "unknown";
+}
+
+std::uint64_t SequenceGapDetector::violations() const noexcept {
+  std::uint64_t total = 0;
+  for (const std::uint64_t n : violations_) add_saturating(total, n);
+  return total;
+}
 
 SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold, std::int64_t resume_silence_us)
     : restart_threshold_(restart_threshold), resume_silence_us_(resume_silence_us) {
@@ -28,14 +50,14 @@ SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold, std::in
 
 SequenceGapDetector::Outcome SequenceGapDetector::observe(std::int64_t first, std::int64_t n_ticks,
                                                           std::int64_t recv_utime) noexcept {
-  const std::int64_t n = n_ticks < 1 ? 1 : n_ticks;
-  // Last tick of the block, saturated at the largest tick number.
-  const std::int64_t last = first > std::numeric_limits<std::int64_t>::max() - (n - 1)
-                                ? std::numeric_limits<std::int64_t>::max()
-                                : first + (n - 1);
+  if (const std::optional<Violation> v = contract_violation(first, n_ticks)) {
+    add_saturating(violations_[static_cast<std::size_t>(*v)], 1);
+    return Outcome::kViolation;
+  }
+  const std::int64_t last = first + (n_ticks - 1);  // <= 2^53 + 999: no overflow
   const std::int64_t silence_us = recv_utime - last_utime_;
   last_utime_ = recv_utime;
-  add_saturating(ticks_, static_cast<std::uint64_t>(n));
+  add_saturating(ticks_, static_cast<std::uint64_t>(n_ticks));
   add_saturating(observed_, 1);
   if (observed_ == 1) {
     first_ = first;

@@ -18,9 +18,17 @@
 //   otherwise (last <= L)      out of order: a late or repeated block; L is kept, and the gap
 //                              it may fill stays counted as missing
 //
-// The ticks come off the wire, so anyone can forge them (seq = INT64_MAX, then 0, ...): the
-// differences are taken in unsigned arithmetic (defined for any pair of int64) and every
-// counter saturates at UINT64_MAX instead of wrapping.
+// The ticks come off the wire, so anyone can forge them. A block the channel contract forbids
+// (lcmtypes/sensor_block_t.lcm, command_block_t.lcm; common/lcm/message_checks.hpp) is counted
+// as a contract violation by its reason and not fed into the arithmetic above (nor into
+// observed(), ticks() or the silence before a resume):
+//   negative_seq   seq < 0
+//   seq_above_max  seq > kMaxTick (2^53): this is also what rules out seq + n_ticks overflowing
+//                  int64, and it bounds every jump: no gap between two admitted blocks is
+//                  longer than the tick range the contract documents
+//   tick_count     n_ticks outside 1..MAX_TICKS (1000)
+// Within the contract the differences are still taken in unsigned arithmetic, and every
+// counter saturates at UINT64_MAX instead of wrapping (many gaps of 2^53 ticks add up).
 
 #include <array>
 #include <cstddef>
@@ -39,7 +47,11 @@ struct SequenceGap {
 
 class SequenceGapDetector {
  public:
-  enum class Outcome { kFirst, kInOrder, kGap, kResume, kOverlap, kDuplicate, kOutOfOrder, kRestart };
+  enum class Outcome { kFirst, kInOrder, kGap, kResume, kOverlap, kDuplicate, kOutOfOrder, kRestart, kViolation };
+  // Why a block was a contract violation (see above).
+  enum class Violation : std::uint8_t { kNegativeSeq, kSeqAboveMax, kTickCount };
+  static constexpr std::size_t kViolationKinds = 3;
+  static const char* to_string(Violation reason) noexcept;  // "negative_seq", "seq_above_max", "tick_count"
 
   // The first gaps are kept (ranges for the summary); later ones are only counted.
   static constexpr std::size_t kKeptGaps = 8;
@@ -50,11 +62,12 @@ class SequenceGapDetector {
   // field if restart_threshold < 1 or resume_silence_us < 0.
   explicit SequenceGapDetector(std::int64_t restart_threshold = 10000, std::int64_t resume_silence_us = 0);
 
-  // A block of `n_ticks` (>= 1; less is taken as 1) from tick `first`, received at
-  // `recv_utime` [us] (only compared with the previous block's, for resumes).
+  // A block of `n_ticks` from tick `first`, received at `recv_utime` [us] (only compared with
+  // the previous block's, for resumes). kViolation (counted, nothing else changes) when the
+  // contract forbids the block.
   Outcome observe(std::int64_t first, std::int64_t n_ticks, std::int64_t recv_utime = 0) noexcept;
 
-  std::uint64_t observed() const noexcept { return observed_; }  // blocks
+  std::uint64_t observed() const noexcept { return observed_; }  // blocks within the contract
   std::uint64_t ticks() const noexcept { return ticks_; }        // ticks in those blocks
   std::uint64_t gap_events() const noexcept { return gap_events_; }
   std::uint64_t missing() const noexcept { return missing_; }  // ticks never seen in order
@@ -65,6 +78,8 @@ class SequenceGapDetector {
   std::uint64_t duplicates() const noexcept { return duplicates_; }
   std::uint64_t out_of_order() const noexcept { return out_of_order_; }
   std::uint64_t restarts() const noexcept { return restarts_; }
+  std::uint64_t violations(Violation reason) const noexcept { return violations_[static_cast<std::size_t>(reason)]; }
+  std::uint64_t violations() const noexcept;  // all reasons
   bool started() const noexcept { return observed_ > 0; }
   std::int64_t first_seq() const noexcept { return first_; }  // meaningful once started()
   std::int64_t last_seq() const noexcept { return last_; }    // highest tick in order since the last restart
@@ -96,6 +111,7 @@ class SequenceGapDetector {
   std::uint64_t duplicates_ = 0;
   std::uint64_t out_of_order_ = 0;
   std::uint64_t restarts_ = 0;
+  std::array<std::uint64_t, kViolationKinds> violations_{};
   std::array<SequenceGap, kKeptGaps> gaps_{};
   std::size_t kept_ = 0;
 };

@@ -13,6 +13,7 @@ std::string_view to_string(ParamsOffer offer) noexcept {
     case ParamsOffer::echo: return "echo";
     case ParamsOffer::stale: return "stale";
     case ParamsOffer::invalid: return "invalid";
+    case ParamsOffer::forged: return "forged";
   }
   return "unknown";
 }
@@ -34,7 +35,13 @@ void ParamsInUse::follow(std::int32_t version) noexcept {
 
 ParamsOffer ParamsInUse::offer(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                                std::string_view source) noexcept {
-  if (publisher_id == own_publisher_id_) return ParamsOffer::echo;
+  if (publisher_id == own_publisher_id_) {
+    if (published(version)) return ParamsOffer::echo;
+    follow(version);  // our next set numbers above it: the compensator takes ours again
+    ++forged_sets_;
+    last_forged_version_ = version;
+    return ParamsOffer::forged;
+  }
   follow(version);
   if (!valid || !in_domain(params)) return ParamsOffer::invalid;
   if (!admission_.is_new(publisher_id, version)) return ParamsOffer::stale;
@@ -57,11 +64,18 @@ std::int32_t ParamsInUse::on_sample(std::int64_t seq) noexcept {
   return applied_version_;
 }
 
+bool ParamsInUse::published(std::int32_t version) const noexcept {
+  if (version < 1 || version > own_published_) return false;
+  return std::find(sent_.begin(), sent_.end(), version) != sent_.end();
+}
+
 std::int32_t ParamsInUse::claim_version() noexcept {
   const std::int32_t top = std::max({highest_seen_, own_published_, version_ < kFollowLimit ? version_ : 0});
   const std::int32_t next = top < std::numeric_limits<std::int32_t>::max() ? top + 1 : top;
   highest_seen_ = next;
   own_published_ = next;
+  sent_[sent_next_] = next;
+  sent_next_ = (sent_next_ + 1) % kSentKept;
   return next;
 }
 

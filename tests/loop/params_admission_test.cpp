@@ -81,6 +81,86 @@ TEST(ParamsAdmission, EachRefusalIsLoggedOncePerReasonPerPublisher) {
   EXPECT_TRUE(a.is_new(kB, 1));  // a refusal records no version
 }
 
+constexpr std::int64_t kSecond_ns = 1'000'000'000;
+
+// One forged set with the re-identifier's own id and the largest version: every later set of the
+// re-identifier is stale. Two refused below the accepted version within the window freeze it out.
+TEST(ParamsAdmission, APublisherWhoseSetsKeepBeingRefusedBelowItsAcceptedVersionIsFrozenOut) {
+  ParamsAdmission a;
+  ParamsAdmission::FrozenList out;
+  a.accept(kA, 2);
+  a.accept(kA, kMax);  // forged
+  std::int64_t t = 100 * kSecond_ns;
+  ASSERT_FALSE(a.is_new(kA, 3));
+  EXPECT_TRUE(a.refuse_stale(kA, 3, t));
+  EXPECT_EQ(a.frozen(t, out), 0u);  // one may be a datagram overtaken by its successor
+  EXPECT_TRUE(a.refuse_stale(kA, 4, t += 5 * kSecond_ns));
+  ASSERT_EQ(a.frozen(t, out), 1u);
+  EXPECT_EQ(out[0].publisher, kA);
+  EXPECT_EQ(out[0].refused_version, 4);
+  EXPECT_EQ(out[0].accepted_version, kMax);
+  EXPECT_EQ(out[0].refusals, 2u);
+  EXPECT_TRUE(a.refuse_stale(kA, 5, t += kSecond_ns));
+  ASSERT_EQ(a.frozen(t, out), 1u);
+  EXPECT_EQ(out[0].refusals, 3u);
+  // Still frozen until the window has passed since the last refusal: then it went quiet.
+  EXPECT_EQ(a.frozen(t + ParamsAdmission::kFrozenWindowNs, out), 1u);
+  EXPECT_EQ(a.frozen(t + ParamsAdmission::kFrozenWindowNs + 1, out), 0u);
+  // After a quiet spell one refusal starts a new run: not frozen again at once.
+  t += 2 * ParamsAdmission::kFrozenWindowNs;
+  EXPECT_TRUE(a.refuse_stale(kA, 6, t));
+  EXPECT_EQ(a.frozen(t, out), 0u);
+  EXPECT_TRUE(a.refuse_stale(kA, 7, t += kSecond_ns));
+  EXPECT_EQ(a.frozen(t, out), 1u);
+}
+
+TEST(ParamsAdmission, RefusalsFurtherApartThanTheWindowDoNotFreeze) {
+  ParamsAdmission a;
+  ParamsAdmission::FrozenList out;
+  a.accept(kA, 50);
+  std::int64_t t = 0;
+  for (std::int32_t v = 10; v < 20; ++v) {
+    EXPECT_TRUE(a.refuse_stale(kA, v, t += ParamsAdmission::kFrozenWindowNs + 1));
+    EXPECT_EQ(a.frozen(t, out), 0u) << v;
+  }
+}
+
+TEST(ParamsAdmission, AnAcceptedSetClearsTheFreeze) {
+  ParamsAdmission a;
+  ParamsAdmission::FrozenList out;
+  a.accept(kA, 40);
+  a.refuse_stale(kA, 3, 0);
+  a.refuse_stale(kA, 4, kSecond_ns);
+  ASSERT_EQ(a.frozen(kSecond_ns, out), 1u);
+  a.accept(kA, 41);  // its sets are taken again
+  EXPECT_EQ(a.frozen(kSecond_ns, out), 0u);
+  a.refuse_stale(kA, 5, 2 * kSecond_ns);  // a new run starts from none
+  EXPECT_EQ(a.frozen(2 * kSecond_ns, out), 0u);
+}
+
+// hystloop-ctl params and hystloop-identify --publish send every set several times: the repeats
+// of the accepted version are stale, but no sign of a freeze.
+TEST(ParamsAdmission, RepeatsOfTheAcceptedVersionDoNotFreeze) {
+  ParamsAdmission a;
+  ParamsAdmission::FrozenList out;
+  a.accept(kA, 7);
+  for (std::int64_t i = 0; i < 10; ++i) EXPECT_FALSE(a.refuse_stale(kA, 7, i * 5'000'000));  // every 5 ms
+  EXPECT_EQ(a.frozen(kSecond_ns, out), 0u);
+}
+
+TEST(ParamsAdmission, OnlyThePublisherFrozenOutIsNamed) {
+  ParamsAdmission a;
+  ParamsAdmission::FrozenList out;
+  a.accept(kA, kMax);
+  a.accept(kB, 9);
+  for (std::int64_t i = 0; i < 3; ++i) {
+    a.refuse_stale(kA, 2 + static_cast<std::int32_t>(i), i * kSecond_ns);
+    a.refuse_stale(kB, 9, i * kSecond_ns);  // repeats
+  }
+  ASSERT_EQ(a.frozen(3 * kSecond_ns, out), 1u);
+  EXPECT_EQ(out[0].publisher, kA);
+}
+
 TEST(ParamsAdmission, PublisherIdsAreNonZeroAndDiffer) {
   std::set<std::int64_t> ids;
   for (int i = 0; i < 100; ++i) {

@@ -7,7 +7,10 @@
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
+
+#include "lcm/message_checks.hpp"
 
 namespace hystloop {
 namespace {
@@ -54,6 +57,36 @@ TEST(LoggerSummary, TheJsonSaysTheDiskFaultAndTheUnknownChannels) {
   const auto lines = summary_lines(s, channels);
   ASSERT_GE(lines.size(), 3u);
   EXPECT_EQ(lines[1].rfind("  DISK FAULT: 2 failed call(s), last disk full", 0), 0u) << lines[1];
+}
+
+// Forged but admissible ticks: two channels with more than 2^63 ticks missing each. Their total
+// wrapped to a small number (2^64 - 2 with INT64_MIN/INT64_MAX ticks); it stops at UINT64_MAX.
+TEST(LoggerSummary, TheTotalOfMissingTicksSaturatesInsteadOfWrapping) {
+  ChannelTable channels(ChannelNames("HX_"));
+  constexpr std::uint64_t kTop = std::numeric_limits<std::uint64_t>::max();
+  for (std::size_t i : {std::size_t{0}, std::size_t{1}}) {  // HX_SENSOR, HX_COMMAND
+    SequenceGapDetector& q = channels[i].sequence;
+    // 1100 gaps of 2^53 - 1 ticks: above 2^63, below 2^64 (the channel's own count is exact).
+    for (int k = 0; k < 1100; ++k) {
+      q.observe(0, 1);
+      q.observe(kMaxTick, 1);
+    }
+    ASSERT_GT(q.missing(), kTop / 2);
+    ASSERT_LT(q.missing(), kTop);
+    q.observe(-1, 1);  // forbidden by the contract: counted, not summed
+  }
+  const std::string json = summary_json(RecordingSummary{}, channels);
+  EXPECT_NE(json.find("\"missing\": " + std::to_string(kTop) + ", \"skipped\": 0, \"contract_violations\": 2}"),
+            std::string::npos)
+      << json.substr(0, 600);
+  EXPECT_NE(json.find("\"contract_violations\": {\"negative_seq\": 1, \"seq_above_max\": 0, \"tick_count\": 0}"),
+            std::string::npos)
+      << json;
+  const auto lines = summary_lines(RecordingSummary{}, channels);
+  ASSERT_GE(lines.size(), 2u);
+  EXPECT_NE(lines[1].find("contract violations 1 (not checked for gaps: negative_seq 1 seq_above_max 0 tick_count 0)"),
+            std::string::npos)
+      << lines[1];
 }
 
 }  // namespace

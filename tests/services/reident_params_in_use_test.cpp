@@ -54,7 +54,7 @@ TEST(ParamsInUse, OurOwnEchoIsIgnoredButASecondReidentifierOnTheHostIsNot) {
   ParamsInUse p(kConfig, "reident@a", kOwn);
   const std::int32_t v = p.adopt_own(kOther);
   EXPECT_EQ(p.offer(kOther, v, kOwn, true, "reident@a"), ParamsOffer::echo);
-  EXPECT_EQ(p.offer(kOther, 1, kOwn, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, v, kOwn, true, "reident@a"), ParamsOffer::echo);  // a UDP repeat
   // Same source, another publisher id: another re-identifier on this host (or our previous run).
   EXPECT_EQ(p.offer(kConfig, 1, kOwn + 1, true, "reident@a"), ParamsOffer::adopted);
   EXPECT_EQ(p.version(), 1);
@@ -142,6 +142,62 @@ TEST(ParamsInUse, ARestartedPublisherIsAdoptedWhateverItsVersion) {
   EXPECT_EQ(p.version(), 2);
   EXPECT_NE(p.generation(), g);  // a refit judged against version 40's set is superseded
   EXPECT_EQ(p.offer(kOther, 39, kIdentify, true, "reident@b"), ParamsOffer::stale);  // the old run's older one
+}
+
+// A forged set with our publisher id (the compensator then refuses our own sets as stale): not
+// ours, so never the set in use, whatever its version; counted.
+TEST(ParamsInUse, ASetWithOurIdThatWeNeverPublishedIsNotAdopted) {
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  const std::int32_t huge = std::numeric_limits<std::int32_t>::max();
+  EXPECT_EQ(p.offer(kOther, huge, kOwn, true, "reident@a"), ParamsOffer::forged);
+  EXPECT_EQ(p.version(), 1);
+  EXPECT_EQ(p.source(), "config");
+  EXPECT_DOUBLE_EQ(p.params().c1, kConfig.c1);
+  EXPECT_EQ(p.forged_sets(), 1u);
+  EXPECT_EQ(p.last_forged_version(), huge);
+  // Ours still come back as echoes; a version below our highest that we never sent is not one.
+  const std::int32_t v = p.adopt_own(kOther);
+  EXPECT_EQ(v, 2);  // a huge version is not followed
+  const std::int32_t w = p.adopt_own(kConfig);
+  EXPECT_EQ(p.offer(kConfig, w, kOwn, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, v, kOwn, true, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, 1, kOwn, true, "reident@a"), ParamsOffer::forged);  // 1 is the config's: never sent
+  EXPECT_EQ(p.offer(kOther, w + 1, kOwn, true, "reident@a"), ParamsOffer::forged);
+  EXPECT_EQ(p.version(), w);
+  EXPECT_DOUBLE_EQ(p.params().c1, kConfig.c1);
+  EXPECT_EQ(p.forged_sets(), 3u);
+  EXPECT_EQ(p.last_forged_version(), w + 1);
+  // Its version is seen: our next set numbers above it, so the compensator takes ours again.
+  EXPECT_EQ(p.adopt_own(kOther), w + 2);
+}
+
+TEST(ParamsInUse, TheCompensatorApplyingAForgedSetIsSeen) {
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  const std::int32_t huge = std::numeric_limits<std::int32_t>::max();
+  EXPECT_FALSE(p.forged_applied());
+  EXPECT_EQ(p.offer(kOther, huge, kOwn, true, "forged"), ParamsOffer::forged);
+  command_ticks(p, 0, 99, 1);
+  p.on_sample(50);
+  EXPECT_FALSE(p.forged_applied());  // not yet swapped in
+  command_ticks(p, 100, 199, huge);
+  p.on_sample(150);
+  EXPECT_TRUE(p.forged_applied());
+  command_ticks(p, 200, 299, 7);  // someone else's set replaced it
+  p.on_sample(250);
+  EXPECT_FALSE(p.forged_applied());
+}
+
+// Echoes come back within milliseconds; the last kSentKept versions we published are kept.
+TEST(ParamsInUse, OnlyTheLastVersionsWePublishedAreKnownAsOurs) {
+  ParamsInUse p(kConfig, "reident@a", kOwn);
+  const std::int32_t first = p.claim_version();
+  std::int32_t last = first;
+  for (std::size_t i = 1; i < ParamsInUse::kSentKept; ++i) last = p.claim_version();
+  EXPECT_EQ(p.offer(kOther, first, kOwn, false, "reident@a"), ParamsOffer::echo);
+  EXPECT_EQ(p.offer(kOther, last, kOwn, false, "reident@a"), ParamsOffer::echo);
+  p.claim_version();
+  EXPECT_EQ(p.offer(kOther, first, kOwn, false, "reident@a"), ParamsOffer::forged);
+  EXPECT_EQ(p.offer(kOther, last, kOwn, false, "reident@a"), ParamsOffer::echo);
 }
 
 }  // namespace

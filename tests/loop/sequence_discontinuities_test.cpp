@@ -1,0 +1,96 @@
+// SequenceDiscontinuities: a confirmed jump or restart is reported from the tick the old stream
+// expected next to the first tick of the new numbering (not the last tick used before and the
+// confirming block's), and a jump and a restart in one report period keep their own ticks.
+#include "loop/sequence_discontinuities.hpp"
+
+#include <gtest/gtest.h>
+
+#include "support/allocation_counter.hpp"
+
+namespace hystloop {
+namespace {
+
+using V = SequenceGuard::Verdict;
+constexpr std::int64_t kStep = 500;        // ticks (the compensator's horizon)
+constexpr std::int64_t kWindow = 100'000;  // us
+constexpr std::int64_t kBlock = 20;        // ticks per block, one block every 2 ms
+constexpr std::int64_t kPeriod = 2'000;    // us
+
+struct Stream {
+  SequenceGuard guard{kStep, kWindow};
+  SequenceDiscontinuities d;
+  std::int64_t t_us = 0;
+  V send(std::int64_t seq) { return d.check(guard, seq, kBlock, t_us += kPeriod); }
+  void run(std::int64_t from, std::int64_t to) {
+    for (std::int64_t s = from; s < to; s += kBlock) ASSERT_EQ(send(s), V::take) << s;
+  }
+};
+
+TEST(SequenceDiscontinuities, NothingBeforeADiscontinuityIsConfirmed) {
+  Stream s;
+  s.run(0, 1000);
+  EXPECT_EQ(s.d.last_jump().expected_tick, -1);
+  EXPECT_EQ(s.d.last_restart().resumed_tick, -1);
+}
+
+TEST(SequenceDiscontinuities, AJumpIsFromTheExpectedTickToTheNewNumberingsFirst) {
+  Stream s;
+  s.run(0, 1000);
+  EXPECT_EQ(s.send(5000), V::hold);
+  EXPECT_EQ(s.send(5020), V::hold);
+  EXPECT_EQ(s.send(5040), V::jump);
+  EXPECT_EQ(s.d.last_jump().expected_tick, 1000);  // not 999, the last tick used
+  EXPECT_EQ(s.d.last_jump().resumed_tick, 5000);   // not 5040, the confirming block's
+  EXPECT_EQ(s.d.last_restart().expected_tick, -1);
+}
+
+TEST(SequenceDiscontinuities, ARestartIsFromTheExpectedTickToTheNewClocksFirst) {
+  Stream s;
+  s.run(50000, 51000);
+  s.t_us += 3'000'000;  // the bridge restarts: quiet, then its clock from 0
+  EXPECT_EQ(s.send(0), V::hold);
+  EXPECT_EQ(s.send(20), V::hold);
+  EXPECT_EQ(s.send(60), V::restart);  // one lost between: still consistent
+  EXPECT_EQ(s.d.last_restart().expected_tick, 51000);
+  EXPECT_EQ(s.d.last_restart().resumed_tick, 0);
+}
+
+// The candidate that is confirmed is the one that counts, not a forged block before it.
+TEST(SequenceDiscontinuities, AnIgnoredCandidateDoesNotLendItsFirstTick) {
+  Stream s;
+  s.run(0, 1000);
+  EXPECT_EQ(s.send(900'000), V::hold);  // forged, far ahead
+  EXPECT_EQ(s.send(8000), V::hold);     // far from both: a new candidate, the forged one ignored
+  EXPECT_EQ(s.send(8020), V::hold);
+  EXPECT_EQ(s.send(8040), V::jump);
+  EXPECT_EQ(s.guard.counters().ignored, 1u);
+  EXPECT_EQ(s.d.last_jump().expected_tick, 1000);
+  EXPECT_EQ(s.d.last_jump().resumed_tick, 8000);
+}
+
+// Both in one report period (three forged blocks far ahead, then the real stream back): each
+// line keeps its own ticks (they once both printed the restart's).
+TEST(SequenceDiscontinuities, AJumpAndARestartKeepTheirOwnTicks) {
+  Stream s;
+  s.run(0, 1000);
+  for (const std::int64_t seq : {5000, 5020, 5040}) s.send(seq);
+  EXPECT_EQ(s.send(1000), V::hold);
+  EXPECT_EQ(s.send(1020), V::hold);
+  EXPECT_EQ(s.send(1040), V::restart);
+  EXPECT_EQ(s.d.last_jump().expected_tick, 1000);
+  EXPECT_EQ(s.d.last_jump().resumed_tick, 5000);
+  EXPECT_EQ(s.d.last_restart().expected_tick, 5060);
+  EXPECT_EQ(s.d.last_restart().resumed_tick, 1000);
+}
+
+TEST(SequenceDiscontinuities, CheckingDoesNotAllocate) {
+  Stream s;
+  const hystloop::testing::AllocationCounter allocations;
+  s.run(0, 1000);
+  for (const std::int64_t seq : {5000, 5020, 5040}) s.send(seq);
+  EXPECT_EQ(allocations.allocations(), 0u);
+  EXPECT_EQ(s.d.last_jump().resumed_tick, 5000);
+}
+
+}  // namespace
+}  // namespace hystloop
