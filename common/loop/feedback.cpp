@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 namespace hystloop {
 namespace {
@@ -42,13 +43,40 @@ void FeedbackGains::validate() const {
   }
 }
 
+double FeedbackGains::max_kd_s() const noexcept {
+  return kMaxServoKdStepGain * (1.0 / tick_rate_hz + 1.0 / (2.0 * std::numbers::pi * d_filter_hz));
+}
+
+void FeedbackGains::check_bounds(std::string_view prefix) const {
+  validate();
+  const auto refuse = [&](const char* name, double value, double bound, const char* unit, const char* why) {
+    char buf[384];
+    std::snprintf(buf, sizeof buf, "must be <= %.6g%s (got %.6g): %s", bound, unit, value, why);
+    throw ParameterError(std::string(prefix) + name, buf);
+  };
+  if (!(kp <= max_kp())) {
+    refuse("kp", kp, max_kp(), "",
+           "above it a proportional servo over-corrects the error by more than itself each tick on a stage that "
+           "follows within a tick (Banning's stage is stable up to 0.4 without the notch)");
+  }
+  if (!(ki <= max_ki_per_s())) {
+    refuse("ki", ki, max_ki_per_s(), " 1/s",
+           "ki dt <= 1 at the tick rate: above it the integral takes in more than a tick's error per tick");
+  }
+  if (!(kd <= max_kd_s())) {
+    refuse("kd", kd, max_kd_s(), " s",
+           "kd / (dt + 1 / (2 pi d_filter_hz)) <= 2: above it the filtered derivative alone over-corrects an error "
+           "step on its first tick more than kp may");
+  }
+}
+
 FeedbackController::FeedbackController(const FeedbackGains& gains) : gains_(gains) {
   gains_.validate();
   notch_ = make_notch(gains_);
 }
 
 void FeedbackController::set_gains(const FeedbackGains& gains) {
-  gains.validate();
+  gains.check_bounds();
   // Keep ki * integral constant so the integral part of the output does not jump.
   if (gains.ki > 0.0 && gains_.ki > 0.0) {
     integral_ *= gains_.ki / gains.ki;

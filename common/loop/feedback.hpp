@@ -13,10 +13,32 @@
 // running ahead of it, so neither clamp winds it up, and a command the clamp cuts never has a
 // grown integral behind it.
 
+#include <string_view>
+
 #include "core/errors.hpp"
 #include "loop/notch_filter.hpp"
 
 namespace hystloop {
+
+// Plausibility bounds on the gains (FeedbackGains::check_bounds), so that a gain the loop cannot
+// use never reaches the actuator. The servo acts on the previous tick's error through the stage,
+// whose gain is r x nominal_gain_m_per_V (r ~ 1; 0.57-1.36 over Banning's hysteresis loop):
+//  - kp <= 2. On a stage that follows the voltage within a tick (no dynamics: the tick's delay
+//    alone) a proportional servo multiplies the error by (1 - r kp) each tick, so above 2 / r it
+//    diverges; only a stage's own lag lets more through, which a servo must not count on.
+//    Banning's stage allows kp 0.40 without the notch (0.20 on a card that reads right after
+//    writing) and 2.8 (1.2) with it: the bound is 5x the former, the default 0.1 is 20x inside.
+//  - ki dt <= 1, dt = 1 / tick_rate_hz. The integral grows by ki dt of the error per tick; at 1 it
+//    takes in a whole tick's error in one tick (deadbeat on a stage without dynamics), above it
+//    over-corrects every tick. At 10 kHz: 10000 1/s, against the largest stable ki 9558 1/s (6172
+//    on a card) with the default notch and kp; the default 2000 1/s is ki dt = 0.2.
+//  - kd / (dt + 1 / (2 pi d_filter_hz)) <= 2: what the filtered derivative adds on the first tick
+//    of an error step, which plays kp's part there, so kp's bound. 5.2e-4 s at the defaults (10 kHz,
+//    a 1 kHz filter); Banning's stage allows 7.1e-4 s (derivative alone) with the notch, 1.5e-4 s
+//    without.
+inline constexpr double kMaxServoKp = 2.0;
+inline constexpr double kMaxServoKiPerTick = 1.0;   // ki dt
+inline constexpr double kMaxServoKdStepGain = 2.0;  // kd / (dt + 1 / (2 pi d_filter_hz))
 
 struct FeedbackGains {
   double kp = 0.0;                       // [-]
@@ -34,6 +56,14 @@ struct FeedbackGains {
   // Throws ParameterError naming the field ("servo.notch_hz"): the notch needs
   // 0 < notch_hz < 0.45 tick_rate_hz and notch_q in [0.1, 50].
   void validate() const;
+  // validate(), then the plausibility bounds above: ParameterError naming the field (prefix +
+  // "kp", "ki", "kd"), the value, the bound and why. Where gains enter (the bridge's config and
+  // HX_CONTROL SET_GAINS, hystloop-ctl) and at FeedbackController::set_gains; not in validate(),
+  // because the offline analysis (servo_loop_response.hpp) explores gains past them on purpose.
+  void check_bounds(std::string_view prefix = "servo.") const;
+  double max_kp() const noexcept { return kMaxServoKp; }
+  double max_ki_per_s() const noexcept { return kMaxServoKiPerTick * tick_rate_hz; }
+  double max_kd_s() const noexcept;
   bool enabled() const noexcept { return kp != 0.0 || ki != 0.0 || kd != 0.0; }
   bool has_notch() const noexcept { return notch_hz > 0.0; }
 };
@@ -61,8 +91,9 @@ class FeedbackController {
     return update(error_m, u_ff_V, dt_s, gains_.u_min_V, gains_.u_max_V);
   }
 
-  // New gains; the integral is rescaled so that its part of the output does not jump, and a
-  // changed notch starts settled at the last output (bumpless).
+  // New gains (check_bounds: a run-time change is refused outside the plausibility bounds, the
+  // gains in force stay); the integral is rescaled so that its part of the output does not jump,
+  // and a changed notch starts settled at the last output (bumpless).
   void set_gains(const FeedbackGains& gains);
   const FeedbackGains& gains() const noexcept { return gains_; }
   void reset() noexcept;

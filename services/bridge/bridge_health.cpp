@@ -31,6 +31,23 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
   if (in.samples_dropped > 0) {
     degraded(fmt::format("{} samples dropped: the I/O thread fell behind", in.samples_dropped));
   }
+  if (in.samples_repaired > 0) {
+    degraded(
+        fmt::format("{} samples held values no message may carry (a servo or a sensor gone wild): recorded "
+                    "with them replaced and flagged (sensor_ticks_repaired)",
+                    in.samples_repaired));
+  }
+  if (in.samples_unpublished > 0) {
+    degraded(fmt::format("{} samples could not be published: missing from the record (sensor_ticks_unpublished)",
+                         in.samples_unpublished));
+  }
+  if (in.commands_too_far_ahead > 0) {
+    degraded(
+        fmt::format("{} commands refused for ticks more than {} s ahead of the bridge's clock "
+                    "(bridge.max_lead_s; rejected_future): a compensator.horizon_s beyond it, or a sensor "
+                    "stream the bridge did not send",
+                    in.commands_too_far_ahead, in.max_lead_s));
+  }
   // A clamped command is not what the compensator and the servo asked for: the rig tracks worse
   // than its figures say, whatever else is well.
   const ClampCounts& c = in.clamped_last_second;

@@ -12,10 +12,12 @@
 #include <spdlog/spdlog.h>
 
 #include "bridge/bridge_health.hpp"
+#include "bridge/servo_request.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
+#include "lcm/message_checks.hpp"
 #include "runtime/counter_baseline.hpp"
 
 namespace hystloop {
@@ -75,18 +77,13 @@ void BridgeService::on_control(const control_t& msg) {
       spdlog::info("DISARM (request {})", msg.request_id);
       return;
     case control_t::SET_GAINS: {
-      FeedbackGains g = gains_;
-      g.kp = msg.kp;
-      g.ki = msg.ki;
-      g.kd = msg.kd;
-      // A sender that knows no notch sends 0 and 0: no notch, which validates as such.
-      g.notch_hz = msg.notch_hz;
-      g.notch_q = msg.notch_q;
+      FeedbackGains g;
       try {
-        g.validate();
+        g = requested_gains(gains_, msg);
       } catch (const std::exception& e) {
         ++control_refused_;
-        spdlog::warn("SET_GAINS (request {}) refused: {}", msg.request_id, e.what());
+        spdlog::warn("SET_GAINS (request {}) refused, the gains in force (kp {}, ki {} 1/s, kd {} s) stay: {}",
+                     msg.request_id, gains_.kp, gains_.ki, gains_.kd, e.what());
         return;
       }
       if (!rt_.push_gains(g)) {
@@ -130,7 +127,33 @@ void BridgeService::on_control(const control_t& msg) {
 
 void BridgeService::publish_block() noexcept {
   if (block_.n_ticks == 0) return;
-  if (sensor_pub_.publish(block_)) ++sensor_blocks_;
+  // Never a silent hole in the record: values the contract refuses (a servo gone wild, a sensor
+  // reading NaN) are replaced and flagged, and what still cannot be sent is counted and logged.
+  if (const SensorRepair r = repair_.repair(block_); r.any()) {
+    ++sensor_blocks_repaired_;
+    sensor_ticks_repaired_ += static_cast<std::uint64_t>(r.ticks);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorRepaired, monotonic_now_ns())) {
+      spdlog::warn(
+          "sensor block from seq {}: {} of {} ticks held values the message contract refuses ({} voltages clamped "
+          "to +-{} V and flagged SATURATED, {} positions replaced by the last good one and flagged SENSOR_FAULT, {} "
+          "references and {} flag words cleared{}); published repaired ({} ticks in {} blocks so far){}",
+          block_.seq, r.ticks, block_.n_ticks, r.voltages, kMaxAbsVoltage_V, r.positions, r.references, r.flag_words,
+          r.buffer_depth ? ", a negative buffer depth set to 0" : "", sensor_ticks_repaired_, sensor_blocks_repaired_,
+          suppressed_note(g));
+    }
+  }
+  if (sensor_pub_.publish(block_)) {
+    ++sensor_blocks_;
+  } else {
+    ++sensor_blocks_unpublished_;
+    sensor_ticks_unpublished_ += static_cast<std::uint64_t>(block_.n_ticks);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorUnpublished, monotonic_now_ns())) {
+      spdlog::error(
+          "sensor block from seq {} ({} ticks) could not be published: {} ticks missing from the record "
+          "so far (sensor_ticks_unpublished){}",
+          block_.seq, block_.n_ticks, sensor_ticks_unpublished_, suppressed_note(g));
+    }
+  }
   sent_.record(last_seq(block_), monotonic_now_ns());
   begin_block(block_, 0, 0, settings_.dt_s());
 }
@@ -262,6 +285,10 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
       {"command_queue_full", command_queue_full_},
       {"command_blocks", command_blocks_},
       {"sensor_blocks", sensor_blocks_},
+      {"sensor_blocks_repaired", sensor_blocks_repaired_},
+      {"sensor_ticks_repaired", sensor_ticks_repaired_},
+      {"sensor_blocks_unpublished", sensor_blocks_unpublished_},
+      {"sensor_ticks_unpublished", sensor_ticks_unpublished_},
       {"control_acted", control_acted_},
       {"control_refused", control_refused_},
   };
@@ -275,6 +302,13 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   const std::uint64_t armed_ticks = late + (k.applied - previous_core_.applied);
   const double late_fraction = armed_ticks > 0 ? static_cast<double>(late) / static_cast<double>(armed_ticks) : 0.0;
   const std::uint64_t dropped = rt.samples_dropped - previous_dropped_;
+  const std::uint64_t too_far_ahead = k.rejected_future - previous_core_.rejected_future;
+  if (too_far_ahead > 0) {  // once a report period, whatever the state (a disarmed bridge is SAFE)
+    spdlog::warn(
+        "{} commands refused for ticks more than {} s ahead of the clock (bridge.max_lead_s): a "
+        "compensator.horizon_s beyond it, or a sensor stream this bridge did not send",
+        too_far_ahead, settings_.max_lead_s);
+  }
   previous_core_ = k;
   previous_dropped_ = rt.samples_dropped;
   if (k.watchdog_trips != trips_reported_) {
@@ -294,6 +328,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   health.late_fraction = late_fraction;
   health.degraded_late_fraction = settings_.degraded_late_fraction;
   health.samples_dropped = dropped;
+  health.commands_too_far_ahead = too_far_ahead;
+  health.max_lead_s = settings_.max_lead_s;
+  health.samples_repaired = sensor_ticks_repaired_ - previous_repaired_;
+  health.samples_unpublished = sensor_ticks_unpublished_ - previous_unpublished_;
+  previous_repaired_ = sensor_ticks_repaired_;
+  previous_unpublished_ = sensor_ticks_unpublished_;
   health.clamped_last_second = rt.clamped_last_second;
   const BridgeHealth assessed = assess_bridge_health(health);
   const std::int8_t state = assessed.state;
@@ -352,9 +392,11 @@ void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) 
         latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,
         static_cast<double>(latency_total_.max_ns()) / 1e3, latency_total_.count());
   }
-  spdlog::info("summary: {} sensor blocks published, {} command blocks received ({} rejected), {} dropped samples",
-               sensor_pub_.counters().published, commands_.counters().received, commands_.counters().rejected_total(),
-               rt.samples_dropped);
+  spdlog::info(
+      "summary: {} sensor blocks published ({} ticks repaired to the message contract, {} ticks not published), {} "
+      "command blocks received ({} rejected), {} dropped samples",
+      sensor_pub_.counters().published, sensor_ticks_repaired_, sensor_ticks_unpublished_,
+      commands_.counters().received, commands_.counters().rejected_total(), rt.samples_dropped);
   spdlog::info(
       "summary: stop: {} from {:.6g} V to the safe {} V in {} ticks ({:.4g} s loop time, {:.4g} s wall; "
       "bound {} s)",

@@ -14,6 +14,7 @@
 #include "bridge/bridge_realtime.hpp"
 #include "bridge/bridge_settings.hpp"
 #include "bridge/send_time_ring.hpp"
+#include "bridge/sensor_block_repair.hpp"
 #include "core/latency_stats.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
@@ -23,6 +24,7 @@
 #include "lcm/subscription.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
+#include "runtime/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -70,6 +72,14 @@ class BridgeService {
   std::uint64_t control_refused_ = 0;
   std::uint64_t command_blocks_ = 0;
   std::uint64_t sensor_blocks_ = 0;
+  // Sensor blocks whose values the contract refuses are published repaired (sensor_block_repair.hpp):
+  std::uint64_t sensor_blocks_repaired_ = 0;
+  std::uint64_t sensor_ticks_repaired_ = 0;
+  std::uint64_t sensor_blocks_unpublished_ = 0;  // ... and any the Publisher still refused (a hole: logged)
+  std::uint64_t sensor_ticks_unpublished_ = 0;
+  SensorBlockRepair repair_;
+  LogLimiter log_limiter_;  // one line a second per reason (LogReason)
+  enum LogReason : std::size_t { kLogSensorRepaired, kLogSensorUnpublished };
   FeedbackGains gains_;  // the servo's, as last set
   std::string summary_json_path_;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
@@ -85,6 +95,8 @@ class BridgeService {
   std::uint64_t trips_reported_ = 0;
   BridgeCounters previous_core_{};
   std::uint64_t previous_dropped_ = 0;
+  std::uint64_t previous_repaired_ = 0;     // sensor_ticks_repaired_ at the last report
+  std::uint64_t previous_unpublished_ = 0;  // sensor_ticks_unpublished_ at the last report
   bool reset_pending_ = false;
   CounterSet counters_;
 };

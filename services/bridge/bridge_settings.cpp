@@ -7,6 +7,7 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include "loop/command_buffer.hpp"
 #include "runtime/config_validation.hpp"
 #include "runtime/rig_auth_config.hpp"
 
@@ -25,6 +26,7 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "bridge.run_seconds",
                                                 "bridge.command_queue_capacity",
                                                 "bridge.block_ticks",
+                                                "bridge.max_lead_s",
                                                 "servo.kp",
                                                 "servo.ki",
                                                 "servo.kd",
@@ -79,6 +81,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
   s.command_queue_capacity =
       static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 16, 100000));
   s.block_ticks = static_cast<int>(config.get_int_in_range("bridge.block_ticks", s.block_ticks, 1, 1000));
+  s.max_lead_s = config.get_in_range("bridge.max_lead_s", s.max_lead_s, 2.0 / s.rate_hz,
+                                     static_cast<double>(CommandBuffer::kCapacityTicks) / s.rate_hz);
 
   SimulatedStageConfig& st = s.stage;
   st.noise_rms_m = config.get_in_range("bridge.noise_rms_m", st.noise_rms_m, 0.0, 1e-6);
@@ -133,7 +137,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
   g.u_min_V = a.u_min_V;
   g.u_max_V = a.u_max_V;
   g.tick_rate_hz = s.rate_hz;
-  validate_config_section(config, "", [&] { g.validate(); });  // its fields are named servo.*
+  // Its fields are named servo.*; the gains within the plausibility bounds (loop/feedback.hpp).
+  validate_config_section(config, "", [&] { g.check_bounds(); });
 
   s.rt.ticks_per_wake = static_cast<int>(config.get_int_in_range("rt.ticks_per_wake", s.rt.ticks_per_wake, 1, 1000));
   if (s.rt.ticks_per_wake > s.block_ticks) {
@@ -184,8 +189,10 @@ std::vector<std::string> describe(const BridgeSettings& s) {
                                   ? fmt::format("notch at {} Hz (Q {})", s.servo.notch_hz, s.servo.notch_q)
                                   : std::string("no notch"),
                               s.servo.enabled() ? "" : " (off: feedforward only)"));
-  lines.push_back(fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s)", s.block_ticks,
-                              s.rate_hz / s.block_ticks));
+  lines.push_back(
+      fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s); commands taken up to {} s "
+                  "ahead of the clock (bridge.max_lead_s)",
+                  s.block_ticks, s.rate_hz / s.block_ticks, s.max_lead_s));
   lines.push_back(fmt::format("rt: {} tick(s) per wake-up, priority {}, I/O priority {}, lock_memory {}, cpu {}",
                               s.rt.ticks_per_wake, s.rt.priority, s.rt.io_priority, s.rt.lock_memory, s.rt.cpu));
   return lines;

@@ -3,14 +3,21 @@
 // switches to it at the next reversal, re-anchored). Both go through one admission path: a
 // diagnostic set (valid = false) is counted and dropped, versions are ordered per publisher over
 // both channels (ParamsAdmission), and the set is validated again here (ModelParamSet::validate
-// via the control law) before it is offered. HX_MODEL's own refusals: a kind or format version
+// via the control law) before it is offered, and against the rig: a set whose small-signal gain
+// over the actuator's range leaves [linear.gain / F, linear.gain * F], or with a subnormal parameter,
+// is refused as params_rejected with the reason (models/gain_plausibility.hpp, F =
+// compensator.plausible_gain_factor): a units error or a corrupted set never reaches the
+// actuator, whatever its model's own domain allows. HX_MODEL's own refusals: a kind or format version
 // this build does not know (model_unknown_kind, model_unknown_format; the Subscription lets them
-// through its envelope check so that they are counted by their reason here).
+// through its envelope check so that they are counted by their reason here). A publisher whose
+// sets keep being refused as stale below the version accepted from it is frozen out
+// (ParamsAdmission::frozen): HX_STATUS says DEGRADED, naming it (report()).
 #include <spdlog/spdlog.h>
 
 #include "compensator/compensator_service.hpp"
 #include "core/errors.hpp"
 #include "core/periodic_timer.hpp"
+#include "models/gain_plausibility.hpp"
 #include "runtime/model_params_message.hpp"
 
 namespace hystloop {
@@ -35,6 +42,12 @@ bool CompensatorService::admit(const ParamsHeader& h) {
   }
   if (!admission_.is_new(h.publisher_id, h.version)) {
     ++counters_.params_stale;
+    // Below the version accepted from it (not a repeat of that one): counts toward frozen out.
+    if (admission_.refuse_stale(h.publisher_id, h.version, monotonic_now_ns())) {
+      ++counters_.params_stale_below;
+    } else {
+      ++counters_.params_stale_repeat;
+    }
     if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale)) {
       spdlog::info(
           "{} parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
@@ -49,6 +62,7 @@ bool CompensatorService::admit(const ParamsHeader& h) {
 void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, bool switch_model) {
   const auto from = static_cast<std::uint64_t>(h.publisher_id);
   try {
+    require_plausible(set, gain_plausibility(settings_));
     if (switch_model) {
       compensator_->offer_model(set, h.version);
     } else {

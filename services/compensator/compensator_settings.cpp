@@ -52,7 +52,44 @@ ShapingFunction read_shaping(const Config& config, const std::string& prefix, co
   return s;
 }
 
+// compensator.plausible_gain_factor, and the models the file sets (and the one the mode starts
+// with) checked against the band every later set is: they reach the actuator as well.
+void read_plausibility(const Config& config, CompensatorSettings& s) {
+  s.plausible_gain_factor = config.get_in_range("compensator.plausible_gain_factor", s.plausible_gain_factor,
+                                                GainPlausibility::kMinFactor, GainPlausibility::kMaxFactor);
+  const CompensatorConfig& c = s.control;
+  if (!(c.linear.gain > 0.0)) {
+    config.fail("linear.gain",
+                "must be > 0: it is the stage's nominal gain, the one every parameter set is checked "
+                "against (compensator.plausible_gain_factor)");
+  }
+  const GainPlausibility rig = gain_plausibility(s);  // its parts were checked by their own keys
+  const std::vector<std::string> keys = config.keys();
+  for (int i = 0; i < kModelKindCount; ++i) {
+    ModelParamSet set;
+    set.kind = static_cast<ModelKind>(i);
+    const std::string section = std::string(to_string(set.kind)) + ".";
+    const bool in_file =
+        std::any_of(keys.begin(), keys.end(), [&](const std::string& k) { return k.rfind(section, 0) == 0; });
+    if (!in_file && model_kind_of(c.mode) != set.kind) continue;
+    set.mem = c.mem;
+    set.pi = c.pi;
+    set.katalenic = c.katalenic;
+    set.linear = c.linear;
+    validate_config_section(config, "", [&] { require_plausible(set, rig); });
+  }
+}
+
 }  // namespace
+
+GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept {
+  GainPlausibility rig;
+  rig.nominal_gain_m_per_V = settings.control.linear.gain;
+  rig.factor = settings.plausible_gain_factor;
+  rig.u_min_V = settings.control.u_min_V;
+  rig.u_max_V = settings.control.u_max_V;
+  return rig;
+}
 
 const std::vector<std::string>& compensator_config_keys() {
   static const std::vector<std::string> keys = {"compensator.mode",
@@ -61,6 +98,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                                 "compensator.run_seconds",
                                                 "compensator.sample_queue_capacity",
                                                 "compensator.plan_slew_fraction",
+                                                "compensator.plausible_gain_factor",
                                                 "actuator.u_min_V",
                                                 "actuator.u_max_V",
                                                 "actuator.slew_V_per_s",
@@ -225,6 +263,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
                           static_cast<double>(CompensatorConfig::kMaxHorizonTicks) * c.dt_s);
   c.horizon_ticks = static_cast<std::int64_t>(std::llround(horizon_s / c.dt_s));
   validate_config_section(config, "", [&] { c.validate(); });
+  read_plausibility(config, s);
 
   TrajectorySpec& t = s.trajectory;
   t.shape = parse_shape(config, config.get<std::string>("trajectory.shape", "hold"));

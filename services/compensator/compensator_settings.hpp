@@ -12,6 +12,7 @@
 #include "core/config.hpp"
 #include "loop/compensator.hpp"
 #include "loop/trajectory.hpp"
+#include "models/gain_plausibility.hpp"
 
 namespace hystloop {
 
@@ -22,7 +23,15 @@ struct CompensatorSettings {
   int sample_queue_capacity = 256;  // LCM's queue for HX_SENSOR [blocks]
   int rt_priority = 0;              // SCHED_FIFO priority 1..99 of the (only) thread; 0 = normal scheduling
   bool lock_memory = false;         // mlockall at start
+  // A parameter set (HX_PARAMS, HX_MODEL, or a model section of the file) whose gain leaves
+  // [linear.gain / F, linear.gain * F] over the actuator's range is refused (models/gain_plausibility.hpp).
+  double plausible_gain_factor = GainPlausibility{}.factor;  // compensator.plausible_gain_factor, F [-]
 };
+
+// The band parameter sets are checked against: the configured linear model's gain (the stage's
+// mean slope, as the bridge's servo.nominal_gain_m_per_V) within plausible_gain_factor, over the
+// actuator's range.
+GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept;
 
 const std::vector<std::string>& compensator_config_keys();
 

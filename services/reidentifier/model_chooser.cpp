@@ -14,8 +14,8 @@ namespace hystloop {
 
 const char* ModelChooser::counter_name(std::size_t i) noexcept {
   static constexpr const char* kNames[kCounters] = {
-      "model_selections", "model_changes",           "model_refits", "model_kept", "model_failed",
-      "model_poisoned",   "model_refits_left_to_mem"};
+      "model_selections",         "model_changes",    "model_refits", "model_kept", "model_failed", "model_poisoned",
+      "model_refits_left_to_mem", "model_implausible"};
   return i < kCounters ? kNames[i] : "model_unknown";
 }
 
@@ -80,6 +80,16 @@ ModelDecision ModelChooser::collect(ReidentCore& core) {
   const bool change = p.kind == ProposalKind::model_change || set.kind != in_use_.kind;
   if (!change && set.kind == ModelKind::mem) {
     ++counters_[left_to_mem];  // the MEM refit publishes MEM's parameters on HX_PARAMS
+    return d;
+  }
+  // What the compensator would refuse as not this stage's (a units error: y 1000x) is not sent.
+  try {
+    require_plausible(set, core.options().plausibility);
+  } catch (const ParameterError& e) {
+    ++counters_[implausible];
+    last_reason_ = std::string("not published: ") + e.what();
+    spdlog::warn("model selection: {} {} refused: {}", to_string(set.kind),
+                 p.kind == ProposalKind::model_change ? "change" : "refit", e.what());
     return d;
   }
   // A proposal made against a set that changed meanwhile (HX_PARAMS from elsewhere) is still

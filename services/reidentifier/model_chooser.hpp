@@ -9,6 +9,8 @@
 //                                    is not MEM, the MEM refits stop (HX_PARAMS stays quiet).
 //   refit of a model other than MEM -> publish on HX_MODEL (new parameters of the model in use).
 //   refit of MEM                  -> left to the MEM refit (HX_PARAMS, as without model choice).
+//   a set whose gain leaves the rig's band (ReidentOptions::plausibility) -> nothing published,
+//                                    counted (model_implausible), the reason in last_reason().
 //
 // Pinning (reidentifier.pin_model, hystloop-ctl pin-model): no automatic change. Pinned to the model in
 // use, only its parameters are refitted; pinned to another kind, the next selection fits that kind
@@ -52,7 +54,18 @@ struct ModelDecision {
 
 class ModelChooser {
  public:
-  enum Counter : std::size_t { selections, changes, refits, kept, failed, poisoned, left_to_mem, kCounters };
+  // implausible: a proposal whose gain left the core's options().plausibility, not published.
+  enum Counter : std::size_t {
+    selections,
+    changes,
+    refits,
+    kept,
+    failed,
+    poisoned,
+    left_to_mem,
+    implausible,
+    kCounters
+  };
   static const char* counter_name(std::size_t i) noexcept;  // "model_selections", ...
 
   // initial: the model the compensator starts with (MEM from the configuration). window: from

@@ -7,12 +7,15 @@
 
 namespace hystloop {
 
-RefitWorker::RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread, OnEvaluated on_evaluated)
+RefitWorker::RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread, OnEvaluated on_evaluated,
+                         std::optional<GainPlausibility> plausibility)
     : options_(options),
       window_(std::move(window)),
       on_evaluated_(std::move(on_evaluated)),
+      plausibility_(plausibility),
       slot_([this] { evaluate_job(); }, start_thread) {
   options_.validate();
+  if (plausibility_) plausibility_->validate();
 }
 
 bool RefitWorker::submit(const MemParams& in_use, std::uint64_t version) noexcept {
@@ -31,6 +34,19 @@ void RefitWorker::evaluate_job() {
     result_.outcome = MemRefitOutcome{};
     result_.outcome.judged_against_version = in_use_version_;
     result_.outcome.reason = std::string("evaluate threw: ") + e.what();
+  }
+  result_.implausible = false;
+  if (plausibility_ && result_.outcome.accepted) {
+    ModelParamSet candidate;
+    candidate.mem = result_.outcome.candidate;
+    try {
+      require_plausible(candidate, *plausibility_);
+    } catch (const std::exception& e) {
+      result_.outcome.accepted = false;
+      result_.outcome.status = FitStatus::out_of_range;
+      result_.outcome.reason = std::string("the fit is not this stage's: ") + e.what();
+      result_.implausible = true;
+    }
   }
   result_.duration_s = std::chrono::duration<double>(clock::now() - start).count();
   result_.window_first_seq = window_.first_seq;

@@ -7,14 +7,19 @@
 //   owner:   idle() -> estimator.snapshot(job_window()) -> submit(in_use, version)
 //            ... later: if (done()) { use result(); release(); }
 //
+// With a GainPlausibility, an accepted candidate whose gain leaves the rig's band is turned into a
+// refusal (out_of_range, `implausible`, the reason said) on the worker, before it is reported: a
+// fit of a plant 1000x too large (a units error) is never published.
 // No call on the owner side blocks, allocates or locks; evaluate allocates, on the worker.
 // Without a thread (start_thread = false) run_pending() evaluates on the calling thread, so a
 // test drives the same handoff step by step, deterministically.
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 #include "ident/online_mem_estimator.hpp"
+#include "models/gain_plausibility.hpp"
 #include "reidentifier/job_slot.hpp"
 
 namespace hystloop {
@@ -24,6 +29,7 @@ struct RefitResult {
   double duration_s = 0.0;  // wall time of evaluate() (instrumentation)
   std::uint64_t window_first_seq = 0;
   std::size_t window_samples = 0;  // samples in the evaluated window
+  bool implausible = false;        // the fit was accepted but its gain left the band: refused
 };
 
 class RefitWorker {
@@ -34,7 +40,7 @@ class RefitWorker {
 
   // `window` comes from OnlineMemEstimator::make_window() (its capacity is the job's).
   RefitWorker(const OnlineMemOptions& options, MemWindow window, bool start_thread = true,
-              OnEvaluated on_evaluated = {});
+              OnEvaluated on_evaluated = {}, std::optional<GainPlausibility> plausibility = std::nullopt);
   ~RefitWorker() = default;  // the slot waits for a running evaluate (time-bounded), then joins
   RefitWorker(const RefitWorker&) = delete;
   RefitWorker& operator=(const RefitWorker&) = delete;
@@ -68,6 +74,7 @@ class RefitWorker {
   std::uint64_t in_use_version_ = 0;
   RefitResult result_;
   OnEvaluated on_evaluated_;
+  std::optional<GainPlausibility> plausibility_;
   JobSlot slot_;  // last: its thread ends before the job's data above is destroyed
 };
 

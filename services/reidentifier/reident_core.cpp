@@ -11,7 +11,7 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
     : options_(options),
       estimator_(options.estimator, options.initial),
       in_use_(options.initial, std::move(own_source), new_publisher_id()),
-      worker_(options.estimator, estimator_.make_window(), start_thread, std::move(on_evaluated)),
+      worker_(options.estimator, estimator_.make_window(), start_thread, std::move(on_evaluated), options.plausibility),
       period_us_(std::llround(options.refit_period_s * 1e6)),
       stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
 
@@ -60,14 +60,43 @@ void ReidentCore::on_command_block(const command_block_t& block) noexcept {
 
 ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                                    std::string_view source) noexcept {
+  if (valid && publisher_id != in_use_.own_publisher_id() && implausible(params)) {
+    // A set the compensator would refuse as not this stage's must not become the set refits are
+    // judged against: offered as invalid, so that its version still counts as seen.
+    in_use_.offer(params, version, publisher_id, /*valid=*/false, source);
+    counters_.add(ReidentCounter::params_implausible);
+    return ParamsOffer::invalid;
+  }
   const ParamsOffer offer = in_use_.offer(params, version, publisher_id, valid, source);
   switch (offer) {
     case ParamsOffer::adopted: counters_.add(ReidentCounter::params_adopted); break;
     case ParamsOffer::echo: counters_.add(ReidentCounter::params_echo); break;
     case ParamsOffer::stale: counters_.add(ReidentCounter::params_stale); break;
     case ParamsOffer::invalid: counters_.add(ReidentCounter::params_invalid); break;
+    case ParamsOffer::forged: break;  // counted by ParamsInUse (forged_sets; params_forged on HX_STATUS)
   }
   return offer;
+}
+
+bool ReidentCore::implausible(const MemParams& params) noexcept {
+  try {
+    params.validate();
+  } catch (...) {
+    return false;  // outside MEM's domain: params_invalid, as ParamsInUse refuses it
+  }
+  try {
+    ModelParamSet set;
+    set.mem = params;
+    require_plausible(set, options_.plausibility);
+    return false;
+  } catch (const ParameterError& e) {
+    try {
+      implausible_reason_ = e.what();
+    } catch (...) {  // out of memory: the count still says it
+    }
+  } catch (...) {
+  }
+  return true;
 }
 
 RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
@@ -107,6 +136,7 @@ RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
   if (!o.accepted) {
     // An "accepted" outcome always has status ok; anything else is a refusal with its reason.
     counters_.add_rejected(o.status);
+    if (r.implausible) counters_.add(ReidentCounter::refits_implausible);
     d.kind = RefitDecision::Kind::refused;
     return d;
   }

@@ -63,7 +63,9 @@ class ReidentCore {
   void on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept;
   // An accepted HX_COMMAND block: which parameter version the compensator applies, by tick.
   void on_command_block(const command_block_t& block) noexcept;
-  // A set on HX_PARAMS; ours (our publisher id, in_use().own_publisher_id()) is an echo.
+  // A set on HX_PARAMS; ours (our publisher id, in_use().own_publisher_id()) is an echo. A valid
+  // set whose gain leaves options().plausibility is not adopted: `invalid`, counted as
+  // params_implausible, the reason in implausible_reason().
   ParamsOffer on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                         std::string_view source) noexcept;
   RefitDecision poll(std::int64_t now_us) noexcept;
@@ -88,12 +90,16 @@ class ReidentCore {
   const LatencyStats& refit_time() const noexcept { return refit_time_; }  // ns, since start
   double last_refit_s() const noexcept { return last_refit_s_; }
   const ParamsInUse& in_use() const noexcept { return in_use_; }
+  // Why the last set on HX_PARAMS counted as params_implausible was refused ("" before any).
+  const std::string& implausible_reason() const noexcept { return implausible_reason_; }
   const ReidentOptions& options() const noexcept { return options_; }
   const OnlineMemEstimator& estimator() const noexcept { return estimator_; }
   RefitWorker& worker() noexcept { return worker_; }
 
  private:
   RefitDecision decide(const RefitResult& result) noexcept;
+  // A set in MEM's domain whose gain leaves options_.plausibility (the reason kept).
+  bool implausible(const MemParams& params) noexcept;
 
   ReidentOptions options_;
   OnlineMemEstimator estimator_;
@@ -111,6 +117,7 @@ class ReidentCore {
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;
   bool mem_refits_ = true;
+  std::string implausible_reason_;
 };
 
 }  // namespace hystloop

@@ -15,10 +15,12 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "refits_attempted",
     "refits_accepted",
     "refits_superseded",
+    "refits_implausible",
     "params_adopted",
     "params_echo",
     "params_stale",
     "params_invalid",
+    "params_implausible",
     "command_versions_dropped",
     // One per refusal reason, in FitStatus's order from kFirstRefusal.
     "refits_rejected_size_mismatch",

@@ -24,10 +24,13 @@ enum class ReidentCounter : std::uint8_t {
   refits_attempted,
   refits_accepted,
   refits_superseded,         // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
+  refits_implausible,        // accepted by the fit, but its gain leaves the rig's band: not published
+                             // (also counted in refits_rejected_out_of_range)
   params_adopted,            // sets from HX_PARAMS that became the set in use
   params_echo,               // our own sets coming back
   params_stale,              // valid sets not newer than the set in use
   params_invalid,            // valid = false sets
+  params_implausible,        // valid sets whose gain leaves the rig's band (models/gain_plausibility.hpp)
   command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
   refits_rejected_first      // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };

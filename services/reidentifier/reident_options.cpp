@@ -30,6 +30,7 @@ constexpr const char* kReidentKeys[] = {
     "reidentifier.model_period_s",
     "reidentifier.model_decimation",
     "reidentifier.pin_model",
+    "reidentifier.plausible_gain_factor",
 };
 
 // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model.
@@ -66,6 +67,26 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   validate_config_section(config, "reident.", [&] { m.selector.validate(); });
 }
 
+// The band every set is checked against, from the keys the compensator reads too; the initial
+// set must lie in it (a units error in the snippet is found at start, not at the first refit).
+void read_plausibility(const Config& config, ReidentOptions& o) {
+  GainPlausibility& p = o.plausibility;
+  p.nominal_gain_m_per_V = config.get<double>("linear.gain", p.nominal_gain_m_per_V);
+  if (!(p.nominal_gain_m_per_V > 0.0) || !std::isfinite(p.nominal_gain_m_per_V)) {
+    config.fail("linear.gain",
+                "must be a finite number > 0: it is the stage's nominal gain, the one every "
+                "parameter set is checked against (reidentifier.plausible_gain_factor)");
+  }
+  p.u_min_V = config.get_in_range("actuator.u_min_V", p.u_min_V, -1e4, 1e4);
+  p.u_max_V = config.get_in_range("actuator.u_max_V", p.u_max_V, -1e4, 1e4);
+  if (!(p.u_max_V > p.u_min_V)) config.fail("actuator.u_max_V", "must be greater than actuator.u_min_V");
+  p.factor = config.get_in_range("reidentifier.plausible_gain_factor", p.factor, GainPlausibility::kMinFactor,
+                                 GainPlausibility::kMaxFactor);
+  ModelParamSet initial;
+  initial.mem = o.initial;
+  validate_config_section(config, "", [&] { require_plausible(initial, p); });
+}
+
 std::size_t samples_of(double seconds, double rate_hz) {
   return static_cast<std::size_t>(std::llround(seconds * rate_hz));
 }
@@ -87,6 +108,7 @@ ReidentOptions read_reident_options(const Config& config) {
   o.initial.c2 = config.get_non_negative("mem.c2", d.c2);
   o.initial.c3 = config.get_positive("mem.c3", d.c3);
   validate_config_section(config, "mem.", [&] { o.initial.validate(); });
+  read_plausibility(config, o);
 
   o.rate_hz = config.get_in_range("reidentifier.rate_hz", o.rate_hz, 1.0, 1e6);
   o.refit_period_s = config.get_in_range("reidentifier.refit_period_s", o.refit_period_s, 0.01, 3600.0);

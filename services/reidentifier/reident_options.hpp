@@ -24,11 +24,19 @@
 //   reidentifier.model_decimation          fit every n-th sample of the window (10: 1 kHz of a 10 kHz window)
 //   reidentifier.pin_model                 "none" (automatic), or mem|pi|katalenic|linear: no automatic change;
 //                                     a kind not in use is fitted and switched to once (hystloop-ctl pin-model)
+//   reidentifier.plausible_gain_factor     F: a set (a refit, a model choice, one on HX_PARAMS) whose gain over
+//                                     the actuator's range leaves [linear.gain / F, linear.gain * F] is refused
+//                                     and counted, never published or adopted (10; models/gain_plausibility.hpp)
+//
+// The band's nominal gain and range are the keys the compensator reads from the same snippet:
+// linear.gain (the stage's mean slope; default the linear model's) and actuator.u_min_V/u_max_V
+// (default -250/250 V).
 
 #include <cstdint>
 
 #include "core/config.hpp"
 #include "ident/online_mem_estimator.hpp"
+#include "models/gain_plausibility.hpp"
 #include "models/mem.hpp"
 #include "reidentifier/model_chooser.hpp"
 
@@ -44,8 +52,9 @@ struct ReidentOptions {
   double stale_after_s = 1.0;
   std::int64_t degraded_after_poisoned = 3;
   std::int64_t lcm_queue = 2000;
-  OnlineMemOptions estimator{};  // window/capacity in samples, gates, fit time bound
-  ModelChoiceOptions models{};   // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model
+  OnlineMemOptions estimator{};     // window/capacity in samples, gates, fit time bound
+  ModelChoiceOptions models{};      // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model
+  GainPlausibility plausibility{};  // linear.gain, actuator.u_min_V/u_max_V, reidentifier.plausible_gain_factor
 };
 
 // Reads and checks mem.{c1,c2,c3} and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are

@@ -20,6 +20,10 @@ std::int64_t steady_ns() noexcept {
 namespace {
 std::int64_t steady_us() noexcept { return steady_ns() / 1000; }
 
+// DEGRADED for this long after a set with our publisher id that we never published [us] (and
+// beyond, while the compensator applies it): long enough to be seen in the 1 Hz status.
+constexpr std::int64_t kForgedDegradedUs = 30'000'000;
+
 ModelParamSet initial_model(const ReidentOptions& options) {
   ModelParamSet set;
   set.kind = ModelKind::mem;  // the compensator's default, configured from the same mem.* keys
@@ -103,9 +107,17 @@ void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
 
 void ReidentService::on_params(const mem_params_t& msg) {
   const MemParams p{msg.c1, msg.c2, msg.c3};
+  const std::uint64_t implausible_before = core_->counters().get(ReidentCounter::params_implausible);
   const ParamsOffer offer = core_->on_params(p, msg.version, msg.publisher_id, msg.valid, msg.source);
-  // Counted by the core (params_adopted, _stale, _invalid); logged at most once a second per kind.
+  // Counted by the core (params_adopted, _stale, _invalid, _implausible); logged at most once a second per kind.
   const auto id = static_cast<std::uint64_t>(msg.publisher_id);
+  if (core_->counters().get(ReidentCounter::params_implausible) != implausible_before) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, steady_ns())) {
+      spdlog::warn("params version {} from '{}' (publisher {:x}) not adopted: {}{}", msg.version,
+                   escape_wire(msg.source), id, core_->implausible_reason(), suppressed_note(g));
+    }
+    return;
+  }
   if (offer == ParamsOffer::adopted) {
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogAdopted, steady_ns())) {
       spdlog::info("params in use now version {} from '{}' (publisher {:x}): c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}{}",
@@ -123,18 +135,28 @@ void ReidentService::on_params(const mem_params_t& msg) {
           "domain{}",
           msg.version, escape_wire(msg.source), id, suppressed_note(g));
     }
+  } else if (offer == ParamsOffer::forged) {
+    forged_seen_us_ = steady_us();
+    if (!forged_logged_) {  // once: the rest are counted (params_forged) and in the status detail
+      forged_logged_ = true;
+      spdlog::warn(
+          "params version {} from '{}' carries our publisher id {:x}, but we never published that version "
+          "(forged?): not used; further ones are counted (params_forged), not logged",
+          msg.version, escape_wire(msg.source), id);
+    }
   }
 }
 
 CounterSet::Entries ReidentService::counter_entries() {
   const ReidentCounters& c = core_->counters();
   CounterSet::Entries entries;
-  entries.reserve(kReidentCounterCount + ModelChooser::kCounters + 1);
+  entries.reserve(kReidentCounterCount + ModelChooser::kCounters + 2);
   for (std::size_t i = 0; i < kReidentCounterCount; ++i) entries.emplace_back(std::string(counter_name(i)), c.at(i));
   for (std::size_t i = 0; i < ModelChooser::kCounters; ++i) {
     entries.emplace_back(ModelChooser::counter_name(i), chooser_->count(static_cast<ModelChooser::Counter>(i)));
   }
   entries.emplace_back("refits_rejected", c.rejected_total());
+  entries.emplace_back("params_forged", core_->in_use().forged_sets());
   return entries;
 }
 
@@ -178,7 +200,7 @@ void ReidentService::publish_decision(const RefitDecision& d) {
   out_.residual_m = d.holdout_rms_candidate_m > 0.0 ? d.holdout_rms_candidate_m : d.fit_residual_rms_m;
   out_.samples_used = static_cast<std::int64_t>(d.samples_used);
   out_.window_s = static_cast<double>(d.window_samples) / options_.rate_hz;
-  out_.valid = valid;
+  out_.valid = valid ? 1 : 0;
   const bool sent = params_out_.publish(out_);
   if (valid) {
     spdlog::info(
@@ -241,6 +263,15 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
     why += fmt::format("last {} windows poisoned (NaN or dropout); ", core_->poisoned_streak());
   }
   const ParamsInUse& in_use = core_->in_use();
+  const bool forged_recent = in_use.forged_sets() > 0 && now_us - forged_seen_us_ < kForgedDegradedUs;
+  if (!stopping && (forged_recent || in_use.forged_applied())) {
+    state = service_status_t::DEGRADED;
+    why += fmt::format(
+        "a set on HX_PARAMS carried our publisher id {:x} with version {}, which we never published "
+        "(forged?): not used{}; {} such sets (params_forged); ",
+        static_cast<std::uint64_t>(in_use.own_publisher_id()), in_use.last_forged_version(),
+        in_use.forged_applied() ? ", but the compensator applies it" : "", in_use.forged_sets());
+  }
   const LatencyStats& refit = core_->refit_time();
   why += fmt::format("params version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", in_use.version(),
                      escape_wire(in_use.source()), in_use.params().c1, in_use.params().c2, in_use.params().c3);

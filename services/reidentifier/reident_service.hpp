@@ -7,7 +7,10 @@
 //                   a block refused as non-finite or out of range poisons the window)
 //   <rig>COMMAND -> ReidentCore::on_command_block: the parameter version the compensator applies,
 //                   by tick (versions seen there are numbered above; status params_version_applied)
-//   <rig>PARAMS  -> a newer valid set from someone else becomes the set in use; our echo ignored
+//   <rig>PARAMS  -> a newer valid set from someone else becomes the set in use; our echo ignored;
+//                   a set with our publisher id and a version we never published is not used,
+//                   logged once, counted (params_forged) and DEGRADED on <rig>STATUS (for 30 s
+//                   after the last one, and while the compensator applies it)
 //   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to "reidentifier" (or to all)
 //   every 10 ms  -> poll the core: publish an accepted candidate on <rig>PARAMS (valid = true,
 //                   residual_m = its held-out RMS); a refused one is counted, logged by the
@@ -82,6 +85,8 @@ class ReidentService {
   CounterSet reported_;  // RESET_COUNTERS baselines of the counters and endpoints
   mem_params_t out_{};
   std::int64_t next_status_us_ = 0;
+  bool forged_logged_ = false;       // a set with our id we never published: warned once
+  std::int64_t forged_seen_us_ = 0;  // steady time of the last one [us]
   // Last: their handlers use everything above.
   std::unique_ptr<Subscription<sensor_block_t>> sensor_;
   std::unique_ptr<Subscription<command_block_t>> command_;

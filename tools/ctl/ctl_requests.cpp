@@ -9,6 +9,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "lcm/message_checks.hpp"
 #include "loop/compensator.hpp"
+#include "loop/feedback.hpp"
 #include "loop/params_admission.hpp"
 
 namespace hystloop::ctl {
@@ -71,6 +72,13 @@ void GainsRequest::validate() const {
   require_non_negative("kp", kp);
   require_non_negative("ki", ki);
   require_non_negative("kd", kd);
+  // The servo's plausibility bounds at the default rig (10 kHz, the 1 kHz derivative filter), as
+  // kMaxNotch_hz assumes it too; the bridge checks again at its own tick rate.
+  FeedbackGains servo;
+  servo.kp = kp;
+  servo.ki = ki;
+  servo.kd = kd;
+  servo.check_bounds("");
   require_in_range("notch-hz", notch_hz, 0.0, kMaxNotch_hz);
   if (notch_hz > 0.0) {
     if (notch_q == 0.0) throw ParameterError("notch-q", "give the notch's quality factor with --notch-hz");

@@ -204,7 +204,8 @@ int run(int argc, char** argv) {
   CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
   pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
 
-  CLI::App* gains = app.add_subcommand("gains", "Bridge: the servo's gains (normalised PID, all >= 0)");
+  CLI::App* gains = app.add_subcommand(
+      "gains", "Bridge: the servo's gains (normalised PID, all >= 0; kp <= 2, ki dt <= 1, kd bounded alike)");
   gains->add_option("--target", o.gains_target, "Process of the servo (the bridge)")->capture_default_str();
   gains->add_option("--kp", o.gains.kp, "Proportional gain [-]")->capture_default_str();
   gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();

@@ -1,0 +1,78 @@
+// The servo's plausibility bounds where gains enter the bridge: its configuration (servo.*, the
+// bounds at the configured tick rate) and HX_CONTROL SET_GAINS, whose request outside them is
+// refused naming the field, the value and the bound, the gains in force staying.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "bridge/bridge_settings.hpp"
+#include "bridge/servo_request.hpp"
+
+namespace hystloop {
+namespace {
+
+std::string refusal(const std::string& yaml) {
+  try {
+    load_bridge_settings(Config::from_string(yaml, "bridge.yaml"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+control_t set_gains(double kp, double ki, double kd) {
+  control_t m{};
+  m.request_id = 1;
+  m.command = control_t::SET_GAINS;
+  m.target = "bridge";
+  m.kp = kp;
+  m.ki = ki;
+  m.kd = kd;
+  return m;
+}
+
+TEST(BridgeGainBounds, TheConfigsGainsAreBoundedAtItsTickRate) {
+  EXPECT_EQ(refusal("servo: {kp: 2.0, ki: 10000, kd: 5.0e-4}"), "accepted");
+  const std::string kp = refusal("servo: {kp: 2.5}");
+  EXPECT_TRUE(contains(kp, "bridge.yaml: servo.kp: must be <= 2 (got 2.5)")) << kp;
+  EXPECT_TRUE(contains(refusal("servo: {kp: 1.0e300}"), "servo.kp")) << refusal("servo: {kp: 1.0e300}");
+  const std::string ki = refusal("servo: {ki: 10001}");
+  EXPECT_TRUE(contains(ki, "bridge.yaml: servo.ki: must be <= 10000 1/s (got 10001)")) << ki;
+  // At 20 kHz a tick is half as long: twice the ki.
+  EXPECT_EQ(refusal("bridge: {rate_hz: 20000}\nservo: {ki: 20000}"), "accepted");
+  EXPECT_TRUE(contains(refusal("bridge: {rate_hz: 20000}\nservo: {ki: 20001}"), "servo.ki"));
+  EXPECT_TRUE(contains(refusal("servo: {kd: 6.0e-4}"), "bridge.yaml: servo.kd: must be <= 0.000518"));
+  EXPECT_EQ(refusal("servo: {kd: 6.0e-4, d_filter_hz: 500}"), "accepted");  // a slower filter: a larger kd
+}
+
+TEST(BridgeGainBounds, ASetGainsBeyondThemIsRefusedNamingTheFieldAndTheGainsInForceStay) {
+  const BridgeSettings s = load_bridge_settings(Config());
+  FeedbackGains in_force = s.servo;
+  in_force.kp = 0.1;
+  in_force.ki = 2000.0;
+  const FeedbackGains before = in_force;
+  try {
+    in_force = requested_gains(in_force, set_gains(1e300, 2000.0, 0.0));
+    FAIL() << "kp 1e300 taken";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "servo.kp");
+    EXPECT_TRUE(contains(e.what(), "must be <= 2 (got 1e+300)")) << e.what();
+  }
+  EXPECT_EQ(in_force.kp, before.kp);
+  EXPECT_EQ(in_force.ki, before.ki);
+  EXPECT_THROW(requested_gains(in_force, set_gains(0.1, 1e5, 0.0)), ParameterError);
+  EXPECT_THROW(requested_gains(in_force, set_gains(0.1, 0.0, 1e-3)), ParameterError);
+
+  // Within them: the request's gains, the rig's nominal gain, range, filter and rate.
+  const FeedbackGains next = requested_gains(in_force, set_gains(2.0, 1e4, 0.0));
+  EXPECT_EQ(next.kp, 2.0);
+  EXPECT_EQ(next.ki, 1e4);
+  EXPECT_EQ(next.nominal_gain_m_per_V, in_force.nominal_gain_m_per_V);
+  EXPECT_EQ(next.tick_rate_hz, s.rate_hz);
+  EXPECT_EQ(next.u_max_V, s.limits.u_max_V);
+}
+
+}  // namespace
+}  // namespace hystloop
