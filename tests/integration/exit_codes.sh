@@ -16,7 +16,7 @@ check() {  # check <want> <program> <args...>
     printf '%s\n' "$out" | head -5 | sed 's/^/    /'
     failed=1
   fi
-  if [ "$want" -eq 0 ] && [ "$rc" -eq 0 ] && ! printf '%s' "$out" | grep -qi "usage\|options"; then
+  if [ "$want" -eq 0 ] && [ "$rc" -eq 0 ] && ! grep -qi "usage\|options" <<<"$out"; then
     echo "FAIL: $(basename "$prog") $*: no usage printed"
     failed=1
   fi
