@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# hystloop-logger on a full disk (issue 12): its output folder is a 2 MB tmpfs, mounted in a
+# hystloop-logger on a full disk: its output folder is a 2 MB tmpfs, mounted in a
 # private mount namespace, half of it taken by a ballast file, and the probe sends ~11 MB.
 # The logger must keep running, say "FAULT: disk full" on HX_STATUS while it cannot write,
 # count every event it could not write as dropped, resume in a new file once the ballast is

@@ -1,4 +1,4 @@
-# The live loop with the re-identifier's automatic model choice on (issue 11): a model change is
+# The live loop with the re-identifier's automatic model choice on: a model change is
 # published on HX_MODEL and adopted by the compensator, nothing refused (model_choice.sh).
 if(TARGET hystloop-bridge AND TARGET hystloop-compensator AND TARGET hystloop-reidentifier AND TARGET hystloop-ctl
    AND TARGET loop_probe)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The live loop with the re-identifier's automatic model choice on (issue 11): bridge, compensator
+# The live loop with the re-identifier's automatic model choice on: bridge, compensator
 # and re-identifier (reidentifier.models mem,pi,linear; a selection every 2 s), the compensator tracking
 # the 1 Hz cosine with MEM from the configured (wrong for this stage) parameters. A model that beats
 # MEM by the margin is published on HX_MODEL and adopted; then `hystloop-ctl pin-model` pins another
