@@ -185,12 +185,13 @@ TEST_F(IdentifyTool, ProgressOfALongFitOnStderr) {
   std::vector<double> y(u.size());
   for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
   write_csv(path("mem.csv"), u, y, 1e4);
-  // Katalenic simulates its operator per evaluation: hundreds of milliseconds, many periods.
+  // Katalenic simulates its operator per evaluation: ~30 ms here, 30 periods of the shortest
+  // --progress-period-s (a 20 ms period once let a quick run finish before its first line).
   // Only stderr is collected: { tool 2>&1 >/dev/null; }.
   auto stderr_of = [&](const std::string& args) {
     return testing::run_tool("{ " + kTool + " " + path("mem.csv") + " " + args + " 2>&1 >/dev/null; }");
   };
-  const ToolRun r = stderr_of("--model katalenic --progress --progress-period-s 0.02");
+  const ToolRun r = stderr_of("--model katalenic --progress --progress-period-s 0.001");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("hystloop-identify: fitting katalenic on 6000 samples: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("fitting katalenic on 6000 samples: done in "), std::string::npos) << r.output;
