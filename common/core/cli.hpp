@@ -30,6 +30,17 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, const char* const* 
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     const std::string program = std::filesystem::path(argc > 0 ? argv[0] : app.get_name()).filename().string();
+    // A word where a command was expected is an unknown command, whatever CLI11 makes of it
+    // ("A subcommand is required", or an extra argument): name it and the commands there are.
+    const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+    if (app.get_require_subcommand_min() > 0 && !commands.empty() && app.get_subcommands().empty() && argc > 1 &&
+        argv[1][0] != '-') {
+      std::string names;
+      for (const CLI::App* c : commands) names += (names.empty() ? "" : ", ") + c->get_name();
+      std::fprintf(stderr, "%s: unknown command '%s' (one of: %s)\nRun with --help for more information.\n",
+                   program.c_str(), argv[1], names.c_str());
+      return kExitUsage;
+    }
     std::fprintf(stderr, "%s: %s\nRun with --help for more information.\n", program.c_str(), e.what());
     return kExitUsage;
   }

@@ -24,7 +24,7 @@ namespace {
 constexpr int kExitBadConfiguration = 2;
 }
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   using namespace hystloop;
   CLI::App app{
       "hystloop-logger: records the rig's LCM channels to rotating event logs\n"
@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   ServiceOptions service;
   LoggerFlags flags;
   add_service_options(app, service);
+  app.footer("");  // its own exit status is in the description above (a disk fault is 1)
   add_logger_options(app, flags);
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
@@ -82,4 +83,10 @@ int main(int argc, char** argv) {
     flush_logging();
     return 1;
   }
+} catch (const std::exception& e) {  // CLI11's set-up, before the handlers below exist: nothing escapes main
+  std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
+  return 1;
+} catch (...) {
+  std::fprintf(stderr, "hystloop-logger: unknown error\n");
+  return 1;
 }

@@ -1,10 +1,14 @@
 #include "runtime/service_options.hpp"
 
 #include "core/cli.hpp"
+#include "core/config.hpp"
 
 namespace hystloop {
 
 void add_service_options(CLI::App& app, ServiceOptions& options) {
+  app.footer(
+      "Exit status: 0 stopped as asked (SIGINT/SIGTERM, SHUTDOWN, --seconds); 1 a runtime failure; 2 a bad "
+      "option, configuration or key file (the message names the field).");
   app.add_option("--config", options.config_file, "YAML configuration file")->check(CLI::ExistingFile);
   app.add_option("--set", options.overrides, "Override a configuration value, KEY=VALUE (repeatable)");
   app.add_option("--lcm-url", options.lcm_url,
@@ -20,6 +24,13 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) { re
 
 Config load_service_config(const ServiceOptions& options) {
   Config config = options.config_file.empty() ? Config() : Config::load_file(options.config_file);
+  // An empty file is almost always the wrong file (or one being written): running on the defaults
+  // without a word would hide that.
+  if (!options.config_file.empty() && config.keys().empty()) {
+    throw ConfigError(options.config_file, "",
+                      "no keys in it (empty, or comments only): give the service's config (e.g. deploy/config/), or "
+                      "leave --config out to run on the defaults");
+  }
   config.apply_overrides(options.overrides);
   return config;
 }

@@ -27,6 +27,13 @@ refused "rt.ticks_per_wake" --set bridge.block_ticks=5 --set rt.ticks_per_wake=1
 refused "did you mean 'actuator.watchdog_s'" --set actuator.watchdog=0.1
 printf 'actuator:\n  slew_V_per_s: -5\n' >"$dir/bad.yaml"
 refused "bad.yaml: actuator.slew_V_per_s" --config "$dir/bad.yaml"
+printf '# nothing yet\n' >"$dir/empty.yaml"
+refused "empty.yaml: no keys in it" --config "$dir/empty.yaml"
+refused "bridge.max_lead_s" --set bridge.max_lead_s=2
+refused "servo.kp" --set servo.kp=1e300
+# Without a key and without the keyless choice a service does not start (this test's namespace
+# chose keyless for it: HYSTLOOP_AUTH_KEYLESS=1 from tools/netns-run --keyless).
+HYSTLOOP_AUTH_KEYLESS=0 refused "auth.key_file: no rig key" --config "$config/bridge.yaml" --seconds 0.1
 # A URL whose packets could leave the host is refused before LCM starts (this script runs inside
 # tools/netns-run: even if it were not, nothing could leave the private namespace).
 refused "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
