@@ -5,17 +5,23 @@
 // back to the same size. What follows the walked encoding goes through a keyed rig's check
 // (common/auth/message_auth.hpp): no input can carry a trailer the verifier takes, since the
 // fuzzer does not know the key; one that did would be a hole in the MAC check or its framing.
+// A MEM parameter set the contract accepts then meets the receivers' plausibility check
+// (common/models/gain_plausibility.hpp): refused with a ParameterError, or let through only with
+// a finite small-signal gain inside the band: nothing else may escape it.
 // The first input byte picks the type; the rest follows its fingerprint.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 #include "auth/message_auth.hpp"
+#include "core/errors.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/wire_layout.hpp"
+#include "models/gain_plausibility.hpp"
 
 namespace {
 
@@ -29,6 +35,21 @@ MessageVerifier& verifier() {
     return MessageVerifier(key, INT64_MAX / 4, 1);
   }();
   return v;
+}
+
+// What the compensator and the re-identifier ask of a set whose values passed the contract.
+void check_plausibility(const mem_params_t& msg) {
+  ModelParamSet set;
+  set.kind = ModelKind::mem;
+  set.mem = MemParams{msg.c1, msg.c2, msg.c3};
+  const GainPlausibility rig{};
+  try {
+    require_plausible(set, rig);
+  } catch (const ParameterError&) {
+    return;  // refused, naming the field: what a receiver counts
+  }
+  const GainRange g = small_signal_gain(set, rig);
+  if (!(g.min_m_per_V >= rig.min_gain_m_per_V() && g.max_m_per_V <= rig.max_gain_m_per_V())) std::abort();
 }
 
 template <class T>
@@ -57,6 +78,7 @@ void receive(const std::uint8_t* data, std::size_t size) {
   // The walk said how long the message is; decode must agree, or the walk lets something through.
   if (decoded != walked) std::abort();
   if (check_message(msg) != Verdict::kOk || !arrays_consistent(msg)) return;
+  if constexpr (std::is_same_v<T, mem_params_t>) check_plausibility(msg);
   // Accepted: what a service would publish again must encode and decode to the same length.
   std::vector<std::uint8_t> again(static_cast<std::size_t>(msg.getEncodedSize()));
   if (msg.encode(again.data(), 0, static_cast<int>(again.size())) != static_cast<int>(again.size())) std::abort();
