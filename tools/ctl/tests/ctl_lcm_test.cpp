@@ -550,7 +550,7 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
       {{"learn"}, "what"},
       {{"status", "--wait-healthy", "bridge", "--timeout", "0"}, "timeout:"},
       {{"watch", "--seconds", "-1"}, "seconds:"},
-      {{"frobnicate"}, "subcommand"},
+      {{"frobnicate"}, "unknown command 'frobnicate' (one of: keygen, status"},
       {{}, "subcommand"},
       {{"--lcm-url", "udpm://239.255.76.67:7667?ttl=1", "arm"}, "lcm.url"},
   };
