@@ -15,7 +15,7 @@ inline constexpr std::string_view kDefaultRigPrefix = "HX_";
 // [A-Z0-9_], starts with a letter and ends with '_'.
 void validate_rig_prefix(std::string_view prefix);
 
-// The channels of DESIGN.md, by suffix.
+// The channels of the contract (docs/CONTRACT.md), by suffix.
 inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_block_t, 10 kHz of ticks in blocks
 inline constexpr std::string_view kCommandSuffix = "COMMAND";        // command_block_t, one block per sensor block
 inline constexpr std::string_view kTrajectorySuffix = "TRAJECTORY";  // trajectory_t, on change

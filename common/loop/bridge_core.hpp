@@ -4,7 +4,7 @@
 // jitter buffer indexed by tick (CommandBuffer). At tick k the core takes the command for k
 // (or holds the last one: a late tick), adds the servo's correction on y_ref - y, clamps to the
 // actuator's range and slew rate, and applies. The servo is told the interval both clamps leave
-// this tick, so its anti-windup sees every clamp. It owns the safety rules of DESIGN.md: range and
+// this tick, so its anti-windup sees every clamp. It owns the safety rules of docs/TIMING.md: range and
 // slew clamp, non-finite and stale rejection, the watchdog on an empty buffer and the ramp to
 // the safe voltage. Time is an argument, so all of it is tested faster than real time.
 

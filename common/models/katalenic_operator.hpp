@@ -1,6 +1,6 @@
 #pragma once
 // The bare parametric hysteresis operator pair of Katalenic, van Lierop & van den Bosch,
-// "Smooth Parametric Hysteresis Operator for Control" (paper in /work/shared/papers), in
+// "Smooth Parametric Hysteresis Operator for Control" (docs/REFERENCES.md [3]), in
 // operator units (no shaping; katalenic.hpp adds shaping and SI units).
 //
 //   direct  (2):  u~ = v~ - M* + W(k2 M* e^{k2 (M* - v~)}) / k2,  M* = M(v, u) + k1

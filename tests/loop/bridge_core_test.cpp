@@ -1,4 +1,4 @@
-// BridgeCore's safety rules (DESIGN.md "Timing" and "Safety"), with time as an argument: which
+// BridgeCore's safety rules (docs/TIMING.md), with time as an argument: which
 // command reaches the actuator at tick k, range and slew clamp, rejections, late ticks, the
 // watchdog and the ramp to the safe voltage. The servo has its own file: bridge_servo_test.cpp.
 #include "loop/bridge_core.hpp"
@@ -286,7 +286,7 @@ TEST(BridgeCore, TheSafeRampNeverExceedsTheSlewLimit) {
   }
 }
 
-// A dead compensator (DESIGN.md, Timing): the bridge follows the plan it was sent, then ramps to
+// A dead compensator (docs/TIMING.md): the bridge follows the plan it was sent, then ramps to
 // safety at most watchdog_s after the last planned tick, and never leaves the range or the slew.
 TEST(BridgeCore, ADeadCompensatorStopsTheStageWithinHorizonPlusWatchdog) {
   const ActuatorLimits lim;

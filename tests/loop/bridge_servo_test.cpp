@@ -1,4 +1,4 @@
-// The bridge's servo (DESIGN.md, Timing): PI on the previous tick's reference minus the measured
+// The bridge's servo (docs/TIMING.md): PI on the previous tick's reference minus the measured
 // position, added to the feedforward, with anti-windup at the actuator's range, a hold while safe,
 // a reset when the command has no reference and bumpless gain changes. Driven on a first-order
 // plant (bridge_test_rig.hpp) with a constant disturbance the feedforward does not know.

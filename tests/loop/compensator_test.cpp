@@ -1,4 +1,4 @@
-// The compensator runs ahead of the bridge (DESIGN.md, Timing): after sample k it has planned
+// The compensator runs ahead of the bridge (docs/TIMING.md): after sample k it has planned
 // every tick through k + horizon, each exactly once, and anything new takes effect at the first
 // tick not yet planned. Experiments have their own file: compensator_experiment_test.cpp.
 #include "loop/compensator.hpp"
