@@ -233,12 +233,14 @@ Verdict check_message(const control_t& msg) noexcept {
   f.require(msg.utime >= 0 && msg.request_id > 0);
   f.text(msg.target);
   f.text(msg.experiment);
-  f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::SET_LEARNING);
+  f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::RELEASE_PARAMS);
   f.require(msg.learning >= control_t::LEARNING_OFF && msg.learning <= control_t::LEARNING_RESET);
   f.require(is_command_mode(msg.mode));
-  f.within(msg.kp, 0.0, kHuge);
-  f.within(msg.ki, 0.0, kHuge);
-  f.within(msg.kd, 0.0, kHuge);
+  f.nan_or_within(msg.kp, 0.0, kHuge);  // NaN: keep the gain in force
+  f.nan_or_within(msg.ki, 0.0, kHuge);
+  f.nan_or_within(msg.kd, 0.0, kHuge);
+  f.nan_or_within(msg.notch_hz, 0.0, kHuge);
+  f.nan_or_within(msg.notch_q, 0.0, kHuge);
   f.within(msg.experiment_amplitude_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
   f.within(msg.experiment_offset_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
   f.within(msg.experiment_frequency_Hz, 0.0, kMaxAbsFrequency_Hz);

@@ -60,7 +60,7 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept;
 // service_status_t: non-empty process, pid > 0, known state, 0..MAX_COUNTERS counters >= 0
 // with matching array sizes, timings NaN (not measured) or finite >= 0.
 Verdict check_message(const service_status_t& msg) noexcept;
-// control_t: known command and mode, request_id > 0, gains finite >= 0; START_EXPERIMENT
+// control_t: known command and mode, request_id > 0, gains and notch NaN (keep) or finite >= 0; START_EXPERIMENT
 // needs a name and amplitude, frequency and duration > 0.
 Verdict check_message(const control_t& msg) noexcept;
 

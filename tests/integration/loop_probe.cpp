@@ -23,6 +23,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -199,7 +200,7 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
     control_t c = valid_control(base_id + i);
     publish_truncated(lcm, ch.control, c);
     publish_unchecked(lcm, ch.control, one_tick_sensor_block());  // wrong type
-    c.kp = kNaN;
+    c.kp = std::numeric_limits<double>::infinity();               // NaN is valid here: "keep the gain in force"
     publish_unchecked(lcm, ch.control, c);
     c.kp = 0.0;
     c.command = 99;
@@ -372,7 +373,7 @@ int status_value(const std::string& dir, const std::string& process, const std::
 }  // namespace
 }  // namespace hystloop
 
-int main(int argc, char** argv) {
+int run_probe(int argc, char** argv) {
   using namespace hystloop;
   CLI::App app{"loop_probe: records, drives and checks a running bridge + compensator"};
   app.require_subcommand(1);
@@ -459,7 +460,7 @@ int main(int argc, char** argv) {
     }
     if (*pa) {
       params.utime = now_utime();
-      params.valid = valid != 0;
+      params.valid = static_cast<std::int8_t>(valid != 0 ? 1 : 0);
       params.source = "loop_probe";
       publish_unchecked(*lcm, ch.params, params);
       return 0;
@@ -469,4 +470,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   return 2;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run_probe(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "loop_probe: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "loop_probe: unknown error\n");
+  }
+  return 1;
 }

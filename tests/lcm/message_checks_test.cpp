@@ -289,10 +289,22 @@ TEST(MessageChecks, ServiceStatus) {
 
 TEST(MessageChecks, Control) {
   auto m = fixtures::control(1);
-  m.ki = kNaN;
+  m.ki = kNaN;  // NaN: keep the gain in force
+  m.notch_hz = kNaN;
+  m.notch_q = kNaN;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.ki = std::numeric_limits<double>::infinity();
   EXPECT_EQ(check_message(m), Verdict::kNonFinite);
   m = fixtures::control(1);
   m.kp = -0.5;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::control(1);
+  m.notch_hz = -1.0;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m = fixtures::control(1);
+  m.command = control_t::RELEASE_PARAMS;  // the last command there is
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.command = control_t::RELEASE_PARAMS + 1;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
   m = fixtures::control(1);
   m.experiment_duration_s = 0.0;  // an experiment needs a duration...
