@@ -18,6 +18,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_checks.hpp"
+#include "lcm/servo_gains_status.hpp"
 #include "runtime/counter_baseline.hpp"
 
 namespace hystloop {
@@ -57,21 +58,31 @@ void BridgeService::on_command(const command_block_t& msg) noexcept {
   }
 }
 
+void BridgeService::act(const control_t& msg) noexcept {
+  ++control_acted_;
+  acks_.acted(msg.request_id);
+}
+
+void BridgeService::refuse(const control_t& msg, std::string why) {
+  ++control_refused_;
+  acks_.refused(msg.request_id, std::move(why), wall_utime());
+}
+
 void BridgeService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   switch (msg.command) {
     case control_t::ARM:
       if (stopping_) {  // the real-time thread would not arm either
-        ++control_refused_;
+        refuse(msg, "the bridge is stopping (ramping to the safe voltage)");
         spdlog::warn("ARM (request {}) refused: the bridge is stopping (ramping to the safe voltage)", msg.request_id);
         return;
       }
-      ++control_acted_;
+      act(msg);
       rt_.request_arm(ArmRequest::kArm);
       spdlog::info("ARM (request {})", msg.request_id);
       return;
     case control_t::DISARM:
-      ++control_acted_;
+      act(msg);
       rt_.request_arm(ArmRequest::kDisarm);
       safe_reason_ = "disarmed via HX_CONTROL";
       spdlog::info("DISARM (request {})", msg.request_id);
@@ -81,18 +92,18 @@ void BridgeService::on_control(const control_t& msg) {
       try {
         g = requested_gains(gains_, msg);
       } catch (const std::exception& e) {
-        ++control_refused_;
+        refuse(msg, e.what());
         spdlog::warn("SET_GAINS (request {}) refused, the gains in force (kp {}, ki {} 1/s, kd {} s) stay: {}",
                      msg.request_id, gains_.kp, gains_.ki, gains_.kd, e.what());
         return;
       }
       if (!rt_.push_gains(g)) {
-        ++control_refused_;
+        refuse(msg, "the real-time thread has not taken the last gains yet: send again");
         spdlog::warn("SET_GAINS (request {}) refused: the real-time thread has not taken the last ones yet",
                      msg.request_id);
         return;
       }
-      ++control_acted_;
+      act(msg);
       gains_ = g;
       spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s, {} (request {})", g.kp, g.ki, g.kd,
                    g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
@@ -100,7 +111,7 @@ void BridgeService::on_control(const control_t& msg) {
       return;
     }
     case control_t::RESET_COUNTERS:
-      ++control_acted_;
+      act(msg);
       // All counters from the next report on (asked for at once, so at most a tick of the
       // real-time thread's events is not counted).
       counters_.rebase("command", commands_.counters());
@@ -110,14 +121,15 @@ void BridgeService::on_control(const control_t& msg) {
       spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
       return;
     case control_t::SHUTDOWN:
-      ++control_acted_;
+      act(msg);
       spdlog::info("SHUTDOWN (request {})", msg.request_id);
       request_stop();
       return;
     default:
       // Meant for the compensator; refused only when addressed to the bridge by name.
       if (msg.target == "bridge") {
-        ++control_refused_;
+        refuse(msg, "command " + std::to_string(msg.command) +
+                        " is not the bridge's (arm, disarm, gains, reset-counters, shutdown)");
         spdlog::warn("control command {} (request {}) is not one the bridge knows; ignored", msg.command,
                      msg.request_id);
       }
@@ -185,7 +197,8 @@ void BridgeService::serve(bool stopping) {
   publish_samples(false);
   if ((fds[0].revents & POLLIN) && dispatch_pending(lcm_) < 0) ++lcm_errors_;
   const auto now = clock::now();
-  if ((now >= next_report_ || reset_pending_) && !awaiting_report_) {
+  // A control request answered is reported at once: its sender waits for the answer.
+  if ((now >= next_report_ || reset_pending_ || acks_.due()) && !awaiting_report_) {
     rt_.reports().request();
     awaiting_report_ = true;
     if (now >= next_report_) next_report_ += std::chrono::seconds(1);
@@ -342,10 +355,15 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
                         detail.empty() ? "" : "; ", rt_.backend().name(), rt.u_applied_V, rt.gain_scale,
                         100.0 * late_fraction, rt.buffer_depth);
+  if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail += "; " + note;
 
   status_.begin(state, detail);
   counters_.report(status_, now);
   status_.counter("armed", rt.armed ? 1 : 0);
+  acks_.report(status_);
+  const ServoGainsFigures gains{gains_.kp, gains_.ki, gains_.kd, gains_.notch_hz,
+                                gains_.has_notch() ? gains_.notch_q : 0.0};
+  for (const ServoGainCounter& c : kServoGainCounters) status_.counter(c.name, servo_gain_counter(c, gains));
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
   status_.counter("clamped_per_s", rt.clamped_last_second.either);
   status_.counter("buffer_depth_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, rt.buffer_depth)));

@@ -22,6 +22,7 @@
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
+#include "runtime/control_acks.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
 #include "runtime/log_limiter.hpp"
@@ -45,6 +46,8 @@ class BridgeService {
  private:
   void on_command(const command_block_t& msg) noexcept;
   void on_control(const control_t& msg);
+  void act(const control_t& msg) noexcept;  // counts it and tells its sender
+  void refuse(const control_t& msg, std::string why);
   void publish_samples(bool flush) noexcept;
   void publish_block() noexcept;
   void serve(bool stopping);  // one pass of the I/O loop: samples out, LCM in, status
@@ -70,6 +73,7 @@ class BridgeService {
   std::uint64_t command_queue_full_ = 0;
   std::uint64_t control_acted_ = 0;
   std::uint64_t control_refused_ = 0;
+  ControlAcks acks_;  // what was done with the last requests, for their senders
   std::uint64_t command_blocks_ = 0;
   std::uint64_t sensor_blocks_ = 0;
   // Sensor blocks whose values the contract refuses are published repaired (sensor_block_repair.hpp):

@@ -1,7 +1,7 @@
 #pragma once
 // HX_CONTROL SET_GAINS: the servo's gains a request asks for. kp, ki, kd and the notch come from
-// the message; the nominal gain, the actuator's range, the derivative filter and the tick rate stay
-// as in force (they are the rig's, not the request's).
+// the message where it gives them (NaN: the one in force stays); the nominal gain, the actuator's range, the derivative
+// filter and the tick rate stay as in force (they are the rig's, not the request's).
 
 #include "hystloop/control_t.hpp"
 #include "loop/feedback.hpp"

@@ -203,6 +203,8 @@ void CompensatorService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   auto refuse = [&](const std::string& why) {
     ++counters_.control_refused;
+    acks_.refused(msg.request_id, why, wall_utime());
+    verdict_due_ = true;  // its sender waits for the answer
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogControlRefused, monotonic_now_ns())) {
       spdlog::warn("control request {} (command {}) refused: {}{}", msg.request_id, msg.command, escape_wire(why),
                    suppressed_note(g));
@@ -276,9 +278,12 @@ void CompensatorService::on_control(const control_t& msg) {
         return;
     }
     ++counters_.control_acted;
+    acks_.acted(msg.request_id);
+    verdict_due_ = true;
   } catch (const std::exception& e) {
     refuse(e.what());
   }
+  if (verdict_due_) report(wall_utime(), false, false);
 }
 
 void CompensatorService::restart_control_law() {
@@ -443,6 +448,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
                           learner.periods_learned, learner.last_error_rms_m * 1e9);
   }
   if (!verdict_.empty() && monotonic_now_ns() < verdict_until_ns_) detail += "; " + verdict_;
+  if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail += "; " + note;
   status_.begin(state, detail);
   reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;
@@ -458,6 +464,9 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
                   static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_refused_version)));
   status_.counter("trajectory_shaped_version",
                   static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_shaped_version)));
+  acks_.report(status_);
+  status_.counter("mode", static_cast<std::uint64_t>(c.mode()));  // the tracking mode (command_block_t.MODE_*)
+  status_.counter("params_version", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.params_version())));
   status_.counter("learning_active", learner.active ? 1u : 0u);
   status_.counter("learning_periods", learner.periods_learned);
   status_.counter("learning_rms_pm", static_cast<std::uint64_t>(std::llround(learner.last_error_rms_m * 1e12)));

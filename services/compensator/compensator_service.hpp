@@ -49,6 +49,7 @@
 #include "loop/params_admission.hpp"
 #include "loop/sequence_discontinuities.hpp"
 #include "loop/sequence_guard.hpp"
+#include "runtime/control_acks.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
 #include "runtime/log_limiter.hpp"
@@ -160,6 +161,7 @@ class CompensatorService {
   Subscription<model_params_t> models_;
   Subscription<control_t> control_;
   ControlFilter filter_{"compensator"};
+  ControlAcks acks_;  // what was done with the last requests, for their senders
   StatusReporter status_;
 
   // What maps utime to loop time, and a trajectory whose start time needs it.

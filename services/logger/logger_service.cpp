@@ -137,10 +137,19 @@ void LoggerService::check_sequence(ChannelSlot& slot, const void* data, std::siz
 void LoggerService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
   if (msg.command == control_t::SHUTDOWN) {
+    acks_.acted(msg.request_id);
     spdlog::info("SHUTDOWN requested (request {})", msg.request_id);
     shutdown_requested_ = true;
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
+    // Sent to every process, it is answered as done (there is nothing to reset here); asked of
+    // the logger by name, it is refused, so the sender learns that these counters do not reset.
+    if (msg.target.empty()) {
+      acks_.acted(msg.request_id);
+    } else {
+      acks_.refused(msg.request_id, "the logger's counters describe the whole recording: they do not reset",
+                    wall_utime());
+    }
     // Anyone can send these: at most one line every 10 s, saying how many were not logged.
     const double now_s = monotonic_s();
     if (now_s - reset_logged_s_ < 10.0) {
@@ -158,7 +167,7 @@ void LoggerService::on_tick(std::int64_t utime) {
   // A disk fault (or the recovery from one) is reported at once, the rest once a second.
   const DiskFaults f = files_->faults();
   const bool disk_news = f.errors != seen_faults_.errors || f.writing != seen_faults_.writing;
-  if (disk_news || utime - last_report_utime_ >= 1000000) report(utime);
+  if (disk_news || acks_.due() || utime - last_report_utime_ >= 1000000) report(utime);
 }
 
 std::string LoggerService::fault_detail(const DiskFaults& f) {
@@ -268,7 +277,9 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   if (state == service_status_t::DEGRADED) {
     detail += " (file " + escaped_for_log(files_->current_file().filename().string()) + ")";
   }
+  if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail = append(detail, note);
   reporter_.begin(state, detail);
+  acks_.report(reporter_);
   for (std::size_t i = 0; i < ChannelTable::kRigChannels; ++i) {
     const ChannelSlot& c = (*channels_)[i];
     const std::string name(c.name_view());

@@ -40,6 +40,7 @@
 #include "logger/logger_options.hpp"
 #include "logger/logger_summary.hpp"
 #include "logger/record_ring.hpp"
+#include "runtime/control_acks.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/status_reporter.hpp"
 
@@ -91,6 +92,7 @@ class LoggerService {
   command_block_t command_block_{};
 
   ControlFilter control_filter_{kProcessName};
+  ControlAcks acks_;  // what was done with the last requests, for their senders
   std::unique_ptr<Subscription<control_t>> control_;
   bool shutdown_requested_ = false;
   StatusReporter reporter_;

@@ -14,8 +14,8 @@ namespace hystloop {
 
 const char* ModelChooser::counter_name(std::size_t i) noexcept {
   static constexpr const char* kNames[kCounters] = {
-      "model_selections",         "model_changes",    "model_refits", "model_kept", "model_failed", "model_poisoned",
-      "model_refits_left_to_mem", "model_implausible"};
+      "model_selections",         "model_changes",     "model_refits", "model_kept", "model_failed", "model_poisoned",
+      "model_refits_left_to_mem", "model_implausible", "model_held"};
   return i < kCounters ? kNames[i] : "model_unknown";
 }
 
@@ -90,6 +90,11 @@ ModelDecision ModelChooser::collect(ReidentCore& core) {
     last_reason_ = std::string("not published: ") + e.what();
     spdlog::warn("model selection: {} {} refused: {}", to_string(set.kind),
                  p.kind == ProposalKind::model_change ? "change" : "refit", e.what());
+    return d;
+  }
+  if (core.held()) {
+    ++counters_[held];
+    last_reason_ = "not published: the operator holds the set in use";
     return d;
   }
   // A proposal made against a set that changed meanwhile (HX_PARAMS from elsewhere) is still

@@ -64,6 +64,7 @@ class ModelChooser {
     poisoned,
     left_to_mem,
     implausible,
+    held,  // a change or refit proposed while the operator holds the set in use: not published
     kCounters
   };
   static const char* counter_name(std::size_t i) noexcept;  // "model_selections", ...

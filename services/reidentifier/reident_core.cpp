@@ -146,6 +146,11 @@ RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
     d.kind = RefitDecision::Kind::superseded;
     return d;
   }
+  if (held_) {
+    counters_.add(ReidentCounter::refits_held);
+    d.kind = RefitDecision::Kind::held;
+    return d;
+  }
   d.version = in_use_.adopt_own(o.candidate);
   counters_.add(ReidentCounter::refits_accepted);
   d.kind = RefitDecision::Kind::accepted;

@@ -31,7 +31,8 @@
 namespace hystloop {
 
 struct RefitDecision {
-  enum class Kind : std::uint8_t { none, accepted, refused, superseded };
+  // held: accepted while the operator holds the set in use (not adopted, not published)
+  enum class Kind : std::uint8_t { none, accepted, refused, superseded, held };
   Kind kind = Kind::none;
   FitStatus status = FitStatus::ok;
   bool fitted = false;  // a fit ran: `candidate` holds fitted parameters
@@ -76,6 +77,10 @@ class ReidentCore {
   // version; while another model is in use, no MEM refit is started (off: MEM refits stop).
   std::int32_t adopt_own_mem(const MemParams& params) noexcept { return in_use_.adopt_own(params); }
   void set_mem_refits(bool on) noexcept { mem_refits_ = on; }
+  // Held: refits still run and are judged and counted, but none becomes the set in use (the
+  // operator's, or the last one published, stays) until released.
+  void hold(bool on) noexcept { held_ = on; }
+  bool held() const noexcept { return held_; }
   bool mem_refits() const noexcept { return mem_refits_; }
 
   // Health, for HX_STATUS.
@@ -117,6 +122,7 @@ class ReidentCore {
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;
   bool mem_refits_ = true;
+  bool held_ = false;
   std::string implausible_reason_;
 };
 

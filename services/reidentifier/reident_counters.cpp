@@ -16,6 +16,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "refits_accepted",
     "refits_superseded",
     "refits_implausible",
+    "refits_held",
     "params_adopted",
     "params_echo",
     "params_stale",

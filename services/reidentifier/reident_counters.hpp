@@ -26,6 +26,7 @@ enum class ReidentCounter : std::uint8_t {
   refits_superseded,         // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
   refits_implausible,        // accepted by the fit, but its gain leaves the rig's band: not published
                              // (also counted in refits_rejected_out_of_range)
+  refits_held,               // accepted while the operator holds the set in use: reported, not published
   params_adopted,            // sets from HX_PARAMS that became the set in use
   params_echo,               // our own sets coming back
   params_stale,              // valid sets not newer than the set in use

@@ -22,6 +22,7 @@ constexpr const char* kReidentKeys[] = {
     "reidentifier.max_solver_time_s",
     "reidentifier.reversal_dead_band_V",
     "reidentifier.publish_invalid",
+    "reidentifier.hold",
     "reidentifier.stale_after_s",
     "reidentifier.degraded_after_poisoned",
     "reidentifier.lcm_queue",
@@ -115,6 +116,7 @@ ReidentOptions read_reident_options(const Config& config) {
   o.window_s = config.get_in_range("reidentifier.window_s", o.window_s, 1e-6, 3600.0);
   o.capacity_s = config.get_in_range("reidentifier.capacity_s", o.capacity_s, 1e-6, 3600.0);
   o.publish_invalid = config.get<bool>("reidentifier.publish_invalid", o.publish_invalid);
+  o.hold = config.get<bool>("reidentifier.hold", o.hold);
   o.stale_after_s = config.get_in_range("reidentifier.stale_after_s", o.stale_after_s, 0.001, 3600.0);
   o.degraded_after_poisoned =
       config.get_int_in_range("reidentifier.degraded_after_poisoned", o.degraded_after_poisoned, 1, 1000000);

@@ -13,6 +13,8 @@
 //   reidentifier.max_solver_time_s         time bound of the nonlinear refinement [s] (0.05)
 //   reidentifier.reversal_dead_band_V      reversals of u smaller than this are not branches [V] (servo jitter; 0)
 //   reidentifier.publish_invalid           also publish refused candidates, valid = false (false; --publish-invalid)
+//   reidentifier.hold                      start holding the set in use: fit and report, publish nothing until
+//                                     released (false; hystloop-ctl hold on|off)
 //   reidentifier.stale_after_s             DEGRADED when no sample arrived for this long [s] (1)
 //   reidentifier.degraded_after_poisoned   DEGRADED when this many windows in a row were poisoned (3)
 //   reidentifier.lcm_queue                 HX_SENSOR (and HX_COMMAND) blocks LCM holds before dropping (>= 100; 2000: 2
@@ -49,6 +51,7 @@ struct ReidentOptions {
   double window_s = 2.0;
   double capacity_s = 10.0;
   bool publish_invalid = false;
+  bool hold = false;  // reidentifier.hold
   double stale_after_s = 1.0;
   std::int64_t degraded_after_poisoned = 3;
   std::int64_t lcm_queue = 2000;

@@ -71,6 +71,8 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       model_out_(lcm, names.model),
       status_(lcm, names.status, kProcessName),
       control_filter_(kProcessName) {
+  core_->hold(options.hold);
+  if (options.hold) spdlog::info("holding the set in use from the start (reidentifier.hold): nothing is published");
   out_.source = own_source_;
   out_.publisher_id = core_->in_use().own_publisher_id();
   model_msg_.source = own_source_;
@@ -164,10 +166,20 @@ void ReidentService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
   if (msg.command == control_t::SET_MODE && msg.target == kProcessName) {
     pin_model(msg);
+  } else if (msg.command == control_t::HOLD_PARAMS || msg.command == control_t::RELEASE_PARAMS) {
+    const bool on = msg.command == control_t::HOLD_PARAMS;
+    core_->hold(on);
+    acks_.acted(msg.request_id);
+    spdlog::info("{} (request {})",
+                 on ? "holding the set in use: refits are judged and reported, nothing is published"
+                    : "released: refits that beat the set in use are published again",
+                 msg.request_id);
   } else if (msg.command == control_t::SHUTDOWN) {
+    acks_.acted(msg.request_id);
     spdlog::info("shutdown requested (request {})", msg.request_id);  // once: the service stops
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
+    acks_.acted(msg.request_id);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogReset, steady_ns())) {
       spdlog::info("counters reset (request {}){}", msg.request_id, suppressed_note(g));
     }
@@ -180,11 +192,24 @@ void ReidentService::on_control(const control_t& msg) {
     reported_.rebase("params_out", params_out_.counters());
     reported_.rebase("model_out", model_out_.counters());
   }
+  if (msg.target == kProcessName && !acks_.due()) {
+    acks_.refused(msg.request_id,
+                  "command " + std::to_string(msg.command) +
+                      " is not the re-identifier's (pin-model, hold, reset-counters, shutdown)",
+                  wall_utime());
+  }
+  if (acks_.due()) publish_status(steady_us(), false);  // its sender waits for the answer
 }
 
 void ReidentService::publish_decision(const RefitDecision& d) {
   using Kind = RefitDecision::Kind;
   if (d.kind == Kind::none) return;
+  if (d.kind == Kind::held) {
+    spdlog::info(
+        "refit held (not published): c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}; held-out RMS {:.3g} m vs {:.3g} m in use",
+        d.candidate.c1, d.candidate.c2, d.candidate.c3, d.holdout_rms_candidate_m, d.holdout_rms_in_use_m);
+    return;
+  }
   if (d.kind == Kind::superseded) {
     spdlog::info("refit accepted but not adopted: the set in use changed to version {} meanwhile",
                  core_->in_use().version());
@@ -241,11 +266,23 @@ void ReidentService::pin_model(const control_t& msg) {
     case command_block_t::MODE_MEM: kind = ModelKind::mem; break;
     case command_block_t::MODE_PI: kind = ModelKind::pi; break;
     case command_block_t::MODE_KATALENIC: kind = ModelKind::katalenic; break;
-    default: spdlog::warn("pin-model request {}: mode {} names no model; ignored", msg.request_id, msg.mode); return;
+    default:
+      spdlog::warn("pin-model request {}: mode {} names no model; ignored", msg.request_id, msg.mode);
+      acks_.refused(msg.request_id, "mode " + std::to_string(msg.mode) + " names no model", wall_utime());
+      return;
   }
+  if (!chooser_->enabled()) {
+    spdlog::warn("pin-model request {} refused: reidentifier.models is off, no model choice runs", msg.request_id);
+    acks_.refused(msg.request_id,
+                  "reidentifier.models is off: no model choice runs to pin (set reidentifier.models: auto, or a list "
+                  "such as mem,pi, and restart the re-identifier)",
+                  wall_utime());
+    return;
+  }
+  acks_.acted(msg.request_id);
   chooser_->pin(kind);
-  spdlog::info("model {} (request {}){}", kind ? "pinned to " + std::string(to_string(*kind)) : "choice automatic",
-               msg.request_id, chooser_->enabled() ? "" : "; note: reidentifier.models is off, no model choice runs");
+  spdlog::info("model {} (request {})", kind ? "pinned to " + std::string(to_string(*kind)) : "choice automatic",
+               msg.request_id);
 }
 
 void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
@@ -283,6 +320,8 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
     why += fmt::format("; refit last {:.1f} ms, p50 {:.1f} ms, max {:.1f} ms", core_->last_refit_s() * 1e3,
                        refit.percentile(0.5) * 1e-6, static_cast<double>(refit.max_ns()) * 1e-6);
   }
+  if (core_->held()) why += "; holding the set in use (hystloop-ctl hold off releases it)";
+  if (const std::string note = acks_.refusal_note(wall_utime()); !note.empty()) why += "; " + note;
   if (chooser_->enabled()) {
     why += fmt::format("; model {}{}", to_string(chooser_->in_use().kind),
                        chooser_->pinned() ? fmt::format(" (pinned to {})", to_string(*chooser_->pinned())) : "");
@@ -290,6 +329,8 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   status_.begin(state, std::move(why));
   reported_.report(status_, counter_entries());
   status_.counter("params_version", static_cast<std::uint64_t>(in_use.version()));
+  status_.counter("params_held", core_->held() ? 1U : 0U);
+  acks_.report(status_);
   if (applied != ParamsInUse::kUnknownVersion) {  // absent until a command at or before a sample is heard
     status_.counter("params_version_applied", static_cast<std::uint64_t>(applied));
   }

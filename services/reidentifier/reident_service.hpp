@@ -39,6 +39,7 @@
 #include "reidentifier/model_chooser.hpp"
 #include "reidentifier/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
+#include "runtime/control_acks.hpp"
 #include "runtime/control_filter.hpp"
 #include "runtime/counter_set.hpp"
 #include "runtime/log_limiter.hpp"
@@ -77,6 +78,7 @@ class ReidentService {
   model_params_t model_msg_{};
   StatusReporter status_;
   ControlFilter control_filter_;
+  ControlAcks acks_;  // what was done with the last requests, for their senders
   // Log lines triggered by messages: at most one a second per kind (the next says how many were not).
   enum LogReason : std::size_t { kLogAdopted, kLogStale, kLogInvalid, kLogReset };
   LogLimiter log_limiter_;

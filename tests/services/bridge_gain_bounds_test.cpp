@@ -3,6 +3,7 @@
 // refused naming the field, the value and the bound, the gains in force staying.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 #include "bridge/bridge_settings.hpp"
@@ -72,6 +73,35 @@ TEST(BridgeGainBounds, ASetGainsBeyondThemIsRefusedNamingTheFieldAndTheGainsInFo
   EXPECT_EQ(next.nominal_gain_m_per_V, in_force.nominal_gain_m_per_V);
   EXPECT_EQ(next.tick_rate_hz, s.rate_hz);
   EXPECT_EQ(next.u_max_V, s.limits.u_max_V);
+}
+
+TEST(BridgeGainBounds, ARequestChangesOnlyTheGainsItGivesNaNKeepsTheOneInForce) {
+  const double keep = std::numeric_limits<double>::quiet_NaN();
+  FeedbackGains in_force;
+  in_force.kp = 0.1;
+  in_force.ki = 600.0;
+  in_force.kd = 1e-5;
+  in_force.notch_hz = 1720.0;
+  in_force.notch_q = 3.0;
+  control_t m = set_gains(0.2, keep, keep);
+  m.notch_hz = keep;
+  m.notch_q = keep;
+  const FeedbackGains next = requested_gains(in_force, m);
+  EXPECT_EQ(next.kp, 0.2);
+  EXPECT_EQ(next.ki, 600.0);  // not 0: the old ctl sent 0 for a gain it was not given
+  EXPECT_EQ(next.kd, 1e-5);
+  EXPECT_EQ(next.notch_hz, 1720.0);
+  EXPECT_EQ(next.notch_q, 3.0);
+
+  m = set_gains(keep, keep, keep);
+  m.notch_hz = 0.0;  // removes the notch, the gains stay
+  m.notch_q = keep;
+  const FeedbackGains no_notch = requested_gains(in_force, m);
+  EXPECT_FALSE(no_notch.has_notch());
+  EXPECT_EQ(no_notch.ki, 600.0);
+
+  // A partial request is bounded like a whole one.
+  EXPECT_THROW(requested_gains(in_force, set_gains(keep, 1e5, keep)), ParameterError);
 }
 
 }  // namespace

@@ -100,6 +100,28 @@ TEST(ReidentCore, AdoptsABetterSetWithTheNextVersion) {
   EXPECT_EQ(rig.core.in_use().version(), 2);
 }
 
+TEST(ReidentCore, HeldItJudgesAndCountsABetterSetButAdoptsNothingUntilReleased) {
+  Rig rig;
+  rig.core.hold(true);
+  rig.advance();
+  const RefitDecision held = rig.refit();
+  ASSERT_EQ(held.kind, Kind::held) << to_string(held.status);
+  EXPECT_LT(testdata::rel_err(held.candidate.c1, rig.truth.c1), 0.01);  // fitted and reported
+  EXPECT_LT(held.holdout_rms_candidate_m, 0.5 * held.holdout_rms_in_use_m);
+  EXPECT_EQ(rig.core.in_use().version(), 1);  // the set in use stays
+  EXPECT_DOUBLE_EQ(rig.core.in_use().params().c1, rig.initial.c1);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_held), 1u);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_accepted), 0u);
+
+  rig.core.hold(false);  // released: the next refit that beats the set in use is adopted
+  rig.now += kSecond;
+  rig.advance();
+  const RefitDecision released = rig.refit();
+  ASSERT_EQ(released.kind, Kind::accepted) << to_string(released.status);
+  EXPECT_EQ(rig.core.in_use().version(), released.version);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_held), 1u);
+}
+
 TEST(ReidentCore, SchedulesOneRefitPerPeriodOnceAFullWindowOfNewDataIsThere) {
   Rig rig;
   rig.advance(0.4);  // less than a window

@@ -1,0 +1,56 @@
+#pragma once
+// The servo's gains in force, as the bridge reports them on HX_STATUS and hystloop-ctl reads them
+// back. service_status_t carries integers only, so each gain travels as a counter in a fixed
+// fraction of its SI unit, named with that unit: "servo_kp_ppm" is kp x 1e6. The resolution
+// (1e-6 of kp, 1 ps of kd, 1 mHz of the notch) is far below anything a gain change is made with;
+// a partial change is merged by the bridge from the exact values, never from these.
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace hystloop {
+
+struct ServoGainsFigures {
+  double kp = 0.0;        // [-]
+  double ki_per_s = 0.0;  // [1/s]
+  double kd_s = 0.0;      // [s]
+  double notch_hz = 0.0;  // [Hz], 0 = no notch
+  double notch_q = 0.0;   // [-]
+};
+
+struct ServoGainCounter {
+  std::string_view name;
+  double scale;  // counter = round(value x scale)
+  double ServoGainsFigures::*value;
+};
+
+inline constexpr std::array<ServoGainCounter, 5> kServoGainCounters{{
+    {"servo_kp_ppm", 1e6, &ServoGainsFigures::kp},
+    {"servo_ki_ppm_per_s", 1e6, &ServoGainsFigures::ki_per_s},
+    {"servo_kd_ps", 1e12, &ServoGainsFigures::kd_s},
+    {"servo_notch_mHz", 1e3, &ServoGainsFigures::notch_hz},
+    {"servo_notch_q_ppm", 1e6, &ServoGainsFigures::notch_q},
+}};
+
+// The counter value of one gain (gains are >= 0 and bounded, so this fits).
+inline std::uint64_t servo_gain_counter(const ServoGainCounter& c, const ServoGainsFigures& g) noexcept {
+  const double v = g.*c.value * c.scale;
+  return v > 0.0 && std::isfinite(v) ? static_cast<std::uint64_t>(std::llround(v)) : 0U;
+}
+
+// The gains from a report's counters; nullopt when any is missing (a bridge that reports none).
+template <class FindCounter>
+std::optional<ServoGainsFigures> servo_gains_from_counters(FindCounter&& find) {
+  ServoGainsFigures g;
+  for (const ServoGainCounter& c : kServoGainCounters) {
+    const std::optional<std::int64_t> v = find(c.name);
+    if (!v) return std::nullopt;
+    g.*c.value = static_cast<double>(*v) / c.scale;
+  }
+  return g;
+}
+
+}  // namespace hystloop
