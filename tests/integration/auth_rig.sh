@@ -36,11 +36,13 @@ sleep 1.0
 "$ctl" --key-file "$key" reset-counters >/dev/null   # signed: counts from here on
 sleep 0.3
 
-# The foreign publisher: no key.
-"$ctl" arm >/dev/null
-"$ctl" mode off >/dev/null
+# The foreign publisher: no key. Nothing it asks for is confirmed (hystloop-ctl exits 1).
+for request in "arm" "mode off" "params --c1 5e-9 --c2 1e-12 --c3 1.2 --version 9"; do
+  # shellcheck disable=SC2086  # the words of the request
+  if "$ctl" $request --timeout 1 >"$dir/foreign.out" 2>&1; then fail "an unsigned '$request' was confirmed"; fi
+  grep -q "not confirmed\|did not adopt" "$dir/foreign.out" || fail "ctl $request: $(cat "$dir/foreign.out")"
+done
 "$ctl" trajectory --shape hold --offset 1e-7 --no-wait >/dev/null  # refused unsigned: no verdict to wait for
-"$ctl" params --c1 5e-9 --c2 1e-12 --c3 1.2 --version 9 >/dev/null
 "$authp" commands --count 10 >/dev/null
 # A signed block captured now and replayed at once: its counter was seen.
 "$authp" capture --channel COMMAND --out "$dir/now.bin" >/dev/null
@@ -89,7 +91,7 @@ echo "bridge refused: command unsigned $(value bridge command.rejected_unsigned)
 start_recording
 "$authp" capture --channel CONTROL --out "$dir/arm.bin" >"$dir/capture_arm.out" 2>&1 & cap=$!; pids+=($cap)
 sleep 0.3
-"$ctl" --key-file "$key" arm >/dev/null
+"$ctl" --key-file "$key" arm --no-wait >/dev/null  # no bridge runs to confirm it: it is captured
 wait $cap || fail "no signed ARM captured"
 "$bridge" "${bridge_args[@]}" "${auth[@]}" --summary-json "$dir/bridge2.json" >"$dir/bridge2.log" 2>&1 & b2=$!; pids+=($b2)
 wait_log "$dir/bridge2.log" "started in the safe state"

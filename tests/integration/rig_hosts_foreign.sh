@@ -26,10 +26,11 @@ foreign_counts >"$out/foreign-before.txt"
 complete_rows() { head -n -1 "$out/desk/sensor.csv"; }
 seq_before=$(complete_rows | tail -n 1 | cut -d, -f1)
 foreign() { in_ns desk "$ctl_exe" --lcm-url "$foreign_url" --allow-network --rig "$prefix" "$@" >/dev/null; }
-foreign arm
-foreign experiment --mem-paper --duration 2
-foreign trajectory --mem-paper --blend 0.5 --no-wait  # refused unsigned: no verdict to wait for
-foreign params --c1 2e-9 --c2 2e-9 --c3 0.3 --version 1000
+if foreign arm --timeout 1 2>/dev/null; then echo "FAIL: a keyless ARM from the desk was confirmed"; fail=1
+else echo "ok:   a keyless ARM from the desk is not confirmed (hystloop-ctl exit 1)"; fi
+foreign experiment --mem-paper --duration 2 --no-wait  # refused unsigned: nobody answers
+foreign trajectory --mem-paper --blend 0.5 --no-wait
+foreign params --c1 2e-9 --c2 2e-9 --c3 0.3 --version 1000 --no-wait
 # A keyless service on a host's network is refused unless that is chosen twice (auth.keyless and
 # auth.allow_keyless_network): the desk has a veth up, and ttl=0 would not keep the LAN out.
 set +e

@@ -24,7 +24,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::chrono::microseconds until(Clock::time_point deadline) {
+std::chrono::microseconds until_deadline(Clock::time_point deadline) {
   return std::max(std::chrono::microseconds(0),
                   std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()));
 }
@@ -51,7 +51,7 @@ int run_status(CtlLink& link, const StatusOptions& o) {
   const auto deadline = after(waiting ? o.timeout_s : o.listen_s);
   HealthVerdict verdict;
   while (Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(100'000))) < 0) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(100'000))) < 0) {
       std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
       return 1;
     }
@@ -123,7 +123,7 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   const auto end = o.seconds > 0 ? after(o.seconds) : Clock::time_point::max();
   while (!stop_requested()) {
     const auto wake = std::min(next_print, end);
-    if (handle_pending(link.lcm(), std::min(until(wake), std::chrono::microseconds(50'000)), 1024) < 0) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(wake), std::chrono::microseconds(50'000)), 1024) < 0) {
       std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
       return 1;
     }
@@ -164,7 +164,7 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
   if (!o.wait) return 0;
   const auto deadline = after(o.timeout_s);
   while (verdict.outcome == TrajectoryOutcome::kPending && Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(50'000))) < 0) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000))) < 0) {
       std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
       return 1;
     }
@@ -201,6 +201,81 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
   return 1;
 }
 
+int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& o,
+                           std::map<std::string, service_status_t>* last) {
+  // Listening before publishing: a process answers right after it acts.
+  AckTracker tracker(msg.request_id, o.expected, o.state);
+  std::map<std::string, service_status_t> heard;
+  Subscription<service_status_t> status(link.lcm(), link.channels().status,
+                                        [&](const service_status_t& s, std::int64_t) {
+                                          tracker.update(s);
+                                          heard[s.process] = s;
+                                        });
+  if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().control.c_str());
+    return 1;
+  }
+  const std::string to_whom = msg.target.empty() ? "every process" : "'" + msg.target + "'";
+  std::printf("hystloop-ctl: sent %s to %s on %s (request %lld)\n", what.c_str(), to_whom.c_str(),
+              link.channels().control.c_str(), static_cast<long long>(msg.request_id));
+  std::fflush(stdout);
+  if (!o.wait) return 0;
+  const auto start = Clock::now();
+  const auto deadline = after(o.timeout_s);
+  const auto gathered = after(std::min(o.gather_s, o.timeout_s));
+  while (Clock::now() < deadline && !tracker.finished(Clock::now() >= gathered)) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(20'000))) < 0) {
+      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
+      return 1;
+    }
+  }
+  if (last != nullptr) *last = heard;
+  const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
+  if (heard.empty()) {
+    std::fprintf(stderr, "hystloop-ctl: no rig is running: nothing reported on %s within %g s (%s not confirmed)\n",
+                 link.channels().status.c_str(), o.timeout_s, what.c_str());
+    return 1;
+  }
+  const bool ok = tracker.all_confirmed(true);
+  for (const std::string& line : describe_answers(tracker, true)) {
+    std::fprintf(ok ? stdout : stderr, "hystloop-ctl: %s\n", line.c_str());
+  }
+  if (ok) {
+    std::printf("hystloop-ctl: %s confirmed in %.0f ms\n", what.c_str(), waited_s * 1e3);
+  } else {
+    std::fprintf(stderr, "hystloop-ctl: %s not confirmed (waited %.1f s of --timeout %g s)\n", what.c_str(), waited_s,
+                 o.timeout_s);
+  }
+  return ok ? 0 : 1;
+}
+
+std::optional<service_status_t> listen_for_status(CtlLink& link, const std::string& process, double timeout_s) {
+  std::optional<service_status_t> found;
+  Subscription<service_status_t> status(link.lcm(), link.channels().status,
+                                        [&](const service_status_t& s, std::int64_t) {
+                                          if (s.process == process) found = s;
+                                        });
+  const auto deadline = after(timeout_s);
+  while (!found && Clock::now() < deadline) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000))) < 0) break;
+  }
+  return found;
+}
+
+StatusWait wait_for_status(CtlLink& link, const std::string& process, const StateCheck& until, double timeout_s) {
+  StatusWait w;
+  Subscription<service_status_t> status(link.lcm(), link.channels().status,
+                                        [&](const service_status_t& s, std::int64_t) {
+                                          w.last[s.process] = s;
+                                          if (s.process == process && until(s)) w.satisfied = true;
+                                        });
+  const auto deadline = after(timeout_s);
+  while (!w.satisfied && Clock::now() < deadline) {
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(20'000))) < 0) break;
+  }
+  return w;
+}
+
 int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const SeriesRunOptions& o) {
   install_stop_handlers();
   SeriesTracker tracker(steps, o.dt_s);
@@ -234,7 +309,8 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
       },
       sensor_queue);
   auto pump = [&](Clock::time_point until_time) {
-    return handle_pending(link.lcm(), std::min(until(until_time), std::chrono::microseconds(50'000)), 4096) >= 0;
+    return handle_pending(link.lcm(), std::min(until_deadline(until_time), std::chrono::microseconds(50'000)), 4096) >=
+           0;
   };
 
   // Commands must flow, and no experiment may be running: ours would queue behind it.
@@ -349,7 +425,8 @@ std::int32_t next_params_version(CtlLink& link, double listen_s) {
       queue);
   const auto deadline = after(listen_s);
   while (Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until(deadline), std::chrono::microseconds(50'000)), 1024) < 0) break;
+    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000)), 1024) < 0)
+      break;
   }
   // Saturating: after a forged 2147483647 the set still goes out (as a new publisher it is taken anyway).
   return highest < std::numeric_limits<std::int32_t>::max() ? highest + 1 : highest;

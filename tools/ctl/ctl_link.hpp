@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
+#include <optional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -11,7 +13,10 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "ctl_ack.hpp"
 #include "ctl_series.hpp"
+#include "hystloop/control_t.hpp"
+#include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
@@ -97,6 +102,33 @@ struct VerdictOptions {
 // not be published.
 int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
                        const VerdictOptions& options);
+
+struct AckOptions {
+  bool wait = true;        // wait for the answers (else: send and return)
+  double timeout_s = 3.0;  // how long
+  // The processes that must answer; empty = every process heard within gather_s.
+  std::vector<std::string> expected;
+  StateCheck state;       // the state a confirming report shows (empty: acting is enough)
+  double gather_s = 1.2;  // with no expected list: how long to collect who is running (status is 1 Hz)
+};
+
+// Publishes `msg` (3 copies) on the control channel, prints "sent <what> ...", and, with wait,
+// follows the status channel until every expected process has answered (ctl_ack.hpp), printing
+// each answer. `last` (if given) receives the latest report of each process heard. Returns 0 when
+// sent (no wait) or confirmed by all, 1 when refused, not confirmed in time, nobody reported, or
+// it could not be published.
+int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& options,
+                           std::map<std::string, service_status_t>* last = nullptr);
+
+// The latest report of `process` within timeout_s (it reports once a second), or nullopt.
+std::optional<service_status_t> listen_for_status(CtlLink& link, const std::string& process, double timeout_s);
+
+struct StatusWait {
+  bool satisfied = false;
+  std::map<std::string, service_status_t> last;  // the latest report of every process heard
+};
+// Follows the status channel until `process` sends a report that `until` accepts, or timeout_s.
+StatusWait wait_for_status(CtlLink& link, const std::string& process, const StateCheck& until, double timeout_s);
 
 // The highest parameter version seen on HX_PARAMS or in HX_COMMAND's ticks within listen_s, plus one
 // (1 when nothing was seen), so that a set sent by hand supersedes the one in use.

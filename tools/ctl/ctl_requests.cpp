@@ -2,6 +2,7 @@
 
 #include <array>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -69,22 +70,23 @@ control_t make_control(std::int8_t command, std::string target, std::int64_t req
 }
 
 void GainsRequest::validate() const {
-  require_non_negative("kp", kp);
-  require_non_negative("ki", ki);
-  require_non_negative("kd", kd);
   // The servo's plausibility bounds at the default rig (10 kHz, the 1 kHz derivative filter), as
-  // kMaxNotch_hz assumes it too; the bridge checks again at its own tick rate.
+  // kMaxNotch_hz assumes it too; the bridge checks again at its own tick rate, with the gains
+  // not given as they are in force there.
   FeedbackGains servo;
-  servo.kp = kp;
-  servo.ki = ki;
-  servo.kd = kd;
+  const auto check = [](const char* name, const std::optional<double>& v, double& into) {
+    if (!v) return;
+    require_non_negative(name, *v);
+    into = *v;
+  };
+  check("kp", kp, servo.kp);
+  check("ki", ki, servo.ki);
+  check("kd", kd, servo.kd);
   servo.check_bounds("");
-  require_in_range("notch-hz", notch_hz, 0.0, kMaxNotch_hz);
-  if (notch_hz > 0.0) {
-    if (notch_q == 0.0) throw ParameterError("notch-q", "give the notch's quality factor with --notch-hz");
-    require_in_range("notch-q", notch_q, kMinNotchQ, kMaxNotchQ);
-  } else if (notch_q != 0.0) {
-    throw ParameterError("notch-q", "only with a notch (--notch-hz > 0)");
+  if (notch_hz) require_in_range("notch-hz", *notch_hz, 0.0, kMaxNotch_hz);
+  if (notch_q) {
+    if (notch_hz && *notch_hz == 0.0) throw ParameterError("notch-q", "only with a notch (--notch-hz > 0)");
+    require_in_range("notch-q", *notch_q, kMinNotchQ, kMaxNotchQ);
   }
 }
 
@@ -103,11 +105,12 @@ void ExperimentRequest::validate() const {
 
 void apply(const GainsRequest& gains, control_t& msg) {
   gains.validate();
-  msg.kp = gains.kp;
-  msg.ki = gains.ki;
-  msg.kd = gains.kd;
-  msg.notch_hz = gains.notch_hz;
-  msg.notch_q = gains.notch_q;
+  const double keep = std::numeric_limits<double>::quiet_NaN();  // the bridge keeps that one
+  msg.kp = gains.kp.value_or(keep);
+  msg.ki = gains.ki.value_or(keep);
+  msg.kd = gains.kd.value_or(keep);
+  msg.notch_hz = gains.notch_hz.value_or(keep);
+  msg.notch_q = gains.notch_q.value_or(keep);
 }
 
 void apply(const ExperimentRequest& experiment, control_t& msg) {

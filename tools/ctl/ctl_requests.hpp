@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,18 +27,20 @@ std::int8_t parse_mode(std::string_view name);
 control_t make_control(std::int8_t command, std::string target, std::int64_t request_id, std::int64_t utime);
 
 struct GainsRequest {
-  double kp = 0.0;  // [-]
-  double ki = 0.0;  // [1/s]
-  double kd = 0.0;  // [s]
-  // The servo's notch at the stage's resonance: centre [Hz], 0 = none (a request without one
-  // removes it), else in (0, kMaxNotch_hz]; and its quality factor, in [kMinNotchQ, kMaxNotchQ]
-  // with a notch, 0 without.
-  double notch_hz = 0.0;
-  double notch_q = 0.0;
+  // Each gain the request changes; one not given stays as in force (sent as NaN).
+  std::optional<double> kp;  // [-]
+  std::optional<double> ki;  // [1/s]
+  std::optional<double> kd;  // [s]
+  // The servo's notch at the stage's resonance: centre [Hz], 0 = remove it, else in
+  // (0, kMaxNotch_hz]; and its quality factor, in [kMinNotchQ, kMaxNotchQ].
+  std::optional<double> notch_hz;
+  std::optional<double> notch_q;
   static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
   static constexpr double kMinNotchQ = 0.1;
   static constexpr double kMaxNotchQ = 50.0;
-  // Gains finite, >= 0 and within the servo's plausibility bounds at 10 kHz (kp <= 2, ki <= 1e4 1/s,
+  // Nothing given: the request is a question (print the gains in force).
+  bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q; }
+  // Given gains finite, >= 0 and within the servo's plausibility bounds at 10 kHz (kp <= 2, ki <= 1e4 1/s,
   // kd <= 5.2e-4 s: loop/feedback.hpp); the notch as above ("notch-hz", "notch-q").
   void validate() const;
 };

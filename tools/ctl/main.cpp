@@ -30,6 +30,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -37,12 +38,15 @@
 
 #include "core/cli.hpp"
 #include "core/errors.hpp"
+#include "ctl_ack.hpp"
 #include "ctl_config_get.hpp"
+#include "ctl_health.hpp"
 #include "ctl_link.hpp"
 #include "ctl_pin_model.hpp"
 #include "ctl_requests.hpp"
 #include "auth/rig_key.hpp"
 #include "lcm/rig_auth.hpp"
+#include "lcm/servo_gains_status.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -74,24 +78,74 @@ struct Options {
   double params_listen_s = 1.5;
   StatusOptions status;
   WatchOptions watch;
+  AckOptions ack;
 };
 
-std::string to_whom(const std::string& target) { return target.empty() ? "every process" : "'" + target + "'"; }
+// Who answers a request: the target named, else the process whose command it is ("" = all heard).
+std::vector<std::string> answering(const std::string& target, const char* owner) {
+  if (!target.empty()) return {target};
+  if (owner != nullptr) return {owner};
+  return {};
+}
 
-int send_control(const Options& o, std::int8_t command, const std::string& target, const char* what,
-                 const std::function<void(control_t&)>& fill = {}) {
+int send_control(const Options& o, std::int8_t command, const std::string& target, const std::string& what,
+                 const char* owner, StateCheck state = {}, const std::function<void(control_t&)>& fill = {},
+                 std::map<std::string, service_status_t>* last = nullptr) {
   const std::int64_t now = wall_utime();
   control_t msg = make_control(command, target, new_request_id(now, static_cast<int>(::getpid())), now);
   if (fill) fill(msg);
   if (check_message(msg) != Verdict::kOk) throw ParameterError(what, "refused by the message contract");
+  AckOptions ack = o.ack;
+  ack.expected = answering(target, owner);
+  ack.state = std::move(state);
   CtlLink link(o.link);
-  if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
-    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().control.c_str());
-    return 1;
+  return send_control_confirmed(link, msg, what, ack, last);
+}
+
+std::string format_gains(const ServoGainsFigures& g) {
+  char text[256];
+  std::snprintf(text, sizeof text, "kp %g, ki %g 1/s, kd %g s, %s", g.kp, g.ki_per_s, g.kd_s,
+                g.notch_hz > 0.0 ? "" : "no notch");
+  std::string out = text;
+  if (g.notch_hz > 0.0) {
+    std::snprintf(text, sizeof text, "notch at %g Hz (Q %g)", g.notch_hz, g.notch_q);
+    out += text;
   }
-  std::printf("hystloop-ctl: sent %s to %s on %s (request %lld)\n", what, to_whom(target).c_str(),
-              link.channels().control.c_str(), static_cast<long long>(msg.request_id));
-  return 0;
+  return out;
+}
+
+std::optional<ServoGainsFigures> gains_of(const service_status_t& s) {
+  return servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); });
+}
+
+int run_gains(Options& o) {
+  const std::string bridge = o.gains_target;
+  if (o.gains.empty()) {  // a question: the gains in force
+    CtlLink link(o.link);
+    const auto report = listen_for_status(link, bridge, o.ack.timeout_s);
+    if (!report) {
+      std::fprintf(stderr, "hystloop-ctl: no status from '%s' on %s within %g s: is a rig running?\n", bridge.c_str(),
+                   link.channels().status.c_str(), o.ack.timeout_s);
+      return 1;
+    }
+    const auto g = gains_of(*report);
+    if (!g) {
+      std::fprintf(stderr, "hystloop-ctl: '%s' reports no servo gains (a build that does not?)\n", bridge.c_str());
+      return 1;
+    }
+    std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
+    return 0;
+  }
+  o.gains.validate();
+  std::map<std::string, service_status_t> last;
+  const int rc = send_control(
+      o, control_t::SET_GAINS, bridge, "SET_GAINS", nullptr, {}, [&](control_t& msg) { apply(o.gains, msg); }, &last);
+  if (const auto it = last.find(bridge); it != last.end()) {
+    if (const auto g = gains_of(it->second)) {
+      std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
+    }
+  }
+  return rc;
 }
 
 int send_trajectory(const Options& o) {
@@ -128,7 +182,34 @@ int send_params(const Options& o) {
   }
   std::printf("hystloop-ctl: sent MEM parameters v%d c1 %g m/V c2 %g c3 %g on %s\n", msg.version, msg.c1, msg.c2,
               msg.c3, link.channels().params.c_str());
-  return 0;
+  std::fflush(stdout);
+  if (!o.ack.wait) return 0;
+  const std::string& compensator = o.verdict.compensator_process;
+  const StatusWait w = wait_for_status(link, compensator, counter_is("params_version", msg.version), o.ack.timeout_s);
+  if (const auto r = w.last.find(kPinModelTarget); r != w.last.end() && find_counter(r->second, "params_held") == 0) {
+    std::printf(
+        "hystloop-ctl: note: the re-identifier runs and is not holding: its next refit replaces this set "
+        "(hystloop-ctl hold on keeps it)\n");
+  }
+  if (w.satisfied) {
+    std::printf("hystloop-ctl: '%s' adopted parameters v%d\n", compensator.c_str(), msg.version);
+    return 0;
+  }
+  const auto c = w.last.find(compensator);
+  if (c == w.last.end()) {
+    std::fprintf(stderr, "hystloop-ctl: no status from '%s' on %s within %g s: %s\n", compensator.c_str(),
+                 link.channels().status.c_str(), o.ack.timeout_s,
+                 w.last.empty() ? "no rig is running" : "is the compensator running, under this name?");
+    return 1;
+  }
+  const auto in_use = find_counter(c->second, "params_version");
+  std::fprintf(stderr,
+               "hystloop-ctl: '%s' did not adopt parameters v%d within %g s (in use: %s). A set is swapped in at "
+               "the next reversal of the stage's input, so a stage at rest takes it only once it moves (--no-wait "
+               "sends it without waiting); refused sets are counted as params_rejected and logged with the reason\n",
+               compensator.c_str(), msg.version, o.ack.timeout_s,
+               in_use ? ("v" + std::to_string(*in_use)).c_str() : "not reported");
+  return 1;
 }
 
 int run_banning_series(Options& o) {
@@ -145,9 +226,20 @@ int run_banning_series(Options& o) {
   return run_series(link, steps, o.series);
 }
 
-CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, Options& o) {
+// Every request that changes state waits for its answer on the status channel.
+void add_wait_options(CLI::App* sub, Options& o) {
+  auto* no_wait = sub->add_flag(
+      "--no-wait", [&o](std::int64_t) { o.ack.wait = false; },
+      "Send and return at once, without waiting for the process to confirm on the status channel");
+  sub->add_option("--timeout", o.ack.timeout_s, "How long to wait for the confirmation [s]")
+      ->capture_default_str()
+      ->excludes(no_wait);
+}
+
+CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, Options& o, bool wait_options = true) {
   CLI::App* sub = app.add_subcommand(name, help);
-  sub->add_option("--target", o.target, "Process the request is for (default: every process)");
+  sub->add_option("--target", o.target, "Process the request is for (default: the process whose command it is)");
+  if (wait_options) add_wait_options(sub, o);
   return sub;
 }
 
@@ -195,37 +287,50 @@ int run(int argc, char** argv) {
   CLI::App* stop_exp = control_subcommand(app, "stop-experiment", "Compensator: stop the identification experiment", o);
   CLI::App* shutdown = app.add_subcommand("shutdown", "Stop a process cleanly (default: every process)");
   shutdown->add_option("process", o.process, "Process to stop (default: all)");
+  add_wait_options(shutdown, o);
   CLI::App* reset = app.add_subcommand("reset-counters", "Zero the status counters of a process (default: all)");
   reset->add_option("process", o.process, "Process (default: all)");
+  add_wait_options(reset, o);
 
   CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
   mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
   std::string pin_model;
   CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
   pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
+  add_wait_options(pin, o);
+  std::string hold_what;
+  CLI::App* hold = app.add_subcommand(
+      "hold",
+      "Re-identifier: hold the parameters and model in use (it keeps fitting and reporting, publishes nothing)");
+  hold->add_option("what", hold_what, "on (hold) or off (release: publish what it fits from now on)")
+      ->required()
+      ->check(CLI::IsMember({"on", "off"}));
+  add_wait_options(hold, o);
 
   CLI::App* gains = app.add_subcommand(
-      "gains", "Bridge: the servo's gains (normalised PID, all >= 0; kp <= 2, ki dt <= 1, kd bounded alike)");
+      "gains",
+      "Bridge: change the servo's gains given (the others stay as in force), or print the gains in force "
+      "(no gain given); normalised PID, all >= 0; kp <= 2, ki dt <= 1, kd bounded alike");
   gains->add_option("--target", o.gains_target, "Process of the servo (the bridge)")->capture_default_str();
-  gains->add_option("--kp", o.gains.kp, "Proportional gain [-]")->capture_default_str();
-  gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]")->capture_default_str();
-  gains->add_option("--kd", o.gains.kd, "Derivative gain [s]")->capture_default_str();
-  gains
-      ->add_option("--notch-hz", o.gains.notch_hz,
-                   "Notch at the stage's resonance [Hz], in (0, 4500]; 0 = none (a request without it removes it)")
-      ->capture_default_str();
+  gains->add_option("--kp", o.gains.kp, "Proportional gain [-]");
+  gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]");
+  gains->add_option("--kd", o.gains.kd, "Derivative gain [s]");
+  gains->add_option("--notch-hz", o.gains.notch_hz,
+                    "Notch at the stage's resonance [Hz], in (0, 4500]; 0 removes the notch");
   gains->add_option("--notch-q", o.gains.notch_q, "The notch's quality factor (centre / width), in [0.1, 50]");
+  add_wait_options(gains, o);
 
   CLI::App* learn = app.add_subcommand("learn", "Compensator: learning of the feedforward for periodic references");
   learn->add_option("what", o.learning, "on, off (drops the correction, ramped out) or reset (starts again)")
       ->required();
   learn->add_option("--target", o.learn_target, "Process that learns (the compensator)")->capture_default_str();
+  add_wait_options(learn, o);
 
   CLI::App* experiment = control_subcommand(
       app, "experiment",
       "Compensator: run an identification experiment (a sine, the MEM paper's input, or Banning's series); "
       "requests sent while one runs wait and run back to back",
-      o);
+      o, false);
   auto* amplitude = experiment->add_option("--amplitude", o.experiment.amplitude_V, "Excitation amplitude [V], > 0");
   auto* frequency = experiment->add_option("--frequency", o.experiment.frequency_Hz, "Excitation frequency [Hz], > 0");
   auto* duration = experiment->add_option("--duration", o.experiment.duration_s,
@@ -262,10 +367,13 @@ int run(int argc, char** argv) {
   plan_option("--frequency-amplitude", o.plan.frequency_amplitude_V, "series: their amplitude [V]");
   experiment->add_flag("--list", o.series_list, "series: print the steps and their duration, send nothing")
       ->needs(series);
-  experiment
-      ->add_flag(
-          "--no-wait", [&](std::int64_t) { o.series.wait = false; }, "series: send and return at once")
-      ->needs(series);
+  experiment->add_flag(
+      "--no-wait",
+      [&](std::int64_t) {
+        o.series.wait = false;
+        o.ack.wait = false;
+      },
+      "Send and return at once (without it: wait for the compensator to confirm; a series is followed to its end)");
   experiment->add_option("--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")
       ->capture_default_str()
       ->needs(series);
@@ -311,6 +419,9 @@ int run(int argc, char** argv) {
                      "publishes with a new publisher id, so the compensator takes it whatever others sent");
   params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
       ->capture_default_str();
+  params->add_option("--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS")
+      ->capture_default_str();
+  add_wait_options(params, o);
 
   CLI::App* watch = app.add_subcommand("watch",
                                        "Print the tracking error (from HX_SENSOR), params version, late "
@@ -339,31 +450,34 @@ int run(int argc, char** argv) {
       CtlLink link(o.link);
       return run_status(link, o.status);
     }
-    if (*arm) return send_control(o, control_t::ARM, o.target, "ARM");
-    if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM");
-    if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT");
-    if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN");
-    if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS");
+    if (*arm) return send_control(o, control_t::ARM, o.target, "ARM", "bridge", counter_is("armed", 1));
+    if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM", "bridge", counter_is("armed", 0));
+    if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT", "compensator");
+    if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN", nullptr);
+    if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
     if (*pin) {
       const std::int8_t m = ctl::pin_model_mode(pin_model);
-      return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, ("PIN_MODEL " + pin_model).c_str(),
+      return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, "PIN_MODEL " + pin_model, nullptr, {},
                           [m](control_t& msg) { msg.mode = m; });
+    }
+    if (*hold) {
+      const bool on = hold_what == "on";
+      return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, ctl::kPinModelTarget,
+                          on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr, counter_is("params_held", on ? 1 : 0));
     }
     if (*mode) {
       const std::int8_t m = parse_mode(o.mode);
-      return send_control(o, control_t::SET_MODE, o.target, ("SET_MODE " + o.mode).c_str(),
+      return send_control(o, control_t::SET_MODE, o.target, "SET_MODE " + o.mode, "compensator", counter_is("mode", m),
                           [m](control_t& msg) { msg.mode = m; });
     }
     if (*gains) {
-      o.gains.validate();
       if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
-      return send_control(o, control_t::SET_GAINS, o.gains_target, "SET_GAINS",
-                          [&](control_t& msg) { apply(o.gains, msg); });
+      return run_gains(o);
     }
     if (*learn) {
       const std::int8_t l = parse_learning(o.learning);
       if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
-      return send_control(o, control_t::SET_LEARNING, o.learn_target, ("SET_LEARNING " + o.learning).c_str(),
+      return send_control(o, control_t::SET_LEARNING, o.learn_target, "SET_LEARNING " + o.learning, nullptr, {},
                           [l](control_t& msg) { msg.learning = l; });
     }
     if (*experiment) {
@@ -376,7 +490,7 @@ int run(int argc, char** argv) {
                              "--banning-series");
       }
       o.experiment.validate();
-      return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT",
+      return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
                           [&](control_t& msg) { apply(o.experiment, msg); });
     }
     if (*trajectory) return send_trajectory(o);

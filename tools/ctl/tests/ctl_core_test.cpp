@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "ctl_ack.hpp"
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
 #include "ctl_series.hpp"
@@ -22,6 +23,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/message_checks.hpp"
+#include "lcm/servo_gains_status.hpp"
 
 using namespace hystloop;
 using namespace hystloop::ctl;
@@ -60,8 +62,11 @@ TEST(CtlRequests, RequestIdsArePositiveAndDiffer) {
 }
 
 TEST(CtlRequests, GainsAndExperimentAreCheckedAndPassTheContract) {
-  EXPECT_EQ(field_of([] { GainsRequest{-1, 0, 0}.validate(); }), "kp");
-  EXPECT_EQ(field_of([] { GainsRequest{0, std::numeric_limits<double>::quiet_NaN(), 0}.validate(); }), "ki");
+  EXPECT_EQ(field_of([] { GainsRequest{-1, 0, 0, std::nullopt, std::nullopt}.validate(); }), "kp");
+  EXPECT_EQ(field_of([] {
+              GainsRequest{0, std::numeric_limits<double>::quiet_NaN(), 0, std::nullopt, std::nullopt}.validate();
+            }),
+            "ki");
   ExperimentRequest x;
   x.amplitude_V = 10;
   x.frequency_Hz = 0;
@@ -83,21 +88,38 @@ TEST(CtlRequests, GainsCarryANotchWithinItsBounds) {
   EXPECT_EQ(msg.notch_hz, 1700.0);
   EXPECT_EQ(msg.notch_q, 4.0);
   EXPECT_EQ(check_message(msg), Verdict::kOk);
-  apply(GainsRequest{0.1, 600, 0}, msg);  // no notch: 0 removes it
+  apply(GainsRequest{0.1, 600, 0, 0.0, std::nullopt}, msg);  // --notch-hz 0 removes it
   EXPECT_EQ(msg.notch_hz, 0.0);
-  EXPECT_EQ(msg.notch_q, 0.0);
+  EXPECT_TRUE(std::isnan(msg.notch_q));
   EXPECT_NO_THROW((GainsRequest{0, 0, 0, 4500.0, 0.1}.validate()));
   EXPECT_NO_THROW((GainsRequest{0, 0, 0, 1e-3, 50.0}.validate()));
+  EXPECT_NO_THROW((GainsRequest{0, 0, 0, 1700.0, std::nullopt}.validate()));  // the Q in force stays
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 4500.1, 2.0}.validate(); }), "notch-hz");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, -1.0, 2.0}.validate(); }), "notch-hz");
   EXPECT_EQ(field_of([] {
               GainsRequest{0, 0, 0, std::numeric_limits<double>::quiet_NaN(), 2.0}.validate();
             }),
             "notch-hz");
-  EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.0}.validate(); }), "notch-q");  // not given
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 0.09}.validate(); }), "notch-q");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 1700.0, 50.5}.validate(); }), "notch-q");
   EXPECT_EQ(field_of([] { GainsRequest{0, 0, 0, 0.0, 3.0}.validate(); }), "notch-q");  // a Q without a notch
+}
+
+TEST(CtlRequests, AGainNotGivenIsSentAsNaNSoTheBridgeKeepsItsOwn) {
+  GainsRequest g;
+  EXPECT_TRUE(g.empty());  // a question, not a request
+  g.kp = 0.2;
+  EXPECT_FALSE(g.empty());
+  control_t msg = make_control(control_t::SET_GAINS, "bridge", 9, 1);
+  apply(g, msg);
+  EXPECT_EQ(msg.kp, 0.2);
+  EXPECT_TRUE(std::isnan(msg.ki));
+  EXPECT_TRUE(std::isnan(msg.kd));
+  EXPECT_TRUE(std::isnan(msg.notch_hz));
+  EXPECT_TRUE(std::isnan(msg.notch_q));
+  EXPECT_EQ(check_message(msg), Verdict::kOk);
+  g.ki = 2e4;  // past ki dt <= 1 at 10 kHz, given alone
+  EXPECT_EQ(field_of([&] { g.validate(); }), "ki");
 }
 
 TEST(CtlRequests, LearningByName) {
@@ -359,6 +381,81 @@ service_status_t compensator_report(std::int64_t accepted, std::int64_t refused,
   s.n_counters = 4;
   return s;
 }
+service_status_t answering(const std::string& process, std::int64_t acted, std::int64_t refused, std::int64_t armed,
+                           const std::string& detail = {}) {
+  service_status_t s{};
+  s.process = process;
+  s.state = service_status_t::HEALTHY;
+  s.detail = detail;
+  s.counter_names = {"control_acted_request", "control_refused_request", "armed"};
+  s.counter_values = {acted, refused, armed};
+  s.n_counters = 3;
+  return s;
+}
+
+TEST(CtlAck, AReportAnswersARequestByItsIdAndTheStateItAskedFor) {
+  const StateCheck armed = counter_is("armed", 1);
+  EXPECT_EQ(read_ack(answering("bridge", 5, 0, 0), 6, armed).outcome, AckOutcome::kPending);
+  EXPECT_EQ(read_ack(answering("bridge", 6, 0, 0), 6, armed).outcome, AckOutcome::kActed);  // not armed yet
+  EXPECT_EQ(read_ack(answering("bridge", 6, 0, 1), 6, armed).outcome, AckOutcome::kConfirmed);
+  EXPECT_EQ(read_ack(answering("bridge", 6, 0, 0), 6).outcome, AckOutcome::kConfirmed);  // no state to show
+  const AckReading refused = read_ack(answering("bridge", 5, 6, 0, "u 0 V; request 6 refused: stopping"), 6, armed);
+  EXPECT_EQ(refused.outcome, AckOutcome::kRefused);
+  EXPECT_EQ(refused.detail, "stopping");
+  EXPECT_EQ(read_ack(answering("bridge", 9, 0, 1), 6, armed).outcome, AckOutcome::kSkipped);
+  service_status_t old_build{};
+  old_build.process = "bridge";
+  EXPECT_FALSE(read_ack(old_build, 6).acknowledges);
+}
+
+TEST(CtlAck, ATrackerWaitsForEveryExpectedProcessOrEveryOneHeard) {
+  AckTracker for_bridge(6, {"bridge"}, counter_is("armed", 1));
+  for_bridge.update(answering("compensator", 6, 0, 1));  // not the one asked
+  EXPECT_FALSE(for_bridge.finished(true));
+  for_bridge.update(answering("bridge", 6, 0, 0));
+  EXPECT_FALSE(for_bridge.finished(true));  // took it, not armed yet
+  for_bridge.update(answering("bridge", 6, 0, 1));
+  EXPECT_TRUE(for_bridge.all_confirmed(true));
+  for_bridge.update(answering("bridge", 7, 0, 0));  // a later request disarmed: the answer stays
+  EXPECT_TRUE(for_bridge.all_confirmed(true));
+
+  AckTracker all(6, {});
+  EXPECT_FALSE(all.finished(true));  // nobody heard
+  all.update(answering("bridge", 6, 0, 0));
+  EXPECT_FALSE(all.finished(false));  // still gathering who runs
+  EXPECT_TRUE(all.finished(true));
+  all.update(answering("logger", 0, 0, 0));
+  EXPECT_FALSE(all.all_confirmed(true));
+  const std::vector<std::string> lines = describe_answers(all, true);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "'bridge' confirmed");
+  EXPECT_NE(lines[1].find("'logger' did not confirm"), std::string::npos) << lines[1];
+  all.update(answering("logger", 0, 6, 0, "request 6 refused: whole recording"));
+  EXPECT_TRUE(all.finished(true));
+  EXPECT_EQ(describe_answers(all, true)[1], "'logger' refused it: whole recording");
+
+  AckTracker missing(6, {"bridge"});
+  EXPECT_EQ(describe_answers(missing, true)[0], "'bridge' sent no status report (is it running, under this name?)");
+}
+
+TEST(CtlAck, ServoGainsTravelAsCountersAndComeBack) {
+  const ServoGainsFigures g{0.1, 600.0, 2.5e-5, 1720.0, 3.5};
+  service_status_t s{};
+  for (const ServoGainCounter& c : kServoGainCounters) {
+    s.counter_names.emplace_back(c.name);
+    s.counter_values.push_back(static_cast<std::int64_t>(servo_gain_counter(c, g)));
+  }
+  const auto back = servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); });
+  ASSERT_TRUE(back.has_value());
+  EXPECT_DOUBLE_EQ(back->kp, 0.1);
+  EXPECT_DOUBLE_EQ(back->ki_per_s, 600.0);
+  EXPECT_DOUBLE_EQ(back->kd_s, 2.5e-5);
+  EXPECT_DOUBLE_EQ(back->notch_hz, 1720.0);
+  EXPECT_DOUBLE_EQ(back->notch_q, 3.5);
+  s.counter_names.pop_back();
+  EXPECT_FALSE(servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); }).has_value());
+}
+
 }  // namespace
 
 TEST(CtlVerdict, CountersSayWhatBecameOfTheVersion) {

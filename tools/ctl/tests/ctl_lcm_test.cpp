@@ -173,7 +173,8 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
        "bridge2",
        [](const control_t& c) {
          EXPECT_EQ(c.kp, 0.1);
-         EXPECT_EQ(c.notch_hz, 0.0);  // none: removes a notch
+         EXPECT_TRUE(std::isnan(c.ki));        // not given: the bridge keeps its own
+         EXPECT_TRUE(std::isnan(c.notch_hz));  // ... and its notch
        }},
       {{"gains", "--kp", "0.2", "--notch-hz", "1720", "--notch-q", "3.5"},
        control_t::SET_GAINS,
@@ -209,7 +210,9 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
   std::vector<std::int64_t> ids;
   for (const auto& c : cases) {
     got.clear();
-    const Result r = run_ctl(with_url(c.args), lcm_.get());
+    std::vector<std::string> args = c.args;
+    args.emplace_back("--no-wait");  // nobody answers here: ControlsWaitForTheAnswer covers that
+    const Result r = run_ctl(with_url(args), lcm_.get());
     ASSERT_EQ(r.exit_code, 0) << c.args[0] << ": " << r.err;
     ASSERT_EQ(got.size(), 3u) << c.args[0];
     for (const auto& msg : got) {
@@ -223,6 +226,87 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
     EXPECT_EQ(std::count(ids.begin(), ids.end(), got[0].request_id), 0) << "request ids must differ";
     ids.push_back(got[0].request_id);
   }
+}
+
+// Every request that changes state waits for the process it is for to answer on HX_STATUS
+// (control_acted_request / control_refused_request carry the request id), and says who did not.
+TEST_F(CtlLcmTest, ControlsWaitForTheAnswerOfTheProcessTheyAreFor) {
+  Publisher<service_status_t> status(*lcm_, ch_.status);
+  struct Player {
+    std::string process;
+    enum class Answer { kAct, kActNoChange, kRefuse, kSilent } answer = Answer::kAct;
+  };
+  std::vector<Player> players;
+  std::int64_t last_id = 0;
+  std::vector<std::int64_t> gains_counters{100'000, 600'000'000, 0, 0, 0};  // kp 0.1, ki 600 1/s
+  Subscription<control_t> sub(*lcm_, ch_.control, [&](const control_t& c, std::int64_t) { last_id = c.request_id; });
+  int ticks = 0;
+  auto play = [&] {
+    if (++ticks % 10 != 0) return;  // every ~20 ms
+    for (const Player& p : players) {
+      if (p.answer == Player::Answer::kSilent) continue;
+      service_status_t s = status_of(p.process, service_status_t::HEALTHY);
+      const bool refuse = p.answer == Player::Answer::kRefuse;
+      s.counter_names = {"control_acted_request", "control_refused_request", "armed",
+                         "servo_kp_ppm",          "servo_ki_ppm_per_s",      "servo_kd_ps",
+                         "servo_notch_mHz",       "servo_notch_q_ppm"};
+      s.counter_values = {refuse ? 0 : last_id, refuse ? last_id : 0, p.answer == Player::Answer::kAct ? 1 : 0};
+      s.counter_values.insert(s.counter_values.end(), gains_counters.begin(), gains_counters.end());
+      s.n_counters = static_cast<std::int32_t>(s.counter_names.size());
+      if (refuse) s.detail = "request " + std::to_string(last_id) + " refused: not today";
+      status.publish(s);
+    }
+  };
+  auto run = [&](std::vector<std::string> args, std::vector<Player> who) {
+    players = std::move(who);
+    last_id = 0;
+    return run_ctl(with_url(std::move(args)), lcm_.get(), play);
+  };
+  using A = Player::Answer;
+
+  Result r = run({"arm"}, {{"bridge", A::kAct}, {"compensator", A::kSilent}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("'bridge' confirmed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ARM confirmed in "), std::string::npos) << r.out;
+
+  // Taken, but the state it asks for does not show: not confirmed.
+  r = run({"arm", "--timeout", "0.5"}, {{"bridge", A::kActNoChange}});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'bridge' took it, but its report does not show the change yet"), std::string::npos) << r.err;
+
+  r = run({"mode", "mem"}, {{"compensator", A::kRefuse}});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'compensator' refused it: not today"), std::string::npos) << r.err;
+
+  r = run({"arm", "--timeout", "0.5"}, {{"compensator", A::kAct}});  // the bridge is missing
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'bridge' sent no status report"), std::string::npos) << r.err;
+
+  r = run({"disarm", "--timeout", "0.5"}, {});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no rig is running"), std::string::npos) << r.err;
+
+  // To every process: each one heard must answer.
+  r = run({"reset-counters"}, {{"bridge", A::kAct}, {"logger", A::kAct}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("'bridge' confirmed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("'logger' confirmed"), std::string::npos) << r.out;
+  r = run({"reset-counters", "--timeout", "1.5"}, {{"bridge", A::kAct}, {"logger", A::kRefuse}});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'logger' refused it"), std::string::npos) << r.err;
+
+  // gains without a gain: the gains in force; with one, the others stay and the result is printed.
+  r = run({"gains"}, {{"bridge", A::kAct}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("servo gains in force: kp 0.1, ki 600 1/s, kd 0 s, no notch"), std::string::npos) << r.out;
+  gains_counters = {200'000, 600'000'000, 0, 1'720'000, 3'000'000};
+  r = run({"gains", "--kp", "0.2"}, {{"bridge", A::kAct}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("kp 0.2, ki 600 1/s, kd 0 s, notch at 1720 Hz (Q 3)"), std::string::npos) << r.out;
+
+  // --no-wait: today's fire and forget.
+  r = run({"arm", "--no-wait"}, {});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 TEST_F(CtlLcmTest, TrajectoriesArriveAsSent) {
@@ -374,8 +458,8 @@ TEST_F(CtlLcmTest, TrajectoryWaitsForTheCompensatorsVerdict) {
 TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
   std::vector<mem_params_t> got;
   Subscription<mem_params_t> sub(*lcm_, ch_.params, [&](const mem_params_t& p, std::int64_t) { got.push_back(p); });
-  Result r =
-      run_ctl(with_url({"params", "--c1", "1.2e-7", "--c2", "3e-9", "--c3", "0.8", "--version", "7"}), lcm_.get());
+  Result r = run_ctl(
+      with_url({"params", "--c1", "1.2e-7", "--c2", "3e-9", "--c3", "0.8", "--version", "7", "--no-wait"}), lcm_.get());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(got.size(), 3u);
   EXPECT_EQ(got[0].version, 7);
@@ -390,11 +474,13 @@ TEST_F(CtlLcmTest, ParamsCarryTheValuesAndANewVersion) {
   command_block_t cmd{};
   std::int64_t seq = 0;
   got.clear();
-  r = run_ctl(with_url({"params", "--c1", "1e-7", "--c2", "0", "--c3", "1", "--listen", "0.5"}), lcm_.get(), [&] {
-    begin_block(cmd, seq, now_us(), seq - 1);
-    for (int i = 0; i < 10; ++i, ++seq) append_tick(cmd, {seq, 0.0, 0.0, i == 9 ? 4 : 5, command_block_t::MODE_MEM});
-    commands.publish(cmd);
-  });
+  r = run_ctl(with_url({"params", "--c1", "1e-7", "--c2", "0", "--c3", "1", "--listen", "0.5", "--no-wait"}),
+              lcm_.get(), [&] {
+                begin_block(cmd, seq, now_us(), seq - 1);
+                for (int i = 0; i < 10; ++i, ++seq)
+                  append_tick(cmd, {seq, 0.0, 0.0, i == 9 ? 4 : 5, command_block_t::MODE_MEM});
+                commands.publish(cmd);
+              });
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_FALSE(got.empty());
   EXPECT_EQ(got.back().version, 6);
@@ -543,9 +629,8 @@ TEST(CtlArguments, InvalidValuesExitTwoNamingTheField) {
       {{"trajectory", "--shape", "sine", "--timeout", "0"}, "timeout:"},
       {{"trajectory", "--shape", "sine", "--timeout", "1", "--no-wait"}, "excludes"},
       {{"gains", "--notch-hz", "5000", "--notch-q", "2"}, "notch-hz:"},
-      {{"gains", "--notch-hz", "1700"}, "notch-q:"},
       {{"gains", "--notch-hz", "1700", "--notch-q", "0.05"}, "notch-q:"},
-      {{"gains", "--notch-q", "2"}, "notch-q: only with a notch"},
+      {{"gains", "--notch-hz", "0", "--notch-q", "2"}, "notch-q: only with a notch"},
       {{"learn", "maybe"}, "learning: must be one of on|off|reset"},
       {{"learn"}, "what"},
       {{"status", "--wait-healthy", "bridge", "--timeout", "0"}, "timeout:"},
