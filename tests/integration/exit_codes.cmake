@@ -2,7 +2,7 @@
 set(_exit_code_programs)
 foreach(_program hystloop-bridge hystloop-compensator hystloop-logger hystloop-reidentifier hystloop-identify
                  hystloop-model hystloop-report hystloop-ctl hystloop-timer-check hystloop-replay-filter
-                 hystloop-replay-compare hystloop-lcm-fanout)
+                 hystloop-replay-compare hystloop-lcm-fanout hystloop-export)
   if(TARGET ${_program})
     list(APPEND _exit_code_programs $<TARGET_FILE:${_program}>)
   endif()

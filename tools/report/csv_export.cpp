@@ -3,8 +3,10 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
+#include "code_legend.hpp"
 #include "decode.hpp"
 #include "lcm/blocks.hpp"
 #include "log_reader.hpp"
@@ -260,16 +262,49 @@ struct ChannelWriter {
   std::ofstream out;
 };
 
-}  // namespace
-
-std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel) {
-  std::string name = channel;
+std::string safe_file_name(std::string name) {
   for (char& c : name) {
     const bool ok =
         (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
     if (!ok) c = '_';
   }
-  return dir / (name + ".csv");
+  return name;
+}
+
+void write_legend(const CsvExport& result, const std::string& csv_header) {
+  std::ofstream out(result.legend_file);
+  out << csv_legend_text(result.channel, result.type_name, csv_header);
+  out.close();
+  if (!out) throw std::runtime_error(result.legend_file.string() + ": cannot write");
+}
+
+}  // namespace
+
+std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel) {
+  return dir / (safe_file_name(channel) + ".csv");
+}
+
+std::filesystem::path csv_legend_path(const std::filesystem::path& dir, const std::string& channel) {
+  return dir / (safe_file_name(channel) + ".legend.txt");
+}
+
+std::string csv_legend_text(const std::string& channel, const std::string& type_name, const std::string& csv_header) {
+  std::string out = "# Integer codes of the columns of " + csv_path("", channel).string() + " (" + type_name +
+                    "), from the constants of lcmtypes/*.lcm\n";
+  std::istringstream columns(csv_header);
+  std::string column;
+  bool any = false;
+  while (std::getline(columns, column, ',')) {
+    if (const CodeLegend* legend = find_code_legend(type_name, column)) {
+      out += column + ": " + legend->text() + '\n';
+      any = true;
+    } else if (type_name == "hystloop.mem_params_t" && column == "valid") {
+      out += "valid: 0=false,1=true\n";  // a boolean of the message, written as 0/1
+      any = true;
+    }
+  }
+  if (!any) out += "# no column of this channel is integer-coded\n";
+  return out;
 }
 
 std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs,
@@ -280,6 +315,7 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
     auto writer = std::make_unique<ChannelWriter>();
     writer->result.channel = channel;
     writer->result.file = csv_path(dir, channel);
+    writer->result.legend_file = csv_legend_path(dir, channel);
     writer->out.open(writer->result.file);
     if (!writer->out) throw std::runtime_error(writer->result.file.string() + ": cannot write");
     writers.push_back(std::move(writer));
@@ -304,9 +340,13 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
   });
   std::vector<CsvExport> results;
   for (auto& w : writers) {
-    if (w->kind == Kind::kUndecided) w->out << "t_s,recv_utime_us\n";  // no event at all
+    if (w->kind == Kind::kUndecided) {  // no event at all
+      w->out << "t_s,recv_utime_us\n";
+      w->result.type_name = type_name(Kind::kUndecided);
+    }
     w->out.close();
     if (!w->out) throw std::runtime_error(w->result.file.string() + ": write failed");
+    write_legend(w->result, w->kind == Kind::kUndecided ? std::string() : header(w->kind));
     results.push_back(w->result);
   }
   return results;

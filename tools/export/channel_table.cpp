@@ -1,0 +1,433 @@
+#include "channel_table.hpp"
+
+#include <iterator>
+#include <stdexcept>
+#include <type_traits>
+
+#include "code_legend.hpp"
+#include "decode.hpp"
+#include "lcm/blocks.hpp"
+#include "log_reader.hpp"
+
+namespace hystloop::exporter {
+
+using report::decode_checked;
+using report::has_fingerprint_of;
+
+namespace {
+
+// Appends one row's fields to a table, creating the columns on its first row (or on a
+// definition pass, which appends nothing): the column list is written once, where the values are.
+class Row {
+ public:
+  Row(ChannelTable& table, bool define_only) : table_(table), define_only_(define_only) {}
+
+  Row& f(const char* name, const char* unit, double v, const char* description = "") {
+    Column& c = column(name, unit, ColumnType::kFloat64, description);
+    if (!define_only_) c.f64.push_back(v);
+    return *this;
+  }
+  Row& i(const char* name, const char* unit, std::int64_t v, const char* description = "") {
+    Column& c = column(name, unit, ColumnType::kInt64, description);
+    if (!define_only_) c.i64.push_back(v);
+    return *this;
+  }
+  // A boolean of the message, as 0/1.
+  Row& b(const char* name, bool v) {
+    Column& c = column(name, "1", ColumnType::kInt64, "");
+    c.legend = "0=false,1=true";
+    if (!define_only_) c.i64.push_back(v ? 1 : 0);
+    return *this;
+  }
+  Row& s(const char* name, const std::string& v, const char* description = "") {
+    Column& c = column(name, "", ColumnType::kText, description);
+    if (!define_only_) c.text.push_back(v);
+    return *this;
+  }
+  // Ragged columns: the row's array, its length in column `count` (or fixed: per_row).
+  template <class T>
+  Row& ragged(const char* name, const char* unit, const std::vector<T>& values, const char* count,
+              std::size_t per_row = 0) {
+    constexpr ColumnType type = std::is_floating_point_v<T> ? ColumnType::kFloat64
+                                : std::is_integral_v<T>     ? ColumnType::kInt64
+                                                            : ColumnType::kText;
+    Column& c = column(name, unit, type, "");
+    c.count_column = count;
+    c.per_row = per_row;
+    if (define_only_) return *this;
+    for (const auto& v : values) {
+      if constexpr (type == ColumnType::kFloat64) {
+        c.f64.push_back(v);
+      } else if constexpr (type == ColumnType::kInt64) {
+        c.i64.push_back(v);
+      } else {
+        c.text.push_back(v);
+      }
+    }
+    return *this;
+  }
+  template <std::size_t N>
+  Row& fixed(const char* name, const char* unit, const double (&values)[N]) {
+    return ragged(name, unit, std::vector<double>(std::begin(values), std::end(values)), "", N);
+  }
+
+ private:
+  Column& column(const char* name, const char* unit, ColumnType type, const char* description) {
+    auto& columns = table_.columns;
+    if (index_ == columns.size()) {
+      Column c;
+      c.name = name;
+      c.unit = type == ColumnType::kText ? "" : unit;
+      c.description = description;
+      c.type = type;
+      if (const auto* legend = report::find_code_legend(table_.type_name, name)) c.legend = legend->text();
+      columns.push_back(std::move(c));
+    }
+    Column& c = columns[index_++];
+    if (c.name != name) throw std::logic_error("column order changed: " + c.name + " vs " + name);
+    return c;
+  }
+
+  ChannelTable& table_;
+  bool define_only_;
+  std::size_t index_ = 0;
+};
+
+enum class Kind { kSensor, kCommand, kTrajectory, kParams, kModel, kStatus, kControl, kUnknown };
+
+Kind kind_of(const lcm::LogEvent& e) {
+  if (has_fingerprint_of<sensor_block_t>(e)) return Kind::kSensor;
+  if (has_fingerprint_of<command_block_t>(e)) return Kind::kCommand;
+  if (has_fingerprint_of<trajectory_t>(e)) return Kind::kTrajectory;
+  if (has_fingerprint_of<mem_params_t>(e)) return Kind::kParams;
+  if (has_fingerprint_of<model_params_t>(e)) return Kind::kModel;
+  if (has_fingerprint_of<service_status_t>(e)) return Kind::kStatus;
+  if (has_fingerprint_of<control_t>(e)) return Kind::kControl;
+  return Kind::kUnknown;
+}
+
+const char* type_name(Kind kind) {
+  switch (kind) {
+    case Kind::kSensor: return "hystloop.sensor_block_t";
+    case Kind::kCommand: return "hystloop.command_block_t";
+    case Kind::kTrajectory: return "hystloop.trajectory_t";
+    case Kind::kParams: return "hystloop.mem_params_t";
+    case Kind::kModel: return "hystloop.model_params_t";
+    case Kind::kStatus: return "hystloop.service_status_t";
+    case Kind::kControl: return "hystloop.control_t";
+    default: return "unknown";
+  }
+}
+
+constexpr const char* kUtime = "sender's time [us since the UNIX epoch]";
+
+void times(Row& r, double t_s, std::int64_t recv_utime) {
+  r.f("t_s", "s", t_s, "receive time after the first sensor tick (hystloop-report's time axis)")
+      .i("recv_utime_us", "us", recv_utime, "the event's log timestamp: its receive time [us since the UNIX epoch]");
+}
+
+void sensor_fields(Row& r, const sensor_block_t& m, const SensorTick& k) {
+  r.i("block_utime_us", "us", m.utime, "time of the block's first sample")
+      .i("block_seq", "1", m.seq)
+      .f("dt_s", "s", m.dt_s, "tick period")
+      .i("buffer_depth_ticks", "tick", m.buffer_depth_ticks, "commands buffered ahead when the block was sent")
+      .i("utime_us", "us", k.utime, "time of this tick's sample")
+      .i("seq", "1", k.seq, "tick number")
+      .f("u_V", "V", k.u_V, "voltage applied, after clamping")
+      .f("u_ff_V", "V", k.u_ff_V, "feedforward part")
+      .f("u_fb_V", "V", k.u_fb_V, "servo correction")
+      .f("y_ref_m", "m", k.y_ref_m, "reference; NaN = none")
+      .f("y_m", "m", k.y_m, "measured position")
+      .i("flags", "1", k.flags);
+}
+
+void command_fields(Row& r, const command_block_t& m, const CommandTick& k) {
+  r.i("block_utime_us", "us", m.utime, kUtime)
+      .i("block_seq", "1", m.seq)
+      .i("sample_seq", "1", m.sample_seq, "last sensor tick the compensator had; -1 = none")
+      .i("seq", "1", k.seq, "tick the command is for")
+      .f("u_ff_V", "V", k.u_ff_V)
+      .f("y_ref_m", "m", k.y_ref_m, "reference; NaN = none")
+      .i("params_version", "1", k.params_version, "model version; 0 = none")
+      .i("mode", "1", k.mode);
+}
+
+void trajectory_fields(Row& r, const trajectory_t& m) {
+  r.i("utime_us", "us", m.utime, kUtime)
+      .i("version", "1", m.version)
+      .i("shape", "1", m.shape)
+      .f("amplitude_m", "m", m.amplitude_m)
+      .f("offset_m", "m", m.offset_m)
+      .f("frequency_Hz", "Hz", m.frequency_Hz)
+      .f("phase_rad", "rad", m.phase_rad)
+      .i("start_utime_us", "us", m.start_utime, "loop time of tau = 0; 0 = as received")
+      .f("blend_s", "s", m.blend_s)
+      .f("corner_s", "s", m.corner_s)
+      .i("if_infeasible", "1", m.if_infeasible)
+      .i("n_points", "1", m.n_points)
+      .ragged("points_t_s", "s", m.points_t_s, "n_points")
+      .ragged("points_y_m", "m", m.points_y_m, "n_points");
+}
+
+void params_fields(Row& r, const mem_params_t& m) {
+  r.i("utime_us", "us", m.utime, kUtime)
+      .i("version", "1", m.version)
+      .i("publisher_id", "1", m.publisher_id)
+      .f("c1_m_per_V", "m/V", m.c1, "MEM slope at a branch point")
+      .f("c2_m_per_V_pow_1_plus_c3", "m/V^(1+c3)", m.c2)
+      .f("c3", "1", m.c3)
+      .f("residual_m", "m", m.residual_m)
+      .i("samples_used", "1", m.samples_used)
+      .f("window_s", "s", m.window_s)
+      .b("valid", m.valid != 0)
+      .s("source", m.source);
+}
+
+void model_fields(Row& r, const model_params_t& m) {
+  r.i("format_version", "1", m.format_version)
+      .i("utime_us", "us", m.utime, kUtime)
+      .i("version", "1", m.version)
+      .i("publisher_id", "1", m.publisher_id)
+      .i("kind", "1", m.kind)
+      .f("mem_c1", "m/V", m.mem_c1)
+      .f("mem_c2", "m/V^(1+c3)", m.mem_c2)
+      .f("mem_c3", "1", m.mem_c3)
+      .f("linear_gain", "m/V", m.linear_gain)
+      .f("linear_offset_m", "m", m.linear_offset_m)
+      .i("n_operators", "1", m.n_operators)
+      .ragged("pi_thresholds_V", "V", m.pi_thresholds_V, "n_operators")
+      .ragged("pi_weights", "m/V", m.pi_weights, "n_operators")
+      .f("kat_k1", "1", m.kat_k1, "operator units")
+      .f("kat_k2", "1", m.kat_k2)
+      .f("kat_k2_slope", "1", m.kat_k2_slope)
+      .f("kat_k2_domain_min", "1", m.kat_k2_domain_min)
+      .f("kat_k2_domain_max", "1", m.kat_k2_domain_max)
+      .f("kat_initial_offset", "1", m.kat_initial_offset)
+      .i("kat_in_shaping", "1", m.kat_in_shaping)
+      .f("kat_in_gain", "1", m.kat_in_gain, "V -> operator units")
+      .f("kat_in_offset", "1", m.kat_in_offset)
+      .fixed("kat_in_coefficients", "1", m.kat_in_coefficients)
+      .f("kat_in_domain_min", "1", m.kat_in_domain_min)
+      .f("kat_in_domain_max", "1", m.kat_in_domain_max)
+      .f("kat_in_amplitude", "1", m.kat_in_amplitude)
+      .f("kat_in_scale", "1", m.kat_in_scale)
+      .i("kat_out_shaping", "1", m.kat_out_shaping)
+      .f("kat_out_gain", "1", m.kat_out_gain, "operator units -> m")
+      .f("kat_out_offset", "1", m.kat_out_offset)
+      .fixed("kat_out_coefficients", "1", m.kat_out_coefficients)
+      .f("kat_out_domain_min", "1", m.kat_out_domain_min)
+      .f("kat_out_domain_max", "1", m.kat_out_domain_max)
+      .f("kat_out_amplitude", "1", m.kat_out_amplitude)
+      .f("kat_out_scale", "1", m.kat_out_scale)
+      .f("residual_m", "m", m.residual_m)
+      .f("heldout_rms_m", "m", m.heldout_rms_m, "NaN = not ranked")
+      .i("samples_used", "1", m.samples_used)
+      .f("window_s", "s", m.window_s)
+      .b("valid", m.valid != 0)
+      .i("stage_kind", "1", m.stage_kind)
+      .f("stage_k", "1/s^2", m.stage_k)
+      .f("stage_c", "1/s", m.stage_c)
+      .i("stage_order", "1", m.stage_order)
+      .s("source", m.source);
+}
+
+void status_fields(Row& r, const service_status_t& m) {
+  r.i("utime_us", "us", m.utime, kUtime)
+      .s("process", m.process)
+      .s("host", m.host)
+      .i("pid", "1", m.pid)
+      .i("state", "1", m.state)
+      .s("detail", m.detail)
+      .i("start_utime_us", "us", m.start_utime, "process start [us since the UNIX epoch]")
+      .f("loop_p50_us", "us", m.loop_p50_us)
+      .f("loop_p99_us", "us", m.loop_p99_us)
+      .f("loop_max_us", "us", m.loop_max_us)
+      .f("latency_p50_us", "us", m.latency_p50_us)
+      .f("latency_p99_us", "us", m.latency_p99_us)
+      .f("latency_max_us", "us", m.latency_max_us)
+      .i("late", "tick", m.late)
+      .i("rejected", "1", m.rejected)
+      .i("n_counters", "1", m.n_counters)
+      .ragged("counter_names", "", m.counter_names, "n_counters")
+      .ragged("counter_values", "1", m.counter_values, "n_counters");
+}
+
+void control_fields(Row& r, const control_t& m) {
+  r.i("utime_us", "us", m.utime, kUtime)
+      .i("request_id", "1", m.request_id)
+      .i("command", "1", m.command)
+      .s("target", m.target, "addressee; empty = every process")
+      .i("mode", "1", m.mode)
+      .f("kp", "1", m.kp)
+      .f("ki_per_s", "1/s", m.ki)
+      .f("kd_s", "s", m.kd)
+      .f("notch_Hz", "Hz", m.notch_hz, "0 = no notch")
+      .f("notch_q", "1", m.notch_q)
+      .s("experiment", m.experiment)
+      .f("experiment_amplitude_V", "V", m.experiment_amplitude_V)
+      .f("experiment_offset_V", "V", m.experiment_offset_V)
+      .f("experiment_frequency_Hz", "Hz", m.experiment_frequency_Hz)
+      .f("experiment_duration_s", "s", m.experiment_duration_s)
+      .i("learning", "1", m.learning);
+}
+
+struct Channel {
+  ChannelTable table;
+  Kind kind = Kind::kUnknown;
+};
+
+}  // namespace
+
+std::size_t Column::size() const noexcept {
+  switch (type) {
+    case ColumnType::kFloat64: return f64.size();
+    case ColumnType::kInt64: return i64.size();
+    default: return text.size();
+  }
+}
+
+const Column* ChannelTable::find(const std::string& name) const noexcept {
+  for (const Column& c : columns) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+std::string type_name_of(const lcm::LogEvent& event) { return type_name(kind_of(event)); }
+
+struct TableBuilder::Impl {
+  std::function<bool(const std::string&)> wanted;
+  std::map<std::string, std::uint64_t> counts;
+  std::map<std::string, std::size_t> index;  // wanted channel -> position in channels
+  std::vector<Channel> channels;
+  std::int64_t t0_utime = 0;
+  double lower_s = 0.0, upper_s = 0.0;
+  sensor_block_t sensor;
+  command_block_t command;
+  trajectory_t trajectory;
+  mem_params_t params;
+  model_params_t model;
+  service_status_t status;
+  control_t control;
+
+  double t_of(std::int64_t utime) const { return static_cast<double>(utime - t0_utime) * 1e-6; }
+  bool in_range(double t) const { return t >= lower_s && t <= upper_s; }
+
+  // The columns of a kind, from a message with one of each array element.
+  static void define(Channel& c) {
+    Row r(c.table, true);
+    times(r, 0.0, 0);
+    switch (c.kind) {
+      case Kind::kSensor: sensor_fields(r, sensor_block_t{}, SensorTick{}); break;
+      case Kind::kCommand: command_fields(r, command_block_t{}, CommandTick{}); break;
+      case Kind::kTrajectory: trajectory_fields(r, trajectory_t{}); break;
+      case Kind::kParams: params_fields(r, mem_params_t{}); break;
+      case Kind::kModel: model_fields(r, model_params_t{}); break;
+      case Kind::kStatus: status_fields(r, service_status_t{}); break;
+      case Kind::kControl: control_fields(r, control_t{}); break;
+      default: r.i("size_bytes", "byte", 0); break;
+    }
+  }
+
+  // false: the event did not decode.
+  bool add(Channel& c, const lcm::LogEvent& e) {
+    ChannelTable& t = c.table;
+    const double event_t = t_of(e.timestamp);
+    auto one_row = [&](auto&& fields) {
+      if (!in_range(event_t)) return;
+      Row r(t, false);
+      times(r, event_t, e.timestamp);
+      fields(r);
+      ++t.rows;
+    };
+    switch (c.kind) {
+      case Kind::kSensor: {
+        if (!decode_checked(e, sensor)) return false;
+        std::size_t i = 0;
+        for_each_tick(sensor, [&](const SensorTick& k) {
+          const double tick_t = t_of(report::tick_recv_utime(e.timestamp, sensor.n_ticks, i++, sensor.dt_s));
+          if (!in_range(tick_t)) return;
+          Row r(t, false);
+          times(r, tick_t, e.timestamp);
+          sensor_fields(r, sensor, k);
+          ++t.rows;
+        });
+        return true;
+      }
+      case Kind::kCommand: {
+        if (!decode_checked(e, command)) return false;
+        if (!in_range(event_t)) return true;
+        for_each_tick(command, [&](const CommandTick& k) {
+          Row r(t, false);
+          times(r, event_t, e.timestamp);
+          command_fields(r, command, k);
+          ++t.rows;
+        });
+        return true;
+      }
+      case Kind::kTrajectory:
+        if (!decode_checked(e, trajectory)) return false;
+        one_row([&](Row& r) { trajectory_fields(r, trajectory); });
+        return true;
+      case Kind::kParams:
+        if (!decode_checked(e, params)) return false;
+        one_row([&](Row& r) { params_fields(r, params); });
+        return true;
+      case Kind::kModel:
+        if (!decode_checked(e, model)) return false;
+        one_row([&](Row& r) { model_fields(r, model); });
+        return true;
+      case Kind::kStatus:
+        if (!decode_checked(e, status)) return false;
+        one_row([&](Row& r) { status_fields(r, status); });
+        return true;
+      case Kind::kControl:
+        if (!decode_checked(e, control)) return false;
+        one_row([&](Row& r) { control_fields(r, control); });
+        return true;
+      default: one_row([&](Row& r) { r.i("size_bytes", "byte", e.datalen); }); return true;
+    }
+  }
+};
+
+TableBuilder::TableBuilder(std::function<bool(const std::string&)> wanted, std::int64_t t0_utime, double lower_s,
+                           double upper_s)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->wanted = std::move(wanted);
+  impl_->t0_utime = t0_utime;
+  impl_->lower_s = lower_s;
+  impl_->upper_s = upper_s;
+}
+
+TableBuilder::~TableBuilder() = default;
+
+void TableBuilder::add(const lcm::LogEvent& event) {
+  auto [count, first] = impl_->counts.try_emplace(event.channel, 0);
+  ++count->second;
+  if (first && impl_->wanted(event.channel)) {  // the first event decides the channel's type and columns
+    Channel c;
+    c.table.channel = event.channel;
+    c.kind = kind_of(event);
+    c.table.type_name = type_name(c.kind);
+    Impl::define(c);
+    impl_->index[event.channel] = impl_->channels.size();
+    impl_->channels.push_back(std::move(c));
+  }
+  const auto it = impl_->index.find(event.channel);
+  if (it == impl_->index.end()) return;
+  Channel& c = impl_->channels[it->second];
+  ++c.table.events;
+  if (!impl_->add(c, event)) ++c.table.skipped;
+}
+
+const std::map<std::string, std::uint64_t>& TableBuilder::channel_counts() const noexcept { return impl_->counts; }
+
+std::vector<ChannelTable> TableBuilder::take() {
+  std::vector<ChannelTable> tables;
+  for (Channel& c : impl_->channels) tables.push_back(std::move(c.table));
+  impl_->channels.clear();
+  impl_->index.clear();
+  return tables;
+}
+
+}  // namespace hystloop::exporter
