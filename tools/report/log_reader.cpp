@@ -81,7 +81,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
       run.command_blocks.push_back({t, command.seq, command.sample_seq, command.n_ticks});
-      for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version); });
+      for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version, k.mode); });
     } else if (event.channel == channels.params) {
       if (!decode_checked(event, params)) return void(++run.undecodable);
       run.params.push_back({t, params.version, params.c1, params.c2, params.c3, params.residual_m, params.valid != 0,

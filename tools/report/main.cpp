@@ -10,12 +10,15 @@
 // A file that is empty, holds no event, bytes that are not events (skipped by the reader) or a
 // truncated last event is named in a warning on stderr; so are events on the rig's channels
 // that do not decode (summary.json: undecodable_events).
+// A log of 4 MB or more gets a line on stderr as each phase starts (not with --quiet).
 // Exit status: 0 done (a missing gnuplot is a warning), 1 a log could not be read, nothing in
 // the logs decoded (no output is written then), or an output could not be written, 2 bad
 // arguments.
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -65,6 +68,33 @@ std::string resolve_channel(const std::string& name, const RunData& run, const s
                        "no channel '" + name + "' in the log (channels: " + (known.empty() ? "none" : known) + ")");
 }
 
+// A line on stderr as each phase of a long log starts (a 30 s run at 10 kHz is some 25 MB and
+// takes seconds), so that a slow report is seen working; nothing for a short log or with --quiet.
+class Progress {
+ public:
+  static constexpr std::uintmax_t kLongLogBytes = 4u << 20;
+
+  Progress(const std::vector<fs::path>& logs, bool quiet) {
+    for (const auto& log : logs) {
+      std::error_code ec;
+      const auto size = fs::file_size(log, ec);
+      if (!ec) bytes_ += size;
+    }
+    enabled_ = !quiet && bytes_ >= kLongLogBytes;
+  }
+  std::uintmax_t bytes() const noexcept { return bytes_; }
+  void phase(const std::string& what) const {
+    if (!enabled_) return;
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start_;
+    std::fprintf(stderr, "hystloop-report: [%5.1f s] %s\n", elapsed.count(), what.c_str());
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::uintmax_t bytes_ = 0;
+  bool enabled_ = false;
+};
+
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
@@ -84,6 +114,11 @@ int run(const Options& o) {
   o.scan.figures.validate();
   if (o.plots.max_points == 0) throw ParameterError("--plot-max-points", "must be > 0 (got 0)");
 
+  const Progress progress(o.logs, o.quiet);
+  char what[96];
+  std::snprintf(what, sizeof what, "reading %zu log file(s), %.1f MB", o.logs.size(),
+                static_cast<double>(progress.bytes()) * 1e-6);
+  progress.phase(what);
   const RunData data = read_logs(o.logs, channels);
   for (const auto& problem : describe_scan_problems(data.files)) {
     std::fprintf(stderr, "hystloop-report: warning: %s\n", problem.c_str());
@@ -105,6 +140,7 @@ int run(const Options& o) {
   fs::create_directories(o.out, ec);
   if (ec || !fs::is_directory(o.out)) throw std::runtime_error(o.out.string() + ": cannot create the folder");
 
+  progress.phase("computing the figures of " + std::to_string(data.samples.size()) + " ticks");
   const ReportMetrics metrics = compute_metrics(data, ro);
   if (data.samples.empty()) {
     std::fprintf(stderr, "hystloop-report: warning: no %s ticks in the log; most figures are null\n",
@@ -114,11 +150,15 @@ int run(const Options& o) {
 
   std::vector<CsvExport> exports;
   if (!csv_channels.empty()) {
+    progress.phase("exporting CSV");
     exports = export_csv(o.logs, csv_channels, data.time_zero_utime(), ro.lower_s(), ro.upper_s(), o.out);
   }
   PlotResult plots;
   if (!o.no_plots) {
-    plots = write_plots(track_points(data, ro), metrics, o.out, o.plots);
+    progress.phase("writing the plots' data");
+    PlotOptions plot_options = o.plots;
+    plot_options.progress = [&progress](const std::string& step) { progress.phase(step); };
+    plots = write_plots(track_points(data, ro), metrics, o.out, plot_options);
     if (!plots.warning.empty()) std::fprintf(stderr, "hystloop-report: warning: %s\n", plots.warning.c_str());
   }
 
@@ -134,7 +174,10 @@ int run(const Options& o) {
   scan.quiet = o.quiet;
   scan.no_plots = o.no_plots;
   scan.plots = o.plots;
-  return write_scan_report(o.logs, data, channels, o.out, scan);
+  progress.phase("looking for a scan (periodic trajectories)");
+  const int rc = write_scan_report(o.logs, data, channels, o.out, scan);
+  progress.phase("done");
+  return rc;
 }
 
 int report_main(int argc, char** argv) {

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <set>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +13,10 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "convergence_plot.hpp"
+#include "model_overlay.hpp"
+#include "plot_series.hpp"
 
 namespace hystloop::report {
 
@@ -25,13 +31,6 @@ std::ofstream open_for_writing(const std::filesystem::path& path) {
 void close_checked(std::ofstream& out, const std::filesystem::path& path) {
   out.close();
   if (!out) throw std::runtime_error(path.string() + ": write failed");
-}
-
-std::string num(double v) {
-  if (!std::isfinite(v)) return "NaN";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
 }
 
 // Runs `gnuplot args...` with `dir` as working directory, output silenced; returns its exit status.
@@ -82,38 +81,63 @@ Histogram run_ahead_histogram(const ReportMetrics& m) {
   return h;
 }
 
-}  // namespace
+std::string joined(const std::set<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : "/") + n;
+  return out;
+}
 
-namespace {
-// convergence.png: the published parameters over time (c1 and the held-out RMS of each
-// set; a model change labelled with its model) above the per-second tracking RMS, with every swap
-// (the second in which the version the compensator applies changed) marked by a vertical line.
-std::string convergence_plot(const ReportMetrics& m) {
+// hysteresis_u_y.png: the measured loop coloured by phase, the MEM model's y for the same u on top.
+std::string u_y_script(const std::array<SeriesFile, 3>& u_y, bool with_model) {
+  static const char* const kTitle[] = {"identification experiment", "tracking", "safe state / holding"};
+  static const char* const kColour[] = {"#1f77b4", "#2ca02c", "#a0a0a0"};
   std::ostringstream gp;
-  gp << "\nset output 'convergence.png'\nset multiplot layout 2,1 title 'Re-identification: parameters and "
-        "tracking error (dashed: a swap at the compensator)'\n";
-  std::int32_t version = m.per_second.front().params_version;
-  int arrow = 0;
-  std::ostringstream arrows;
-  for (const auto& bin : m.per_second) {
-    if (bin.params_version != version) {
-      arrows << "set arrow " << ++arrow << " from " << num(bin.t_s) << ", graph 0 to " << num(bin.t_s)
-             << ", graph 1 nohead dt 2 lc rgb 'red'\n";
-      version = bin.params_version;
-    }
+  gp << "\nset output 'hysteresis_u_y.png'\n"
+     << "set title 'Hysteresis loop: applied voltage u -> measured position y, by phase"
+     << (with_model ? "; dashed: the MEM model for the same u" : "")
+     << "'\nset xlabel 'u [V]'\nset ylabel 'y [µm]'\nplot ";
+  std::string sep;
+  for (std::size_t g = 0; g < u_y.size(); ++g) {
+    if (u_y[g].file.empty()) continue;
+    gp << sep << "'" << u_y[g].file.filename().string() << "' using 2:3 with lines lw 2 lc rgb '" << kColour[g]
+       << "' title 'measured, " << kTitle[g] << "'";
+    sep = ", ";
   }
-  for (const auto& p : m.params_history) {
-    if (p.model_change) gp << "set label '" << p.model << "' at " << num(p.t_s) << ", graph 0.9\n";
+  bool titled = false;
+  for (std::size_t g = 0; with_model && g < 2; ++g) {  // the model over the experiment and tracking
+    if (u_y[g].file.empty()) continue;
+    gp << sep << "'" << u_y[g].file.filename().string() << "' using 2:4 with lines dt 2 lw 1 lc rgb '#ff7f0e' "
+       << (titled ? "notitle" : "title 'MEM model (the set in use, else the latest identified)'");
+    titled = true;
   }
-  gp << arrows.str() << "set xlabel 't [s]'\nset ylabel 'c1 [nm/V]'\nset y2label 'held-out RMS [nm]'\n"
-     << "set y2tics\nset ytics nomirror\n"
-     << "plot 'params.dat' using 1:($8 == 1 ? $3 : NaN) with linespoints pt 7 title 'c1 (MEM sets)', "
-     << "'params.dat' using 1:($8 == 1 ? $7 : NaN) axes x1y2 with points pt 5 title 'held-out RMS of the set'\n"
-     << "unset label\nunset y2tics\nunset y2label\nset ytics mirror\nset ylabel 'RMS error [nm]'\n"
-     << "plot 'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n"
-     << "unset arrow\nunset multiplot\n";
+  gp << "\n";
   return gp.str();
 }
+
+// hysteresis_yref_y.png, as the MEM paper's Fig. 11: y_ref -> y with and without compensation.
+std::string yref_y_script(const std::array<SeriesFile, 3>& yref_y) {
+  static const char* const kTitle[] = {"without compensation", "with compensation", "compensation unknown"};
+  static const char* const kColour[] = {"#d62728", "#1f77b4", "#a0a0a0"};
+  const bool without = !yref_y[0].file.empty(), with = !yref_y[1].file.empty();
+  std::ostringstream gp;
+  gp << "\nset output 'hysteresis_yref_y.png'\nset title 'Reference y_ref -> measured position y ";
+  if (without && with) {
+    gp << "with and without compensation (cf. the MEM paper, Fig. 11)";
+  } else {
+    const std::size_t only = with ? 1 : (without ? 0 : 2);
+    gp << "(cf. the MEM paper, Fig. 11): only " << kTitle[only] << " (" << joined(yref_y[only].modes)
+       << ") in this log";
+  }
+  gp << "'\nset xlabel 'y_ref [µm]'\nset ylabel 'y [µm]'\nset size ratio -1\nplot ";
+  for (std::size_t g = 0; g < yref_y.size(); ++g) {
+    if (yref_y[g].file.empty()) continue;
+    gp << "'" << yref_y[g].file.filename().string() << "' using 2:3 with lines lw 1 lc rgb '" << kColour[g]
+       << "' title '" << kTitle[g] << " (mode " << joined(yref_y[g].modes) << ")', ";
+  }
+  gp << "x with lines dt 2 lc rgb 'gray' title 'y = y_ref'\nset size noratio\n";
+  return gp.str();
+}
+
 }  // namespace
 
 std::filesystem::path find_executable(const std::string& name) {
@@ -136,85 +160,86 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
   const bool have_tracking = m.tracking_samples > 0;
   const bool have_run_ahead = !m.run_ahead_ticks.empty();
 
-  {  // track.dat: every n-th tick.
-    const auto path = dir / "track.dat";
-    auto out = open_for_writing(path);
-    out << "# t_s u_V y_um y_ref_um e_nm   (e = y_ref - y; NaN: no reference for the tick)\n";
-    const std::size_t step = std::max<std::size_t>(
-        1, (ticks.size() + options.max_points - 1) / std::max<std::size_t>(options.max_points, 1));
+  const std::size_t step = decimation_step(ticks.size(), options.max_points);
+  {  // track.dat: every step-th tick.
+    DataFile out(dir / "track.dat");
+    out.text(
+        "# t_s u_V y_µm y_ref_µm e_nm mode params_version   (e = y_ref - y; NaN: no reference for the tick; mode: "
+        "command_block_t MODE_*, -1 and version -1: no command logged)\n");
     for (std::size_t i = 0; i < ticks.size(); i += step) {
       const auto& p = ticks[i];
-      out << num(p.t_s) << ' ' << num(p.u_V) << ' ' << num(p.y_m * 1e6) << ' ' << num(p.y_ref_m * 1e6) << ' '
-          << num((p.y_ref_m - p.y_m) * 1e9) << '\n';
+      out.num(p.t_s).num(p.u_V).num(p.y_m * 1e6).num(p.y_ref_m * 1e6).num((p.y_ref_m - p.y_m) * 1e9);
+      out.integer(p.mode).integer(p.params_version.value_or(-1));
+      out.end_row();
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
   {
-    const auto path = dir / "per_second.dat";
-    auto out = open_for_writing(path);
-    out << "# t_s rms_error_nm params_version   (t_s = start of the second)\n";
+    DataFile out(dir / "per_second.dat");
+    out.text("# t_s rms_error_nm params_version   (t_s = start of the second)\n");
     for (const auto& bin : m.per_second) {
-      out << num(bin.t_s) << ' ' << num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")) << ' '
-          << bin.params_version << '\n';
+      out.num(bin.t_s).num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")).integer(bin.params_version);
+      out.end_row();
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
   if (!m.params_history.empty()) {
-    const auto path = dir / "params.dat";
-    auto out = open_for_writing(path);
-    out << "# t_s version c1_nm_per_V c2 c3 residual_nm heldout_rms_nm valid model_change model   (one published "
-           "set per row; c1..c3 NaN unless the model is MEM)\n";
+    DataFile out(dir / "params.dat");
+    out.text(
+        "# t_s version c1_nm_per_V c2_m_per_V^(1+c3) c3 residual_nm heldout_rms_nm valid model_change model   (one "
+        "published set per row; c1..c3 NaN unless the model is MEM)\n");
     for (const auto& p : m.params_history) {
-      out << num(p.t_s) << ' ' << p.version << ' ' << num(p.c1 * 1e9) << ' ' << num(p.c2) << ' ' << num(p.c3) << ' '
-          << num(p.residual_m * 1e9) << ' ' << num(p.heldout_rms_m * 1e9) << ' ' << (p.valid ? 1 : 0) << ' '
-          << (p.model_change ? 1 : 0) << ' ' << p.model << '\n';
+      out.num(p.t_s).integer(p.version).num(p.c1 * 1e9).num(p.c2).num(p.c3).num(p.residual_m * 1e9);
+      out.num(p.heldout_rms_m * 1e9).integer(p.valid ? 1 : 0).integer(p.model_change ? 1 : 0);
+      out.text(" ").text(p.model).end_row();
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
   const Histogram hist = run_ahead_histogram(m);
   {
-    const auto path = dir / "run_ahead_hist.dat";
-    auto out = open_for_writing(path);
-    out << "# bin_low_ticks bin_high_ticks count   (run-ahead margin of each command block: seq - sample_seq)\n";
+    DataFile out(dir / "run_ahead_hist.dat");
+    out.text("# bin_low_ticks bin_high_ticks count   (run-ahead margin of each command block: seq - sample_seq)\n");
     for (std::size_t i = 0; i < hist.counts.size(); ++i) {
       const double lo = hist.lo - 0.5 + hist.width * static_cast<double>(i);  // edges between whole ticks
-      out << num(lo) << ' ' << num(lo + hist.width) << ' ' << hist.counts[i] << '\n';
+      out.num(lo).num(lo + hist.width).integer(static_cast<long long>(hist.counts[i]));
+      out.end_row();
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
+  }
+  const std::vector<double> model_y = mem_model_y(ticks, m);
+  const auto u_y = write_u_y_series(ticks, model_y, dir, options.max_points);
+  const auto yref_y = write_yref_y_series(ticks, dir, options.max_points);
+  for (const auto* series : {&u_y, &yref_y}) {
+    for (const auto& f : *series) {
+      if (!f.file.empty()) result.data_files.push_back(f.file);
+    }
   }
 
   std::vector<std::string> images;
   std::ostringstream gp;
   gp << "# Re-plot with: cd <this folder> && gnuplot plots.gp   (terminal: edit the first line)\n"
      << "set terminal @TERMINAL@ size 1000,700 noenhanced\n"
-     << "set grid\nset key top left\n";
+     << "set encoding utf8\nset grid\nset key top left\n";
   if (have_ticks) {
     images.push_back("hysteresis_u_y.png");
-    gp << "\nset output 'hysteresis_u_y.png'\nset title 'Hysteresis loop: applied voltage u -> measured position y'\n"
-       << "set xlabel 'u [V]'\nset ylabel 'y [um]'\n"
-       << "plot 'track.dat' using 2:3 with lines lw 1 title 'y(u)'\n";
+    gp << u_y_script(u_y, !model_y.empty());
   }
   if (have_tracking) {
     images.push_back("hysteresis_yref_y.png");
-    gp << "\nset output 'hysteresis_yref_y.png'\n"
-       << "set title 'Reference y_ref -> measured position y (cf. the MEM paper, Fig. 11)'\n"
-       << "set xlabel 'y_ref [um]'\nset ylabel 'y [um]'\nset size ratio -1\n"
-       << "plot 'track.dat' using 4:3 with lines lw 1 title 'y(y_ref)', x with lines dt 2 lc rgb 'gray' title 'y = "
-          "y_ref'\n"
-       << "set size noratio\n";
+    gp << yref_y_script(yref_y);
     images.push_back("tracking_error.png");
     gp << "\nset output 'tracking_error.png'\nset title 'Tracking error e = y_ref - y'\n"
        << "set xlabel 't [s]'\nset ylabel 'e [nm]'\n"
        << "plot 'track.dat' using 1:5 with lines lw 1 title 'e', "
        << "'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n";
   }
-  if (!m.params_history.empty() && !m.per_second.empty()) {
+  if (const std::string convergence = convergence_script(m); !convergence.empty()) {
     images.push_back("convergence.png");
-    gp << convergence_plot(m);
+    gp << convergence;
   }
   if (have_run_ahead) {
     images.push_back("run_ahead_histogram.png");
@@ -229,7 +254,9 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
   result.script = dir / "plots.gp";
   auto write_script = [&](const std::string& terminal) {
     std::string text = gp.str();
-    text.replace(text.find("@TERMINAL@"), 10, terminal);
+    for (auto at = text.find("@TERMINAL@"); at != std::string::npos; at = text.find("@TERMINAL@", at)) {
+      text.replace(at, 10, terminal);
+    }
     auto out = open_for_writing(result.script);
     out << text;
     close_checked(out, result.script);
@@ -250,6 +277,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     if (run_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // terminal not built in
     write_script(terminal);
     for (const auto& image : images) std::filesystem::remove(dir / image);
+    if (options.progress) options.progress("rendering " + std::to_string(images.size()) + " plots with gnuplot");
     const int rc = run_in(dir, exe, {"plots.gp"}, "gnuplot.log");
     result.terminal = terminal;
     for (const auto& image : images) {

@@ -2,16 +2,23 @@
 // The report's plots: data files and a gnuplot script written into the output folder
 // (so a user can edit and re-run `gnuplot plots.gp` there), then rendered to PNG with
 // gnuplot's pngcairo terminal, or its libgd png terminal where cairo is missing.
-//   hysteresis_u_y.png     applied voltage u -> measured y (the stage's hysteresis loop)
-//   hysteresis_yref_y.png  reference y_ref -> measured y (as the MEM paper's Fig. 11)
+//   hysteresis_u_y.png     applied voltage u -> measured y (the stage's hysteresis loop), coloured
+//                          by phase (identification experiment, tracking, the rest: u_y_*.dat),
+//                          the MEM model's y for the same u dashed on top (model_overlay.hpp)
+//   hysteresis_yref_y.png  reference y_ref -> measured y with and without compensation, as the MEM
+//                          paper's Fig. 11 (yref_y_*.dat; the title says when the log has only one)
 //   tracking_error.png     e = y_ref - y over time [nm], with the per-second RMS
-//   convergence.png        the published parameter sets over time above the per-second RMS, every
-//                          swap marked (params.dat: one row per set)
+//   convergence.png        c1 (with the held-out RMS), c2 and c3 of the published sets over time
+//                          above the per-second RMS, every swap marked at its tick
+//                          (convergence_plot.hpp; params.dat: one row per set)
 //   run_ahead_histogram.png  run-ahead margin of the command blocks [ticks]
+// The per-tick files (track.dat, u_y_*.dat, yref_y_*.dat) hold at most about max_points rows:
+// gnuplot's time grows with the points, and a 30 s run at 10 kHz has 300k ticks.
 // A plot whose data is empty is left out of the script.
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,8 +27,9 @@
 namespace hystloop::report {
 
 struct PlotOptions {
-  std::string gnuplot = "gnuplot";   // executable, searched in PATH unless it contains '/'
-  std::size_t max_points = 200'000;  // track.dat is decimated to at most this many rows
+  std::string gnuplot = "gnuplot";                   // executable, searched in PATH unless it contains '/'
+  std::size_t max_points = 20'000;                   // the per-tick data files are decimated to at most this many rows
+  std::function<void(const std::string&)> progress;  // told as a long step starts (may be empty)
 };
 
 struct PlotResult {

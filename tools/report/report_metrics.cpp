@@ -146,7 +146,9 @@ std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& op
   for (const auto& s : run.samples) {
     const double t = static_cast<double>(s.recv_utime - t0) * 1e-6;
     if (t < lo || t > hi) continue;
-    points.push_back({t, s.u_V, s.y_m, s.y_ref_m});
+    const VersionRun* command = run.command_versions.run_at(s.seq);
+    points.push_back({t, s.u_V, s.y_m, s.y_ref_m, command != nullptr ? command->mode : VersionRun::kUnknownMode,
+                      command != nullptr ? std::optional<std::int32_t>(command->version) : std::nullopt, armed(s)});
   }
   return points;
 }
@@ -172,6 +174,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   double sum_sq = 0.0;
   const SampleRecord* prev = nullptr;
   std::int64_t safe_transitions = 0;
+  std::optional<std::int32_t> applied;  // the version of the last tick with a logged command
 
   for (const auto& s : run.samples) {
     const double t = t_of(s.recv_utime);
@@ -191,7 +194,11 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     }
     prev = &s;
     BinSum& bin = bins[static_cast<std::int64_t>(std::floor(t))];
-    if (const auto version = run.command_versions.at(s.seq)) bin.version = *version;
+    if (const auto version = run.command_versions.at(s.seq)) {
+      bin.version = *version;
+      if (applied && *applied != *version) m.swaps.push_back({t, s.seq, *applied, *version});
+      applied = version;
+    }
     const bool range_clamped = (s.flags & kSaturatedFlag) != 0, slew_clamped = (s.flags & kSlewLimitedFlag) != 0;
     m.clamped_range_samples += range_clamped ? 1 : 0;
     m.clamped_slew_samples += slew_clamped ? 1 : 0;

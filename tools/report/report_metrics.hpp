@@ -62,6 +62,14 @@ struct ParamsPoint {
   bool model_change = false;   // from HX_MODEL: the feedforward switched to this model
 };
 
+// The compensator began applying another parameter version: the first sensor tick whose command
+// was computed with `to` (the tick after the last one with `from`).
+struct ParamsSwap {
+  double t_s = 0.0;
+  std::int64_t seq = 0;
+  std::int32_t from = 0, to = 0;
+};
+
 struct ReportMetrics {
   std::size_t samples = 0;  // sensor samples in the range
   double duration_s = 0.0;  // last minus first sample time in the range
@@ -101,6 +109,7 @@ struct ReportMetrics {
   std::vector<std::pair<std::string, std::int64_t>> commands_rejected_counters;
 
   std::vector<ParamsPoint> params_history;  // in the range, one entry per (version, valid)
+  std::vector<ParamsSwap> swaps;            // in the range, in time order
   std::optional<MemParams> params_initial, params_final;
   std::size_t params_updates = 0;
 
@@ -119,12 +128,16 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options);
 // Nearest-rank percentile of an ascending vector, q in [0, 1]; nullopt when empty.
 std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) noexcept;
 
-// One tick (for plots): time, applied voltage, measured and reference position.
+// One tick (for plots): time, applied voltage, measured and reference position, and what the
+// compensator commanded it with.
 struct TrackPoint {
   double t_s;
   double u_V;
   double y_m;
-  double y_ref_m;  // NaN when the tick had no reference
+  double y_ref_m;                                   // NaN when the tick had no reference
+  std::int8_t mode = VersionRun::kUnknownMode;      // command_block_t::MODE_* of its command
+  std::optional<std::int32_t> params_version = {};  // of its command; none when no command was logged
+  bool armed = true;                                // no SAFE_STATE
 };
 // Every sensor tick of the range, in log order.
 std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& options);

@@ -47,21 +47,27 @@ struct CommandBlockRecord {
   std::int32_t n_ticks = 0;
 };
 
-// params_version of the command ticks [first_seq, end_seq): consecutive ticks with one version.
+// params_version and mode of the command ticks [first_seq, end_seq): consecutive ticks with one
+// version and one mode.
 struct VersionRun {
   std::int64_t first_seq = 0;
   std::int64_t end_seq = 0;
   std::int32_t version = 0;
+  std::int8_t mode = kUnknownMode;  // command_block_t::MODE_*
+
+  static constexpr std::int8_t kUnknownMode = -1;
 };
 
-// The parameter version each commanded tick was computed with. A tick is normally sent once;
+// The parameter version and mode each commanded tick was computed with. A tick is normally sent once;
 // a command tick at or before the highest one already logged is a re-send and is ignored (the
 // first logged command for a tick is the one the bridge used).
 class CommandVersions {
  public:
-  void add(std::int64_t seq, std::int32_t version);
+  void add(std::int64_t seq, std::int32_t version, std::int8_t mode = VersionRun::kUnknownMode);
   // The version of tick `seq`, if a command for it was logged.
   std::optional<std::int32_t> at(std::int64_t seq) const noexcept;
+  // The run holding tick `seq` (its version and mode), nullptr if no command for it was logged.
+  const VersionRun* run_at(std::int64_t seq) const noexcept;
   const std::vector<VersionRun>& runs() const noexcept { return runs_; }
 
  private:

@@ -84,7 +84,7 @@ struct ReferenceFigures {
   Verdict verdict = Verdict::kUnconfirmed;
   std::string verdict_detail;  // why refused, how shaped, or the compensator's note (e.g. the corner)
   std::optional<SegmentFigures> off, on;
-  std::string label() const;  // "triangle 1 um 10 Hz"
+  std::string label() const;  // "triangle 1 µm 10 Hz"
 };
 
 struct ScanResult {

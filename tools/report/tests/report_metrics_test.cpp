@@ -5,6 +5,8 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "model_overlay.hpp"
+#include "models/mem.hpp"
 #include "report_metrics.hpp"
 
 using namespace hystloop;
@@ -18,7 +20,7 @@ SampleRecord tick(std::int64_t t, std::int64_t seq, double y_ref, double y, std:
   return {t, seq, 0.0, y_ref, y, flags};
 }
 
-// ticks at tick_us apart, reference 1 um, y off by 0, 1 or 2 nm; every command at version 0.
+// ticks at tick_us apart, reference 1 µm, y off by 0, 1 or 2 nm; every command at version 0.
 RunData ramp_run(std::int64_t ticks, std::int64_t tick_us) {
   RunData run;
   for (std::int64_t k = 0; k < ticks; ++k) {
@@ -292,4 +294,56 @@ TEST(ComputeMetrics, ParamsBeforeTheRangeAreTheInitialSet) {
   EXPECT_EQ(m.params_updates, 2u);
   EXPECT_EQ(m.samples, 50'000u);
   EXPECT_NEAR(m.duration_s, 4.9999, 1e-9);
+}
+
+TEST(CommandVersions, AModeChangeStartsARunAndEachTickKeepsItsMode) {
+  CommandVersions v;
+  for (std::int64_t k = 0; k < 10; ++k) v.add(k, 0, 5);   // an experiment
+  for (std::int64_t k = 10; k < 20; ++k) v.add(k, 0, 1);  // linear, same version
+  EXPECT_EQ(v.runs().size(), 2u);
+  ASSERT_NE(v.run_at(9), nullptr);
+  EXPECT_EQ(v.run_at(9)->mode, 5);
+  EXPECT_EQ(v.run_at(10)->mode, 1);
+  EXPECT_EQ(v.run_at(20), nullptr);
+}
+
+TEST(ComputeMetrics, ASwapIsDatedAtTheFirstTickCommandedWithTheNewVersion) {
+  RunData run;
+  for (std::int64_t k = 0; k < 3000; ++k) {
+    run.samples.push_back(tick(kT0 + k * 1000, k, 1e-6, 1e-6));
+    run.command_versions.add(k, k < 1234 ? 1 : (k < 2345 ? 2 : 5), 2);
+  }
+  const auto m = compute_metrics(run, {});
+  ASSERT_EQ(m.swaps.size(), 2u);
+  EXPECT_EQ(m.swaps[0].seq, 1234);
+  EXPECT_DOUBLE_EQ(m.swaps[0].t_s, 1.234);  // not the start of its second
+  EXPECT_EQ(m.swaps[0].from, 1);
+  EXPECT_EQ(m.swaps[0].to, 2);
+  EXPECT_EQ(m.swaps[1].seq, 2345);
+  EXPECT_EQ(m.swaps[1].to, 5);
+  const auto points = track_points(run, {});
+  EXPECT_EQ(points[1233].params_version, 1);
+  EXPECT_EQ(points[1234].params_version, 2);
+  EXPECT_EQ(points[0].mode, 2);
+}
+
+TEST(MemModelY, IsTheSetInUseForTheSameUAndTheFirstIdentifiedBeforeAnySet) {
+  const hystloop::MemParams stage = hystloop::MemParams::paper_like();
+  ReportMetrics m;
+  m.params_history.push_back({5.0, 7, stage.c1, stage.c2, stage.c3, 1e-9, true, "mem", 1e-9, false});
+  m.params_history.push_back({6.0, 8, 2 * stage.c1, stage.c2, stage.c3, 1e-9, false, "mem", 1e-9, false});  // invalid
+  std::vector<TrackPoint> ticks;
+  hystloop::MemModel truth(stage);
+  for (int k = 0; k < 10'000; ++k) {
+    const double u = 200.0 * std::sin(2.0 * M_PI * k / 2000.0);
+    TrackPoint p{k * 1e-3, u, truth.forward(u) + 1e-7, std::nan("")};  // the stage 0.1 µm off the model's origin
+    if (k >= 5000) p.params_version = 7;
+    ticks.push_back(p);
+  }
+  const auto y = mem_model_y(ticks, m);
+  ASSERT_EQ(y.size(), ticks.size());
+  for (std::size_t i = 0; i < y.size(); ++i) ASSERT_NEAR(y[i], ticks[i].y_m, 1e-15) << i;
+
+  m.params_history[0].valid = false;  // no valid set: nothing to draw
+  EXPECT_TRUE(mem_model_y(ticks, m).empty());
 }

@@ -6,13 +6,13 @@
 // stretch of constant magnitude m has RMS m and max m):
 //   0.0 s            no reference
 //   0.95 s           SET_LEARNING off
-//   1.0 s            trajectory A: triangle 1 um at 50 Hz (200-tick period), blend 0.2 s: taken
+//   1.0 s            trajectory A: triangle 1 µm at 50 Hz (200-tick period), blend 0.2 s: taken
 //   1.0 .. 1.7 s     |e| = 100 nm (the approach and settling the table skips: blend + 0.5 s)
 //   1.7 .. 4.0 s     |e| = 8 nm; clamped ticks at 1.1 s (5 saturated), 2.0 s (3 slew-limited),
 //                    2.5 s (1 both); 2 late ticks at 3.0 s
 //   4.0 s, 4.02 s    SET_LEARNING on, then reset: the segment measured starts at 4.02 s
 //   4.02 .. 7.0 s    |e| = 1 nm + 7 nm * 0.5^p in period p after 4.02 s: converged after 6 periods
-//   7.0 s            trajectory B: sine 1 um at 10 Hz, refused (A runs on)
+//   7.0 s            trajectory B: sine 1 µm at 10 Hz, refused (A runs on)
 //   8.0 s            DISARM: nothing after it belongs to a reference
 // Every request is sent 3 times (as hystloop-ctl does); the compensator reports once a second
 // and right after each verdict.
