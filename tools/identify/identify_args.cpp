@@ -30,7 +30,14 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   app.add_option("--form", args.form, "MEM data form: integrated branches or the paper's derivative")
       ->check(CLI::IsMember({"integrated", "derivative"}))
       ->capture_default_str();
-  app.add_option("--out", args.out, "write the YAML config snippet to this file");
+  app.add_option("--out", args.out,
+                 "write the YAML config snippet to this file; or, given a folder (one that exists, or a name ending "
+                 "in '/'), write config.yaml there with the plots of the fit: loop_u_y.png (measured and model "
+                 "loops, u -> y), residual.png (measured - model against time), heldout_u_y.png (the held-out "
+                 "branch, predicted by the model fitted without it), candidates.png (--model auto: every model "
+                 "side by side), their data (fit_<model>.dat, heldout_<model>.dat: t, u, y measured, y model, "
+                 "residual, held out) and plots.gp to re-run gnuplot there");
+  app.add_option("--gnuplot", args.gnuplot, "gnuplot executable for the plots of --out DIR")->capture_default_str();
   app.add_option("--noise-rms-m", args.noise_rms_m, "sensor noise RMS [m]; 0 = estimate from the data")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -47,7 +54,8 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   auto* logs = app.add_option_group("LCM logs", "reading HX_SENSOR from LCM event logs");
   logs->add_flag("--log", args.log,
                  "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
-  logs->add_option("--rig", args.rig, "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>PARAMS")
+  logs->add_option("--rig", args.rig,
+                   "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>MODEL or <rig>PARAMS")
       ->capture_default_str();
   logs->add_option("--dt", args.dt_s, "tick period [s]: t = (seq - first seq) * dt")->capture_default_str();
   logs->add_option("--time-from", args.time_from, "time base: seq (* --dt) or utime (the samples' timestamps)")
@@ -57,9 +65,11 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
   logs->add_option("--experiment", args.experiment,
                    "fit only this experiment the loop ran (numbered from 0 as listed; e.g. the one hystloop-ctl "
-                   "experiment --mem-paper ran)");
+                   "experiment --mem-paper ran). A log with several experiments needs it (or --from/--to): "
+                   "without, they are listed and the exit status is 2");
   logs->add_option("--compensator", args.compensator,
-                   "banning: process name of the compensator whose HX_CONTROL experiment requests count")
+                   "process name of the compensator: whose HX_CONTROL experiment requests count, and whose "
+                   "HX_STATUS says whether a published set was adopted")
       ->capture_default_str();
   logs->add_option("--max-late", args.max_late,
                    "banning: skip a frequency-response experiment if more than this fraction of its samples were "
@@ -71,9 +81,20 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "(a frequency-response experiment may miss none)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  auto* pub = app.add_option_group("publishing", "sending the fitted MEM set to a running compensator");
+  auto* pub = app.add_option_group("publishing", "sending the fitted set to a running compensator");
   pub->add_flag("--publish", args.publish,
-                "after a successful MEM fit, publish mem_params_t on <rig>PARAMS (3 times, 10 ms apart)");
+                "after a successful fit, publish the set (3 times, 10 ms apart): any model as model_params_t on "
+                "<rig>MODEL (the compensator switches to it at its next reversal); --model mem as mem_params_t on "
+                "<rig>PARAMS (see --publish-on); then wait until the compensator uses it (--timeout, --no-wait)");
+  pub->add_option("--publish-on", args.publish_on,
+                  "params: MEM parameters on <rig>PARAMS, the compensator's mode unchanged (default for --model mem); "
+                  "model: <rig>MODEL, the feedforward switches to the model (default for the others)")
+      ->check(CLI::IsMember({"params", "model"}));
+  pub->add_option("--timeout", args.timeout_s,
+                  "after publishing, wait at most this long for the compensator (--compensator) to report the "
+                  "set's version in use [s] (default 5); exit 1 if it does not")
+      ->check(CLI::Range(0.0, 600.0));
+  pub->add_flag("--no-wait", args.no_wait, "publish and exit 0 without waiting for the set to be adopted");
   pub->add_option("--version", args.version,
                   "parameter set version (default: 1 + the highest heard on <rig>PARAMS / <rig>COMMAND, at least 2)");
   pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
@@ -112,10 +133,20 @@ std::optional<std::string> check_identify_args(IdentifyArgs& args) {
   if (!args.from_logs && range) return "--from/--to select a range of an LCM log";
   if (!args.from_logs && args.experiment) return "--experiment selects an experiment of an LCM log";
   const bool mem = args.choice.mode == ModelChoice::Mode::single && args.choice.kind == ModelKind::mem;
-  if (args.publish && !mem) {
-    return "--publish sends MEM parameters (mem_params_t on HX_PARAMS): only with --model mem (got --model " +
+  if (args.publish && banning) {
+    return "--publish: Banning's model is identified offline only and has no kind on HX_MODEL; write it with --out "
+           "and give it to the compensator's config (--params)";
+  }
+  if (!args.publish_on.empty() && !args.publish) return "--publish-on " + args.publish_on + ": only with --publish";
+  if (args.publish_on == "params" && !mem) {
+    return "--publish-on params sends MEM parameters (mem_params_t on HX_PARAMS): only with --model mem (got --model " +
            args.model + ")";
   }
+  args.publish_on_params = mem && args.publish_on != "model";
+  if ((args.timeout_s || args.no_wait) && !args.publish) {
+    return std::string(args.no_wait ? "--no-wait" : "--timeout") + ": only with --publish";
+  }
+  if (args.timeout_s && args.no_wait) return "--timeout and --no-wait: choose one";
   if (args.experiment && range) return "--experiment selects its own samples: not with --from/--to";
   if (args.from_logs && banning && range) {
     return "--from/--to do not apply to --model banning on logs: the experiments are found by their requests "

@@ -31,7 +31,8 @@ struct IdentifyArgs {
   std::string model = "auto";
   ModelChoice choice{};  // from `model`, by check_identify_args
   std::string form = "integrated";
-  std::string out;
+  std::string out;  // the YAML file, or a folder for config.yaml and the plots (identify_output.hpp)
+  std::string gnuplot = "gnuplot";
   double noise_rms_m = 0.0;
   double min_snr = 3.0;
   std::size_t operators = 15;
@@ -53,7 +54,11 @@ struct IdentifyArgs {
   double listen_s = 0.5;
   std::string lcm_url;
   bool allow_network = false;
-  std::string key_file;  // the rig key: sign the set (README "Authenticated rig")
+  std::string key_file;            // the rig key: sign the set (README "Authenticated rig")
+  std::string publish_on;          // "params" (MEM on HX_PARAMS) or "model" (HX_MODEL); empty: by the model
+  bool publish_on_params = false;  // by check_identify_args
+  std::optional<double> timeout_s;
+  bool no_wait = false;
   // bounds
   std::size_t max_samples = kDefaultMaxSamples;
   std::size_t decimate = 1;
@@ -63,8 +68,9 @@ struct IdentifyArgs {
 
 void add_identify_options(CLI::App& app, IdentifyArgs& args);
 
-// The combinations CLI11 cannot check (mixed inputs, log-only options on a CSV, --publish
-// without MEM, ...). Fills args.choice and args.from_logs; returns the reason for a usage error.
+// The combinations CLI11 cannot check (mixed inputs, log-only options on a CSV, --publish of
+// Banning's model, ...). Fills args.choice, args.from_logs and args.publish_on_params; returns
+// the reason for a usage error.
 std::optional<std::string> check_identify_args(IdentifyArgs& args);
 
 }  // namespace hystloop

@@ -1,10 +1,13 @@
 // hystloop-identify's work once its options are checked (identify_args.hpp): read the inputs
-// (CSV or LCM logs), fit the chosen model, print and emit the YAML snippet, publish a MEM set.
+// (CSV or LCM logs), fit the chosen model, print it, write the YAML snippet and the plots
+// (identify_output.hpp), publish the set and wait for its adoption (params_publish.hpp).
 #include "identify_run.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <filesystem>
+#include <optional>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -14,12 +17,14 @@
 #include "core/cli.hpp"
 #include "core/clock.hpp"
 #include "core/errors.hpp"
+#include "fit_curves.hpp"
 #include "fit_progress.hpp"
 #include "ident/banning_fit.hpp"
 #include "ident/fit_checks.hpp"
 #include "ident/model_selection.hpp"
 #include "ident/params_yaml.hpp"
 #include "ident/sample_csv.hpp"
+#include "identify_output.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/rig_auth.hpp"
 #include "log_experiments.hpp"
@@ -59,73 +64,90 @@ int refuse(FitStatus status, const std::string& reason) {
   return 1;
 }
 
-int emit(const IdentifyArgs& args, const std::string& yaml) {
-  std::cout << "--- YAML\n" << yaml;
-  if (!args.out.empty()) {
-    std::ofstream f(args.out);
-    f << "# written by hystloop-identify\n" << yaml;
-    if (!f) {
-      std::cerr << "hystloop-identify: cannot write " << args.out << "\n";
-      return 2;
-    }
-    std::cout << "written to " << args.out << "\n";
-  }
-  return 0;
+// One run's context: its options, where the results go, the link a set is published on.
+struct Run {
+  const IdentifyArgs& args;
+  OutputTarget out;
+  ParamsLink* link = nullptr;  // --publish
+  std::string heading;         // of the plots: what was fitted
+};
+
+// What a successful fit hands on: the snippet, the set to publish, the plots.
+struct Fitted {
+  std::string yaml;
+  std::optional<ModelParamSet> set;  // --publish on HX_MODEL
+  std::optional<MemFitResult> mem;   // --model mem: --publish on HX_PARAMS
+  FitFigures figures;
+  std::optional<FitPlotInput> plots;
+};
+
+double window_of(const SampleTable& s, std::size_t end) {
+  return end < 2 || s.t.size() < end ? 0.0 : s.t[end - 1] - s.t.front();
 }
 
-int publish_fit(ParamsLink& link, const IdentifyArgs& args, const MemFitResult& r, double window_s) {
-  std::int32_t version = 0;
-  if (args.version) {
-    version = *args.version;
-  } else {
-    const std::int32_t heard = link.highest_version_heard();
-    version = next_params_version(heard);
-    if (heard > 0) {
-      std::printf("version in use on %s: %d\n", link.channels().prefix.c_str(), heard);
-    } else {
-      std::printf("no parameter version heard on %s/%s in %.2g s\n", link.channels().params.c_str(),
-                  link.channels().command.c_str(), args.listen_s);
-    }
-  }
-  const mem_params_t msg = to_mem_params(r, window_s, version, wall_utime(), identify_source());
-  const int sent = link.publish(msg);
-  if (sent == 0) {
-    std::cerr << "hystloop-identify: the parameters were not published (refused by the mem_params_t contract check "
-                 "or by LCM)\n";
-    return kExitFailure;
-  }
-  std::printf("published MEM parameters v%d on %s (%d time(s)) via %s, source '%s'\n", version,
-              link.channels().params.c_str(), sent, link.url().c_str(), msg.source.c_str());
-  return 0;
+ModelSelectionOptions selection_options(const IdentifyArgs& args) {
+  ModelSelectionOptions o;
+  o.mem.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
+  o.mem.noise_rms_m = args.noise_rms_m;
+  o.mem.min_snr = args.min_snr;
+  o.pi.operators = args.operators;
+  o.katalenic.output_polynomial_degree = args.katalenic_degree;
+  return o;
 }
 
-int fit_mem_and_emit(const IdentifyArgs& args, const SampleTable& s, ParamsLink* link) {
-  MemFitOptions o;
-  o.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
-  o.noise_rms_m = args.noise_rms_m;
-  o.min_snr = args.min_snr;
+// The plots of one model fitted on the whole record; its held-out branch from the same model
+// fitted on the record's first part (as --model auto ranks it), when the record allows one.
+FitPlotInput single_model_plots(const Run& run, ModelKind kind, const SampleTable& s, FitCurve chosen) {
+  FitPlotInput in;
+  in.heading = run.heading;
+  in.chosen = std::move(chosen);
+  ModelSelectionOptions o = selection_options(run.args);
+  o.candidates = {kind};
+  ModelSelection sel;
+  {
+    const ProgressStage stage(
+        on_samples("fitting " + std::string(to_string(kind)) + " again without the held-out branch", s.u.size()));
+    sel = select_model(s.u, s.y, o);
+  }
+  std::vector<FitCurve> curves = ranked_curves(sel, s.u, s.y);
+  if (curves.empty()) {
+    const std::string why = !sel.reason.empty() ? sel.reason : sel.ranking.empty() ? "" : sel.ranking.front().reason;
+    std::printf("plots: no held-out branch (%s)\n", why.c_str());
+    return in;
+  }
+  std::printf("held out from t = %.4g s (sample %zu): %s fitted on the record before predicts it to %.4g nm RMS\n",
+              s.t[sel.split_index], sel.split_index, std::string(to_string(kind)).c_str(),
+              curves.front().heldout_rms_m * 1e9);
+  in.heldout = std::move(curves.front());
+  return in;
+}
+
+int fit_mem_model(const Run& run, const SampleTable& s, Fitted& out) {
+  const IdentifyArgs& args = run.args;
+  MemFitOptions o = selection_options(args).mem;
   MemFitResult r;
   {
     const ProgressStage stage(on_samples("fitting mem", s.u.size()));
     r = fit_mem(s.u, s.y, o);
   }
-  if (!r.ok()) {
-    if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
-    return refuse(r.status, r.reason);
-  }
+  if (!r.ok()) return refuse(r.status, r.reason);
   std::printf("MEM (%s form): c1 = %.6g m/V, c2 = %.6g m/V^(1+c3), c3 = %.6g\n", args.form.c_str(), r.params.c1,
               r.params.c2, r.params.c3);
   std::printf("fit: residual %.4g nm RMS, noise %.4g nm, %zu samples, %zu branches, %.1f ms\n", r.residual_rms_m * 1e9,
               r.noise_rms_m * 1e9, r.samples_used, r.branches_used, r.solve_time_s * 1e3);
-  const int written = emit(args, to_yaml(r.params));
-  if (written != 0 || link == nullptr) return written;
-  const double window_s = s.t.size() < 2 ? 0.0 : s.t.back() - s.t.front();
-  return publish_fit(*link, args, r, window_s);
+  out.yaml = to_yaml(r.params);
+  out.set = ModelParamSet{};
+  out.set->kind = ModelKind::mem;
+  out.set->mem = r.params;
+  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
+  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::mem, s, whole_record_curve(r, s.u, s.y));
+  out.mem = std::move(r);
+  return 0;
 }
 
-int fit_pi_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+int fit_pi_model(const Run& run, const SampleTable& s, Fitted& out) {
   PiFitOptions o;
-  o.operators = args.operators;
+  o.operators = run.args.operators;
   PiFitResult r;
   {
     const ProgressStage stage(on_samples("fitting pi", s.u.size()));
@@ -138,15 +160,21 @@ int fit_pi_and_emit(const IdentifyArgs& args, const SampleTable& s) {
   std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
               r.solve_time_s * 1e3);
   try {
-    return emit(args, to_yaml(to_pi_params(r)));
+    out.set = ModelParamSet{};
+    out.set->kind = ModelKind::pi;
+    out.set->pi = to_pi_params(r);
   } catch (const ParameterError& e) {
     return refuse(FitStatus::out_of_range, e.what());
   }
+  out.yaml = to_yaml(out.set->pi);
+  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
+  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::pi, s, whole_record_curve(r, s.u));
+  return 0;
 }
 
-int fit_katalenic_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+int fit_katalenic_model(const Run& run, const SampleTable& s, Fitted& out) {
   KatalenicFitOptions o;
-  o.output_polynomial_degree = args.katalenic_degree;
+  o.output_polynomial_degree = run.args.katalenic_degree;
   KatalenicFitResult r;
   {
     const ProgressStage stage(on_samples("fitting katalenic", s.u.size()));
@@ -157,34 +185,42 @@ int fit_katalenic_and_emit(const IdentifyArgs& args, const SampleTable& s) {
               r.params.output_shaping.gain);
   std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
               r.solve_time_s * 1e3);
-  return emit(args, to_yaml(r.params));
+  out.yaml = to_yaml(r.params);
+  out.set = ModelParamSet{};
+  out.set->kind = ModelKind::katalenic;
+  out.set->katalenic = r.params;
+  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
+  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::katalenic, s, whole_record_curve(r, s.u));
+  return 0;
 }
 
-int fit_linear_and_emit(const IdentifyArgs& args, const SampleTable& s) {
+int fit_linear_model(const Run& run, const SampleTable& s, Fitted& out) {
   const LinearFitResult r = fit_linear(s.u, s.y);
   if (!r.ok()) return refuse(r.status, r.reason);
   std::printf("linear: gain = %.6g m/V, offset = %.6g m\n", r.gain_m_per_V, r.offset_m);
   std::printf("fit: residual %.4g nm RMS, %zu samples\n", r.residual_rms_m * 1e9, r.samples_used);
-  return emit(args, to_yaml(to_linear_params(r)));
+  out.set = ModelParamSet{};
+  out.set->kind = ModelKind::linear;
+  out.set->linear = to_linear_params(r);
+  out.yaml = to_yaml(out.set->linear);
+  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
+  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::linear, s, whole_record_curve(r, s.u));
+  return 0;
 }
 
-int fit_single(const IdentifyArgs& args, ModelKind kind, const SampleTable& s, ParamsLink* link) {
+int fit_single(const Run& run, ModelKind kind, const SampleTable& s, Fitted& out) {
   switch (kind) {
-    case ModelKind::mem: return fit_mem_and_emit(args, s, link);
-    case ModelKind::pi: return fit_pi_and_emit(args, s);
-    case ModelKind::katalenic: return fit_katalenic_and_emit(args, s);
-    case ModelKind::linear: return fit_linear_and_emit(args, s);
+    case ModelKind::mem: return fit_mem_model(run, s, out);
+    case ModelKind::pi: return fit_pi_model(run, s, out);
+    case ModelKind::katalenic: return fit_katalenic_model(run, s, out);
+    case ModelKind::linear: return fit_linear_model(run, s, out);
   }
   return kExitFailure;
 }
 
 // Every model of the set fitted and ranked on held-out data; the best one emitted.
-int fit_auto_and_emit(const IdentifyArgs& args, const SampleTable& s) {
-  ModelSelectionOptions o;
-  o.mem.form = args.form == "derivative" ? MemFitForm::derivative : MemFitForm::integrated;
-  o.mem.noise_rms_m = args.noise_rms_m;
-  o.pi.operators = args.operators;
-  o.katalenic.output_polynomial_degree = args.katalenic_degree;
+int fit_auto(const Run& run, const SampleTable& s, Fitted& out) {
+  const ModelSelectionOptions o = selection_options(run.args);
   ModelSelection sel;
   {
     const ProgressStage stage(on_samples("fitting and ranking every model (auto)", s.u.size()));
@@ -198,19 +234,106 @@ int fit_auto_and_emit(const IdentifyArgs& args, const SampleTable& s) {
                 r.fit_time_s * 1e3, r.reason.empty() ? "" : "  ", r.reason.c_str());
   }
   if (!sel.ok()) return refuse(sel.status, sel.reason);
+  const ModelScore& best = sel.ranking.front();
   std::printf("held out from sample %zu of %zu; best: %s\n", sel.split_index, s.u.size(),
-              std::string(to_string(sel.ranking.front().kind)).c_str());
+              std::string(to_string(best.kind)).c_str());
+  ModelParamSet set;
+  set.kind = best.kind;
+  std::size_t samples_used = 0;
   try {
-    switch (sel.ranking.front().kind) {
-      case ModelKind::mem: return emit(args, to_yaml(sel.mem.params));
-      case ModelKind::pi: return emit(args, to_yaml(to_pi_params(sel.pi)));
-      case ModelKind::katalenic: return emit(args, to_yaml(sel.katalenic.params));
-      case ModelKind::linear: return emit(args, to_yaml(to_linear_params(sel.linear)));
+    switch (best.kind) {
+      case ModelKind::mem:
+        set.mem = sel.mem.params, samples_used = sel.mem.samples_used;
+        out.yaml = to_yaml(set.mem);
+        break;
+      case ModelKind::pi:
+        set.pi = to_pi_params(sel.pi), samples_used = sel.pi.samples_used;
+        out.yaml = to_yaml(set.pi);
+        break;
+      case ModelKind::katalenic:
+        set.katalenic = sel.katalenic.params, samples_used = sel.katalenic.samples_used;
+        out.yaml = to_yaml(set.katalenic);
+        break;
+      case ModelKind::linear:
+        set.linear = to_linear_params(sel.linear), samples_used = sel.linear.samples_used;
+        out.yaml = to_yaml(set.linear);
+        break;
     }
   } catch (const ParameterError& e) {
     return refuse(FitStatus::out_of_range, e.what());
   }
-  return 1;
+  out.set = set;
+  out.figures = {best.train_rms_m, best.holdout_rms_m, samples_used, window_of(s, sel.split_index + 1)};
+  if (run.out.plots_dir) {
+    FitPlotInput in;
+    in.heading = run.heading;
+    in.candidates = ranked_curves(sel, s.u, s.y);
+    in.chosen = in.candidates.front();
+    out.plots = std::move(in);
+  }
+  return 0;
+}
+
+std::int32_t version_to_publish(ParamsLink& link, const IdentifyArgs& args) {
+  if (args.version) return *args.version;
+  const std::int32_t heard = link.highest_version_heard();
+  if (heard > 0) {
+    std::printf("version in use on %s: %d\n", link.channels().prefix.c_str(), heard);
+  } else {
+    std::printf("no parameter version heard on %s/%s/%s in %.2g s\n", link.channels().params.c_str(),
+                link.channels().model.c_str(), link.channels().command.c_str(), args.listen_s);
+  }
+  return next_params_version(heard);
+}
+
+// Publishes the set (HX_PARAMS for a MEM set unless --publish-on model, else HX_MODEL), then
+// waits for the compensator to adopt it unless --no-wait.
+int publish_fitted(ParamsLink& link, const IdentifyArgs& args, const Fitted& f) {
+  const std::int32_t version = version_to_publish(link, args);
+  int sent = 0;
+  std::string channel, what, source;
+  if (args.publish_on_params && f.mem) {
+    const mem_params_t msg = to_mem_params(*f.mem, f.figures.window_s, version, wall_utime(), identify_source());
+    sent = link.publish(msg);
+    channel = link.channels().params, what = "MEM", source = msg.source;
+  } else {
+    try {
+      f.set->validate();
+    } catch (const ParameterError& e) {
+      std::cerr << "hystloop-identify: the set was not published: " << e.what() << "\n";
+      return kExitFailure;
+    }
+    const model_params_t msg = to_model_params(*f.set, f.figures, version, wall_utime(), identify_source());
+    sent = link.publish(msg);
+    channel = link.channels().model, what = std::string(to_string(f.set->kind));
+    source = msg.source;
+  }
+  if (sent == 0) {
+    std::cerr << "hystloop-identify: the parameters were not published (refused by the message contract check "
+                 "or by LCM)\n";
+    return kExitFailure;
+  }
+  std::printf("published %s parameters v%d on %s (%d time(s)) via %s, source '%s'\n", what.c_str(), version,
+              channel.c_str(), sent, link.url().c_str(), source.c_str());
+  if (args.no_wait) return 0;
+  std::fflush(stdout);
+  const ParamsLink::Adoption a = link.wait_for_adoption(version);
+  if (a.adopted) {
+    std::printf("%s\n", a.verdict.c_str());
+    return 0;
+  }
+  std::cerr << "hystloop-identify: " << a.verdict << "\n";
+  return kExitFailure;
+}
+
+// The common end of every fit: the snippet, the plots, the publishing.
+int finish(const Run& run, const SampleTable& s, const Fitted& f) {
+  if (const int rc = write_yaml(run.out, f.yaml)) return rc;
+  if (f.plots) {
+    if (const int rc = write_plots(run.out, s, *f.plots, run.args.gnuplot)) return rc;
+  }
+  if (run.link == nullptr) return 0;
+  return publish_fitted(*run.link, run.args, f);
 }
 
 int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExperimentData>& data);
@@ -261,10 +384,14 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
   std::printf("fit: centre line %.4g nm RMS, slopes %.3g %% RMS, areas %.3g %% RMS, magnitudes %.3g %% RMS, %.1f ms\n",
               r.centre_rms_m * 1e9, r.slope_rel_rms * 100.0, r.area_rel_rms * 100.0, r.magnitude_rel_rms * 100.0,
               r.solve_time_s * 1e3);
-  return emit(args, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
+  const OutputTarget out = output_target(args.out);
+  if (out.plots_dir) {
+    std::printf("plots: none for banning (its fit is on loop features of several experiments, not one record)\n");
+  }
+  return write_yaml(out, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
 }
 
-LoggedExperiments read_experiments(const IdentifyArgs& args) {
+ExperimentLogOptions experiment_options(const IdentifyArgs& args) {
   ExperimentLogOptions o;
   o.control_channel = channel_name(args.rig, kControlSuffix);
   o.command_channel = channel_name(args.rig, kCommandSuffix);
@@ -274,7 +401,11 @@ LoggedExperiments read_experiments(const IdentifyArgs& args) {
   o.max_not_as_commanded = args.max_late;
   o.max_missing = args.max_missing;
   o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
-  LoggedExperiments logged = read_logged_experiments(args.files, o);
+  return o;
+}
+
+LoggedExperiments read_experiments(const IdentifyArgs& args) {
+  LoggedExperiments logged = read_logged_experiments(args.files, experiment_options(args));
   std::cout << describe(logged);
   return logged;
 }
@@ -282,6 +413,31 @@ LoggedExperiments read_experiments(const IdentifyArgs& args) {
 struct SampleBudgetError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// A log whose record holds several experiments, none chosen: one fit over all of them mixes
+// loops of different amplitudes and offsets (and the settling between) into a model that fits
+// none (on the demo's log MEM's c3 lands on its search bound). Lists them and says how to pick.
+struct SeveralExperiments : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void throw_if_several_experiments(const IdentifyArgs& args) {
+  const ExperimentLogOptions o = experiment_options(args);
+  if (count_experiment_requests(args.files, o) < 2) return;  // the cheap look: one experiment at most
+  LoggedExperiments logged;
+  try {
+    logged = read_logged_experiments(args.files, o);
+  } catch (const SampleLogError&) {
+    return;  // requests but no experiment ran: the record is fitted as it is
+  }
+  const std::size_t n = logged.experiments.size();
+  if (n < 2) return;
+  const std::string where = args.files.size() == 1 ? args.files.front() : "the log";
+  throw SeveralExperiments(where + " holds " + std::to_string(n) +
+                           " experiments the loop ran; fit one with --experiment N (N as listed), or a time range "
+                           "with --from S --to S (--model banning fits a series of them):\n" +
+                           list_experiments(logged, o));
+}
 
 // Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
 // SampleLogError / SampleBudgetError.
@@ -325,6 +481,7 @@ std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
     tables.push_back(std::move(e.samples));
     return tables;
   }
+  if (!args.from_s && !args.to_s) throw_if_several_experiments(args);
   LogSamples samples = read_sample_logs(args.files, o);
   std::cout << describe(samples, o);
   tables.push_back(std::move(samples.table));
@@ -351,6 +508,17 @@ int usage_error(const std::string& message) {
   return kExitUsage;
 }
 
+std::string heading_of(const IdentifyArgs& args) {
+  std::string h = std::filesystem::path(args.files.front()).filename().string();
+  if (args.files.size() > 1) h += " + " + std::to_string(args.files.size() - 1) + " more";
+  if (args.experiment) h += ", experiment " + std::to_string(*args.experiment);
+  if (args.from_s || args.to_s) {
+    h += ", t in [" + (args.from_s ? std::to_string(*args.from_s) : std::string("start")) + ", " +
+         (args.to_s ? std::to_string(*args.to_s) : std::string("end")) + ") s";
+  }
+  return h;
+}
+
 int fit_inputs(const IdentifyArgs& args) {
   std::unique_ptr<ParamsLink> link;
   if (args.publish) {
@@ -361,6 +529,8 @@ int fit_inputs(const IdentifyArgs& args) {
     p.rig = args.rig;
     p.version = args.version;
     p.listen_s = args.listen_s;
+    p.compensator = args.compensator;
+    if (args.timeout_s) p.timeout_s = *args.timeout_s;
     link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
   } else {
     validate_rig_prefix(args.rig);
@@ -373,12 +543,17 @@ int fit_inputs(const IdentifyArgs& args) {
     samples += t.u.size();
   }
   if (auto why = over_sample_budget(samples, args.max_samples, args.decimate)) return usage_error(*why);
-  switch (args.choice.mode) {
-    case ModelChoice::Mode::banning: return fit_banning_files(args, tables);
-    case ModelChoice::Mode::automatic: return fit_auto_and_emit(args, tables.front());
-    case ModelChoice::Mode::single: return fit_single(args, args.choice.kind, tables.front(), link.get());
+  if (args.choice.mode == ModelChoice::Mode::banning) return fit_banning_files(args, tables);
+  const Run run{args, output_target(args.out), link.get(), heading_of(args)};
+  Fitted fitted;
+  const SampleTable& record = tables.front();
+  const int rc = args.choice.mode == ModelChoice::Mode::automatic ? fit_auto(run, record, fitted)
+                                                                  : fit_single(run, args.choice.kind, record, fitted);
+  if (rc != 0) {
+    if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
+    return rc;
   }
-  return kExitFailure;
+  return finish(run, record, fitted);
 }
 
 }  // namespace
@@ -397,6 +572,8 @@ int run_identify(const IdentifyArgs& args) {
   } catch (const SampleLogError& e) {
     return usage_error(e.what());
   } catch (const SampleBudgetError& e) {
+    return usage_error(e.what());
+  } catch (const SeveralExperiments& e) {
     return usage_error(e.what());
   } catch (const ParameterError& e) {
     return usage_error(e.what());

@@ -61,6 +61,11 @@ std::string label(const LoggedExperiment& e) {
          std::to_string(e.request_id) + ")";
 }
 
+// A request the compensator takes as its own (addressed to it, or to everyone).
+bool for_compensator(const control_t& control, const ExperimentLogOptions& o) {
+  return control.target.empty() || control.target == o.compensator_process;
+}
+
 Record read_record(const std::vector<std::string>& files, const ExperimentLogOptions& o, LoggedExperiments& out) {
   Record r;
   std::set<std::int64_t> ids;
@@ -85,7 +90,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
         }
       } else if (event->channel == o.control_channel) {
         if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
-        if (!control.target.empty() && control.target != o.compensator_process) continue;
+        if (!for_compensator(control, o)) continue;
         if (control.command == control_t::STOP_EXPERIMENT) {
           r.stops.push_back(event->timestamp);
           continue;
@@ -241,6 +246,7 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
                          std::to_string(r.commands.size()) + " command ticks, " + std::to_string(out.requests) +
                          " START_EXPERIMENT requests logged)");
   }
+  out.first_sample_seq = r.samples.empty() ? 0 : r.samples.front().seq;
   std::size_t next = 0;  // first request not yet accounted for
   for (std::size_t bi = 0; bi < blocks.size(); ++bi) {
     const Block& b = blocks[bi];
@@ -311,6 +317,22 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
   return out;
 }
 
+std::size_t count_experiment_requests(const std::vector<std::string>& files, const ExperimentLogOptions& o) {
+  std::set<std::int64_t> ids;
+  control_t control{};
+  for (const auto& file : files) {
+    if (!std::filesystem::is_regular_file(file)) return 0;
+    lcm::LogFile log(file, "r");
+    if (!log.good()) return 0;
+    while (const lcm::LogEvent* event = log.readNextEvent()) {
+      if (event->channel != o.control_channel) continue;
+      if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
+      if (for_compensator(control, o) && control.command == control_t::START_EXPERIMENT) ids.insert(control.request_id);
+    }
+  }
+  return ids.size();
+}
+
 std::string describe(const LoggedExperiments& logged) {
   std::ostringstream o;
   std::size_t usable = 0, measured = 0;
@@ -335,6 +357,24 @@ std::string describe(const LoggedExperiments& logged) {
   }
   for (const auto& n : logged.notes) o << "  note: " << n << "\n";
   return o.str();
+}
+
+std::string list_experiments(const LoggedExperiments& logged, const ExperimentLogOptions& options) {
+  std::string out = "    N  kind    offset [V]  amplitude [V]  frequency [Hz]  duration [s]  time in the record [s]\n";
+  char line[256];
+  for (std::size_t i = 0; i < logged.experiments.size(); ++i) {
+    const LoggedExperiment& e = logged.experiments[i];
+    const char* kind = e.spec.settle ? "settle" : "sine";
+    const double from_s = static_cast<double>(e.begin_tick - logged.first_sample_seq) * options.dt_s;
+    const double to_s = static_cast<double>(e.end_tick - logged.first_sample_seq) * options.dt_s;
+    std::snprintf(line, sizeof line, "  %3zu  %-6s  %10.4g  %13.4g  %14.4g  %12.4g  %9.4f .. %-9.4f  ", i, kind,
+                  e.spec.offset_V, e.spec.amplitude_V, e.spec.frequency_hz,
+                  static_cast<double>(e.end_tick - e.begin_tick) * options.dt_s, from_s, to_s);
+    out += line;
+    out += e.usable() ? (e.spec.settle ? "settling, not for fitting" : "usable") : "cannot be used: " + e.problem;
+    out += "\n";
+  }
+  return out;
 }
 
 }  // namespace hystloop

@@ -64,15 +64,27 @@ struct LoggedExperiments {
   std::vector<LoggedExperiment> experiments;  // in the order they ran
   std::vector<std::string> notes;             // what else was found: dropped requests, unexplained ticks
   std::size_t files = 0;
-  std::size_t requests = 0;  // distinct START_EXPERIMENT requests for the compensator
-  std::size_t blocks = 0;    // runs of EXPERIMENT command ticks
+  std::size_t requests = 0;           // distinct START_EXPERIMENT requests for the compensator
+  std::size_t blocks = 0;             // runs of EXPERIMENT command ticks
+  std::int64_t first_sample_seq = 0;  // of the record's first sample: t = 0 of --from/--to (LogTimeBase::seq)
 };
 
 // Reads the files in order as one record. Throws SampleLogError (log_samples.hpp) for a file
 // that cannot be read or a log without any experiment tick; ParameterError for bad options.
 LoggedExperiments read_logged_experiments(const std::vector<std::string>& files, const ExperimentLogOptions& options);
 
+// Distinct START_EXPERIMENT requests for the compensator in the files, read without keeping any
+// sample (a cheap look before deciding whether a log holds several experiments); 0 for a file
+// that cannot be read (the reader that follows says why).
+std::size_t count_experiment_requests(const std::vector<std::string>& files, const ExperimentLogOptions& options);
+
 // A table, one line per experiment, and the notes.
 std::string describe(const LoggedExperiments& logged);
+
+// For a user who has to pick one (a log with several experiments, none chosen): a table of every
+// experiment, its index, kind (sine, or settle: not for fitting), offset, amplitude,
+// frequency, duration and its time range in the record [s after the first sample, as --from/--to
+// count], usable or why not.
+std::string list_experiments(const LoggedExperiments& logged, const ExperimentLogOptions& options);
 
 }  // namespace hystloop

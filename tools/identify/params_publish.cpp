@@ -4,15 +4,18 @@
 #include <limits>
 #include <thread>
 
+#include "adoption_watch.hpp"
 #include "core/errors.hpp"
 #include "core/process.hpp"
 #include "hystloop/command_block_t.hpp"
+#include "hystloop/service_status_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "lcm/url.hpp"
 #include "loop/params_admission.hpp"
+#include "runtime/model_params_message.hpp"
 
 namespace hystloop {
 
@@ -23,6 +26,8 @@ void PublishOptions::validate() const {
     throw ParameterError("repeats", "must be 1..10 (got " + std::to_string(repeats) + ")");
   }
   validate_rig_prefix(rig);
+  require_in_range("timeout", timeout_s, 0.0, 600.0);
+  if (compensator.empty()) throw ParameterError("compensator", "must name the compensator's process");
 }
 
 std::int32_t next_params_version(std::int32_t highest_heard) noexcept {
@@ -42,7 +47,24 @@ mem_params_t to_mem_params(const MemFitResult& fit, double window_s, std::int32_
   m.residual_m = fit.residual_rms_m;
   m.samples_used = static_cast<std::int64_t>(fit.samples_used);
   m.window_s = window_s;
-  m.valid = fit.ok();
+  m.valid = static_cast<std::int8_t>(fit.ok() ? 1 : 0);
+  m.source = source;
+  return m;
+}
+
+model_params_t to_model_params(const ModelParamSet& set, const FitFigures& fit, std::int32_t version,
+                               std::int64_t utime_us, const std::string& source) {
+  model_params_t m{};
+  set_model(m, set);
+  m.utime = utime_us;
+  m.version = version;
+  m.publisher_id = process_publisher_id();  // one sequence per run over HX_PARAMS and HX_MODEL
+  m.residual_m = fit.residual_m;
+  m.heldout_rms_m = fit.heldout_rms_m;
+  m.samples_used = static_cast<std::int64_t>(fit.samples_used);
+  m.window_s = fit.window_s;
+  m.valid = true;
+  m.stage_kind = model_params_t::STAGE_UNCHANGED;
   m.source = source;
   return m;
 }
@@ -59,6 +81,8 @@ std::int32_t ParamsLink::highest_version_heard() {
   std::int32_t highest = 0;
   Subscription<mem_params_t> params(
       *lcm_, channels_.params, [&](const mem_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
+  Subscription<model_params_t> models(
+      *lcm_, channels_.model, [&](const model_params_t& p, std::int64_t) { highest = std::max(highest, p.version); });
   Subscription<command_block_t>::Options queue;
   queue.queue_capacity = 4'000;  // blocks of the whole listening time
   Subscription<command_block_t> commands(
@@ -77,15 +101,48 @@ std::int32_t ParamsLink::highest_version_heard() {
   return highest;
 }
 
-int ParamsLink::publish(const mem_params_t& msg) {
-  Publisher<mem_params_t> publisher(*lcm_, channels_.params);
+namespace {
+
+template <class T>
+int publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg, const PublishOptions& options) {
+  Publisher<T> publisher(lcm, channel);
   int sent = 0;
-  for (int i = 0; i < options_.repeats; ++i) {
-    if (i > 0) std::this_thread::sleep_for(options_.gap);
+  for (int i = 0; i < options.repeats; ++i) {
+    if (i > 0) std::this_thread::sleep_for(options.gap);
     if (publisher.publish(msg)) ++sent;
     if (publisher.counters().invalid > 0) return 0;  // refused by the contract: never retried
   }
   return sent;
+}
+
+}  // namespace
+
+int ParamsLink::publish(const mem_params_t& msg) { return publish_repeated(*lcm_, channels_.params, msg, options_); }
+
+int ParamsLink::publish(const model_params_t& msg) { return publish_repeated(*lcm_, channels_.model, msg, options_); }
+
+ParamsLink::Adoption ParamsLink::wait_for_adoption(std::int32_t version) {
+  AdoptionWatch watch(options_.compensator, version);
+  Subscription<service_status_t> status(*lcm_, channels_.status,
+                                        [&](const service_status_t& s, std::int64_t) { watch.on_status(s); });
+  Subscription<command_block_t>::Options queue;
+  queue.queue_capacity = 4'000;
+  Subscription<command_block_t> commands(
+      *lcm_, channels_.command,
+      [&](const command_block_t& c, std::int64_t) {
+        if (c.n_ticks > 0)
+          watch.on_command_version(command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version);
+      },
+      queue);
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const auto deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.timeout_s));
+  for (auto now = start; now < deadline && !watch.adopted(); now = Clock::now()) {
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now);
+    if (handle_pending(*lcm_, std::min(left, std::chrono::microseconds(50'000)), 1024) < 0) break;
+  }
+  return {watch.adopted(), watch.verdict(options_.timeout_s, channels_.status)};
 }
 
 }  // namespace hystloop

@@ -358,12 +358,25 @@ TEST_F(IdentifyLog, ToolReadsAnyNameWithLogAndRefusesBadInput) {
   EXPECT_NE(range.output.find("to: must be > from"), std::string::npos) << range.output;
 }
 
-TEST_F(IdentifyLog, ToolPublishesOnlyMem) {
+// What cannot be published is refused before any LCM is opened (publishing itself, on HX_MODEL
+// and HX_PARAMS, and the adoption: identify_publish_test.cpp, inside a private namespace).
+TEST_F(IdentifyLog, ToolRefusesWhatCannotBePublished) {
   write_log(path("run.lcmlog"), mem_record(truth_));
-  const ToolRun pi = run_tool(path("run.lcmlog") + " --model pi --publish");
+  const ToolRun pi = run_tool(path("run.lcmlog") + " --model pi --publish --publish-on params");
   EXPECT_EQ(pi.exit_code, 2) << pi.output;
+  EXPECT_NE(pi.output.find("--publish-on params sends MEM parameters"), std::string::npos) << pi.output;
   EXPECT_NE(pi.output.find("only with --model mem"), std::string::npos) << pi.output;
-  // A URL whose packets could leave the host: identify_publish_test.cpp, inside a private namespace.
+  const ToolRun banning = run_tool(path("run.lcmlog") + " --model banning --publish");
+  EXPECT_EQ(banning.exit_code, 2) << banning.output;
+  EXPECT_NE(banning.output.find("Banning's model is identified offline only"), std::string::npos) << banning.output;
+  for (const char* alone : {"--no-wait", "--timeout 2", "--publish-on model"}) {
+    const ToolRun r = run_tool(path("run.lcmlog") + " --model mem " + alone);
+    EXPECT_EQ(r.exit_code, 2) << alone << ": " << r.output;
+    EXPECT_NE(r.output.find("only with --publish"), std::string::npos) << alone << ": " << r.output;
+  }
+  const ToolRun both = run_tool(path("run.lcmlog") + " --model mem --publish --timeout 2 --no-wait");
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_NE(both.output.find("choose one"), std::string::npos) << both.output;
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // hystloop-identify --publish against real udpm LCM (ttl=0) inside tools/netns-run: the test
-// subscribes to HX_PARAMS, runs the tool on a recorded log as a child process, keeps
-// dispatching (and, where needed, plays a rig whose parameter set in use has a version) until
-// the child exits, then checks what arrived: the fitted values, valid = true, the version.
+// subscribes to HX_PARAMS and HX_MODEL, runs the tool on a recorded log as a child process, keeps
+// dispatching (and, where needed, plays a rig whose parameter set in use has a version, or a
+// compensator that reports on HX_STATUS the version it uses) until the child exits, then checks
+// what arrived -- the fitted values, valid = true, the version, the signature on a keyed rig --
+// and what the tool said of the adoption.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -10,6 +12,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -21,10 +25,13 @@
 #include <vector>
 
 #include "hystloop/command_block_t.hpp"
+#include "hystloop/model_params_t.hpp"
+#include "hystloop/service_status_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
+#include "lcm/rig_auth.hpp"
 #include "lcm/subscription.hpp"
 #include "sensor_log_fixture.hpp"
 
@@ -60,6 +67,7 @@ Result run_tool(const std::vector<std::string>& args, lcm::LCM& lcm, const std::
   std::vector<std::string> all{HYSTLOOP_IDENTIFY_EXE};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(all.size() + 1);
   for (auto& a : all) argv.push_back(a.data());
   argv.push_back(nullptr);
   Result r;
@@ -97,14 +105,19 @@ class IdentifyPublish : public ::testing::Test {
         std::make_unique<Subscription<mem_params_t>>(*lcm_, ch_.params, [this](const mem_params_t& m, std::int64_t) {
           if (m.source.rfind("hystloop-identify@", 0) == 0) received_.push_back(m);
         });
+    models_ =
+        std::make_unique<Subscription<model_params_t>>(*lcm_, ch_.model, [this](const model_params_t& m, std::int64_t) {
+          if (m.source.rfind("hystloop-identify@", 0) == 0) models_received_.push_back(m);
+        });
   }
   void TearDown() override {
     std::error_code ec;
     fs::remove_all(dir_, ec);
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  // Fire and forget (--no-wait): no compensator runs in these tests unless one is played.
   std::vector<std::string> args(const std::string& log, std::vector<std::string> more) const {
-    std::vector<std::string> a{log, "--model", "mem", "--publish", "--lcm-url", kUrl};
+    std::vector<std::string> a{log, "--model", "mem", "--publish", "--lcm-url", kUrl, "--no-wait"};
     a.insert(a.end(), more.begin(), more.end());
     return a;
   }
@@ -114,6 +127,8 @@ class IdentifyPublish : public ::testing::Test {
   std::unique_ptr<lcm::LCM> lcm_;
   std::unique_ptr<Subscription<mem_params_t>> params_;
   std::vector<mem_params_t> received_;
+  std::unique_ptr<Subscription<model_params_t>> models_;
+  std::vector<model_params_t> models_received_;
   const MemParams truth_ = MemParams::paper_like();
 };
 
@@ -234,6 +249,155 @@ TEST_F(IdentifyPublish, RefusedFitPublishesNothing) {
   EXPECT_NE(r.out.find("constant_input"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("nothing published"), std::string::npos) << r.out;
   EXPECT_TRUE(received_.empty());
+}
+
+// Any model goes out on HX_MODEL as model_params_t: its kind and the values printed, the next
+// version, valid, the stage left to the receiver. --model mem too when asked (--publish-on model).
+TEST_F(IdentifyPublish, AnyModelArrivesOnHxModelWithTheFittedValues) {
+  write_log(path("run.lcmlog"), mem_record(truth_, 0.5e-9));
+  const Result r = run_tool(
+      {path("run.lcmlog"), "--model", "linear", "--publish", "--lcm-url", kUrl, "--no-wait", "--listen-s", "0.1"},
+      *lcm_);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("published linear parameters v2 on HX_MODEL (3 time(s))"), std::string::npos) << r.out;
+  EXPECT_TRUE(received_.empty()) << "a linear set on HX_PARAMS";
+  ASSERT_GE(models_received_.size(), 1u) << r.out;
+  double gain = 0.0, offset = 0.0;
+  ASSERT_EQ(std::sscanf(r.out.substr(r.out.find("linear: gain = ")).c_str(), "linear: gain = %lf m/V, offset = %lf m",
+                        &gain, &offset),
+            2)
+      << r.out;
+  for (const auto& m : models_received_) {
+    EXPECT_EQ(m.kind, model_params_t::KIND_LINEAR);
+    EXPECT_EQ(m.format_version, model_params_t::FORMAT_VERSION);
+    EXPECT_EQ(m.version, 2);
+    EXPECT_NE(m.publisher_id, 0);
+    EXPECT_TRUE(m.valid);
+    EXPECT_EQ(m.stage_kind, model_params_t::STAGE_UNCHANGED);
+    EXPECT_NEAR(m.linear_gain, gain, 1e-5 * std::abs(gain));
+    EXPECT_NEAR(m.linear_offset_m, offset, 1e-5 * std::abs(offset) + 1e-15);
+    EXPECT_GT(m.residual_m, 0.0);
+    EXPECT_GT(m.samples_used, 15'000);
+    EXPECT_NEAR(m.window_s, 1.9999, 1e-9);
+  }
+
+  models_received_.clear();
+  const Result mem = run_tool(args(path("run.lcmlog"), {"--publish-on", "model", "--version", "9"}), *lcm_);
+  ASSERT_EQ(mem.exit_code, 0) << mem.out;
+  EXPECT_NE(mem.out.find("published mem parameters v9 on HX_MODEL"), std::string::npos) << mem.out;
+  ASSERT_GE(models_received_.size(), 1u) << mem.out;
+  EXPECT_EQ(models_received_.front().kind, model_params_t::KIND_MEM);
+  EXPECT_NEAR(models_received_.front().mem_c1, truth_.c1, 0.01 * truth_.c1);
+  EXPECT_NEAR(models_received_.front().mem_c2, truth_.c2, 0.01 * truth_.c2);
+  EXPECT_NEAR(models_received_.front().mem_c3, truth_.c3, 0.01 * truth_.c3);
+  EXPECT_NEAR(models_received_.front().mem_c3, printed(mem.out, "c3"), 1e-5 * truth_.c3);
+}
+
+// On a keyed rig the set is signed with the rig key: a receiver holding the key takes it.
+TEST_F(IdentifyPublish, OnAKeyedRigTheSetIsSigned) {
+  write_log(path("run.lcmlog"), mem_record(truth_, 0.5e-9));
+  {
+    std::ofstream key(path("rig.key"));
+    key << "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f\n";
+  }
+  fs::permissions(path("rig.key"), fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+  Subscription<model_params_t>::Options keyed;
+  keyed.auth = rig_auth_from_key_file(path("rig.key"), "key");
+  std::vector<model_params_t> verified;
+  Subscription<model_params_t> signed_models(
+      *lcm_, ch_.model, [&](const model_params_t& m, std::int64_t) { verified.push_back(m); }, keyed);
+  ASSERT_TRUE(signed_models.authenticated());
+  const Result r = run_tool({path("run.lcmlog"), "--model", "pi", "--publish", "--lcm-url", kUrl, "--no-wait",
+                             "--listen-s", "0.1", "--key-file", path("rig.key")},
+                            *lcm_);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  ASSERT_GE(verified.size(), 1u) << r.out;
+  EXPECT_EQ(verified.front().kind, model_params_t::KIND_PI);
+  EXPECT_EQ(verified.front().n_operators, 15);
+  EXPECT_EQ(signed_models.counters().rejected_total(), 0u);
+
+  // Unsigned, the same receiver refuses it.
+  verified.clear();
+  const Result u = run_tool(
+      {path("run.lcmlog"), "--model", "pi", "--publish", "--lcm-url", kUrl, "--no-wait", "--listen-s", "0.1"}, *lcm_);
+  ASSERT_EQ(u.exit_code, 0) << u.out;
+  EXPECT_TRUE(verified.empty());
+  EXPECT_GE(signed_models.counters().rejected(RejectReason::kUnsigned), 1u);
+}
+
+// A compensator played here: it reports on HX_STATUS, 50 times a second, the version it uses in
+// the counter "params_version"; with `adopts` it takes the first set from the tool on HX_MODEL.
+struct FakeCompensator {
+  FakeCompensator(lcm::LCM& lcm, const ChannelNames& ch, std::string name, bool adopts)
+      : status(lcm, ch.status), process(std::move(name)) {
+    if (adopts) {
+      models = std::make_unique<Subscription<model_params_t>>(
+          lcm, ch.model, [this](const model_params_t& m, std::int64_t) { in_use = m.version; });
+    }
+  }
+  void tick() {
+    if (++ticks % 10 != 0) return;
+    service_status_t s{};
+    s.utime = kFirstUtime;
+    s.process = process;
+    s.host = "test";
+    s.pid = 4242;
+    s.state = service_status_t::HEALTHY;
+    s.n_counters = 2;
+    s.counter_names = {"params_version", "samples"};
+    s.counter_values = {in_use, 100};
+    s.loop_p50_us = s.loop_p99_us = s.loop_max_us = std::nan("");
+    s.latency_p50_us = s.latency_p99_us = s.latency_max_us = std::nan("");
+    status.publish(s);
+  }
+  Publisher<service_status_t> status;
+  std::unique_ptr<Subscription<model_params_t>> models;
+  std::string process;
+  std::int64_t in_use = 1;
+  int ticks = 0;
+};
+
+TEST_F(IdentifyPublish, AdoptedWhenTheCompensatorReportsTheVersionInUse) {
+  write_log(path("run.lcmlog"), mem_record(truth_, 0.5e-9));
+  FakeCompensator comp(*lcm_, ch_, "compensator", true);
+  const Result r = run_tool({path("run.lcmlog"), "--model", "mem", "--publish-on", "model", "--publish", "--lcm-url",
+                             kUrl, "--version", "5", "--timeout", "10"},
+                            *lcm_, [&] { comp.tick(); });
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("adopted by 'compensator' (version 5)"), std::string::npos) << r.out;
+  EXPECT_EQ(comp.in_use, 5);
+}
+
+TEST_F(IdentifyPublish, NotAdoptedNamesTheCompensatorAndTheVersionItUses) {
+  write_log(path("run.lcmlog"), mem_record(truth_, 0.5e-9));
+  FakeCompensator comp(*lcm_, ch_, "compensator", false);  // hears nothing: keeps v1
+  const Result r = run_tool({path("run.lcmlog"), "--model", "katalenic", "--publish", "--lcm-url", kUrl, "--version",
+                             "5", "--timeout", "0.5"},
+                            *lcm_, [&] { comp.tick(); });
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("published katalenic parameters v5 on HX_MODEL"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not adopted within 0.5 s ('compensator' in use: version 1)"), std::string::npos) << r.out;
+  ASSERT_GE(models_received_.size(), 1u);
+  EXPECT_EQ(models_received_.front().kind, model_params_t::KIND_KATALENIC);
+
+  // Another process reports, the compensator does not (--compensator names the one that counts).
+  FakeCompensator bridge(*lcm_, ch_, "bridge", false);
+  const Result b = run_tool({path("run.lcmlog"), "--model", "linear", "--publish", "--lcm-url", kUrl, "--timeout",
+                             "0.5", "--compensator", "comp2", "--listen-s", "0.1"},
+                            *lcm_, [&] { bridge.tick(); });
+  EXPECT_EQ(b.exit_code, 1) << b.out;
+  EXPECT_NE(b.out.find("not adopted within 0.5 s (no 'comp2' reported on HX_STATUS; heard: bridge)"), std::string::npos)
+      << b.out;
+}
+
+TEST_F(IdentifyPublish, NothingOnHxStatusMeansNoRigIsRunning) {
+  write_log(path("run.lcmlog"), mem_record(truth_, 0.5e-9));
+  const Result r = run_tool(
+      {path("run.lcmlog"), "--model", "mem", "--publish", "--lcm-url", kUrl, "--listen-s", "0.1", "--timeout", "0.3"},
+      *lcm_);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("published MEM parameters v2 on HX_PARAMS"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no rig is running (nothing reported on HX_STATUS within 0.3 s)"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -11,7 +11,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
+#include <regex>
 #include <set>
 #include <string>
 #include <vector>
@@ -365,6 +367,40 @@ TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
   r = testing::run_tool(tool + " --model mem --experiment 1 --from 1");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("not with --from/--to"), std::string::npos) << r.output;
+}
+
+// A log with two experiments and none chosen: a fit over both would mix two loops into a model
+// that fits neither, so the tool lists them (index, kind, amplitude, frequency, duration, time
+// range) and names --experiment, exit 2; the first of them then fits as --experiment 0.
+TEST_F(IdentifySeries, TwoExperimentsAreListedAndNoneIsFittedUntilOneIsChosen) {
+  std::vector<ctl::SeriesStep> two(2);
+  two[0].request = {"sine", 250.0, 10.0, 1.0, 0.0};  // the MEM paper's input, 1 s
+  two[1].request = {"sine", 100.0, 5.0, 0.4, 50.0};
+  const Recording rec = record_series(path("two.lcmlog"), two, {}, 1.6);
+  // t as --from/--to count it: from the record's first sample; experiment 1 follows 0 at once.
+  const double t0 = static_cast<double>(rec.first_experiment_tick - kFirstSeq) * 1e-4;
+  char t[4][16];
+  for (int i = 0; i < 4; ++i) std::snprintf(t[i], sizeof t[i], "%.4f", t0 + std::array{0.0, 1.0, 1.0, 1.4}[i]);
+  const std::string tool = std::string(HYSTLOOP_IDENTIFY_EXE) + " " + path("two.lcmlog");
+  for (const char* model : {"mem", "auto"}) {
+    const auto r = testing::run_tool(tool + " --model " + model + " --out " + path("never.yaml"));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("holds 2 experiments the loop ran; fit one with --experiment N"), std::string::npos)
+        << r.output;
+    // Both listed with their figures: index, kind, offset, amplitude, frequency, duration, time range.
+    const std::regex row0("\\n +0  sine +0 +250 +10 +1 +" + std::string(t[0]) + " \\.\\. " + t[1] + " +usable");
+    const std::regex row1("\\n +1  sine +50 +100 +5 +0\\.4 +" + std::string(t[2]) + " \\.\\. " + t[3] + " +usable");
+    EXPECT_TRUE(std::regex_search(r.output, row0)) << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, row1)) << r.output;
+    EXPECT_EQ(r.output.find("c3 ="), std::string::npos) << "fitted although none was chosen: " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(path("never.yaml")));
+  }
+  const auto one = testing::run_tool(tool + " --model mem --experiment 0");
+  EXPECT_EQ(one.exit_code, 0) << one.output;
+  EXPECT_NE(one.output.find("fitting experiment 0: 10000 samples"), std::string::npos) << one.output;
+  // A time range is a choice too: the record as it is, between the times given.
+  const auto range = testing::run_tool(tool + " --model linear --from " + t[2] + " --to " + t[3]);
+  EXPECT_EQ(range.exit_code, 0) << range.output;
 }
 
 }  // namespace
