@@ -2,12 +2,16 @@
 // The MEM model's position for the logged voltages, for the u -> y plot: the measured loop with
 // the loop the model in use predicts for the same u on top of it.
 //
-// The set of a tick: its command's params_version when that is a valid MEM set of the report,
-// else the latest valid MEM set published at or before the tick, else the first valid MEM set
-// of the report (the identification experiment comes before the set fitted to it, so its ticks
-// get the loop identified from them). The model starts on its skeleton at the first tick's u,
-// offset to pass through the first measured y; a change of set keeps the current point
-// (MemModel::set_params), as the compensator's swap does.
+// The set of a tick: for a tick of an identification experiment (MODE_EXPERIMENT) the first
+// valid MEM set published after it with a fit residual (the one fitted from it; a set sent by
+// hand carries none);
+// else its command's params_version
+// when that is a valid MEM set of the report, else the latest valid MEM set published at or
+// before the tick, else the first valid MEM set of the report. The model starts on its skeleton
+// at the first tick's u, offset to pass through the first measured y; a change of set keeps the
+// current point (MemModel::set_params), as the compensator's swap does; at each reversal of u
+// the model's branch is moved to start at the measured y, so that the plot compares branch
+// shapes and does not accumulate the offset of a long open-loop run.
 
 #include <vector>
 

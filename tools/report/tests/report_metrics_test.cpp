@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "model_overlay.hpp"
 #include "models/mem.hpp"
 #include "report_metrics.hpp"
@@ -346,4 +347,40 @@ TEST(MemModelY, IsTheSetInUseForTheSameUAndTheFirstIdentifiedBeforeAnySet) {
 
   m.params_history[0].valid = false;  // no valid set: nothing to draw
   EXPECT_TRUE(mem_model_y(ticks, m).empty());
+}
+
+// An identification experiment is drawn with the set fitted from it (published after it), not
+// the set it is to replace; and every branch starts at the measured y of its reversal, so a
+// stage that creeps away from the model moves the model with it.
+TEST(MemModelY, AnExperimentGetsTheSetFittedFromItAndEachBranchStartsAtTheMeasuredReversal) {
+  const hystloop::MemParams stage = hystloop::MemParams::paper_like();
+  hystloop::MemParams wrong = stage;
+  wrong.c1 *= 3.0;
+  ReportMetrics m;
+  m.params_history.push_back({-1.0, 1, wrong.c1, wrong.c2, wrong.c3, 1e-9, true, "mem", 1e-9, false});
+  m.params_history.push_back({15.0, 1, wrong.c1, wrong.c2, wrong.c3, 0.0, true, "mem", 0.0, false});  // by hand
+  m.params_history.push_back({20.0, 2, stage.c1, stage.c2, stage.c3, 1e-9, true, "mem", 1e-9, false});
+  std::vector<TrackPoint> ticks;
+  hystloop::MemModel truth(stage);
+  std::vector<std::size_t> reversal_ticks;
+  double prev_du = 0.0, prev_u = 0.0;
+  for (int k = 0; k < 10'000; ++k) {
+    const double u = 200.0 * std::sin(2.0 * M_PI * k / 2000.0);
+    const double creep_m = 2e-12 * k;  // 20 nm over the record
+    TrackPoint p{k * 1e-3, u, truth.forward(u) + creep_m, std::nan("")};
+    p.mode = command_block_t::MODE_EXPERIMENT;
+    p.params_version = 1;  // the set in use while the experiment runs
+    ticks.push_back(p);
+    const double du = u - prev_u;
+    if (k > 1 && du * prev_du < 0.0) reversal_ticks.push_back(static_cast<std::size_t>(k - 1));
+    prev_du = du, prev_u = u;
+  }
+  const auto y = mem_model_y(ticks, m);
+  ASSERT_EQ(y.size(), ticks.size());
+  ASSERT_GE(reversal_ticks.size(), 8u);
+  // With the set fitted from the experiment the model follows the stage to its creep within a
+  // branch (at most the 2 pm/tick creep of one branch, 1000 ticks), not the wrong set's 3x slope.
+  double worst = 0.0;
+  for (std::size_t i = 0; i < y.size(); ++i) worst = std::max(worst, std::abs(y[i] - ticks[i].y_m));
+  EXPECT_LT(worst, 2.5e-9);
 }
