@@ -46,7 +46,8 @@ TEST(ControlAcks, TheReasonOfARefusalIsShownForAWhileThenNotAnyMore) {
   EXPECT_EQ(acks.refusal_note(0), "");
   acks.refused(7, "reidentifier.models is off", 5'000'000);
   EXPECT_EQ(acks.refusal_note(5'000'000), "request 7 refused: reidentifier.models is off");
-  EXPECT_EQ(acks.refusal_note(5'000'000 + ControlAcks::kReasonShownUs), "request 7 refused: reidentifier.models is off");
+  EXPECT_EQ(acks.refusal_note(5'000'000 + ControlAcks::kReasonShownUs),
+            "request 7 refused: reidentifier.models is off");
   EXPECT_EQ(acks.refusal_note(5'000'001 + ControlAcks::kReasonShownUs), "");
   acks.acted(8);  // acting on a later one leaves the last refusal as it was
   EXPECT_EQ(acks.last_refused(), 7);

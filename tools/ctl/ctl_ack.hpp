@@ -32,7 +32,7 @@ using StateCheck = std::function<bool(const service_status_t&)>;
 
 struct AckReading {
   AckOutcome outcome = AckOutcome::kPending;
-  std::string detail;        // kRefused: the process's reason; else its status detail
+  std::string detail;         // kRefused: the process's reason; else its status detail
   bool acknowledges = false;  // the report carries control_acted_request (a build that answers)
 };
 

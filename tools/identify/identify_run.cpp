@@ -439,6 +439,28 @@ void throw_if_several_experiments(const IdentifyArgs& args) {
                            list_experiments(logged, o));
 }
 
+// A fit of a whole log that holds an experiment the loop ran (several are refused before the
+// fit: throw_if_several_experiments): the record mixes it with whatever else ran (tracking,
+// settling), which is rarely one model's data (the demo's log: one identification experiment,
+// then tracking, fails on MEM's c3 bound). Says so after the fit, failed or not, and lists it.
+void note_experiments_in_whole_log(const IdentifyArgs& args) {
+  if (!args.from_logs || args.experiment || args.from_s || args.to_s) return;
+  const ExperimentLogOptions o = experiment_options(args);
+  if (count_experiment_requests(args.files, o) == 0) return;
+  LoggedExperiments logged;
+  try {
+    logged = read_logged_experiments(args.files, o);
+  } catch (const SampleLogError&) {
+    return;
+  }
+  if (logged.experiments.empty()) return;
+  std::cerr << "hystloop-identify: note: this fit is over the whole record, and the log holds "
+            << logged.experiments.size()
+            << " experiment(s) the loop ran; fit one alone with --experiment N (N as listed), or a time range with "
+               "--from S --to S:\n"
+            << list_experiments(logged, o);
+}
+
 // Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
 // SampleLogError / SampleBudgetError.
 std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
@@ -549,6 +571,7 @@ int fit_inputs(const IdentifyArgs& args) {
   const SampleTable& record = tables.front();
   const int rc = args.choice.mode == ModelChoice::Mode::automatic ? fit_auto(run, record, fitted)
                                                                   : fit_single(run, args.choice.kind, record, fitted);
+  note_experiments_in_whole_log(args);
   if (rc != 0) {
     if (link != nullptr) std::cerr << "hystloop-identify: nothing published\n";
     return rc;

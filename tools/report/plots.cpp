@@ -107,7 +107,9 @@ std::string u_y_script(const std::array<SeriesFile, 3>& u_y, bool with_model) {
   for (std::size_t g = 0; with_model && g < 2; ++g) {  // the model over the experiment and tracking
     if (u_y[g].file.empty()) continue;
     gp << sep << "'" << u_y[g].file.filename().string() << "' using 2:4 with lines dt 2 lw 1 lc rgb '#ff7f0e' "
-       << (titled ? "notitle" : "title 'MEM model from each reversal (the set in use; over the experiment, the set fitted from it)'");
+       << (titled
+               ? "notitle"
+               : "title 'MEM model from each reversal (the set in use; over the experiment, the set fitted from it)'");
     titled = true;
   }
   gp << "\n";

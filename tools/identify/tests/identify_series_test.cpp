@@ -369,6 +369,24 @@ TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
   EXPECT_NE(r.output.find("not with --from/--to"), std::string::npos) << r.output;
 }
 
+// A log with one experiment fitted whole (the demo's: the identification experiment, then
+// tracking) is fitted as asked, with a note that lists the experiment and names --experiment.
+TEST_F(IdentifySeries, OneExperimentInAWholeLogFitIsNotedWithHowToFitItAlone) {
+  std::vector<ctl::SeriesStep> one(1);
+  one[0].request = {"sine", 250.0, 10.0, 1.0, 0.0};
+  record_series(path("one.lcmlog"), one, {}, 1.6);
+  const std::string tool = std::string(HYSTLOOP_IDENTIFY_EXE) + " " + path("one.lcmlog");
+  auto r = testing::run_tool(tool + " --model linear");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the log holds 1 experiment(s) the loop ran; fit one alone with --experiment N"),
+            std::string::npos)
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("\\n +0  sine +0 +250 +10 +1 "))) << r.output;
+  r = testing::run_tool(tool + " --model linear --experiment 0");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("note: this fit is over the whole record"), std::string::npos) << r.output;
+}
+
 // A log with two experiments and none chosen: a fit over both would mix two loops into a model
 // that fits neither, so the tool lists them (index, kind, amplitude, frequency, duration, time
 // range) and names --experiment, exit 2; the first of them then fits as --experiment 0.
