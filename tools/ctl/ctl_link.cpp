@@ -109,6 +109,8 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
                                           if (s.process == o.compensator_process) {
                                             line.learning_rms_nm = learning_rms_nm(s);
                                             line.learning_periods = find_counter(s, "learning_periods");
+                                            line.trajectories_refused = find_counter(s, "trajectory_refused");
+                                            line.trajectories_shaped = find_counter(s, "trajectories_shaped");
                                           }
                                           if (s.process != o.bridge_process) return;
                                           line.late_delta = s.late - late_before_report.value_or(s.late);

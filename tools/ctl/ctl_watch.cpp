@@ -73,6 +73,10 @@ std::string format_watch_line(const WatchLine& l) {
     out += buf;
     out += " (" + (l.learning_periods ? std::to_string(*l.learning_periods) : std::string("--")) + " periods)";
   }
+  const std::int64_t refused = l.trajectories_refused.value_or(0), shaped = l.trajectories_shaped.value_or(0);
+  if (refused > 0 || shaped > 0) {
+    out += "  trajectories refused " + std::to_string(refused) + ", shaped " + std::to_string(shaped);
+  }
   return out;
 }
 

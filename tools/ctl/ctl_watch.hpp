@@ -41,13 +41,18 @@ struct WatchLine {
   // [nm] and the periods learned.
   std::optional<double> learning_rms_nm;
   std::optional<std::int64_t> learning_periods;
+  // Compensator status: trajectories it refused, and those it took shaped to the actuator's
+  // limits, since it started; shown once either is non-zero.
+  std::optional<std::int64_t> trajectories_refused;
+  std::optional<std::int64_t> trajectories_shaped;
 };
 
 // The compensator's learning error [nm] from its counter learning_rms_nm, or learning_rms_pm (finer).
 std::optional<double> learning_rms_nm(const service_status_t& compensator);
 
 // " 12 s  rms   27.9 nm  max   80.1 nm  ticks 10000/10000  params v3  late 0 (+0)  clamped 0/s  buf min 212
-//  bridge HEALTHY" and, when the compensator reports learning, "  learned 12.3 nm (34 periods)"
+//  bridge HEALTHY" and, when the compensator reports learning, "  learned 12.3 nm (34 periods)",
+// and when it refused or shaped a trajectory, "  trajectories refused 1, shaped 2"
 std::string format_watch_line(const WatchLine& line);
 
 }  // namespace hystloop::ctl

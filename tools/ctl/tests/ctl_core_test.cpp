@@ -358,6 +358,14 @@ TEST(CtlWatch, LineIsTidy) {
   EXPECT_EQ(format_watch_line(l),
             "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
             "clamped 14/s  buf min 212  bridge HEALTHY  learned 9.0 nm (31 periods)");
+  l.trajectories_refused = 0;
+  l.trajectories_shaped = 0;
+  EXPECT_EQ(format_watch_line(l).find("trajectories"), std::string::npos);  // none: not said
+  l.trajectories_refused = 1;
+  l.trajectories_shaped = 2;
+  EXPECT_NE(format_watch_line(l).find("  learned 9.0 nm (31 periods)  trajectories refused 1, shaped 2"),
+            std::string::npos)
+      << format_watch_line(l);
   service_status_t comp{};
   comp.counter_names = {"learning_rms_pm", "learning_periods"};
   comp.counter_values = {12345, 4};
