@@ -35,7 +35,8 @@ std::string convergence_script(const ReportMetrics& m) {
   }
   gp << "set multiplot layout " << (have_mem ? 4 : 1)
      << ",1 title 'Re-identification: parameter sets and tracking error (dashed red: a swap at the compensator)'\n"
-     << "set xlabel 't [s]'\n";
+     << "set xlabel 't [s]'\n"
+     << "set key below horizontal  # the series fill their panels' corners: a key inside would hide points\n";
   if (have_mem) {
     gp << "set title 'c1: slope at a reversal" << (have_heldout ? ", and the held-out RMS of each set" : "") << "'\n"
        << "set ylabel 'c1 [nm/V]'\n";
@@ -55,6 +56,7 @@ std::string convergence_script(const ReportMetrics& m) {
      << "set ylabel 'RMS error [nm]'\n"
      << "plot 'per_second.dat' using ($1+0.5):2 with linespoints lw 2 pt 7 title 'RMS per second'\n"
      << "unset multiplot\nunset title\nunset arrow\nunset label\nset autoscale x\nunset lmargin\nunset rmargin\n"
+     << "set key inside top left\n"
      << "set terminal @TERMINAL@ size 1000,700 noenhanced\n";
   return gp.str();
 }
