@@ -90,6 +90,11 @@ void OnlineMemEstimator::snapshot(MemWindow& out) const {
   out.poison_seq = hit ? poison_seq_ : 0;
 }
 
+namespace {
+// A held-out branch spans at least this fraction of the window's input range [-].
+constexpr double kHeldOutMinSpan = 0.1;
+}  // namespace
+
 MemRefitOutcome OnlineMemEstimator::evaluate(const MemWindow& w, const MemParams& in_use, std::uint64_t version,
                                              const OnlineMemOptions& o) {
   MemRefitOutcome out;
@@ -106,8 +111,21 @@ MemRefitOutcome OnlineMemEstimator::evaluate(const MemWindow& w, const MemParams
   }
   if (w.u.size() != w.y.size() || w.u.empty()) return refuse(FitStatus::size_mismatch, "empty window");
   const std::vector<BranchSegment> branches = split_branches(w.u, o.fit.reversal_dead_band_V);
-  // Complete branches end at the next reversal: all but the last one.
-  const std::size_t complete = branches.empty() ? 0 : branches.size() - 1;
+  // Complete branches end at the next reversal: all but the last one. The held-out ones end at
+  // the last complete branch that spans a real part of the window's input: a servo's jitter at
+  // a turning point makes branches of a sample or two, and the offset-free RMS over such a
+  // branch is about 0 for any set, which would judge every candidate "no better". Branches
+  // after it are neither fitted nor held out.
+  std::size_t complete = branches.empty() ? 0 : branches.size() - 1;
+  if (complete > 0) {
+    const auto [ulo, uhi] = std::minmax_element(w.u.begin(), w.u.end());
+    const double significant_V = kHeldOutMinSpan * (*uhi - *ulo);
+    while (complete > 0) {
+      const BranchSegment& b = branches[complete - 1];
+      if (b.size() > 1 && std::abs(w.u[b.end - 1] - b.origin_u) >= significant_V) break;
+      --complete;
+    }
+  }
   if (complete < o.holdout_branches + o.fit.min_branches) {
     const auto [lo, hi] = std::minmax_element(w.u.begin(), w.u.end());
     if (*hi - *lo < std::max(o.fit.min_input_range_V, 1e-300)) {

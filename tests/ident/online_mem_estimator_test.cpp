@@ -52,6 +52,32 @@ TEST(OnlineMemEstimator, ConvergesAfterAStepChangeOfThePlantGain) {
   EXPECT_EQ(est.refits_accepted(), 1u);
 }
 
+// A window that ends on the servo's jitter at a turning point: u reverses a few times by
+// millivolts, so the last complete branches are a sample or two long and say nothing about the
+// model (an offset-free RMS over one sample is 0 for any set). The judge holds out the last
+// branch that spans a real part of the window's input range instead, so a better set is still
+// recognised as better.
+TEST(OnlineMemEstimator, JitterAtTheWindowsEndDoesNotBecomeTheHeldOutBranch) {
+  const MemParams truth = testdata::piezo_truth();
+  const MemParams wrong = scaled(truth, 3.0);
+  auto u = testdata::sine_input(250.0, 1.0, 1e4, 2.75);  // ends at a trough ...
+  const double top = u.back();
+  for (int i = 0; i < 40; ++i) u.push_back(top + ((i / 2) % 2 == 0 ? 0.002 : -0.002));  // ... then jitters
+  auto y = testdata::mem_branches(u, truth);
+  testdata::add_noise(y, 1e-10, 31);
+  MemWindow w;
+  w.u = u;
+  w.y = y;
+  OnlineMemOptions o;
+  o.window_samples = u.size();
+  o.capacity_samples = u.size();
+  const MemRefitOutcome out = OnlineMemEstimator::evaluate(w, wrong, 1, o);
+  ASSERT_EQ(out.status, FitStatus::ok) << out.reason;
+  EXPECT_TRUE(out.accepted);
+  EXPECT_GT(out.holdout_rms_in_use_m, 1e-8) << out.reason;  // the wrong set is visibly wrong ...
+  EXPECT_LT(out.holdout_rms_candidate_m, 0.1 * out.holdout_rms_in_use_m) << out.reason;  // ... and the fit is not
+}
+
 TEST(OnlineMemEstimator, GarbageWindowsAreRefusedAndPublishNothing) {
   const MemParams truth = testdata::piezo_truth();
   const auto u = testdata::sine_input(250.0, 10.0, 1e4, 2.0);
