@@ -200,7 +200,7 @@ TEST_F(IdentifyPlots, WithoutGnuplotTheDataAndScriptStayAndTheFitSucceeds) {
 
 // --- the adoption verdict ---
 
-service_status_t status(const std::string& process, std::vector<std::pair<std::string, std::int64_t>> counters) {
+service_status_t status(const std::string& process, const std::vector<std::pair<std::string, std::int64_t>>& counters) {
   service_status_t s{};
   s.process = process;
   s.n_counters = static_cast<std::int32_t>(counters.size());
