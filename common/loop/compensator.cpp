@@ -21,6 +21,11 @@ constexpr double kMaxCornerShare = 0.125;
 constexpr double kDryRunPeriods = 1.25;
 constexpr std::int64_t kDryRunMaxTicks = 200'000;
 constexpr double kLearningSlewShare = 0.97;
+// What a learned correction may take the plan to: above it the learning is held back (and not
+// learned from) rather than let into the servo's headroom. 2 % of the slew limit is ~4.5 standard
+// deviations of the default servo's tick-to-tick response to 1 nm of sensor noise (0.02 V), so
+// the bridge does not clamp beside a learned line.
+constexpr double kLearningPlanShare = 0.98;
 
 std::string si(double value, const char* unit) {
   char buf[64];
@@ -115,9 +120,12 @@ void Compensator::set_stage(const StageModel& stage) noexcept {
   stage_model_ = stage;
   if (stage.has_dynamics()) {
     stage_inverse_.emplace(stage.second_order, config_.dt_s);  // validated by the caller
+    servo_share_stage_.emplace(stage.second_order);
   } else {
     stage_inverse_.reset();
+    servo_share_stage_.reset();
   }
+  servo_share_seq_ = -1;
   stage_fresh_ = true;
   ++counters_.stage_swaps;
 }
@@ -580,7 +588,26 @@ void Compensator::observe(const CompensatorInput& sample) noexcept {
     restart_reference(loop_time(next_tick_), sample.y_m);
   }
   if (anchor_offset_.observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) ++counters_.reanchors;
-  learner_.observe(sample.seq, sample.y_m);
+  learner_.observe(sample.seq, sample.y_m - servo_share_m(sample));
+}
+
+double Compensator::servo_share_m(const CompensatorInput& sample) noexcept {
+  // The learning corrects the feedforward, so it must see the feedforward's own error. The servo
+  // on y_ref - y works against every correction (what reaches the position is the correction
+  // times the loop's sensitivity S, 0.16 at 50 Hz with the default gains), which would slow the
+  // learning to a crawl where S is small and leave the update's premise, a plant from correction
+  // to position near 1, untrue. The position the servo's voltage bought, the stage (linearised at
+  // the linear model's gain) driven by u_V - u_ff_V, is taken out of the measurement: what is left
+  // is y_ff, the position the feedforward alone would have made, and r - y_ff is what the
+  // learning removes. Noise is untouched (it enters y, not u_ff), so the noise bound holds as is.
+  const double du = sample.u_V - sample.u_ff_V;
+  const bool consecutive = servo_share_seq_ >= 0 && sample.seq == servo_share_seq_ + 1;
+  servo_share_seq_ = sample.seq;
+  if (!std::isfinite(du)) return 0.0;
+  const double w = linear_.params().gain * du;
+  if (!servo_share_stage_) return w;
+  if (!consecutive) servo_share_stage_->reset(w);
+  return servo_share_stage_->step(w, config_.dt_s);
 }
 
 void Compensator::take_params_from(const Compensator& old) noexcept {
@@ -703,7 +730,8 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   }
   // The reference the inverse aims at: with what the learning has found this point of the period
   // needs, and, for hysteresis then stage, through the stage's inverse first.
-  const double r = y_ref + learner_.correction(k, y_ref);
+  const double correction = learner_.correction(k, y_ref);
+  const double r = y_ref + correction;
   const bool stage_first = stage_inverse_ && stage_model_.order == BanningOrder::kHysteresisThenStage;
   if (stage_first && stage_fresh_) {
     stage_inverse_->reset(r);
@@ -734,16 +762,32 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   extent_.u_max_V = std::max(extent_.u_max_V, u);
   extent_.rate_max_V_per_s = std::max(extent_.rate_max_V_per_s, rate);
   ++extent_.ticks;
+  // A learned correction is admitted only beside a line that leaves room for it (take_trajectory),
+  // so where the plan with it would leave the limits, it is the learning's excess: held back,
+  // counted as such (not a clamp of the line) and not learned from at that tick.
+  const bool learned = correction != 0.0;
   if (u < config_.u_min_V || u > config_.u_max_V) {
-    ++counters_.u_clamped;
+    if (learned) {
+      ++counters_.learning_held;
+      learner_.hold(k);
+    } else {
+      ++counters_.u_clamped;
+    }
     u = std::clamp(u, config_.u_min_V, config_.u_max_V);
   }
   // The plan keeps within the share of the slew limit a trajectory was admitted at (the rest is
   // the servo's, beside the sensor); what learning or a swap would ask beyond it is held back here
   // and counted, not clamped by the bridge behind the servo's back.
-  const double max_step = config_.plan_slew_fraction * config_.slew_V_per_s * config_.dt_s;
+  const double max_step =
+      (learned ? std::min(config_.plan_slew_fraction, kLearningPlanShare) : config_.plan_slew_fraction) *
+      config_.slew_V_per_s * config_.dt_s;
   if (std::abs(u - last_u_) > max_step) {
-    ++counters_.u_slew_clamped;
+    if (learned) {
+      learner_.hold(k);
+      ++counters_.learning_held;
+    } else {
+      ++counters_.u_slew_clamped;
+    }
     u = last_u_ + std::copysign(max_step, u - last_u_);
   }
   // The anchor compares the measured position with the reference the model was asked for (not

@@ -51,6 +51,7 @@
 #include "models/model_set.hpp"
 #include "models/prandtl_ishlinskii.hpp"
 #include "models/reversal_detector.hpp"
+#include "models/second_order_stage.hpp"
 #include "models/stage_inverse.hpp"
 
 namespace hystloop {
@@ -123,6 +124,10 @@ struct CompensatorInput {
   std::int64_t seq = 0;  // tick of the sample
   double u_V = 0.0;      // voltage applied at that tick
   double y_m = 0.0;      // measured position
+  // The feedforward the bridge applied at that tick (sensor_block_t.u_ff_V): u_V - u_ff_V is what
+  // the servo (and any clamp) added, whose share of the position the learning takes out. NaN: not
+  // known (the learning then sees the servo's share as part of the error).
+  double u_ff_V = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CompensatorCounters {
@@ -141,6 +146,7 @@ struct CompensatorCounters {
   std::uint64_t reanchors_skipped = 0;     // not re-anchored: the branch ended (or the mode changed) first
   std::uint64_t u_clamped = 0;             // feedforward ticks held inside [u_min_V, u_max_V]
   std::uint64_t u_slew_clamped = 0;        // feedforward ticks held within the slew limit
+  std::uint64_t learning_held = 0;         // ticks whose learned correction the limits held back
   std::uint64_t trajectories_refused = 0;  // infeasible (or invalid) trajectories not taken
   std::uint64_t trajectories_shaped = 0;   // taken after shaping to feasibility
   std::uint64_t stage_swaps = 0;           // stage models swapped in
@@ -235,6 +241,8 @@ class Compensator {
   void take_params_from(const Compensator& old) noexcept;
 
  private:
+  // The position the servo's share of the voltage made at this sample [m] (observe, for the learning).
+  double servo_share_m(const CompensatorInput& sample) noexcept;
   CommandTick plan_tick(std::int64_t k) noexcept;
   void apply_trajectory(const TrajectorySpec& spec, double start_s) noexcept;
   bool feasible(const PlanExtent& e) const noexcept;
@@ -280,10 +288,14 @@ class Compensator {
   std::optional<StageInverse> stage_inverse_;
   bool stage_fresh_ = true;  // the stage inverse starts at rest at the next reference
   PeriodicLearner learner_;
-  bool learner_restart_ = true;  // the trajectory or its start changed: restart learning at the next tick
-  bool learning_room_ = true;    // the trajectory leaves room for learning's corrections (take_trajectory)
-  double last_w_ = 0.0;          // the stage-inverted reference last planned (the hysteresis model's target)
-  PlanExtent extent_{};          // of the tracking ticks planned (dry runs read it)
+  // The stage driven by the servo's share of the voltage (u_V - u_ff_V, times the linear gain):
+  // where the servo has moved the stage, which the learning adds back to the measured error.
+  std::optional<SecondOrderStage> servo_share_stage_;
+  std::int64_t servo_share_seq_ = -1;  // the last sample it was stepped with
+  bool learner_restart_ = true;        // the trajectory or its start changed: restart learning at the next tick
+  bool learning_room_ = true;          // the trajectory leaves room for learning's corrections (take_trajectory)
+  double last_w_ = 0.0;                // the stage-inverted reference last planned (the hysteresis model's target)
+  PlanExtent extent_{};                // of the tracking ticks planned (dry runs read it)
   double last_u_wanted_ = std::numeric_limits<double>::quiet_NaN();  // the last tick's u before any clamp
   ExperimentQueue experiments_;
   ReversalDetector reversals_;

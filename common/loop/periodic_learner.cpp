@@ -80,6 +80,7 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
   ring_k_.assign(ring, kNoTick);
   ring_r_.assign(ring, 0.0);
   ring_c_.assign(ring, 0.0);
+  ring_held_.assign(ring, 0);
   for (auto* v : {&table_, &next_, &acc_, &tmp_}) v->assign(static_cast<std::size_t>(max_period_), 0.0);
 }
 
@@ -189,7 +190,15 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
   ring_k_[s] = k;
   ring_r_[s] = r_k_m;
   ring_c_[s] = c;
+  ring_held_[s] = 0;
   return c;
+}
+
+void PeriodicLearner::hold(std::int64_t k) noexcept {
+  const std::size_t s = slot(k);
+  if (ring_k_[s] != k || ring_held_[s] != 0) return;
+  ring_held_[s] = 1;
+  ++figures_.ticks_held;
 }
 
 void PeriodicLearner::account_skipped(std::uint64_t n) noexcept {
@@ -224,7 +233,7 @@ void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
   if (ring_k_[s] == k && std::isfinite(e) && std::isfinite(ring_c_[s])) {
     // The part of the update that is this period's own: c_applied + gain*e, or its gain-weighted
     // share gain*(c_applied + e) when lag-compensated (learn_from_period adds the rest).
-    acc_[static_cast<std::size_t>(k - start)] = applied_weight_ * ring_c_[s] + gain_ * e;
+    acc_[static_cast<std::size_t>(k - start)] = applied_weight_ * ring_c_[s] + (ring_held_[s] != 0 ? 0.0 : gain_ * e);
     cur_sum_sq_ += e * e;
     cur_max_ = std::max(cur_max_, std::abs(e));
   } else {

@@ -3,7 +3,9 @@
 // times). The compensator adds, per planned tick k, a correction c_k [m] to the reference r_k it
 // feeds into the model's inverse; the inverse cancels the stage, so the plant from the corrected
 // reference to the position is close to identity (T ≈ 1, up to model error), and what repeats
-// in the error e_k = r_k - y_k can be learned from one period and removed in the next ones:
+// in the error e_k = r_k - y_k can be learned from one period and removed in the next ones (y_k
+// as the compensator observes it: the measured position less what the servo's voltage made, so
+// that the servo, which works against every correction, is no part of T):
 //
 //   c_new[i] = clamp( Q( c_applied[i] + gain * e[i] ), ±max_correction_m ),  i = phase in the period
 //
@@ -126,6 +128,7 @@ struct LearnerFigures {
   std::uint64_t periods_learned = 0;    // a new table was computed from them
   std::uint64_t periods_skipped = 0;    // a sample was missing (or NaN, or too late): not learned from
   std::uint64_t tables_adopted = 0;     // new tables taken into use (at a period boundary)
+  std::uint64_t ticks_held = 0;         // planned ticks a limit held back (hold()): not learned from
   double last_error_rms_m = 0.0;        // e over the last period learned from
   double last_error_max_m = 0.0;        // max |e| over it
   double correction_rms_m = 0.0;        // of the table in use (0 when none)
@@ -158,6 +161,10 @@ class PeriodicLearner {
   // plan; ticks may be missing; NaN = no sample. Completing a period computes the next table,
   // adopted at the next period boundary of the plan.
   void observe(std::int64_t k, double y_m) noexcept;
+  // Planned tick k (the last correction() asked for) was held back by a limit of the plan: its
+  // error is not the table's to remove, and learning it would only grow the table there tick
+  // after tick (the learning's windup). Its phase keeps what was applied (e taken as 0).
+  void hold(std::int64_t k) noexcept;
 
   const LearnerFigures& figures() const noexcept { return figures_; }
   bool enabled() const noexcept { return enabled_; }
@@ -213,6 +220,7 @@ class PeriodicLearner {
   // Per planned tick (ring over the lag): which tick the slot holds, its r_k and applied c_k.
   std::vector<std::int64_t> ring_k_;
   std::vector<double> ring_r_, ring_c_;
+  std::vector<std::uint8_t> ring_held_;  // the plan could not apply what tick asked (hold())
   // Per phase [max_period]: the table in use, the next one, the period being observed's share of
   // the update (c_applied + gain*e, or gain*(c_applied + e)), and the filter's scratch.
   std::vector<double> table_, next_, acc_, tmp_;

@@ -32,6 +32,7 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
   a.reanchors_skipped += b.reanchors_skipped;
   a.u_clamped += b.u_clamped;
   a.u_slew_clamped += b.u_slew_clamped;
+  a.learning_held += b.learning_held;
   a.trajectories_refused += b.trajectories_refused;
   a.trajectories_shaped += b.trajectories_shaped;
   a.stage_swaps += b.stage_swaps;
@@ -96,7 +97,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
     case SequenceGuard::Verdict::take: break;
   }
   const SensorTick last = sensor_tick(msg, msg.u_V.size() - 1);
-  for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m}); });
+  for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m, t.u_ff_V}); });
   last_sample_utime_ = last.utime;
   ++blocks_in_period_;
   if (!have_sample_) {
@@ -338,6 +339,7 @@ CounterSet::Entries CompensatorService::collect_counters() const {
           {"reanchors_skipped", c.reanchors_skipped},
           {"u_clamped", c.u_clamped},
           {"u_slew_clamped", c.u_slew_clamped},
+          {"learning_held", c.learning_held},
           {"trajectories_shaped", c.trajectories_shaped},
           {"stage_swaps", c.stage_swaps},
           {"experiment_ramped", c.experiment_ramped},

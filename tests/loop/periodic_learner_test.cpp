@@ -78,6 +78,28 @@ TEST(PeriodicLearner, AnErrorImpulseLearnsTheSymmetricWindowAroundIt) {
   EXPECT_NEAR(l.figures().correction_rms_m, std::sqrt((2 * 1 + 2 * 4 + 2 * 9 + 16) / 20.0) * g * delta / 16.0, 1e-20);
 }
 
+// A tick the plan held back (a limit cut what its correction asked) is not learned from: its
+// error would only grow the table there period after period. The same impulse as above, held,
+// leaves the next table at zero; the figures count the tick once, however often it is held.
+TEST(PeriodicLearner, AHeldTickIsNotLearnedFrom) {
+  PeriodicLearner l({}, kLearnDt, 0);
+  l.restart(0, 20);
+  const double delta = 16 * kNm;
+  for (std::int64_t k = 0; k < 20; ++k) {
+    EXPECT_EQ(l.correction(k, 0.0), 0.0);
+    if (k == 1) {
+      l.hold(1);
+      l.hold(1);
+      l.hold(0);  // planned over (the ring holds one tick here): not the slot's tick, ignored
+    }
+    l.observe(k, k == 1 ? -delta : 0.0);
+  }
+  EXPECT_EQ(l.figures().periods_learned, 1u);
+  EXPECT_NEAR(l.figures().last_error_max_m, delta, 1e-18);  // the error is still reported
+  EXPECT_EQ(l.figures().ticks_held, 1u);
+  for (std::int64_t i = 0; i < 20; ++i) EXPECT_EQ(l.correction(20 + i, 0.0), 0.0) << i;
+}
+
 // A constant error (y = delta, r = 0) seen 40 ticks late on 20-tick periods: period p's table is
 // adopted at period p + 3 (L = 3). Q keeps a constant, so each table is one number, and the one
 // in use in period q is exactly what the update's recursion gives:
