@@ -9,6 +9,7 @@
 
 #include "runtime/config_validation.hpp"
 #include "runtime/rig_auth_config.hpp"
+#include "runtime/stage_config.hpp"
 
 namespace hystloop {
 namespace {
@@ -225,27 +226,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   c.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", c.slew_V_per_s);
   c.plan_slew_fraction = config.get_in_range("compensator.plan_slew_fraction", c.plan_slew_fraction, 0.05, 1.0);
 
-  const std::string stage_kind = config.get<std::string>("stage.kind", "none");
-  if (stage_kind == "second_order") {
-    c.stage.kind = StageModel::Kind::kSecondOrder;
-  } else if (stage_kind != "none") {
-    config.fail("stage.kind", "must be none or second_order (got '" + stage_kind + "')");
-  } else {
-    for (const char* key : {"stage.k", "stage.c"}) {
-      if (config.has(key)) config.fail("stage.kind", std::string("is none: set it to second_order to use ") + key);
-    }
-  }
-  c.stage.second_order.k = config.get_positive("stage.k", c.stage.second_order.k);
-  c.stage.second_order.c = config.get_positive("stage.c", c.stage.second_order.c);
-  const std::string order = config.get<std::string>("stage.order", "hysteresis_then_stage");
-  if (order == "hysteresis_then_stage") {
-    c.stage.order = BanningOrder::kHysteresisThenStage;
-  } else if (order == "stage_then_hysteresis") {
-    c.stage.order = BanningOrder::kStageThenHysteresis;
-  } else {
-    config.fail("stage.order", "must be hysteresis_then_stage or stage_then_hysteresis (got '" + order + "')");
-  }
-  validate_config_section(config, "", [&] { c.stage.validate(c.dt_s); });
+  c.stage = read_stage_model(config, c.stage, c.dt_s);
 
   LearningConfig& l = c.learning;
   l.enabled = config.get<bool>("learning.enabled", l.enabled);

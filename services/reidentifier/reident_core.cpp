@@ -10,6 +10,7 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
                          RefitWorker::OnEvaluated on_evaluated)
     : options_(options),
       estimator_(options.estimator, options.initial),
+      stage_removal_(options.stage, 1.0 / options.rate_hz),
       in_use_(options.initial, std::move(own_source), new_publisher_id()),
       worker_(options.estimator, estimator_.make_window(), start_thread, std::move(on_evaluated), options.plausibility),
       period_us_(std::llround(options.refit_period_s * 1e6)),
@@ -22,6 +23,8 @@ void ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_
 void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcept {
   last_sample_us_ = now_us;
   const std::int64_t seq = tick.seq;
+  // The stage's removal looks at neighbouring samples: any break hands out the held one as it is.
+  if (seq != last_seq_ + 1) flush_stage_removal();
   if (last_seq_ >= 0) {
     // Ticks refused on the wire since the last one were not lost: they are no gap.
     const std::int64_t missing = seq - last_seq_ - 1 - refused_since_last_;
@@ -37,19 +40,28 @@ void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcep
   in_use_.on_sample(seq);
   if ((tick.flags & sensor_block_t::SAFE_STATE) != 0) {
     counters_.add(ReidentCounter::skipped_safe_state);
+    flush_stage_removal();
     return;
   }
   if ((tick.flags & sensor_block_t::SENSOR_FAULT) != 0) {
     counters_.add(ReidentCounter::skipped_sensor_fault);
+    flush_stage_removal();
     return;
   }
-  estimator_.feed(tick.u_V, tick.y_m);
+  HysteresisSample ready[2];
+  const std::size_t n = stage_removal_.feed(tick.u_V, tick.y_m, ready);
+  for (std::size_t i = 0; i < n; ++i) estimator_.feed(ready[i].u, ready[i].y);
+}
+
+void ReidentCore::flush_stage_removal() noexcept {
+  if (const auto held = stage_removal_.reset()) estimator_.feed(held->u, held->y);
 }
 
 void ReidentCore::on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept {
   // The estimator counts the marker as non-finite: one per block is enough to poison the window.
   last_sample_us_ = now_us;
   refused_since_last_ += ticks > 0 ? ticks : 1;
+  flush_stage_removal();
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   estimator_.feed(kNaN, kNaN);
 }

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <string>
 
+#include "ident/stage_removal.hpp"
 #include "core/latency_stats.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "lcm/blocks.hpp"
@@ -102,12 +103,14 @@ class ReidentCore {
   RefitWorker& worker() noexcept { return worker_; }
 
  private:
+  void flush_stage_removal() noexcept;  // a break in the stream: the held sample goes to the estimator as measured
   RefitDecision decide(const RefitResult& result) noexcept;
   // A set in MEM's domain whose gain leaves options_.plausibility (the reason kept).
   bool implausible(const MemParams& params) noexcept;
 
   ReidentOptions options_;
   OnlineMemEstimator estimator_;
+  StageRemoval stage_removal_;  // the stage taken out of each sample before the estimator sees it
   ParamsInUse in_use_;
   RefitWorker worker_;
   ReidentCounters counters_;

@@ -1,3 +1,4 @@
+#include "runtime/stage_config.hpp"
 #include "reidentifier/reident_options.hpp"
 
 #include <algorithm>
@@ -112,6 +113,7 @@ ReidentOptions read_reident_options(const Config& config) {
   read_plausibility(config, o);
 
   o.rate_hz = config.get_in_range("reidentifier.rate_hz", o.rate_hz, 1.0, 1e6);
+  o.stage = read_stage_model(config, o.stage, 1.0 / o.rate_hz);
   o.refit_period_s = config.get_in_range("reidentifier.refit_period_s", o.refit_period_s, 0.01, 3600.0);
   o.window_s = config.get_in_range("reidentifier.window_s", o.window_s, 1e-6, 3600.0);
   o.capacity_s = config.get_in_range("reidentifier.capacity_s", o.capacity_s, 1e-6, 3600.0);

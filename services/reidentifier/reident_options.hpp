@@ -36,6 +36,7 @@
 
 #include <cstdint>
 
+#include "models/stage_inverse.hpp"
 #include "core/config.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "models/gain_plausibility.hpp"
@@ -58,9 +59,10 @@ struct ReidentOptions {
   OnlineMemOptions estimator{};     // window/capacity in samples, gates, fit time bound
   ModelChoiceOptions models{};      // reidentifier.models, model_margin, model_period_s, model_decimation, pin_model
   GainPlausibility plausibility{};  // linear.gain, actuator.u_min_V/u_max_V, reidentifier.plausible_gain_factor
+  StageModel stage{};               // stage.*: taken out of the samples before they are fitted (none: as measured)
 };
 
-// Reads and checks mem.{c1,c2,c3} and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are
+// Reads and checks mem.{c1,c2,c3}, stage.* and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are
 // refused ("did you mean"); other sections belong to the processes sharing the file (the compensator checks the rest of
 // mem.*). Throws ConfigError naming the field.
 ReidentOptions read_reident_options(const Config& config);

@@ -86,5 +86,33 @@ TEST(ReidentOptions, TheDeployedDefaultsLoad) {
   EXPECT_EQ(o.lcm_queue, d.lcm_queue);
 }
 
+// The stage the re-identifier takes out of the samples must be the one the compensator inverts:
+// a fit on samples with the stage left in (or taken out twice) is the stage's lag read as hysteresis.
+TEST(ReidentOptions, TheDeployedStageIsTheCompensators) {
+  for (const char* dir : {"/deploy/config/", "/deploy/config/scan/"}) {
+    const std::string root = std::string(HYSTLOOP_SOURCE_DIR) + dir;
+    const ReidentOptions o = read_reident_options(Config::load_file(root + "reidentifier.yaml"));
+    const Config compensator = Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml");
+    EXPECT_TRUE(o.stage.has_dynamics()) << dir;
+    EXPECT_EQ(compensator.get<std::string>("stage.kind"), "second_order") << dir;
+    EXPECT_DOUBLE_EQ(o.stage.second_order.k, compensator.get<double>("stage.k")) << dir;
+    EXPECT_DOUBLE_EQ(o.stage.second_order.c, compensator.get<double>("stage.c")) << dir;
+  }
+}
+
+TEST(ReidentOptions, ReadsAndChecksTheStage) {
+  EXPECT_FALSE(read_reident_options(Config()).stage.has_dynamics()) << "none by default: samples as measured";
+  const ReidentOptions o = read_reident_options(Config::from_string(
+      "stage: {kind: second_order, k: 2.0e8, c: 3.0e3, order: stage_then_hysteresis}\n"));
+  EXPECT_TRUE(o.stage.has_dynamics());
+  EXPECT_DOUBLE_EQ(o.stage.second_order.k, 2.0e8);
+  EXPECT_DOUBLE_EQ(o.stage.second_order.c, 3.0e3);
+  EXPECT_EQ(o.stage.order, BanningOrder::kStageThenHysteresis);
+  EXPECT_NE(refusal("stage: {kind: third_order}").find("stage.kind: must be none or second_order"), std::string::npos);
+  EXPECT_NE(refusal("stage: {kind: second_order, k: -1}").find("stage.k"), std::string::npos);
+  EXPECT_NE(refusal("stage: {k: 1.0e8}").find("stage.kind: is none"), std::string::npos);
+  EXPECT_NE(refusal("stage: {kind: second_order, order: sideways}").find("stage.order"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hystloop
