@@ -766,13 +766,18 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   // so where the plan with it would leave the limits, it is the learning's excess: held back,
   // counted as such (not a clamp of the line) and not learned from at that tick.
   const bool learned = correction != 0.0;
-  if (u < config_.u_min_V || u > config_.u_max_V) {
-    if (learned) {
+  bool held = false;  // a tick both limits hold back is one tick held
+  const auto limited = [&](std::uint64_t& clamp_count) {
+    if (!learned) {
+      ++clamp_count;
+    } else if (!held) {
+      held = true;
       ++counters_.learning_held;
       learner_.hold(k);
-    } else {
-      ++counters_.u_clamped;
     }
+  };
+  if (u < config_.u_min_V || u > config_.u_max_V) {
+    limited(counters_.u_clamped);
     u = std::clamp(u, config_.u_min_V, config_.u_max_V);
   }
   // The plan keeps within the share of the slew limit a trajectory was admitted at (the rest is
@@ -782,12 +787,7 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
       (learned ? std::min(config_.plan_slew_fraction, kLearningPlanShare) : config_.plan_slew_fraction) *
       config_.slew_V_per_s * config_.dt_s;
   if (std::abs(u - last_u_) > max_step) {
-    if (learned) {
-      learner_.hold(k);
-      ++counters_.learning_held;
-    } else {
-      ++counters_.u_slew_clamped;
-    }
+    limited(counters_.u_slew_clamped);
     u = last_u_ + std::copysign(max_step, u - last_u_);
   }
   // The anchor compares the measured position with the reference the model was asked for (not
