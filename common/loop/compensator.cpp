@@ -353,20 +353,9 @@ double Compensator::feasible_amplitude(const TrajectorySpec& spec, double start_
 }
 
 std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const {
-  std::string why;
+  std::string why = limits_left(e);
   const double slew_allowed = config_.plan_slew_fraction * config_.slew_V_per_s;
   const bool slew = e.rate_max_V_per_s > slew_allowed;
-  if (slew) {
-    why = "its feedforward needs " + si(e.rate_max_V_per_s, "V/s") + ", above " +
-          si(100.0 * config_.plan_slew_fraction, "%") + " of the actuator's slew limit " +
-          si(config_.slew_V_per_s, "V/s") + " (actuator.slew_V_per_s; the rest is the servo's headroom)";
-  }
-  if (e.u_min_V < config_.u_min_V || e.u_max_V > config_.u_max_V) {
-    if (!why.empty()) why += ", and ";
-    why += "its feedforward needs u from " + si(e.u_min_V, "V") + " to " + si(e.u_max_V, "V") +
-           ", outside the actuator's range " + si(config_.u_min_V, "V") + " to " + si(config_.u_max_V, "V") +
-           " (actuator.u_min_V/u_max_V)";
-  }
   if (periodic(spec)) {
     const double a = feasible_amplitude(spec, start_s, e);
     if (std::abs(a) > 0.0) {
@@ -381,15 +370,52 @@ std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_
   return why;
 }
 
+std::string Compensator::limits_left(const PlanExtent& e) const {
+  std::string why;
+  if (e.rate_max_V_per_s > config_.plan_slew_fraction * config_.slew_V_per_s) {
+    why = "its feedforward needs " + si(e.rate_max_V_per_s, "V/s") + ", above " +
+          si(100.0 * config_.plan_slew_fraction, "%") + " of the actuator's slew limit " +
+          si(config_.slew_V_per_s, "V/s") + " (actuator.slew_V_per_s; the rest is the servo's headroom)";
+  }
+  if (e.u_min_V < config_.u_min_V || e.u_max_V > config_.u_max_V) {
+    if (!why.empty()) why += ", and ";
+    why += "its feedforward needs u from " + si(e.u_min_V, "V") + " to " + si(e.u_max_V, "V") +
+           ", outside the actuator's range " + si(config_.u_min_V, "V") + " to " + si(config_.u_max_V, "V") +
+           " (actuator.u_min_V/u_max_V)";
+  }
+  return why;
+}
+
+void Compensator::check_running_line(const ModelParamSet& candidate, bool switch_model) const {
+  if (next_tick_ < 0 || in_experiment_ || awaiting_anchor_ || !periodic(trajectory_)) return;
+  const bool in_use = (switch_model && mode_ != FeedforwardMode::kOff) || mode_of(candidate.kind) == mode_ ||
+                      (!switch_model && mode_ == FeedforwardMode::kMem);
+  if (!in_use) return;  // a set for a model not in use changes nothing the line needs
+  Compensator c = *this;  // off the per-sample path: the line planned as if the set were in
+  c.pending_ = Pending{candidate, switch_model};
+  c.swap_params(next_tick_);
+  // The slew only: a set asking a volt beyond the range at the line's extremes is clamped there
+  // by the plan, a loss of nanometres at two points, where refusing it could keep a set that a
+  // wrong start left far off (the demo's repair); beyond the slew the whole line is held back.
+  PlanExtent e = c.dry_run_periodic(trajectory_);
+  e.u_min_V = std::max(e.u_min_V, config_.u_min_V);
+  e.u_max_V = std::min(e.u_max_V, config_.u_max_V);
+  if (feasible(e)) return;
+  throw ParameterError("params", "under this set the line in force (" + si(trajectory_.amplitude_m * 1e6, "um") +
+                                     " at " + si(trajectory_.frequency_hz, "Hz") +
+                                     ") would leave the actuator's limits: " + limits_left(e) + "; the set in use stays");
+}
+
 void Compensator::offer_mem_params(const MemParams& params, std::int32_t version) {
+  ModelParamSet set;
+  set.mem = params;
   try {
     params.validate();
+    check_running_line(set, false);
   } catch (const ParameterError&) {
     ++counters_.params_rejected;
     throw;
   }
-  ModelParamSet set;
-  set.mem = params;
   pending_ = Pending{set, false};
   pending_version_ = version;
   ++counters_.params_accepted;
@@ -398,6 +424,7 @@ void Compensator::offer_mem_params(const MemParams& params, std::int32_t version
 void Compensator::offer_model(const ModelParamSet& params, std::int32_t version) {
   try {
     params.validate(config_.dt_s);
+    check_running_line(params, true);
   } catch (const ParameterError&) {
     ++counters_.params_rejected;
     throw;

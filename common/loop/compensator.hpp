@@ -210,6 +210,9 @@ class Compensator {
   // the mode is off, the feedforward switches to that model, started where the plan is (no
   // step in u) and re-anchored at the measured position as offer_mem_params' sets are. A later
   // offer replaces one still waiting. Not on the per-sample path (may be called between plans).
+  // Both refuse (ParameterError, params_rejected) a set under which the periodic line in force
+  // would need more of the slew limit than it was admitted at: a refit of other loops can
+  // misjudge the slope of this line's, and the bridge would clamp it behind the servo's back.
   void offer_model(const ModelParamSet& params, std::int32_t version);
   void set_mode(FeedforwardMode mode);  // re-initialises that inverse where the plan is
   // Starts the experiment at the next planned tick, or queues it behind the running one.
@@ -248,6 +251,10 @@ class Compensator {
   bool feasible(const PlanExtent& e) const noexcept;
   double choose_corner(const TrajectorySpec& spec, std::string& note) const;
   std::string infeasibility(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const;
+  std::string limits_left(const PlanExtent& e) const;  // which limit e leaves, and by how much
+  // Throws ParameterError when `candidate` swapped in would take the periodic line in force
+  // beyond the plan's share of the slew (a dry run in a copy; nothing to check without a line).
+  void check_running_line(const ModelParamSet& candidate, bool switch_model) const;
   double feasible_amplitude(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const;
   void restart_learning(std::int64_t k) noexcept;
   void set_stage(const StageModel& stage) noexcept;

@@ -243,6 +243,39 @@ TEST(CompensatorLimits, ParameterSetsCarryAStageThatIsValidatedAndSwappedAtAReve
   EXPECT_EQ(c.params_version(), 3);
 }
 
+// A refit of other loops can misjudge the slope of the line's: a set under which the line in
+// force would leave the limits is refused where it enters, and the plan goes on with the set in use.
+TEST(CompensatorLimits, ASetUnderWhichTheRunningLineWouldLeaveTheLimitsIsRefused) {
+  Compensator c(linear_config(true));
+  FeedforwardLimits limits;
+  limits.fraction = kShare;
+  const double a = 0.9 * largest_sine_amplitude_m(LinearPlant{kGain, SecondOrderStageParams{}}, limits, 100.0, 0.0);
+  c.take_trajectory(sine(a, 100.0), kNaN);
+  plan_for(c, 0.1);
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.linear.gain = 0.8 * kGain;  // 0.9 / 0.8 = 112 % of the plan's share of the slew
+  try {
+    c.offer_model(set, 2);
+    FAIL() << "a set needing 112 % of the slew for the running line was taken";
+  } catch (const ParameterError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("would leave the actuator's limits"), std::string::npos) << what;
+    EXPECT_NE(what.find("actuator.slew_V_per_s"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(c.params_pending());
+  EXPECT_EQ(c.counters().params_rejected, 1u);
+  EXPECT_EQ(c.counters().u_slew_clamped, 0u);
+  set.linear.gain = 1.05 * kGain;  // 86 % of the share: inside
+  EXPECT_NO_THROW(c.offer_model(set, 3));
+  plan_for(c, 0.1);
+  EXPECT_EQ(c.params_version(), 3);
+  // Without a periodic line there is nothing to check against: any valid set is taken.
+  Compensator idle(linear_config(true));
+  set.linear.gain = 0.5 * kGain;
+  EXPECT_NO_THROW(idle.offer_model(set, 2));
+}
+
 TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
   CompensatorConfig c = linear_config(true);
   c.stage.second_order.c = 1e-3;
