@@ -390,7 +390,7 @@ void Compensator::check_running_line(const ModelParamSet& candidate, bool switch
   if (next_tick_ < 0 || in_experiment_ || awaiting_anchor_ || !periodic(trajectory_)) return;
   const bool in_use = (switch_model && mode_ != FeedforwardMode::kOff) || mode_of(candidate.kind) == mode_ ||
                       (!switch_model && mode_ == FeedforwardMode::kMem);
-  if (!in_use) return;  // a set for a model not in use changes nothing the line needs
+  if (!in_use) return;    // a set for a model not in use changes nothing the line needs
   Compensator c = *this;  // off the per-sample path: the line planned as if the set were in
   c.pending_ = Pending{candidate, switch_model};
   c.swap_params(next_tick_);
@@ -403,7 +403,8 @@ void Compensator::check_running_line(const ModelParamSet& candidate, bool switch
   if (feasible(e)) return;
   throw ParameterError("params", "under this set the line in force (" + si(trajectory_.amplitude_m * 1e6, "um") +
                                      " at " + si(trajectory_.frequency_hz, "Hz") +
-                                     ") would leave the actuator's limits: " + limits_left(e) + "; the set in use stays");
+                                     ") would leave the actuator's limits: " + limits_left(e) +
+                                     "; the set in use stays");
 }
 
 void Compensator::offer_mem_params(const MemParams& params, std::int32_t version) {

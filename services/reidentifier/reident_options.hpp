@@ -62,9 +62,9 @@ struct ReidentOptions {
   StageModel stage{};               // stage.*: taken out of the samples before they are fitted (none: as measured)
 };
 
-// Reads and checks mem.{c1,c2,c3}, stage.* and reidentifier.*. Unknown reidentifier.* keys (and the old section reident:) are
-// refused ("did you mean"); other sections belong to the processes sharing the file (the compensator checks the rest of
-// mem.*). Throws ConfigError naming the field.
+// Reads and checks mem.{c1,c2,c3}, stage.* and reidentifier.*. Unknown reidentifier.* keys (and the old section
+// reident:) are refused ("did you mean"); other sections belong to the processes sharing the file (the compensator
+// checks the rest of mem.*). Throws ConfigError naming the field.
 ReidentOptions read_reident_options(const Config& config);
 
 }  // namespace hystloop

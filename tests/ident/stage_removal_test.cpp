@@ -44,13 +44,15 @@ std::vector<double> through_stage(const std::vector<double>& w) {
   SecondOrderStage stage(banning_stage().second_order);
   stage.reset(w.front());
   std::vector<double> y;
+  y.reserve(w.size());
   for (const double wk : w) y.push_back(stage.step(wk, kDt));
   return y;
 }
 
 std::vector<double> sine(double amplitude, double frequency_hz, std::size_t n) {
   std::vector<double> s(n);
-  for (std::size_t k = 0; k < n; ++k) s[k] = amplitude * std::sin(2.0 * std::numbers::pi * frequency_hz * kDt * static_cast<double>(k));
+  for (std::size_t k = 0; k < n; ++k)
+    s[k] = amplitude * std::sin(2.0 * std::numbers::pi * frequency_hz * kDt * static_cast<double>(k));
   return s;
 }
 

@@ -102,8 +102,8 @@ TEST(ReidentOptions, TheDeployedStageIsTheCompensators) {
 
 TEST(ReidentOptions, ReadsAndChecksTheStage) {
   EXPECT_FALSE(read_reident_options(Config()).stage.has_dynamics()) << "none by default: samples as measured";
-  const ReidentOptions o = read_reident_options(Config::from_string(
-      "stage: {kind: second_order, k: 2.0e8, c: 3.0e3, order: stage_then_hysteresis}\n"));
+  const ReidentOptions o = read_reident_options(
+      Config::from_string("stage: {kind: second_order, k: 2.0e8, c: 3.0e3, order: stage_then_hysteresis}\n"));
   EXPECT_TRUE(o.stage.has_dynamics());
   EXPECT_DOUBLE_EQ(o.stage.second_order.k, 2.0e8);
   EXPECT_DOUBLE_EQ(o.stage.second_order.c, 3.0e3);
