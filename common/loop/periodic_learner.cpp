@@ -49,6 +49,7 @@ void LearningConfig::validate(double dt_s) const {
   // without one a plant delay of a tick makes the learning diverge near Nyquist.
   require_in_range("learning.cutoff_hz", cutoff_hz, 1.0 / max_period_s, 0.25 / dt_s);
   require_in_range("learning.fade_s", fade_s, dt_s, 10.0);
+  require_in_range("learning.blend_s", blend_s, 0.0, 1.0);
 }
 
 PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std::int64_t max_lag_ticks)
@@ -59,6 +60,7 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
       max_period_(0),
       window_(2),
       fade_ticks_(1),
+      blend_ticks_(0),
       filter_cutoff_hz_(0.0),
       lag_compensated_(config.lag_compensated),
       enabled_(config.enabled) {
@@ -66,6 +68,7 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
   require_in_range("learning.max_lag_ticks", static_cast<double>(max_lag_ticks), 0.0, 1e6);
   max_period_ = static_cast<std::int64_t>(std::floor(config.max_period_s / dt_s + 1e-9));
   fade_ticks_ = std::max<std::int64_t>(1, std::llround(config.fade_s / dt_s));
+  blend_ticks_ = std::llround(config.blend_s / dt_s);
   // The longest window whose -6 dB frequency is still at or above the cutoff: an M-tick mean's
   // -3 dB is near 0.443 / (M dt); start there and correct for the discrete response.
   std::int64_t m = std::max<std::int64_t>(2, static_cast<std::int64_t>(0.443 / (config.cutoff_hz * dt_s)));
@@ -81,7 +84,7 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
   ring_r_.assign(ring, 0.0);
   ring_c_.assign(ring, 0.0);
   ring_held_.assign(ring, 0);
-  for (auto* v : {&table_, &next_, &acc_, &tmp_}) v->assign(static_cast<std::size_t>(max_period_), 0.0);
+  for (auto* v : {&table_, &next_, &prev_, &acc_, &tmp_}) v->assign(static_cast<std::size_t>(max_period_), 0.0);
 }
 
 double PeriodicLearner::filter_null_hz() const noexcept { return 1.0 / (static_cast<double>(window_) * dt_s_); }
@@ -138,6 +141,8 @@ void PeriodicLearner::begin_again() noexcept {
 
 void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
   have_table_ = false;
+  have_prev_ = false;
+  blend_n_ = 0;
   pending_ = false;
   cur_open_ = false;
   scale_ = 1.0;
@@ -172,18 +177,23 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
     if (k >= table_k0_) {
       const std::int64_t i = phase(k);
       if (pending_ && i == 0) {
-        // Only at a boundary: the table in use never changes inside a period.
+        // Only at a boundary: the table in use never changes inside a period except by the
+        // blend from the one before (rotated out, no copy).
+        std::swap(prev_, table_);
         std::swap(table_, next_);
+        have_prev_ = have_table_;
         have_table_ = true;
+        adopted_k_ = k;
+        blend_n_ = std::min(blend_ticks_, table_n_);
         pending_ = false;
         ++figures_.tables_adopted;
         table_rms_m_ = pending_rms_m_;
         figures_.correction_rms_m = table_rms_m_;
       }
-      if (have_table_) c = table_[static_cast<std::size_t>(i)];
+      if (have_table_) c = in_use(k, i);
     }
   } else if (mode_ == Mode::kFading) {
-    c = scale_ * table_[static_cast<std::size_t>(phase(k))];
+    c = scale_ * in_use(k, phase(k));
     figures_.correction_rms_m = scale_ * table_rms_m_;
   }
   const std::size_t s = slot(k);
@@ -192,6 +202,14 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
   ring_c_[s] = c;
   ring_held_[s] = 0;
   return c;
+}
+
+double PeriodicLearner::in_use(std::int64_t k, std::int64_t i) const noexcept {
+  const double now = table_[static_cast<std::size_t>(i)];
+  const std::int64_t into = k - adopted_k_;
+  if (into < 0 || into + 1 >= blend_n_) return now;
+  const double before = have_prev_ ? prev_[static_cast<std::size_t>(i)] : 0.0;
+  return before + (now - before) * static_cast<double>(into + 1) / static_cast<double>(blend_n_);
 }
 
 void PeriodicLearner::hold(std::int64_t k) noexcept {

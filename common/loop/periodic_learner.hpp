@@ -90,6 +90,15 @@
 // sigma^2 times the energy of the recursion's impulse response (0.233 nm for T = 0.9 e^{-jw},
 // D = 10).
 //
+// A new table never steps the reference either: from the boundary where it is adopted it takes
+// over from the one in use along a linear blend of blend_s (at most the period). A step in the
+// correction is a step in the reference that the stage's exact inverse (models/stage_inverse.hpp)
+// answers with a ringing at half the tick rate, about 2.2 times the step and decaying by |z0| =
+// 0.93 per tick: on the live loop the first table of a 10 Hz line, a few nanometres at phase 0,
+// rang at the slew limit for a dozen ticks (26 nm of error) until the tables settled. Blended
+// over 50 ticks the same step is a kink of 1/50 of it. What was applied is what the update
+// reads (c_applied per tick), so the blend changes the path to the fixed point, not the point.
+//
 // Stop, off, restart and reset never step the reference: the correction in use fades out
 // linearly over fade_s (a step of at most max_correction_m / fade_ticks per tick on the fade's
 // account, beside the table's own tick-to-tick change), then a new learning starts from zero at
@@ -115,6 +124,7 @@ struct LearningConfig {
   double max_correction_m = 0.2e-6;  // |c_k| bound [m]: the learned table is clamped inside it
   double max_period_s = 1.0;         // longest period learned; a longer one is not learned
   double fade_s = 0.05;              // stop/off/restart/reset: the correction fades out over this time
+  double blend_s = 0.005;            // a new table takes over from the one in use over this time (0: at once)
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;
@@ -175,6 +185,7 @@ class PeriodicLearner {
   double filter_null_hz() const noexcept;
   double filter_norm_sq() const noexcept;
   std::int64_t fade_ticks() const noexcept { return fade_ticks_; }
+  std::int64_t blend_ticks() const noexcept { return blend_ticks_; }
   std::int64_t max_period_ticks() const noexcept { return max_period_; }
   double gain() const noexcept { return gain_; }
   bool lag_compensated() const noexcept { return lag_compensated_; }
@@ -187,12 +198,13 @@ class PeriodicLearner {
   void learn_from_period() noexcept;                  // acc_ -> next_ (filter, clamp)
   void account_skipped(std::uint64_t n) noexcept;
   std::int64_t phase(std::int64_t k) const noexcept;  // of k in the table's period [0, n)
+  double in_use(std::int64_t k, std::int64_t i) const noexcept;  // table_ at phase i, blended at tick k
   std::size_t slot(std::int64_t k) const noexcept;
 
   double dt_s_, gain_;
   double applied_weight_;  // of c_applied in acc_: 1 (plain), gain (lag-compensated)
   double max_correction_m_;
-  std::int64_t max_period_, window_, fade_ticks_;
+  std::int64_t max_period_, window_, fade_ticks_, blend_ticks_;
   double filter_cutoff_hz_;
   bool lag_compensated_;
 
@@ -208,6 +220,10 @@ class PeriodicLearner {
   double pending_rms_m_ = 0.0, table_rms_m_ = 0.0;         // RMS of next_ and of table_
   double scale_ = 1.0;                                     // of the table while fading
   std::int64_t fade_left_ = 0;                             // ticks until the fade reaches 0
+  // The blend from prev_ (the table in use before, zero for the first) to table_, from tick
+  // adopted_k_ over blend_n_ ticks.
+  bool have_prev_ = false;
+  std::int64_t adopted_k_ = 0, blend_n_ = 0;
   std::int64_t learn_start_ = 0;
   std::int64_t last_planned_ = std::numeric_limits<std::int64_t>::min();
 
@@ -221,9 +237,10 @@ class PeriodicLearner {
   std::vector<std::int64_t> ring_k_;
   std::vector<double> ring_r_, ring_c_;
   std::vector<std::uint8_t> ring_held_;  // the plan could not apply what tick asked (hold())
-  // Per phase [max_period]: the table in use, the next one, the period being observed's share of
-  // the update (c_applied + gain*e, or gain*(c_applied + e)), and the filter's scratch.
-  std::vector<double> table_, next_, acc_, tmp_;
+  // Per phase [max_period]: the table in use, the next one, the one table_ is taking over from,
+  // the period being observed's share of the update (c_applied + gain*e, or gain*(c_applied +
+  // e)), and the filter's scratch.
+  std::vector<double> table_, next_, prev_, acc_, tmp_;
   LearnerFigures figures_;
 };
 

@@ -114,6 +114,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                                 "learning.max_period_s",
                                                 "learning.lag_compensated",
                                                 "learning.fade_s",
+                                                "learning.blend_s",
                                                 "rt.priority",
                                                 "rt.lock_memory",
                                                 "mem.c1",
@@ -237,6 +238,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   l.max_period_s = config.get_positive("learning.max_period_s", l.max_period_s);
   l.lag_compensated = config.get<bool>("learning.lag_compensated", l.lag_compensated);
   l.fade_s = config.get_positive("learning.fade_s", l.fade_s);
+  l.blend_s = config.get_in_range("learning.blend_s", l.blend_s, 0.0, 1.0);
   validate_config_section(config, "", [&] { l.validate(c.dt_s); });  // its fields are named learning.*
 
   const double horizon_s =

@@ -131,7 +131,7 @@ class LagCompensatedInsideTheBound : public ::testing::TestWithParam<Inside> {};
 TEST_P(LagCompensatedInsideTheBound, ConvergesAsPredicted) {
   const LinearPlant plant{GetParam().plant_gain, 0};
   const std::int64_t d = GetParam().d, n = period_for(d), periods = 60;
-  PeriodicLearner learner({}, kLearnDt, testing::kMaxLag);
+  PeriodicLearner learner(testing::stepwise(), kLearnDt, testing::kMaxLag);
   ASSERT_TRUE(learner.lag_compensated());
   LearningLoop loop(
       learner, periods * n, plant, [n](std::int64_t k) { return testing::raster(k, n, 300 * kNm); },
@@ -180,7 +180,7 @@ TEST(PeriodicLearnerLag, OutsideTheBoundThePlainUpdateStillConverges) {
     const std::int64_t n = period_for(d), periods = d == 2 ? 150 : 400;
     double last_error[2] = {0.0, 0.0};
     for (const bool lag_compensated : {true, false}) {
-      LearningConfig config;
+      LearningConfig config = testing::stepwise();
       config.lag_compensated = lag_compensated;
       PeriodicLearner learner(config, kLearnDt, testing::kMaxLag);
       LearningLoop loop(
@@ -243,7 +243,7 @@ TEST(PeriodicLearnerLag, LineRatesWithinTwentyPeriods) {
       const double a = line.amplitude_m;
       double period_20[2] = {0.0, 0.0};
       for (const bool lag_compensated : {true, false}) {
-        LearningConfig config;
+        LearningConfig config = testing::stepwise();
         config.lag_compensated = lag_compensated;
         PeriodicLearner learner(config, kLearnDt, testing::kMaxLag);
         LearningLoop loop(

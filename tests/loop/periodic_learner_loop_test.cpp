@@ -35,7 +35,7 @@ constexpr double kNm = 1e-9;
 constexpr double kSigma = 1e-9;  // the sensor's white noise
 
 LearningConfig with_update(bool lag_compensated) {
-  LearningConfig c;
+  LearningConfig c = testing::stepwise();
   c.lag_compensated = lag_compensated;
   return c;
 }
@@ -317,7 +317,7 @@ TEST(PeriodicLearner, RestartFadesTheOldTableOutAndLearnsTheNewReference) {
   constexpr std::int64_t na = 1000, nb = 700;
   const LinearPlant plant{0.9, 0};
   std::int64_t k0 = std::numeric_limits<std::int64_t>::max();  // where reference B begins
-  PeriodicLearner learner({}, kLearnDt, testing::kMaxLag);
+  PeriodicLearner learner(testing::stepwise(), kLearnDt, testing::kMaxLag);
   LearningLoop loop(
       learner, 25 * na + 25 * nb, plant,
       [&k0](std::int64_t k) { return k < k0 ? raster(k, na, 500 * kNm) : raster(k - k0, nb, 400 * kNm); },
@@ -347,7 +347,7 @@ TEST(PeriodicLearner, RestartFadesTheOldTableOutAndLearnsTheNewReference) {
 
 TEST(PeriodicLearner, StopFadesOutAndLearnsNothingMore) {
   constexpr std::int64_t n = 1000;
-  PeriodicLearner learner({}, kLearnDt, testing::kMaxLag);
+  PeriodicLearner learner(testing::stepwise(), kLearnDt, testing::kMaxLag);
   LearningLoop loop(
       learner, 30 * n, {0.9, 0}, [](std::int64_t k) { return raster(k, n, 500 * kNm); },
       [](std::int64_t k) { return disturbance(k, n); }, kSigma, 9);
@@ -373,7 +373,7 @@ TEST(PeriodicLearner, StopFadesOutAndLearnsNothingMore) {
 TEST(PeriodicLearner, OffOnAndResetFadeOutThenLearnAgain) {
   constexpr std::int64_t n = 1000;
   const LinearPlant plant{0.9, 0};
-  PeriodicLearner learner({}, kLearnDt, testing::kMaxLag);
+  PeriodicLearner learner(testing::stepwise(), kLearnDt, testing::kMaxLag);
   LearningLoop loop(
       learner, 75 * n, plant, [](std::int64_t k) { return raster(k, n, 500 * kNm); },
       [](std::int64_t k) { return disturbance(k, n); }, kSigma, 13);

@@ -31,6 +31,15 @@
 namespace hystloop::testing {
 
 inline constexpr double kLearnDt = 1e-4;
+
+// The learner with its tables adopted in one step at the boundary (blend_s = 0): the tables in
+// use are then exactly what the update's recursion says, which is what these tests check. The
+// deployed blend is tested on its own (PeriodicLearner.ANewTableTakesOverAlongTheBlend).
+inline LearningConfig stepwise() {
+  LearningConfig c;
+  c.blend_s = 0.0;
+  return c;
+}
 inline constexpr std::int64_t kHorizon = 500;
 inline constexpr std::int64_t kBlock = 20;
 inline constexpr std::int64_t kMaxLag = kHorizon + kBlock;

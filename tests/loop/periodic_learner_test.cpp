@@ -33,7 +33,7 @@ double tick(PeriodicLearner& l, std::int64_t k, double y) {
 }
 
 TEST(PeriodicLearner, FilterIsTheTriangleNearestBelowTheCutoff) {
-  PeriodicLearner l({}, kLearnDt, 0);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 0);
   EXPECT_EQ(l.filter_half_width(), 4);  // 1 kHz at 10 kHz
   EXPECT_NEAR(l.filter_cutoff_hz(), 1138.5, 0.1);
   EXPECT_DOUBLE_EQ(l.filter_null_hz(), 2500.0);
@@ -54,7 +54,7 @@ TEST(PeriodicLearner, FilterIsTheTriangleNearestBelowTheCutoff) {
 // One error sample at phase 1 of a 20-tick period: the next period's correction is gain x the
 // triangle centred on it (zero phase: symmetric, nothing delayed), wrapped over the period's end.
 TEST(PeriodicLearner, AnErrorImpulseLearnsTheSymmetricWindowAroundIt) {
-  PeriodicLearner l({}, kLearnDt, 0);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 0);
   l.restart(0, 20);
   const double delta = 16 * kNm;
   for (std::int64_t k = 0; k < 20; ++k) EXPECT_EQ(tick(l, k, k == 1 ? -delta : 0.0), 0.0);
@@ -82,7 +82,7 @@ TEST(PeriodicLearner, AnErrorImpulseLearnsTheSymmetricWindowAroundIt) {
 // error would only grow the table there period after period. The same impulse as above, held,
 // leaves the next table at zero; the figures count the tick once, however often it is held.
 TEST(PeriodicLearner, AHeldTickIsNotLearnedFrom) {
-  PeriodicLearner l({}, kLearnDt, 0);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 0);
   l.restart(0, 20);
   const double delta = 16 * kNm;
   for (std::int64_t k = 0; k < 20; ++k) {
@@ -110,7 +110,7 @@ TEST(PeriodicLearner, EachUpdateLearnsThroughTheLagAsItsRecursionSays) {
   const double delta = 8 * kNm;
   double in_period_4[2] = {0.0, 0.0};  // lag-compensated, plain
   for (const bool lag_compensated : {true, false}) {
-    LearningConfig config;
+    LearningConfig config = testing::stepwise();
     config.lag_compensated = lag_compensated;
     PeriodicLearner l(config, kLearnDt, ahead + 5);
     EXPECT_EQ(l.lag_compensated(), lag_compensated);
@@ -148,7 +148,7 @@ TEST(PeriodicLearner, ATableLearnedWhileAnotherWaitsBuildsOnTheWaitingOne) {
   constexpr std::int64_t n = 20;
   const double delta = 8 * kNm;
   for (const bool lag_compensated : {true, false}) {
-    LearningConfig config;
+    LearningConfig config = testing::stepwise();
     config.lag_compensated = lag_compensated;
     PeriodicLearner l(config, kLearnDt, 5 * n);
     l.restart(0, n);
@@ -170,7 +170,7 @@ TEST(PeriodicLearner, WithoutLagBothUpdatesAreTheSame) {
   constexpr std::int64_t n = 100, periods = 30;
   std::vector<double> corr[2];
   for (const bool lag_compensated : {true, false}) {
-    LearningConfig config;
+    LearningConfig config = testing::stepwise();
     config.lag_compensated = lag_compensated;
     PeriodicLearner learner(config, kLearnDt, 0);
     testing::LearningLoop loop(
@@ -192,8 +192,38 @@ TEST(PeriodicLearner, WithoutLagBothUpdatesAreTheSame) {
   EXPECT_GT(largest, 50 * kNm);
 }
 
+// A new table takes over from the one in use along a linear blend of blend_s from the boundary
+// (5 ms, 50 ticks, by default; never longer than the period): the first table of a constant
+// error, c0 = -gain delta everywhere, enters as c0 (j + 1) / 50 at tick j of its first period, and
+// the largest tick-to-tick change of the correction is |c0| / 50 where without the blend it is
+// the whole step |c0|, which the stage's inverse would turn into a ringing at half the tick rate.
+TEST(PeriodicLearner, ANewTableTakesOverAlongTheBlend) {
+  const double delta = 10 * kNm;
+  for (const std::int64_t n : {200, 20}) {
+    for (const bool blended : {true, false}) {
+      LearningConfig config;
+      if (!blended) config.blend_s = 0.0;
+      PeriodicLearner l(config, kLearnDt, 0);
+      EXPECT_EQ(l.blend_ticks(), blended ? 50 : 0);
+      l.restart(0, n);
+      for (std::int64_t k = 0; k < n; ++k) ASSERT_EQ(tick(l, k, delta), 0.0);
+      const double c0 = -l.gain() * delta;
+      const std::int64_t over = blended ? std::min<std::int64_t>(50, n) : 1;
+      double previous = 0.0, largest_step = 0.0;
+      for (std::int64_t j = 0; j < n; ++j) {
+        const double c = l.correction(n + j, 0.0);
+        const double expected = c0 * static_cast<double>(std::min(j + 1, over)) / static_cast<double>(over);
+        ASSERT_NEAR(c, expected, 1e-22) << "period " << n << ", tick " << j << (blended ? ", blended" : ", stepwise");
+        largest_step = std::max(largest_step, std::abs(c - previous));
+        previous = c;
+      }
+      EXPECT_NEAR(largest_step, std::abs(c0) / static_cast<double>(over), 1e-22);
+    }
+  }
+}
+
 TEST(PeriodicLearner, TheTableIsClampedToTheBound) {
-  PeriodicLearner l({}, kLearnDt, 0);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 0);
   l.restart(0, 20);
   for (std::int64_t k = 0; k < 20; ++k) tick(l, k, k == 5 ? -10e-6 : 0.0);
   double largest = 0.0;
@@ -204,7 +234,7 @@ TEST(PeriodicLearner, TheTableIsClampedToTheBound) {
 // A period with a hole (a tick not delivered, NaN, a sample later than max_lag_ticks, periods
 // without any sample) is not learned from: the table from period 0 stays until period 6's.
 TEST(PeriodicLearner, APeriodWithAMissingSampleIsSkipped) {
-  PeriodicLearner l({}, kLearnDt, 5);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 5);
   l.restart(0, 20);
   const double delta = 16 * kNm;
   for (std::int64_t k = 0; k < 20; ++k) tick(l, k, k == 1 ? -delta : 0.0);
@@ -233,7 +263,7 @@ TEST(PeriodicLearner, APeriodWithAMissingSampleIsSkipped) {
 }
 
 TEST(PeriodicLearner, IdleForPeriodsItCannotLearnAndBeforeK0) {
-  PeriodicLearner l({}, kLearnDt, 0);
+  PeriodicLearner l(testing::stepwise(), kLearnDt, 0);
   EXPECT_FALSE(l.figures().active);
   for (const std::int64_t n : {std::int64_t{1}, std::int64_t{0}, l.max_period_ticks() + 1}) {
     l.restart(0, n);
@@ -254,7 +284,7 @@ TEST(PeriodicLearner, IdleForPeriodsItCannotLearnAndBeforeK0) {
 }
 
 TEST(PeriodicLearner, DisabledByConfigLearnsOnlyWhenTurnedOn) {
-  LearningConfig c;
+  LearningConfig c = testing::stepwise();
   c.enabled = false;
   PeriodicLearner l(c, kLearnDt, 0);
   l.restart(0, 20);
@@ -271,7 +301,7 @@ TEST(PeriodicLearner, DisabledByConfigLearnsOnlyWhenTurnedOn) {
 TEST(PeriodicLearner, PerSampleCallsAndStateChangesAllocateNothing) {
   constexpr std::int64_t n = 300;
   for (const bool lag_compensated : {true, false}) {
-    LearningConfig config;
+    LearningConfig config;  // the deployed one: its blends too
     config.lag_compensated = lag_compensated;
     PeriodicLearner learner(config, kLearnDt, testing::kMaxLag);
     testing::LearningLoop loop(
@@ -319,8 +349,9 @@ TEST(PeriodicLearner, ValidationNamesTheField) {
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.max_period_s = 1e-4; })), "learning.max_period_s");
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.max_period_s = 60.0; })), "learning.max_period_s");
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.fade_s = 0.0; })), "learning.fade_s");
+  EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.blend_s = -1e-3; })), "learning.blend_s");
   EXPECT_EQ(refused_field([] { PeriodicLearner l({}, 0.0, 500); }), "compensator.dt_s");
-  EXPECT_EQ(refused_field([] { PeriodicLearner l({}, kLearnDt, -1); }), "learning.max_lag_ticks");
+  EXPECT_EQ(refused_field([] { PeriodicLearner l(testing::stepwise(), kLearnDt, -1); }), "learning.max_lag_ticks");
   try {
     LearningConfig c;
     c.gain = 2.0;
