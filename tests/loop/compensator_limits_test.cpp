@@ -276,6 +276,46 @@ TEST(CompensatorLimits, ASetUnderWhichTheRunningLineWouldLeaveTheLimitsIsRefused
   EXPECT_NO_THROW(idle.offer_model(set, 2));
 }
 
+// Inside the plan's share but past the learning's 97 %, a set may not take the running line
+// nearer the slew limit than the set in use does (the servo's headroom is what is left); one that
+// takes it back from there, or stays below 97 %, is taken.
+TEST(CompensatorLimits, NearTheSlewLimitASetMayNotTakeTheLineNearer) {
+  Compensator c(linear_config(true));
+  FeedforwardLimits limits;
+  limits.fraction = kShare;
+  const double full = largest_sine_amplitude_m(LinearPlant{kGain, SecondOrderStageParams{}}, limits, 100.0, 0.0);
+  c.take_trajectory(sine(0.980 / kShare * full, 100.0), kNaN);  // 98.0 % of the slew
+  plan_for(c, 0.1);
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.linear.gain = kGain * 0.980 / 0.986;  // 98.6 %: inside the 99 % share, but nearer
+  try {
+    c.offer_model(set, 2);
+    FAIL() << "a set taking the line from 98.0 % to 98.6 % of the slew was taken";
+  } catch (const ParameterError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("nearer the limit than under the set in use (98"), std::string::npos) << what;
+    EXPECT_NE(what.find("the set in use stays"), std::string::npos) << what;
+  }
+  EXPECT_EQ(c.counters().params_rejected, 1u);
+  set.linear.gain = kGain * 0.980 / 0.975;  // 97.5 %: further from the limit
+  EXPECT_NO_THROW(c.offer_model(set, 3));
+  plan_for(c, 0.1);
+  EXPECT_EQ(c.params_version(), 3);
+  set.linear.gain = kGain * 0.980 / 0.978;  // 97.8 %: nearer than 97.5 %, still past 97 %
+  EXPECT_THROW(c.offer_model(set, 4), ParameterError);
+  set.linear.gain = kGain * 0.980 / 0.965;  // 96.5 %: below the learning's share, taken
+  EXPECT_NO_THROW(c.offer_model(set, 5));
+}
+
+TEST(CompensatorLimits, IdleTakesAnyValidSet) {
+  Compensator idle(linear_config(true));
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.linear.gain = 0.5 * kGain;
+  EXPECT_NO_THROW(idle.offer_model(set, 2));
+}
+
 TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
   CompensatorConfig c = linear_config(true);
   c.stage.second_order.c = 1e-3;
