@@ -92,6 +92,38 @@ bool consistent(const ModelScore& s, const OnlineSelectorOptions& o) {
 
 }  // namespace
 
+std::vector<std::size_t> decimate_keeping_extremes(std::span<const double> u, std::size_t n) {
+  // The servo's response to the sensor's noise moves u by ~0.02 V a tick: a turn that small is
+  // the noise's, and keeping it would weight the fit towards the noisiest samples of each reversal.
+  constexpr double kTurnTolerance_V = 0.1;
+  std::vector<std::size_t> kept;
+  if (u.empty()) return kept;
+  n = std::max<std::size_t>(n, 1);
+  kept.reserve(u.size() / n + 16);
+  for (std::size_t k = 0; k < u.size(); k += n) {
+    kept.push_back(k);
+    const std::size_t end = std::min(k + n, u.size() - 1);  // the next kept sample (or the last)
+    if (end <= k + 1) continue;
+    std::size_t hi = k + 1, lo = k + 1;
+    for (std::size_t i = k + 2; i < end; ++i) {
+      if (u[i] > u[hi]) hi = i;
+      if (u[i] < u[lo]) lo = i;
+    }
+    const bool above = u[hi] > std::max(u[k], u[end]) + kTurnTolerance_V;
+    const bool below = u[lo] < std::min(u[k], u[end]) - kTurnTolerance_V;
+    if (above && below) {
+      kept.push_back(std::min(hi, lo));
+      kept.push_back(std::max(hi, lo));
+    } else if (above) {
+      kept.push_back(hi);
+    } else if (below) {
+      kept.push_back(lo);
+    }
+  }
+  if (kept.back() != u.size() - 1 && n > 1) kept.push_back(u.size() - 1);
+  return kept;
+}
+
 ModelProposal propose_model(std::span<const double> u_in, std::span<const double> y_in, const ModelParamSet& in_use,
                             const OnlineSelectorOptions& o) {
   o.validate();
@@ -105,7 +137,10 @@ ModelProposal propose_model(std::span<const double> u_in, std::span<const double
     out.reason = "u and y differ in length";
     return out;
   }
-  for (std::size_t k = 0; k < u_in.size(); k += o.decimation) {
+  const std::vector<std::size_t> kept = decimate_keeping_extremes(u_in, o.decimation);
+  u.reserve(kept.size());
+  y.reserve(kept.size());
+  for (const std::size_t k : kept) {
     u.push_back(u_in[k]);
     y.push_back(y_in[k]);
   }

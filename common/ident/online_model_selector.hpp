@@ -42,7 +42,7 @@ struct OnlineSelectorOptions {
   // window that changed under it (a swap's transient, the loop moving): it is not proposed.
   double max_holdout_to_train = 2.0;
   bool pinned = false;                // never propose a different model (parameters are still refitted)
-  std::size_t decimation = 1;         // fit every n-th sample of the window (>= 1; 10 kHz / 10 = 1 kHz)
+  std::size_t decimation = 1;         // fit every n-th sample of the window, and its extremes (>= 1; 10 kHz / 10 = 1 kHz)
   ModelSelectionOptions selection{};  // candidates, held-out fraction, fitter options
 
   void validate() const;  // throws ParameterError naming the field
@@ -74,6 +74,16 @@ struct ModelProposal {
 // compensator runs now. Throws ParameterError for invalid options or an invalid in_use.
 ModelProposal propose_model(std::span<const double> u_V, std::span<const double> y_m, const ModelParamSet& in_use,
                             const OnlineSelectorOptions& options = {});
+
+// The samples a decimated fit keeps: every n-th, and inside each block of n the sample where u
+// is largest or smallest when it passes the block's ends by more than 0.1 V (a reversal, not the
+// servo's tick-to-tick noise). Hysteresis is
+// rate-independent, so the models need u's turning points, not an even clock: every 10th
+// sample of a 100 Hz line misses its peaks by up to 5 % of the amplitude, and a play operator
+// fed the missed peak starts its next branch in the wrong place (fitted PI sets then had their
+// slope steps where the stage's were not, which rang the 1.72 kHz resonance at 10 nm). Between
+// two kept samples u is monotone up to what turns inside a block twice. Indices increasing.
+std::vector<std::size_t> decimate_keeping_extremes(std::span<const double> u, std::size_t n);
 
 // The output a parameter set predicts for u over the window, as select_model scores its
 // candidates (MEM from the first reversal at the measured y, PI/Katalenic from u[0], linear).

@@ -4,13 +4,45 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "ident/mem_test_data.hpp"
 
 namespace hystloop {
 namespace {
+
+// A 100 Hz line at 10 kHz decimated by 10: every 10th sample misses the peaks (ticks 48 and 98
+// of each 100 here), the decimation that keeps extremes has each peak exactly, u is monotone
+// between any two kept samples, and it keeps no more than two samples a reversal beyond every
+// 10th (and the last).
+TEST(DecimateKeepingExtremes, KeepsEveryNthAndEachPeak) {
+  std::vector<double> u(2000);
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    u[k] = 75.0 * std::sin(2.0 * std::numbers::pi * (static_cast<double>(k) + 27.0) / 100.0);
+  }
+  // The peaks: u = +75 at k = 100 j + 98, -75 at 100 j + 48 (a phase off the tens).
+  const std::vector<std::size_t> kept = decimate_keeping_extremes(u, 10);
+  std::size_t peaks = 0;
+  for (const std::size_t k : kept) peaks += std::abs(std::abs(u[k]) - 75.0) < 1e-9 ? 1 : 0;
+  EXPECT_EQ(peaks, 40u);  // 20 periods, two peaks each
+  for (std::size_t i = 0; i + 2 < kept.size(); ++i) {
+    // Between kept samples the path is monotone: no sample beyond the two ends.
+    const double lo = std::min(u[kept[i]], u[kept[i + 1]]), hi = std::max(u[kept[i]], u[kept[i + 1]]);
+    for (std::size_t k = kept[i] + 1; k < kept[i + 1]; ++k) {
+      ASSERT_GE(u[k], lo - 1e-12) << k;
+      ASSERT_LE(u[k], hi + 1e-12) << k;
+    }
+  }
+  EXPECT_EQ(kept.size(), 200u + 40u + 1u);
+  EXPECT_EQ(kept.back(), u.size() - 1);
+  // Every sample without decimation; nothing from nothing.
+  EXPECT_EQ(decimate_keeping_extremes(u, 1).size(), u.size());
+  EXPECT_TRUE(decimate_keeping_extremes(std::vector<double>{}, 10).empty());
+}
 
 // 4 s of a 1 Hz, 200 V sine at 1 kHz (eight branches, as the tracking loop's window holds).
 std::vector<double> window_input() { return testdata::sine_input(200.0, 1.0, 1e3, 4.0); }
