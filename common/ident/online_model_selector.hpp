@@ -41,8 +41,8 @@ struct OnlineSelectorOptions {
   // A candidate whose held-out RMS exceeds this multiple of its own fit residual was fitted to a
   // window that changed under it (a swap's transient, the loop moving): it is not proposed.
   double max_holdout_to_train = 2.0;
-  bool pinned = false;                // never propose a different model (parameters are still refitted)
-  std::size_t decimation = 1;         // fit every n-th sample of the window, and its extremes (>= 1; 10 kHz / 10 = 1 kHz)
+  bool pinned = false;         // never propose a different model (parameters are still refitted)
+  std::size_t decimation = 1;  // fit every n-th sample of the window, and its extremes (>= 1; 10 kHz / 10 = 1 kHz)
   ModelSelectionOptions selection{};  // candidates, held-out fraction, fitter options
 
   void validate() const;  // throws ParameterError naming the field

@@ -197,7 +197,7 @@ class PeriodicLearner {
   void start_learning(std::int64_t from_k) noexcept;  // zero table, first period at or after from_k
   void learn_from_period() noexcept;                  // acc_ -> next_ (filter, clamp)
   void account_skipped(std::uint64_t n) noexcept;
-  std::int64_t phase(std::int64_t k) const noexcept;  // of k in the table's period [0, n)
+  std::int64_t phase(std::int64_t k) const noexcept;             // of k in the table's period [0, n)
   double in_use(std::int64_t k, std::int64_t i) const noexcept;  // table_ at phase i, blended at tick k
   std::size_t slot(std::int64_t k) const noexcept;
 
