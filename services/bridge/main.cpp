@@ -9,6 +9,7 @@
 
 #include "bridge/bridge_service.hpp"
 #include "bridge/probe_hardware.hpp"
+#include "core/cli.hpp"
 #include "core/logging.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
@@ -77,7 +78,7 @@ int main(int argc, char** argv) try {
     if (!probe) configure_rig_auth(config, url);  // the probe drives the card alone: no LCM
   } catch (const std::exception& e) {             // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   }
 
   if (probe) return probe_hardware(settings, probe_options, stdout);
@@ -99,7 +100,7 @@ int main(int argc, char** argv) try {
     return rc;
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     flush_logging();

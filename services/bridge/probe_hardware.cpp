@@ -10,6 +10,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "bridge/comedi_backend.hpp"
+#include "core/cli.hpp"
 
 namespace hystloop {
 namespace {
@@ -189,7 +190,7 @@ int probe_hardware(const BridgeSettings& settings, const ProbeOptions& options, 
     return drive(settings, options, out);
   } catch (const ParameterError& e) {
     std::fprintf(out, "refused: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(out, "failed: %s\n", e.what());
     return 1;

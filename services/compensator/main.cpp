@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "compensator/compensator_service.hpp"
+#include "core/cli.hpp"
 #include "core/logging.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
     configure_rig_auth(config, url);
   } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
     std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   }
 
   try {
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
     return rc;
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     flush_logging();

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <string>
 #include <thread>
 
@@ -206,15 +207,25 @@ TEST(BridgeSettings, TheStopRampBoundFollowsTheActuator) {
 }
 
 // The safe-state hook: the simulators have no output stage to hold; it must be callable at any
-// time, more than once, without stepping.
+// time, more than once, without stepping, and leave the simulated stage as it was: a backend
+// told to hold safe between its steps reads what an identical one that was not told reads.
 TEST(StageBackend, SimulatorsHoldSafeTrivially) {
   BridgeSettings s;
   for (const char* name : {"sim", "ro"}) {
-    auto backend = make_stage_backend(name, s.stage);
-    backend->hold_safe(0.0);
-    backend->step(10.0, 0.0, 1e-4);
-    backend->hold_safe(0.0);
-    backend->hold_safe(-5.0);
+    auto held = make_stage_backend(name, s.stage);
+    auto untouched = make_stage_backend(name, s.stage);
+    EXPECT_TRUE(held->simulated()) << name;
+    held->hold_safe(0.0);
+    for (int k = 0; k < 50; ++k) {
+      const double u = 10.0 * std::sin(0.1 * k);
+      const double t = 1e-4 * k;
+      const StageReading a = held->step(u, t, 1e-4);
+      const StageReading b = untouched->step(u, t, 1e-4);
+      ASSERT_EQ(a.y_m, b.y_m) << name << ", tick " << k;
+      ASSERT_EQ(a.flags, b.flags) << name << ", tick " << k;
+      EXPECT_FALSE(a.go_safe) << name;
+      held->hold_safe(k % 2 == 0 ? 0.0 : -5.0);
+    }
   }
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <set>
 
+#include "core/cli.hpp"
 #include "core/config.hpp"
 
 namespace hystloop::ctl {
@@ -46,7 +47,7 @@ int run_config_get(const ConfigGetOptions& o) {
     return 0;
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-ctl: config-get: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   }
 }
 

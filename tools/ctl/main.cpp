@@ -502,7 +502,7 @@ int run(int argc, char** argv) {
     }
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
     return 1;

@@ -47,7 +47,7 @@ struct OpenError : std::runtime_error {
 
 int refuse(const std::string& message) {
   std::cerr << kTool << ": " << message << "\n";
-  return 2;
+  return kExitUsage;
 }
 
 // Assignments in the order they apply: the file first, then each --param over it.

@@ -220,7 +220,7 @@ int report_main(int argc, char** argv) {
     return run(o);
   } catch (const ParameterError& e) {
     std::fprintf(stderr, "hystloop-report: %s\n", e.what());
-    return 2;
+    return kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-report: %s\n", e.what());
     return 1;
