@@ -45,7 +45,8 @@ TEST(OnlineMemEstimator, ConvergesAfterAStepChangeOfThePlantGain) {
   ASSERT_EQ(changed.status, FitStatus::ok) << changed.reason;
   EXPECT_TRUE(changed.accepted);
   EXPECT_EQ(est.version(), 2u);
-  EXPECT_LT(rel_err(est.params().c1, after.c1), 0.01);
+  // Measured 3.7e-4, 8.9e-3 and 1.7e-3 (1 nm of noise on one 2 s window): bounds within 10x.
+  EXPECT_LT(rel_err(est.params().c1, after.c1), 3e-3);
   EXPECT_LT(rel_err(est.params().c2, after.c2), 0.02);
   EXPECT_LT(rel_err(est.params().c3, after.c3), 0.01);
   EXPECT_LT(changed.holdout_rms_candidate_m, 0.5 * changed.holdout_rms_in_use_m);
