@@ -16,7 +16,7 @@
 #include "runtime/rig_auth_config.hpp"
 #include "runtime/service_options.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   using namespace hystloop;
   CLI::App app{
       "hystloop-compensator: turns the reference (HX_TRAJECTORY) into the feedforward voltage that makes "
@@ -76,4 +76,10 @@ int main(int argc, char** argv) {
     flush_logging();
     return 1;
   }
+} catch (const std::exception& e) {  // CLI11's set-up, before the handlers below exist: nothing escapes main
+  std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
+  return 1;
+} catch (...) {
+  std::fprintf(stderr, "hystloop-compensator: unknown error\n");
+  return 1;
 }

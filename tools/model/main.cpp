@@ -157,7 +157,7 @@ int run(Args& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{
       "Run a hysteresis model over a CSV file (header row, comma separated, SI units).\n"
       "--forward reads columns t,u [s, V] and writes t,u,y [m]; --inverse reads t,y_ref [s, m] and writes t,y_ref,u "
@@ -181,4 +181,10 @@ int main(int argc, char** argv) {
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   if (!args.forward && !args.inverse) return refuse("choose --forward (t,u -> y) or --inverse (t,y_ref -> u)");
   return run(args);
+} catch (const std::exception& e) {  // CLI11's set-up and what run() lets through: nothing escapes main
+  std::cerr << kTool << ": " << e.what() << "\n";
+  return 1;
+} catch (...) {
+  std::cerr << kTool << ": unknown error\n";
+  return 1;
 }
