@@ -15,5 +15,5 @@ banning_table() {
       printf "| %s [%s] | %.4g | %s | %s |\n", k, u, t, g == "" ? "n/a" : sprintf("%.6g", g), err }'
   done
   echo
-  sed -n 's/^\(log:\|fit:\)/- &/p' "$w/identify.txt"
+  sed -n 's/^\(log:\|fit:\|lag:\)/- &/p' "$w/identify.txt"
 }

@@ -10,12 +10,14 @@
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
 #include "core/errors.hpp"
 #include "ident/ceres_budget.hpp"
 #include "ident/fit_checks.hpp"
+#include "models/coleman_hodgdon.hpp"
 
 namespace hystloop {
 
@@ -31,6 +33,7 @@ namespace {
 
 struct SineFit {
   double offset = 0.0, amplitude = 0.0, rss = 0.0;
+  double phase = 0.0;  // x = offset + amplitude sin(w k + phase)
 };
 
 // Least squares x = c0 + cs sin(w k) + cc cos(w k) at a given frequency.
@@ -46,7 +49,12 @@ SineFit sine_fit(std::span<const double> x, double f, double fs) {
     xx += x[k] * x[k];
   }
   const Eigen::Vector3d c = g.ldlt().solve(r);
-  return {c[0], std::hypot(c[1], c[2]), xx - c.dot(r)};
+  return {c[0], std::hypot(c[1], c[2]), xx - c.dot(r), std::atan2(c[2], c[1])};
+}
+
+// (21): the loop's peak-to-peak slope at amplitude amp [V].
+double ch_slope_closed(double a, double b, double alpha, double amp) {
+  return a + (b - a) / alpha * std::tanh(alpha * amp) / amp;
 }
 
 }  // namespace
@@ -92,8 +100,9 @@ SineEstimate estimate_sine(std::span<const double> u, double fs, bool refine_fre
 
 double first_harmonic_amplitude(std::span<const double> y, double f, double fs) { return sine_fit(y, f, fs).amplitude; }
 
-double stage_magnitude_model(double k, double c, double omega, double T) noexcept {
-  if (!(T > 0.0)) return k / std::hypot(k - omega * omega, c * omega);
+std::complex<double> stage_response_model(double k, double c, double omega, double T) noexcept {
+  using C = std::complex<double>;
+  if (!(T > 0.0)) return k / C(k - omega * omega, c * omega);
   // Exact ZOH: exp of the augmented [A B; 0 0] T gives Phi and Gamma at once.
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   m(0, 1) = 1.0;
@@ -101,13 +110,36 @@ double stage_magnitude_model(double k, double c, double omega, double T) noexcep
   m(1, 1) = -c;
   m(1, 2) = k;
   const Eigen::Matrix3d e = (m * T).exp();
-  using C = std::complex<double>;
   const C z = std::polar(1.0, omega * T);
   // (z I - Phi)^{-1} Gamma, first row (y = x_0).
   const C a00 = z - e(0, 0), a01 = -e(0, 1), a10 = -e(1, 0), a11 = z - e(1, 1);
   const C det = a00 * a11 - a01 * a10;
-  const C x0 = (a11 * e(0, 2) - a01 * e(1, 2)) / det;
-  return std::abs(x0);
+  return (a11 * e(0, 2) - a01 * e(1, 2)) / det;
+}
+
+double stage_magnitude_model(double k, double c, double omega, double T) noexcept {
+  return std::abs(stage_response_model(k, c, omega, T));
+}
+
+double loop_lag_area_per_rad(const ColemanHodgdonParams& h, double offset_V, double amplitude_V) {
+  // Starts at the loop's lower tip, which Theorem 3 places at (offset - A, a offset - slope A),
+  // so that the loop is periodic from the start (from inside it, it would settle only as
+  // exp(-2 alpha A) a half period); the second period is integrated. 4096 steps a period: the
+  // model is exact per step, the sum a midpoint rule.
+  constexpr int kSteps = 4096;
+  const double dth = 2.0 * std::numbers::pi / kSteps;
+  ColemanHodgdon ch(h);
+  const double slope = ch_slope_closed(h.a, h.b, h.alpha, amplitude_V);
+  ch.reset(offset_V - amplitude_V, h.a * offset_V - slope * amplitude_V);
+  double integral = 0.0;
+  double w_prev = ch.output(), u_prev = offset_V - amplitude_V;
+  for (int k = 1; k <= 2 * kSteps; ++k) {
+    const double u = offset_V - amplitude_V * std::cos(dth * k);
+    const double w = ch.step(u);
+    if (k > kSteps) integral += (w - w_prev) * (u - u_prev) / dth;
+    w_prev = w, u_prev = u;
+  }
+  return integral;
 }
 
 namespace {
@@ -159,10 +191,6 @@ ceres::Solver::Options solver_options() {
   return o;
 }
 
-double ch_slope_closed(double a, double b, double alpha, double amp) {
-  return a + (b - a) / alpha * std::tanh(alpha * amp) / amp;
-}
-
 // Inverts (25) for h (paper order): ptp = 2 a h A + 2 (b - a)/alpha tanh(alpha A h), increasing in h.
 double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp) {
   auto f = [&](double h) {
@@ -180,6 +208,15 @@ double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp
 FitCheck refusal(FitStatus status, std::string reason) { return {status, std::move(reason)}; }
 
 using PointRefs = std::vector<BanningPoint*>;
+
+// Small loops seed b; the larger ones' areas give alpha. The amplitude is read from noisy data:
+// one at the bound (the plan's 5 V) must not move between the sets from run to run.
+bool small_loop(const BanningPoint& p, const BanningFitOptions& o) {
+  return p.amplitude_V <= o.small_amplitude_max_V * 1.01;
+}
+
+// Phase of b behind a, in (-pi, pi].
+double phase_behind(double a, double b) { return std::remainder(a - b, 2.0 * std::numbers::pi); }
 
 // 1. Offset, amplitude and frequency of every experiment's input; loop features of the slow
 // ones, the first-harmonic magnitude of the fast ones. An experiment that is not a sine is
@@ -208,7 +245,10 @@ FitCheck measure_experiments(std::span<const BanningExperimentData> experiments,
     pt.offset_V = se.offset, pt.amplitude_V = se.amplitude, pt.frequency_Hz = se.frequency_Hz;
     pt.magnitude_experiment = se.frequency_Hz >= o.frequency_threshold_Hz;
     if (pt.magnitude_experiment) {
-      pt.magnitude = first_harmonic_amplitude(ex.y, se.frequency_Hz, ex.sample_rate_Hz);  // ptp/2 for now
+      const SineFit yu = sine_fit(ex.u, se.frequency_Hz, ex.sample_rate_Hz);
+      const SineFit yf = sine_fit(ex.y, se.frequency_Hz, ex.sample_rate_Hz);
+      pt.response_m = yf.amplitude;
+      pt.phase_lag_rad = phase_behind(yu.phase, yf.phase);
       pt.used = true;
     } else {
       const LoopFeatureResult lf = extract_loop_features(ex.u, ex.y, o.loop);
@@ -255,7 +295,7 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
   double b0 = 0.0;
   std::size_t n = 0;
   for (const auto* p : loops) {
-    if (p->amplitude_V <= o.small_amplitude_max_V) b0 += p->features.slope, ++n;
+    if (small_loop(*p, o)) b0 += p->features.slope, ++n;
   }
   if (n == 0) {  // no small loop: the smallest one
     b0 = (*std::min_element(loops.begin(), loops.end(), [](auto* l, auto* r) {
@@ -271,7 +311,7 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
   }
   std::vector<double> alphas;
   for (const auto* p : loops) {
-    if (p->amplitude_V > o.small_amplitude_max_V && p->features.area > 0.0) {
+    if (p->area_fitted && p->features.area > 0.0) {
       alphas.push_back(3.0 * p->features.area / (4.0 * (a - b0) * std::pow(p->amplitude_V, 3)));
     }
   }
@@ -293,9 +333,9 @@ FitCheck refine_b_alpha(const PointRefs& loops, const BanningFitOptions& o, cons
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SlopeResidual, 1, 2>(
                                  new SlopeResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9}),
                              nullptr, x);
-    if (p->amplitude_V > o.small_amplitude_max_V) {
+    if (p->area_fitted) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AreaResidual, 1, 2>(
-                                   new AreaResidual{a * 1e9, p->amplitude_V, p->features.area * 1e9}),
+                                   new AreaResidual{a * 1e9, p->amplitude_V, (p->features.area + p->lag_area) * 1e9}),
                                nullptr, x);
     }
   }
@@ -320,9 +360,10 @@ FitCheck refine_b_alpha(const PointRefs& loops, const BanningFitOptions& o, cons
   for (const auto* p : loops) {
     const double A = p->amplitude_V;
     ss += std::pow((ch_slope_closed(a, b, al, A) - p->features.slope) / p->features.slope, 2);
-    if (A > o.small_amplitude_max_V) {
+    if (p->area_fitted) {
       const double eps = 4.0 * (a - b) / al * (A - std::tanh(al * A) / al);
-      sa += std::pow((eps - p->features.area) / p->features.area, 2), ++na;
+      const double area = p->features.area + p->lag_area;
+      sa += std::pow((eps - area) / area, 2), ++na;
     }
   }
   res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
@@ -340,7 +381,7 @@ FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFi
   const ColemanHodgdonParams& h = res.hysteresis;
   double peak_h = 0.0, peak_f = 0.0;
   for (auto* p : mags) {
-    const double ptp = 2.0 * p->magnitude;
+    const double ptp = 2.0 * p->response_m;
     if (o.order == BanningOrder::kStageThenHysteresis) {
       p->magnitude = invert_peak_to_peak(h, ptp, p->amplitude_V);
     } else {  // hysteresis first: the stage sees a loop of slope (21) at the drive amplitude
@@ -378,6 +419,65 @@ FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFi
   return {};
 }
 
+// 6. The lag. Below f_n / 2 each magnitude experiment's phase, less the stage model's, is fitted
+// by phi0 + w tau: phi0 the small loop's own phase (rate independent), tau what the model lacks
+// (the sampling's pairing of u and y, a sensor's delay). Each loop's area is then corrected by
+// what the lag at its frequency, stage and delay, added to it (or, a lead, took from it).
+// Refused (areas as measured, with a note) without two such experiments an octave apart, or when
+// the lag is too large for the first-order correction.
+void correct_for_lag(const PointRefs& loops, const PointRefs& mags, double sample_rate_Hz, const BanningFitOptions& o,
+                     BanningFitResult& res) {
+  constexpr double kMaxLoopLag_rad = 0.05;
+  const double T = o.zoh_magnitude ? 1.0 / sample_rate_Hz : 0.0;
+  const double k = res.stage.k, c = res.stage.c;
+  const double w_limit = 0.5 * res.stage.natural_frequency();
+  auto stage_lag = [&](double w) { return -std::arg(stage_response_model(k, c, w, T)); };
+  Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  std::size_t n = 0;
+  double w_lo = std::numeric_limits<double>::infinity(), w_hi = 0.0;
+  for (const auto* p : mags) {
+    const double w = 2.0 * std::numbers::pi * p->frequency_Hz;
+    if (!(w < w_limit)) continue;
+    const Eigen::Vector2d phi(1.0, w);
+    g += phi * phi.transpose();
+    r += phi * (p->phase_lag_rad - stage_lag(w));
+    ++n, w_lo = std::min(w_lo, w), w_hi = std::max(w_hi, w);
+  }
+  if (n < 2 || !(w_hi >= 2.0 * w_lo)) {
+    res.lag_note = "fewer than 2 magnitude experiments below f_n/2 an octave apart: areas not corrected for the lag";
+    return;
+  }
+  const Eigen::Vector2d x = g.ldlt().solve(r);
+  double ss = 0.0;
+  for (const auto* p : mags) {
+    const double w = 2.0 * std::numbers::pi * p->frequency_Hz;
+    if (w < w_limit) ss += std::pow(p->phase_lag_rad - stage_lag(w) - x[0] - x[1] * w, 2);
+  }
+  double worst = 0.0;
+  for (const auto* p : loops) {
+    const double w = 2.0 * std::numbers::pi * p->frequency_Hz;
+    worst = std::max(worst, std::abs(stage_lag(w) + w * x[1]));
+  }
+  if (!std::isfinite(x[1]) || !(worst <= kMaxLoopLag_rad)) {
+    std::ostringstream s;
+    s << "the lag at the loops' frequency is " << worst << " rad (delay " << x[1]
+      << " s beyond the stage): too large to correct the areas to first order; measure slower loops";
+    res.lag_note = s.str();
+    return;
+  }
+  res.lag_identified = true;
+  res.delay_s = x[1];
+  res.lag_experiments = n;
+  res.lag_phase_rms_rad = std::sqrt(ss / static_cast<double>(n));
+  for (auto* p : loops) {
+    const double w = 2.0 * std::numbers::pi * p->frequency_Hz;
+    p->lag_rad = stage_lag(w) + w * x[1];
+    // A lag widens the (counter-clockwise) loop, a lead narrows it.
+    p->lag_area = -p->lag_rad * loop_lag_area_per_rad(res.hysteresis, p->offset_V, p->amplitude_V);
+  }
+}
+
 }  // namespace
 
 BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments, const BanningFitOptions& o) {
@@ -388,6 +488,7 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
   PointRefs loops, mags;  // into res.points, which no longer grows
   for (auto& p : res.points) {
     if (p.used) (p.magnitude_experiment ? mags : loops).push_back(&p);
+    p.area_fitted = p.used && !p.magnitude_experiment && !small_loop(p, o);
   }
   if (FitCheck c = fit_centre_line(loops, o, res); !c.ok()) return timer.finish(res, c);
   double x[2] = {0.0, 0.0};
@@ -398,10 +499,18 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
                         mags.empty() ? "no magnitude experiments: stage (k, c) not identified"
                                      : "fewer than 3 magnitude experiments: stage (k, c) not identified");
   }
-  if (FitCheck c = fit_stage(mags, experiments.front().sample_rate_Hz, o, timer.clock(), res); !c.ok()) {
-    return timer.finish(res, c);
-  }
+  const double fs = experiments.front().sample_rate_Hz;
+  if (FitCheck c = fit_stage(mags, fs, o, timer.clock(), res); !c.ok()) return timer.finish(res, c);
   res.stage_identified = true;
+  if (!o.correct_lag) {
+    res.lag_note = "areas not corrected for the lag (correct_lag = false)";
+  } else {
+    correct_for_lag(loops, mags, fs, o, res);
+    if (res.lag_identified) {  // once more on the corrected areas, from where the first pass ended
+      if (FitCheck c = refine_b_alpha(loops, o, timer.clock(), x, res); !c.ok()) return timer.finish(res, c);
+      if (FitCheck c = fit_stage(mags, fs, o, timer.clock(), res); !c.ok()) return timer.finish(res, c);
+    }
+  }
   return timer.finish(res, FitStatus::ok);
 }
 

@@ -30,9 +30,14 @@ check() {  # name, truth, relative tolerance
     bad "$1 = $v, truth $2: more than $3 off"
   fi
 }
+# The series runs its loops at 4 Hz, where the sampled sensor's lead takes ~1 % of each area:
+# the fit measures that lag from the phases and corrects for it (measured: alpha 0.002 % off;
+# uncorrected it was 5 %).
+grep -q "^lag: .* beyond the stage model" "$report" && ok "the areas were corrected for the lag: $(grep '^lag:' "$report")" \
+  || bad "no lag correction in the report"
 check a 8.58e-9 0.01
-check b 6.07e-9 0.02
-check alpha 0.0123 0.05
+check b 6.07e-9 0.01
+check alpha 0.0123 0.01
 check k 1.17e8 0.02
 check c 2.03e3 0.05
 exit "$fail"

@@ -367,9 +367,11 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
       std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V, p.frequency_Hz,
                   p.magnitude);
     } else {
-      std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V\n", i,
+      std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V", i,
                   p.offset_V, p.amplitude_V, p.frequency_Hz, p.features.y_centre * 1e9, p.features.slope * 1e9,
                   p.features.area * 1e9);
+      if (p.lag_area != 0.0) std::printf(" %+.3g for the lag", p.lag_area * 1e9);
+      std::printf("\n");
     }
   }
   if (!r.ok()) return refuse(r.status, r.reason);
@@ -384,6 +386,19 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
   std::printf("fit: centre line %.4g nm RMS, slopes %.3g %% RMS, areas %.3g %% RMS, magnitudes %.3g %% RMS, %.1f ms\n",
               r.centre_rms_m * 1e9, r.slope_rel_rms * 100.0, r.area_rel_rms * 100.0, r.magnitude_rel_rms * 100.0,
               r.solve_time_s * 1e3);
+  if (r.lag_identified) {
+    double lo = 1e300, hi = 0.0;
+    for (const auto& p : r.points) {
+      if (!p.area_fitted || !(p.features.area > 0.0)) continue;
+      lo = std::min(lo, p.lag_area / p.features.area), hi = std::max(hi, p.lag_area / p.features.area);
+    }
+    std::printf(
+        "lag: %.3g us beyond the stage model (phases of %zu magnitude experiments below f_n/2, %.2g mrad RMS); "
+        "the areas alpha is fitted to corrected by %+.2g .. %+.2g %%\n",
+        r.delay_s * 1e6, r.lag_experiments, r.lag_phase_rms_rad * 1e3, lo * 100.0, hi * 100.0);
+  } else if (!r.lag_note.empty()) {
+    std::printf("lag: %s\n", r.lag_note.c_str());
+  }
   const OutputTarget out = output_target(args.out);
   if (out.plots_dir) {
     std::printf("plots: none for banning (its fit is on loop features of several experiments, not one record)\n");

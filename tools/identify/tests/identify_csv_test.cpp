@@ -99,7 +99,7 @@ TEST_F(IdentifyTool, BanningFromOneFileWithAnExperimentColumn) {
   plan_options.small_amplitudes_V = {1.0, 3.0};
   plan_options.amplitudes_V = {50.0, 100.0, 200.0};
 #if defined(__SANITIZE_ADDRESS__)
-  plan_options.hysteresis_frequency_Hz = 5.0;  // lighter under the sanitizer (adds ~0.5 % area)
+  plan_options.hysteresis_frequency_Hz = 5.0;  // lighter under the sanitizer (the fit corrects the lag)
   plan_options.settle_periods = 10;
 #else
   plan_options.hysteresis_frequency_Hz = 2.0;
