@@ -503,6 +503,12 @@ double Compensator::restart_at_reversal(FeedforwardMode mode, double u_rev) noex
   return last_w_ - shift_m_;
 }
 
+bool Compensator::params_held_by_learning() const noexcept {
+  const LearnerFigures& f = learner_.figures();
+  const std::int64_t after = config_.learning.hold_params_after;
+  return pending_.has_value() && after > 0 && f.active && f.tables_this_line >= static_cast<std::uint64_t>(after);
+}
+
 void Compensator::swap_params(std::int64_t k) noexcept {
   const ModelParamSet& p = pending_->params;
   const FeedforwardMode to = mode_of(p.kind);
@@ -762,7 +768,7 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   }
   if (reversals_.update(y_ref) == ReversalDetector::Event::kReversal) {
     ++counters_.reversals;
-    if (pending_) swap_params(k);
+    if (pending_ && !params_held_by_learning()) swap_params(k);
     u_prev_rev_ = last_u_ - anchor_offset_.u_offset(k);
   }
   if (inverse_fresh_) {

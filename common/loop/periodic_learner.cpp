@@ -50,6 +50,7 @@ void LearningConfig::validate(double dt_s) const {
   require_in_range("learning.cutoff_hz", cutoff_hz, 1.0 / max_period_s, 0.25 / dt_s);
   require_in_range("learning.fade_s", fade_s, dt_s, 10.0);
   require_in_range("learning.blend_s", blend_s, 0.0, 1.0);
+  if (hold_params_after < 0) throw ParameterError("learning.hold_params_after", "must be >= 0 (0: never hold)");
 }
 
 PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std::int64_t max_lag_ticks)
@@ -148,6 +149,7 @@ void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
   scale_ = 1.0;
   table_rms_m_ = 0.0;
   figures_.correction_rms_m = 0.0;
+  figures_.tables_this_line = 0;
   if (!enabled_ || !has_target_) {
     mode_ = Mode::kIdle;
   } else {
@@ -187,6 +189,7 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
         blend_n_ = std::min(blend_ticks_, table_n_);
         pending_ = false;
         ++figures_.tables_adopted;
+        ++figures_.tables_this_line;
         table_rms_m_ = pending_rms_m_;
         figures_.correction_rms_m = table_rms_m_;
       }

@@ -125,6 +125,10 @@ struct LearningConfig {
   double max_period_s = 1.0;         // longest period learned; a longer one is not learned
   double fade_s = 0.05;              // stop/off/restart/reset: the correction fades out over this time
   double blend_s = 0.005;            // a new table takes over from the one in use over this time (0: at once)
+  // A line that has taken this many tables keeps the parameter set it learned under: a set that
+  // arrives later waits (Compensator::params_held_by_learning) until learning stops, is reset or
+  // the line ends. 0: sets are swapped in as they come.
+  std::int64_t hold_params_after = 10;
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;
@@ -138,6 +142,7 @@ struct LearnerFigures {
   std::uint64_t periods_learned = 0;    // a new table was computed from them
   std::uint64_t periods_skipped = 0;    // a sample was missing (or NaN, or too late): not learned from
   std::uint64_t tables_adopted = 0;     // new tables taken into use (at a period boundary)
+  std::uint64_t tables_this_line = 0;   // of those, since learning last (re)started
   std::uint64_t ticks_held = 0;         // planned ticks a limit held back (hold()): not learned from
   double last_error_rms_m = 0.0;        // e over the last period learned from
   double last_error_max_m = 0.0;        // max |e| over it

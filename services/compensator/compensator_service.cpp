@@ -471,6 +471,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   status_.counter("params_version", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.params_version())));
   status_.counter("learning_active", learner.active ? 1u : 0u);
   status_.counter("learning_periods", learner.periods_learned);
+  status_.counter("params_held_by_learning", c.params_held_by_learning() ? 1u : 0u);
   status_.counter("learning_rms_pm", static_cast<std::uint64_t>(std::llround(learner.last_error_rms_m * 1e12)));
   if (c.next_tick() >= 0) {
     status_.counter("plan_ahead_ticks",

@@ -228,6 +228,64 @@ TEST(CompensatorLimits, LearningFollowsTheTrajectory) {
   EXPECT_FALSE(c.learner().figures().active);
 }
 
+// A converged learned line keeps the set it learned under: one offered after
+// learning.hold_params_after tables waits through the line's reversals, and is swapped in at the
+// first reversal once learning stops.
+TEST(CompensatorLimits, AConvergedLearnedLineKeepsItsSetUntilLearningStops) {
+  Compensator c(linear_config(false));
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  plan_for(c, 0.5);  // 25 periods
+  ASSERT_GE(c.learner().figures().tables_this_line, 10U);
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.linear.gain = 1.01 * kGain;
+  c.offer_model(set, 2);
+  plan_for(c, 0.1);  // 10 reversals
+  EXPECT_TRUE(c.params_pending());
+  EXPECT_TRUE(c.params_held_by_learning());
+  EXPECT_NE(c.params_version(), 2);
+  c.set_learning(false);
+  plan_for(c, 0.1);
+  EXPECT_FALSE(c.params_pending());
+  EXPECT_FALSE(c.params_held_by_learning());
+  EXPECT_EQ(c.params_version(), 2);
+  EXPECT_DOUBLE_EQ(c.model_params().linear.gain, 1.01 * kGain);
+}
+
+// Before the line has taken hold_params_after tables, or with the hold off (0), a set is swapped
+// in at the next reversal as always; a new line starts counting again.
+TEST(CompensatorLimits, BeforeConvergenceOrWithTheHoldOffASetIsSwappedAtTheNextReversal) {
+  ModelParamSet set;
+  set.kind = ModelKind::linear;
+  set.linear.gain = 1.01 * kGain;
+  {
+    Compensator c(linear_config(false));
+    c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+    plan_for(c, 0.1);  // 5 periods: fewer than 10 tables
+    ASSERT_LT(c.learner().figures().tables_this_line, 10U);
+    c.offer_model(set, 2);
+    plan_for(c, 0.02);
+    EXPECT_EQ(c.params_version(), 2);
+    plan_for(c, 0.5);
+    c.take_trajectory(sine(0.4e-6, 50.0), kNaN);  // a new line: the set offered now is swapped in
+    plan_for(c, 0.1);
+    EXPECT_EQ(c.learner().figures().period_ticks, 200);
+    c.offer_model(set, 3);
+    plan_for(c, 0.02);
+    EXPECT_EQ(c.params_version(), 3);
+  }
+  CompensatorConfig never = linear_config(false);
+  never.learning.hold_params_after = 0;
+  Compensator c(never);
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  plan_for(c, 0.5);
+  ASSERT_GE(c.learner().figures().tables_this_line, 10U);
+  c.offer_model(set, 2);
+  plan_for(c, 0.02);
+  EXPECT_FALSE(c.params_held_by_learning());
+  EXPECT_EQ(c.params_version(), 2);
+}
+
 TEST(CompensatorLimits, ParameterSetsCarryAStageThatIsValidatedAndSwappedAtAReversal) {
   Compensator c(linear_config(false));
   ModelParamSet set;

@@ -203,6 +203,14 @@ int send_params(const Options& o) {
     return 1;
   }
   const auto in_use = find_counter(c->second, "params_version");
+  if (find_counter(c->second, "params_held_by_learning").value_or(0) != 0) {
+    std::fprintf(stderr,
+                 "hystloop-ctl: '%s' holds parameters v%d (in use: %s): the running line's learning has converged "
+                 "under the set in use (learning.hold_params_after), so a new set waits until learning stops, is "
+                 "reset or the line ends ('hystloop-ctl learn off' or 'learn reset' lets it in at the next reversal)\n",
+                 compensator.c_str(), msg.version, in_use ? ("v" + std::to_string(*in_use)).c_str() : "not reported");
+    return 1;
+  }
   std::fprintf(stderr,
                "hystloop-ctl: '%s' did not adopt parameters v%d within %g s (in use: %s). A set is swapped in at "
                "the next reversal of the stage's input, so a stage at rest takes it only once it moves (--no-wait "
