@@ -109,7 +109,10 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "~150 (mem) to ~300 (auto) bytes per sample")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  bounds->add_option("--decimate", args.decimate, "keep every K-th sample (rate-independent models lose little)")
+  bounds
+      ->add_option("--decimate", args.decimate,
+                   "keep every K-th sample and, but for banning, the input's turning points between them "
+                   "(rate-independent models lose little)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   bounds->add_flag("--progress", args.progress,

@@ -574,10 +574,13 @@ int fit_inputs(const IdentifyArgs& args) {
   }
   if (args.from_logs && args.choice.mode == ModelChoice::Mode::banning) return fit_banning_logs(args);
   std::vector<SampleTable> tables = read_inputs(args, args.from_logs);
+  // The budget counts every K-th sample (what --decimate promises), not the turning points kept
+  // beside them: a few per reversal.
   std::size_t samples = 0;
+  const bool rate_independent = args.choice.mode != ModelChoice::Mode::banning;
   for (auto& t : tables) {
-    decimate(t, args.decimate);
-    samples += t.u.size();
+    samples += (t.u.size() + args.decimate - 1) / args.decimate;
+    decimate(t, args.decimate, rate_independent);
   }
   if (auto why = over_sample_budget(samples, args.max_samples, args.decimate)) return usage_error(*why);
   if (args.choice.mode == ModelChoice::Mode::banning) return fit_banning_files(args, tables);

@@ -2,26 +2,39 @@
 
 #include <cctype>
 #include <fstream>
+#include <vector>
+
+#include "ident/online_model_selector.hpp"
 
 namespace hystloop {
 namespace {
 
 template <typename T>
-void keep_every(std::vector<T>& v, std::size_t stride) {
+void keep(std::vector<T>& v, const std::vector<std::size_t>& kept) {
+  if (v.empty()) return;
   std::size_t n = 0;
-  for (std::size_t k = 0; k < v.size(); k += stride) v[n++] = std::move(v[k]);
+  for (const std::size_t k : kept) {     // kept increases: k >= n
+    if (k != n) v[n] = std::move(v[k]);  // never onto itself: a self-moved string is left empty
+    ++n;
+  }
   v.resize(n);
   v.shrink_to_fit();
 }
 
 }  // namespace
 
-void decimate(SampleTable& table, std::size_t stride) {
-  if (stride <= 1) return;
-  keep_every(table.t, stride);
-  keep_every(table.u, stride);
-  keep_every(table.y, stride);
-  keep_every(table.experiment, stride);
+void decimate(SampleTable& table, std::size_t stride, bool keep_turns) {
+  if (stride <= 1 || table.u.empty()) return;
+  std::vector<std::size_t> kept;
+  if (keep_turns) {
+    kept = decimate_keeping_extremes(table.u, stride);
+  } else {
+    for (std::size_t k = 0; k < table.u.size(); k += stride) kept.push_back(k);
+  }
+  keep(table.t, kept);
+  keep(table.u, kept);
+  keep(table.y, kept);
+  keep(table.experiment, kept);
 }
 
 std::size_t count_csv_rows(const std::string& path) {

@@ -19,8 +19,12 @@ namespace hystloop {
 
 inline constexpr std::size_t kDefaultMaxSamples = 2'000'000;
 
-// Keeps samples 0, stride, 2 stride, ... of every column (stride >= 1; 1 keeps all).
-void decimate(SampleTable& table, std::size_t stride);
+// Keeps samples 0, stride, 2 stride, ... of every column (stride >= 1; 1 keeps all), and with
+// keep_turns the input's turning points between them (decimate_keeping_extremes): a fast line's
+// peaks fall between kept samples, and a hysteresis model fed a missed peak starts its next
+// branch in the wrong place. Only for the rate-independent models: Banning's fit reads sines
+// at a uniform rate.
+void decimate(SampleTable& table, std::size_t stride, bool keep_turns);
 
 // Data rows of a CSV (lines that are not blank, not '#' comments, not the header), counted
 // without storing them; 0 if the file cannot be read (the reader then says why).

@@ -4,13 +4,17 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include "ident/banning_experiments.hpp"
 #include "ident/mem_test_data.hpp"
+#include "sample_budget.hpp"
 #include "support/tool_run.hpp"
 
 namespace hystloop {
@@ -175,6 +179,39 @@ TEST_F(IdentifyTool, MoreSamplesThanTheBoundAreRefusedWithAHint) {
       run_tool(path("mem.csv") + " --model mem --max-samples 5000 --decimate 4 --out " + path("params.yaml"));
   ASSERT_EQ(d.exit_code, 0) << d.output;
   EXPECT_NEAR(YAML::LoadFile(path("params.yaml"))["mem"]["c1"].as<double>(), truth.c1, 0.02 * truth.c1);
+}
+
+// --decimate K keeps every K-th sample and, for the rate-independent models, the input's turns
+// between them: a 100 Hz line at 10 kHz with K = 10 has its peaks between kept samples. Every
+// column keeps the same rows. Banning's fit reads sines at a uniform rate: plain stride there.
+TEST(IdentifyDecimate, KeepsEveryKthSampleAndTheTurnsBetweenThem) {
+  SampleTable full;
+  for (int k = 0; k < 400; ++k) {
+    full.t.push_back(k * 1e-4);
+    full.u.push_back(100.0 * std::sin(2.0 * std::numbers::pi * 100.0 * k * 1e-4));  // peaks at k = 25, 75, ...
+    full.y.push_back(full.u.back() * 1e-8);
+    full.experiment.push_back(std::to_string(k));
+  }
+  const double peak = *std::max_element(full.u.begin(), full.u.end());
+  SampleTable turns = full, plain = full;
+  decimate(turns, 10, true);
+  decimate(plain, 10, false);
+  ASSERT_EQ(plain.u.size(), 40U);
+  EXPECT_LT(*std::max_element(plain.u.begin(), plain.u.end()), peak - 1.0);  // the plain stride misses it
+  EXPECT_DOUBLE_EQ(*std::max_element(turns.u.begin(), turns.u.end()), peak);
+  EXPECT_GT(turns.u.size(), 40U);
+  EXPECT_LT(turns.u.size(), 60U);  // two turns a period, four periods, and the last sample
+  for (const SampleTable* d : {&turns, &plain}) {
+    ASSERT_EQ(d->t.size(), d->u.size());
+    ASSERT_EQ(d->y.size(), d->u.size());
+    ASSERT_EQ(d->experiment.size(), d->u.size());
+    for (std::size_t i = 0; i < d->u.size(); ++i) {
+      const auto k = static_cast<std::size_t>(std::stoul(d->experiment[i]));
+      EXPECT_EQ(d->u[i], full.u[k]);
+      EXPECT_EQ(d->t[i], full.t[k]);
+      EXPECT_EQ(d->y[i], full.y[k]);
+    }
+  }
 }
 
 TEST_F(IdentifyTool, ProgressOfALongFitOnStderr) {
