@@ -215,7 +215,7 @@ bool small_loop(const BanningPoint& p, const BanningFitOptions& o) {
   return p.amplitude_V <= o.small_amplitude_max_V * 1.01;
 }
 
-// Phase of b behind a, in (-pi, pi].
+// Phase of b behind a, in [-pi, pi].
 double phase_behind(double a, double b) { return std::remainder(a - b, 2.0 * std::numbers::pi); }
 
 // 1. Offset, amplitude and frequency of every experiment's input; loop features of the slow
@@ -506,7 +506,9 @@ BanningFitResult fit_banning(std::span<const BanningExperimentData> experiments,
     res.lag_note = "areas not corrected for the lag (correct_lag = false)";
   } else {
     correct_for_lag(loops, mags, fs, o, res);
-    if (res.lag_identified) {  // once more on the corrected areas, from where the first pass ended
+    // Once more on the corrected areas, from where the first pass ended. The lag itself stays as
+    // the first pass's stage and loop gave it: their refit moves it by second-order amounts.
+    if (res.lag_identified) {
       if (FitCheck c = refine_b_alpha(loops, o, timer.clock(), x, res); !c.ok()) return timer.finish(res, c);
       if (FitCheck c = fit_stage(mags, fs, o, timer.clock(), res); !c.ok()) return timer.finish(res, c);
     }

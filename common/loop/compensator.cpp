@@ -504,9 +504,16 @@ double Compensator::restart_at_reversal(FeedforwardMode mode, double u_rev) noex
 }
 
 bool Compensator::params_held_by_learning() const noexcept {
+  if (!pending_) return false;
   const LearnerFigures& f = learner_.figures();
   const std::int64_t after = config_.learning.hold_params_after;
-  return pending_.has_value() && after > 0 && f.active && f.tables_this_line >= static_cast<std::uint64_t>(after);
+  if (after <= 0 || !f.active || f.tables_this_line < static_cast<std::uint64_t>(after)) return false;
+  // A table near its bound is no converged line: a model far off, which the new set may repair.
+  if (!(f.correction_rms_m < 0.5 * config_.learning.max_correction_m)) return false;
+  // A set for a model the line does not use changes nothing it learned: it goes in as always.
+  const FeedforwardMode to = mode_of(pending_->params.kind);
+  const bool switching = pending_->switch_model && mode_ != FeedforwardMode::kOff && to != mode_;
+  return switching || to == mode_;
 }
 
 void Compensator::swap_params(std::int64_t k) noexcept {

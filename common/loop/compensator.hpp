@@ -229,9 +229,10 @@ class Compensator {
   // The model in use with its parameters (kind follows the mode; MEM when the mode is off).
   ModelParamSet model_params() const noexcept;
   bool params_pending() const noexcept { return pending_.has_value(); }
-  // A converged learned line keeps the set it learned under (learning.hold_params_after): its
-  // tables have learned that set's error, and a new one would only be a step of the error they
-  // must learn again. A pending set waits until learning stops, is reset or the line ends.
+  // A learned line keeps the set it learned under once it has taken learning.hold_params_after
+  // tables and its table is well inside learning.max_correction_m: the tables have learned that
+  // set's error, and a new one would only be a step of the error they must learn again. A pending
+  // set for the model in use waits until learning stops, is reset or the line ends.
   bool params_held_by_learning() const noexcept;
   double anchor_offset_m() const noexcept { return shift_m_; }  // the re-anchoring's output offset
   std::int32_t params_version() const noexcept { return params_version_; }

@@ -125,9 +125,10 @@ struct LearningConfig {
   double max_period_s = 1.0;         // longest period learned; a longer one is not learned
   double fade_s = 0.05;              // stop/off/restart/reset: the correction fades out over this time
   double blend_s = 0.005;            // a new table takes over from the one in use over this time (0: at once)
-  // A line that has taken this many tables keeps the parameter set it learned under: a set that
-  // arrives later waits (Compensator::params_held_by_learning) until learning stops, is reset or
-  // the line ends. 0: sets are swapped in as they come.
+  // A line that has taken this many tables (its table under half of max_correction_m) keeps the
+  // parameter set it learned under: a set for its model that arrives later waits
+  // (Compensator::params_held_by_learning) until learning stops, is reset or the line ends.
+  // 0: sets are swapped in as they come.
   std::int64_t hold_params_after = 10;
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.

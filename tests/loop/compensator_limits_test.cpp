@@ -49,10 +49,13 @@ TrajectorySpec triangle(double amplitude_m, double frequency_hz, double corner_s
 
 // Plans `seconds` of loop time as a stage that follows perfectly would answer it (each sample
 // the tick's own voltage and reference: feedforward only, tracking exact), and returns the
-// largest tick-to-tick step of u_ff [V].
-double plan_for(Compensator& c, double seconds, std::vector<CommandTick>* ticks = nullptr) {
+// largest tick-to-tick step of u_ff [V]. `carry` keeps the planned ticks from one call to the
+// next (else a call's first samples, planned by the one before, answer 0).
+double plan_for(Compensator& c, double seconds, std::vector<CommandTick>* ticks = nullptr,
+                std::map<std::int64_t, CommandTick>* carry = nullptr) {
   std::vector<CommandTick> out(64);
-  std::map<std::int64_t, CommandTick> planned;
+  std::map<std::int64_t, CommandTick> own;
+  std::map<std::int64_t, CommandTick>& planned = carry ? *carry : own;
   double last = 0.0, worst = 0.0;
   bool first = true;
   const auto n = static_cast<std::int64_t>(std::llround(seconds / c.config().dt_s));
@@ -233,23 +236,44 @@ TEST(CompensatorLimits, LearningFollowsTheTrajectory) {
 // first reversal once learning stops.
 TEST(CompensatorLimits, AConvergedLearnedLineKeepsItsSetUntilLearningStops) {
   Compensator c(linear_config(false));
+  std::map<std::int64_t, CommandTick> planned;
   c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
-  plan_for(c, 0.5);  // 25 periods
+  plan_for(c, 0.5, nullptr, &planned);  // 25 periods
   ASSERT_GE(c.learner().figures().tables_this_line, 10U);
   ModelParamSet set;
   set.kind = ModelKind::linear;
   set.linear.gain = 1.01 * kGain;
   c.offer_model(set, 2);
-  plan_for(c, 0.1);  // 10 reversals
+  plan_for(c, 0.1, nullptr, &planned);  // 10 reversals
   EXPECT_TRUE(c.params_pending());
   EXPECT_TRUE(c.params_held_by_learning());
   EXPECT_NE(c.params_version(), 2);
   c.set_learning(false);
-  plan_for(c, 0.1);
+  plan_for(c, 0.1, nullptr, &planned);
   EXPECT_FALSE(c.params_pending());
   EXPECT_FALSE(c.params_held_by_learning());
   EXPECT_EQ(c.params_version(), 2);
   EXPECT_DOUBLE_EQ(c.model_params().linear.gain, 1.01 * kGain);
+  // Learning again: converged once more, a set waits again, and `learn reset` lets it in.
+  c.set_learning(true);
+  plan_for(c, 0.5, nullptr, &planned);
+  ASSERT_GE(c.learner().figures().tables_this_line, 10U);
+  set.linear.gain = 1.02 * kGain;
+  c.offer_model(set, 3);
+  plan_for(c, 0.05, nullptr, &planned);
+  EXPECT_TRUE(c.params_held_by_learning());
+  c.reset_learning();
+  plan_for(c, 0.05, nullptr, &planned);
+  EXPECT_EQ(c.params_version(), 3);
+  // A set for a model the line does not use is not held: MEM parameters under the linear model.
+  plan_for(c, 0.5, nullptr, &planned);
+  ASSERT_GE(c.learner().figures().tables_this_line, 10U);
+  MemParams mem = MemParams::paper_like();
+  c.offer_mem_params(mem, 4);
+  EXPECT_FALSE(c.params_held_by_learning());
+  plan_for(c, 0.05, nullptr, &planned);
+  EXPECT_EQ(c.params_version(), 4);
+  EXPECT_EQ(c.mode(), FeedforwardMode::kLinear);
 }
 
 // Before the line has taken hold_params_after tables, or with the hold off (0), a set is swapped
@@ -260,28 +284,30 @@ TEST(CompensatorLimits, BeforeConvergenceOrWithTheHoldOffASetIsSwappedAtTheNextR
   set.linear.gain = 1.01 * kGain;
   {
     Compensator c(linear_config(false));
+    std::map<std::int64_t, CommandTick> planned;
     c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
-    plan_for(c, 0.1);  // 5 periods: fewer than 10 tables
+    plan_for(c, 0.1, nullptr, &planned);  // 5 periods: fewer than 10 tables
     ASSERT_LT(c.learner().figures().tables_this_line, 10U);
     c.offer_model(set, 2);
-    plan_for(c, 0.02);
+    plan_for(c, 0.02, nullptr, &planned);
     EXPECT_EQ(c.params_version(), 2);
-    plan_for(c, 0.5);
+    plan_for(c, 0.5, nullptr, &planned);
     c.take_trajectory(sine(0.4e-6, 50.0), kNaN);  // a new line: the set offered now is swapped in
-    plan_for(c, 0.1);
+    plan_for(c, 0.1, nullptr, &planned);
     EXPECT_EQ(c.learner().figures().period_ticks, 200);
     c.offer_model(set, 3);
-    plan_for(c, 0.02);
+    plan_for(c, 0.02, nullptr, &planned);
     EXPECT_EQ(c.params_version(), 3);
   }
   CompensatorConfig never = linear_config(false);
   never.learning.hold_params_after = 0;
   Compensator c(never);
+  std::map<std::int64_t, CommandTick> planned;
   c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
-  plan_for(c, 0.5);
+  plan_for(c, 0.5, nullptr, &planned);
   ASSERT_GE(c.learner().figures().tables_this_line, 10U);
   c.offer_model(set, 2);
-  plan_for(c, 0.02);
+  plan_for(c, 0.02, nullptr, &planned);
   EXPECT_FALSE(c.params_held_by_learning());
   EXPECT_EQ(c.params_version(), 2);
 }

@@ -205,9 +205,10 @@ int send_params(const Options& o) {
   const auto in_use = find_counter(c->second, "params_version");
   if (find_counter(c->second, "params_held_by_learning").value_or(0) != 0) {
     std::fprintf(stderr,
-                 "hystloop-ctl: '%s' holds parameters v%d (in use: %s): the running line's learning has converged "
-                 "under the set in use (learning.hold_params_after), so a new set waits until learning stops, is "
-                 "reset or the line ends ('hystloop-ctl learn off' or 'learn reset' lets it in at the next reversal)\n",
+                 "hystloop-ctl: '%s' did not adopt parameters v%d (in use: %s): a set is waiting because the "
+                 "running line has learned under the set in use (learning.hold_params_after); it waits until "
+                 "learning stops, is reset or the line ends ('hystloop-ctl learn off' or 'learn reset' lets the "
+                 "newest accepted set in at the next reversal)\n",
                  compensator.c_str(), msg.version, in_use ? ("v" + std::to_string(*in_use)).c_str() : "not reported");
     return 1;
   }

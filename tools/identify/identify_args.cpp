@@ -112,7 +112,8 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   bounds
       ->add_option("--decimate", args.decimate,
                    "keep every K-th sample and, but for banning, the input's turning points between them "
-                   "(rate-independent models lose little)")
+                   "(rate-independent models lose little; --max-samples counts the K-th samples, the turns come "
+                   "on top: a few per reversal of a slow record)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   bounds->add_flag("--progress", args.progress,

@@ -364,13 +364,18 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
     if (!p.used) {
       std::printf("%10zu  skipped: %s\n", i, p.note.c_str());
     } else if (p.magnitude_experiment) {
-      std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V, p.frequency_Hz,
-                  p.magnitude);
+      if (r.stage_identified) {
+        std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V,
+                    p.frequency_Hz, p.magnitude);
+      } else {  // h needs the stage fit: the first harmonic of y as measured
+        std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  y1 = %.5g nm\n", i, p.offset_V, p.amplitude_V,
+                    p.frequency_Hz, p.response_m * 1e9);
+      }
     } else {
       std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V", i,
                   p.offset_V, p.amplitude_V, p.frequency_Hz, p.features.y_centre * 1e9, p.features.slope * 1e9,
                   p.features.area * 1e9);
-      if (p.lag_area != 0.0) std::printf(" %+.3g for the lag", p.lag_area * 1e9);
+      if (p.area_fitted && p.lag_area != 0.0) std::printf(" %+.3g for the lag", p.lag_area * 1e9);
       std::printf("\n");
     }
   }
@@ -387,7 +392,7 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
               r.centre_rms_m * 1e9, r.slope_rel_rms * 100.0, r.area_rel_rms * 100.0, r.magnitude_rel_rms * 100.0,
               r.solve_time_s * 1e3);
   if (r.lag_identified) {
-    double lo = 1e300, hi = 0.0;
+    double lo = 1e300, hi = -1e300;
     for (const auto& p : r.points) {
       if (!p.area_fitted || !(p.features.area > 0.0)) continue;
       lo = std::min(lo, p.lag_area / p.features.area), hi = std::max(hi, p.lag_area / p.features.area);
