@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -45,6 +46,19 @@ inline std::optional<int> parse_cli(CLI::App& app, int argc, const char* const* 
     return kExitUsage;
   }
   return std::nullopt;
+}
+
+// The last guard of every main, called from its final catch (...): what no other handler took
+// (CLI11's own set-up, a bug) is printed as "<program>: <what>" and the program exits 1.
+inline int exit_on_escaped_exception(const char* program) noexcept {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", program, e.what());
+  } catch (...) {
+    std::fprintf(stderr, "%s: unknown error\n", program);
+  }
+  return kExitFailure;
 }
 
 }  // namespace hystloop

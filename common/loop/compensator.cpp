@@ -511,15 +511,18 @@ bool Compensator::params_held_by_learning() const noexcept {
   // A table near its bound is no converged line: a model far off, which the new set may repair.
   if (!(f.correction_rms_m < 0.5 * config_.learning.max_correction_m)) return false;
   // A set for a model the line does not use changes nothing it learned: it goes in as always.
+  return pending_switches_model() || mode_of(pending_->params.kind) == mode_;
+}
+
+bool Compensator::pending_switches_model() const noexcept {
   const FeedforwardMode to = mode_of(pending_->params.kind);
-  const bool switching = pending_->switch_model && mode_ != FeedforwardMode::kOff && to != mode_;
-  return switching || to == mode_;
+  return pending_->switch_model && mode_ != FeedforwardMode::kOff && to != mode_;
 }
 
 void Compensator::swap_params(std::int64_t k) noexcept {
   const ModelParamSet& p = pending_->params;
   const FeedforwardMode to = mode_of(p.kind);
-  const bool switching = pending_->switch_model && mode_ != FeedforwardMode::kOff && to != mode_;
+  const bool switching = pending_switches_model();
   const bool in_use = switching || to == mode_;
   const double u_shift = anchor_offset_.u_offset(k);
   const double u_rev = last_u_ - u_shift;  // this reversal, in the model's coordinates

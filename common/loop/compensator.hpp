@@ -267,7 +267,8 @@ class Compensator {
   double feedforward(double y_ref) noexcept;
   void reset_inverse(double y0) noexcept;
   void restart_reference(double t_s, double from_m) noexcept;
-  void swap_params(std::int64_t k) noexcept;  // at a reversal: the pending set in, re-anchored
+  void swap_params(std::int64_t k) noexcept;     // at a reversal: the pending set in, re-anchored
+  bool pending_switches_model() const noexcept;  // the pending set (there is one) changes the mode
   // Restarts `mode`'s inverse at this reversal (u_rev, model coordinates) without a step; returns
   // the model's output there.
   double restart_at_reversal(FeedforwardMode mode, double u_rev) noexcept;

@@ -76,10 +76,6 @@ int main(int argc, char** argv) try {
     flush_logging();
     return 1;
   }
-} catch (const std::exception& e) {  // CLI11's set-up, before the handlers below exist: nothing escapes main
-  std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
-  return 1;
-} catch (...) {
-  std::fprintf(stderr, "hystloop-compensator: unknown error\n");
-  return 1;
+} catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-compensator");
 }

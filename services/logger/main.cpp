@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "core/cli.hpp"
 #include "core/config.hpp"
 #include "core/errors.hpp"
 #include "core/logging.hpp"
@@ -83,10 +84,6 @@ int main(int argc, char** argv) try {
     flush_logging();
     return 1;
   }
-} catch (const std::exception& e) {  // CLI11's set-up, before the handlers below exist: nothing escapes main
-  std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
-  return 1;
-} catch (...) {
-  std::fprintf(stderr, "hystloop-logger: unknown error\n");
-  return 1;
+} catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-logger");
 }

@@ -525,10 +525,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
-  } catch (...) {
-    std::fprintf(stderr, "hystloop-ctl: unknown error\n");
+  } catch (...) {  // what the program's own handlers did not take
+    return hystloop::exit_on_escaped_exception("hystloop-ctl");
   }
-  return 1;
 }

@@ -72,10 +72,7 @@ int export_main(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return export_main(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-export: %s\n", e.what());
-  } catch (...) {
-    std::fprintf(stderr, "hystloop-export: unknown error\n");
+  } catch (...) {  // what the program's own handlers did not take
+    return hystloop::exit_on_escaped_exception("hystloop-export");
   }
-  return kExitFailure;
 }

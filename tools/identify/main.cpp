@@ -58,10 +58,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const std::exception& e) {  // run_identify reports what it expects; this is the rest
-    std::cerr << "hystloop-identify: " << e.what() << "\n";
-  } catch (...) {
-    std::cerr << "hystloop-identify: unknown error\n";
+  } catch (...) {  // what the program's own handlers did not take
+    return hystloop::exit_on_escaped_exception("hystloop-identify");
   }
-  return 1;
 }

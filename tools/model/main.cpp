@@ -181,10 +181,6 @@ int main(int argc, char** argv) try {
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   if (!args.forward && !args.inverse) return refuse("choose --forward (t,u -> y) or --inverse (t,y_ref -> u)");
   return run(args);
-} catch (const std::exception& e) {  // CLI11's set-up and what run() lets through: nothing escapes main
-  std::cerr << kTool << ": " << e.what() << "\n";
-  return 1;
-} catch (...) {
-  std::cerr << kTool << ": unknown error\n";
-  return 1;
+} catch (...) {  // CLI11's set-up and what run() lets through: nothing escapes main
+  return hystloop::exit_on_escaped_exception(kTool);
 }

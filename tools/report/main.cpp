@@ -233,10 +233,7 @@ int report_main(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return report_main(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
-  } catch (...) {
-    std::fprintf(stderr, "hystloop-report: unknown error\n");
+  } catch (...) {  // what the program's own handlers did not take
+    return hystloop::exit_on_escaped_exception("hystloop-report");
   }
-  return 1;
 }
