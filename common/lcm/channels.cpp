@@ -32,6 +32,7 @@ ChannelNames::ChannelNames(std::string_view rig_prefix)
       params(prefix + std::string(kParamsSuffix)),
       status(prefix + std::string(kStatusSuffix)),
       control(prefix + std::string(kControlSuffix)),
-      model(prefix + std::string(kModelSuffix)) {}
+      model(prefix + std::string(kModelSuffix)),
+      sim_truth(prefix + std::string(kSimTruthSuffix)) {}
 
 }  // namespace hystloop

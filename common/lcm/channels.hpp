@@ -25,6 +25,8 @@ inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_para
 inline constexpr std::string_view kModelSuffix = "MODEL";
 inline constexpr std::string_view kStatusSuffix = "STATUS";    // service_status_t, 1 Hz per process
 inline constexpr std::string_view kControlSuffix = "CONTROL";  // control_t, on demand
+// sim_truth_t, after each sensor block, from a simulated stage only: its true position.
+inline constexpr std::string_view kSimTruthSuffix = "SIM_TRUTH";
 
 // Suffix and LCM type name ("hystloop.sensor_block_t") of every channel, e.g. for a
 // logger that records them all or a tool that lists them.
@@ -32,7 +34,7 @@ struct ChannelSpec {
   std::string_view suffix;
   std::string_view type_name;
 };
-inline constexpr std::array<ChannelSpec, 7> kChannelSpecs{{
+inline constexpr std::array<ChannelSpec, 8> kChannelSpecs{{
     {kSensorSuffix, "hystloop.sensor_block_t"},
     {kCommandSuffix, "hystloop.command_block_t"},
     {kTrajectorySuffix, "hystloop.trajectory_t"},
@@ -40,6 +42,7 @@ inline constexpr std::array<ChannelSpec, 7> kChannelSpecs{{
     {kStatusSuffix, "hystloop.service_status_t"},
     {kControlSuffix, "hystloop.control_t"},
     {kModelSuffix, "hystloop.model_params_t"},
+    {kSimTruthSuffix, "hystloop.sim_truth_t"},
 }};
 
 // The full names for one prefix, built once (publishing then never builds a string).
@@ -52,6 +55,7 @@ struct ChannelNames {
   std::string status;
   std::string control;
   std::string model;
+  std::string sim_truth;
 
   // Validates the prefix (throws ParameterError naming "rig.prefix").
   explicit ChannelNames(std::string_view rig_prefix = kDefaultRigPrefix);

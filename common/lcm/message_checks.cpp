@@ -68,6 +68,18 @@ Verdict check_message(const sensor_block_t& msg) noexcept {
   return f.verdict();
 }
 
+Verdict check_message(const sim_truth_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0);
+  f.tick(msg.seq);
+  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= sim_truth_t::MAX_TICKS && arrays_consistent(msg);
+  f.require(count_ok);
+  if (count_ok) {
+    for (const double y : msg.y_true_m) f.within(y, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  }
+  return f.verdict();
+}
+
 Verdict check_message(const command_block_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.sample_seq >= -1 && msg.sample_seq <= kMaxTick);

@@ -15,6 +15,7 @@
 #include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/reject_reason.hpp"
 
@@ -33,6 +34,9 @@ inline constexpr std::int64_t kMaxTick = std::int64_t{1} << 53;  // 28,000 years
 // u_fb and y within the sanity bounds, y_ref finite or NaN (none), known flags; seq, utime and
 // buffer depth >= 0, 0 < dt_s <= 1 s.
 Verdict check_message(const sensor_block_t& msg) noexcept;
+// sim_truth_t: 1..MAX_TICKS ticks with the array of that size, each within the position bound;
+// seq and utime >= 0.
+Verdict check_message(const sim_truth_t& msg) noexcept;
 // command_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u_ff,
 // y_ref finite or NaN (no reference), params_version >= 0, a known mode; seq >= 0,
 // sample_seq >= -1, utime >= 0.

@@ -21,6 +21,8 @@ void reserve_storage(command_block_t& m) {
   reserve_all(command_block_t::MAX_TICKS, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
 }
 
+void reserve_storage(sim_truth_t& m) { m.y_true_m.reserve(sim_truth_t::MAX_TICKS); }
+
 void clear_arrays(sensor_block_t& m) noexcept {
   m.u_V.clear();
   m.u_ff_V.clear();
@@ -37,6 +39,8 @@ void clear_arrays(command_block_t& m) noexcept {
   m.mode.clear();
 }
 
+void clear_arrays(sim_truth_t& m) noexcept { m.y_true_m.clear(); }
+
 bool arrays_consistent(const sensor_block_t& m) noexcept {
   return all_sized(m.n_ticks, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
 }
@@ -44,6 +48,8 @@ bool arrays_consistent(const sensor_block_t& m) noexcept {
 bool arrays_consistent(const command_block_t& m) noexcept {
   return all_sized(m.n_ticks, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
 }
+
+bool arrays_consistent(const sim_truth_t& m) noexcept { return all_sized(m.n_ticks, m.y_true_m); }
 
 void reserve_storage(trajectory_t& msg) {
   msg.points_t_s.reserve(trajectory_t::MAX_POINTS);

@@ -14,6 +14,7 @@
 #include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 
 namespace hystloop {
@@ -22,6 +23,7 @@ inline constexpr std::size_t kReservedStringChars = 64;
 
 void reserve_storage(sensor_block_t& msg);
 void reserve_storage(command_block_t& msg);
+void reserve_storage(sim_truth_t& msg);
 void reserve_storage(trajectory_t& msg);
 void reserve_storage(mem_params_t& msg);
 void reserve_storage(model_params_t& msg);
@@ -33,6 +35,7 @@ void reserve_storage(control_t& msg);
 // would keep the previous message's elements.
 void clear_arrays(sensor_block_t& msg) noexcept;
 void clear_arrays(command_block_t& msg) noexcept;
+void clear_arrays(sim_truth_t& msg) noexcept;
 inline void clear_arrays(mem_params_t&) noexcept {}
 void clear_arrays(model_params_t& msg) noexcept;
 inline void clear_arrays(control_t&) noexcept {}
@@ -44,6 +47,7 @@ void clear_arrays(service_status_t& msg) noexcept;
 // message even when its value check is switched off.
 bool arrays_consistent(const sensor_block_t& msg) noexcept;
 bool arrays_consistent(const command_block_t& msg) noexcept;
+bool arrays_consistent(const sim_truth_t& msg) noexcept;
 inline bool arrays_consistent(const mem_params_t&) noexcept { return true; }
 bool arrays_consistent(const model_params_t& msg) noexcept;
 inline bool arrays_consistent(const control_t&) noexcept { return true; }

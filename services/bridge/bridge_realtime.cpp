@@ -167,7 +167,8 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
 
   const OutgoingTick out{SensorTick{wall_utime(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
                                     decided.y_ref_m, reading.y_m, decided.flags | reading.flags},
-                         static_cast<std::int32_t>(std::min<std::int64_t>(decided.buffer_depth, INT32_MAX))};
+                         static_cast<std::int32_t>(std::min<std::int64_t>(decided.buffer_depth, INT32_MAX)),
+                         reading.y_true_m};
   if (samples_.try_push(out)) {
     if ((k + 1) % settings_.block_ticks == 0) {  // a block is complete: wake the I/O thread
       const std::uint64_t one = 1;

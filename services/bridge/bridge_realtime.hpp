@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -28,6 +29,7 @@ namespace hystloop {
 struct OutgoingTick {
   SensorTick tick;
   std::int32_t buffer_depth = 0;
+  double y_true_m = std::numeric_limits<double>::quiet_NaN();  // StageReading::y_true_m
 };
 
 // How the stop's ramp to actuator.safe_u_V went (BridgeRealtime::begin_safe_stop / stop).

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <chrono>
 #include <ctime>
@@ -45,6 +46,10 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
       gains_(settings.servo) {
   reserve_storage(block_);
   begin_block(block_, 0, 0, settings_.dt_s());
+  if (rt_.backend().simulated()) {
+    truth_pub_.emplace(lcm, channels.sim_truth);
+    reserve_storage(truth_);
+  }
 }
 
 void BridgeService::on_command(const command_block_t& msg) noexcept {
@@ -167,7 +172,30 @@ void BridgeService::publish_block() noexcept {
     }
   }
   sent_.record(last_seq(block_), monotonic_now_ns());
+  publish_truth();
   begin_block(block_, 0, 0, settings_.dt_s());
+}
+
+void BridgeService::publish_truth() noexcept {
+  if (!truth_pub_ || truth_.n_ticks == 0) return;
+  // The truth's ticks are the sensor block's: same seq, same count (a tick without a finite
+  // truth empties the block, so a receiver never pairs it with the wrong ticks).
+  if (truth_.n_ticks == block_.n_ticks && !truth_pub_->publish(truth_)) ++truth_unpublished_;
+  truth_.n_ticks = 0;
+  truth_.y_true_m.clear();
+}
+
+void BridgeService::append_truth(const OutgoingTick& t) noexcept {
+  if (!truth_pub_) return;
+  if (block_.n_ticks == 1) {  // the tick just appended began a block
+    truth_.utime = block_.utime;
+    truth_.seq = block_.seq;
+    truth_.n_ticks = 0;
+    truth_.y_true_m.clear();
+  }
+  if (!std::isfinite(t.y_true_m) || truth_.n_ticks != block_.n_ticks - 1) return;
+  truth_.y_true_m.push_back(t.y_true_m);  // within the reserved MAX_TICKS
+  ++truth_.n_ticks;
 }
 
 void BridgeService::publish_samples(bool flush) noexcept {
@@ -176,6 +204,7 @@ void BridgeService::publish_samples(bool flush) noexcept {
     if (block_.n_ticks > 0 && t->tick.seq != last_seq(block_) + 1) publish_block();
     if (block_.n_ticks == 0) begin_block(block_, t->tick.seq, t->tick.utime, settings_.dt_s());
     append_tick(block_, t->tick);
+    append_truth(*t);
     block_.buffer_depth_ticks = t->buffer_depth;
     if ((t->tick.seq + 1) % settings_.block_ticks == 0 || block_.n_ticks == sensor_block_t::MAX_TICKS) publish_block();
   }
@@ -306,6 +335,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
       {"control_refused", control_refused_},
   };
   rt_.backend().append_counters(now);  // e.g. comedi: sensor_faults, sensor_fault_safe, comedi_read_errors
+  if (truth_pub_) now.emplace_back("sim_truth_unpublished", truth_unpublished_);
   if (reset_pending_) {
     counters_.rebase(now);
     reset_pending_ = false;

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <memory>
 #include <string>
 
@@ -19,6 +20,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
@@ -50,6 +52,8 @@ class BridgeService {
   void refuse(const control_t& msg, std::string why);
   void publish_samples(bool flush) noexcept;
   void publish_block() noexcept;
+  void append_truth(const OutgoingTick& t) noexcept;
+  void publish_truth() noexcept;
   void serve(bool stopping);  // one pass of the I/O loop: samples out, LCM in, status
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
   void log_safe_stop(const SafeStopResult& safe) const;
@@ -61,6 +65,10 @@ class BridgeService {
   BridgeRealtime rt_;
   Publisher<sensor_block_t> sensor_pub_;
   sensor_block_t block_{};  // being filled; storage reserved
+  // A simulated stage's true position for the same ticks, published after block_ (none on hardware).
+  std::optional<Publisher<sim_truth_t>> truth_pub_;
+  sim_truth_t truth_{};
+  std::uint64_t truth_unpublished_ = 0;  // blocks the Publisher refused
   Subscription<command_block_t> commands_;
   Subscription<control_t> control_;
   ControlFilter filter_{"bridge"};

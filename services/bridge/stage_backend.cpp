@@ -9,7 +9,8 @@ SimulatedBackend::SimulatedBackend(std::string name, const SimulatedStageConfig&
     : name_(std::move(name)), stage_(config) {}
 
 StageReading SimulatedBackend::step(double u_V, double t_s, double dt_s) noexcept {
-  return {stage_.step(u_V, t_s, dt_s), sample_flags::kSimulated};
+  const double y_m = stage_.step(u_V, t_s, dt_s);
+  return {y_m, stage_.true_position_m(), sample_flags::kSimulated};
 }
 
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config) {

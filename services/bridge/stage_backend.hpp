@@ -4,6 +4,7 @@
 // tick; it must not allocate, lock, log or block longer than a fraction of the period.
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -15,7 +16,10 @@
 namespace hystloop {
 
 struct StageReading {
-  double y_m = 0.0;        // measured position [m]
+  double y_m = 0.0;  // measured position [m]
+  // A simulator's true position [m] (y_m without the sensor noise); NaN for hardware, which
+  // cannot know it. Published on HX_SIM_TRUTH when finite.
+  double y_true_m = std::numeric_limits<double>::quiet_NaN();
   std::int32_t flags = 0;  // sample_flags bits the backend adds (kSimulated, a sensor fault, ...)
   bool go_safe = false;    // the backend asks for the safe state (e.g. its sensor failed too often in a row):
                            // the bridge disarms as for DISARM (ramp to actuator.safe_u_V; re-arm via ARM)

@@ -2,7 +2,7 @@
 // tools/netns-run):
 //
 //   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv,
-//   HX_COMMAND -> D/command.csv,
+//   HX_COMMAND -> D/command.csv, HX_SIM_TRUTH -> D/truth.csv (seq,y_true_m),
 //                                                HX_STATUS -> D/status.log (one line per report)
 //   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
 //                                reset_counters|shutdown [--target P] [--mode N] [--kp --ki --kd]
@@ -41,6 +41,7 @@
 #include "lcm/connection.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
+#include "hystloop/sim_truth_t.hpp"
 
 namespace hystloop {
 namespace {
@@ -61,12 +62,14 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   std::FILE* sensor = std::fopen((dir + "/sensor.csv").c_str(), "w");
   std::FILE* command = std::fopen((dir + "/command.csv").c_str(), "w");
   std::FILE* status = std::fopen((dir + "/status.log").c_str(), "w");
-  if (!sensor || !command || !status) {
+  std::FILE* truth = std::fopen((dir + "/truth.csv").c_str(), "w");
+  if (!sensor || !command || !status || !truth) {
     std::fprintf(stderr, "loop_probe: cannot write into %s\n", dir.c_str());
     return 2;
   }
   std::fprintf(sensor, "seq,utime,u_V,y_m,flags,y_ref_m,u_ff_V,u_fb_V\n");
   std::fprintf(command, "seq,sample_seq,u_ff_V,y_ref_m,params_version,mode\n");
+  std::fprintf(truth, "seq,y_true_m\n");
   Subscription<sensor_block_t>::Options so;
   so.queue_capacity = 100000;
   Subscription<sensor_block_t> s(
@@ -91,6 +94,17 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
         });
       },
       co);
+  Subscription<sim_truth_t>::Options to;
+  to.queue_capacity = 100000;
+  Subscription<sim_truth_t> tr(
+      lcm, ch.sim_truth,
+      [&](const sim_truth_t& m, std::int64_t) {
+        for (std::size_t i = 0; i < m.y_true_m.size(); ++i) {
+          std::fprintf(truth, "%lld,%.17g\n", static_cast<long long>(m.seq + static_cast<std::int64_t>(i)),
+                       m.y_true_m[i]);
+        }
+      },
+      to);
   Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
     std::fprintf(status,
                  "process=%s state=%d late=%lld rejected=%lld loop_p50_us=%.3f loop_p99_us=%.3f loop_max_us=%.3f "
@@ -112,10 +126,11 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   std::fclose(sensor);
   std::fclose(command);
   std::fclose(status);
-  std::printf("recorded %llu samples, %llu commands, %llu status reports\n",
-              static_cast<unsigned long long>(s.counters().accepted),
-              static_cast<unsigned long long>(c.counters().accepted),
-              static_cast<unsigned long long>(st.counters().accepted));
+  std::fclose(truth);
+  std::printf(
+      "recorded %llu samples, %llu commands, %llu true-position blocks, %llu status reports\n",
+      static_cast<unsigned long long>(s.counters().accepted), static_cast<unsigned long long>(c.counters().accepted),
+      static_cast<unsigned long long>(tr.counters().accepted), static_cast<unsigned long long>(st.counters().accepted));
   return 0;
 }
 

@@ -48,7 +48,7 @@ public class DecodeCheck {
         }
       }
     }
-    if (byFingerprint.size() != 7) fail("expected 7 LCM types in the jar, found " + byFingerprint.size());
+    if (byFingerprint.size() != 8) fail("expected 8 LCM types in the jar, found " + byFingerprint.size());
 
     lcm.spy.LCMTypeDatabase spyTypes = new lcm.spy.LCMTypeDatabase();
     for (Map.Entry<Long, Class<?>> e : byFingerprint.entrySet()) {

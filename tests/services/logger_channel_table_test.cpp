@@ -59,6 +59,7 @@ TEST(ChannelTable, AThousandJunkNamesFirstNeverEvictTheRigsChannels) {
   ASSERT_EQ(unknown.kept_count(), UnknownChannels::kKeptNames);
   std::string first = "HX_JUNK_";
   first += std::to_string(spare);
+  if (spare % 7 == 0) first += "\x01\n";  // as the loop above made it
   EXPECT_EQ(unknown.kept_name(0), first);
 }
 

@@ -1,9 +1,12 @@
 #include "log_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <unordered_map>
+#include <vector>
 
 #include "decode.hpp"
 #include "event_file.hpp"
@@ -62,6 +65,16 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
   model_params_t model;
   service_status_t status;
   control_t control;
+  sim_truth_t truth;
+  // A truth block is matched to the sensor block with its seq and n_ticks (the bridge sends it
+  // right after; kept the other way round too, should the network reorder them).
+  std::unordered_map<std::int64_t, std::size_t> block_first_sample;  // sensor block seq -> samples index
+  std::unordered_map<std::int64_t, std::vector<double>> truth_waiting;
+  const auto apply_truth = [&](std::size_t first, std::int32_t n, const std::vector<double>& y) {
+    if (y.size() != static_cast<std::size_t>(n) || first + y.size() > run.samples.size()) return;
+    for (std::size_t i = 0; i < y.size(); ++i) run.samples[first + i].y_true_m = y[i];
+    run.truth_ticks += y.size();
+  };
   run.files = for_each_event(files, [&](const lcm::LogEvent& event) {
     ++run.events;
     ++run.channel_counts[event.channel];
@@ -78,6 +91,25 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
         armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
       });
       run.sensor_blocks.push_back({t, sensor.seq, sensor.n_ticks, sensor.dt_s, sensor.buffer_depth_ticks, armed});
+      const std::size_t first = run.samples.size() - static_cast<std::size_t>(sensor.n_ticks);
+      block_first_sample[sensor.seq] = first;
+      if (const auto w = truth_waiting.find(sensor.seq); w != truth_waiting.end()) {
+        apply_truth(first, sensor.n_ticks, w->second);
+        truth_waiting.erase(w);
+      }
+    } else if (event.channel == channels.sim_truth) {
+      if (!decode_checked(event, truth)) return void(++run.undecodable);
+      const auto b = block_first_sample.find(truth.seq);
+      if (b == block_first_sample.end()) {
+        truth_waiting[truth.seq] = truth.y_true_m;
+      } else if (run.samples[b->second].seq == truth.seq) {
+        const std::size_t n = std::min(run.samples.size() - b->second, static_cast<std::size_t>(truth.n_ticks));
+        // The block's ticks are consecutive from its seq: n_ticks must match the sensor block's.
+        if (n == static_cast<std::size_t>(truth.n_ticks) &&
+            run.samples[b->second + n - 1].seq == truth.seq + truth.n_ticks - 1) {
+          apply_truth(b->second, truth.n_ticks, truth.y_true_m);
+        }
+      }
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
       run.command_blocks.push_back({t, command.seq, command.sample_seq, command.n_ticks});

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -27,6 +28,9 @@ struct SampleRecord {
   double y_ref_m = 0.0;  // NaN: no reference
   double y_m = 0.0;
   std::int32_t flags = 0;
+  // The simulated stage's true position at this tick (HX_SIM_TRUTH); NaN: none (hardware, or
+  // its truth block was not in the log).
+  double y_true_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 // One HX_SENSOR block (its ticks are in RunData::samples).
@@ -128,6 +132,7 @@ struct RunData {
   std::vector<ParamsRecord> params;
   std::vector<StatusRecord> statuses;
   std::vector<SafeRequestRecord> safe_requests;
+  std::uint64_t truth_ticks = 0;                                 // samples given a true position from HX_SIM_TRUTH
   std::map<std::string, std::uint64_t> channel_counts;           // every event of every channel
   std::map<std::string, std::vector<std::int64_t>> event_times;  // receive time of every event, by channel
   std::uint64_t events = 0;

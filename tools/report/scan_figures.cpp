@@ -110,8 +110,8 @@ SegmentFigures measure(const RunData& run, const ScanEvents& events, const ScanT
   f.period_ticks = std::max<std::int64_t>(1, std::llround(1.0 / (t.frequency_hz * dt_s)));
   const double last_from_s = std::max(f.analysed_from_s, f.end_s - o.last_s);
 
-  RmsSum all, last;
-  double max_abs = 0.0;
+  RmsSum all, last, truth;
+  double max_abs = 0.0, max_abs_true = 0.0;
   std::int64_t first_seq = std::numeric_limits<std::int64_t>::max(),
                last_seq = std::numeric_limits<std::int64_t>::min();
   for (const auto& s : run.samples) {
@@ -130,10 +130,20 @@ SegmentFigures measure(const RunData& run, const ScanEvents& events, const ScanT
     all.add(e);
     max_abs = std::max(max_abs, std::abs(e));
     if (t_s >= last_from_s) last.add(e);
+    if (std::isfinite(s.y_true_m)) {
+      const double e_true = s.y_ref_m - s.y_true_m;
+      truth.add(e_true);
+      max_abs_true = std::max(max_abs_true, std::abs(e_true));
+    }
   }
   f.analysed_ticks = all.n;
+  f.true_ticks = truth.n;
   f.rms_m = all.rms();
   if (all.n > 0) f.max_abs_m = max_abs;
+  if (truth.n > 0 && truth.n == all.n) {  // only over the same ticks as the measured figures
+    f.rms_true_m = truth.rms();
+    f.max_abs_true_m = max_abs_true;
+  }
   f.rms_last_m = last.rms();
 
   if (f.ticks > 0) {  // complete periods from the segment's first tick, by tick number

@@ -18,6 +18,8 @@
 //   rms, max |e|       after the settling time: blend_s + settle_s after a trajectory, settle_s
 //                      after a learning request (the approach, and the learner's fade and lag);
 //   rms_last           over the segment's last last_s seconds;
+//   rms_true, max_true as rms and max, against the true position of a simulated stage
+//                      (HX_SIM_TRUTH), when the log has it for every analysed tick;
 //   clamped ticks      flags SATURATED | SLEW_LIMITED over the whole segment (approach included),
 //                      with late (LATE_COMMAND) and safe (SAFE_STATE) ticks the same way;
 //   period RMS         of each complete period from the segment's start (period = round(1 / (f dt))
@@ -58,6 +60,10 @@ struct SegmentFigures {
   std::size_t ticks = 0;           // sensor ticks in the segment
   std::size_t analysed_ticks = 0;  // after the settling time, with a reference
   std::optional<double> rms_m, max_abs_m, rms_last_m;
+  // rms and max |y_ref - y_true| over the same ticks, against the simulated stage's true position
+  // (HX_SIM_TRUTH): only when every analysed tick has one (true_ticks == analysed_ticks).
+  std::size_t true_ticks = 0;
+  std::optional<double> rms_true_m, max_abs_true_m;
   std::size_t clamped_ticks = 0, saturated_ticks = 0, slew_limited_ticks = 0, late_ticks = 0, safe_ticks = 0;
   std::int64_t period_ticks = 0;
   std::vector<double> period_rms_m;

@@ -35,6 +35,9 @@ Json segment_json(const std::optional<SegmentFigures>& s) {
               {"rms_error_m", num(s->rms_m)},
               {"max_abs_error_m", num(s->max_abs_m)},
               {"rms_error_last_s_m", num(s->rms_last_m)},
+              {"true_position_ticks", s->true_ticks},
+              {"rms_error_true_m", num(s->rms_true_m)},
+              {"max_abs_error_true_m", num(s->max_abs_true_m)},
               {"clamped_ticks", s->clamped_ticks},
               {"saturated_ticks", s->saturated_ticks},
               {"slew_limited_ticks", s->slew_limited_ticks},
@@ -183,11 +186,12 @@ std::string scan_table(const ScanResult& scan) {
   char last[32];
   std::snprintf(last, sizeof last, "%g", scan.options.last_s);
   md << "| reference | learning | RMS [nm] | RMS last " << last
-     << " s [nm] | max [nm] | clamped ticks | late ticks | periods | converged after | model | note |\n"
-     << "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |\n";
+     << " s [nm] | max [nm] | RMS true [nm] | max true [nm] | clamped ticks | late ticks | periods | converged after | "
+        "model | note |\n"
+     << "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |\n";
   for (const auto& r : scan.references) {
     if (r.verdict == Verdict::kRefused) {
-      md << "| " << cell(r.label()) << " | — | — | — | — | — | — | — | — | — | **refused**: "
+      md << "| " << cell(r.label()) << " | — | — | — | — | — | — | — | — | — | — | — | **refused**: "
          << cell(r.verdict_detail.empty() ? "(no reason given)" : r.verdict_detail) << " |\n";
       continue;
     }
@@ -205,7 +209,7 @@ std::string scan_table(const ScanResult& scan) {
       }
       first = false;
       if (!*s) {
-        md << "| " << cell(r.label()) << " | " << learning << " | — | — | — | — | — | — | — | — | not measured"
+        md << "| " << cell(r.label()) << " | " << learning << " | — | — | — | — | — | — | — | — | — | — | not measured"
            << (note.empty() ? "" : "; " + cell(note)) << " |\n";
         continue;
       }
@@ -223,9 +227,9 @@ std::string scan_table(const ScanResult& scan) {
         converged = "not settled";
       }
       md << "| " << cell(r.label()) << " | " << learning << " | " << nm(f.rms_m) << " | " << nm(f.rms_last_m) << " | "
-         << nm(f.max_abs_m, "%.1f") << " | " << f.clamped_ticks << " | " << f.late_ticks << " | "
-         << f.period_rms_m.size() << " | " << converged << " | " << (f.mode.empty() ? "—" : f.mode) << " | "
-         << cell(note) << " |\n";
+         << nm(f.max_abs_m, "%.1f") << " | " << nm(f.rms_true_m) << " | " << nm(f.max_abs_true_m, "%.1f") << " | "
+         << f.clamped_ticks << " | " << f.late_ticks << " | " << f.period_rms_m.size() << " | " << converged << " | "
+         << (f.mode.empty() ? "—" : f.mode) << " | " << cell(note) << " |\n";
     }
   }
   return md.str();

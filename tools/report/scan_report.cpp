@@ -51,7 +51,9 @@ int write_scan_report(const std::vector<std::filesystem::path>& logs, const RunD
   std::snprintf(rule, sizeof rule, "stays within %g x the median of the last %zu", o.figures.converge_factor,
                 o.figures.converge_tail);
   md +=
-      "\nRMS and max of y_ref - y (measured) after each segment's settling time; clamped ticks (SATURATED or "
+      "\nRMS and max of y_ref - y (measured) after each segment's settling time; RMS true and max true the same "
+      "against the simulated stage's true position (HX_SIM_TRUTH; — without it, e.g. on hardware); clamped ticks "
+      "(SATURATED or "
       "SLEW_LIMITED) and late ticks over the whole segment; converged after: periods before the first from which "
       "every period's RMS " +
       std::string(rule) + " (scan.json: every figure, the per-period series).\n";

@@ -33,6 +33,7 @@
 
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/blocks.hpp"
@@ -145,11 +146,23 @@ service_status_t compensator_status(double t_s) {
   return s;
 }
 
-void write_log(const fs::path& file) {
+// The simulated stage's true position in the generated log (write_log's `truth`): its error
+// y_ref - y_true is half the measured one, same sign.
+struct TruthBlocks {
+  bool on = false;
+  std::int64_t missing_block = -1;  // the first seq of a block whose truth is left out
+};
+
+void write_log(const fs::path& file, TruthBlocks truth = {}) {
   std::vector<Event> events;
   sensor_block_t sb{};
   reserve_storage(sb);
+  sim_truth_t tb{};
   for (std::int64_t first = 0; first < kTicks; first += kBlock) {
+    tb.utime = at(t_of(first));
+    tb.seq = first;
+    tb.n_ticks = static_cast<std::int32_t>(kBlock);
+    tb.y_true_m.clear();
     begin_block(sb, first, at(t_of(first)), 1e-4);
     for (std::int64_t k = first; k < first + kBlock; ++k) {
       const double m = magnitude(k);
@@ -158,9 +171,16 @@ void write_log(const fs::path& file) {
       t.y_m = (m > 0.0 ? t.y_ref_m : 0.0) - ((k % 2) != 0 ? m : -m);
       t.flags = flags(k);
       append_tick(sb, t);
+      tb.y_true_m.push_back(m > 0.0 ? t.y_ref_m - 0.5 * (t.y_ref_m - t.y_m) : t.y_m);
     }
     sb.buffer_depth_ticks = 400;
-    add(events, at(t_of(first + kBlock - 1)), "HX_SENSOR", sb);  // received with its last tick
+    const std::int64_t received = at(t_of(first + kBlock - 1));  // with its last tick
+    // Every other truth block before its sensor block: the reader pairs them either way.
+    const bool truth_first = (first / kBlock) % 2 == 1;
+    const bool with_truth = truth.on && first != truth.missing_block;
+    if (with_truth && truth_first) add(events, received, "HX_SIM_TRUTH", tb);
+    add(events, received, "HX_SENSOR", sb);
+    if (with_truth && !truth_first) add(events, received, "HX_SIM_TRUTH", tb);
   }
   add(events, at(0.95), "HX_CONTROL", control(1, control_t::SET_LEARNING, control_t::LEARNING_OFF), 3);
   add(events, at(1.0), "HX_TRAJECTORY", trajectory(kVersionA, trajectory_t::TRIANGLE, 50.0), 3);
@@ -219,6 +239,39 @@ class ScanLog : public ::testing::Test {
 fs::path ScanLog::dir_;
 
 }  // namespace
+
+TEST_F(ScanLog, MeasuresAgainstTheSimulatorsTruePositionWhenTheLogHasIt) {
+  write_log(dir_ / "truth.lcmlog", {true, -1});
+  const ChannelNames channels("HX_");
+  const RunData run = read_logs({dir_ / "truth.lcmlog"}, channels);
+  EXPECT_EQ(run.truth_ticks, static_cast<std::uint64_t>(kTicks));
+  EXPECT_EQ(run.undecodable, 0u);
+  const ScanResult scan =
+      compute_scan(run, read_scan_events({dir_ / "truth.lcmlog"}, channels, "compensator"), ScanOptions{});
+  ASSERT_TRUE(scan.references[0].off && scan.references[0].on);
+  for (const auto* f : {&*scan.references[0].off, &*scan.references[0].on}) {
+    EXPECT_EQ(f->true_ticks, f->analysed_ticks);
+    ASSERT_TRUE(f->rms_true_m && f->max_abs_true_m);
+    EXPECT_NEAR(*f->rms_true_m, 0.5 * *f->rms_m, 1e-15);
+    EXPECT_NEAR(*f->max_abs_true_m, 0.5 * *f->max_abs_m, 1e-15);
+  }
+  EXPECT_NE(scan_table(scan).find("| triangle 1 µm 50 Hz | off | 8.00 | 8.00 | 8.0 | 4.00 | 4.0 | 9 |"),
+            std::string::npos)
+      << scan_table(scan);
+
+  // Without the truth of one analysed block the segment gets no true figures (they would cover
+  // other ticks than the measured ones); the other segment keeps them.
+  const std::int64_t missing = (tick_of(5.0) / kBlock) * kBlock;
+  write_log(dir_ / "truth_gap.lcmlog", {true, missing});
+  const RunData gap = read_logs({dir_ / "truth_gap.lcmlog"}, channels);
+  EXPECT_EQ(gap.truth_ticks, static_cast<std::uint64_t>(kTicks - kBlock));
+  const ScanResult with_gap =
+      compute_scan(gap, read_scan_events({dir_ / "truth_gap.lcmlog"}, channels, "compensator"), ScanOptions{});
+  const SegmentFigures& on = *with_gap.references[0].on;
+  EXPECT_EQ(on.true_ticks, on.analysed_ticks - static_cast<std::size_t>(kBlock));
+  EXPECT_FALSE(on.rms_true_m || on.max_abs_true_m);
+  EXPECT_TRUE(with_gap.references[0].off->rms_true_m);
+}
 
 TEST(ScanFigures, PeriodsToConvergeFindsTheFirstPeriodOfTheSettledTail) {
   std::vector<double> r{9, 7, 5, 3, 1.3, 1.0, 1.1, 0.9, 1.0, 1.05, 1.0, 0.95, 1.0, 1.1, 1.0};
@@ -305,7 +358,8 @@ TEST_F(ScanLog, MeasuresEachReferenceWithLearningOffAndOn) {
   EXPECT_EQ(scan.refused(), 1u);
 
   const std::string table = scan_table(scan);
-  EXPECT_NE(table.find("| triangle 1 µm 50 Hz | off | 8.00 | 8.00 | 8.0 | 9 | 2 | 150 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| triangle 1 µm 50 Hz | off | 8.00 | 8.00 | 8.0 | — | — | 9 | 2 | 150 |"), std::string::npos)
+      << table;
   EXPECT_NE(table.find("| triangle 1 µm 50 Hz | on |"), std::string::npos) << table;
   EXPECT_NE(table.find("**refused**: its feedforward needs 1e+05 V/s; at 10 Hz"), std::string::npos) << table;
 }
