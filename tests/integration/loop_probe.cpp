@@ -99,10 +99,8 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   Subscription<sim_truth_t> tr(
       lcm, ch.sim_truth,
       [&](const sim_truth_t& m, std::int64_t) {
-        for (std::size_t i = 0; i < m.y_true_m.size(); ++i) {
-          std::fprintf(truth, "%lld,%.17g\n", static_cast<long long>(m.seq + static_cast<std::int64_t>(i)),
-                       m.y_true_m[i]);
-        }
+        long long seq = m.seq;
+        for (const double y : m.y_true_m) std::fprintf(truth, "%lld,%.17g\n", seq++, y);
       },
       to);
   Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
