@@ -177,17 +177,16 @@ void BridgeService::publish_block() noexcept {
 }
 
 void BridgeService::publish_truth() noexcept {
-  if (!truth_pub_ || truth_.n_ticks == 0) return;
-  // The truth's ticks are the sensor block's: same seq, same count (a tick without a finite
-  // truth empties the block, so a receiver never pairs it with the wrong ticks).
-  if (truth_.n_ticks == block_.n_ticks && !truth_pub_->publish(truth_)) ++truth_unpublished_;
-  truth_.n_ticks = 0;
-  truth_.y_true_m.clear();
+  // The truth's ticks are the sensor block's: same seq, same count. A tick without a finite truth
+  // leaves the block short, and a short block is not sent, so a receiver never pairs it wrongly.
+  if (truth_pub_ && truth_.n_ticks > 0 && truth_.n_ticks == block_.n_ticks && !truth_pub_->publish(truth_)) {
+    ++truth_unpublished_;
+  }
 }
 
 void BridgeService::append_truth(const OutgoingTick& t) noexcept {
   if (!truth_pub_) return;
-  if (block_.n_ticks == 1) {  // the tick just appended began a block
+  if (block_.n_ticks == 1) {  // the tick just appended began a block: so does the truth's
     truth_.utime = block_.utime;
     truth_.seq = block_.seq;
     truth_.n_ticks = 0;

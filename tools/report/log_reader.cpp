@@ -1,6 +1,5 @@
 #include "log_reader.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -68,12 +67,16 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
   sim_truth_t truth;
   // A truth block is matched to the sensor block with its seq and n_ticks (the bridge sends it
   // right after; kept the other way round too, should the network reorder them).
-  std::unordered_map<std::int64_t, std::size_t> block_first_sample;  // sensor block seq -> samples index
+  struct BlockSamples {
+    std::size_t first = 0;  // index in run.samples of the block's first tick
+    std::size_t n = 0;      // its ticks
+  };
+  std::unordered_map<std::int64_t, BlockSamples> sensor_blocks;  // by the block's seq
   std::unordered_map<std::int64_t, std::vector<double>> truth_waiting;
-  const auto apply_truth = [&](std::size_t first, std::int32_t n, const std::vector<double>& y) {
-    if (y.size() != static_cast<std::size_t>(n) || first + y.size() > run.samples.size()) return;
-    for (std::size_t i = 0; i < y.size(); ++i) run.samples[first + i].y_true_m = y[i];
-    run.truth_ticks += y.size();
+  const auto apply_truth = [&](const BlockSamples& b, const std::vector<double>& y) {
+    if (y.size() != b.n) return;  // not this block's truth
+    for (std::size_t i = 0; i < b.n; ++i) run.samples[b.first + i].y_true_m = y[i];
+    run.truth_ticks += b.n;
   };
   run.files = for_each_event(files, [&](const lcm::LogEvent& event) {
     ++run.events;
@@ -91,24 +94,19 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
         armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
       });
       run.sensor_blocks.push_back({t, sensor.seq, sensor.n_ticks, sensor.dt_s, sensor.buffer_depth_ticks, armed});
-      const std::size_t first = run.samples.size() - static_cast<std::size_t>(sensor.n_ticks);
-      block_first_sample[sensor.seq] = first;
+      const auto n = static_cast<std::size_t>(sensor.n_ticks);
+      const BlockSamples block{run.samples.size() - n, n};
+      sensor_blocks[sensor.seq] = block;
       if (const auto w = truth_waiting.find(sensor.seq); w != truth_waiting.end()) {
-        apply_truth(first, sensor.n_ticks, w->second);
+        apply_truth(block, w->second);
         truth_waiting.erase(w);
       }
     } else if (event.channel == channels.sim_truth) {
       if (!decode_checked(event, truth)) return void(++run.undecodable);
-      const auto b = block_first_sample.find(truth.seq);
-      if (b == block_first_sample.end()) {
+      if (const auto b = sensor_blocks.find(truth.seq); b != sensor_blocks.end()) {
+        apply_truth(b->second, truth.y_true_m);
+      } else {
         truth_waiting[truth.seq] = truth.y_true_m;
-      } else if (run.samples[b->second].seq == truth.seq) {
-        const std::size_t n = std::min(run.samples.size() - b->second, static_cast<std::size_t>(truth.n_ticks));
-        // The block's ticks are consecutive from its seq: n_ticks must match the sensor block's.
-        if (n == static_cast<std::size_t>(truth.n_ticks) &&
-            run.samples[b->second + n - 1].seq == truth.seq + truth.n_ticks - 1) {
-          apply_truth(b->second, truth.n_ticks, truth.y_true_m);
-        }
       }
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
