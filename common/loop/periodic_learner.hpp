@@ -128,8 +128,11 @@ struct LearningConfig {
   // A line that has taken this many tables (its table under half of max_correction_m) keeps the
   // parameter set it learned under: a set for its model that arrives later waits
   // (Compensator::params_held_by_learning) until learning stops, is reset or the line ends.
-  // 0: sets are swapped in as they come.
-  std::int64_t hold_params_after = 10;
+  // 0: sets are swapped in as they come. 1 (from the line's first table): a swap is a step of the
+  // error the tables are learning, and it costs the same before the line has converged as after,
+  // while the tables correct what the new set would (a model far off, whose table nears its
+  // bound, is not held).
+  std::int64_t hold_params_after = 1;
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;

@@ -251,9 +251,10 @@ TEST(MemFit, RecoversTheProjectModelsParameters) {
   testdata::add_noise(y, 1e-9, 99);
   const MemFitResult noisy = fit_mem(u, y);
   ASSERT_TRUE(noisy.ok()) << noisy.reason;
-  EXPECT_LT(testdata::rel_err(noisy.params.c1, truth.c1), 0.01);
+  // Measured 6.2e-5, 2.6e-3 and 3.4e-4 (1 nm of noise): bounds within 10x.
+  EXPECT_LT(testdata::rel_err(noisy.params.c1, truth.c1), 6e-4);
   EXPECT_LT(testdata::rel_err(noisy.params.c2, truth.c2), 0.02);
-  EXPECT_LT(testdata::rel_err(noisy.params.c3, truth.c3), 0.01);
+  EXPECT_LT(testdata::rel_err(noisy.params.c3, truth.c3), 3e-3);
 }
 
 }  // namespace

@@ -283,7 +283,9 @@ TEST(CompensatorLimits, BeforeConvergenceOrWithTheHoldOffASetIsSwappedAtTheNextR
   set.kind = ModelKind::linear;
   set.linear.gain = 1.01 * kGain;
   {
-    Compensator c(linear_config(false));
+    CompensatorConfig ten = linear_config(false);
+    ten.learning.hold_params_after = 10;
+    Compensator c(ten);
     std::map<std::int64_t, CommandTick> planned;
     c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
     plan_for(c, 0.1, nullptr, &planned);  // 5 periods: fewer than 10 tables

@@ -32,7 +32,7 @@ std::string refusal(const std::string& yaml) {
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-TEST(BridgeSettings, DefaultsAreTheIssues) {
+TEST(BridgeSettings, DefaultsWithoutAConfig) {
   const BridgeSettings s = load_bridge_settings(Config());
   EXPECT_EQ(s.backend, "sim");
   EXPECT_EQ(s.rate_hz, 10000.0);
@@ -44,7 +44,7 @@ TEST(BridgeSettings, DefaultsAreTheIssues) {
   EXPECT_EQ(s.stage.banning.hysteresis.a, 8.58e-9);  // Table 1
   EXPECT_EQ(s.stage.banning.stage.k, 1.17e8);        // Table 2
   EXPECT_FALSE(s.auto_arm);
-  // Blocks of 10 ticks (1 kHz of HX_SENSOR messages); the clock wakes every tick; LCM queues
+  // Blocks of 20 ticks (500 HX_SENSOR messages a second); the clock wakes every tick; LCM queues
   // 256 command blocks.
   EXPECT_EQ(s.block_ticks, 20);
   EXPECT_EQ(s.rt.ticks_per_wake, 1);
