@@ -516,7 +516,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
     return 1;
   }
-  return 2;
+  return kExitUsage;
 }
 
 }  // namespace

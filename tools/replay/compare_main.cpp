@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     if (expected.by_seq.empty()) {
       std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(),
                    channels.command.c_str());
-      return 2;
+      return hystloop::kExitUsage;
     }
     const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
     if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
@@ -62,6 +62,6 @@ int main(int argc, char** argv) {
     return report.exit_code();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-compare: %s\n", e.what());
-    return 2;
+    return hystloop::kExitUsage;
   }
 }

@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());
-    return 2;
+    return hystloop::kExitUsage;
   }
   return 0;
 }

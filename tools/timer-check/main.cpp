@@ -113,6 +113,6 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-timer-check: %s\n", e.what());
-    return 2;
+    return hystloop::kExitUsage;
   }
 }
