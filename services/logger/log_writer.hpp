@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <thread>
 
-#include "logger/channel_table.hpp"
+#include "record/channel_table.hpp"
 #include "logger/log_file_set.hpp"
-#include "logger/record_ring.hpp"
+#include "record/record_ring.hpp"
 
 namespace hystloop {
 

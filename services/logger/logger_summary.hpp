@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "logger/channel_table.hpp"
+#include "record/channel_table.hpp"
 #include "logger/log_file_set.hpp"
 
 namespace hystloop {

@@ -1,7 +1,7 @@
 // The logger's channel table ("junk traffic blinds the logger"): the rig's six
 // channels hold their slots from the start; 1000 junk names sent first take the spare slots
 // and are then counted (bounded), never evicting the rig's channels.
-#include "logger/channel_table.hpp"
+#include "record/channel_table.hpp"
 
 #include <gtest/gtest.h>
 

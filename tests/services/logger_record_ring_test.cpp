@@ -1,4 +1,4 @@
-#include "logger/record_ring.hpp"
+#include "record/record_ring.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // the period, a full window of new data), adoption and versions, garbage refused and counted,
 // skipped, refused and missing ticks, the version the compensator applies (HX_COMMAND ahead of
 // the samples), health, and an allocation-free block path.
-#include "reidentifier/reident_core.hpp"
+#include "reident/reident_core.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The re-identifier's counters on HX_STATUS: one per refusal reason a refit can have, none that
 // can never move ("refits_rejected_ok" and "refits_rejected_invalid_options" were).
-#include "reidentifier/reident_counters.hpp"
+#include "reident/reident_counters.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,8 +9,8 @@
 
 #include "core/config.hpp"
 #include "core/errors.hpp"
-#include "reidentifier/model_chooser.hpp"
-#include "reidentifier/reident_core.hpp"
+#include "reident/model_chooser.hpp"
+#include "reident/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "reident_test_data.hpp"
 

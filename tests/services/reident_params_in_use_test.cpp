@@ -1,6 +1,6 @@
 // ParamsInUse: which set candidates are judged against, the versions we publish, and the
 // version the compensator applies at a sample (HX_COMMAND, planned ahead of the samples).
-#include "reidentifier/params_in_use.hpp"
+#include "reident/params_in_use.hpp"
 
 #include <gtest/gtest.h>
 

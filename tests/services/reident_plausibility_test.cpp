@@ -8,8 +8,8 @@
 #include <string>
 
 #include "core/config.hpp"
-#include "reidentifier/model_chooser.hpp"
-#include "reidentifier/reident_core.hpp"
+#include "reident/model_chooser.hpp"
+#include "reident/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "services/reident_test_data.hpp"
 

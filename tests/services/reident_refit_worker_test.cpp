@@ -1,6 +1,6 @@
 // RefitWorker: the lock-free handoff of one refit job between the I/O thread and the worker,
 // stepped by hand (no thread) and with the real thread; the owner's side never allocates.
-#include "reidentifier/refit_worker.hpp"
+#include "reident/refit_worker.hpp"
 
 #include <gtest/gtest.h>
 

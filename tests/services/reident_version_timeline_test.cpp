@@ -1,6 +1,6 @@
 // VersionTimeline: the params_version of HX_COMMAND by tick, looked up at a sample's tick
 // while the commands run ahead of it; restarts, re-plans, reordering, overflow, no allocation.
-#include "reidentifier/version_timeline.hpp"
+#include "reident/version_timeline.hpp"
 
 #include <gtest/gtest.h>
 

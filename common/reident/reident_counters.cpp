@@ -1,4 +1,4 @@
-#include "reidentifier/reident_counters.hpp"
+#include "reident/reident_counters.hpp"
 
 namespace hystloop {
 

@@ -20,7 +20,7 @@
 
 #include "ident/online_mem_estimator.hpp"
 #include "models/gain_plausibility.hpp"
-#include "reidentifier/job_slot.hpp"
+#include "reident/job_slot.hpp"
 
 namespace hystloop {
 

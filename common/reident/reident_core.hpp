@@ -24,10 +24,10 @@
 #include "core/latency_stats.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "lcm/blocks.hpp"
-#include "reidentifier/params_in_use.hpp"
-#include "reidentifier/refit_worker.hpp"
-#include "reidentifier/reident_counters.hpp"
-#include "reidentifier/reident_options.hpp"
+#include "reident/params_in_use.hpp"
+#include "reident/refit_worker.hpp"
+#include "reident/reident_counters.hpp"
+#include "reident/options.hpp"
 
 namespace hystloop {
 

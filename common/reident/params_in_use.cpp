@@ -1,4 +1,4 @@
-#include "reidentifier/params_in_use.hpp"
+#include "reident/params_in_use.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "logger/unknown_channels.hpp"
+#include "record/unknown_channels.hpp"
 
 #include <cstdio>
 #include <cstring>

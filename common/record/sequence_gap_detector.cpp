@@ -1,4 +1,4 @@
-#include "logger/sequence_gap_detector.hpp"
+#include "record/sequence_gap_detector.hpp"
 
 #include <optional>
 #include <string>

@@ -1,4 +1,4 @@
-#include "reidentifier/model_chooser.hpp"
+#include "reident/model_chooser.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -7,8 +7,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/errors.hpp"
 #include "ident/online_mem_estimator.hpp"
-#include "reidentifier/reident_core.hpp"
+#include "reident/reident_core.hpp"
 
 namespace hystloop {
 

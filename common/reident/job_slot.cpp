@@ -1,4 +1,4 @@
-#include "reidentifier/job_slot.hpp"
+#include "reident/job_slot.hpp"
 
 #include <sys/resource.h>
 #include <sys/syscall.h>

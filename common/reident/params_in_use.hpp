@@ -38,7 +38,7 @@
 
 #include "loop/params_admission.hpp"
 #include "models/mem.hpp"
-#include "reidentifier/version_timeline.hpp"
+#include "reident/version_timeline.hpp"
 
 namespace hystloop {
 

@@ -30,7 +30,7 @@
 #include "ident/online_mem_estimator.hpp"
 #include "ident/online_model_selector.hpp"
 #include "models/model_set.hpp"
-#include "reidentifier/job_slot.hpp"
+#include "reident/job_slot.hpp"
 
 namespace hystloop {
 

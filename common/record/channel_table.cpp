@@ -1,4 +1,4 @@
-#include "logger/channel_table.hpp"
+#include "record/channel_table.hpp"
 
 #include <cstring>
 #include <string>

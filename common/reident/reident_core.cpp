@@ -1,8 +1,10 @@
-#include "reidentifier/reident_core.hpp"
+#include "reident/reident_core.hpp"
 
 #include <cmath>
 #include <limits>
 #include <utility>
+
+#include "core/errors.hpp"
 
 namespace hystloop {
 

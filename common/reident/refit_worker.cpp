@@ -1,4 +1,4 @@
-#include "reidentifier/refit_worker.hpp"
+#include "reident/refit_worker.hpp"
 
 #include <chrono>
 #include <exception>

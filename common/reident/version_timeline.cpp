@@ -1,4 +1,4 @@
-#include "reidentifier/version_timeline.hpp"
+#include "reident/version_timeline.hpp"
 
 namespace hystloop {
 

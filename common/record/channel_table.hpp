@@ -19,8 +19,8 @@
 #include <string_view>
 
 #include "lcm/channels.hpp"
-#include "logger/sequence_gap_detector.hpp"
-#include "logger/unknown_channels.hpp"
+#include "record/sequence_gap_detector.hpp"
+#include "record/unknown_channels.hpp"
 
 namespace hystloop {
 
