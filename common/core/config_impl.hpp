@@ -22,7 +22,4 @@ struct Config::Impl {
 // "a.b.c" -> {"a", "b", "c"}; empty parts are left in for the caller to refuse.
 std::vector<std::string> split_config_path(std::string_view path);
 
-// Levenshtein distance, for "did you mean".
-std::size_t edit_distance(std::string_view a, std::string_view b);
-
 }  // namespace hystloop

@@ -4,6 +4,7 @@
 
 #include "core/config.hpp"
 #include "core/config_impl.hpp"
+#include "core/edit_distance.hpp"
 
 namespace hystloop {
 namespace {
@@ -70,21 +71,6 @@ std::string suggestion(std::string_view key, const std::vector<std::string>& kno
 }
 
 }  // namespace
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
 
 std::vector<std::string> Config::keys() const {
   std::vector<std::string> out;

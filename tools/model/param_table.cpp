@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cmath>
 
+#include "core/edit_distance.hpp"
+
 namespace hystloop::model_tool {
 namespace {
 
@@ -11,24 +13,6 @@ std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
   return s;
-}
-
-// Edits (insert, delete, substitute, swap two neighbours) from a to b: "gian" is one from "gain".
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  const std::size_t w = b.size() + 1;
-  std::vector<std::size_t> d((a.size() + 1) * w);
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      std::size_t best = std::min(
-          {d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + (a[i - 1] == b[j - 1] ? 0U : 1U)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
-        best = std::min(best, d[(i - 2) * w + j - 2] + 1);
-      d[i * w + j] = best;
-    }
-  }
-  return d[a.size() * w + b.size()];
 }
 
 }  // namespace
