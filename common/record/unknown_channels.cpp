@@ -1,6 +1,5 @@
 #include "record/unknown_channels.hpp"
 
-#include <cstdio>
 #include <cstring>
 
 namespace hystloop {
@@ -35,22 +34,6 @@ void UnknownChannels::count(const char* name, std::size_t length) noexcept {
     }
     return;
   }
-}
-
-std::string escaped_for_log(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    const auto b = static_cast<unsigned char>(c);
-    if (b >= 0x20 && b < 0x7f && c != '\\') {
-      out += c;
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", static_cast<unsigned>(b));
-      out += hex;
-    }
-  }
-  return out;
 }
 
 }  // namespace hystloop

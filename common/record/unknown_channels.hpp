@@ -42,8 +42,4 @@ class UnknownChannels {
   std::size_t kept_ = 0;
 };
 
-// `text` with every byte outside printable ASCII (and the backslash) written as \xNN: a name
-// that came off the wire, made safe for a log line, HX_STATUS detail or a terminal.
-std::string escaped_for_log(std::string_view text);
-
 }  // namespace hystloop

@@ -11,6 +11,7 @@
 
 #include "core/clock.hpp"
 #include "core/errors.hpp"
+#include "core/escape.hpp"
 #include "core/process.hpp"
 #include "core/saturating.hpp"
 #include "lcm/connection.hpp"
@@ -63,7 +64,7 @@ LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const Log
   // compile (no message is dispatched before run()).
   raw_ = lcm_subscribe(lcm_.getUnderlyingLCM(), channels_regex_.c_str(), &LoggerService::on_raw, this);
   if (raw_ == nullptr) {
-    throw ParameterError("logger.channels", "LCM refuses '" + escaped_for_log(channels_regex_) +
+    throw ParameterError("logger.channels", "LCM refuses '" + escape_wire(channels_regex_, kEscapeUncut) +
                                                 "' (not a regular expression it can compile)");
   }
   try {
@@ -172,7 +173,7 @@ void LoggerService::on_tick(std::int64_t utime) {
 
 std::string LoggerService::fault_detail(const DiskFaults& f) {
   std::string detail;
-  const std::string file = escaped_for_log(files_->current_file().filename().string());
+  const std::string file = escape_wire(files_->current_file().filename().string());
   if (!f.writing || f.errors > seen_faults_.errors) {
     detail = "FAULT: " + f.reason() + "; " + std::to_string(f.events_lost) + " events not written so far";
     if (!f.writing)
@@ -198,7 +199,7 @@ std::string LoggerService::unknown_channels_detail() {
   const UnknownChannels& u = channels_->unknown();
   if (u.messages() <= seen_unrecorded_) return {};
   std::string names;
-  for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escaped_for_log(u.kept_name(i)) + "'";
+  for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escape_wire(u.kept_name(i)) + "'";
   const std::string distinct = (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct());
   std::string detail = "not recorded: " + std::to_string(u.messages() - seen_unrecorded_) + " message(s) on " +
                        distinct + " channel(s) beyond the table's " + std::to_string(ChannelTable::kMaxChannels) +
@@ -275,7 +276,7 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   std::int8_t state = detail.empty() ? service_status_t::HEALTHY : service_status_t::DEGRADED;
   if (state_override >= 0) state = state_override;
   if (state == service_status_t::DEGRADED) {
-    detail += " (file " + escaped_for_log(files_->current_file().filename().string()) + ")";
+    detail += " (file " + escape_wire(files_->current_file().filename().string()) + ")";
   }
   if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail = append(detail, note);
   reporter_.begin(state, detail);

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "core/escape.hpp"
 #include "core/saturating.hpp"
 
 namespace hystloop {
@@ -148,7 +149,7 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
   if (channels.unknown().messages() > 0) {
     const UnknownChannels& u = channels.unknown();
     std::string names;
-    for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escaped_for_log(u.kept_name(i)) + "'";
+    for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escape_wire(u.kept_name(i)) + "'";
     lines.push_back("  not recorded: " + std::to_string(u.messages()) + " message(s) on " +
                     (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct()) +
                     " channel(s) without a slot (first: " + names + ")");
@@ -156,7 +157,7 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
     std::ostringstream line;
-    line << "  " << escaped_for_log(c.name_view()) << ": received " << c.received << ", written " << c.written.load()
+    line << "  " << escape_wire(c.name_view()) << ": received " << c.received << ", written " << c.written.load()
          << ", dropped " << c.dropped();
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;

@@ -2,9 +2,7 @@
 // Log hygiene for what arrives off the wire. A service under malformed or hostile input must not
 // flood its log: LogLimiter lets at most one line per reason through per interval (1 s), and the
 // next line let through says how many of that reason were suppressed since the last one.
-// escape_wire() makes text from a message safe to put into a log line: printable ASCII stays,
-// a backslash doubles, every other byte (control bytes, escape sequences, non-ASCII) becomes \xNN,
-// and the result is cut at max_chars input bytes (marked "...").
+// escape_wire() (core/escape.hpp) makes text from a message safe to put into a log line.
 //
 // Reasons are small integers (an enum's value, < kMaxReasons) chosen by the service. Time is an
 // argument (a steady clock in ns). No allocation, lock or throw in allow().
@@ -14,6 +12,8 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+
+#include "core/escape.hpp"
 
 namespace hystloop {
 
@@ -48,8 +48,5 @@ class LogLimiter {
 
 // "; N more suppressed" for a Gate that suppressed lines before it, else "".
 std::string suppressed_note(const LogLimiter::Gate& gate);
-
-// Text from a message, safe in a log line (see above).
-std::string escape_wire(std::string_view text, std::size_t max_chars = 160);
 
 }  // namespace hystloop

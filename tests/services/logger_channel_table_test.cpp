@@ -83,9 +83,5 @@ TEST(UnknownChannels, DistinctNamesAreCountedInBoundedMemoryThenAsALowerBound) {
   EXPECT_TRUE(unknown.distinct_is_lower_bound());
 }
 
-TEST(UnknownChannels, NamesOffTheWireAreEscapedForLogs) {
-  EXPECT_EQ(escaped_for_log("HX_A\x01\n\\b\xff"), "HX_A\\x01\\x0a\\x5cb\\xff");
-}
-
 }  // namespace
 }  // namespace hystloop
