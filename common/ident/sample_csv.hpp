@@ -5,23 +5,12 @@
 // A malformed file is refused with a message naming the file, line and column.
 
 #include <istream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/csv_error.hpp"
+
 namespace hystloop {
-
-class CsvError : public std::runtime_error {
- public:
-  CsvError(std::string file, std::size_t line, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), file_(std::move(file)), line_(line) {}
-  std::size_t line() const noexcept { return line_; }
-  const std::string& file() const noexcept { return file_; }
-
- private:
-  std::string file_;
-  std::size_t line_;
-};
 
 struct SampleTable {
   std::vector<double> t, u, y;          // [s], [V], [m]

@@ -9,22 +9,13 @@
 #include <istream>
 #include <ostream>
 #include <span>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/csv_error.hpp"
+
 namespace hystloop::model_tool {
-
-class CsvError : public std::runtime_error {
- public:
-  CsvError(const std::string& file, std::size_t line, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + message), line_(line) {}
-  std::size_t line() const noexcept { return line_; }
-
- private:
-  std::size_t line_;
-};
 
 struct CsvColumns {
   std::vector<std::string> names;           // the requested columns, in the requested order
