@@ -14,6 +14,7 @@
 
 #include "bridge/bridge_health.hpp"
 #include "bridge/servo_request.hpp"
+#include "core/clock.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
@@ -454,7 +455,7 @@ void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) 
 void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult& safe) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  const double wall_s = monotonic_s() - started_s_;
   const ResourceUsage usage = read_resource_usage();
   const auto pct = [&](double q) { return latency_total_.count() > 0 ? latency_total_.percentile(q) / 1e3 : -1.0; };
   const std::string json = fmt::format(

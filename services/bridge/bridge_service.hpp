@@ -6,8 +6,8 @@
 
 #include <chrono>
 #include <cstdint>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
@@ -16,6 +16,7 @@
 #include "bridge/bridge_settings.hpp"
 #include "bridge/send_time_ring.hpp"
 #include "bridge/sensor_block_repair.hpp"
+#include "core/clock.hpp"
 #include "core/latency_stats.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
@@ -94,7 +95,7 @@ class BridgeService {
   enum LogReason : std::size_t { kLogSensorRepaired, kLogSensorUnpublished };
   FeedbackGains gains_;  // the servo's, as last set
   std::string summary_json_path_;
-  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  double started_s_ = monotonic_s();  // [s], core/clock.hpp
 
   // I/O loop state.
   std::chrono::steady_clock::time_point next_report_{};

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "compensator/trajectory_message.hpp"
+#include "core/clock.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
@@ -498,13 +499,12 @@ int CompensatorService::run() {
   for (const std::string& line : describe(settings_)) spdlog::info("{}", line);
   spdlog::info("channels: {} in, {} out; {}, {}, {} in", samples_.channel(), command_pub_.channel(),
                trajectories_.channel(), params_.channel(), control_.channel());
-  const auto started = std::chrono::steady_clock::now();
+  const double started_s = monotonic_s();
   IoLoopOptions options;
   options.poll_timeout = std::chrono::microseconds(20000);
   const int errors = run_io_loop(lcm_, options, [&](std::int64_t utime) {
     report(utime, false);
-    if (settings_.run_seconds > 0 &&
-        std::chrono::steady_clock::now() - started >= std::chrono::duration<double>(settings_.run_seconds)) {
+    if (settings_.run_seconds > 0 && monotonic_s() - started_s >= settings_.run_seconds) {
       spdlog::info("--seconds {} reached", settings_.run_seconds);
       request_stop();
     }

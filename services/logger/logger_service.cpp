@@ -23,11 +23,6 @@
 namespace hystloop {
 
 namespace {
-std::int64_t monotonic_ns() noexcept {
-  using namespace std::chrono;
-  return duration_cast<nanoseconds>(steady_clock::now().time_since_epoch()).count();
-}
-
 // Decodes a block as a Subscription would (fingerprint, length fields walked before decode
 // trusts them, the whole buffer used) but without the value check: a block's ticks count for
 // gap detection whatever its values. False if it is not a block of that type with >= 1 tick.

@@ -6,19 +6,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/clock.hpp"
 #include "core/process.hpp"
 #include "runtime/io_loop.hpp"
 #include "runtime/model_params_message.hpp"
 
 namespace hystloop {
 
-std::int64_t steady_ns() noexcept {
-  using namespace std::chrono;
-  return duration_cast<nanoseconds>(steady_clock::now().time_since_epoch()).count();
-}
-
 namespace {
-std::int64_t steady_us() noexcept { return steady_ns() / 1000; }
+std::int64_t steady_us() noexcept { return monotonic_ns() / 1000; }
 
 // DEGRADED for this long after a set with our publisher id that we never published [us] (and
 // beyond, while the compensator applies it): long enough to be seen in the 1 Hz status.
@@ -43,7 +39,7 @@ RefitWorker::OnEvaluated refusal_logger() {
       last = FitStatus::ok;
       return;
     }
-    const std::int64_t now = steady_ns();
+    const std::int64_t now = monotonic_ns();
     const bool news = r.outcome.status != last || now - last_info_ns >= 60'000'000'000;
     const auto level = news ? spdlog::level::info : spdlog::level::debug;
     spdlog::log(level, "refit refused ({}): {} [window {} samples from seq {}, {:.1f} ms{}]",
@@ -102,9 +98,9 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
 ReidentService::~ReidentService() = default;
 
 void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
-  const std::int64_t t0 = steady_ns();
+  const std::int64_t t0 = monotonic_ns();
   core_->on_sensor_block(msg, t0 / 1000);
-  block_cost_.add(steady_ns() - t0);
+  block_cost_.add(monotonic_ns() - t0);
 }
 
 void ReidentService::on_params(const mem_params_t& msg) {
@@ -114,24 +110,24 @@ void ReidentService::on_params(const mem_params_t& msg) {
   // Counted by the core (params_adopted, _stale, _invalid, _implausible); logged at most once a second per kind.
   const auto id = static_cast<std::uint64_t>(msg.publisher_id);
   if (core_->counters().get(ReidentCounter::params_implausible) != implausible_before) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, steady_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, monotonic_ns())) {
       spdlog::warn("params version {} from '{}' (publisher {:x}) not adopted: {}{}", msg.version,
                    escape_wire(msg.source), id, core_->implausible_reason(), suppressed_note(g));
     }
     return;
   }
   if (offer == ParamsOffer::adopted) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogAdopted, steady_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogAdopted, monotonic_ns())) {
       spdlog::info("params in use now version {} from '{}' (publisher {:x}): c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}{}",
                    msg.version, escape_wire(msg.source), id, msg.c1, msg.c2, msg.c3, suppressed_note(g));
     }
   } else if (offer == ParamsOffer::stale) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogStale, steady_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogStale, monotonic_ns())) {
       spdlog::debug("params version {} from '{}' (publisher {:x}) ignored: not newer than the last from it{}",
                     msg.version, escape_wire(msg.source), id, suppressed_note(g));
     }
   } else if (offer == ParamsOffer::invalid) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, steady_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, monotonic_ns())) {
       spdlog::info(
           "params version {} from '{}' (publisher {:x}) not used: marked invalid or outside the model's "
           "domain{}",
@@ -180,7 +176,7 @@ void ReidentService::on_control(const control_t& msg) {
     request_stop();
   } else if (msg.command == control_t::RESET_COUNTERS) {
     acks_.acted(msg.request_id);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogReset, steady_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogReset, monotonic_ns())) {
       spdlog::info("counters reset (request {}){}", msg.request_id, suppressed_note(g));
     }
     core_->reset_refit_time();

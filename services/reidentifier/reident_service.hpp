@@ -96,7 +96,4 @@ class ReidentService {
   std::unique_ptr<Subscription<control_t>> control_;
 };
 
-// Steady (monotonic) clock in nanoseconds; / 1000 is the core's time base.
-std::int64_t steady_ns() noexcept;
-
 }  // namespace hystloop
