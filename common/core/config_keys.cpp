@@ -16,7 +16,7 @@ void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vect
   }
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
-    collect_leaves(kv.second, prefix.empty() ? key : prefix + "." + key, out);
+    collect_leaves(kv.second, prefix.empty() ? key : std::string(prefix).append(".").append(key), out);
   }
 }
 

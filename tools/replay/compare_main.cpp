@@ -22,7 +22,7 @@
 #include "command_comparison.hpp"
 #include "core/errors.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"Compares a replayed compensator's commands with a recorded log's (tools/replay-check)."};
   std::string expected_log, actual_log, inputs_log, rig = std::string(hystloop::kDefaultRigPrefix);
   hystloop::replay::CompareTolerance tolerance;
@@ -64,4 +64,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hystloop-replay-compare: %s\n", e.what());
     return hystloop::kExitUsage;
   }
+} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-replay-compare");
 }

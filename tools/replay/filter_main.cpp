@@ -20,7 +20,7 @@
 #include "command_alteration.hpp"
 #include "replay_inputs.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"Prepares LCM event logs for a replay regression (tools/replay-check)."};
   app.require_subcommand(1);
   std::string log, out, rig = std::string(hystloop::kDefaultRigPrefix);
@@ -70,4 +70,6 @@ int main(int argc, char** argv) {
     return hystloop::kExitUsage;
   }
   return 0;
+} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-replay-filter");
 }
