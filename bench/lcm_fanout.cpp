@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -38,7 +39,7 @@
 
 namespace {
 
-using hystloop::monotonic_now_ns;
+using hystloop::monotonic_ns;
 
 constexpr std::size_t kMaxChannelLength = 63;     // LCM's limit on a channel name
 constexpr std::int64_t kMaxWaitNs = 100'000'000;  // the wait loop wakes at least every 100 ms
@@ -58,9 +59,7 @@ double cpu_seconds() noexcept {
   return usage.user_cpu_s + usage.system_cpu_s;
 }
 
-double seconds_since(std::int64_t start_ns) noexcept {
-  return 1e-9 * static_cast<double>(monotonic_now_ns() - start_ns);
-}
+double seconds_since(std::int64_t start_ns) noexcept { return 1e-9 * static_cast<double>(monotonic_ns() - start_ns); }
 
 void check_channel(const std::string& channel) {
   if (channel.empty()) throw hystloop::ParameterError("channel", "must not be empty");
@@ -74,7 +73,7 @@ int publish(const Options& opt, std::int64_t start_ns) {
   check_channel(opt.channel);
   auto lcm = hystloop::open_lcm(opt.url, opt.allow_network);
   const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
-  const auto wanted = static_cast<std::uint64_t>(opt.seconds * 1e9 / static_cast<double>(period) + 0.5);
+  const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
   std::vector<std::uint8_t> payload(static_cast<std::size_t>(opt.bytes), 0x5a);
 
   hystloop::PeriodicTimer timer(period);  // clock_nanosleep(TIMER_ABSTIME) on a fixed grid
@@ -127,7 +126,7 @@ int listen(const Options& opt, std::int64_t start_ns) {
 
   const std::int64_t end_ns = start_ns + static_cast<std::int64_t>(opt.seconds * 1e9);
   while (!hystloop::stop_requested()) {
-    const std::int64_t left_ns = end_ns - monotonic_now_ns();
+    const std::int64_t left_ns = end_ns - monotonic_ns();
     if (left_ns <= 0) break;
     const std::int64_t wait_ns = std::min(left_ns, kMaxWaitNs);
     if (lcm) {
@@ -156,8 +155,8 @@ void add_common(CLI::App& cmd, Options& opt, bool channel_required) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  const std::int64_t start_ns = monotonic_now_ns();
+int main(int argc, char** argv) try {
+  const std::int64_t start_ns = monotonic_ns();
   Options opt;
   CLI::App app{
       "Measures the CPU a process spends on LCM multicast traffic: publish raw payloads, or listen and count."};
@@ -190,4 +189,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hystloop-lcm-fanout: %s\n", e.what());
     return 1;
   }
+} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-lcm-fanout");
 }

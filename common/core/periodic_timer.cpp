@@ -20,12 +20,6 @@ timespec to_timespec(std::int64_t ns) noexcept {
 }
 }  // namespace
 
-std::int64_t monotonic_now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
-}
-
 bool set_thread_timer_slack_ns(std::int64_t slack_ns) noexcept {
   return slack_ns > 0 && ::prctl(PR_SET_TIMERSLACK, static_cast<unsigned long>(slack_ns), 0, 0, 0) == 0;
 }
@@ -70,7 +64,7 @@ void DeadlineSchedule::reanchor(std::int64_t next_deadline_ns) noexcept {
   first_ns_ = next_deadline_ns - static_cast<std::int64_t>(next_tick_) * period_ns_;
 }
 
-PeriodicTimer::PeriodicTimer(std::int64_t period_ns) : PeriodicTimer(period_ns, monotonic_now_ns() + period_ns) {}
+PeriodicTimer::PeriodicTimer(std::int64_t period_ns) : PeriodicTimer(period_ns, monotonic_ns() + period_ns) {}
 
 PeriodicTimer::PeriodicTimer(std::int64_t period_ns, std::int64_t first_deadline_ns)
     : schedule_(first_deadline_ns, period_ns) {}
@@ -81,13 +75,13 @@ TickInfo PeriodicTimer::wait_next() noexcept {
   // Returns at once if the deadline has passed; EINTR (a signal) sleeps again.
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
   }
-  const TickInfo info = schedule_.on_wake(monotonic_now_ns());
+  const TickInfo info = schedule_.on_wake(monotonic_ns());
   ++served_;
   skipped_ += info.skipped;
   lateness_.add(info.lateness_ns);
   return info;
 }
 
-void PeriodicTimer::restart() noexcept { schedule_.reanchor(monotonic_now_ns() + schedule_.period_ns()); }
+void PeriodicTimer::restart() noexcept { schedule_.reanchor(monotonic_ns() + schedule_.period_ns()); }
 
 }  // namespace hystloop

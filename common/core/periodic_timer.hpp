@@ -17,6 +17,7 @@
 
 #include <cstdint>
 
+#include "core/clock.hpp"
 #include "core/latency_stats.hpp"
 
 namespace hystloop {
@@ -29,9 +30,6 @@ struct TickInfo {
   std::int64_t lateness_ns = 0;  // wake_ns - deadline_ns (>= 0 on Linux)
   std::uint64_t skipped = 0;     // deadlines passed over since the previous tick
 };
-
-// CLOCK_MONOTONIC now, in nanoseconds.
-std::int64_t monotonic_now_ns() noexcept;
 
 // Sets how much later than asked the kernel may end the calling thread's timed
 // sleeps (prctl PR_SET_TIMERSLACK; default 50'000 ns, ignored for SCHED_FIFO).

@@ -52,7 +52,7 @@ void BridgeRealtime::start() {
 void BridgeRealtime::begin_safe_stop() noexcept {
   if (stop_result_.requested) return;
   stop_result_.requested = true;
-  safe_stop_begin_ns_ = monotonic_now_ns();
+  safe_stop_begin_ns_ = monotonic_ns();
   safe_stop_.store(true, std::memory_order_release);
 }
 
@@ -61,9 +61,8 @@ SafeStopResult BridgeRealtime::stop() {
     begin_safe_stop();
     const std::int64_t deadline_ns =
         safe_stop_begin_ns_ + static_cast<std::int64_t>(settings_.stop_ramp_timeout_s * 1e9);
-    while (!safe_reached() && monotonic_now_ns() < deadline_ns)
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    const std::int64_t waited_ns = monotonic_now_ns() - safe_stop_begin_ns_;
+    while (!safe_reached() && monotonic_ns() < deadline_ns) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const std::int64_t waited_ns = monotonic_ns() - safe_stop_begin_ns_;
     stop_.store(true, std::memory_order_release);
     thread_.join();
     // Joined: the thread's stop_* fields are ours to read.
@@ -125,7 +124,7 @@ void BridgeRealtime::run() noexcept {
 }
 
 void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
-  const std::int64_t start_ns = monotonic_now_ns();
+  const std::int64_t start_ns = monotonic_ns();
 
   if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
     stop_u_start_V_ = core_.last_applied_V();
@@ -159,7 +158,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   if (arming_.stopping() && !safe_reached_.load(std::memory_order_relaxed)) {
     if (decided.u_applied_V != u_before_V) ++stop_ramp_ticks_;
     if (!core_.armed() && decided.u_applied_V == settings_.limits.safe_u_V) {
-      stop_reached_ns_ = monotonic_now_ns();
+      stop_reached_ns_ = monotonic_ns();
       backend_->hold_safe(settings_.limits.safe_u_V);
       reached_now = true;  // published once this tick's sample is queued
     }
@@ -180,7 +179,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   if (reached_now) safe_reached_.store(true, std::memory_order_release);
 
   RtReport& report = reports_.current();
-  report.work.add(monotonic_now_ns() - start_ns);
+  report.work.add(monotonic_ns() - start_ns);
   reports_.serve_request([&](RtReport& r) {
     r.core = core_.counters();
     r.ticks_skipped = ticks_skipped_;

@@ -86,12 +86,12 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
 }
 
 void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
-  const std::int64_t start_ns = monotonic_now_ns();
+  const std::int64_t start_ns = monotonic_ns();
   // The block's own time, not the receive time: the commands stay a function of the messages.
   // discontinuities_ notes where a confirmed jump or restart went, for log_sequence_events().
   switch (discontinuities_.check(guard_, msg.seq, msg.n_ticks, msg.utime)) {
     case SequenceGuard::Verdict::hold:  // a jump or a restart not confirmed yet: not used
-      work_.add(monotonic_now_ns() - start_ns);
+      work_.add(monotonic_ns() - start_ns);
       return;
     case SequenceGuard::Verdict::restart: restart_control_law(); break;
     case SequenceGuard::Verdict::jump:
@@ -124,7 +124,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
   // recv_utime is LCM's receive time on this host's clock; a value outside [0, 10 s) is not a latency.
   const std::int64_t latency_us = wall_utime() - recv_utime;
   if (latency_us >= 0 && latency_us < 10'000'000) latency_.add(latency_us * 1000);
-  work_.add(monotonic_now_ns() - start_ns);
+  work_.add(monotonic_ns() - start_ns);
 }
 
 void CompensatorService::publish_plan() noexcept {
@@ -173,8 +173,8 @@ void CompensatorService::decide_trajectory(std::int64_t version, const std::stri
     verdict_ = verdict.empty() ? std::string()
                                : fmt::format("trajectory {} {}: {}", version, shaped ? "shaped" : "taken", verdict);
   }
-  verdict_until_ns_ = monotonic_now_ns() + 10'000'000'000;  // 10 s in the status detail
-  verdict_due_ = true;                                      // answered at once, not at the next second
+  verdict_until_ns_ = monotonic_ns() + 10'000'000'000;  // 10 s in the status detail
+  verdict_due_ = true;                                  // answered at once, not at the next second
 }
 
 void CompensatorService::on_trajectory(const trajectory_t& msg) {
@@ -185,7 +185,7 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
   try {
     apply_trajectory(trajectory_from_message(msg), msg.start_utime, msg.version);
     trajectory_version_ = msg.version;
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_ns())) {
       spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", msg.version,
                    msg.shape, msg.amplitude_m, msg.offset_m, msg.frequency_Hz, msg.blend_s, suppressed_note(g));
       if (!verdict_.empty()) spdlog::info("{}", verdict_);
@@ -194,7 +194,7 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
     ++counters_.trajectory_refused;
     refused_version_ = msg.version;  // its repeats are the same refusal
     decide_trajectory(msg.version, e.what(), true, false);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_ns())) {
       spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
     }
   }
@@ -207,13 +207,13 @@ void CompensatorService::on_control(const control_t& msg) {
     ++counters_.control_refused;
     acks_.refused(msg.request_id, why, wall_utime());
     verdict_due_ = true;  // its sender waits for the answer
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogControlRefused, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogControlRefused, monotonic_ns())) {
       spdlog::warn("control request {} (command {}) refused: {}{}", msg.request_id, msg.command, escape_wire(why),
                    suppressed_note(g));
     }
   };
   // What a request did is logged too, at most once a second (the next line says how many were not).
-  auto acted = [&] { return log_limiter_.allow(kLogControl, monotonic_now_ns()); };
+  auto acted = [&] { return log_limiter_.allow(kLogControl, monotonic_ns()); };
   try {
     switch (msg.command) {
       case control_t::SET_MODE:
@@ -423,7 +423,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
                           clamped_in_period_);
   }
   ParamsAdmission::FrozenList frozen;
-  const std::size_t n_frozen = admission_.frozen(monotonic_now_ns(), frozen);
+  const std::size_t n_frozen = admission_.frozen(monotonic_ns(), frozen);
   if (n_frozen > 0 && (state == service_status_t::HEALTHY || state == service_status_t::DEGRADED)) {
     state = service_status_t::DEGRADED;
     for (std::size_t i = 0; i < n_frozen; ++i) {
@@ -450,7 +450,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     detail += fmt::format("; learning a {}-tick period ({} periods learned, last {:.3g} nm RMS)", learner.period_ticks,
                           learner.periods_learned, learner.last_error_rms_m * 1e9);
   }
-  if (!verdict_.empty() && monotonic_now_ns() < verdict_until_ns_) detail += "; " + verdict_;
+  if (!verdict_.empty() && monotonic_ns() < verdict_until_ns_) detail += "; " + verdict_;
   if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail += "; " + note;
   status_.begin(state, detail);
   reported_.report(status_, counters);

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <optional>
@@ -38,9 +39,9 @@ struct Result {
 
 Result run(const Options& opt) {
   const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
-  const auto wanted = static_cast<std::uint64_t>(opt.seconds * 1e9 / static_cast<double>(period) + 0.5);
+  const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
   hystloop::PeriodicTimer timer(period);
-  const std::int64_t start = hystloop::monotonic_now_ns();
+  const std::int64_t start = hystloop::monotonic_ns();
   Result r;
   hystloop::TickInfo t;
   do {
@@ -48,7 +49,7 @@ Result run(const Options& opt) {
     const auto overdue = t.lateness_ns + static_cast<std::int64_t>(t.skipped) * period;
     if (overdue > r.worst_overdue_ns) r.worst_overdue_ns = overdue;
   } while (t.tick + 1 < wanted && !hystloop::stop_requested());
-  r.elapsed_s = 1e-9 * static_cast<double>(hystloop::monotonic_now_ns() - start);
+  r.elapsed_s = 1e-9 * static_cast<double>(hystloop::monotonic_ns() - start);
   r.served = timer.ticks_served();
   r.skipped = timer.skipped_total();
   r.deadlines = t.tick + 1;
@@ -65,7 +66,7 @@ bool consistent(const Result& r, std::uint64_t wanted) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   Options opt;
   CLI::App app{"Runs the hystloop periodic timer and reports its wake-up lateness and missed ticks."};
   app.add_option("--rate", opt.rate_hz, "Tick rate [Hz]")->check(CLI::Range(0.1, 1e6))->capture_default_str();
@@ -85,7 +86,7 @@ int main(int argc, char** argv) {
     if (opt.rt_priority) hystloop::set_realtime_priority(*opt.rt_priority);
 
     const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
-    const auto wanted = static_cast<std::uint64_t>(opt.seconds * 1e9 / static_cast<double>(period) + 0.5);
+    const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
     const Result r = run(opt);
     const auto& l = r.lateness;
     const auto usage = hystloop::read_resource_usage();
@@ -115,4 +116,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hystloop-timer-check: %s\n", e.what());
     return hystloop::kExitUsage;
   }
+} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-timer-check");
 }
