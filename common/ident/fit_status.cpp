@@ -5,7 +5,6 @@ namespace hystloop {
 std::string_view to_string(FitStatus status) noexcept {
   switch (status) {
     case FitStatus::ok: return "ok";
-    case FitStatus::invalid_options: return "invalid_options";
     case FitStatus::size_mismatch: return "size_mismatch";
     case FitStatus::non_finite_data: return "non_finite_data";
     case FitStatus::constant_input: return "constant_input";

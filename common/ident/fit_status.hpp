@@ -1,6 +1,7 @@
 #pragma once
 // Why a fit was refused. Every fitter in common/ident returns one of these with a sentence in
-// `reason`; only `ok` means the parameters may be used.
+// `reason`; only `ok` means the parameters may be used. Options a fitter cannot run with are not
+// a status: their validate() throws ParameterError where they enter, before any data is looked at.
 
 #include <string_view>
 
@@ -8,7 +9,6 @@ namespace hystloop {
 
 enum class FitStatus {
   ok,
-  invalid_options,   // the options themselves failed validate()
   size_mismatch,     // u and y (or t) spans of different length, or empty
   non_finite_data,   // NaN / Inf in the samples
   constant_input,    // u spans less than the minimum input range

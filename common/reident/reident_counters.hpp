@@ -36,8 +36,7 @@ enum class ReidentCounter : std::uint8_t {
   refits_rejected_first      // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };
 
-// A refit's refusals start at size_mismatch: `ok` is no refusal, and `invalid_options` cannot
-// happen online (the options were validated at start), so neither has a counter that never moves.
+// A refit's refusals start at size_mismatch: `ok` is no refusal, so it has no counter.
 inline constexpr FitStatus kFirstRefusal = FitStatus::size_mismatch;
 inline constexpr std::size_t kRefusalCount =
     static_cast<std::size_t>(FitStatus::poisoned_window) - static_cast<std::size_t>(kFirstRefusal) + 1;
@@ -50,7 +49,7 @@ std::string_view counter_name(std::size_t index) noexcept;
 class ReidentCounters {
  public:
   void add(ReidentCounter c, std::uint64_t n = 1) noexcept { values_[index(c)] += n; }
-  // ok / invalid_options (a caller's bug, not a refit's outcome) count as solver_failure.
+  // ok (a caller's bug, not a refit's outcome) counts as solver_failure.
   void add_rejected(FitStatus s) noexcept { values_[rejected_index(s)] += 1; }
   void set(ReidentCounter c, std::uint64_t total) noexcept { values_[index(c)] = total; }  // mirrored totals
   // Since start.
