@@ -55,7 +55,7 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
 
 void BridgeService::on_command(const command_block_t& msg) noexcept {
   ++command_blocks_;
-  if (const auto elapsed = sent_.elapsed_since(msg.sample_seq, monotonic_now_ns())) {
+  if (const auto elapsed = sent_.elapsed_since(msg.sample_seq, monotonic_ns())) {
     latency_.add(*elapsed);
     latency_total_.add(*elapsed);
   }
@@ -150,7 +150,7 @@ void BridgeService::publish_block() noexcept {
   if (const SensorRepair r = repair_.repair(block_); r.any()) {
     ++sensor_blocks_repaired_;
     sensor_ticks_repaired_ += static_cast<std::uint64_t>(r.ticks);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorRepaired, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorRepaired, monotonic_ns())) {
       spdlog::warn(
           "sensor block from seq {}: {} of {} ticks held values the message contract refuses ({} voltages clamped "
           "to +-{} V and flagged SATURATED, {} positions replaced by the last good one and flagged SENSOR_FAULT, {} "
@@ -165,14 +165,14 @@ void BridgeService::publish_block() noexcept {
   } else {
     ++sensor_blocks_unpublished_;
     sensor_ticks_unpublished_ += static_cast<std::uint64_t>(block_.n_ticks);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorUnpublished, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogSensorUnpublished, monotonic_ns())) {
       spdlog::error(
           "sensor block from seq {} ({} ticks) could not be published: {} ticks missing from the record "
           "so far (sensor_ticks_unpublished){}",
           block_.seq, block_.n_ticks, sensor_ticks_unpublished_, suppressed_note(g));
     }
   }
-  sent_.record(last_seq(block_), monotonic_now_ns());
+  sent_.record(last_seq(block_), monotonic_ns());
   publish_truth();
   begin_block(block_, 0, 0, settings_.dt_s());
 }
@@ -307,20 +307,20 @@ void BridgeService::log_safe_stop(const SafeStopResult& r) const {
 }
 
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
-  const BridgeCounters& k = rt.core;
+  const BridgeCounters& core = rt.core;
   CounterSet::Entries now = {
-      {"ticks", k.ticks},
-      {"applied", k.applied},
-      {"late", k.late},
-      {"stale", k.stale},
-      {"duplicates", k.duplicates},
-      {"rejected_nonfinite", k.rejected_nonfinite},
-      {"rejected_future", k.rejected_future},
-      {"clamped", k.clamped},
-      {"slew_limited", k.slew_limited},
-      {"clamped_either", k.clamped_either},
-      {"watchdog_trips", k.watchdog_trips},
-      {"safe_ticks", k.safe_ticks},
+      {"ticks", core.ticks},
+      {"applied", core.applied},
+      {"late", core.late},
+      {"stale", core.stale},
+      {"duplicates", core.duplicates},
+      {"rejected_nonfinite", core.rejected_nonfinite},
+      {"rejected_future", core.rejected_future},
+      {"clamped", core.clamped},
+      {"slew_limited", core.slew_limited},
+      {"clamped_either", core.clamped_either},
+      {"watchdog_trips", core.watchdog_trips},
+      {"safe_ticks", core.safe_ticks},
       {"ticks_skipped", rt.ticks_skipped},
       {"ticks_caught_up", rt.ticks_caught_up},
       {"samples_dropped", rt.samples_dropped},
@@ -341,21 +341,21 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     reset_pending_ = false;
   }
   // Late fraction of this report period, over the ticks that were armed.
-  const std::uint64_t late = k.late - previous_core_.late;
-  const std::uint64_t armed_ticks = late + (k.applied - previous_core_.applied);
+  const std::uint64_t late = core.late - previous_core_.late;
+  const std::uint64_t armed_ticks = late + (core.applied - previous_core_.applied);
   const double late_fraction = armed_ticks > 0 ? static_cast<double>(late) / static_cast<double>(armed_ticks) : 0.0;
   const std::uint64_t dropped = rt.samples_dropped - previous_dropped_;
-  const std::uint64_t too_far_ahead = k.rejected_future - previous_core_.rejected_future;
+  const std::uint64_t too_far_ahead = core.rejected_future - previous_core_.rejected_future;
   if (too_far_ahead > 0) {  // once a report period, whatever the state (a disarmed bridge is SAFE)
     spdlog::warn(
         "{} commands refused for ticks more than {} s ahead of the clock (bridge.max_lead_s): a "
         "compensator.horizon_s beyond it, or a sensor stream this bridge did not send",
         too_far_ahead, settings_.max_lead_s);
   }
-  previous_core_ = k;
+  previous_core_ = core;
   previous_dropped_ = rt.samples_dropped;
-  if (k.watchdog_trips != trips_reported_) {
-    trips_reported_ = k.watchdog_trips;
+  if (core.watchdog_trips != trips_reported_) {
+    trips_reported_ = core.watchdog_trips;
     safe_reason_ =
         fmt::format("watchdog: no command buffered for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
                     settings_.limits.watchdog_s, rt.last_trip_tick);
@@ -410,11 +410,11 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   counters_.report(status_, "command", commands_.counters());
   counters_.report(status_, "control", control_.counters());
   counters_.report(status_, "sensor", sensor_pub_.counters());
-  status_.add_rejected(static_cast<std::int64_t>(counters_.since("rejected_nonfinite", k.rejected_nonfinite) +
-                                                 counters_.since("rejected_future", k.rejected_future) +
+  status_.add_rejected(static_cast<std::int64_t>(counters_.since("rejected_nonfinite", core.rejected_nonfinite) +
+                                                 counters_.since("rejected_future", core.rejected_future) +
                                                  counters_.since("command_queue_full", command_queue_full_) +
                                                  counters_.since("control_refused", control_refused_)));
-  status_.late(static_cast<std::int64_t>(counters_.since("late", k.late)));
+  status_.late(static_cast<std::int64_t>(counters_.since("late", core.late)));
   status_.loop_timing(rt.work);
   status_.latency(latency_);
   status_.publish(utime);

@@ -25,14 +25,14 @@ namespace hystloop {
 bool CompensatorService::admit(const ParamsHeader& h) {
   // Each refusal is counted; it is logged once per reason and publisher (ParamsAdmission), and
   // of those at most one line per reason a second (many publishers: forged ids).
-  const auto log_refusal = [&](ParamsRefusal reason) {
+  const auto log_refusal = [&](ParamsRefusal reason, LogReason line) {
     if (!admission_.first_refusal(h.publisher_id, reason)) return LogLimiter::Gate{};
-    return log_limiter_.allow(kLogParamsInvalid + static_cast<std::size_t>(reason), monotonic_now_ns());
+    return log_limiter_.allow(line, monotonic_ns());
   };
   const auto from = static_cast<std::uint64_t>(h.publisher_id);
   if (!h.valid) {
     ++counters_.params_invalid;
-    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::invalid)) {
+    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::invalid, kLogParamsInvalid)) {
       spdlog::warn(
           "{} parameters v{} from '{}' (publisher {:x}) are marked invalid; not used (further invalid "
           "sets from this publisher are counted, params_invalid, not logged){}",
@@ -43,12 +43,12 @@ bool CompensatorService::admit(const ParamsHeader& h) {
   if (!admission_.is_new(h.publisher_id, h.version)) {
     ++counters_.params_stale;
     // Below the version accepted from it (not a repeat of that one): counts toward frozen out.
-    if (admission_.refuse_stale(h.publisher_id, h.version, monotonic_now_ns())) {
+    if (admission_.refuse_stale(h.publisher_id, h.version, monotonic_ns())) {
       ++counters_.params_stale_below;
     } else {
       ++counters_.params_stale_repeat;
     }
-    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale)) {
+    if (const LogLimiter::Gate g = log_refusal(ParamsRefusal::stale, kLogParamsStale)) {
       spdlog::info(
           "{} parameters v{} from '{}' (publisher {:x}) ignored: not newer than v{} accepted from it "
           "(further stale sets from this publisher are counted, params_stale, not logged){}",
@@ -69,7 +69,7 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
       compensator_->offer_mem_params(set.mem, h.version);
     }
     admission_.accept(h.publisher_id, h.version);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_ns())) {
       spdlog::info(
           "{} parameters v{} from '{}' (publisher {:x}) accepted ({}; residual {:.3g} m); swapped in at the "
           "next reversal{}",
@@ -78,7 +78,7 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
   } catch (const ParameterError& e) {
     ++counters_.params_refused;
     if (!admission_.first_refusal(h.publisher_id, ParamsRefusal::refused)) return;
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsRefused, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsRefused, monotonic_ns())) {
       spdlog::warn(
           "{} parameters v{} from '{}' (publisher {:x}) refused: {} (further refusals from this publisher "
           "are counted, params_rejected, not logged){}",
@@ -102,7 +102,7 @@ void CompensatorService::on_model(const model_params_t& msg) {
   if (!set) {
     std::uint64_t& count = format_known ? counters_.model_unknown_kind : counters_.model_unknown_format;
     ++count;
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogModelUnknown, monotonic_now_ns())) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogModelUnknown, monotonic_ns())) {
       spdlog::warn(
           "model parameters v{} from '{}' (publisher {:x}) refused: {} {} is not one this build knows "
           "(counted, {}){}",

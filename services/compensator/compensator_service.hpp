@@ -135,7 +135,6 @@ class CompensatorService {
   void restart_control_law();
   void log_sequence_events();
   // Log-line reasons (LogLimiter): each at most once a second, the next saying how many were suppressed.
-  // kLogParamsInvalid + ParamsRefusal: one reason each (invalid, stale, refused).
   enum LogReason : std::size_t {
     kLogTrajectory,
     kLogTrajectoryRefused,
