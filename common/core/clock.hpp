@@ -7,7 +7,9 @@
 //                   (clock_nanosleep), so a tick's deadline and a cost measured around it agree.
 //                   monotonic_s() is the same clock in seconds.
 // Algorithms in common/ do not read either: they take time as an argument (or, for the fitters'
-// time budget, a FitClock: ident/fit_clock.hpp), so they stay reproducible under test.
+// time budget, a FitClock: ident/fit_clock.hpp), so they stay reproducible under test. The one
+// reader in common/ is the re-identifier's worker jobs (reident/), which time themselves for the
+// status line: instrumentation that no result depends on.
 
 #include <time.h>
 

@@ -1,12 +1,12 @@
 #include "reident/model_chooser.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <utility>
 
 #include <spdlog/spdlog.h>
 
+#include "core/clock.hpp"
 #include "core/errors.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "reident/reident_core.hpp"
@@ -31,7 +31,7 @@ ModelChooser::ModelChooser(const ModelChoiceOptions& options, const ModelParamSe
 }
 
 void ModelChooser::evaluate_job() {
-  const auto t0 = std::chrono::steady_clock::now();
+  const double t0_s = monotonic_s();
   try {
     result_ = job_poisoned_ ? ModelProposal{} : propose_model(window_.u, window_.y, job_in_use_, job_options_);
     if (job_poisoned_) result_.reason = "window poisoned (non-finite sample or dropout)";
@@ -39,7 +39,7 @@ void ModelChooser::evaluate_job() {
     result_ = ModelProposal{};
     result_.reason = e.what();
   }
-  duration_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  duration_s_ = monotonic_s() - t0_s;
   spdlog::debug("model selection: {} ({:.0f} ms)", result_.reason, duration_s_ * 1e3);
 }
 

@@ -1,9 +1,10 @@
 #include "reident/refit_worker.hpp"
 
-#include <chrono>
 #include <exception>
 #include <string>
 #include <utility>
+
+#include "core/clock.hpp"
 
 namespace hystloop {
 
@@ -26,8 +27,7 @@ bool RefitWorker::submit(const MemParams& in_use, std::uint64_t version) noexcep
 }
 
 void RefitWorker::evaluate_job() {
-  using clock = std::chrono::steady_clock;
-  const auto start = clock::now();
+  const double start_s = monotonic_s();
   try {
     result_.outcome = OnlineMemEstimator::evaluate(window_, in_use_, in_use_version_, options_);
   } catch (const std::exception& e) {  // nothing may escape a thread; a failed refit is a refusal
@@ -48,7 +48,7 @@ void RefitWorker::evaluate_job() {
       result_.implausible = true;
     }
   }
-  result_.duration_s = std::chrono::duration<double>(clock::now() - start).count();
+  result_.duration_s = monotonic_s() - start_s;
   result_.window_first_seq = window_.first_seq;
   result_.window_samples = window_.u.size();
   if (on_evaluated_) {
