@@ -36,6 +36,27 @@ double rounded_triangle(double x, double corner) noexcept {
 
 }  // namespace
 
+std::string_view to_string(TrajectoryShape shape) noexcept {
+  const auto i = static_cast<std::size_t>(shape);
+  return i < kTrajectoryShapeNames.size() ? kTrajectoryShapeNames[i] : "unknown";
+}
+
+std::optional<TrajectoryShape> trajectory_shape_named(std::string_view name) noexcept {
+  for (std::size_t i = 0; i < kTrajectoryShapeNames.size(); ++i) {
+    if (kTrajectoryShapeNames[i] == name) return static_cast<TrajectoryShape>(i);
+  }
+  return std::nullopt;
+}
+
+std::string trajectory_shape_choices() {
+  std::string out;
+  for (std::size_t i = 0; i < kTrajectoryShapeNames.size(); ++i) {
+    if (i > 0) out += i + 1 == kTrajectoryShapeNames.size() ? " or " : ", ";
+    out += kTrajectoryShapeNames[i];
+  }
+  return out;
+}
+
 void TrajectorySpec::validate() const {
   require_finite("trajectory.amplitude_m", amplitude_m);
   require_finite("trajectory.offset_m", offset_m);

@@ -6,10 +6,21 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <string_view>
 
 namespace hystloop {
 
 enum class TrajectoryShape : std::int8_t { kHold = 0, kSine = 1, kCosine = 2, kTriangle = 3, kPoints = 4 };
+
+// The shapes' names, in the enum's order: the one table behind config (trajectory.shape), ctl's
+// --shape, describe() and the report. trajectory_t's shape constants are the same numbers
+// (lcm/trajectory_shape.hpp maps and checks them).
+inline constexpr std::array<std::string_view, 5> kTrajectoryShapeNames{"hold", "sine", "cosine", "triangle", "points"};
+std::string_view to_string(TrajectoryShape shape) noexcept;  // "unknown" outside the enum
+std::optional<TrajectoryShape> trajectory_shape_named(std::string_view name) noexcept;
+// "hold, sine, cosine, triangle or points", for a refusal that lists what is accepted.
+std::string trajectory_shape_choices();
 
 // y_ref(t) for t >= start_s. Before start_s the reference approaches the shape's first value
 // from hold_m along a raised cosine over blend_s (it holds hold_m before that), so switching

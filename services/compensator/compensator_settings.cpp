@@ -15,12 +15,8 @@ namespace hystloop {
 namespace {
 
 TrajectoryShape parse_shape(const Config& config, const std::string& name) {
-  if (name == "hold") return TrajectoryShape::kHold;
-  if (name == "sine") return TrajectoryShape::kSine;
-  if (name == "cosine") return TrajectoryShape::kCosine;
-  if (name == "triangle") return TrajectoryShape::kTriangle;
-  if (name == "points") return TrajectoryShape::kPoints;
-  config.fail("trajectory.shape", "must be hold, sine, cosine, triangle or points (got '" + name + "')");
+  if (const auto shape = trajectory_shape_named(name)) return *shape;
+  config.fail("trajectory.shape", "must be " + trajectory_shape_choices() + " (got '" + name + "')");
 }
 
 ShapingFunction read_shaping(const Config& config, const std::string& prefix, const ShapingFunction& fallback) {
@@ -322,10 +318,8 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
                               c.learning.cutoff_hz, c.learning.max_correction_m, c.learning.max_period_s,
                               c.learning.lag_compensated ? ", lag-compensated" : ""));
   lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
-  static const char* shapes[] = {"hold", "sine", "cosine", "triangle", "points"};
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
-                              shapes[static_cast<int>(t.shape)], t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s,
-                              t.n_points));
+                              to_string(t.shape), t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s, t.n_points));
   return lines;
 }
 

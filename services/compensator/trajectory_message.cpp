@@ -3,19 +3,15 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "lcm/trajectory_shape.hpp"
 
 namespace hystloop {
 
 TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
   TrajectorySpec spec;
-  switch (msg.shape) {
-    case trajectory_t::HOLD: spec.shape = TrajectoryShape::kHold; break;
-    case trajectory_t::SINE: spec.shape = TrajectoryShape::kSine; break;
-    case trajectory_t::COSINE: spec.shape = TrajectoryShape::kCosine; break;
-    case trajectory_t::TRIANGLE: spec.shape = TrajectoryShape::kTriangle; break;
-    case trajectory_t::POINTS: spec.shape = TrajectoryShape::kPoints; break;
-    default: throw ParameterError("trajectory.shape", "unknown shape " + std::to_string(msg.shape));
-  }
+  const auto shape = trajectory_shape_from_wire(msg.shape);
+  if (!shape) throw ParameterError("trajectory.shape", "unknown shape " + std::to_string(msg.shape));
+  spec.shape = *shape;
   spec.amplitude_m = msg.amplitude_m;
   spec.offset_m = msg.offset_m;
   spec.frequency_hz = msg.frequency_Hz > 0.0 ? msg.frequency_Hz : 1.0;  // ignored for HOLD and POINTS

@@ -12,6 +12,19 @@
 namespace hystloop {
 namespace {
 
+TEST(Trajectory, ShapeNamesAreOneTableBothWays) {
+  for (std::size_t i = 0; i < kTrajectoryShapeNames.size(); ++i) {
+    const auto shape = static_cast<TrajectoryShape>(i);
+    EXPECT_EQ(trajectory_shape_named(to_string(shape)), shape) << i;
+  }
+  EXPECT_EQ(trajectory_shape_named("triangle"), TrajectoryShape::kTriangle);
+  EXPECT_EQ(to_string(TrajectoryShape::kCosine), "cosine");
+  EXPECT_FALSE(trajectory_shape_named("Triangle").has_value());  // names are exact, as in the config
+  EXPECT_FALSE(trajectory_shape_named("").has_value());
+  EXPECT_EQ(to_string(static_cast<TrajectoryShape>(9)), "unknown");
+  EXPECT_EQ(trajectory_shape_choices(), "hold, sine, cosine, triangle or points");
+}
+
 TEST(Trajectory, MemPaperReferenceIsEq24) {
   const TrajectorySpec s = mem_paper_reference(0.0);
   for (double t : {0.0, 0.1, 0.25, 0.5, 0.77, 3.0}) {

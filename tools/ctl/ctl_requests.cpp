@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "lcm/message_checks.hpp"
+#include "lcm/trajectory_shape.hpp"
 #include "loop/compensator.hpp"
 #include "loop/feedback.hpp"
 #include "loop/params_admission.hpp"
@@ -16,14 +17,6 @@
 namespace hystloop::ctl {
 
 namespace {
-
-constexpr std::array<std::pair<std::string_view, std::int8_t>, 5> kShapes{{
-    {"hold", trajectory_t::HOLD},
-    {"sine", trajectory_t::SINE},
-    {"cosine", trajectory_t::COSINE},
-    {"triangle", trajectory_t::TRIANGLE},
-    {"points", trajectory_t::POINTS},
-}};
 
 constexpr std::array<std::pair<std::string_view, std::int8_t>, 3> kLearning{{
     {"on", control_t::LEARNING_ON},
@@ -41,6 +34,11 @@ std::int8_t lookup(const std::array<std::pair<std::string_view, std::int8_t>, N>
     names += key;
   }
   throw ParameterError(std::string(field), "must be one of " + names + " (got '" + std::string(name) + "')");
+}
+
+std::int8_t shape_on_wire(std::string_view name) {
+  if (const auto shape = trajectory_shape_named(name)) return to_wire(*shape);
+  throw ParameterError("shape", "must be " + trajectory_shape_choices() + " (got '" + std::string(name) + "')");
 }
 
 std::string str(double v) {
@@ -123,7 +121,7 @@ void apply(const ExperimentRequest& experiment, control_t& msg) {
 }
 
 void TrajectoryRequest::validate() const {
-  const std::int8_t s = lookup(kShapes, "shape", shape);
+  const std::int8_t s = shape_on_wire(shape);
   require_in_range("amplitude", amplitude_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   require_in_range("offset", offset_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   require_finite("phase", phase_rad);
@@ -202,7 +200,7 @@ trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t vers
   trajectory_t msg{};
   msg.utime = utime;
   msg.version = version;
-  msg.shape = lookup(kShapes, "shape", request.shape);
+  msg.shape = shape_on_wire(request.shape);
   const bool periodic =
       msg.shape == trajectory_t::SINE || msg.shape == trajectory_t::COSINE || msg.shape == trajectory_t::TRIANGLE;
   msg.amplitude_m = request.amplitude_m;

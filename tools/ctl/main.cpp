@@ -47,6 +47,7 @@
 #include "auth/rig_key.hpp"
 #include "lcm/rig_auth.hpp"
 #include "lcm/servo_gains_status.hpp"
+#include "loop/trajectory.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -388,7 +389,7 @@ int run(int argc, char** argv) {
       ->needs(series);
 
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
-  trajectory->add_option("--shape", o.trajectory.shape, "cosine, sine, triangle, hold or points");
+  trajectory->add_option("--shape", o.trajectory.shape, trajectory_shape_choices());
   trajectory->add_option("--amplitude", o.trajectory.amplitude_m, "Peak amplitude [m] (may be negative)")
       ->capture_default_str();
   trajectory->add_option("--frequency", o.trajectory.frequency_Hz, "Frequency [Hz] of the periodic shapes")

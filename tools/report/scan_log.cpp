@@ -1,9 +1,12 @@
 #include "scan_log.hpp"
 
 #include <set>
+#include <string>
+#include <string_view>
 #include <utility>
 
 #include "decode.hpp"
+#include "lcm/trajectory_shape.hpp"
 #include "log_reader.hpp"
 #include "models/model_set.hpp"
 
@@ -11,15 +14,9 @@ namespace hystloop::report {
 
 namespace {
 
-const char* shape_name(std::int8_t shape) noexcept {
-  switch (shape) {
-    case trajectory_t::HOLD: return "hold";
-    case trajectory_t::SINE: return "sine";
-    case trajectory_t::COSINE: return "cosine";
-    case trajectory_t::TRIANGLE: return "triangle";
-    case trajectory_t::POINTS: return "points";
-    default: return "unknown";
-  }
+std::string_view shape_name(std::int8_t shape) noexcept {
+  const auto known = trajectory_shape_from_wire(shape);
+  return known ? to_string(*known) : "unknown";
 }
 
 std::optional<ScanControl::Kind> control_kind(const control_t& c) noexcept {
@@ -66,8 +63,9 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
     const std::int64_t t = event.timestamp;
     if (event.channel == channels.trajectory) {
       if (!decode_checked(event, trajectory) || !versions.insert(trajectory.version).second) return;
-      out.trajectories.push_back({t, trajectory.version, shape_name(trajectory.shape), trajectory.amplitude_m,
-                                  trajectory.offset_m, trajectory.frequency_Hz, trajectory.blend_s, trajectory.corner_s,
+      out.trajectories.push_back({t, trajectory.version, std::string(shape_name(trajectory.shape)),
+                                  trajectory.amplitude_m, trajectory.offset_m, trajectory.frequency_Hz,
+                                  trajectory.blend_s, trajectory.corner_s,
                                   trajectory.if_infeasible == trajectory_t::SHAPE});
     } else if (event.channel == channels.control) {
       if (!decode_checked(event, control)) return;
