@@ -61,7 +61,16 @@ std::optional<ModelKind> model_kind_of(FeedforwardMode mode) noexcept {
 FeedforwardMode parse_feedforward_mode(const std::string& name, const std::string& field) {
   if (name == "off") return FeedforwardMode::kOff;
   if (const auto kind = parse_model_kind(name)) return mode_of(*kind);
-  throw ParameterError(field, "unknown mode '" + name + "' (expected off, linear, mem, pi or katalenic)");
+  throw ParameterError(field, "unknown mode '" + name + "' (expected " + selectable_mode_choices() + ")");
+}
+
+std::string selectable_mode_choices() {
+  std::string out;
+  for (auto m = static_cast<int>(FeedforwardMode::kOff); m <= static_cast<int>(FeedforwardMode::kKatalenic); ++m) {
+    if (!out.empty()) out += m == static_cast<int>(FeedforwardMode::kKatalenic) ? " or " : ", ";
+    out += to_string(static_cast<FeedforwardMode>(m));
+  }
+  return out;
 }
 
 const char* to_string(FeedforwardMode mode) noexcept {

@@ -68,6 +68,8 @@ enum class FeedforwardMode : std::int8_t {
 
 // Parses "off|linear|mem|pi|katalenic"; throws ParameterError naming `field`.
 FeedforwardMode parse_feedforward_mode(const std::string& name, const std::string& field = "compensator.mode");
+// "off, linear, mem, pi or katalenic": the modes a config or SET_MODE may select, in wire order.
+std::string selectable_mode_choices();
 const char* to_string(FeedforwardMode mode) noexcept;
 // The mode that inverts `kind`, and the model a mode inverts (none for off and experiment).
 FeedforwardMode mode_of(ModelKind kind) noexcept;

@@ -12,6 +12,7 @@
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
+#include "lcm/feedforward_mode.hpp"
 #include "runtime/counter_baseline.hpp"
 #include "runtime/io_loop.hpp"
 
@@ -216,15 +217,17 @@ void CompensatorService::on_control(const control_t& msg) {
   auto acted = [&] { return log_limiter_.allow(kLogControl, monotonic_ns()); };
   try {
     switch (msg.command) {
-      case control_t::SET_MODE:
-        if (msg.mode < command_block_t::MODE_OFF || msg.mode > command_block_t::MODE_KATALENIC) {
-          return refuse("mode " + std::to_string(msg.mode) + " is not selectable (off, linear, mem, pi, katalenic)");
+      case control_t::SET_MODE: {
+        const auto mode = feedforward_mode_from_wire(msg.mode);
+        if (!mode || *mode == FeedforwardMode::kExperiment) {
+          return refuse("mode " + std::to_string(msg.mode) + " is not selectable (" + selectable_mode_choices() + ")");
         }
-        compensator_->set_mode(static_cast<FeedforwardMode>(msg.mode));
+        compensator_->set_mode(*mode);
         if (const LogLimiter::Gate g = acted()) {
           spdlog::info("mode {} (request {}){}", to_string(compensator_->mode()), msg.request_id, suppressed_note(g));
         }
         break;
+      }
       case control_t::START_EXPERIMENT: {
         const ExperimentSpec e =
             make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,

@@ -8,6 +8,7 @@
 
 #include "core/clock.hpp"
 #include "core/process.hpp"
+#include "lcm/feedforward_mode.hpp"
 #include "runtime/io_loop.hpp"
 #include "runtime/model_params_message.hpp"
 
@@ -255,17 +256,13 @@ void ReidentService::publish_model(const ModelDecision& d) {
 }
 
 void ReidentService::pin_model(const control_t& msg) {
-  std::optional<ModelKind> kind;
-  switch (msg.mode) {
-    case command_block_t::MODE_OFF: break;  // automatic choice again
-    case command_block_t::MODE_LINEAR: kind = ModelKind::linear; break;
-    case command_block_t::MODE_MEM: kind = ModelKind::mem; break;
-    case command_block_t::MODE_PI: kind = ModelKind::pi; break;
-    case command_block_t::MODE_KATALENIC: kind = ModelKind::katalenic; break;
-    default:
-      spdlog::warn("pin-model request {}: mode {} names no model; ignored", msg.request_id, msg.mode);
-      acks_.refused(msg.request_id, "mode " + std::to_string(msg.mode) + " names no model", wall_utime());
-      return;
+  // MODE_OFF: the automatic choice again; a model's mode pins that model; anything else names none.
+  const auto mode = feedforward_mode_from_wire(msg.mode);
+  const std::optional<ModelKind> kind = mode ? model_kind_of(*mode) : std::nullopt;
+  if (!kind && mode != FeedforwardMode::kOff) {
+    spdlog::warn("pin-model request {}: mode {} names no model; ignored", msg.request_id, msg.mode);
+    acks_.refused(msg.request_id, "mode " + std::to_string(msg.mode) + " names no model", wall_utime());
+    return;
   }
   if (!chooser_->enabled()) {
     spdlog::warn("pin-model request {} refused: reidentifier.models is off, no model choice runs", msg.request_id);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "hystloop/command_block_t.hpp"
+#include "lcm/feedforward_mode.hpp"
 
 namespace hystloop::report {
 
@@ -135,15 +136,8 @@ std::size_t decimation_step(std::size_t n, std::size_t max_points) noexcept {
 }
 
 const char* mode_name(std::int8_t mode) noexcept {
-  switch (mode) {
-    case command_block_t::MODE_OFF: return "off";
-    case command_block_t::MODE_LINEAR: return "linear";
-    case command_block_t::MODE_MEM: return "mem";
-    case command_block_t::MODE_PI: return "pi";
-    case command_block_t::MODE_KATALENIC: return "katalenic";
-    case command_block_t::MODE_EXPERIMENT: return "experiment";
-    default: return "unknown";
-  }
+  const auto known = feedforward_mode_from_wire(mode);
+  return known ? to_string(*known) : "unknown";
 }
 
 TickPhase phase_of(const TrackPoint& p) noexcept {

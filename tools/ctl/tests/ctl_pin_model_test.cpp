@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
+#include "lcm/feedforward_mode.hpp"
 
 namespace hystloop::ctl {
 namespace {
@@ -18,6 +19,32 @@ TEST(CtlPinModel, NamesMapToTheModesTheReidentifierReads) {
   EXPECT_EQ(pin_model_mode("auto"), command_block_t::MODE_OFF);
   EXPECT_EQ(pin_model_mode("off"), command_block_t::MODE_OFF);
   for (const char* bad : {"", "banning", "MEM", "experiment"}) EXPECT_THROW(pin_model_mode(bad), ParameterError) << bad;
+}
+
+TEST(CtlPinModel, TheRefusalListsEveryModelAndAuto) {
+  try {
+    pin_model_mode("banning");
+    FAIL() << "banning accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected mem, pi, katalenic, linear or auto (got \"banning\")"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// The wire's mode numbers and FeedforwardMode are one numbering (lcm/feedforward_mode.hpp): every
+// MODE_* round-trips, a number beyond them is refused, and the modes a config may name are listed.
+TEST(FeedforwardModeWire, EveryModeRoundTripsAndOthersAreRefused) {
+  for (std::int8_t w = command_block_t::MODE_OFF; w <= command_block_t::MODE_EXPERIMENT; ++w) {
+    const auto mode = feedforward_mode_from_wire(w);
+    ASSERT_TRUE(mode.has_value()) << int{w};
+    EXPECT_EQ(to_wire(*mode), w);
+  }
+  EXPECT_EQ(feedforward_mode_from_wire(command_block_t::MODE_PI), FeedforwardMode::kPi);
+  for (std::int8_t w : {std::int8_t{-1}, std::int8_t{6}, std::int8_t{127}}) {
+    EXPECT_FALSE(feedforward_mode_from_wire(w).has_value()) << int{w};
+  }
+  EXPECT_EQ(selectable_mode_choices(), "off, linear, mem, pi or katalenic");
 }
 
 }  // namespace
