@@ -8,12 +8,14 @@
 #include <cstdio>
 #include <chrono>
 #include <ctime>
+#include <exception>
 #include <thread>
 
 #include <spdlog/spdlog.h>
 
 #include "bridge/bridge_health.hpp"
 #include "bridge/servo_request.hpp"
+#include "runtime/summary_file.hpp"
 #include "core/clock.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
@@ -458,29 +460,52 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
   const double wall_s = monotonic_s() - started_s_;
   const ResourceUsage usage = read_resource_usage();
   const auto pct = [&](double q) { return latency_total_.count() > 0 ? latency_total_.percentile(q) / 1e3 : -1.0; };
-  const std::string json = fmt::format(
-      "{{\"ticks\": {}, \"armed_ticks\": {}, \"late_ticks\": {}, \"late_tick_fraction\": {:.9g}, "
-      "\"watchdog_trips\": {}, \"buffer_min_depth_ticks\": {}, \"ticks_skipped\": {}, \"ticks_caught_up\": {}, "
-      "\"stale\": {}, \"duplicates\": {}, \"rejected\": {}, \"samples_dropped\": {}, \"sensor_blocks\": {}, "
-      "\"command_blocks\": {}, \"block_to_answer_us\": {{\"p50\": {:.1f}, \"p99\": {:.1f}, \"max\": {:.1f}, "
-      "\"count\": {}}}, \"applied\": {}, \"clamped\": {}, \"slew_limited\": {}, "
-      "\"clamped_ticks\": {{\"range\": {}, \"slew\": {}, \"either\": {}}}, \"rejected_nonfinite\": {}, "
-      "\"rejected_future\": {}, \"command_blocks_rejected\": {}, "
-      "\"wall_s\": {:.3f}, \"cpu_s\": {:.3f}, \"cpu_fraction\": {:.4f}, "
-      "\"stop\": {{\"safe_reached\": {}, \"u_start_V\": {:.9g}, \"ramp_ticks\": {}, \"ramp_s\": {:.6g}, "
-      "\"wall_s\": {:.6g}, \"bound_s\": {:.6g}, \"safe_u_V\": {:.6g}}}}}\n",
-      c.ticks, static_cast<std::uint64_t>(armed_ticks), c.late,
-      armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0, c.watchdog_trips, rt.min_depth_total,
-      rt.ticks_skipped, rt.ticks_caught_up, c.stale, c.duplicates, c.rejected_nonfinite + c.rejected_future,
-      rt.samples_dropped, sensor_blocks_, command_blocks_, pct(0.5), pct(0.99),
-      latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0, latency_total_.count(),
-      c.applied, c.clamped, c.slew_limited, c.clamped, c.slew_limited, c.clamped_either, c.rejected_nonfinite,
-      c.rejected_future, commands_.counters().rejected_total(), wall_s, usage.user_cpu_s + usage.system_cpu_s,
-      wall_s > 0 ? (usage.user_cpu_s + usage.system_cpu_s) / wall_s : 0.0, safe.reached, safe.u_start_V,
-      safe.ramp_ticks, safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s, settings_.limits.safe_u_V);
-  std::FILE* f = std::fopen(summary_json_path_.c_str(), "w");
-  if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
-    spdlog::error("could not write the summary to {}", summary_json_path_);
+  // One decimal for the latencies [us], as the log lines print them.
+  const auto us = [](double v) { return v < 0 ? v : std::round(v * 10.0) / 10.0; };
+  const double cpu_s = usage.user_cpu_s + usage.system_cpu_s;
+  const nlohmann::ordered_json json = {
+      {"ticks", c.ticks},
+      {"armed_ticks", static_cast<std::uint64_t>(armed_ticks)},
+      {"late_ticks", c.late},
+      {"late_tick_fraction", armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0},
+      {"watchdog_trips", c.watchdog_trips},
+      {"buffer_min_depth_ticks", rt.min_depth_total},
+      {"ticks_skipped", rt.ticks_skipped},
+      {"ticks_caught_up", rt.ticks_caught_up},
+      {"stale", c.stale},
+      {"duplicates", c.duplicates},
+      {"rejected", c.rejected_nonfinite + c.rejected_future},
+      {"samples_dropped", rt.samples_dropped},
+      {"sensor_blocks", sensor_blocks_},
+      {"command_blocks", command_blocks_},
+      {"block_to_answer_us",
+       {{"p50", us(pct(0.5))},
+        {"p99", us(pct(0.99))},
+        {"max", us(latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0)},
+        {"count", latency_total_.count()}}},
+      {"applied", c.applied},
+      {"clamped", c.clamped},
+      {"slew_limited", c.slew_limited},
+      {"clamped_ticks", {{"range", c.clamped}, {"slew", c.slew_limited}, {"either", c.clamped_either}}},
+      {"rejected_nonfinite", c.rejected_nonfinite},
+      {"rejected_future", c.rejected_future},
+      {"command_blocks_rejected", commands_.counters().rejected_total()},
+      {"wall_s", wall_s},
+      {"cpu_s", cpu_s},
+      {"cpu_fraction", wall_s > 0 ? cpu_s / wall_s : 0.0},
+      {"stop",
+       {{"safe_reached", safe.reached},
+        {"u_start_V", safe.u_start_V},
+        {"ramp_ticks", safe.ramp_ticks},
+        {"ramp_s", safe.ramp_s},
+        {"wall_s", safe.wall_s},
+        {"bound_s", settings_.stop_ramp_timeout_s},
+        {"safe_u_V", settings_.limits.safe_u_V}}},
+  };
+  try {
+    write_file_atomically(summary_json_path_, to_json_text(json));
+  } catch (const std::exception& e) {
+    spdlog::error("could not write the summary: {}", e.what());
   }
 }
 

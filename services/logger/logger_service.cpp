@@ -15,6 +15,7 @@
 #include "core/process.hpp"
 #include "core/saturating.hpp"
 #include "lcm/connection.hpp"
+#include "runtime/summary_file.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"

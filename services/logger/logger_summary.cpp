@@ -7,32 +7,12 @@
 #include <system_error>
 
 #include "core/escape.hpp"
+#include "runtime/summary_file.hpp"
 #include "core/saturating.hpp"
 
 namespace hystloop {
 
 namespace {
-std::string json_string(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20 ||
-            static_cast<unsigned char>(c) >= 0x7f) {  // keep the JSON valid UTF-8
-          char escaped[8];
-          std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          out += escaped;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
 
 struct Totals {
   std::uint64_t received = 0, written = 0, dropped = 0, bytes_written = 0, gap_events = 0, missing = 0, skipped = 0;
@@ -63,69 +43,97 @@ Totals totals_of(const ChannelTable& channels) {
 }  // namespace
 
 std::string summary_json(const RecordingSummary& s, const ChannelTable& channels) {
+  using Json = nlohmann::ordered_json;
   const Totals t = totals_of(channels);
-  std::ostringstream j;
-  j.precision(6);
-  j << std::fixed;
-  j << "{\n  \"recording\": " << json_string(s.recording) << ",\n  \"start_utime\": " << s.start_utime
-    << ",\n  \"stop_utime\": " << s.stop_utime << ",\n  \"duration_s\": " << s.duration_s
-    << ",\n  \"stop_reason\": " << json_string(s.stop_reason) << ",\n  \"files\": [";
-  for (std::size_t i = 0; i < s.files.size(); ++i) {
-    const LogFileInfo& f = s.files[i];
-    j << (i ? "," : "") << "\n    {\"path\": " << json_string(f.path.string()) << ", \"events\": " << f.events
-      << ", \"bytes\": " << f.bytes << "}";
-  }
-  j << "\n  ],\n  \"totals\": {\"received\": " << t.received << ", \"written\": " << t.written
-    << ", \"dropped\": " << saturating_add(t.dropped, s.unrecorded_channel)
-    << ", \"bytes_written\": " << t.bytes_written << ", \"gap_events\": " << t.gap_events
-    << ", \"missing\": " << t.missing << ", \"skipped\": " << t.skipped
-    << ", \"contract_violations\": " << t.contract_violations << "},\n";
-  j << "  \"dropped\": {\"queue_full\": " << t.queue_full << ", \"oversize\": " << t.oversize
-    << ", \"write_failed\": " << t.write_failed << ", \"unrecorded_channel\": " << s.unrecorded_channel << "},\n";
+  Json files = Json::array();
+  for (const LogFileInfo& f : s.files)
+    files.push_back({{"path", f.path.string()}, {"events", f.events}, {"bytes", f.bytes}});
   const DiskFaults& d = s.disk;
-  j << "  \"disk\": {\"ok\": " << (d.errors == 0 ? "true" : "false") << ", \"errors\": " << d.errors
-    << ", \"last_error\": " << json_string(d.errors == 0 ? "" : d.reason()) << ", \"events_lost\": " << d.events_lost
-    << ", \"files_truncated\": " << d.files_truncated << ", \"files_removed\": " << d.files_removed
-    << ", \"unconfirmed_events\": " << d.unconfirmed_events << ", \"recoveries\": " << d.recoveries << "},\n";
   const UnknownChannels& u = channels.unknown();
-  j << "  \"unknown_channels\": {\"messages\": " << u.messages() << ", \"distinct\": " << u.distinct()
-    << ", \"distinct_is_lower_bound\": " << (u.distinct_is_lower_bound() ? "true" : "false") << ", \"first\": [";
-  for (std::size_t i = 0; i < u.kept_count(); ++i) j << (i ? ", " : "") << json_string(u.kept_name(i));
-  j << "]},\n";
-  j << "  \"queue\": {\"capacity_bytes\": " << s.queue_capacity_bytes
-    << ", \"high_water_bytes\": " << s.queue_high_water_bytes << "},\n";
-  j << "  \"process\": {\"cpu_user_s\": " << s.cpu_user_s << ", \"cpu_system_s\": " << s.cpu_system_s
-    << ", \"peak_rss_bytes\": " << s.peak_rss_bytes << "},\n  \"channels\": {";
+  Json first_unknown = Json::array();
+  for (std::size_t i = 0; i < u.kept_count(); ++i) first_unknown.push_back(std::string(u.kept_name(i)));
+  Json per_channel = Json::object();
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
-    j << (i ? "," : "") << "\n    " << json_string(c.name_view()) << ": {\"received\": " << c.received
-      << ", \"bytes_received\": " << c.bytes_received << ", \"written\": " << c.written.load()
-      << ", \"bytes_written\": " << c.bytes_written.load() << ", \"dropped\": " << c.dropped()
-      << ", \"dropped_queue_full\": " << c.dropped_queue_full << ", \"dropped_oversize\": " << c.dropped_oversize
-      << ", \"write_failed\": " << c.write_failed.load();
+    Json ch = {{"received", c.received},
+               {"bytes_received", c.bytes_received},
+               {"written", c.written.load()},
+               {"bytes_written", c.bytes_written.load()},
+               {"dropped", c.dropped()},
+               {"dropped_queue_full", c.dropped_queue_full},
+               {"dropped_oversize", c.dropped_oversize},
+               {"write_failed", c.write_failed.load()}};
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
-      j << ",\n      \"sequence\": {\"blocks\": " << q.observed() << ", \"ticks\": " << q.ticks()
-        << ", \"first_seq\": " << q.first_seq() << ", \"last_seq\": " << q.last_seq()
-        << ", \"gap_events\": " << q.gap_events() << ", \"missing\": " << q.missing()
-        << ", \"resumes\": " << q.resumes() << ", \"skipped\": " << q.skipped() << ", \"overlaps\": " << q.overlaps()
-        << ", \"overlap_ticks\": " << q.overlap_ticks() << ", \"duplicates\": " << q.duplicates()
-        << ", \"out_of_order\": " << q.out_of_order() << ", \"restarts\": " << q.restarts()
-        << ", \"undecodable\": " << c.undecodable << ", \"contract_violations\": {";
+      Json violations = Json::object();
       for (std::size_t v = 0; v < SequenceGapDetector::kViolationKinds; ++v) {
         const auto reason = static_cast<SequenceGapDetector::Violation>(v);
-        j << (v ? ", " : "") << "\"" << SequenceGapDetector::to_string(reason) << "\": " << q.violations(reason);
+        violations[std::string(SequenceGapDetector::to_string(reason))] = q.violations(reason);
       }
-      j << "}, \"gaps\": [";
+      Json gaps = Json::array();
       for (std::size_t g = 0; g < q.kept_gap_count(); ++g) {
-        j << (g ? ", " : "") << "[" << q.kept_gaps()[g].first_missing << ", " << q.kept_gaps()[g].last_missing << "]";
+        gaps.push_back({q.kept_gaps()[g].first_missing, q.kept_gaps()[g].last_missing});
       }
-      j << "]}";
+      ch["sequence"] = {{"blocks", q.observed()},
+                        {"ticks", q.ticks()},
+                        {"first_seq", q.first_seq()},
+                        {"last_seq", q.last_seq()},
+                        {"gap_events", q.gap_events()},
+                        {"missing", q.missing()},
+                        {"resumes", q.resumes()},
+                        {"skipped", q.skipped()},
+                        {"overlaps", q.overlaps()},
+                        {"overlap_ticks", q.overlap_ticks()},
+                        {"duplicates", q.duplicates()},
+                        {"out_of_order", q.out_of_order()},
+                        {"restarts", q.restarts()},
+                        {"undecodable", c.undecodable},
+                        {"contract_violations", violations},
+                        {"gaps", gaps}};
     }
-    j << "}";
+    per_channel[std::string(c.name_view())] = ch;
   }
-  j << "\n  }\n}\n";
-  return j.str();
+  const Json j = {
+      {"recording", s.recording},
+      {"start_utime", s.start_utime},
+      {"stop_utime", s.stop_utime},
+      {"duration_s", s.duration_s},
+      {"stop_reason", s.stop_reason},
+      {"files", files},
+      {"totals",
+       {{"received", t.received},
+        {"written", t.written},
+        {"dropped", saturating_add(t.dropped, s.unrecorded_channel)},
+        {"bytes_written", t.bytes_written},
+        {"gap_events", t.gap_events},
+        {"missing", t.missing},
+        {"skipped", t.skipped},
+        {"contract_violations", t.contract_violations}}},
+      {"dropped",
+       {{"queue_full", t.queue_full},
+        {"oversize", t.oversize},
+        {"write_failed", t.write_failed},
+        {"unrecorded_channel", s.unrecorded_channel}}},
+      {"disk",
+       {{"ok", d.errors == 0},
+        {"errors", d.errors},
+        {"last_error", d.errors == 0 ? std::string() : d.reason()},
+        {"events_lost", d.events_lost},
+        {"files_truncated", d.files_truncated},
+        {"files_removed", d.files_removed},
+        {"unconfirmed_events", d.unconfirmed_events},
+        {"recoveries", d.recoveries}}},
+      {"unknown_channels",
+       {{"messages", u.messages()},
+        {"distinct", u.distinct()},
+        {"distinct_is_lower_bound", u.distinct_is_lower_bound()},
+        {"first", first_unknown}}},
+      {"queue", {{"capacity_bytes", s.queue_capacity_bytes}, {"high_water_bytes", s.queue_high_water_bytes}}},
+      {"process",
+       {{"cpu_user_s", s.cpu_user_s}, {"cpu_system_s", s.cpu_system_s}, {"peak_rss_bytes", s.peak_rss_bytes}}},
+      {"channels", per_channel},
+  };
+  return to_json_text(j);
 }
 
 std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelTable& channels) {
@@ -183,24 +191,6 @@ std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelT
                     std::to_string(f.bytes) + " bytes");
   }
   return lines;
-}
-
-void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  std::error_code ec;
-  const auto fail = [&](const std::string& what) {
-    std::filesystem::remove(tmp, ec);  // no stray temporary file left behind
-    throw std::runtime_error(what);
-  };
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) fail("cannot write " + tmp.string());
-    out << text;
-    out.flush();
-    if (!out) fail("cannot write " + tmp.string() + " (disk full?)");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) fail("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
 }
 
 }  // namespace hystloop

@@ -56,13 +56,11 @@ struct RecordingSummary {
   std::int64_t peak_rss_bytes = 0;
 };
 
+// The summary as JSON text (runtime/summary_file.hpp: write it with write_file_atomically).
 std::string summary_json(const RecordingSummary& summary, const ChannelTable& channels);
 
 // A few lines: files, per-channel counts, gaps and drops.
 std::vector<std::string> summary_lines(const RecordingSummary& summary, const ChannelTable& channels);
 
-// Writes `text` to `path` (through a temporary file and a rename, so a reader never sees
-// half of it; the temporary file is removed if that fails). Throws std::runtime_error naming the path.
-void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace hystloop

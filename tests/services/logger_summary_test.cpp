@@ -1,6 +1,7 @@
 // The logger's summary file: a summary that cannot be written leaves no stray
 // temporary file, and the JSON reports the disk faults and the channels without a slot.
 #include "logger/logger_summary.hpp"
+#include "runtime/summary_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <limits>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "lcm/message_checks.hpp"
 
@@ -42,18 +45,20 @@ TEST(LoggerSummary, TheJsonSaysTheDiskFaultAndTheUnknownChannels) {
   s.disk.events_lost = 17;
   s.disk.last_errno = ENOSPC;
   s.disk.last_op = DiskOp::kWrite;
-  const std::string json = summary_json(s, channels);
-  EXPECT_NE(json.find("\"disk\": {\"ok\": false, \"errors\": 2, \"last_error\": \"disk full (write: No space left on "
-                      "device)\", \"events_lost\": 17"),
-            std::string::npos)
-      << json;
+  const std::string text = summary_json(s, channels);
+  const auto json = nlohmann::json::parse(text);
+  EXPECT_EQ(json["disk"]["ok"], false) << text;
+  EXPECT_EQ(json["disk"]["errors"], 2);
+  EXPECT_EQ(json["disk"]["last_error"], "disk full (write: No space left on device)");
+  EXPECT_EQ(json["disk"]["events_lost"], 17);
   // 100 names offered; the table keeps kMaxChannels - kRigChannels of them, the rest are unknown.
   const std::size_t kept = ChannelTable::kMaxChannels - ChannelTable::kRigChannels;
-  const std::string unknown = std::to_string(100 - kept);
-  EXPECT_NE(json.find("\"unknown_channels\": {\"messages\": " + unknown + ", \"distinct\": " + unknown +
-                      ", \"distinct_is_lower_bound\": false, \"first\": [\"HX_J" + std::to_string(kept) + "\""),
-            std::string::npos)
-      << json;
+  const auto& unknown = json["unknown_channels"];
+  EXPECT_EQ(unknown["messages"], 100 - kept) << text;
+  EXPECT_EQ(unknown["distinct"], 100 - kept);
+  EXPECT_EQ(unknown["distinct_is_lower_bound"], false);
+  ASSERT_FALSE(unknown["first"].empty());
+  EXPECT_EQ(unknown["first"][0], "HX_J" + std::to_string(kept));
   const auto lines = summary_lines(s, channels);
   ASSERT_GE(lines.size(), 3u);
   EXPECT_EQ(lines[1].rfind("  DISK FAULT: 2 failed call(s), last disk full", 0), 0u) << lines[1];
@@ -61,6 +66,19 @@ TEST(LoggerSummary, TheJsonSaysTheDiskFaultAndTheUnknownChannels) {
 
 // Forged but admissible ticks: two channels with more than 2^63 ticks missing each. Their total
 // wrapped to a small number (2^64 - 2 with INT64_MIN/INT64_MAX ticks); it stops at UINT64_MAX.
+// Text off the wire that is not UTF-8 (a channel name of raw bytes) is replaced, and the summary
+// stays valid JSON instead of being lost.
+TEST(LoggerSummary, ANameThatIsNotUtf8StillGivesValidJson) {
+  ChannelTable channels(ChannelNames("HX_"));
+  channels.find_or_add("HX_\xff\xfe");
+  RecordingSummary s;
+  s.recording = "run\x80";
+  const std::string text = summary_json(s, channels);
+  const auto json = nlohmann::json::parse(text);           // throws on invalid JSON or UTF-8
+  EXPECT_EQ(json["recording"], "run\xef\xbf\xbd");         // U+FFFD
+  for (const unsigned char c : text) EXPECT_LT(c, 0x80u);  // written as ASCII with \u escapes
+}
+
 TEST(LoggerSummary, TheTotalOfMissingTicksSaturatesInsteadOfWrapping) {
   ChannelTable channels(ChannelNames("HX_"));
   constexpr std::uint64_t kTop = std::numeric_limits<std::uint64_t>::max();
@@ -75,13 +93,15 @@ TEST(LoggerSummary, TheTotalOfMissingTicksSaturatesInsteadOfWrapping) {
     ASSERT_LT(q.missing(), kTop);
     q.observe(-1, 1);  // forbidden by the contract: counted, not summed
   }
-  const std::string json = summary_json(RecordingSummary{}, channels);
-  EXPECT_NE(json.find("\"missing\": " + std::to_string(kTop) + ", \"skipped\": 0, \"contract_violations\": 2}"),
-            std::string::npos)
-      << json.substr(0, 600);
-  EXPECT_NE(json.find("\"contract_violations\": {\"negative_seq\": 1, \"seq_above_max\": 0, \"tick_count\": 0}"),
-            std::string::npos)
-      << json;
+  const std::string text = summary_json(RecordingSummary{}, channels);
+  const auto json = nlohmann::json::parse(text);
+  EXPECT_EQ(json["totals"]["missing"].get<std::uint64_t>(), kTop) << text.substr(0, 600);
+  EXPECT_EQ(json["totals"]["skipped"], 0);
+  EXPECT_EQ(json["totals"]["contract_violations"], 2);
+  const auto& violations = json["channels"]["HX_SENSOR"]["sequence"]["contract_violations"];
+  EXPECT_EQ(violations["negative_seq"], 1) << text;
+  EXPECT_EQ(violations["seq_above_max"], 0);
+  EXPECT_EQ(violations["tick_count"], 0);
   const auto lines = summary_lines(RecordingSummary{}, channels);
   ASSERT_GE(lines.size(), 2u);
   EXPECT_NE(lines[1].find("contract violations 1 (not checked for gaps: negative_seq 1 seq_above_max 0 tick_count 0)"),
