@@ -50,8 +50,7 @@ run_case() {  # name: sigterm | shutdown
   # How long the ramp took: the bridge's log and its summary.
   grep -q "safe state reached: ramped from" "$dir/bridge.log" || fail "$name: the bridge's log does not say the ramp ended"
   grep -q "summary: stop: ramped from" "$dir/bridge.log" || fail "$name: the bridge's summary does not say the ramp"
-  local json; json=$(cat "$dir/bridge_summary.json")
-  field() { sed -n "s/.*\"stop\": {[^}]*\"$1\": \([^,}]*\).*/\1/p" <<<"$json"; }
+  field() { jq -r ".stop.$1" "$dir/bridge_summary.json"; }
   [ "$(field safe_reached)" = true ] || fail "$name: summary says safe_reached = $(field safe_reached)"
   local u0 ticks wall timeout_s; u0=$(field u_start_V); ticks=$(field ramp_ticks); wall=$(field wall_s); timeout_s=$(field bound_s)
   [ "$timeout_s" = 0.75 ] || fail "$name: the stop's bound is $timeout_s s, expected 0.75 s (0.25 s ramp + 0.5 s)"
