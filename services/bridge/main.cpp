@@ -3,18 +3,15 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <exception>
 
 #include <spdlog/spdlog.h>
 
 #include "bridge/bridge_service.hpp"
 #include "bridge/probe_hardware.hpp"
 #include "core/cli.hpp"
-#include "core/logging.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
-#include "lcm/url.hpp"
-#include "runtime/rig_auth_config.hpp"
+#include "runtime/service_main.hpp"
 #include "runtime/service_options.hpp"
 
 int main(int argc, char** argv) try {
@@ -69,22 +66,18 @@ int main(int argc, char** argv) try {
 
   BridgeSettings settings;
   std::string url;
-  try {
-    init_logging("bridge", options.log_level,
-                 options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
-    const Config config = load_service_config(options);
-    settings = load_bridge_settings(config);
-    url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
-    if (!probe) configure_rig_auth(config, url);  // the probe drives the card alone: no LCM
-  } catch (const std::exception& e) {             // ConfigError / ParameterError: bad configuration
-    std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
-    return kExitUsage;
-  }
+  const auto refused = configure_or_refuse("hystloop-bridge", [&] {
+    // The probe drives the card alone: no LCM, so no rig authentication.
+    url = set_up_service("bridge", options,
+                         {.adjust = {},
+                          .read = [&](const Config& config) { settings = load_bridge_settings(config); },
+                          .rig_auth = !probe});
+  });
+  if (refused) return *refused;
 
   if (probe) return probe_hardware(settings, probe_options, stdout);
 
-  try {
-    install_stop_handlers();
+  return run_service([&] {
     if (settings.rt.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
     if (settings.rt.io_priority > 0) {
       // Before LCM starts: its receive thread inherits the I/O thread's scheduling.
@@ -95,17 +88,8 @@ int main(int argc, char** argv) try {
     spdlog::info("lcm: {}", url);
     BridgeService service(settings, *lcm, channels);
     service.write_summary_to(summary_json);
-    const int rc = service.run();
-    flush_logging();
-    return rc;
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-bridge: %s\n", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return 1;
-  }
+    return service.run();
+  });
 } catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
   return hystloop::exit_on_escaped_exception("hystloop-bridge");
 }

@@ -2,18 +2,13 @@
 // feedforward through the selected model's inverse, planned ahead of the bridge's clock.
 #include <CLI/CLI.hpp>
 
-#include <cstdio>
-#include <exception>
-
 #include <spdlog/spdlog.h>
 
 #include "compensator/compensator_service.hpp"
 #include "core/cli.hpp"
-#include "core/logging.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
-#include "lcm/url.hpp"
-#include "runtime/rig_auth_config.hpp"
+#include "runtime/service_main.hpp"
 #include "runtime/service_options.hpp"
 
 int main(int argc, char** argv) try {
@@ -42,21 +37,17 @@ int main(int argc, char** argv) try {
 
   CompensatorSettings settings;
   std::string url;
-  try {
-    init_logging("compensator", options.log_level,
-                 options.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(options.log_file));
-    Config config = load_service_config(options);
-    for (const auto& file : params_files) merge_params_file(config, file);
-    settings = load_compensator_settings(config);
-    url = resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network);
-    configure_rig_auth(config, url);
-  } catch (const std::exception& e) {  // ConfigError / ParameterError: bad configuration
-    std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
-    return kExitUsage;
-  }
+  const auto refused = configure_or_refuse("hystloop-compensator", [&] {
+    url = set_up_service("compensator", options,
+                         {.adjust =
+                              [&](Config& config) {
+                                for (const auto& file : params_files) merge_params_file(config, file);
+                              },
+                          .read = [&](const Config& config) { settings = load_compensator_settings(config); }});
+  });
+  if (refused) return *refused;
 
-  try {
-    install_stop_handlers();
+  return run_service([&] {
     if (settings.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
     // Before LCM starts: its receive thread inherits this thread's scheduling.
     if (settings.rt_priority > 0) spdlog::info("scheduling: {}", set_realtime_priority(settings.rt_priority).detail);
@@ -65,17 +56,8 @@ int main(int argc, char** argv) try {
     spdlog::info("lcm: {}", url);
     CompensatorService service(settings, *lcm, channels);
     if (!summary_json.empty()) service.write_summary_to(summary_json);
-    const int rc = service.run();
-    flush_logging();
-    return rc;
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-compensator: %s\n", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return 1;
-  }
+    return service.run();
+  });
 } catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
   return hystloop::exit_on_escaped_exception("hystloop-compensator");
 }

@@ -2,28 +2,17 @@
 // and lcm-spy read them), counts every message, drop and tick gap, reports them in
 // HX_STATUS at 1 Hz and in a summary JSON written at close. See logger_service.hpp and
 // logger_options.hpp; `hystloop-logger --help` lists the options.
-#include <cstdio>
-#include <exception>
-
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "core/cli.hpp"
 #include "core/config.hpp"
-#include "core/errors.hpp"
-#include "core/logging.hpp"
-#include "core/process.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
-#include "lcm/url.hpp"
 #include "logger/logger_options.hpp"
 #include "logger/logger_service.hpp"
-#include "runtime/rig_auth_config.hpp"
+#include "runtime/service_main.hpp"
 #include "runtime/service_options.hpp"
-
-namespace {
-constexpr int kExitBadConfiguration = 2;
-}
 
 int main(int argc, char** argv) try {
   using namespace hystloop;
@@ -46,44 +35,26 @@ int main(int argc, char** argv) try {
 
   LoggerOptions options;
   std::string url;
-  std::unique_ptr<ChannelNames> names;
-  try {
-    init_logging(LoggerService::kProcessName, service.log_level,
-                 service.log_file.empty() ? std::nullopt : std::optional(service.log_file));
-    Config config = load_service_config(service);
-    apply_logger_flags(flags, config);
-    options = read_logger_options(config);
-    names = std::make_unique<ChannelNames>(service.rig_prefix);
-    url = resolve_lcm_url_for_10khz(service.lcm_url, service.allow_network);
-    configure_rig_auth(config, url);
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-logger: %s\n", e.what());
-    return kExitBadConfiguration;
-  }
+  const auto refused = configure_or_refuse("hystloop-logger", [&] {
+    url = set_up_service(LoggerService::kProcessName, service,
+                         {.adjust = [&](Config& config) { apply_logger_flags(flags, config); },
+                          .read = [&](const Config& config) { options = read_logger_options(config); }});
+  });
+  if (refused) return *refused;
 
-  try {
-    install_stop_handlers();
-    spdlog::info("lcm: url {}, rig {}", url, names->prefix);
+  return run_service([&] {
+    const ChannelNames names(service.rig_prefix);
+    spdlog::info("lcm: url {}, rig {}", url, names.prefix);
     spdlog::info("logger: out_dir {}, file_prefix '{}', max_file_mb {}, max_file_s {}, summary {}, channels '{}'",
                  options.out_dir.string(), options.file_prefix, options.max_file_mb, options.max_file_s,
                  options.summary_file.empty() ? "<next to the logs>" : options.summary_file.string(),
-                 options.channels.empty() ? names->all_channels_regex() : options.channels);
+                 options.channels.empty() ? names.all_channels_regex() : options.channels);
     spdlog::info("logger: queue_mb {}, lcm_queue {}, flush_interval_s {}, restart_threshold {}", options.queue_mb,
                  options.lcm_queue, options.flush_interval_s, options.restart_threshold);
     auto lcm = open_lcm(url, service.allow_network);
-    LoggerService logger(*lcm, *names, options);
-    const int rc = logger.run();
-    flush_logging();
-    return rc;
-  } catch (const ParameterError& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return kExitBadConfiguration;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return 1;
-  }
+    LoggerService logger(*lcm, names, options);
+    return logger.run();
+  });
 } catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
   return hystloop::exit_on_escaped_exception("hystloop-logger");
 }

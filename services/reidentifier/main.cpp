@@ -2,31 +2,21 @@
 // off the receive thread, and publishes on <rig>PARAMS only candidates that pass every gate
 // (fit succeeded and in range, residual bound, better on held-out branches than the set in
 // use). See reident_service.hpp and reident_options.hpp; `--help` lists the options.
-#include <cstdio>
-#include <exception>
-#include <memory>
-#include <optional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "core/cli.hpp"
 #include "core/config.hpp"
-#include "core/errors.hpp"
-#include "core/logging.hpp"
-#include "core/process.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
-#include "lcm/url.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "reidentifier/reident_service.hpp"
-#include "runtime/rig_auth_config.hpp"
+#include "runtime/service_main.hpp"
 #include "runtime/service_options.hpp"
 
-namespace {
-constexpr int kExitBadConfiguration = 2;
-}
-
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   using namespace hystloop;
   CLI::App app{
       "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
@@ -54,25 +44,20 @@ int main(int argc, char** argv) {
 
   ReidentOptions options;
   std::string url;
-  std::unique_ptr<ChannelNames> names;
-  try {
-    init_logging(ReidentService::kProcessName, service.log_level,
-                 service.log_file.empty() ? std::nullopt : std::optional(service.log_file));
-    Config config = load_service_config(service);
-    if (publish_invalid) config.apply_override("reidentifier.publish_invalid=true");
-    options = read_reident_options(config);
-    names = std::make_unique<ChannelNames>(service.rig_prefix);
-    url = resolve_lcm_url_for_10khz(service.lcm_url, service.allow_network);
-    configure_rig_auth(config, url);
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-reidentifier: %s\n", e.what());
-    return kExitBadConfiguration;
-  }
+  const auto refused = configure_or_refuse("hystloop-reidentifier", [&] {
+    url = set_up_service(ReidentService::kProcessName, service,
+                         {.adjust =
+                              [&](Config& config) {
+                                if (publish_invalid) config.apply_override("reidentifier.publish_invalid=true");
+                              },
+                          .read = [&](const Config& config) { options = read_reident_options(config); }});
+  });
+  if (refused) return *refused;
 
-  try {
-    install_stop_handlers();
+  return run_service([&] {
+    const ChannelNames names(service.rig_prefix);
     const OnlineMemOptions& e = options.estimator;
-    spdlog::info("lcm: url {}, rig {}", url, names->prefix);
+    spdlog::info("lcm: url {}, rig {}", url, names.prefix);
     spdlog::info("mem: c1 {:.9g} m/V, c2 {:.9g} m/V^(1+c3), c3 {:.9g} (initial set in use, version 1)",
                  options.initial.c1, options.initial.c2, options.initial.c3);
     spdlog::info(
@@ -88,20 +73,9 @@ int main(int argc, char** argv) {
                  mc.enabled ? "on" : "off", mc.selector.selection.candidates.size(), mc.selector.margin, mc.period_s,
                  mc.selector.decimation, mc.pinned ? std::string(to_string(*mc.pinned)) : std::string("no"));
     auto lcm = open_lcm(url, service.allow_network);
-    int rc = 0;
-    {
-      ReidentService reident(*lcm, *names, options);
-      rc = reident.run();
-    }  // joins the refit worker before the log is flushed
-    flush_logging();
-    return rc;
-  } catch (const ParameterError& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return kExitBadConfiguration;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    flush_logging();
-    return 1;
-  }
+    ReidentService reident(*lcm, names, options);
+    return reident.run();  // the service (and its refit worker) ends before run_service flushes the log
+  });
+} catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main
+  return hystloop::exit_on_escaped_exception("hystloop-reidentifier");
 }
