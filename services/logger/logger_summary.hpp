@@ -62,5 +62,4 @@ std::string summary_json(const RecordingSummary& summary, const ChannelTable& ch
 // A few lines: files, per-channel counts, gaps and drops.
 std::vector<std::string> summary_lines(const RecordingSummary& summary, const ChannelTable& channels);
 
-
 }  // namespace hystloop
