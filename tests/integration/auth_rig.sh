@@ -31,10 +31,11 @@ start_recording
 wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
 grep -q "auth: sensor blocks, commands, control" "$dir/bridge.log" || fail "the bridge did not say it checks signatures"
-sleep 1.0
+wait_until 20 "the compensator published commands" commands_recorded 0
 "$authp" capture --channel COMMAND --out "$dir/early.bin" >/dev/null || fail "no command block to capture"
 "$ctl" --key-file "$key" reset-counters >/dev/null   # signed: counts from here on
-sleep 0.3
+wait_log "$dir/bridge.log" "RESET_COUNTERS (request"
+wait_log "$dir/compensator.log" "RESET_COUNTERS (request"
 
 # The foreign publisher: no key. Nothing it asks for is confirmed (hystloop-ctl exits 1).
 for request in "arm" "mode off" "params --c1 5e-9 --c2 1e-12 --c3 1.2 --version 9"; do
@@ -53,9 +54,16 @@ done
 "$authp" replay --channel SENSOR --in "$dir/sensor.bin"
 # The one captured before the reset, now older than auth.max_skew_s (2 s): a recording.
 sleep_left=$(awk -v t="$(stat -c %Y "$dir/early.bin")" -v now="$(date +%s)" 'BEGIN { s = t + 3.2 - now; print (s > 0 ? s : 0) }')
-sleep "$sleep_left"
+sleep "$sleep_left"   # a duration: until the early block is older than the skew window
 "$authp" replay --channel COMMAND --in "$dir/early.bin"
-sleep 1.3   # a status report after the last one
+# Reports that count everything refused (the exact counts are checked below, on the last report).
+refusals_reported() {
+  status_at_least bridge command.rejected_unsigned 10 command.rejected_replayed 1 command.rejected_skewed 1 \
+    control.rejected_unsigned 3 command.accepted 101 &&
+  status_at_least compensator trajectory.rejected_unsigned 1 params.rejected_unsigned 1 control.rejected_unsigned 1 \
+    sensor.rejected_unsigned 3 sensor.rejected_replayed 1 sensor.accepted 101
+}
+wait_until 20 "both services reported every refused message" refusals_reported
 kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
@@ -90,13 +98,15 @@ echo "bridge refused: command unsigned $(value bridge command.rejected_unsigned)
 # stays in the safe state.
 start_recording
 "$authp" capture --channel CONTROL --out "$dir/arm.bin" >"$dir/capture_arm.out" 2>&1 & cap=$!; pids+=($cap)
-sleep 0.3
-"$ctl" --key-file "$key" arm --no-wait >/dev/null  # no bridge runs to confirm it: it is captured
+# No bridge runs to confirm the ARM: it is captured. Signed ARMs until the capture (subscribed at
+# some point after its start) took one.
+arm_captured() { kill -0 $cap 2>/dev/null || return 0; "$ctl" --key-file "$key" arm --no-wait >/dev/null; return 1; }
+wait_until 10 "the capture took a signed ARM" arm_captured
 wait $cap || fail "no signed ARM captured"
 "$bridge" "${bridge_args[@]}" "${auth[@]}" --summary-json "$dir/bridge2.json" >"$dir/bridge2.log" 2>&1 & b2=$!; pids+=($b2)
 wait_log "$dir/bridge2.log" "started in the safe state"
 "$authp" replay --channel CONTROL --in "$dir/arm.bin"
-sleep 1.3   # a status report after it
+wait_until 20 "the restarted bridge reported the replayed ARM" status_at_least bridge control.rejected_replayed 1
 kill -TERM $b2; wait $b2 || fail "the restarted bridge exited with $?"
 stop_recording
 [ "$(value bridge control.rejected_replayed)" -ge 1 ] || fail "the restarted bridge did not refuse the ARM signed before it started (control.rejected_replayed $(value bridge control.rejected_replayed))"

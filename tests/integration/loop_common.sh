@@ -45,3 +45,49 @@ expect_value() {  # process key expected
   local v; v="$(value "$1" "$2")" || fail "$1 reports no $2"
   [ "$v" = "$3" ] || fail "$1 $2 = $v, expected $3"
 }
+
+# Bounded waits on a condition instead of fixed sleeps (a fixed sleep is too long on a quiet
+# machine and too short on a busy one). wait_until polls a command every 0.05 s until it
+# succeeds, and fails naming what did not happen after TIMEOUT_S (whole seconds; be generous:
+# sanitizer builds and loaded hosts are slow).
+wait_until() {  # timeout_s description command...
+  local timeout_s="$1" what="$2"; shift 2
+  local deadline=$(( ${EPOCHREALTIME/./} + timeout_s * 1000000 ))
+  until "$@"; do
+    [ "${EPOCHREALTIME/./}" -lt "$deadline" ] || fail "timed out after ${timeout_s} s waiting until $what"
+    sleep 0.05
+  done
+}
+# The last report (not STOPPING) of a process in the recorder's status.log, as status-value reads it.
+last_status() {  # process
+  awk -v p="process=$1 " 'index($0, p) == 1 && index($0, " state=4 ") == 0 { last = $0 } END { print last }' \
+    "$dir/status.log" 2>/dev/null
+}
+# True when the last report of a process has each key at or above its value (the counters).
+status_at_least() {  # process key min [key min]...
+  local line; line="$(last_status "$1")"; shift
+  [ -n "$line" ] || return 1
+  awk -v line="${line% detail=*}" -v want="$*" 'BEGIN {
+    n = split(line, w, " "); for (i = n; i >= 1; i--) { eq = index(w[i], "="); v[substr(w[i], 1, eq - 1)] = substr(w[i], eq + 1) }
+    m = split(want, k, " "); for (i = 1; i < m; i += 2) if (!(k[i] in v) || v[k[i]] + 0 < k[i + 1] + 0) exit 1
+  }'
+}
+# One value of the last report of a process (the first of duplicate names, as status-value).
+status_key() {  # process key
+  local line; line="$(last_status "$1")"
+  awk -v line="${line% detail=*}" -v k="$2" 'BEGIN {
+    n = split(line, w, " "); for (i = 1; i <= n; i++) if (index(w[i], k "=") == 1) { print substr(w[i], length(k) + 2); exit 0 }
+    exit 1 }'
+}
+# How many reports (STOPPING ones too) a process has sent so far.
+status_reports() { grep -c "^process=$1 " "$dir/status.log" 2>/dev/null || true; }
+# Waits for count more reports of a process after now: with count 2, one of them was composed after
+# whatever happened before the call (the first may have been on its way already).
+wait_reports() {  # process count description
+  local want=$(( $(status_reports "$1") + $2 ))
+  wait_until 20 "$3 ($2 more status reports of $1)" status_reports_reach "$1" "$want"
+}
+status_reports_reach() { [ "$(status_reports "$1")" -ge "$2" ]; }
+# True when the recorder's command.csv has grown beyond a size (bytes): it is written in 4 kB
+# chunks, so growth means commands were published (by the compensator) after the size was taken.
+commands_recorded() { [ "$(stat -c %s "$dir/command.csv" 2>/dev/null || echo 0)" -gt "$1" ]; }

@@ -11,14 +11,25 @@ start_recording
 "$bridge" "${bridge_args[@]}" --auto-arm >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
-sleep 1.0
+wait_until 20 "the bridge reported itself armed (--auto-arm)" status_at_least bridge armed 1
 "$probe" control --command reset_counters    # counts from here on
-sleep 0.1
+wait_log "$dir/bridge.log" "RESET_COUNTERS (request"
+wait_log "$dir/compensator.log" "RESET_COUNTERS (request"
 "$probe" inject --target bridge --count $n
 "$probe" inject --target compensator --count $n
 "$probe" params --version 7 --c1 5e-9 --c2 1e-12 --c3 1.2 --valid 0   # a diagnostic set: never used
 "$probe" control --command set_mode --target compensator --mode 5     # experiment is not a mode
-sleep 2.3
+# Reports that count every bad message (the exact counts are checked below, on the last report).
+counted() {
+  local reason keys=() ckeys=()
+  for reason in decode_failed wrong_type non_finite out_of_range; do
+    keys+=(command.rejected_$reason $n control.rejected_$reason $((2 * n)))
+    ckeys+=(sensor.rejected_$reason $n trajectory.rejected_$reason $n params.rejected_$reason $n
+            control.rejected_$reason $((2 * n)))
+  done
+  status_at_least bridge "${keys[@]}" && status_at_least compensator "${ckeys[@]}" params_invalid 1 control_refused 1
+}
+wait_until 20 "both services reported every bad message" counted
 kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"

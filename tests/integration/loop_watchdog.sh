@@ -16,36 +16,38 @@ start_recording
 "$bridge" "${bridge_args[@]}" --set bridge.max_lead_s=0.25 >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 wait_log "$dir/compensator1.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
-sleep 0.2
+# Commands flow before the ARM.
+wait_until 20 "the compensator published commands" commands_recorded 0
 "$probe" control --command arm
 wait_log "$dir/bridge.log" "ARM (request"
-sleep 1.0
+wait_until 20 "the bridge reported itself armed" status_at_least bridge armed 1
 "$probe" control --command reset_counters
-sleep 0.2
+wait_log "$dir/bridge.log" "RESET_COUNTERS (request"
 kill -STOP $c1
-sleep $stop_s
+sleep $stop_s   # a duration: the stall under test
 kill -CONT $c1
-sleep 0.5
+sleep 0.5       # a duration: the two stalls apart (the buffer refilled), not one longer stall
 # The bridge itself stalled (a VM's vCPU taken away): its simulated clock catches up at most
 # twice as fast while the compensator refills the buffer, so that costs nothing either.
 kill -STOP $bpid
-sleep 0.3
+sleep 0.3       # a duration: the stall under test
 kill -CONT $bpid
-sleep 1.2
+# A report composed after the catch-up (0.15 s at most, at twice the speed).
+wait_reports bridge 2 "a bridge report after the stalls"
 late_after_stop=$(value bridge late)
 trips_after_stop=$(value bridge watchdog_trips)
 kill -KILL $c1
 wait $c1 2>/dev/null || true
-sleep 1.0
 wait_log "$dir/bridge.log" "watchdog: no command"
+recorded=$(stat -c %s "$dir/command.csv")   # no commands from here until the new compensator's
 "$compensator" "${compensator_args[@]}" >"$dir/compensator2.log" 2>&1 & c2=$!; pids+=($c2)
 wait_log "$dir/compensator2.log" "channels:"
-sleep 0.6
+wait_until 20 "the restarted compensator published commands" commands_recorded "$recorded"
 "$probe" control --command arm
-for _ in $(seq 100); do [ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ] && break; sleep 0.05; done
 # Tracking after the trip must come from this ARM (the bridge waits for one after a watchdog trip).
-[ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ] || fail "the bridge did not take the second ARM within 5 s"
-sleep 2.2
+second_arm() { [ "$(grep -c 'ARM (request' "$dir/bridge.log")" -ge 2 ]; }
+wait_until 10 "the bridge took the second ARM" second_arm
+sleep 2.2   # a duration: tracking after the re-arm (the analysis wants >= 15000 ticks of it)
 kill -TERM $bpid $c2
 wait $bpid || fail "the bridge exited with $? on SIGTERM"
 wait $c2 || fail "the compensator exited with $? on SIGTERM"

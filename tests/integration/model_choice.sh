@@ -31,7 +31,14 @@ pin=linear; [ "$first" = linear ] && pin=pi
 "$ctl" pin-model "$pin" >"$dir/ctl.out" 2>&1 || { cat "$dir/ctl.out"; fail "hystloop-ctl pin-model $pin"; }
 wait_for "$dir/reident.log" "model pinned to $pin" 5
 wait_for "$dir/reident.log" "published model change to $pin" 20
-sleep 2.5  # the swap waits for a reversal (every 0.5 s); the status reports come at 1 Hz
+# The swap waits for a reversal (every 0.5 s); the status reports come at 1 Hz: until the
+# compensator reports every published change adopted and the pinned model running.
+pin_adopted() {
+  local changes; changes="$(status_key reidentifier model_changes)" || return 1
+  [ "$changes" -ge 2 ] && [ "$(status_key compensator model_switches)" = "$changes" ] &&
+    [[ "$(last_status compensator)" == *"detail=mode $pin,"* ]]
+}
+wait_until 20 "the compensator reported the pinned model $pin adopted" pin_adopted
 "$probe" control --command shutdown
 for p in $bpid $cpid $rpid; do
   for _ in $(seq 100); do kill -0 $p 2>/dev/null || break; sleep 0.1; done

@@ -21,33 +21,38 @@ start_logger 1
 start_reident 1
 wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
-sleep 0.3
+wait_until 20 "the compensator published commands (before the ARM)" commands_recorded 0
 "$probe" control --command arm
 wait_log "$dir/bridge.log" "ARM (request"
 "$probe" trajectory --version 1 --shape 2 --amplitude-m -1.6e-6 --frequency-hz 1 --blend-s 0.5
-sleep 3
+wait_log "$dir/compensator.log" "trajectory v1"
+sleep 3   # a duration: the rig tracks under load before the forged traffic
 # Forged traffic from outside the rig: a parameter set with the highest version there is, and
 # sensor blocks far behind the bridge's clock (loop_probe inject: seq 1, plus malformed ones).
 "$probe" params --version 2147483647 --c1 5e-9 --c2 1e-12 --c3 1.2
 "$probe" inject --target compensator --count 3
-sleep 3
+wait_until 20 "the compensator reported the forged messages" status_at_least compensator \
+  sensor.rejected_out_of_range 3 trajectory.rejected_out_of_range 3 params.rejected_out_of_range 3 \
+  control.rejected_out_of_range 3 params.received 1
 kill -KILL $lpid; wait $lpid 2>/dev/null || true
-sleep 0.5
+sleep 0.5   # a duration: the rig runs without a logger
 start_logger 2
-sleep 2
+wait_log "$dir/logger2.log" "recording '"
+# The new logger's file has events in it (flushed every 0.2 s).
+second_log_written() { [ "$(find "$dir/logs" -name '*.lcmlog' -size +0 | wc -l)" -ge 2 ]; }
+wait_until 20 "the restarted logger wrote its file" second_log_written
 accepted_before=$(value compensator params_accepted)
 kill -KILL $rpid; wait $rpid 2>/dev/null || true
-sleep 0.5
+sleep 0.5   # a duration: the rig runs without a re-identifier
 start_reident 2
-for _ in $(seq 240); do  # the restarted re-identifier needs a window of branches (4 s) to refit
-  [ "$(value compensator params_accepted)" -gt "$accepted_before" ] && break
-  sleep 0.05
-done
-sleep 1
+# The restarted re-identifier needs a window of branches (4 s) to refit.
+wait_until 30 "the compensator accepted a set from the restarted re-identifier" \
+  status_at_least compensator params_accepted $((accepted_before + 1))
+wait_reports bridge 2 "a bridge report with the new set in use"
 trips=$(value bridge watchdog_trips)
 accepted_after=$(value compensator params_accepted)
 "$probe" control --command disarm
-sleep 0.4
+wait_log "$dir/bridge.log" "DISARM (request"
 kill -TERM $bpid $cpid $rpid $lpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
