@@ -40,4 +40,13 @@ void require_in_range(std::string_view field, double value, double lo, double hi
   }
 }
 
+std::string choice_list(std::span<const std::string_view> choices) {
+  std::string out;
+  for (std::size_t i = 0; i < choices.size(); ++i) {
+    if (i > 0) out += i + 1 == choices.size() ? " or " : ", ";
+    out += choices[i];
+  }
+  return out;
+}
+
 }  // namespace hystloop

@@ -3,6 +3,7 @@
 // before they can reach a model or the actuator. Inside the per-sample loop
 // nothing throws; a status value leads to a safe state instead.
 
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -29,5 +30,8 @@ void require_positive(std::string_view field, double value);
 void require_non_negative(std::string_view field, double value);
 // Throws ParameterError unless lo <= value <= hi (and finite).
 void require_in_range(std::string_view field, double value, double lo, double hi);
+
+// "a, b or c": what a refusal lists as accepted ("" for none, "a" for one).
+std::string choice_list(std::span<const std::string_view> choices);
 
 }  // namespace hystloop

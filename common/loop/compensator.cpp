@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <string_view>
+#include <vector>
 
 #include "core/errors.hpp"
 
@@ -65,12 +67,11 @@ FeedforwardMode parse_feedforward_mode(const std::string& name, const std::strin
 }
 
 std::string selectable_mode_choices() {
-  std::string out;
+  std::vector<std::string_view> names;
   for (auto m = static_cast<int>(FeedforwardMode::kOff); m <= static_cast<int>(FeedforwardMode::kKatalenic); ++m) {
-    if (!out.empty()) out += m == static_cast<int>(FeedforwardMode::kKatalenic) ? " or " : ", ";
-    out += to_string(static_cast<FeedforwardMode>(m));
+    names.emplace_back(to_string(static_cast<FeedforwardMode>(m)));
   }
-  return out;
+  return choice_list(names);
 }
 
 const char* to_string(FeedforwardMode mode) noexcept {

@@ -48,14 +48,7 @@ std::optional<TrajectoryShape> trajectory_shape_named(std::string_view name) noe
   return std::nullopt;
 }
 
-std::string trajectory_shape_choices() {
-  std::string out;
-  for (std::size_t i = 0; i < kTrajectoryShapeNames.size(); ++i) {
-    if (i > 0) out += i + 1 == kTrajectoryShapeNames.size() ? " or " : ", ";
-    out += kTrajectoryShapeNames[i];
-  }
-  return out;
-}
+std::string trajectory_shape_choices() { return choice_list(kTrajectoryShapeNames); }
 
 void TrajectorySpec::validate() const {
   require_finite("trajectory.amplitude_m", amplitude_m);

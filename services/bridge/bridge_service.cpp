@@ -15,7 +15,6 @@
 
 #include "bridge/bridge_health.hpp"
 #include "bridge/servo_request.hpp"
-#include "runtime/summary_file.hpp"
 #include "core/clock.hpp"
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
@@ -24,6 +23,7 @@
 #include "lcm/message_checks.hpp"
 #include "lcm/servo_gains_status.hpp"
 #include "runtime/counter_baseline.hpp"
+#include "runtime/summary_file.hpp"
 
 namespace hystloop {
 namespace {
@@ -459,9 +459,6 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
   const double armed_ticks = static_cast<double>(c.applied + c.late);
   const double wall_s = monotonic_s() - started_s_;
   const ResourceUsage usage = read_resource_usage();
-  const auto pct = [&](double q) { return latency_total_.count() > 0 ? latency_total_.percentile(q) / 1e3 : -1.0; };
-  // One decimal for the latencies [us], as the log lines print them.
-  const auto us = [](double v) { return v < 0 ? v : std::round(v * 10.0) / 10.0; };
   const double cpu_s = usage.user_cpu_s + usage.system_cpu_s;
   const nlohmann::ordered_json json = {
       {"ticks", c.ticks},
@@ -478,11 +475,7 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
       {"samples_dropped", rt.samples_dropped},
       {"sensor_blocks", sensor_blocks_},
       {"command_blocks", command_blocks_},
-      {"block_to_answer_us",
-       {{"p50", us(pct(0.5))},
-        {"p99", us(pct(0.99))},
-        {"max", us(latency_total_.count() > 0 ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0)},
-        {"count", latency_total_.count()}}},
+      {"block_to_answer_us", latency_summary_us(latency_total_)},
       {"applied", c.applied},
       {"clamped", c.clamped},
       {"slew_limited", c.slew_limited},
@@ -502,11 +495,7 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
         {"bound_s", settings_.stop_ramp_timeout_s},
         {"safe_u_V", settings_.limits.safe_u_V}}},
   };
-  try {
-    write_file_atomically(summary_json_path_, to_json_text(json));
-  } catch (const std::exception& e) {
-    spdlog::error("could not write the summary: {}", e.what());
-  }
+  write_summary_file(summary_json_path_, json);
 }
 
 }  // namespace hystloop

@@ -1,7 +1,5 @@
 // CompensatorService::write_summary_json: the run's figures at exit (--summary-json), the same as
 // the "summary:" log lines, for scripts (bench/run-all) that should not read log lines.
-#include <cmath>
-#include <exception>
 
 #include <spdlog/spdlog.h>
 
@@ -13,9 +11,6 @@ namespace hystloop {
 void CompensatorService::write_summary_json() const {
   if (summary_json_path_.empty()) return;
   const CompensatorCounters& c = compensator_->counters();
-  const bool timed = latency_total_.count() > 0;
-  // One decimal for the latencies [us], as the log lines print them.
-  const auto us = [](double v) { return v < 0 ? v : std::round(v * 10.0) / 10.0; };
   const nlohmann::ordered_json json = {
       {"samples", c.samples},
       {"command_ticks", counters_.command_ticks_published},
@@ -27,17 +22,9 @@ void CompensatorService::write_summary_json() const {
       {"params_refused", c.params_rejected + counters_.params_refused},
       {"params_swapped", c.params_swapped},
       {"params_invalid", counters_.params_invalid},
-      {"block_to_answer_us",
-       {{"p50", us(timed ? latency_total_.percentile(0.5) / 1e3 : -1.0)},
-        {"p99", us(timed ? latency_total_.percentile(0.99) / 1e3 : -1.0)},
-        {"max", us(timed ? static_cast<double>(latency_total_.max_ns()) / 1e3 : -1.0)},
-        {"count", latency_total_.count()}}},
+      {"block_to_answer_us", latency_summary_us(latency_total_)},
   };
-  try {
-    write_file_atomically(summary_json_path_, to_json_text(json));
-  } catch (const std::exception& e) {
-    spdlog::error("could not write the summary: {}", e.what());
-  }
+  write_summary_file(summary_json_path_, json);
 }
 
 }  // namespace hystloop

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string_view>
+#include <vector>
+
 #include <limits>
 
 namespace hystloop {
@@ -31,6 +34,14 @@ TEST(Errors, AcceptsBoundaries) {
   EXPECT_THROW(require_positive("x", 0.0), ParameterError);
   EXPECT_NO_THROW(require_in_range("x", 1.0, 0.0, 1.0));
   EXPECT_THROW(require_in_range("x", 1.0000001, 0.0, 1.0), ParameterError);
+}
+
+TEST(ChoiceList, ListsWhatIsAcceptedWithOrBeforeTheLast) {
+  using V = std::vector<std::string_view>;
+  EXPECT_EQ(choice_list(V{}), "");
+  EXPECT_EQ(choice_list(V{"mem"}), "mem");
+  EXPECT_EQ(choice_list(V{"mem", "pi"}), "mem or pi");
+  EXPECT_EQ(choice_list(V{"off", "linear", "mem"}), "off, linear or mem");
 }
 
 }  // namespace

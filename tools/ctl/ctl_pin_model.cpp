@@ -1,5 +1,8 @@
 #include "ctl_pin_model.hpp"
 
+#include <string_view>
+#include <vector>
+
 #include "core/errors.hpp"
 #include "lcm/feedforward_mode.hpp"
 
@@ -8,9 +11,10 @@ namespace hystloop::ctl {
 std::int8_t pin_model_mode(const std::string& name) {
   if (name == "auto" || name == "off") return to_wire(FeedforwardMode::kOff);
   if (const auto kind = parse_model_kind(name)) return to_wire(mode_of(*kind));
-  std::string names;
-  for (int i = 0; i < kModelKindCount; ++i) names.append(to_string(static_cast<ModelKind>(i))).append(", ");
-  throw ParameterError("model", "expected " + names.substr(0, names.size() - 2) + " or auto (got \"" + name + "\")");
+  std::vector<std::string_view> names;
+  for (int i = 0; i < kModelKindCount; ++i) names.push_back(to_string(static_cast<ModelKind>(i)));
+  names.emplace_back("auto");
+  throw ParameterError("model", "expected " + choice_list(names) + " (got \"" + name + "\")");
 }
 
 }  // namespace hystloop::ctl
