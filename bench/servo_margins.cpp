@@ -13,18 +13,24 @@
 //    with and without the notch; then that cosine with every feedforward, the former defaults
 //    (run_tracking, as tests/sim/tracking_test) against the defaults; then a 1 um 100 Hz sine
 //    whose feedforward the slew limit clamps, feedforward only against the servo.
+// 4. kp against the sensor's noise at the slew limit: the servo's tick-to-tick step for 1 nm of
+//    white error, and the 200 Hz, 0.25 um scan line (sim/scan_experiment.hpp; its feedforward
+//    needs ~98 % of the slew) over 12 noise seeds, 4 s each: ticks whose servo step the bridge
+//    clipped, and the RMS, for kp 0.1 and the defaults' kp.
 //
 //   servo_margins [CONFIG]    CONFIG: the bridge's settings (default deploy/config/bridge.yaml)
 
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "bridge/bridge_settings.hpp"
 #include "core/config.hpp"
 #include "loop/servo_loop_response.hpp"
+#include "sim/scan_experiment.hpp"
 #include "sim/tracking_experiment.hpp"
 
 namespace {
@@ -121,6 +127,54 @@ double slew_clamped_sine(const FeedbackGains* servo, double gain_m_per_V, std::u
   }
   *clamped = bridge.counters().clamped_either;
   return std::sqrt(sum / n);
+}
+
+// RMS of the servo's step from one tick to the next [V] for white error of 1 nm RMS, open loop.
+double servo_noise_step_V(const FeedbackGains& g) {
+  FeedbackController c(g);
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, 1e-9);
+  constexpr int kSettle = 1000, kTicks = 200000;
+  double last = 0.0, sum = 0.0;
+  for (int k = 0; k < kSettle + kTicks; ++k) {
+    const double u = c.update(noise(rng), 0.0, 1.0 / g.tick_rate_hz);
+    if (k >= kSettle) sum += (u - last) * (u - last);
+    last = u;
+  }
+  return std::sqrt(sum / kTicks);
+}
+
+void kp_at_the_slew_limit(const FeedbackGains& defaults) {
+  std::printf(
+      "\nkp against the sensor's noise at the slew limit: the servo's step for 1 nm of white error (open loop), "
+      "and the 200 Hz, 0.25 um sine over 12 seeds x 4 s (clamped ticks, runs with any, mean RMS of the true "
+      "error)\n\n| kp | servo step | clamped ticks | runs with a clamp | RMS |\n|---|---|---|---|---|\n");
+  const ScanReference line{"sine 200 Hz 0.25 um", TrajectoryShape::kSine, 0.25e-6, 200.0};
+  constexpr int kSeeds = 12;
+  for (const double kp : {0.1, defaults.kp}) {
+    FeedbackGains g = defaults;
+    g.kp = kp;
+    std::uint64_t clamped = 0;
+    int runs_clamped = 0;
+    double rms_sum = 0.0;
+    for (int s = 0; s < kSeeds; ++s) {
+      TrackingExperiment e;
+      e.seed = 7 + 13 * static_cast<std::uint64_t>(s);
+      ScanOptions o;
+      o.kp = g.kp;
+      o.ki = g.ki;
+      o.notch_hz = g.notch_hz;
+      o.notch_q = g.notch_q;
+      o.measure_periods = static_cast<int>(4.0 * line.frequency_hz);
+      const ScanRun run = run_scan(e, identify_for_scan(e, line.amplitude_m), line, o);
+      clamped += run.clamped_ticks;
+      runs_clamped += run.clamped_ticks > 0 ? 1 : 0;
+      rms_sum += run.stats.rms_true_m;
+    }
+    std::printf("| %.2g | %.3f V | %llu | %d of %d | %.3f nm |\n", kp, servo_noise_step_V(g),
+                static_cast<unsigned long long>(clamped), runs_clamped, kSeeds, rms_sum / kSeeds * 1e9);
+    std::fflush(stdout);
+  }
 }
 
 }  // namespace
@@ -232,5 +286,6 @@ int main(int argc, char** argv) {
   std::printf("| former defaults | %.1f nm | %llu |\n", rms * 1e9, static_cast<unsigned long long>(clamped));
   rms = slew_clamped_sine(&defaults, gain, &clamped);
   std::printf("| defaults | %.1f nm | %llu |\n", rms * 1e9, static_cast<unsigned long long>(clamped));
+  kp_at_the_slew_limit(defaults);
   return id.ok ? 0 : 1;
 }

@@ -36,7 +36,7 @@ struct ScanOptions {
   std::optional<FeedforwardMode> mode;  // nullopt: the identification's best (hystloop-identify --model auto)
   bool stage_inverse = true;            // Banning's k, c inverted beside the hysteresis
   bool servo = true;                    // the bridge's servo as deploy/config/bridge.yaml sets it:
-  double kp = 0.1, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
+  double kp = 0.05, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
   bool learning = false;
   int settle_periods = 20;     // the error is measured after these whole periods ...
   int measure_periods = 10;    // ... over these

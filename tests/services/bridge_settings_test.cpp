@@ -97,7 +97,7 @@ TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
   EXPECT_GE(s.rt.ticks_per_wake, 1);
   EXPECT_LE(s.rt.ticks_per_wake, s.block_ticks);
   EXPECT_EQ(s.command_queue_capacity, 256);
-  EXPECT_EQ(s.servo.kp, 0.1);
+  EXPECT_EQ(s.servo.kp, 0.05);
   EXPECT_EQ(s.servo.ki, 2000.0);  // with the notch at the resonance (bridge_servo_margins_test)
   EXPECT_EQ(s.servo.kd, 0.0);
   EXPECT_EQ(s.servo.nominal_gain_m_per_V, 6.3e-9);
