@@ -89,9 +89,19 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   std::optional<std::int64_t> late_before_report;
   Subscription<sensor_block_t>::Options sensor_queue;
   sensor_queue.queue_capacity = 4'000;  // blocks: a few seconds of them
+  TruthPairing truth;
   Subscription<sensor_block_t> samples(
       link.lcm(), link.channels().sensor,
-      [&](const sensor_block_t& b, std::int64_t) { line.second.add_sensor_block(b); }, sensor_queue);
+      [&](const sensor_block_t& b, std::int64_t) {
+        line.second.add_sensor_block(b);
+        truth.add_sensor_block(b, line.second);
+      },
+      sensor_queue);
+  Subscription<sim_truth_t>::Options truth_queue;
+  truth_queue.queue_capacity = sensor_queue.queue_capacity;
+  Subscription<sim_truth_t> truths(
+      link.lcm(), link.channels().sim_truth,
+      [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); }, truth_queue);
   Subscription<command_block_t>::Options command_queue;
   command_queue.queue_capacity = 4'000;
   Subscription<command_block_t> commands(

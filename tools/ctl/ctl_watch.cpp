@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "ctl_health.hpp"
 #include "lcm/blocks.hpp"
@@ -25,9 +26,50 @@ void WatchSecond::add_sensor_block(const sensor_block_t& block) noexcept {
   if (armed) buffer_min_ticks = std::min(buffer_min_ticks.value_or(block.buffer_depth_ticks), block.buffer_depth_ticks);
 }
 
+void WatchSecond::add_true_error(double e_m) noexcept {
+  ++true_tracking;
+  true_sum_sq_m2 += e_m * e_m;
+  true_max_abs_m = std::max(true_max_abs_m, std::abs(e_m));
+}
+
 std::optional<double> WatchSecond::rms_m() const noexcept {
   if (tracking == 0) return std::nullopt;
   return std::sqrt(sum_sq_m2 / static_cast<double>(tracking));
+}
+
+std::optional<double> WatchSecond::true_rms_m() const noexcept {
+  if (true_tracking == 0) return std::nullopt;
+  return std::sqrt(true_sum_sq_m2 / static_cast<double>(true_tracking));
+}
+
+void TruthPairing::pair(const std::vector<double>& y_ref, const std::vector<double>& y_true,
+                        WatchSecond& into) noexcept {
+  if (y_ref.size() != y_true.size()) return;  // not the same block after all
+  for (std::size_t i = 0; i < y_ref.size(); ++i) {
+    if (std::isfinite(y_ref[i]) && std::isfinite(y_true[i])) into.add_true_error(y_ref[i] - y_true[i]);
+  }
+}
+
+void TruthPairing::keep(std::deque<Block>& waiting, Block block) {
+  if (waiting.size() == kWaiting) waiting.pop_front();
+  waiting.push_back(std::move(block));
+}
+
+void TruthPairing::add_sensor_block(const sensor_block_t& block, WatchSecond& into) {
+  Block b{block.seq, {}};
+  b.y_m.reserve(static_cast<std::size_t>(std::max(block.n_ticks, 0)));
+  for_each_tick(block, [&](const SensorTick& t) { b.y_m.push_back(t.y_ref_m); });
+  const auto match = std::find_if(truths_.begin(), truths_.end(), [&](const Block& t) { return t.seq == b.seq; });
+  if (match == truths_.end()) return keep(refs_, std::move(b));
+  pair(b.y_m, match->y_m, into);
+  truths_.erase(match);
+}
+
+void TruthPairing::add_truth_block(const sim_truth_t& truth, WatchSecond& into) {
+  const auto match = std::find_if(refs_.begin(), refs_.end(), [&](const Block& r) { return r.seq == truth.seq; });
+  if (match == refs_.end()) return keep(truths_, Block{truth.seq, truth.y_true_m});
+  pair(match->y_m, truth.y_true_m, into);
+  refs_.erase(match);
 }
 
 std::optional<double> learning_rms_nm(const service_status_t& compensator) {
@@ -47,6 +89,10 @@ std::string format_watch_line(const WatchLine& l) {
     std::snprintf(buf, sizeof buf, "  rms %7s nm  max %7s nm", "--", "--");
   }
   out += buf;
+  if (const auto true_rms = l.second.true_rms_m()) {
+    std::snprintf(buf, sizeof buf, "  true %.2f nm max %.1f nm", *true_rms * 1e9, l.second.true_max_abs_m * 1e9);
+    out += buf;
+  }
   std::snprintf(buf, sizeof buf, "  ticks %6llu/%llu", static_cast<unsigned long long>(l.second.tracking),
                 static_cast<unsigned long long>(l.second.samples));
   out += buf;

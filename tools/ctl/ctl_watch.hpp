@@ -1,14 +1,19 @@
 #pragma once
 // `hystloop-ctl watch`: the tracking error of the running loop, per second. The bridge records
 // each tick's reference and measured position in HX_SENSOR, so a tick's error y_ref - y comes
-// from its sensor block alone; ticks without a reference (NaN) have none.
+// from its sensor block alone; ticks without a reference (NaN) have none. With a simulated
+// stage the bridge also publishes the true position (HX_SIM_TRUTH), and watch gives the error
+// against it beside the measured one, whose sensor noise is the floor.
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 
 namespace hystloop::ctl {
 
@@ -20,12 +25,38 @@ struct WatchSecond {
   double sum_sq_m2 = 0.0;
   double max_abs_m = 0.0;
   std::optional<std::int32_t> buffer_min_ticks;  // lowest buffer depth of an armed sensor block
+  std::uint64_t true_tracking = 0;               // ticks with a reference and their true position
+  double true_sum_sq_m2 = 0.0;
+  double true_max_abs_m = 0.0;
 
   void add_error(double e_m) noexcept;
+  void add_true_error(double e_m) noexcept;
   // Every tick of the block (its error where it has a reference), and its buffer depth when no
   // tick is SAFE_STATE. Allocation-free.
   void add_sensor_block(const sensor_block_t& block) noexcept;
   std::optional<double> rms_m() const noexcept;
+  std::optional<double> true_rms_m() const noexcept;
+};
+
+// Pairs each HX_SIM_TRUTH block with the HX_SENSOR block of the same seq, in either arrival
+// order (the two channels are not ordered against each other), and adds the true error
+// y_ref - y_true of every tick with a reference to the second. A block waits for its partner
+// among the last kWaiting of its channel; one whose partner never comes (a lost message) is
+// dropped with them, so the true figures may cover fewer ticks than the measured ones.
+class TruthPairing {
+ public:
+  static constexpr std::size_t kWaiting = 64;
+  void add_sensor_block(const sensor_block_t& block, WatchSecond& into);
+  void add_truth_block(const sim_truth_t& truth, WatchSecond& into);
+
+ private:
+  struct Block {
+    std::int64_t seq = 0;
+    std::vector<double> y_m;  // the references (sensor) or the true positions (truth)
+  };
+  static void pair(const std::vector<double>& y_ref, const std::vector<double>& y_true, WatchSecond& into) noexcept;
+  static void keep(std::deque<Block>& waiting, Block block);
+  std::deque<Block> refs_, truths_;
 };
 
 struct WatchLine {
@@ -50,7 +81,8 @@ struct WatchLine {
 // The compensator's learning error [nm] from its counter learning_rms_nm, or learning_rms_pm (finer).
 std::optional<double> learning_rms_nm(const service_status_t& compensator);
 
-// " 12 s  rms   27.9 nm  max   80.1 nm  ticks 10000/10000  params v3  late 0 (+0)  clamped 0/s  buf min 212
+// " 12 s  rms   27.9 nm  max   80.1 nm  [true 0.55 nm max 3.1 nm]  ticks 10000/10000  params v3  late 0 (+0)  clamped
+// 0/s  buf min 212
 //  bridge HEALTHY" and, when the compensator reports learning, "  learned 12.3 nm (34 periods)",
 // and when it refused or shaped a trajectory, "  trajectories refused 1, shaped 2"
 std::string format_watch_line(const WatchLine& line);

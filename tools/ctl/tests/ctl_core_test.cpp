@@ -337,6 +337,55 @@ TEST(CtlWatch, SensorBlocksGiveTheExactRmsAndTheLowestArmedBufferDepth) {
   EXPECT_FALSE(WatchSecond{}.buffer_min_ticks);
 }
 
+// The true error pairs each truth block with the sensor block of its seq whichever comes first;
+// a block whose partner was lost adds nothing, and ticks without a reference have no error.
+TEST(CtlWatch, TruthBlocksPairWithTheirSensorBlocksInEitherOrder) {
+  constexpr std::int64_t kBlockTicks = 4;
+  auto sensor = [](std::int64_t seq) {
+    sensor_block_t b{};
+    reserve_storage(b);
+    begin_block(b, seq, 1'000'000 + seq * 100, 1e-4);
+    for (std::int64_t k = 0; k < kBlockTicks; ++k) {
+      SensorTick t{};
+      t.y_ref_m = k == 0 ? std::nan("") : 1e-6;
+      t.y_m = 1e-6 - 2e-9;  // measured error 2 nm
+      append_tick(b, t);
+    }
+    return b;
+  };
+  auto truth = [](std::int64_t seq, double error_m) {
+    sim_truth_t t{};
+    t.seq = seq;
+    t.n_ticks = kBlockTicks;
+    t.y_true_m.assign(kBlockTicks, 1e-6 - error_m);
+    return t;
+  };
+  TruthPairing pairing;
+  WatchSecond second;
+  pairing.add_sensor_block(sensor(0), second);
+  pairing.add_truth_block(truth(0, 1e-9), second);  // after its sensor block
+  pairing.add_truth_block(truth(4, 3e-9), second);  // before it
+  EXPECT_EQ(second.true_tracking, 3u);
+  pairing.add_sensor_block(sensor(4), second);
+  pairing.add_sensor_block(sensor(8), second);       // its truth was lost
+  pairing.add_truth_block(truth(12, 1e-9), second);  // its sensor block was lost
+  ASSERT_EQ(second.true_tracking, 6u);
+  EXPECT_NEAR(*second.true_rms_m(), std::sqrt((3 * 1e-18 + 3 * 9e-18) / 6), 1e-18);
+  EXPECT_NEAR(second.true_max_abs_m, 3e-9, 1e-21);
+  sim_truth_t short_block = truth(16, 1e-9);
+  short_block.y_true_m.pop_back();
+  short_block.n_ticks = kBlockTicks - 1;
+  pairing.add_sensor_block(sensor(16), second);
+  pairing.add_truth_block(short_block, second);  // not the same ticks: not paired
+  EXPECT_EQ(second.true_tracking, 6u);
+  // Far more unpaired blocks than it keeps: the oldest go, the newest still pair.
+  for (std::int64_t n = 0; n < 1000; ++n) pairing.add_sensor_block(sensor(100 + n * kBlockTicks), second);
+  pairing.add_truth_block(truth(100 + 999 * kBlockTicks, 1e-9), second);
+  pairing.add_truth_block(truth(100, 1e-9), second);
+  EXPECT_EQ(second.true_tracking, 9u);
+  EXPECT_FALSE(WatchSecond{}.true_rms_m());
+}
+
 TEST(CtlWatch, LineIsTidy) {
   WatchLine l;
   l.elapsed_s = 12;
@@ -353,6 +402,12 @@ TEST(CtlWatch, LineIsTidy) {
   EXPECT_EQ(format_watch_line(l),
             "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
             "clamped 14/s  buf min 212  bridge HEALTHY");
+  WatchLine with_truth = l;
+  with_truth.second.add_true_error(0.55e-9);
+  with_truth.second.add_true_error(-3.1e-9);
+  EXPECT_NE(format_watch_line(with_truth).find("max    27.9 nm  true 2.23 nm max 3.1 nm  ticks      2/10000"),
+            std::string::npos)
+      << format_watch_line(with_truth);
   l.learning_rms_nm = 9;
   l.learning_periods = 31;
   EXPECT_EQ(format_watch_line(l),
