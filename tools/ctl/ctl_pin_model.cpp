@@ -12,6 +12,7 @@ std::int8_t pin_model_mode(const std::string& name) {
   if (name == "auto" || name == "off") return to_wire(FeedforwardMode::kOff);
   if (const auto kind = parse_model_kind(name)) return to_wire(mode_of(*kind));
   std::vector<std::string_view> names;
+  names.reserve(kModelKindCount + 1);
   for (int i = 0; i < kModelKindCount; ++i) names.push_back(to_string(static_cast<ModelKind>(i)));
   names.emplace_back("auto");
   throw ParameterError("model", "expected " + choice_list(names) + " (got \"" + name + "\")");
