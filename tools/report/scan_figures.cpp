@@ -72,7 +72,26 @@ struct Segment {
   std::int64_t start_utime = 0, end_utime = 0;
   double skip_s = 0.0;
   LearningState learning = LearningState::kUnknown;
+  // Ended by a DISARM or SHUTDOWN: the safe-state ticks it ends with are the stop's. The report
+  // dates a block's ticks back from its arrival, one tick apart, but the bridge runs a block's
+  // ticks in a burst (rt.ticks_per_wake), so those of the burst after the stop came in are dated
+  // up to a block before the request.
+  bool ends_at_stop = false;
 };
+
+// The first seq of the run of safe-state ticks that ends the segment, if it ends with one.
+std::optional<std::int64_t> trailing_safe_from(const RunData& run, const Segment& seg) {
+  std::optional<std::int64_t> from;
+  for (const auto& s : run.samples) {
+    if (s.recv_utime < seg.start_utime || s.recv_utime >= seg.end_utime) continue;
+    if ((s.flags & sensor_block_t::SAFE_STATE) == 0) {
+      from.reset();
+    } else if (!from) {
+      from = s.seq;
+    }
+  }
+  return from;
+}
 
 void add_compensator_figures(const ScanEvents& events, const Segment& seg, SegmentFigures& f) {
   const ScanCompensatorStatus* before = nullptr;
@@ -114,8 +133,12 @@ SegmentFigures measure(const RunData& run, const ScanEvents& events, const ScanT
   double max_abs = 0.0, max_abs_true = 0.0;
   std::int64_t first_seq = std::numeric_limits<std::int64_t>::max(),
                last_seq = std::numeric_limits<std::int64_t>::min();
+  const std::int64_t stop_seq = seg.ends_at_stop
+                                    ? trailing_safe_from(run, seg).value_or(std::numeric_limits<std::int64_t>::max())
+                                    : std::numeric_limits<std::int64_t>::max();
   for (const auto& s : run.samples) {
     if (s.recv_utime < seg.start_utime || s.recv_utime >= seg.end_utime) continue;
+    if (s.seq >= stop_seq) continue;
     ++f.ticks;
     first_seq = std::min(first_seq, s.seq);
     last_seq = std::max(last_seq, s.seq);
@@ -285,6 +308,7 @@ ScanResult compute_scan(const RunData& run, const ScanEvents& events, const Scan
     }
   };
   for (const Boundary& b : boundaries(events)) {
+    seg.ends_at_stop = b.control == ScanControl::Kind::kStop;
     close(b.utime);
     seg = Segment{b.utime, b.utime, o.settle_s, learning};
     if (b.trajectory) {

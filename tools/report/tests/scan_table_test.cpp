@@ -364,6 +364,32 @@ TEST_F(ScanLog, MeasuresEachReferenceWithLearningOffAndOn) {
   EXPECT_NE(table.find("**refused**: its feedforward needs 1e+05 V/s; at 10 Hz"), std::string::npos) << table;
 }
 
+// The safe-state ticks a segment ends with when a DISARM ends it are the stop's: the bridge ran
+// them after the request, though a block's ticks are dated back from its arrival. Safe ticks
+// before them (a watchdog trip mid-line) still count.
+TEST_F(ScanLog, TheSafeTicksOfTheStopAreNotTheSegments) {
+  const ChannelNames channels("HX_");
+  RunData run = read_logs({log()}, channels);
+  ScanEvents events = read_scan_events({log()}, channels, "compensator");
+  // Without the refused B at 7 s, A's learning-on segment runs from 4.02 s to the DISARM at 8 s.
+  std::erase_if(events.trajectories, [](const ScanTrajectory& t) { return t.version == kVersionB; });
+  std::size_t trailing = 0;
+  for (auto& sample : run.samples) {
+    const bool trip = sample.seq >= tick_of(6.0) && sample.seq < tick_of(6.0) + 3;
+    const bool stop = sample.recv_utime >= at(7.9985) && sample.recv_utime < at(8.0);
+    if (trip || stop) sample.flags |= sensor_block_t::SAFE_STATE;
+    trailing += stop ? 1 : 0;
+  }
+  ASSERT_GT(trailing, 10u);
+  const ScanResult scan = compute_scan(run, events, ScanOptions{});
+  ASSERT_EQ(scan.references.size(), 1u);
+  ASSERT_TRUE(scan.references[0].on);
+  const SegmentFigures& on = *scan.references[0].on;
+  EXPECT_NEAR(on.end_s, 8.0, 1e-6);
+  EXPECT_EQ(on.safe_ticks, 3u);
+  EXPECT_EQ(on.ticks, static_cast<std::size_t>(tick_of(8.0) - tick_of(4.02)) - trailing);
+}
+
 TEST_F(ScanLog, InfersTheLearningStateWithoutRequests) {
   const ChannelNames channels("HX_");
   const RunData run = read_logs({log()}, channels);
