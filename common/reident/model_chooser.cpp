@@ -1,9 +1,11 @@
 #include "reident/model_chooser.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <utility>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "core/clock.hpp"
@@ -14,9 +16,16 @@
 namespace hystloop {
 
 const char* ModelChooser::counter_name(std::size_t i) noexcept {
-  static constexpr const char* kNames[kCounters] = {
-      "model_selections",         "model_changes",     "model_refits", "model_kept", "model_failed", "model_poisoned",
-      "model_refits_left_to_mem", "model_implausible", "model_held"};
+  static constexpr const char* kNames[kCounters] = {"model_selections",
+                                                    "model_changes",
+                                                    "model_refits",
+                                                    "model_kept",
+                                                    "model_failed",
+                                                    "model_poisoned",
+                                                    "model_refits_left_to_mem",
+                                                    "model_implausible",
+                                                    "model_held",
+                                                    "model_unsettled"};
   return i < kCounters ? kNames[i] : "model_unknown";
 }
 
@@ -27,7 +36,20 @@ ModelChooser::ModelChooser(const ModelChoiceOptions& options, const ModelParamSe
       window_(std::move(window)),
       slot_([this] { evaluate_job(); }, options.enabled && start_thread) {
   options_.selector.validate();
+  if (options_.regime_factor != 0.0) require_in_range("regime_factor", options_.regime_factor, 1.0, 1e6);
   in_use_.validate();
+}
+
+std::optional<double> ModelChooser::recent_median_then_add(double best_m) {
+  std::optional<double> median;
+  const std::size_t n = std::min(recent_count_, kRecentFits);
+  if (n >= 2) {
+    std::array<double, kRecentFits> sorted = recent_best_m_;
+    std::sort(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n));
+    median = n % 2 == 1 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+  }
+  if (std::isfinite(best_m)) recent_best_m_[recent_count_++ % kRecentFits] = best_m;
+  return median;
 }
 
 void ModelChooser::evaluate_job() {
@@ -70,9 +92,25 @@ ModelDecision ModelChooser::collect(ReidentCore& core) {
     return d;
   }
   ++counters_[selections];
+  const std::optional<double> recent_m = recent_median_then_add(p.winner_holdout_rms_m);
   const bool pinned_elsewhere = options_.pinned && *options_.pinned != in_use_.kind;
   if (!p.proposes() && !pinned_elsewhere) {
     ++counters_[kept];
+    return d;
+  }
+  // Below a nanometre a window is explained to a nanopositioning sensor's noise: a ratio of such
+  // residuals (noise-free test data fits to 1e-15 m) says nothing about the regime.
+  constexpr double kRegimeFloor_m = 1e-9;
+  const double proposed_m =
+      p.kind == ProposalKind::model_change ? p.winner_holdout_rms_m : p.in_use_refit_holdout_rms_m;
+  if (p.proposes() && options_.regime_factor > 0.0 && recent_m &&
+      proposed_m > options_.regime_factor * std::max(*recent_m, kRegimeFloor_m)) {
+    ++counters_[unsettled];
+    last_reason_ = fmt::format(
+        "not published: held-out RMS {:.3g} m, more than {:g} x the recent selections' {:.3g} m (a window across "
+        "a change of regime)",
+        proposed_m, options_.regime_factor, *recent_m);
+    spdlog::info("model selection: {} {}", to_string(p.params.kind), last_reason_);
     return d;
   }
   // Pinned to a kind not in use: the user asked for it, so it is switched to whether or not it

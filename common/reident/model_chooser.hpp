@@ -11,6 +11,13 @@
 //   refit of MEM                  -> left to the MEM refit (HX_PARAMS, as without model choice).
 //   a set whose gain leaves the rig's band (ReidentOptions::plausibility) -> nothing published,
 //                                    counted (model_implausible), the reason in last_reason().
+//   a set that explains its window more than regime_factor x worse (held-out RMS) than the best
+//   fits of the last kRecentFits selections did (their median, at least 1 nm) -> nothing published, counted
+//   (model_unsettled): the window holds two regimes, e.g. an identification sine and the line
+//   after it, which no one set of the model describes; a set fitted across them (a PI-15 spread
+//   over both amplitudes, 10 nm against 1.5 nm) can track the line that follows far worse than
+//   the set in use. Every selection's best fit enters the median, so a lasting change of regime
+//   (every window fitted worse from now on) is published after kRecentFits - 1 selections.
 //
 // Pinning (reidentifier.pin_model, hystloop-ctl pin-model): no automatic change. Pinned to the model in
 // use, only its parameters are refitted; pinned to another kind, the next selection fits that kind
@@ -22,6 +29,7 @@
 // Handoff through a JobSlot (job_slot.hpp), as RefitWorker's: whoever moves the slot's state owns
 // the job's data. start_thread = false: run_pending() runs the job on the caller (tests).
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -41,6 +49,7 @@ struct ModelChoiceOptions {
   double period_s = 5.0;             // reidentifier.model_period_s
   std::optional<ModelKind> pinned;   // reidentifier.pin_model (none = automatic)
   OnlineSelectorOptions selector{};  // margin (reidentifier.model_margin), candidates (reidentifier.models)
+  double regime_factor = 3.0;        // reidentifier.model_regime_factor (> 1; 0 = off), see above
 };
 
 struct ModelDecision {
@@ -64,13 +73,16 @@ class ModelChooser {
     poisoned,
     left_to_mem,
     implausible,
-    held,  // a change or refit proposed while the operator holds the set in use: not published
+    held,       // a change or refit proposed while the operator holds the set in use: not published
+    unsettled,  // a proposal fitted across a change of regime (regime_factor): not published
     kCounters
   };
   static const char* counter_name(std::size_t i) noexcept;  // "model_selections", ...
 
   // initial: the model the compensator starts with (MEM from the configuration). window: from
   // OnlineMemEstimator::make_window(), the job's preallocated copy of the estimator's window.
+  static constexpr std::size_t kRecentFits = 3;
+
   ModelChooser(const ModelChoiceOptions& options, const ModelParamSet& initial, MemWindow window,
                bool start_thread = true);
   ~ModelChooser() = default;  // the slot waits for a selection in flight, then joins
@@ -95,6 +107,9 @@ class ModelChooser {
  private:
   void evaluate_job();
   ModelDecision collect(ReidentCore& core);
+  // The median of the recent selections' best held-out RMS [m] (nullopt: fewer than two yet),
+  // then `best_m` joins them.
+  std::optional<double> recent_median_then_add(double best_m);
 
   ModelChoiceOptions options_;
   ModelParamSet in_use_;
@@ -111,6 +126,8 @@ class ModelChooser {
   double last_duration_s_ = 0.0;
   std::string last_reason_;
   std::uint64_t counters_[kCounters]{};
+  std::array<double, kRecentFits> recent_best_m_{};  // a ring of the last selections' best held-out RMS
+  std::size_t recent_count_ = 0;
   JobSlot slot_;  // last: its thread ends before the job's data above is destroyed
 };
 

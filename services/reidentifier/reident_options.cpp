@@ -30,12 +30,13 @@ constexpr const char* kReidentKeys[] = {
     "reidentifier.models",
     "reidentifier.model_margin",
     "reidentifier.model_period_s",
+    "reidentifier.model_regime_factor",
     "reidentifier.model_decimation",
     "reidentifier.pin_model",
     "reidentifier.plausible_gain_factor",
 };
 
-// reidentifier.models, model_margin, model_period_s, model_decimation, pin_model.
+// reidentifier.models, model_margin, model_period_s, model_regime_factor, model_decimation, pin_model.
 void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   const std::string models = config.get<std::string>("reidentifier.models", "off");
   m.enabled = models != "off";
@@ -58,6 +59,9 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   }
   m.selector.margin = config.get_in_range("reidentifier.model_margin", m.selector.margin, 0.0, 0.9);
   m.period_s = config.get_in_range("reidentifier.model_period_s", m.period_s, 0.1, 3600.0);
+  m.regime_factor = config.get_in_range("reidentifier.model_regime_factor", m.regime_factor, 0.0, 1e6);
+  if (m.regime_factor != 0.0 && m.regime_factor < 1.0)
+    config.fail("reidentifier.model_regime_factor", "must be 0 (off) or >= 1");
   m.selector.decimation =
       static_cast<std::size_t>(config.get_int_in_range("reidentifier.model_decimation", 10, 1, 1000));
   const std::string pin = config.get<std::string>("reidentifier.pin_model", "none");

@@ -12,6 +12,7 @@
 #include "reident/model_chooser.hpp"
 #include "reident/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
+#include "models/linear.hpp"
 #include "reident_test_data.hpp"
 
 namespace hystloop {
@@ -101,6 +102,54 @@ TEST(ReidentModelChooser, APoisonedWindowProposesNothing) {
   EXPECT_TRUE(r.core.mem_refits());
 }
 
+// A window across two regimes: here small loops (20 V), then the major loop (250 V), which a
+// linear model explains far worse. The first refits on the big loops are more than
+// regime_factor x worse than the recent ones: not published, counted; once every window is of the
+// new regime the median follows it and the refit is published. With the factor 0, at once.
+TEST(ReidentModelChooser, ARefitAcrossAChangeOfRegimeWaitsUntilTheRegimeLasts) {
+  for (const double factor : {3.0, 0.0}) {
+    SCOPED_TRACE(factor);
+    Rig r;
+    testdata::SineRecord small;
+    small.u = testdata::sine_input(20.0, 10.0, 1e4, 2.0);
+    small.y = testdata::mem_branches(small.u, r.truth);
+    testdata::add_noise(small.y, 1e-9, 5);
+    const testdata::SineRecord big = r.record;
+    r.record = small;
+    ModelChoiceOptions o = enabled(ModelKind::linear);
+    o.selector.selection.candidates = {ModelKind::linear};
+    o.regime_factor = factor;
+    ModelParamSet linear;
+    linear.kind = ModelKind::linear;
+    linear.mem = r.truth;
+    linear.linear = linear_params_from_mem(r.truth, 250.0);
+    ModelChooser chooser(o, linear, r.core.estimator().make_window(), false);
+    auto select = [&] {
+      r.stream(0.6);
+      r.now += 2 * kSecond;
+      chooser.poll(r.core, r.now);
+      EXPECT_TRUE(chooser.run_pending());
+      return chooser.poll(r.core, r.now);
+    };
+    select();
+    select();  // two selections of the small loops: the median holds
+    r.record = big;
+    const std::uint64_t refits_before = chooser.count(ModelChooser::refits);
+    const ModelDecision first = select();
+    if (factor == 0.0) {
+      EXPECT_EQ(first.kind, ModelDecision::Kind::refit) << chooser.last_reason();
+      continue;
+    }
+    EXPECT_EQ(first.kind, ModelDecision::Kind::none);
+    EXPECT_NE(chooser.last_reason().find("change of regime"), std::string::npos) << chooser.last_reason();
+    EXPECT_EQ(select().kind, ModelDecision::Kind::none) << chooser.last_reason();
+    EXPECT_EQ(chooser.count(ModelChooser::unsettled), 2u);
+    EXPECT_EQ(chooser.count(ModelChooser::refits), refits_before);
+    EXPECT_EQ(select().kind, ModelDecision::Kind::refit) << chooser.last_reason();  // the regime lasted
+    EXPECT_EQ(chooser.count(ModelChooser::unsettled), 2u);
+  }
+}
+
 TEST(ReidentModelChooser, ConfigKeys) {
   const auto read = [](const std::string& yaml) { return read_reident_options(Config::from_string(yaml)); };
   EXPECT_FALSE(read("reidentifier: {}").models.enabled);
@@ -109,10 +158,13 @@ TEST(ReidentModelChooser, ConfigKeys) {
   EXPECT_EQ(o.models.selector.selection.candidates, (std::vector<ModelKind>{ModelKind::mem, ModelKind::pi}));
   EXPECT_DOUBLE_EQ(o.models.selector.margin, 0.2);
   EXPECT_EQ(o.models.pinned, ModelKind::pi);
+  EXPECT_DOUBLE_EQ(o.models.regime_factor, 3.0);
+  EXPECT_DOUBLE_EQ(read("reidentifier: {model_regime_factor: 0}").models.regime_factor, 0.0);
   EXPECT_EQ(read("reidentifier: {models: auto}").models.selector.selection.candidates.size(), 4u);
   for (const char* bad : {"reidentifier: {models: banning}", "reidentifier: {models: \"mem,mem\"}",
                           "reidentifier: {model_margin: 0.95}", "reidentifier: {pin_model: preisach}",
-                          "reidentifier: {model_decimation: 0}", "reidentifier: {model_period_s: 0}"}) {
+                          "reidentifier: {model_decimation: 0}", "reidentifier: {model_period_s: 0}",
+                          "reidentifier: {model_regime_factor: 0.5}", "reidentifier: {model_regime_factor: -1}"}) {
     EXPECT_THROW(read(bad), ConfigError) << bad;
   }
 }
