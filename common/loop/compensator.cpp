@@ -110,12 +110,7 @@ void CompensatorConfig::validate() const {
 Compensator::Compensator(const CompensatorConfig& config)
     : config_((config.validate(), config)),
       mode_(config.mode),
-      mem_(config.mem),
-      pi_(config.pi),
-      katalenic_(config.katalenic),
-      linear_(config.linear),
-      pi_model_(config.pi),
-      katalenic_model_(config.katalenic),
+      inverses_(config.mem, config.pi, config.katalenic, config.linear),
       anchor_offset_(config.reanchor_ticks, config.reanchor_ramp_ticks,
                      config.slew_fraction * config.slew_V_per_s * config.dt_s,
                      config.reanchor_u_rate_V_per_s * config.dt_s),
@@ -464,53 +459,19 @@ void Compensator::offer_model(const ModelParamSet& params, std::int32_t version)
 
 ModelParamSet Compensator::model_params() const noexcept {
   ModelParamSet set;
-  set.mem = mem_.params();
-  set.pi = pi_.params();
-  set.katalenic = katalenic_.params();
-  set.linear = linear_.params();
+  inverses_.get_params(set);
   set.kind = model_kind_of(mode_).value_or(ModelKind::mem);
   return set;
 }
 
 double Compensator::nominal_slope() const noexcept {
-  switch (mode_) {
-    case FeedforwardMode::kMem: return mem_.params().c1;
-    case FeedforwardMode::kPi: return pi_.params().weights[0];
-    default: return linear_.params().gain;
-  }
+  return inverses_.nominal_slope(model_kind_of(mode_).value_or(ModelKind::linear));
 }
-
-namespace {
-// Model and inverse at the end of the monotone branch u_from -> u_to (from a virgin start at
-// u_from); returns the output there.
-template <class Model, class Inverse>
-double replay_branch(Model& model, Inverse& inverse, double u_from, double u_to) noexcept {
-  model.reset(u_from);
-  const double y_from = model.output();
-  const double y_to = model.forward(u_to);
-  inverse.reset(y_from);
-  inverse.inverse(y_to);
-  return y_to;
-}
-}  // namespace
 
 double Compensator::restart_at_reversal(FeedforwardMode mode, double u_rev) noexcept {
-  // The state a periodic input leaves at a reversal: the branch from the previous reversal to
-  // this one, replayed through the forward model (it sets every play / the operator that the
-  // branch swept) and then through the inverse, which ends at u_rev.
-  switch (mode) {
-    case FeedforwardMode::kMem: mem_.reset_to_branch(last_w_ - shift_m_, u_rev); return last_w_ - shift_m_;
-    case FeedforwardMode::kPi: return replay_branch(pi_model_, pi_, u_prev_rev_, u_rev);
-    case FeedforwardMode::kKatalenic: return replay_branch(katalenic_model_, katalenic_, u_prev_rev_, u_rev);
-    case FeedforwardMode::kLinear: {
-      const double y0 = linear_.params().gain * u_rev + linear_.params().offset;
-      linear_.reset(y0);
-      return y0;
-    }
-    case FeedforwardMode::kOff:
-    case FeedforwardMode::kExperiment: break;
-  }
-  return last_w_ - shift_m_;
+  const double w = last_w_ - shift_m_;
+  const auto kind = model_kind_of(mode);
+  return kind ? inverses_.restart_at_reversal(*kind, u_prev_rev_, u_rev, w) : w;
 }
 
 bool Compensator::params_held_by_learning() const noexcept {
@@ -536,12 +497,7 @@ void Compensator::swap_params(std::int64_t k) noexcept {
   const bool in_use = switching || to == mode_;
   const double u_shift = anchor_offset_.u_offset(k);
   const double u_rev = last_u_ - u_shift;  // this reversal, in the model's coordinates
-  switch (p.kind) {
-    case ModelKind::mem: mem_.set_params(p.mem); break;
-    case ModelKind::pi: pi_.set_params(p.pi), pi_model_.set_params(p.pi); break;
-    case ModelKind::katalenic: katalenic_.set_params(p.katalenic), katalenic_model_.set_params(p.katalenic); break;
-    case ModelKind::linear: linear_.set_params(p.linear); break;
-  }
+  inverses_.set_params(p);
   if (p.stage) set_stage(*p.stage);  // at a reversal the stage is nearly at rest: restart it there
   params_version_ = pending_version_;
   pending_.reset();
@@ -560,7 +516,7 @@ void Compensator::swap_params(std::int64_t k) noexcept {
   if (mode_ == FeedforwardMode::kLinear) {
     // A line has no branch to anchor: its fitted offset puts it through the middle of the loop,
     // where anchoring it at a reversal would put it at the loop's edge. Ramp back to that.
-    anchor_offset_.ramp_to(0.0, u_shift, k, linear_.params().gain);
+    anchor_offset_.ramp_to(0.0, u_shift, k, inverses_.linear_params().gain);
   } else {
     anchor_offset_.start_measuring(k);
   }
@@ -573,7 +529,7 @@ void Compensator::set_mode(FeedforwardMode mode) {
   if (mode != mode_) {
     mode_ = mode;
     inverse_fresh_ = true;
-    if (counters_.planned > 0) anchor_ = Anchor{last_u_, last_w_, kNaN};
+    if (counters_.planned > 0) anchor_ = StagePoint{last_u_, last_w_, kNaN};
   }
 }
 
@@ -602,38 +558,12 @@ void Compensator::start_experiment(const ExperimentSpec& spec) {
 void Compensator::stop_experiment() noexcept { experiments_.stop(loop_time(std::max<std::int64_t>(next_tick_, 0))); }
 
 void Compensator::reset_inverse(double y0) noexcept {
-  switch (mode_) {
-    case FeedforwardMode::kMem:
-      // A virgin stage starts on the skeleton; one that has moved (after an experiment or a
-      // mode switch) is on a branch through where it is now, and the voltage must not jump.
-      if (anchor_ && std::isfinite(anchor_->branch_u_V)) {
-        // The stage is on the branch that began at branch_u_V (the experiment's last reversal)
-        // and passes through the measured (u, y): continue it there, direction and all.
-        mem_.continue_branch(anchor_->branch_u_V, anchor_->u_V, anchor_->y_m);
-      } else if (anchor_) {
-        mem_.reset_to_branch(anchor_->y_m, anchor_->u_V);
-      } else {
-        mem_.reset(y0);
-      }
-      break;
-    case FeedforwardMode::kPi: pi_.reset(y0); break;
-    case FeedforwardMode::kKatalenic: katalenic_.reset(y0); break;
-    case FeedforwardMode::kLinear: linear_.reset(y0); break;
-    case FeedforwardMode::kOff:
-    case FeedforwardMode::kExperiment: break;
-  }
+  if (const auto kind = model_kind_of(mode_)) inverses_.start(*kind, y0, anchor_);
 }
 
 double Compensator::feedforward(double y_ref) noexcept {
-  switch (mode_) {
-    case FeedforwardMode::kMem: return mem_.inverse(y_ref);
-    case FeedforwardMode::kPi: return pi_.inverse(y_ref);
-    case FeedforwardMode::kKatalenic: return katalenic_.inverse(y_ref);
-    case FeedforwardMode::kLinear: return linear_.inverse(y_ref);
-    case FeedforwardMode::kOff:
-    case FeedforwardMode::kExperiment: return 0.0;
-  }
-  return 0.0;
+  const auto kind = model_kind_of(mode_);
+  return kind ? inverses_.inverse(*kind, y_ref) : 0.0;
 }
 
 void Compensator::observe(const CompensatorInput& sample) noexcept {
@@ -655,7 +585,7 @@ void Compensator::observe(const CompensatorInput& sample) noexcept {
   if (awaiting_anchor_ && sample.seq >= anchor_tick_) {
     // The experiment's end has been measured: track again from where the stage is.
     awaiting_anchor_ = false;
-    anchor_ = Anchor{sample.u_V, sample.y_m, experiment_branch_u_};
+    anchor_ = StagePoint{sample.u_V, sample.y_m, experiment_branch_u_};
     restart_reference(loop_time(next_tick_), sample.y_m);
   }
   if (anchor_offset_.observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) ++counters_.reanchors;
@@ -675,19 +605,14 @@ double Compensator::servo_share_m(const CompensatorInput& sample) noexcept {
   const bool consecutive = servo_share_seq_ >= 0 && sample.seq == servo_share_seq_ + 1;
   servo_share_seq_ = sample.seq;
   if (!std::isfinite(du)) return 0.0;
-  const double w = linear_.params().gain * du;
+  const double w = inverses_.linear_params().gain * du;
   if (!servo_share_stage_) return w;
   if (!consecutive) servo_share_stage_->reset(w);
   return servo_share_stage_->step(w, config_.dt_s);
 }
 
 void Compensator::take_params_from(const Compensator& old) noexcept {
-  mem_.set_params(old.mem_params());
-  pi_.set_params(old.pi_.params());
-  pi_model_.set_params(old.pi_.params());
-  katalenic_.set_params(old.katalenic_.params());
-  katalenic_model_.set_params(old.katalenic_.params());
-  linear_.set_params(old.linear_.params());
+  inverses_.take_params_from(old.inverses_);
   params_version_ = old.params_version_;
   const std::uint64_t swaps = counters_.stage_swaps;
   set_stage(old.stage_model_);

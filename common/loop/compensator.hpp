@@ -43,6 +43,7 @@
 #include "loop/experiment.hpp"
 #include "loop/experiment_queue.hpp"
 #include "loop/feedforward_anchor.hpp"
+#include "loop/hysteresis_inverses.hpp"
 #include "loop/periodic_learner.hpp"
 #include "loop/trajectory.hpp"
 #include "models/katalenic.hpp"
@@ -227,7 +228,7 @@ class Compensator {
 
   const CompensatorCounters& counters() const noexcept { return counters_; }
   FeedforwardMode mode() const noexcept { return mode_; }
-  const MemParams& mem_params() const noexcept { return mem_.params(); }
+  const MemParams& mem_params() const noexcept { return inverses_.mem_params(); }
   // The model in use with its parameters (kind follows the mode; MEM when the mode is off).
   ModelParamSet model_params() const noexcept;
   bool params_pending() const noexcept { return pending_.has_value(); }
@@ -283,12 +284,7 @@ class Compensator {
   bool trajectory_timed_ = false;         // start_s was given: an experiment's end does not move it
   TrajectorySpec previous_trajectory_{};  // the reference a new one's approach fades out
   bool from_moving_ = false;              // ... while that approach lasts
-  MemInverse mem_;
-  PiInverse pi_;
-  KatalenicInverse katalenic_;
-  LinearInverse linear_;
-  PiModel pi_model_;  // forward models, to restart PI / Katalenic at a reversal
-  KatalenicModel katalenic_model_;
+  HysteresisInverses inverses_;
   struct Pending {
     ModelParamSet params;
     bool switch_model;  // offer_model: make it the feedforward; offer_mem_params: parameters only
@@ -328,12 +324,7 @@ class Compensator {
   // After an experiment: hold last_u_ until the sample of tick anchor_tick_ is observed.
   bool awaiting_anchor_ = false;
   std::int64_t anchor_tick_ = 0;
-  struct Anchor {
-    double u_V;
-    double y_m;
-    double branch_u_V;  // the voltage where the stage's current branch began; NaN = unknown
-  };
-  std::optional<Anchor> anchor_;  // where the stage is, when it is not virgin
+  std::optional<StagePoint> anchor_;  // where the stage is, when it is not virgin
   CompensatorCounters counters_;
 };
 
