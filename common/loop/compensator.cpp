@@ -507,6 +507,9 @@ void Compensator::swap_params(std::int64_t k) noexcept {
     mode_ = to;
     ++counters_.model_switches;
   }
+  // A line learning under the old set that has no table yet: what it has observed is the old
+  // set's error, which its first table would carry over to the new one. It learns from here.
+  if (learner_.figures().active && learner_.figures().tables_this_line == 0) learner_.reset();
   // At a reversal the inverse starts a new branch from its last point: new parameters change
   // the slope of what follows, never the voltage already reached. MEM remembers nothing else;
   // the others restart at this reversal, and the offset takes up where their output is there.

@@ -234,7 +234,8 @@ class Compensator {
   bool params_pending() const noexcept { return pending_.has_value(); }
   // A learned line keeps the set it learned under once it has taken learning.hold_params_after
   // tables and its table is well inside learning.max_correction_m: the tables have learned that
-  // set's error, and a new one would only be a step of the error they must learn again. A pending
+  // set's error, and a new one would only be a step of the error they must learn again. (A set
+  // swapped in before the first table restarts the learning's periods at the swap.) A pending
   // set for the model in use waits until learning stops, is reset or the line ends.
   bool params_held_by_learning() const noexcept;
   double anchor_offset_m() const noexcept { return shift_m_; }  // the re-anchoring's output offset

@@ -276,6 +276,41 @@ TEST(CompensatorLimits, AConvergedLearnedLineKeepsItsSetUntilLearningStops) {
   EXPECT_EQ(c.mode(), FeedforwardMode::kLinear);
 }
 
+// A set swapped in before a learned line's first table: the periods observed until then carry
+// the old set's error, so the learning starts again at the swap and the first table is the new
+// set's. Here the old set leaves a constant 5 nm on the line, the new one none: a table learned
+// across the swap would hold about gain x 5 nm.
+TEST(CompensatorLimits, ASetSwappedInBeforeTheFirstTableIsLearnedFromTheSwapOn) {
+  Compensator c(linear_config(false));
+  c.take_trajectory(sine(0.5e-6, 50.0), kNaN);
+  std::map<std::int64_t, CommandTick> planned;
+  std::vector<CommandTick> out(64);
+  bool offered = false;
+  for (std::int64_t k = 0; k < 4000; ++k) {  // 0.4 s: 20 periods
+    const std::int64_t seq = std::max<std::int64_t>(c.last_seq() + 1, 0);
+    const auto it = planned.find(seq);
+    const bool tracked = it != planned.end() && std::isfinite(it->second.y_ref_m);
+    const double error = tracked && it->second.params_version != 2 ? 5e-9 : 0.0;
+    c.observe({seq, tracked ? it->second.u_ff_V : 0.0, tracked ? it->second.y_ref_m + error : 0.0});
+    while (const std::size_t m = c.plan(out)) {
+      for (std::size_t i = 0; i < m; ++i) planned[out[i].seq] = out[i];
+    }
+    if (!offered && c.learner().figures().active && c.last_seq() > 600) {
+      // Learning since the line began, a period and a half observed: no table is in use yet.
+      ASSERT_EQ(c.learner().figures().tables_this_line, 0U);
+      ModelParamSet set;
+      set.kind = ModelKind::linear;
+      set.linear.gain = kGain;
+      c.offer_model(set, 2);
+      offered = true;
+    }
+  }
+  ASSERT_TRUE(offered);
+  EXPECT_EQ(c.params_version(), 2);
+  ASSERT_GE(c.learner().figures().tables_this_line, 5U);
+  EXPECT_LT(c.learner().figures().correction_rms_m, 0.05e-9);
+}
+
 // Before the line has taken hold_params_after tables, or with the hold off (0), a set is swapped
 // in at the next reversal as always; a new line starts counting again.
 TEST(CompensatorLimits, BeforeConvergenceOrWithTheHoldOffASetIsSwappedAtTheNextReversal) {
