@@ -83,7 +83,13 @@ bool scan_table() {
     all_taken = all_taken && !inverse.refused && !learned.refused;
     char corner[32] = "—";
     if (r.shape == TrajectoryShape::kTriangle) std::snprintf(corner, sizeof corner, "%.2f ms", inverse.corner_s * 1e3);
-    std::printf("| %s | %s | %s | %s | %s | %s | %d |\n", r.name.c_str(), corner, to_string(inverse.mode),
+    std::string name = r.name;
+    if (inverse.shaped) {  // scaled into the limits, the servo's reserve included
+      char to[64];
+      std::snprintf(to, sizeof to, " (shaped to %.3g um)", inverse.amplitude_m * 1e6);
+      name += to;
+    }
+    std::printf("| %s | %s | %s | %s | %s | %s | %d |\n", name.c_str(), corner, to_string(inverse.mode),
                 cell(plain).c_str(), cell(inverse).c_str(), cell(learned).c_str(), learned.periods_to_converge);
     if (inverse.refused) std::printf("\n(refused: %s)\n", inverse.reason.c_str());
     std::fflush(stdout);

@@ -19,15 +19,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // A triangle's corners are rounded over at most this share of the period each (the rest of the
 // line is straight: what a raster scan uses).
 constexpr double kMaxCornerShare = 0.125;
+// Learning needs room beside a line: a line whose feedforward needs more of the slew limit than
+// this is tracked without (reached only where compensator.servo_slew_reserve is set below 2 %).
+constexpr double kLearningSlewShare = 0.97;
 // A dry run covers the approach and this many periods: both corners and the branch after each.
 constexpr double kDryRunPeriods = 1.25;
 constexpr std::int64_t kDryRunMaxTicks = 200'000;
-constexpr double kLearningSlewShare = 0.97;
-// What a learned correction may take the plan to: above it the learning is held back (and not
-// learned from) rather than let into the servo's headroom. 2 % of the slew limit is ~4.5 standard
-// deviations of the default servo's tick-to-tick response to 1 nm of sensor noise (0.02 V), so
-// the bridge does not clamp beside a learned line.
-constexpr double kLearningPlanShare = 0.98;
 
 std::string si(double value, const char* unit) {
   char buf[64];
@@ -101,6 +98,7 @@ void CompensatorConfig::validate() const {
   stage.validate(dt_s);
   learning.validate(dt_s);
   require_in_range("compensator.plan_slew_fraction", plan_slew_fraction, 0.05, 1.0);
+  require_in_range("compensator.servo_slew_reserve", servo_slew_reserve, 0.0, plan_slew_fraction - 0.05);
   if (horizon_ticks < 1 || horizon_ticks > kMaxHorizonTicks) {
     throw ParameterError("compensator.horizon_s", "must be 1 to " + std::to_string(kMaxHorizonTicks) + " ticks (got " +
                                                       std::to_string(horizon_ticks) + ")");
@@ -285,8 +283,8 @@ PlanExtent Compensator::dry_run_periodic(const TrajectorySpec& spec) const {
 
 bool Compensator::feasible(const PlanExtent& e) const noexcept {
   if (e.ticks == 0) return true;
-  return e.rate_max_V_per_s <= config_.plan_slew_fraction * config_.slew_V_per_s && e.u_min_V >= config_.u_min_V &&
-         e.u_max_V <= config_.u_max_V;
+  return e.rate_max_V_per_s <= config_.tracking_slew_fraction() * config_.slew_V_per_s &&
+         e.u_min_V >= config_.u_min_V && e.u_max_V <= config_.u_max_V;
 }
 
 double Compensator::choose_corner(const TrajectorySpec& spec, std::string& note) const {
@@ -346,8 +344,8 @@ double Compensator::feasible_amplitude(const TrajectorySpec& spec, double start_
   PlanExtent now = e;
   for (int i = 0; i < 8; ++i) {
     double ratio = 1.0;
-    if (now.rate_max_V_per_s > config_.plan_slew_fraction * config_.slew_V_per_s)
-      ratio = std::min(ratio, config_.plan_slew_fraction * config_.slew_V_per_s / now.rate_max_V_per_s);
+    const double allowed = config_.tracking_slew_fraction() * config_.slew_V_per_s;
+    if (now.rate_max_V_per_s > allowed) ratio = std::min(ratio, allowed / now.rate_max_V_per_s);
     if (now.u_max_V > config_.u_max_V && now.u_max_V > 0.0) ratio = std::min(ratio, config_.u_max_V / now.u_max_V);
     if (now.u_min_V < config_.u_min_V && now.u_min_V < 0.0) ratio = std::min(ratio, config_.u_min_V / now.u_min_V);
     t.amplitude_m *= 0.99 * ratio;
@@ -359,7 +357,7 @@ double Compensator::feasible_amplitude(const TrajectorySpec& spec, double start_
 
 std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const {
   std::string why = limits_left(e);
-  const double slew_allowed = config_.plan_slew_fraction * config_.slew_V_per_s;
+  const double slew_allowed = config_.tracking_slew_fraction() * config_.slew_V_per_s;
   const bool slew = e.rate_max_V_per_s > slew_allowed;
   if (periodic(spec)) {
     const double a = feasible_amplitude(spec, start_s, e);
@@ -377,10 +375,11 @@ std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_
 
 std::string Compensator::limits_left(const PlanExtent& e) const {
   std::string why;
-  if (e.rate_max_V_per_s > config_.plan_slew_fraction * config_.slew_V_per_s) {
+  if (e.rate_max_V_per_s > config_.tracking_slew_fraction() * config_.slew_V_per_s) {
     why = "its feedforward needs " + si(e.rate_max_V_per_s, "V/s") + ", above " +
-          si(100.0 * config_.plan_slew_fraction, "%") + " of the actuator's slew limit " +
-          si(config_.slew_V_per_s, "V/s") + " (actuator.slew_V_per_s; the rest is the servo's headroom)";
+          si(100.0 * config_.tracking_slew_fraction(), "%") + " of the actuator's slew limit " +
+          si(config_.slew_V_per_s, "V/s") +
+          " (actuator.slew_V_per_s; the rest is the servo's headroom, compensator.servo_slew_reserve)";
   }
   if (e.u_min_V < config_.u_min_V || e.u_max_V > config_.u_max_V) {
     if (!why.empty()) why += ", and ";
@@ -411,22 +410,6 @@ void Compensator::check_running_line(const ModelParamSet& candidate, bool switch
     throw ParameterError("params", "under this set " + line + " would leave the actuator's limits: " + limits_left(e) +
                                        "; the set in use stays");
   }
-  // Inside the plan's share but past the learning's, the servo's headroom is a per cent or two:
-  // a set that takes the line nearer the limit than the set in use does eats into it, and the
-  // bridge clamps what the servo adds (a 200 Hz line re-identified into a model needing 98.9 %
-  // clamped 13 ticks in 4 s where the set before, at 98 %, clamped none). Not nearer, or not
-  // past the learning's share, it is taken.
-  const double room = kLearningSlewShare * config_.slew_V_per_s;
-  if (e.rate_max_V_per_s <= room) return;
-  Compensator now = *this;
-  const double rate_in_use = now.dry_run_periodic(trajectory_).rate_max_V_per_s;
-  if (e.rate_max_V_per_s <= std::max(rate_in_use, room)) return;
-  throw ParameterError("params", "under this set " + line + " would need " + si(e.rate_max_V_per_s, "V/s") + " (" +
-                                     si(100.0 * e.rate_max_V_per_s / config_.slew_V_per_s, "%") +
-                                     " of the actuator's slew limit), nearer the limit than under the set in use (" +
-                                     si(100.0 * rate_in_use / config_.slew_V_per_s, "%") + ") and past " +
-                                     si(100.0 * kLearningSlewShare, "%") +
-                                     ", where the servo's headroom is too small to lose; the set in use stays");
 }
 
 void Compensator::offer_mem_params(const MemParams& params, std::int32_t version) {
@@ -782,9 +765,7 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   // The plan keeps within the share of the slew limit a trajectory was admitted at (the rest is
   // the servo's, beside the sensor); what learning or a swap would ask beyond it is held back here
   // and counted, not clamped by the bridge behind the servo's back.
-  const double max_step =
-      (learned ? std::min(config_.plan_slew_fraction, kLearningPlanShare) : config_.plan_slew_fraction) *
-      config_.slew_V_per_s * config_.dt_s;
+  const double max_step = config_.tracking_slew_fraction() * config_.slew_V_per_s * config_.dt_s;
   if (std::abs(u - last_u_) > max_step) {
     limited(counters_.u_slew_clamped);
     u = last_u_ + std::copysign(max_step, u - last_u_);

@@ -14,10 +14,11 @@
 // the stage-then-hysteresis order): the inverse of the whole series model. For a periodic
 // reference a PeriodicLearner adds a correction per tick of the period, learned from the errors
 // of earlier periods. A trajectory is checked before it is taken: a dry run of this plan over
-// its approach and its first periods must stay inside the actuator's range and plan_slew_fraction
-// of its slew limit, or it is refused with the limit named and the largest feasible amplitude
-// and frequency (or shaped to feasibility when asked). A triangle's corners are rounded; with
-// corner_s 0 the shortest rounding the limits allow is chosen by the same dry run.
+// its approach and its first periods must stay inside the actuator's range and
+// tracking_slew_fraction() of its slew limit, or it is refused with the limit named and the
+// largest feasible amplitude and frequency (or shaped to feasibility when asked). A triangle's
+// corners are rounded; with corner_s 0 the shortest rounding the limits allow is chosen by the
+// same dry run.
 //
 // A new trajectory, mode or experiment takes effect at the first tick not yet planned. New
 // parameters (offer_mem_params, or any model's with offer_model) are validated when offered and
@@ -115,9 +116,17 @@ struct CompensatorConfig {
   // 10 Hz and up: a slower reference (the MEM paper's 1 Hz cosine) is the re-identification's,
   // and what is learned there adds small reversals that start new branches of MEM's memory.
   LearningConfig learning = default_learning();
-  // A trajectory is taken only when its feedforward needs at most this fraction of the slew
-  // limit (the rest is the servo's and the learning's headroom) and stays inside the range.
+  // An experiment (the servo off) is planned within plan_slew_fraction of the slew limit; a
+  // trajectory, which the servo corrects, is taken only when its feedforward needs at most
+  // plan_slew_fraction - servo_slew_reserve of it and stays inside the range. The reserve is the
+  // servo's room at the line's fastest ticks: its tick-to-tick response to 1 nm of sensor noise
+  // (0.033 V RMS open loop with the default gains, bench/servo_margins) and, where a line starts,
+  // the integrator unwinding what it held on the previous one (0.1-0.16 V per tick, measured
+  // live; docs/TRACKING.md). 2 % = 0.1 V per tick at 5e4 V/s.
   double plan_slew_fraction = 0.99;
+  double servo_slew_reserve = 0.02;
+  // The share of the slew limit a tracked line's feedforward may use.
+  double tracking_slew_fraction() const noexcept { return plan_slew_fraction - servo_slew_reserve; }
 
   static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer
   void validate() const;                                  // throws ParameterError naming the field

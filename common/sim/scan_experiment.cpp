@@ -36,6 +36,7 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
     c.compensator.stage.order = c.stage.banning.order;
   }
   c.compensator.learning.enabled = o.learning;
+  c.compensator.servo_slew_reserve = o.servo_slew_reserve;
   if (o.servo) {
     c.servo.kp = o.kp;
     c.servo.ki = o.ki;
@@ -49,6 +50,7 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
   spec.amplitude_m = r.amplitude_m;
   spec.frequency_hz = r.frequency_hz;
   spec.blend_s = 0.2;
+  spec.shape_if_infeasible = o.shape_if_infeasible;
   const double start_s = 0.3;
   ScanRun run;
   run.mode = c.compensator.mode;
@@ -56,6 +58,8 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
   try {
     const TrajectoryVerdict v = sim.compensator().take_trajectory(spec, start_s);
     run.reason = v.note;
+    run.shaped = v.shaped;
+    run.amplitude_m = v.spec.amplitude_m;
     run.corner_s = v.spec.corner_s;
   } catch (const ParameterError& err) {
     run.refused = true;

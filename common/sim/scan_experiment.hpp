@@ -38,14 +38,20 @@ struct ScanOptions {
   bool servo = true;                    // the bridge's servo as deploy/config/bridge.yaml sets it:
   double kp = 0.05, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
   bool learning = false;
+  // A line outside the actuator's limits (the servo's reserve included) is scaled to fit, as
+  // deploy/hystloop scan asks (scan.yaml if_infeasible: shape); false: refused.
+  bool shape_if_infeasible = true;
+  double servo_slew_reserve = CompensatorConfig{}.servo_slew_reserve;  // of the slew limit, kept for the servo
   int settle_periods = 20;     // the error is measured after these whole periods ...
   int measure_periods = 10;    // ... over these
   double min_measure_s = 0.2;  // at least this long (more periods at high rates)
 };
 
 struct ScanRun {
-  bool refused = false;  // the compensator refused the reference (reason says why)
-  std::string reason;    // or how it was taken (the corner chosen, the shaping)
+  bool refused = false;      // the compensator refused the reference (reason says why)
+  std::string reason;        // or how it was taken (the corner chosen, the shaping)
+  bool shaped = false;       // the amplitude was scaled to fit the limits ...
+  double amplitude_m = 0.0;  // ... to this (the reference's own when not shaped)
   double corner_s = 0.0;
   TrackingStats stats;                   // over the measured periods
   std::vector<double> rms_per_period_m;  // true-position RMS of every whole period from the start

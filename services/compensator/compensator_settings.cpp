@@ -95,6 +95,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                                 "compensator.run_seconds",
                                                 "compensator.sample_queue_capacity",
                                                 "compensator.plan_slew_fraction",
+                                                "compensator.servo_slew_reserve",
                                                 "compensator.plausible_gain_factor",
                                                 "actuator.u_min_V",
                                                 "actuator.u_max_V",
@@ -223,6 +224,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   c.u_max_V = config.get<double>("actuator.u_max_V", c.u_max_V);
   c.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", c.slew_V_per_s);
   c.plan_slew_fraction = config.get_in_range("compensator.plan_slew_fraction", c.plan_slew_fraction, 0.05, 1.0);
+  c.servo_slew_reserve =
+      config.get_in_range("compensator.servo_slew_reserve", c.servo_slew_reserve, 0.0, c.plan_slew_fraction - 0.05);
 
   c.stage = read_stage_model(config, c.stage, c.dt_s);
 
@@ -302,8 +305,9 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
   lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
                               c.katalenic.k2_slope));
-  lines.push_back(fmt::format("actuator: u in [{}, {}] V, slew {:.4g} V/s (the plan uses at most {:.0f} % of it)",
-                              c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction));
+  lines.push_back(fmt::format(
+      "actuator: u in [{}, {}] V, slew {:.4g} V/s (an experiment uses at most {:.0f} % of it, a trajectory {:.0f} %)",
+      c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction, 100.0 * c.tracking_slew_fraction()));
   if (c.stage.has_dynamics()) {
     lines.push_back(fmt::format(
         "stage: second order k {:.6g} 1/s^2, c {:.6g} 1/s ({:.4g} Hz, zeta {:.3g}), {}, inverted",

@@ -21,8 +21,10 @@ namespace hystloop {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kGain = 6.34e-9;                              // LinearParams' default [m/V]
-const double kShare = CompensatorConfig{}.plan_slew_fraction;  // of the slew limit a plan may use
+constexpr double kGain = 6.34e-9;  // LinearParams' default [m/V]
+// Of the slew limit an experiment's plan may use, and a trajectory's (the rest is the servo's).
+const double kExperimentShare = CompensatorConfig{}.plan_slew_fraction;
+const double kShare = CompensatorConfig{}.tracking_slew_fraction();
 
 CompensatorConfig linear_config(bool stage) {
   CompensatorConfig c;
@@ -397,36 +399,40 @@ TEST(CompensatorLimits, ASetUnderWhichTheRunningLineWouldLeaveTheLimitsIsRefused
   EXPECT_NO_THROW(idle.offer_model(set, 2));
 }
 
-// Inside the plan's share but past the learning's 97 %, a set may not take the running line
-// nearer the slew limit than the set in use does (the servo's headroom is what is left); one that
-// takes it back from there, or stays below 97 %, is taken.
-TEST(CompensatorLimits, NearTheSlewLimitASetMayNotTakeTheLineNearer) {
-  Compensator c(linear_config(true));
+// A tracked line leaves the servo its reserve at the line's fastest ticks (what the servo adds
+// there would otherwise be clipped by the bridge): a line or a set that takes the line into it is
+// refused naming the reserve, while an experiment, with the servo off, may use the whole share.
+TEST(CompensatorLimits, ATrackedLineLeavesTheServoItsReserve) {
+  CompensatorConfig config = linear_config(true);
+  ASSERT_GT(config.servo_slew_reserve, 0.0);
+  Compensator c(config);
   FeedforwardLimits limits;
-  limits.fraction = kShare;
+  limits.fraction = 1.0;
   const double full = largest_sine_amplitude_m(LinearPlant{kGain, SecondOrderStageParams{}}, limits, 100.0, 0.0);
-  c.take_trajectory(sine(0.980 / kShare * full, 100.0), kNaN);  // 98.0 % of the slew
+  const double past = 0.5 * (kShare + kExperimentShare);  // inside the plan's share, in the reserve
+  try {
+    c.take_trajectory(sine(past * full, 100.0), kNaN);
+    FAIL() << "a line needing " << 100.0 * past << " % of the slew was taken";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("compensator.servo_slew_reserve"), std::string::npos) << e.what();
+  }
+  const double line = kShare - 0.005;
+  EXPECT_NO_THROW(c.take_trajectory(sine(line * full, 100.0), kNaN));
   plan_for(c, 0.1);
   ModelParamSet set;
   set.kind = ModelKind::linear;
-  set.linear.gain = kGain * 0.980 / 0.986;  // 98.6 %: inside the 99 % share, but nearer
-  try {
-    c.offer_model(set, 2);
-    FAIL() << "a set taking the line from 98.0 % to 98.6 % of the slew was taken";
-  } catch (const ParameterError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("nearer the limit than under the set in use (98"), std::string::npos) << what;
-    EXPECT_NE(what.find("the set in use stays"), std::string::npos) << what;
-  }
+  set.linear.gain = kGain * line / (kShare + 0.003);  // would take the line into the reserve
+  EXPECT_THROW(c.offer_model(set, 2), ParameterError);
   EXPECT_EQ(c.counters().params_rejected, 1u);
-  set.linear.gain = kGain * 0.980 / 0.975;  // 97.5 %: further from the limit
+  set.linear.gain = kGain * line / (kShare - 0.002);  // nearer the limit, still outside the reserve
   EXPECT_NO_THROW(c.offer_model(set, 3));
   plan_for(c, 0.1);
   EXPECT_EQ(c.params_version(), 3);
-  set.linear.gain = kGain * 0.980 / 0.978;  // 97.8 %: nearer than 97.5 %, still past 97 %
-  EXPECT_THROW(c.offer_model(set, 4), ParameterError);
-  set.linear.gain = kGain * 0.980 / 0.965;  // 96.5 %: below the learning's share, taken
-  EXPECT_NO_THROW(c.offer_model(set, 5));
+  // The servo is off during an excitation: a sine needing the reserve is queued.
+  ExperimentSpec sine_V;
+  sine_V.amplitude_V = 100.0;
+  sine_V.frequency_hz = past * 5e4 / (2.0 * std::numbers::pi * sine_V.amplitude_V);
+  EXPECT_NO_THROW(c.start_experiment(sine_V));
 }
 
 TEST(CompensatorLimits, IdleTakesAnyValidSet) {
@@ -446,6 +452,9 @@ TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
   EXPECT_THROW(Compensator{c}, ParameterError);
   c = linear_config(true);
   c.plan_slew_fraction = 0.0;
+  EXPECT_THROW(Compensator{c}, ParameterError);
+  c = linear_config(true);
+  c.servo_slew_reserve = c.plan_slew_fraction;  // nothing left for a trajectory
   EXPECT_THROW(Compensator{c}, ParameterError);
 }
 
@@ -487,7 +496,7 @@ TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
   c.start_experiment(high);
   std::vector<CommandTick> ticks;
   const double worst = plan_for(c, 0.12, &ticks);
-  EXPECT_LE(worst, kShare * 5e4 * 1e-4 + 1e-9);
+  EXPECT_LE(worst, kExperimentShare * 5e4 * 1e-4 + 1e-9);
   EXPECT_GT(c.counters().experiment_ramped, 38u);  // 200 V at 4.95 V per tick, and 100 V from 0 V
 }
 
