@@ -283,8 +283,8 @@ PlanExtent Compensator::dry_run_periodic(const TrajectorySpec& spec) const {
 
 bool Compensator::feasible(const PlanExtent& e) const noexcept {
   if (e.ticks == 0) return true;
-  return e.rate_max_V_per_s <= config_.tracking_slew_fraction() * config_.slew_V_per_s &&
-         e.u_min_V >= config_.u_min_V && e.u_max_V <= config_.u_max_V;
+  return e.rate_max_V_per_s <= config_.tracking_slew_V_per_s() && e.u_min_V >= config_.u_min_V &&
+         e.u_max_V <= config_.u_max_V;
 }
 
 double Compensator::choose_corner(const TrajectorySpec& spec, std::string& note) const {
@@ -344,7 +344,7 @@ double Compensator::feasible_amplitude(const TrajectorySpec& spec, double start_
   PlanExtent now = e;
   for (int i = 0; i < 8; ++i) {
     double ratio = 1.0;
-    const double allowed = config_.tracking_slew_fraction() * config_.slew_V_per_s;
+    const double allowed = config_.tracking_slew_V_per_s();
     if (now.rate_max_V_per_s > allowed) ratio = std::min(ratio, allowed / now.rate_max_V_per_s);
     if (now.u_max_V > config_.u_max_V && now.u_max_V > 0.0) ratio = std::min(ratio, config_.u_max_V / now.u_max_V);
     if (now.u_min_V < config_.u_min_V && now.u_min_V < 0.0) ratio = std::min(ratio, config_.u_min_V / now.u_min_V);
@@ -357,7 +357,7 @@ double Compensator::feasible_amplitude(const TrajectorySpec& spec, double start_
 
 std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const {
   std::string why = limits_left(e);
-  const double slew_allowed = config_.tracking_slew_fraction() * config_.slew_V_per_s;
+  const double slew_allowed = config_.tracking_slew_V_per_s();
   const bool slew = e.rate_max_V_per_s > slew_allowed;
   if (periodic(spec)) {
     const double a = feasible_amplitude(spec, start_s, e);
@@ -375,7 +375,7 @@ std::string Compensator::infeasibility(const TrajectorySpec& spec, double start_
 
 std::string Compensator::limits_left(const PlanExtent& e) const {
   std::string why;
-  if (e.rate_max_V_per_s > config_.tracking_slew_fraction() * config_.slew_V_per_s) {
+  if (e.rate_max_V_per_s > config_.tracking_slew_V_per_s()) {
     why = "its feedforward needs " + si(e.rate_max_V_per_s, "V/s") + ", above " +
           si(100.0 * config_.tracking_slew_fraction(), "%") + " of the actuator's slew limit " +
           si(config_.slew_V_per_s, "V/s") +
@@ -765,7 +765,7 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   // The plan keeps within the share of the slew limit a trajectory was admitted at (the rest is
   // the servo's, beside the sensor); what learning or a swap would ask beyond it is held back here
   // and counted, not clamped by the bridge behind the servo's back.
-  const double max_step = config_.tracking_slew_fraction() * config_.slew_V_per_s * config_.dt_s;
+  const double max_step = config_.tracking_slew_V_per_s() * config_.dt_s;
   if (std::abs(u - last_u_) > max_step) {
     limited(counters_.u_slew_clamped);
     u = last_u_ + std::copysign(max_step, u - last_u_);

@@ -127,6 +127,7 @@ struct CompensatorConfig {
   double servo_slew_reserve = 0.02;
   // The share of the slew limit a tracked line's feedforward may use.
   double tracking_slew_fraction() const noexcept { return plan_slew_fraction - servo_slew_reserve; }
+  double tracking_slew_V_per_s() const noexcept { return tracking_slew_fraction() * slew_V_per_s; }
 
   static constexpr std::int64_t kMaxHorizonTicks = 8000;  // within the bridge's jitter buffer
   void validate() const;                                  // throws ParameterError naming the field

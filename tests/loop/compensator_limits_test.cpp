@@ -435,6 +435,26 @@ TEST(CompensatorLimits, ATrackedLineLeavesTheServoItsReserve) {
   EXPECT_NO_THROW(c.start_experiment(sine_V));
 }
 
+// Learning's corrections need room beside the line as the servo does. With the default reserve
+// every line taken leaves it; a rig that sets the reserve below 2 % gets lines past 97 % tracked
+// without learning, and told so.
+TEST(CompensatorLimits, ALineWithoutRoomForCorrectionsIsTrackedWithoutLearning) {
+  CompensatorConfig config = linear_config(true);
+  config.servo_slew_reserve = 0.0;
+  FeedforwardLimits limits;
+  limits.fraction = 1.0;
+  const double full = largest_sine_amplitude_m(LinearPlant{kGain, SecondOrderStageParams{}}, limits, 100.0, 0.0);
+  for (const double share : {0.96, 0.98}) {
+    Compensator c(config);
+    c.set_learning(true);
+    const TrajectoryVerdict v = c.take_trajectory(sine(share * full, 100.0), kNaN);
+    plan_for(c, 0.2);
+    const bool learns = share < 0.97;
+    EXPECT_EQ(v.note.find("learning off for it") == std::string::npos, learns) << share << ": " << v.note;
+    EXPECT_EQ(c.learner().figures().period_ticks > 0, learns) << share;
+  }
+}
+
 TEST(CompensatorLimits, IdleTakesAnyValidSet) {
   Compensator idle(linear_config(true));
   ModelParamSet set;
