@@ -7,6 +7,12 @@
 
 namespace hystloop {
 
+// The largest tick number (sensor_block_t.seq, command_block_t.seq and sample_seq) a message may
+// carry: seq + any horizon or block length then stays exact and far from the int64 ceiling.
+inline constexpr std::int64_t kMaxTick = std::int64_t{1} << 53;  // 28,000 years at 10 kHz
+// The most ticks one sensor or command block carries (their MAX_TICKS, checked in lcm/).
+inline constexpr std::int64_t kMaxBlockTicks = 1000;
+
 // What the bridge did at one tick.
 struct SensorTick {
   std::int64_t utime = 0;  // [us]

@@ -17,6 +17,7 @@
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/sim_truth_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "core/ticks.hpp"
 #include "lcm/reject_reason.hpp"
 
 namespace hystloop {
@@ -26,9 +27,8 @@ inline constexpr double kMaxAbsPosition_m = 1.0;   // a nanopositioner moves mic
 inline constexpr double kMaxAbsFrequency_Hz = 1.0e5;
 inline constexpr double kMaxDuration_s = 86400.0;
 inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FAULT
-// The largest tick number (sensor_block_t.seq, command_block_t.seq and sample_seq) a message may
-// carry: seq + any horizon or block length then stays exact and far from the int64 ceiling.
-inline constexpr std::int64_t kMaxTick = std::int64_t{1} << 53;  // 28,000 years at 10 kHz
+static_assert(kMaxBlockTicks == sensor_block_t::MAX_TICKS && kMaxBlockTicks == command_block_t::MAX_TICKS,
+              "core/ticks.hpp's block bound is the wire's");
 
 // sensor_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u, u_ff,
 // u_fb and y within the sanity bounds, y_ref finite or NaN (none), known flags; seq, utime and

@@ -553,13 +553,14 @@ double Compensator::feedforward(double y_ref) noexcept {
 }
 
 void Compensator::observe(const CompensatorInput& sample) noexcept {
-  if (sample.seq <= last_seq_) {
-    ++counters_.out_of_order;
-    return;
+  switch (ticks_.observe(sample.seq, 1)) {
+    case SequenceGapDetector::Outcome::kFirst:
+    case SequenceGapDetector::Outcome::kInOrder:
+    case SequenceGapDetector::Outcome::kGap: break;
+    default: ++counters_.out_of_order; return;  // late, repeated or outside the contract
   }
   ++counters_.samples;
-  if (last_seq_ >= 0) counters_.gaps += static_cast<std::uint64_t>(sample.seq - last_seq_ - 1);
-  last_seq_ = sample.seq;
+  counters_.gaps = ticks_.missing();
   if (next_tick_ < 0 || counters_.planned == 0) {  // nothing was due before the first plan
     next_tick_ = sample.seq + 1;
   } else if (next_tick_ <= sample.seq) {

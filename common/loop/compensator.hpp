@@ -40,6 +40,7 @@
 #include <span>
 #include <string>
 
+#include "core/sequence_gap_detector.hpp"
 #include "core/ticks.hpp"
 #include "loop/experiment.hpp"
 #include "loop/experiment_queue.hpp"
@@ -254,7 +255,7 @@ class Compensator {
   std::size_t experiments_queued() const noexcept { return experiments_.queued(); }
   const TrajectorySpec& trajectory() const noexcept { return trajectory_; }
   double loop_time(std::int64_t seq) const noexcept { return static_cast<double>(seq) * config_.dt_s; }
-  std::int64_t last_seq() const noexcept { return last_seq_; }  // last sample observed (-1: none)
+  std::int64_t last_seq() const noexcept { return ticks_.started() ? ticks_.last_seq() : -1; }  // -1: none yet
   // First tick not yet planned (-1 before the first sample).
   std::int64_t next_tick() const noexcept { return next_tick_; }
   const CompensatorConfig& config() const noexcept { return config_; }
@@ -326,7 +327,9 @@ class Compensator {
   bool in_experiment_ = false;
   double experiment_branch_u_ = 0.0;  // the voltage of its last reversal [V]
 
-  std::int64_t last_seq_ = -1;
+  // The samples' numbering. A step back is never a restart here: the service builds a new
+  // Compensator when its SequenceGuard confirms one.
+  SequenceGapDetector ticks_{SequenceGapDetector::kNeverRestarts};
   std::int64_t next_tick_ = -1;
   std::int64_t plan_end_ = -1;  // last tick the plan must reach
   double last_ref_ = 0.0;       // last reference planned

@@ -19,7 +19,7 @@
 #include <string_view>
 
 #include "lcm/channels.hpp"
-#include "record/sequence_gap_detector.hpp"
+#include "core/sequence_gap_detector.hpp"
 #include "record/unknown_channels.hpp"
 
 namespace hystloop {

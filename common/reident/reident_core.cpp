@@ -25,19 +25,20 @@ void ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_
 void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcept {
   last_sample_us_ = now_us;
   const std::int64_t seq = tick.seq;
+  const std::uint64_t missing_before = ticks_.missing();
+  const SequenceGapDetector::Outcome step = ticks_.observe(seq, 1);
   // The stage's removal looks at neighbouring samples: any break hands out the held one as it is.
-  if (seq != last_seq_ + 1) flush_stage_removal();
-  if (last_seq_ >= 0) {
+  if (step != SequenceGapDetector::Outcome::kInOrder) flush_stage_removal();
+  if (step == SequenceGapDetector::Outcome::kGap) {
     // Ticks refused on the wire since the last one were not lost: they are no gap.
-    const std::int64_t missing = seq - last_seq_ - 1 - refused_since_last_;
-    if (seq > last_seq_ + 1 && missing > 0) {
+    const auto jumped = static_cast<std::int64_t>(ticks_.missing() - missing_before);
+    if (const std::int64_t missing = jumped - refused_since_last_; missing > 0) {
       counters_.add(ReidentCounter::seq_gaps);
       counters_.add(ReidentCounter::samples_missed, static_cast<std::uint64_t>(missing));
-    } else if (seq <= last_seq_) {
-      counters_.add(ReidentCounter::seq_restarts);
     }
+  } else if (step == SequenceGapDetector::Outcome::kRestart || step == SequenceGapDetector::Outcome::kDuplicate) {
+    counters_.add(ReidentCounter::seq_restarts);  // the numbering went back or repeated a tick
   }
-  last_seq_ = seq;
   refused_since_last_ = 0;
   in_use_.on_sample(seq);
   if ((tick.flags & sensor_block_t::SAFE_STATE) != 0) {

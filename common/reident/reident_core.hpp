@@ -22,6 +22,7 @@
 
 #include "ident/stage_removal.hpp"
 #include "core/latency_stats.hpp"
+#include "core/sequence_gap_detector.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "lcm/blocks.hpp"
 #include "reident/params_in_use.hpp"
@@ -119,8 +120,10 @@ class ReidentCore {
   std::int64_t stale_after_us_;
   std::int64_t next_refit_us_ = INT64_MIN;
   std::uint64_t fed_at_last_snapshot_ = 0;
-  std::int64_t last_seq_ = -1;
-  std::int64_t refused_since_last_ = 0;  // ticks refused on the wire since last_seq_ (estimated)
+  // The samples' numbering. Every step back is a restart: nothing in front of the re-identifier
+  // holds blocks for confirmation, and a bridge that restarted numbers from 0 again.
+  SequenceGapDetector ticks_{0};
+  std::int64_t refused_since_last_ = 0;  // ticks refused on the wire since the last sample (estimated)
   std::int64_t last_sample_us_ = -1;
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;

@@ -18,7 +18,7 @@ enum class ReidentCounter : std::uint8_t {
   skipped_sensor_fault,  // flagged SENSOR_FAULT: y is the last good value
   seq_gaps,              // a jump forward in seq not explained by samples refused on the wire
   samples_missed,        // ticks missing in those gaps
-  seq_restarts,          // seq went backwards (a bridge restart)
+  seq_restarts,          // seq went backwards or repeated a tick (a bridge restart)
   non_finite,            // NaN/Inf samples (a marker per block refused on the wire, or fed): poison the window
   dropouts,              // y stuck while u moves: poisons the window
   refits_attempted,

@@ -1,4 +1,4 @@
-#include "record/sequence_gap_detector.hpp"
+#include "core/sequence_gap_detector.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "lcm/message_checks.hpp"
+#include "core/ticks.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
@@ -201,8 +201,35 @@ TEST(SequenceGapDetector, ForgedTicksSaturateTheCountersInsteadOfWrapping) {
   EXPECT_EQ(d.ticks(), 4u * 2100u);
 }
 
+// One tick at a time, as the compensator and the re-identifier use it: with kNeverRestarts a step
+// back is a late tick whatever its size (the compensator's guard finds restarts); with threshold
+// 0 every step back is a restart (nothing holds the re-identifier's blocks for confirmation).
+TEST(SequenceGapDetector, TickByTickEitherNeverOrAlwaysRestarts) {
+  SequenceGapDetector never(SequenceGapDetector::kNeverRestarts);
+  EXPECT_EQ(never.observe(100, 1), Outcome::kFirst);
+  EXPECT_EQ(never.observe(101, 1), Outcome::kInOrder);
+  EXPECT_EQ(never.observe(105, 1), Outcome::kGap);
+  EXPECT_EQ(never.observe(105, 1), Outcome::kDuplicate);
+  EXPECT_EQ(never.observe(0, 1), Outcome::kOutOfOrder);  // 105 ticks back: still late
+  EXPECT_EQ(never.observe(103, 1), Outcome::kOutOfOrder);
+  EXPECT_EQ(never.observe(-1, 1), Outcome::kViolation);
+  EXPECT_EQ(never.observe(106, 1), Outcome::kInOrder);
+  EXPECT_EQ(never.missing(), 3u);
+  EXPECT_EQ(never.restarts(), 0u);
+  EXPECT_EQ(never.last_seq(), 106);
+
+  SequenceGapDetector always(0);
+  always.observe(40, 1);
+  EXPECT_EQ(always.observe(40, 1), Outcome::kDuplicate);
+  EXPECT_EQ(always.observe(39, 1), Outcome::kRestart);  // one tick back
+  EXPECT_EQ(always.observe(40, 1), Outcome::kInOrder);  // the stream continues from there
+  EXPECT_EQ(always.observe(0, 1), Outcome::kRestart);
+  EXPECT_EQ(always.restarts(), 2u);
+  EXPECT_EQ(always.missing(), 0u);
+}
+
 TEST(SequenceGapDetector, RefusesBadSettingsNamingTheField) {
-  EXPECT_THROW(SequenceGapDetector(0), ParameterError);
+  EXPECT_THROW(SequenceGapDetector(-1), ParameterError);
   try {
     SequenceGapDetector d(-3);
     ADD_FAILURE();

@@ -1,8 +1,11 @@
 #pragma once
 // Watches the ticks the blocks of one channel cover (HX_SENSOR, HX_COMMAND: a block covers
 // ticks seq .. seq + n_ticks - 1, and the next one should start right after it) and says
-// what each new block means, counting in ticks. Pure logic: no clock (the caller passes the
-// receive time), no I/O, no allocation; observe() is on the logger's receive path.
+// what each new block means, counting in ticks. The one tracker of tick numbering: the logger
+// feeds it blocks, the compensator and the re-identifier one tick at a time (a tick is a block
+// of one); SequenceGuard (loop/) decides whether the compensator believes a block, not what was
+// lost. Pure logic: no clock (the caller passes the receive time), no I/O, no allocation, so
+// observe() may sit on a receive or a per-sample path.
 //
 //   L = highest tick seen since the last restart, P = first tick of the block that set it;
 //   a new block covers [first, last]:
@@ -12,7 +15,8 @@
 //                              silent that long (a sender that stalled or restarted and then
 //                              started later on purpose, as the compensator does: its commands
 //                              run ahead of the bridge's clock): counted apart, as skipped ticks
-//   L - first > threshold      restart (the sender began counting again; no gap counted)
+//   L - first > threshold      restart (the sender began counting again; no gap counted);
+//                              threshold 0: every step back is one, kNeverRestarts: none is
 //   first <= L < last          overlap: ticks first..L seen again (counted), then in order
 //   [first, last] == [P, L]    duplicate of the last block (L kept)
 //   otherwise (last <= L)      out of order: a late or repeated block; L is kept, and the gap
@@ -33,6 +37,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 namespace hystloop {
 
@@ -56,10 +61,13 @@ class SequenceGapDetector {
   // The first gaps are kept (ranges for the summary); later ones are only counted.
   static constexpr std::size_t kKeptGaps = 8;
 
+  // A stream whose restarts someone else detects (the compensator's SequenceGuard).
+  static constexpr std::int64_t kNeverRestarts = std::numeric_limits<std::int64_t>::max();
+
   // `restart_threshold` [ticks]: a step back by more than this is a restart, not a late
   // block. `resume_silence_us` [us]: a forward jump after at least this long without a block
   // is a resume, not a gap (0 = every jump is a gap). Throws ParameterError naming the
-  // field if restart_threshold < 1 or resume_silence_us < 0.
+  // field if restart_threshold < 0 or resume_silence_us < 0.
   explicit SequenceGapDetector(std::int64_t restart_threshold = 10000, std::int64_t resume_silence_us = 0);
 
   // A block of `n_ticks` from tick `first`, received at `recv_utime` [us] (only compared with

@@ -1,19 +1,15 @@
-#include "record/sequence_gap_detector.hpp"
+#include "core/sequence_gap_detector.hpp"
 
 #include <optional>
 #include <string>
 
 #include "core/errors.hpp"
 #include "core/saturating.hpp"
-#include "lcm/message_checks.hpp"
+#include "core/ticks.hpp"
 
 namespace hystloop {
 
 namespace {
-// Both block channels share one bound on the ticks per block.
-constexpr std::int64_t kMaxBlockTicks = sensor_block_t::MAX_TICKS;
-static_assert(kMaxBlockTicks == static_cast<std::int64_t>(command_block_t::MAX_TICKS));
-
 std::optional<SequenceGapDetector::Violation> contract_violation(std::int64_t first, std::int64_t n_ticks) noexcept {
   using V = SequenceGapDetector::Violation;
   if (first < 0) return V::kNegativeSeq;
@@ -40,8 +36,8 @@ std::uint64_t SequenceGapDetector::violations() const noexcept {
 
 SequenceGapDetector::SequenceGapDetector(std::int64_t restart_threshold, std::int64_t resume_silence_us)
     : restart_threshold_(restart_threshold), resume_silence_us_(resume_silence_us) {
-  if (restart_threshold < 1) {
-    throw ParameterError("restart_threshold", "must be >= 1 (got " + std::to_string(restart_threshold) + ")");
+  if (restart_threshold < 0) {
+    throw ParameterError("restart_threshold", "must be >= 0 (got " + std::to_string(restart_threshold) + ")");
   }
   if (resume_silence_us < 0) {
     throw ParameterError("resume_silence_us", "must be >= 0 (got " + std::to_string(resume_silence_us) + ")");
