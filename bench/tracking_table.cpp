@@ -19,10 +19,12 @@
 //
 //   tracking_table            prints the tables (Markdown) and the identified MEM parameters
 //   tracking_table --scan     prints the scan table only
+//   tracking_table --scan --block-ticks N   the same with sensor blocks of N ticks (default 10)
 //   tracking_table --help     this text
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -63,7 +65,7 @@ std::string cell(const hystloop::ScanRun& r) {
 }
 
 // The line-rate table of docs/TRACKING.md ("Scans at line rate").
-bool scan_table() {
+bool scan_table(int block_ticks) {
   using namespace hystloop;
   const TrackingExperiment experiment;
   std::printf(
@@ -74,6 +76,7 @@ bool scan_table() {
     const IdentifiedModels id = identify_for_scan(experiment, r.amplitude_m);
     if (id.ranking.empty()) return false;
     ScanOptions o;
+    o.block_ticks = block_ticks;
     o.stage_inverse = false;
     const ScanRun plain = run_scan(experiment, id, r, o);
     o.stage_inverse = true;
@@ -103,10 +106,24 @@ int main(int argc, char** argv) {
   using namespace hystloop;
   if (argc > 1) {
     const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
-    if (std::strcmp(argv[1], "--scan") == 0) return scan_table() ? 0 : 1;
+    if (std::strcmp(argv[1], "--scan") == 0) {
+      int block_ticks = ScanOptions{}.block_ticks;
+      if (argc == 4 && std::strcmp(argv[2], "--block-ticks") == 0) {
+        block_ticks = std::atoi(argv[3]);
+        if (block_ticks < 1 || block_ticks > 1000) {
+          std::fprintf(stderr, "tracking_table: --block-ticks must be in [1, 1000] (got %s)\n", argv[3]);
+          return 2;
+        }
+      } else if (argc != 2) {
+        std::fprintf(stderr, "tracking_table: --scan takes only --block-ticks N\n");
+        return 2;
+      }
+      return scan_table(block_ticks) ? 0 : 1;
+    }
     std::printf(
-        "usage: tracking_table [--scan] [--help]\nPrints the tracking tables of docs/BENCHMARKS.md and "
-        "docs/TRACKING.md (--scan: the line-rate scan table only).\n");
+        "usage: tracking_table [--scan [--block-ticks N]] [--help]\nPrints the tracking tables of "
+        "docs/BENCHMARKS.md and docs/TRACKING.md (--scan: the line-rate scan table only; --block-ticks: "
+        "sensor blocks of N ticks, default 10).\n");
     return help ? 0 : 2;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -167,7 +184,7 @@ int main(int argc, char** argv) {
   o.reidentify = Reidentify::select;
   reid_row("gain +10 %/30 s, offline MEM start, automatic, [20, 30) s", drift, id, o);
   std::printf("\n");
-  const bool scans = scan_table();
+  const bool scans = scan_table(hystloop::ScanOptions{}.block_ticks);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("\n(%.0f s of simulated loop at 10 kHz in %.1f s of wall time)\n",
               experiment.identify_s + 12 * experiment.track_s + 3 * 4 * 12.0 + 2 * 4 * 30.0, seconds);

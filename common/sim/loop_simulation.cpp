@@ -15,7 +15,6 @@ LoopSimulation::LoopSimulation(const LoopSimulationConfig& config)
       compensator_(config.compensator),
       plan_(1000) {
   require_in_range("loop.block_ticks", config.block_ticks, 1, 1000);
-  bridge_.arm(0);
 }
 
 void LoopSimulation::run(double seconds, const std::function<void(const LoopTick&)>& on_tick) {
@@ -41,6 +40,12 @@ void LoopSimulation::run(double seconds, const std::function<void(const LoopTick
     if ((k_ + 1) % config_.block_ticks == 0) {  // a sensor block is complete: the compensator answers it
       while (const std::size_t planned = compensator_.plan(plan_)) {
         for (std::size_t j = 0; j < planned; ++j) bridge_.submit(plan_[j]);
+      }
+      // As the bridge's auto_arm does: armed once commands flow, so that a first block longer
+      // than the watchdog's time does not trip it before anything was planned.
+      if (!armed_) {
+        bridge_.arm(k_ + 1);
+        armed_ = true;
       }
     }
     if (keep_history_) history_.push_back(rec);

@@ -75,6 +75,7 @@ class LoopSimulation {
   std::vector<LoopTick> history_;
   std::vector<CommandTick> plan_;  // scratch for the compensator's plan
   double y_last_m_ = 0.0;
+  bool armed_ = false;  // the bridge arms at the first plan
 };
 
 }  // namespace hystloop

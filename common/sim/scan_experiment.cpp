@@ -37,6 +37,7 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
   }
   c.compensator.learning.enabled = o.learning;
   c.compensator.servo_slew_reserve = o.servo_slew_reserve;
+  c.block_ticks = o.block_ticks;
   if (o.servo) {
     c.servo.kp = o.kp;
     c.servo.ki = o.ki;
