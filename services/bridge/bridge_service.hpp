@@ -14,8 +14,8 @@
 
 #include "bridge/bridge_realtime.hpp"
 #include "bridge/bridge_settings.hpp"
-#include "bridge/send_time_ring.hpp"
-#include "bridge/sensor_block_repair.hpp"
+#include "core/send_time_ring.hpp"
+#include "lcm/sensor_block_repair.hpp"
 #include "core/clock.hpp"
 #include "core/latency_stats.hpp"
 #include "hystloop/command_block_t.hpp"
@@ -26,9 +26,9 @@
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "runtime/control_acks.hpp"
-#include "runtime/control_filter.hpp"
+#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "runtime/log_limiter.hpp"
+#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

@@ -50,9 +50,9 @@
 #include "loop/sequence_discontinuities.hpp"
 #include "loop/sequence_guard.hpp"
 #include "runtime/control_acks.hpp"
-#include "runtime/control_filter.hpp"
+#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "runtime/log_limiter.hpp"
+#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

@@ -41,7 +41,7 @@
 #include "logger/logger_summary.hpp"
 #include "record/record_ring.hpp"
 #include "runtime/control_acks.hpp"
-#include "runtime/control_filter.hpp"
+#include "lcm/control_filter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

@@ -40,9 +40,9 @@
 #include "reident/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_acks.hpp"
-#include "runtime/control_filter.hpp"
+#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "runtime/log_limiter.hpp"
+#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

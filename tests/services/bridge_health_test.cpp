@@ -84,5 +84,21 @@ TEST(BridgeHealth, SafeAndStoppingSayTheirOwnReason) {
   EXPECT_EQ(assess_bridge_health(in).detail, "stopping: at the safe 0 V");
 }
 
+// Repaired or unpublished samples make the bridge's status DEGRADED, saying so.
+TEST(BridgeHealth, APeriodWithRepairedSamplesIsDegradedAndSaysWhy) {
+  BridgeHealthInput in;
+  in.armed = true;
+  EXPECT_EQ(assess_bridge_health(in).state, service_status_t::HEALTHY);
+  in.samples_repaired = 20;
+  BridgeHealth h = assess_bridge_health(in);
+  EXPECT_EQ(h.state, service_status_t::DEGRADED);
+  EXPECT_NE(h.detail.find("20 samples held values no message may carry"), std::string::npos) << h.detail;
+  in.samples_repaired = 0;
+  in.samples_unpublished = 20;
+  h = assess_bridge_health(in);
+  EXPECT_EQ(h.state, service_status_t::DEGRADED);
+  EXPECT_NE(h.detail.find("missing from the record"), std::string::npos) << h.detail;
+}
+
 }  // namespace
 }  // namespace hystloop

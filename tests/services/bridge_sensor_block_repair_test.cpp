@@ -3,16 +3,13 @@
 // tick flagged, the last good values carried across blocks, a block that passes left as it is, no
 // allocation; a period with such samples DEGRADED; and the probe's case, a servo gone wild (kp = 1e300) whose
 // corrections no message may carry, ends up in a block that passes the Publisher's check with every tick in it.
-#include "bridge/sensor_block_repair.hpp"
+#include "lcm/sensor_block_repair.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include "bridge/bridge_health.hpp"
-#include "hystloop/service_status_t.hpp"
 
 #include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
@@ -131,28 +128,6 @@ TEST(BridgeSensorBlockRepair, AServoGoneWildStillLeavesEveryTickInTheRecord) {
       EXPECT_NE(b.flags[static_cast<std::size_t>(i)] & kSaturated, 0) << i;
     }
   }
-}
-
-}  // namespace
-}  // namespace hystloop
-
-namespace hystloop {
-namespace {
-
-// Repaired or unpublished samples make the bridge's status DEGRADED, saying so.
-TEST(BridgeSensorBlockRepair, APeriodWithRepairedSamplesIsDegradedAndSaysWhy) {
-  BridgeHealthInput in;
-  in.armed = true;
-  EXPECT_EQ(assess_bridge_health(in).state, service_status_t::HEALTHY);
-  in.samples_repaired = 20;
-  BridgeHealth h = assess_bridge_health(in);
-  EXPECT_EQ(h.state, service_status_t::DEGRADED);
-  EXPECT_NE(h.detail.find("20 samples held values no message may carry"), std::string::npos) << h.detail;
-  in.samples_repaired = 0;
-  in.samples_unpublished = 20;
-  h = assess_bridge_health(in);
-  EXPECT_EQ(h.state, service_status_t::DEGRADED);
-  EXPECT_NE(h.detail.find("missing from the record"), std::string::npos) << h.detail;
 }
 
 }  // namespace

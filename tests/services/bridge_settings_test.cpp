@@ -12,7 +12,7 @@
 
 #include "bridge/bridge_settings.hpp"
 #include "bridge/rt_report.hpp"
-#include "bridge/send_time_ring.hpp"
+#include "core/send_time_ring.hpp"
 #include "bridge/stage_backend.hpp"
 #include "support/allocation_counter.hpp"
 

@@ -1,4 +1,4 @@
-#include "bridge/sensor_block_repair.hpp"
+#include "lcm/sensor_block_repair.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "runtime/log_limiter.hpp"
+#include "core/log_limiter.hpp"
 
 namespace hystloop {
 

@@ -1,6 +1,6 @@
 // LogLimiter: at most one line per reason per interval, the next one says how many were
 // suppressed; escape_wire: text off the wire never puts control bytes into a log line.
-#include "runtime/log_limiter.hpp"
+#include "core/log_limiter.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "runtime/control_filter.hpp"
+#include "lcm/control_filter.hpp"
 
 #include <algorithm>
 
