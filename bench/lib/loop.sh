@@ -97,8 +97,8 @@ stop_summaries() {
     printf s "stop: %s from %.6g V to the safe %s V in %s ticks (%.4g s loop time, %.4g s wall; bound %s s)" e,
       ($23 == "true" ? "ramped" : "ramp NOT finished"), $24, $25, $26, $27, $28, $29
   }'
-  jq -r '[.samples, .command_ticks, .command_blocks, .ticks_planned_too_late, .gaps, .out_of_order, .params_accepted,
-          .params_refused, .params_swapped, .params_invalid,
+  jq -r '[.samples, .command_ticks_published, .command_blocks_published, .ticks_behind, .gaps, .out_of_order,
+          .params_accepted, .params_rejected, .params_swapped, .params_invalid,
           .block_to_answer_us.p50, .block_to_answer_us.p99, .block_to_answer_us.max, .block_to_answer_us.count] | @tsv' \
     "$1/compensator.json" |
   awk -F'\t' '{

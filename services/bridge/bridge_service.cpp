@@ -308,7 +308,8 @@ void BridgeService::log_safe_stop(const SafeStopResult& r) const {
   }
 }
 
-void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
+// The counters HX_STATUS carries, under their names; the summary file writes the same list.
+CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
   const BridgeCounters& core = rt.core;
   CounterSet::Entries now = {
       {"ticks", core.ticks},
@@ -338,6 +339,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   };
   rt_.backend().append_counters(now);  // e.g. comedi: sensor_faults, sensor_fault_safe, comedi_read_errors
   if (truth_pub_) now.emplace_back("sim_truth_unpublished", truth_unpublished_);
+  return now;
+}
+
+void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
+  const BridgeCounters& core = rt.core;
+  CounterSet::Entries now = counter_entries(rt);
   if (reset_pending_) {
     counters_.rebase(now);
     reset_pending_ = false;
@@ -460,41 +467,27 @@ void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult&
   const double wall_s = monotonic_s() - started_s_;
   const ResourceUsage usage = read_resource_usage();
   const double cpu_s = usage.user_cpu_s + usage.system_cpu_s;
-  const nlohmann::ordered_json json = {
-      {"ticks", c.ticks},
-      {"armed_ticks", static_cast<std::uint64_t>(armed_ticks)},
-      {"late_ticks", c.late},
-      {"late_tick_fraction", armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0},
-      {"watchdog_trips", c.watchdog_trips},
-      {"buffer_min_depth_ticks", rt.min_depth_total},
-      {"ticks_skipped", rt.ticks_skipped},
-      {"ticks_caught_up", rt.ticks_caught_up},
-      {"stale", c.stale},
-      {"duplicates", c.duplicates},
-      {"rejected", c.rejected_nonfinite + c.rejected_future},
-      {"samples_dropped", rt.samples_dropped},
-      {"sensor_blocks", sensor_blocks_},
-      {"command_blocks", command_blocks_},
-      {"block_to_answer_us", latency_summary_us(latency_total_)},
-      {"applied", c.applied},
-      {"clamped", c.clamped},
-      {"slew_limited", c.slew_limited},
-      {"clamped_ticks", {{"range", c.clamped}, {"slew", c.slew_limited}, {"either", c.clamped_either}}},
-      {"rejected_nonfinite", c.rejected_nonfinite},
-      {"rejected_future", c.rejected_future},
-      {"command_blocks_rejected", commands_.counters().rejected_total()},
-      {"wall_s", wall_s},
-      {"cpu_s", cpu_s},
-      {"cpu_fraction", wall_s > 0 ? cpu_s / wall_s : 0.0},
-      {"stop",
-       {{"safe_reached", safe.reached},
-        {"u_start_V", safe.u_start_V},
-        {"ramp_ticks", safe.ramp_ticks},
-        {"ramp_s", safe.ramp_s},
-        {"wall_s", safe.wall_s},
-        {"bound_s", settings_.stop_ramp_timeout_s},
-        {"safe_u_V", settings_.limits.safe_u_V}}},
-  };
+  // Every HX_STATUS counter under its name (counter_entries()), then the figures derived from them.
+  nlohmann::ordered_json json;
+  for (const auto& [name, value] : counter_entries(rt)) json[name] = value;
+  json["armed_ticks"] = static_cast<std::uint64_t>(armed_ticks);
+  json["late_ticks"] = c.late;
+  json["late_tick_fraction"] = armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0;
+  json["buffer_min_depth_ticks"] = rt.min_depth_total;
+  json["rejected"] = c.rejected_nonfinite + c.rejected_future;
+  json["block_to_answer_us"] = latency_summary_us(latency_total_);
+  json["clamped_ticks"] = {{"range", c.clamped}, {"slew", c.slew_limited}, {"either", c.clamped_either}};
+  json["command_blocks_rejected"] = commands_.counters().rejected_total();
+  json["wall_s"] = wall_s;
+  json["cpu_s"] = cpu_s;
+  json["cpu_fraction"] = wall_s > 0 ? cpu_s / wall_s : 0.0;
+  json["stop"] = {{"safe_reached", safe.reached},
+                  {"u_start_V", safe.u_start_V},
+                  {"ramp_ticks", safe.ramp_ticks},
+                  {"ramp_s", safe.ramp_s},
+                  {"wall_s", safe.wall_s},
+                  {"bound_s", settings_.stop_ramp_timeout_s},
+                  {"safe_u_V", settings_.limits.safe_u_V}};
   write_summary_file(summary_json_path_, json);
 }
 

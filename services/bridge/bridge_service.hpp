@@ -14,21 +14,21 @@
 
 #include "bridge/bridge_realtime.hpp"
 #include "bridge/bridge_settings.hpp"
-#include "core/send_time_ring.hpp"
-#include "lcm/sensor_block_repair.hpp"
 #include "core/clock.hpp"
 #include "core/latency_stats.hpp"
+#include "core/log_limiter.hpp"
+#include "core/send_time_ring.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/sim_truth_t.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/control_filter.hpp"
 #include "lcm/publisher.hpp"
+#include "lcm/sensor_block_repair.hpp"
 #include "lcm/subscription.hpp"
 #include "runtime/control_acks.hpp"
-#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -56,6 +56,7 @@ class BridgeService {
   void append_truth(const OutgoingTick& t) noexcept;
   void publish_truth() noexcept;
   void serve(bool stopping);  // one pass of the I/O loop: samples out, LCM in, status
+  CounterSet::Entries counter_entries(const RtReport& rt) const;
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
   void log_safe_stop(const SafeStopResult& safe) const;
   void log_summary(const RtReport& rt, const SafeStopResult& safe) const;

@@ -1,9 +1,11 @@
 #include "compensator/compensator_service.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string_view>
 
 #include <spdlog/spdlog.h>
 
@@ -514,13 +516,18 @@ int CompensatorService::run() {
   });
   spdlog::info("stopping{}", stop_signal() ? fmt::format(" on signal {}", stop_signal()) : std::string());
   report(wall_utime(), true);
-  const CompensatorCounters& c = compensator_->counters();
+  // From the counters HX_STATUS carries (collect_counters(): the whole run, across bridge restarts).
+  const CounterSet::Entries totals = collect_counters();
+  const auto total = [&totals](std::string_view name) {
+    const auto it = std::find_if(totals.begin(), totals.end(), [name](const auto& e) { return e.first == name; });
+    return it == totals.end() ? std::uint64_t{0} : it->second;
+  };
   spdlog::info(
       "summary: {} samples, {} command ticks published in {} blocks, {} ticks planned too late, {} gaps, "
       "{} out of order, params {} accepted / {} refused / {} swapped, {} invalid sets ignored",
-      c.samples, counters_.command_ticks_published, counters_.command_blocks_published, c.ticks_behind, c.gaps,
-      c.out_of_order, c.params_accepted, c.params_rejected + counters_.params_refused, c.params_swapped,
-      counters_.params_invalid);
+      total("samples"), total("command_ticks_published"), total("command_blocks_published"), total("ticks_behind"),
+      total("gaps"), total("out_of_order"), total("params_accepted"), total("params_rejected"), total("params_swapped"),
+      total("params_invalid"));
   if (latency_total_.count() > 0) {
     spdlog::info("summary: sensor block received -> its answer published p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us",
                  latency_total_.percentile(0.5) / 1e3, latency_total_.percentile(0.99) / 1e3,

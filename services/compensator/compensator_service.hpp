@@ -36,6 +36,7 @@
 #include "core/latency_stats.hpp"
 #include <array>
 
+#include "core/log_limiter.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
@@ -43,6 +44,7 @@
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/control_filter.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "loop/compensator.hpp"
@@ -50,9 +52,7 @@
 #include "loop/sequence_discontinuities.hpp"
 #include "loop/sequence_guard.hpp"
 #include "runtime/control_acks.hpp"
-#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -98,6 +98,8 @@ class CompensatorService {
   int run();
   // At exit, run() writes the run's figures (as its summary log lines) to this JSON file.
   void write_summary_to(std::string path) { summary_json_path_ = std::move(path); }
+  // Writes it now: every HX_STATUS counter under its name, over the whole run (compensator_summary.cpp).
+  void write_summary_json() const;
 
   // The handlers, public so that tests can drive the service without a network.
   void on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept;
@@ -194,8 +196,6 @@ class CompensatorService {
   std::uint64_t swaps_reported_ = 0;
   CounterSet reported_;
   std::string summary_json_path_;
-
-  void write_summary_json() const;  // compensator_summary.cpp
 };
 
 }  // namespace hystloop

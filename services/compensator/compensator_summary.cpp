@@ -1,5 +1,5 @@
-// CompensatorService::write_summary_json: the run's figures at exit (--summary-json), the same as
-// the "summary:" log lines, for scripts (bench/run-all) that should not read log lines.
+// CompensatorService::write_summary_json: the run's figures at exit (--summary-json): the counters
+// HX_STATUS carries, under the same names, for scripts (bench/run-all) that should not read log lines.
 
 #include <spdlog/spdlog.h>
 
@@ -10,20 +10,11 @@ namespace hystloop {
 
 void CompensatorService::write_summary_json() const {
   if (summary_json_path_.empty()) return;
-  const CompensatorCounters& c = compensator_->counters();
-  const nlohmann::ordered_json json = {
-      {"samples", c.samples},
-      {"command_ticks", counters_.command_ticks_published},
-      {"command_blocks", counters_.command_blocks_published},
-      {"ticks_planned_too_late", c.ticks_behind},
-      {"gaps", c.gaps},
-      {"out_of_order", c.out_of_order},
-      {"params_accepted", c.params_accepted},
-      {"params_refused", c.params_rejected + counters_.params_refused},
-      {"params_swapped", c.params_swapped},
-      {"params_invalid", counters_.params_invalid},
-      {"block_to_answer_us", latency_summary_us(latency_total_)},
-  };
+  // Every counter under its HX_STATUS name (the same list, collect_counters()), over the whole run
+  // (the control laws a bridge restart retired included), then the latency.
+  nlohmann::ordered_json json;
+  for (const auto& [name, value] : collect_counters()) json[name] = value;
+  json["block_to_answer_us"] = latency_summary_us(latency_total_);
   write_summary_file(summary_json_path_, json);
 }
 

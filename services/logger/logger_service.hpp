@@ -33,15 +33,15 @@
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/control_filter.hpp"
 #include "lcm/subscription.hpp"
-#include "record/channel_table.hpp"
 #include "logger/log_file_set.hpp"
 #include "logger/log_writer.hpp"
 #include "logger/logger_options.hpp"
 #include "logger/logger_summary.hpp"
+#include "record/channel_table.hpp"
 #include "record/record_ring.hpp"
 #include "runtime/control_acks.hpp"
-#include "lcm/control_filter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

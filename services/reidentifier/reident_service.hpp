@@ -28,21 +28,21 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/latency_stats.hpp"
+#include "core/log_limiter.hpp"
+#include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/model_params_t.hpp"
-#include "hystloop/command_block_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/control_filter.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "reident/model_chooser.hpp"
 #include "reident/reident_core.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_acks.hpp"
-#include "lcm/control_filter.hpp"
 #include "runtime/counter_set.hpp"
-#include "core/log_limiter.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {

@@ -6,6 +6,8 @@
 // once, at its start time when it has one; control requests that are not the compensator's are
 // refused or ignored; a bridge restart restarts the control law; old config keys say where they went.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <bit>
@@ -18,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -803,6 +806,47 @@ TEST(CompensatorService, StatusCountersKeepCountingAcrossABridgeRestart) {
   EXPECT_EQ(value("command_ticks_published"), static_cast<std::int64_t>(h.ticks.size()));
   EXPECT_EQ(value("samples"), 180);
   EXPECT_EQ(value("planned"), static_cast<std::int64_t>(h.ticks.size()));
+}
+
+// The summary file carries every counter HX_STATUS does, under the same name and over the whole
+// run: a bridge restart's retired control law still counts (it once wrote the last law's alone).
+TEST(CompensatorService, TheSummaryFileHasTheStatusCountersOverTheWholeRun) {
+  Harness h;
+  Subscription<service_status_t> status(*h.lcm, h.channels.status);
+  h.run(50000, 100);
+  h.run(0, 100);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  ASSERT_EQ(status.counters().accepted, 1u);
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("compensator_summary_" + std::to_string(::getpid()) + ".json");
+  h.service.write_summary_to(path.string());
+  h.service.write_summary_json();
+  std::ifstream in(path);
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  std::filesystem::remove(path);
+  const service_status_t& s = status.latest();
+  const auto status_value = [&](const std::string& name) -> std::optional<std::int64_t> {
+    for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
+      if (s.counter_names[i] == name) return s.counter_values[i];
+    }
+    return std::nullopt;
+  };
+  std::size_t counters = 0;
+  for (const auto& [name, value] : summary.items()) {
+    if (name == "block_to_answer_us") continue;
+    ++counters;
+    const std::optional<std::int64_t> reported = status_value(name);
+    ASSERT_TRUE(reported.has_value()) << name << " is in the summary, not on HX_STATUS";
+    EXPECT_EQ(value.get<std::int64_t>(), *reported) << name;
+  }
+  EXPECT_GE(counters, 30u);
+  for (const char* name : {"command_ticks_published", "ticks_behind", "params_rejected", "sensor_blocks_held"}) {
+    EXPECT_TRUE(summary.contains(name)) << name;
+  }
+  EXPECT_EQ(summary["samples"], 180);
+  EXPECT_EQ(summary["bridge_restarts"], 1);
+  EXPECT_TRUE(summary.contains("block_to_answer_us"));
 }
 
 std::string settings_refusal(const std::string& yaml) {
