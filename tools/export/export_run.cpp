@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <chrono>
 #include <fstream>
 #include <map>
 #include <set>
@@ -11,6 +10,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/clock.hpp"
 #include "core/errors.hpp"
 #include "decode.hpp"
 #include "event_file.hpp"
@@ -61,9 +61,9 @@ class Progress {
     ++events_;
     bytes_ += 28.0 + static_cast<double>(e.channel.size()) + static_cast<double>(e.datalen);  // header + body
     if (out_ == nullptr || (events_ & 0xfff) != 0) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_ < std::chrono::seconds(2)) return;
-    last_ = now;
+    const double now_s = monotonic_s();
+    if (now_s - last_s_ < 2.0) return;  // a line every 2 s at most
+    last_s_ = now_s;
     std::fprintf(out_, "hystloop-export: read %.0f %% of %.1f MB (%llu events)\n",
                  total_bytes_ > 0 ? 100.0 * bytes_ / total_bytes_ : 100.0, total_bytes_ * 1e-6,
                  static_cast<unsigned long long>(events_));
@@ -73,7 +73,7 @@ class Progress {
   std::FILE* out_;
   double total_bytes_ = 0.0, bytes_ = 0.0;
   unsigned long long events_ = 0;
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  double last_s_ = monotonic_s();
 };
 
 // The processes that reported on a status channel: "bridge@stage-pc pid 41 started 1700000000000000".

@@ -17,7 +17,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -27,6 +26,7 @@
 #include <vector>
 
 #include "core/cli.hpp"
+#include "core/clock.hpp"
 #include "core/errors.hpp"
 #include "csv_export.hpp"
 #include "lcm/channels.hpp"
@@ -85,12 +85,11 @@ class Progress {
   std::uintmax_t bytes() const noexcept { return bytes_; }
   void phase(const std::string& what) const {
     if (!enabled_) return;
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start_;
-    std::fprintf(stderr, "hystloop-report: [%5.1f s] %s\n", elapsed.count(), what.c_str());
+    std::fprintf(stderr, "hystloop-report: [%5.1f s] %s\n", monotonic_s() - start_s_, what.c_str());
   }
 
  private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  double start_s_ = monotonic_s();
   std::uintmax_t bytes_ = 0;
   bool enabled_ = false;
 };
