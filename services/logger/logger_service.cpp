@@ -148,15 +148,10 @@ void LoggerService::on_control(const control_t& msg) {
                     wall_utime());
     }
     // Anyone can send these: at most one line every 10 s, saying how many were not logged.
-    const double now_s = monotonic_s();
-    if (now_s - reset_logged_s_ < 10.0) {
-      ++reset_log_suppressed_;
-      return;
+    if (const LogLimiter::Gate g = slow_log_.allow(kLogResetIgnored, monotonic_ns())) {
+      spdlog::info("RESET_COUNTERS ignored: the logger's counters describe the whole recording (see the summary){}",
+                   suppressed_note(g));
     }
-    spdlog::info("RESET_COUNTERS ignored: the logger's counters describe the whole recording (see the summary){}",
-                 reset_log_suppressed_ > 0 ? " [" + std::to_string(reset_log_suppressed_) + " more not logged]" : "");
-    reset_logged_s_ = now_s;
-    reset_log_suppressed_ = 0;
   }
 }
 
@@ -200,16 +195,10 @@ std::string LoggerService::unknown_channels_detail() {
   std::string detail = "not recorded: " + std::to_string(u.messages() - seen_unrecorded_) + " message(s) on " +
                        distinct + " channel(s) beyond the table's " + std::to_string(ChannelTable::kMaxChannels) +
                        " (first: " + names + ")";
-  const double now_s = monotonic_s();
-  if (u.distinct() > seen_unknown_names_ && now_s - unknown_logged_s_ >= 10.0) {
-    spdlog::warn("{}{}", detail,
-                 unknown_log_suppressed_ > 0
-                     ? " [" + std::to_string(unknown_log_suppressed_) + " similar warnings suppressed]"
-                     : std::string());
-    unknown_logged_s_ = now_s;
-    unknown_log_suppressed_ = 0;
-  } else if (u.distinct() > seen_unknown_names_) {
-    ++unknown_log_suppressed_;
+  if (u.distinct() > seen_unknown_names_) {
+    if (const LogLimiter::Gate g = slow_log_.allow(kLogUnknownChannels, monotonic_ns())) {
+      spdlog::warn("{}{}", detail, suppressed_note(g));
+    }
   }
   seen_unrecorded_ = u.messages();
   seen_unknown_names_ = u.distinct();

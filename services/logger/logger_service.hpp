@@ -33,6 +33,7 @@
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/channels.hpp"
+#include "core/log_limiter.hpp"
 #include "lcm/control_filter.hpp"
 #include "lcm/subscription.hpp"
 #include "logger/log_file_set.hpp"
@@ -114,10 +115,9 @@ class LoggerService {
   std::uint64_t seen_unknown_names_ = 0;
   DiskFaults seen_faults_{};
   std::int64_t last_report_utime_ = 0;
-  double unknown_logged_s_ = -1e300;  // unknown channels are logged at most every 10 s
-  std::uint64_t unknown_log_suppressed_ = 0;
-  double reset_logged_s_ = -1e300;  // so are ignored RESET_COUNTERS
-  std::uint64_t reset_log_suppressed_ = 0;
+  // Unknown channels and ignored RESET_COUNTERS (anyone can send them) are logged at most every 10 s.
+  enum LogReason : std::size_t { kLogUnknownChannels, kLogResetIgnored };
+  LogLimiter slow_log_{10'000'000'000};
 };
 
 }  // namespace hystloop
