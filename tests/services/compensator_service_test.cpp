@@ -20,7 +20,6 @@
 #include <map>
 #include <memory>
 #include <numbers>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -782,42 +781,38 @@ TEST(CompensatorService, AParameterSetWaitingForAReversalSurvivesABridgeRestart)
   EXPECT_EQ(h.service.compensator().mem_params().c1, 5.5e-9);
 }
 
-// HX_STATUS counters only count up (CounterSet): a bridge restart replaces the control law but
-// not what it counted.
-TEST(CompensatorService, StatusCountersKeepCountingAcrossABridgeRestart) {
-  Harness h;
+// Blocks under one numbering, then a bridge restart's, then one HX_STATUS report: its counters by name.
+std::map<std::string, std::int64_t> status_after_a_restart(Harness& h) {
   Subscription<service_status_t> status(*h.lcm, h.channels.status);
   h.run(50000, 100);
   h.run(0, 100);
   h.service.report(wall_utime(), false);
   h.drain();
-  ASSERT_EQ(status.counters().accepted, 1u);
+  EXPECT_EQ(status.counters().accepted, 1u);
+  std::map<std::string, std::int64_t> counters;
   const service_status_t& s = status.latest();
-  const auto value = [&](const std::string& name) -> std::int64_t {
-    for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
-      if (s.counter_names[i] == name) return s.counter_values[i];
-    }
-    ADD_FAILURE() << name << " not reported";
-    return -1;
-  };
-  EXPECT_EQ(value("bridge_restarts"), 1);
-  EXPECT_EQ(value("sensor_blocks_held"), 2);  // the new numbering's first two, before the third confirmed it
-  EXPECT_EQ(value("sensor_jumps_ignored"), 0);
-  EXPECT_EQ(value("command_ticks_published"), static_cast<std::int64_t>(h.ticks.size()));
-  EXPECT_EQ(value("samples"), 180);
-  EXPECT_EQ(value("planned"), static_cast<std::int64_t>(h.ticks.size()));
+  for (std::size_t i = 0; i < s.counter_names.size(); ++i) counters[s.counter_names[i]] = s.counter_values[i];
+  return counters;
+}
+
+// HX_STATUS counters only count up (CounterSet): a bridge restart replaces the control law but
+// not what it counted.
+TEST(CompensatorService, StatusCountersKeepCountingAcrossABridgeRestart) {
+  Harness h;
+  const std::map<std::string, std::int64_t> value = status_after_a_restart(h);
+  EXPECT_EQ(value.at("bridge_restarts"), 1);
+  EXPECT_EQ(value.at("sensor_blocks_held"), 2);  // the new numbering's first two, before the third confirmed it
+  EXPECT_EQ(value.at("sensor_jumps_ignored"), 0);
+  EXPECT_EQ(value.at("command_ticks_published"), static_cast<std::int64_t>(h.ticks.size()));
+  EXPECT_EQ(value.at("samples"), 180);
+  EXPECT_EQ(value.at("planned"), static_cast<std::int64_t>(h.ticks.size()));
 }
 
 // The summary file carries every counter HX_STATUS does, under the same name and over the whole
 // run: a bridge restart's retired control law still counts (it once wrote the last law's alone).
 TEST(CompensatorService, TheSummaryFileHasTheStatusCountersOverTheWholeRun) {
   Harness h;
-  Subscription<service_status_t> status(*h.lcm, h.channels.status);
-  h.run(50000, 100);
-  h.run(0, 100);
-  h.service.report(wall_utime(), false);
-  h.drain();
-  ASSERT_EQ(status.counters().accepted, 1u);
+  const std::map<std::string, std::int64_t> reported = status_after_a_restart(h);
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / ("compensator_summary_" + std::to_string(::getpid()) + ".json");
   h.service.write_summary_to(path.string());
@@ -825,20 +820,12 @@ TEST(CompensatorService, TheSummaryFileHasTheStatusCountersOverTheWholeRun) {
   std::ifstream in(path);
   const nlohmann::json summary = nlohmann::json::parse(in);
   std::filesystem::remove(path);
-  const service_status_t& s = status.latest();
-  const auto status_value = [&](const std::string& name) -> std::optional<std::int64_t> {
-    for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
-      if (s.counter_names[i] == name) return s.counter_values[i];
-    }
-    return std::nullopt;
-  };
   std::size_t counters = 0;
   for (const auto& [name, value] : summary.items()) {
     if (name == "block_to_answer_us") continue;
     ++counters;
-    const std::optional<std::int64_t> reported = status_value(name);
-    ASSERT_TRUE(reported.has_value()) << name << " is in the summary, not on HX_STATUS";
-    EXPECT_EQ(value.get<std::int64_t>(), *reported) << name;
+    ASSERT_TRUE(reported.contains(name)) << name << " is in the summary, not on HX_STATUS";
+    EXPECT_EQ(value.get<std::int64_t>(), reported.at(name)) << name;
   }
   EXPECT_GE(counters, 30u);
   for (const char* name : {"command_ticks_published", "ticks_behind", "params_rejected", "sensor_blocks_held"}) {
