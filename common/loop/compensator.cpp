@@ -609,6 +609,25 @@ void Compensator::take_params_from(const Compensator& old) noexcept {
   pending_version_ = old.pending_version_;
 }
 
+Compensator Compensator::restarted(CompensatorConfig config, std::string& refusal) const {
+  config.mem = mem_params();
+  config.mode = mode();
+  TrajectorySpec reference = trajectory();
+  reference.hold_m = 0.0;
+  Compensator next(config);
+  next.take_params_from(*this);
+  refusal.clear();
+  try {
+    next.set_trajectory(reference, std::numeric_limits<double>::quiet_NaN());
+  } catch (const ParameterError& e) {
+    // Taken before, infeasible now (the sets in use changed since): hold where the new law starts
+    // rather than clamp; the operator sends it again, or a feasible one.
+    next.set_trajectory(TrajectorySpec{}, std::numeric_limits<double>::quiet_NaN());
+    refusal = e.what();
+  }
+  return next;
+}
+
 void Compensator::restart_reference(double t_s, double from_m) noexcept {
   trajectory_.blend_s = std::max(trajectory_.blend_s, 0.5);
   const double earliest = t_s + trajectory_.blend_s;

@@ -262,6 +262,11 @@ class Compensator {
   // A restarted control law keeps the parameter sets `old` was given: the one in use with its
   // version, and one waiting for a reversal.
   void take_params_from(const Compensator& old) noexcept;
+  // The control law for a bridge that restarted (its tick numbering went back): a new one from
+  // `config` with what is in force here — the parameter sets, the tracking mode (an experiment is
+  // not one), the reference from its start. A reference the sets now in force make infeasible is
+  // not taken again: the new law holds where it starts and `refusal` says why (else it is cleared).
+  Compensator restarted(CompensatorConfig config, std::string& refusal) const;
 
  private:
   // The position the servo's share of the voltage made at this sample [m] (observe, for the learning).

@@ -294,25 +294,13 @@ void CompensatorService::on_control(const control_t& msg) {
 }
 
 void CompensatorService::restart_control_law() {
-  // The bridge restarted (its seq went back): a new control law with what is in force now.
-  CompensatorConfig config = settings_.control;
-  const Compensator& old = *compensator_;
-  config.mem = old.mem_params();
-  config.mode = old.mode();  // the tracking mode (an experiment is not one)
-  TrajectorySpec reference = old.trajectory();
-  reference.hold_m = 0.0;
-  Compensator next(config);
-  next.take_params_from(old);
-  retired_ += old.counters();
-  try {
-    next.set_trajectory(reference, kNaN);
-  } catch (const ParameterError& e) {
-    // Taken before, infeasible now (the parameters in use changed since): hold where the new
-    // control law starts rather than clamp; the operator sends it again, or a feasible one.
-    next.set_trajectory(TrajectorySpec{}, kNaN);
+  std::string refusal;
+  Compensator next = compensator_->restarted(settings_.control, refusal);
+  if (!refusal.empty()) {
     ++counters_.trajectory_refused;
-    spdlog::warn("after the bridge's restart the trajectory in force was not taken again: {}", escape_wire(e.what()));
+    spdlog::warn("after the bridge's restart the trajectory in force was not taken again: {}", escape_wire(refusal));
   }
+  retired_ += compensator_->counters();
   compensator_.emplace(std::move(next));
   have_sample_ = false;
   ++counters_.bridge_restarts;

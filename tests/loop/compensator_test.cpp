@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "compensator_rig.hpp"
@@ -253,6 +254,44 @@ TEST(Compensator, SwapsParametersOnlyAtAReversalAndWithoutABump) {
   EXPECT_EQ(comp.params_version(), 6);
   EXPECT_EQ(comp.mem_params().c2, MemParams{}.c2 * 0.7);
   EXPECT_LT(max_step, 0.5);  // a smooth 1 Hz sweep of ~+-250 V moves < 0.2 V per tick: no jump
+}
+
+// A bridge restart starts a new law with what was in force: the sets (and their version), the
+// mode, the reference from its start; what the old law counted stays with the old law.
+TEST(Compensator, ARestartedLawKeepsWhatIsInForce) {
+  Compensator comp(compensator_config(FeedforwardMode::kMem, 300));
+  PlanRecorder rec;
+  comp.set_trajectory(mem_paper_reference(0.0), 0.0);
+  MemParams p;
+  p.c1 *= 1.2;
+  for (std::int64_t s = 0; s < 6000; ++s) {
+    comp.observe({s, 0.0, 0.0});
+    if (s == 2000) comp.offer_mem_params(p, 5);  // swapped at the peak, tick 5000
+    if ((s + 1) % 10 == 0) rec.drain(comp);
+  }
+  ASSERT_EQ(comp.params_version(), 5);
+  std::string refusal = "stale";
+  const Compensator next = comp.restarted(compensator_config(FeedforwardMode::kMem, 300), refusal);
+  EXPECT_EQ(refusal, "");
+  EXPECT_EQ(next.params_version(), 5);
+  EXPECT_EQ(next.mem_params().c1, p.c1);
+  EXPECT_EQ(next.mode(), FeedforwardMode::kMem);
+  EXPECT_EQ(next.trajectory().amplitude_m, comp.trajectory().amplitude_m);
+  EXPECT_EQ(next.trajectory().hold_m, 0.0);
+  EXPECT_EQ(next.last_seq(), -1);  // a new numbering: nothing observed yet
+  EXPECT_EQ(next.counters().planned, 0u);
+}
+
+// A reference the new law's limits no longer allow is not taken again: it holds, saying why.
+TEST(Compensator, ARestartedLawHoldsWhereTheReferenceInForceIsInfeasibleNow) {
+  Compensator comp(compensator_config(FeedforwardMode::kMem, 300));
+  comp.set_trajectory(mem_paper_reference(0.0), 0.0);
+  CompensatorConfig tight = compensator_config(FeedforwardMode::kMem, 300);
+  tight.slew_V_per_s = 100.0;  // the 1 Hz +-250 V sweep needs ~1600 V/s
+  std::string refusal;
+  const Compensator next = comp.restarted(tight, refusal);
+  EXPECT_NE(refusal.find("slew"), std::string::npos) << refusal;
+  EXPECT_EQ(next.trajectory().amplitude_m, TrajectorySpec{}.amplitude_m);
 }
 
 TEST(Compensator, RefusesInvalidParametersAndKeepsTheOldOnes) {
