@@ -12,6 +12,13 @@ safe_V=0.0; ramp=1000; dt=1e-4  # deploy/config/bridge.yaml
 # A reference held at 1.6 um: ~190 V on the simulated stage once the 0.5 s blend is over.
 hold_args=(--config "$config/compensator.yaml" --set trajectory.shape=hold --set trajectory.offset_m=1.6e-6)
 
+# True when the recorder holds 10000 samples and the last complete one is above 150 V (the last
+# line may be half written).
+held_high() {
+  samples_recorded 10000 &&
+    tail -n 2 "$dir/sensor.csv" | awk -F, 'NR == 1 { u = $3 < 0 ? -$3 : $3; high = u > 150 } END { exit !high }'
+}
+
 run_case() {  # name: sigterm | shutdown
   local name="$1"
   start_recording
@@ -20,7 +27,9 @@ run_case() {  # name: sigterm | shutdown
   bpid=$!; pids+=($bpid)
   wait_log "$dir/compensator.log" "channels:"
   wait_log "$dir/bridge.log" "started in the safe state"
-  sleep 1.5
+  # Stopped once the stage holds the large voltage (past the blend) and the recorder has the
+  # second of samples the checks below want.
+  wait_until 30 "$name: the stage held above 150 V with 10000 samples recorded" held_high
   if [ "$name" = sigterm ]; then
     kill -TERM $bpid  # the compensator keeps sending: the bridge must not arm again
   else
@@ -31,7 +40,8 @@ run_case() {  # name: sigterm | shutdown
   wait $bpid || fail "$name: the bridge exited with $?"
   kill -TERM $cpid 2>/dev/null || true
   wait $cpid || true
-  sleep 0.2  # the bridge's last blocks reach the recorder
+  wait_until 10 "$name: the recorder had the bridge's STOPPING report (sent after its last samples)" \
+    stopping_reported bridge
   stop_recording
   "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "$name: unsafe samples"; }
   get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }

@@ -58,7 +58,12 @@ expect_ctl 0 params --c1 6.0e-9 --c2 1e-12 --c3 1.2
 says "adopted parameters v"
 held_version="$(grep -o 'adopted parameters v[0-9]*' "$dir/ctl.out" | grep -o '[0-9]*$')"
 grep -q "note: the re-identifier runs and is not holding" "$dir/ctl.out" && fail "ctl params warned although held"
-sleep 4
+# Held while it refits with the set in use: a refit finished after a report composed after the
+# set was adopted (a refit the hold did not hold back would be published and replace the set).
+wait_reports reidentifier 2 "a re-identifier report after the set was adopted"
+attempted_with_set="$(status_key reidentifier refits_attempted)" || fail "no refits_attempted"
+wait_until 30 "the re-identifier finished a refit with the operator's set in use" \
+  status_at_least reidentifier refits_attempted $((attempted_with_set + 1))
 expect_value reidentifier params_held 1
 expect_value compensator params_version "$held_version"
 [ "$(grep -c "published params version" "$dir/reident.log" || true)" = "$published_before" ] ||

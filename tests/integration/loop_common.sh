@@ -46,18 +46,9 @@ expect_value() {  # process key expected
   [ "$v" = "$3" ] || fail "$1 $2 = $v, expected $3"
 }
 
-# Bounded waits on a condition instead of fixed sleeps (a fixed sleep is too long on a quiet
-# machine and too short on a busy one). wait_until polls a command every 0.05 s until it
-# succeeds, and fails naming what did not happen after TIMEOUT_S (whole seconds; be generous:
-# sanitizer builds and loaded hosts are slow).
-wait_until() {  # timeout_s description command...
-  local timeout_s="$1" what="$2"; shift 2
-  local deadline=$(( ${EPOCHREALTIME/./} + timeout_s * 1000000 ))
-  until "$@"; do
-    [ "${EPOCHREALTIME/./}" -lt "$deadline" ] || fail "timed out after ${timeout_s} s waiting until $what"
-    sleep 0.05
-  done
-}
+# Bounded waits on a condition instead of fixed sleeps: wait_until (wait_common.sh) fails
+# through fail() above, naming what did not happen.
+source "$here/wait_common.sh"
 # The last report (not STOPPING) of a process in the recorder's status.log, as status-value reads it.
 last_status() {  # process
   awk -v p="process=$1 " 'index($0, p) == 1 && index($0, " state=4 ") == 0 { last = $0 } END { print last }' \
@@ -91,3 +82,9 @@ status_reports_reach() { [ "$(status_reports "$1")" -ge "$2" ]; }
 # True when the recorder's command.csv has grown beyond a size (bytes): it is written in 4 kB
 # chunks, so growth means commands were published (by the compensator) after the size was taken.
 commands_recorded() { [ "$(stat -c %s "$dir/command.csv" 2>/dev/null || echo 0)" -gt "$1" ]; }
+# True when the recorder has written at least n samples to sensor.csv (written in 4 kB chunks: a
+# few dozen behind what it received).
+samples_recorded() { [ $(( $(wc -l 2>/dev/null <"$dir/sensor.csv" || echo 1) - 1 )) -ge "$1" ]; }
+# True when the recorder has a process's STOPPING report: the bridge publishes it after its last
+# sensor block and the recorder handles its socket in order, so every block is recorded by then.
+stopping_reported() { grep -q "^process=$1 state=4 " "$dir/status.log" 2>/dev/null; }

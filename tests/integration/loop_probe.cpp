@@ -3,7 +3,8 @@
 //
 //   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv,
 //   HX_COMMAND -> D/command.csv, HX_SIM_TRUTH -> D/truth.csv (seq,y_true_m),
-//                                                HX_STATUS -> D/status.log (one line per report)
+//                                                HX_STATUS -> D/status.log (one line per report:
+//                                                process=P state=S ... counters ... host=H pid=N detail=D)
 //   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
 //                                reset_counters|shutdown [--target P] [--mode N] [--kp --ki --kd]
 //   loop_probe inject  --target bridge|compensator [--count N]
@@ -113,7 +114,8 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
       std::fprintf(status, " %s=%lld", m.counter_names[static_cast<std::size_t>(i)].c_str(),
                    static_cast<long long>(m.counter_values[static_cast<std::size_t>(i)]));
     }
-    std::fprintf(status, " detail=%s\n", m.detail.c_str());
+    // Who sent it: two processes of one name (a restarted or a foreign one) are told apart.
+    std::fprintf(status, " host=%s pid=%d detail=%s\n", m.host.c_str(), static_cast<int>(m.pid), m.detail.c_str());
     std::fflush(status);
   });
   std::fclose(std::fopen((dir + "/recording").c_str(), "w"));  // ready marker

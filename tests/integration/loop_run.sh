@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Bridge + compensator for 3 s with the product's defaults: samples flow at 10 kHz in blocks,
+# Bridge + compensator for ~3.5 s with the product's defaults: samples flow at 10 kHz in blocks,
 # commands planned ahead are applied, the bridge reports HEALTHY, never trips its 2 ms watchdog;
 # both stop on a SHUTDOWN request. Inside tools/netns-run.
 #   loop_run.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
@@ -9,7 +9,9 @@ start_recording
 "$bridge" "${bridge_args[@]}" --auto-arm >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)
 wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
-sleep 3.6
+# The run lasts until the recorder holds 35000 samples (3.5 s of the loop's ticks: what the checks
+# below need), however long a loaded machine takes to get there.
+wait_until 40 "the recorder held 35000 samples" samples_recorded 35000
 "$probe" control --command shutdown
 for p in $bpid $cpid; do
   for _ in $(seq 50); do kill -0 $p 2>/dev/null || break; sleep 0.1; done

@@ -18,6 +18,7 @@ set -euo pipefail
 src="$1" build="$2" probe="$3" out="$4"
 [ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
 source "$(dirname "$0")/summary_checks.sh"
+source "$(dirname "$0")/wait_common.sh"; wait_fail=die  # fail is the count of failed checks here
 rm -rf "$out"; mkdir -p "$out"
 sfx=$$ prefix=HXR_ br="hxbr$$"
 declare -A holder=()
@@ -124,12 +125,12 @@ print_loop_summary "$s1"
 
 # --- phase 2: the compensator moves from "control" to "desk" while the loop runs -------------
 LOG_DIR="$out/log2" hy stage "$out/rig.yaml" up logger || die "up logger again"
-sleep 2
+sleep 2  # a duration: the loop tracks, recorded by the new logger, before the compensator moves
 t_move=$(date +%s.%N)
 hy control "$out/rig.yaml" down compensator || die "down compensator on control"
 hy desk "$out/rig-moved.yaml" up || die "up --host desk (the compensator)"
 echo "compensator moved control -> desk in $(awk -v a="$t_move" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }') s"
-sleep 1
+# `up` returned once the moved compensator reported from the desk; status listens 2.5 s itself.
 hy desk "$out/rig-moved.yaml" status >"$out/status-moved.txt" 2>&1 || { cat "$out/status-moved.txt"; die "status after the move"; }
 grep -Eq '^compensator +desk +desk ' "$out/status-moved.txt" || { cat "$out/status-moved.txt"; die "the compensator does not report from desk"; }
 echo "ok:   status shows the compensator on desk"

@@ -6,7 +6,14 @@
 # kind is counted refused as unsigned on HX_STATUS (the desk's recording of it).
 # Uses rig_hosts.sh's in_ns, ctl_exe, build, cfg, out, prefix, fail.
 foreign_url="udpm://239.255.76.67:7667?ttl=1"
-last_report() { grep "^process=$1 " "$out/desk/status.log" | tail -n 1; }
+# The rig's services by host: the keyless compensator below reports as "compensator" too, from the
+# desk, so every count is read from the reports of the real one (host and pid are in each line).
+declare -A home=([bridge]=stage [compensator]=control)
+last_report() { grep "^process=$1 .* host=${home[$1]} pid=" "$out/desk/status.log" | tail -n 1; }
+reports() {  # process -> how many reports of it (from its host) the desk has recorded
+  local n; n=$(grep -c "^process=$1 .* host=${home[$1]} pid=" "$out/desk/status.log" 2>/dev/null) || true
+  echo "${n:-0}"
+}
 counter() {  # process, counter name -> its value in the last report (the last of duplicate names)
   last_report "$1" | tr ' ' '\n' | awk -F= -v k="$2" '$1 == k { v = $2 } END { print v + 0 }'
 }
@@ -19,7 +26,9 @@ foreign_counts() {
     done
   done
 }
-sleep 1.2  # a status report of each after `up`
+# The counts before: a report of each (`status` heard them already; the desk's recorder too).
+heard_both() { [ "$(reports bridge)" -gt 0 ] && [ "$(reports compensator)" -gt 0 ]; }
+wait_until 20 "the desk recorded a report of the bridge and of the compensator" heard_both
 foreign_counts >"$out/foreign-before.txt"
 # The recorder is still writing sensor.csv: its last line may be incomplete, so every read below
 # drops it (a half-written row once read as "u moved" and a truncated seq as the start).
@@ -45,7 +54,11 @@ else echo "FAIL: a keyless compensator on a host network: exit $rc, $(head -c 30
 in_ns desk timeout -s TERM 2 "$build/services/compensator/hystloop-compensator" --config "$cfg/compensator.yaml" \
   --lcm-url "$foreign_url" --allow-network --rig "$prefix" --set auth.keyless=true \
   --set auth.allow_keyless_network=true >"$out/foreign-compensator.log" 2>&1 || true
-sleep 2.5  # the real compensator's report is the last again (the keyless one also reported as "compensator")
+# The counts after: two more reports of each once the keyless compensator has ended, so one of
+# them was composed after all the foreign traffic.
+want_bridge=$(( $(reports bridge) + 2 )) want_compensator=$(( $(reports compensator) + 2 ))
+reported_after() { [ "$(reports bridge)" -ge "$want_bridge" ] && [ "$(reports compensator)" -ge "$want_compensator" ]; }
+wait_until 20 "two more reports of the bridge and of the compensator after the foreign traffic" reported_after
 foreign_counts >"$out/foreign-after.txt"
 value_in() { awk -F= -v k="$1" '$1 == k { print $2 }' "$2"; }
 delta() { echo $(($(value_in "$1" "$out/foreign-after.txt") - $(value_in "$1" "$out/foreign-before.txt"))); }

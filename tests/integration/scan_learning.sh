@@ -33,17 +33,13 @@ wait_log "$dir/bridge.log" "started in the safe state"
 grep "accepted\|shaped" "$dir/ctl-trajectory.out"
 
 # Learning from its first periods on: wait until it has learned some, then until it has learned
-# learn_periods (at most 30 s; the compensator reports once a second).
-periods() { value compensator learning_periods 2>/dev/null || echo 0; }
-deadline=$((SECONDS + 30)) first=0
-while first="$(periods)"; [ "$first" -lt 10 ]; do
-  [ $SECONDS -lt $deadline ] || fail "the compensator learned no period (learning_periods $first)"
-  sleep 0.2
-done
-while last="$(periods)"; [ "$last" -lt "$learn_periods" ]; do
-  [ $SECONDS -lt $deadline ] || fail "learning_periods stayed at $last (from $first), expected $learn_periods"
-  sleep 0.2
-done
+# learn_periods (the compensator reports once a second).
+wait_until 30 "the compensator learned a period (learning_periods >= 10)" \
+  status_at_least compensator learning_periods 10
+first="$(status_key compensator learning_periods)"
+wait_until 30 "the compensator learned $learn_periods periods (from $first)" \
+  status_at_least compensator learning_periods "$learn_periods"
+last="$(status_key compensator learning_periods)"
 [ "$last" -gt "$first" ] || fail "learning_periods did not grow ($first -> $last)"
 expect_value compensator learning_active 1
 
