@@ -7,6 +7,7 @@ set -euo pipefail
 probe="$1"; rounds="${2:-300}"
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"  # 10 kHz survives a busy CPU (see url.hpp)
 [ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
+source "$(dirname "$0")/wait_common.sh"
 dir="$(mktemp -d)"; logger=""
 cleanup() { [ -n "$logger" ] && kill "$logger" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
@@ -23,25 +24,17 @@ marks() { { grep -a -o 'WARMUP_SENSOR' "$dir/run.lcmlog" 2>/dev/null || true; } 
 # lcm-logger gives no ready signal: warm-up rounds on another prefix until its file shows them
 # (a fixed sleep lost the first rounds on a loaded machine; a non-empty file is not enough either:
 # the first event can be in it before the round's sensor message; check-log counts these apart).
-for _ in $(seq 200); do
+# One round per try: a busy machine can make lcm-logger drop a message (its queue holds 30).
+warmup_recorded() {  # marks before
   "$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
-  [ "$(marks)" -gt 0 ] && break
-  sleep 0.05
-done
-[ "$(marks)" -gt 0 ] || { echo "lcm-logger never recorded the warm-up messages" >&2; exit 1; }
+  [ "$(marks)" -gt "$1" ]
+}
+wait_until 20 "lcm-logger recorded a warm-up round" warmup_recorded 0
 # 1000 rounds/s: about the loop's own message rate.
 "$probe" publish --url "$url" --prefix HX_ --rounds "$rounds" --rate-hz 1000
 # The same at the end: the logger handles its socket in order, so once a round sent after them
 # is in the file, so is every HX_ message.
-before=$(marks)
-# A busy machine can make lcm-logger drop a message (its queue holds 30): send the closing round
-# again until one is in the file.
-for _ in $(seq 200); do
-  "$probe" publish --url "$url" --prefix WARMUP_ --rounds 1 --rate-hz 1000 >/dev/null
-  [ "$(marks)" -gt "$before" ] && break
-  sleep 0.05
-done
-[ "$(marks)" -gt "$before" ] || { echo "lcm-logger never recorded the closing warm-up round" >&2; exit 1; }
+wait_until 20 "lcm-logger recorded the closing warm-up round" warmup_recorded "$(marks)"
 kill -INT "$logger"; wait "$logger" || true; logger=""
 
 echo "== read the log back"

@@ -16,6 +16,7 @@ if [ "$(id -u)" != 0 ]; then echo "SKIP: mounting a tmpfs needs root"; exit 77; 
 if [ "${HYSTLOOP_MOUNTNS:-0}" != 1 ]; then  # again, in a private mount namespace
   exec unshare -m --propagation private -- env HYSTLOOP_MOUNTNS=1 "$0" "$@"
 fi
+source "$(dirname "$0")/wait_common.sh"
 dir="$(mktemp -d)"; pid=""; watcher=""
 cleanup() {
   [ -n "$pid" ] && kill "$pid" 2>/dev/null
@@ -36,10 +37,13 @@ watcher=$!
 pid=$!
 "$probe" publish --url "$url" "${stream[@]}" --rate-hz 2000 &
 publisher=$!
-for _ in $(seq 100); do grep -q '"FAULT: disk full' "$dir/status.jsonl" && break; sleep 0.05; done
+wait_until 30 "the logger reported FAULT: disk full on HX_STATUS" file_has "$dir/status.jsonl" '"FAULT: disk full'
 rm "$dir/disk/ballast"  # space again: the logger resumes at its next retry
 wait "$publisher"
-sleep 0.5
+# Still running once it has handled the whole stream: it answers a request sent after it.
+if ! "$probe" sync --url "$url" --wait-logger-s 20; then
+  kill -0 "$pid" 2>/dev/null && { echo "the logger runs but did not answer after the stream" >&2; exit 1; }
+fi
 kill -0 "$pid" || { echo "the logger did not keep running on a full disk" >&2; cat "$dir/logger.err" >&2; exit 1; }
 kill -TERM "$pid"; rc=0; wait "$pid" || rc=$?; pid=""
 kill "$watcher" 2>/dev/null || true; wait "$watcher" 2>/dev/null || true; watcher=""

@@ -5,6 +5,7 @@
 //   logger_probe check-log --prefix P --blocks N [--block-ticks B] [--gap-at G --gap-len L] [--commands M] FILE...
 //   logger_probe shutdown  --url U --prefix P          (control_t SHUTDOWN addressed to "logger")
 //   logger_probe wait-logger --url U --prefix P [--wait-logger-s T]   (until the logger reports)
+//   logger_probe sync      --url U --prefix P [--wait-logger-s T]   (until the logger answers a request sent now)
 //   logger_probe read-logs FILE...      (every event of every file, whatever the channel)
 //   logger_probe watch-status --url U --prefix P [--seconds S]   (the logger's HX_STATUS as JSON lines)
 //
@@ -21,7 +22,11 @@
 // hold at least one event and to end exactly where its last complete event ends (what
 // lcm-logplayer needs to play it to the end); it prints {"files": F, "events": N} with N
 // the events read. `watch-status` prints every status of process "logger" for S seconds
-// (default 10) as one JSON object a line: {"state", "detail", "counters": {...}}.
+// (default 10) as one JSON object a line: {"state", "detail", "counters": {...}}. `sync` sends a
+// control request and waits for the logger's answer on HX_STATUS (it reports at once after it
+// answers): the logger handles its one socket in order, so once it answered, it has received
+// everything published before the request (what a test waits for before stopping it); prints the
+// logger's received counters; exit 1 if no answer came within T seconds (default 5).
 // Exit status 0 = as expected, 1 = not, 2 = usage.
 #include <chrono>
 #include <cstdio>
@@ -298,6 +303,57 @@ int wait_logger(const Options& o) {
   return 1;
 }
 
+// RESET_COUNTERS to every process: the logger answers it as done (its counters describe the whole
+// recording and do not reset), so nothing about the recording changes but the request itself.
+int sync_logger(const Options& o) {
+  const ChannelNames ch(o.prefix);
+  auto lcm = open_lcm(o.url);
+  const std::int64_t now_us =
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count();
+  control_t msg{};
+  msg.utime = now_us;
+  msg.request_id = now_us;  // unique per call (0 is never acted on)
+  msg.command = control_t::RESET_COUNTERS;
+  bool answered = false;
+  std::string received;
+  Subscription<service_status_t> status(*lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
+    if (m.process != "logger") return;
+    bool acted = false;
+    std::string counts;
+    for (int i = 0; i < m.n_counters; ++i) {
+      const std::string& name = m.counter_names[static_cast<std::size_t>(i)];
+      const std::int64_t value = m.counter_values[static_cast<std::size_t>(i)];
+      if (name == "control_acted_request" && value == msg.request_id) acted = true;
+      if (name.size() > 9 && name.compare(name.size() - 9, 9, ".received") == 0) {
+        counts += " " + name + "=" + std::to_string(value);
+      }
+    }
+    if (acted && !answered) {
+      answered = true;
+      received = counts;
+    }
+  });
+  Publisher<control_t> publisher(*lcm, ch.control);
+  // Sent again every 0.5 s while unanswered, as senders do over UDP (the logger acts once per id).
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_logger_s);
+  auto next_send = std::chrono::steady_clock::now();
+  while (!answered && std::chrono::steady_clock::now() < until) {
+    if (std::chrono::steady_clock::now() >= next_send) {
+      if (!publisher.publish(msg)) std::fprintf(stderr, "logger_probe sync: publishing the request failed\n");
+      next_send += std::chrono::milliseconds(500);
+    }
+    handle_pending(*lcm, std::chrono::milliseconds(20));
+  }
+  if (!answered) {
+    std::fprintf(stderr, "logger_probe sync: the logger did not answer request %lld within %.1f s\n",
+                 static_cast<long long>(msg.request_id), o.wait_logger_s);
+    return 1;
+  }
+  std::printf("logger_probe sync: the logger answered;%s\n", received.c_str());
+  return 0;
+}
+
 int shutdown(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
@@ -323,6 +379,7 @@ int main(int argc, char** argv) {
     if (o.mode == "check-log") return hystloop::check_log(o);
     if (o.mode == "shutdown") return hystloop::shutdown(o);
     if (o.mode == "wait-logger") return hystloop::wait_logger(o);
+    if (o.mode == "sync") return hystloop::sync_logger(o);
     if (o.mode == "read-logs") return hystloop::read_logs(o);
     if (o.mode == "watch-status") return hystloop::watch_status(o);
     std::fprintf(stderr, "logger_probe: unknown mode %s\n", o.mode.c_str());

@@ -37,7 +37,8 @@ echo "== record (SIGTERM to stop)"
 "$logger" --lcm-url "$url" --out-dir "$dir/a" --log-level warn &
 pid=$!
 "$probe" publish --url "$url" "${stream[@]}" --rate-hz 2000
-sleep 0.2
+# Stopped once it has received the whole stream (it answered a request sent after it).
+"$probe" sync --url "$url" --wait-logger-s 20 || { echo "the logger did not answer after the stream" >&2; exit 1; }
 kill -TERM "$pid"; rc=0; wait "$pid" || rc=$?; pid=""
 [ "$rc" = 0 ] || { echo "logger exited $rc after SIGTERM" >&2; exit 1; }
 files=("$dir"/a/hystloop-*.000.lcmlog)
@@ -53,7 +54,7 @@ echo "== play it with lcm-logplayer into a second logger (stopped by SIGINT)"
 pid=$!
 "$probe" wait-logger --url "$url"
 lcm-logplayer --lcm-url="$url" --speed=1.0 "${files[0]}"
-sleep 0.2
+"$probe" sync --url "$url" --wait-logger-s 20 || { echo "the logger did not answer after the replay" >&2; exit 1; }
 kill -INT "$pid"; rc=0; wait "$pid" || rc=$?; pid=""
 [ "$rc" = 0 ] || { echo "logger exited $rc after SIGINT" >&2; exit 1; }
 replayed=("$dir"/b/hystloop-*.000.lcmlog)

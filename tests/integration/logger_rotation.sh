@@ -18,7 +18,8 @@ record() {  # <out dir> <rate> logger options...
   "$logger" --lcm-url "$url" --out-dir "$out" --file-prefix rot_ --log-level warn "$@" &
   pid=$!
   "$probe" publish --url "$url" "${stream[@]}" --rate-hz "$rate"
-  sleep 0.2
+  # Stopped once it has received the whole stream (it answered a request sent after it).
+  "$probe" sync --url "$url" --wait-logger-s 20 || { echo "the logger did not answer after the stream" >&2; exit 1; }
   kill -TERM "$pid"; local rc=0; wait "$pid" || rc=$?; pid=""
   [ "$rc" = 0 ] || { echo "logger exited $rc" >&2; exit 1; }
 }
