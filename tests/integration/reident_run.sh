@@ -61,7 +61,8 @@ case "$what" in
     check_bad "lcm.url" --lcm-url "udpm://239.255.76.67:7667?ttl=1"
     check_bad "reidentifier.lcm_queue" --set reidentifier.lcm_queue=10
     start
-    sleep 1.5
+    # Stopped once it serves (its first HX_STATUS), as a running re-identifier is.
+    "$stream" status --url "$url" || fail "no HX_STATUS from the re-identifier: $(cat "$dir/stderr")"
     kill -0 "$pid" || fail "exited early: $(cat "$dir/stderr")"
     stop_within_1s
     grep -q "reidentifier: rate_hz 10000" "$dir/reident.log" || fail "configuration not logged at start"

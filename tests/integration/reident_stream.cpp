@@ -4,11 +4,12 @@
 //   reident_stream good    --url U [--duration-s 6] [--frequency-hz 1] [--tolerance 0.03] [--expect-invalid 1]
 //   reident_stream garbage --url U [--phase-s 2]
 //   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reidentifier" (after its first status)
+//   reident_stream status  --url U      until the re-identifier's first status (it serves; exit 1 if none in 10 s)
 //
-// Both wait for the re-identifier's first HX_STATUS, then stream 10 kHz of real time as the
-// bridge and compensator do: one sensor_block_t of 10 ticks per millisecond, and command_block_t
-// for the ticks up to 30 ms (300 ticks) ahead of it, reading HX_PARAMS and HX_STATUS between
-// blocks, then wait --settle-s for the last reports.
+// Every mode waits for the re-identifier's first HX_STATUS; good and garbage then stream 10 kHz
+// of real time as the bridge and compensator do: one sensor_block_t of 10 ticks per millisecond,
+// and command_block_t for the ticks up to 30 ms (300 ticks) ahead of it, reading HX_PARAMS and
+// HX_STATUS between blocks, then wait --settle-s for the last reports.
 //  good:    first announces an external valid set (version 5, source "probe") equal to the
 //           re-identifier's initial params; the commands say the compensator applies version 7
 //           (a set the re-identifier never heard on HX_PARAMS); then streams u = 250 sin(2 pi f t),
@@ -78,8 +79,8 @@ Options parse(int argc, char** argv) {
   Options o;
   if (argc < 2) throw std::invalid_argument("usage: reident_stream good|garbage --url U [options]");
   o.mode = argv[1];
-  if (o.mode != "good" && o.mode != "garbage" && o.mode != "shutdown") {
-    throw std::invalid_argument("mode must be good, garbage or shutdown");
+  if (o.mode != "good" && o.mode != "garbage" && o.mode != "shutdown" && o.mode != "status") {
+    throw std::invalid_argument("mode must be good, garbage, shutdown or status");
   }
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -139,6 +140,7 @@ class Stream {
       std::fprintf(stderr, "reident_stream: no HX_STATUS from reident within 10 s\n");
       return 1;
     }
+    if (o_.mode == "status") return 0;
     if (o_.mode == "shutdown") {
       control_t c{};
       c.utime = 1;
