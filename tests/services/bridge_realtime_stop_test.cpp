@@ -22,7 +22,8 @@ constexpr double kDt = 1e-4;
 // What the backend saw. Written on the real-time thread (step, the first hold_safe) and the
 // test's thread (the later hold_safe calls, after the join); read after the join.
 struct Record {
-  std::vector<double> u_V;  // every step's voltage
+  std::vector<double> u_V;            // every step's voltage
+  std::atomic<std::size_t> steps{0};  // how many steps so far, for the test's thread to wait on
   std::atomic<double> last_u_V{0.0};
   std::atomic<int> holds{0};
   std::size_t steps_at_first_hold = 0;
@@ -36,6 +37,7 @@ class RecordingBackend final : public StageBackend {
   StageReading step(double u_V, double, double) noexcept override {
     if (r_.u_V.size() < r_.u_V.capacity()) r_.u_V.push_back(u_V);
     r_.last_u_V.store(u_V);
+    r_.steps.fetch_add(1);
     return {0.0, 4};
   }
   const std::string& name() const noexcept override { return name_; }
@@ -65,16 +67,24 @@ BridgeSettings fast_ramp_settings() {
   return s;
 }
 
+// Polls `done` every millisecond until it holds or a deadline generous for a loaded machine and a
+// sanitizer build passes; true if it held.
+template <class Condition>
+bool eventually(Condition done) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() >= until) return done();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
 // Started, armed by the first command and driven to `u_V` (the slew limit: 5 V per tick).
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, Record& record, double u_V) {
   auto rt = std::make_unique<BridgeRealtime>(s, std::make_unique<RecordingBackend>(record));
   for (std::int64_t k = 0; k < 8000; ++k) EXPECT_TRUE(rt->push_command({k, u_V, std::nan(""), 1, 2}));
   rt->start();
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (record.last_u_V.load() != u_V && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  EXPECT_EQ(record.last_u_V.load(), u_V) << "the stage never got there";
+  EXPECT_TRUE(eventually([&] { return record.last_u_V.load() == u_V; })) << "the stage never got there";
   return rt;
 }
 
@@ -110,13 +120,15 @@ TEST(BridgeRealtimeStop, StopRampsRefusesToArmAndReportsTheRamp) {
   Record record;
   auto rt = drive_to(s, record, -200.0);
   rt->begin_safe_stop();
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (!rt->safe_reached() && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  ASSERT_TRUE(rt->safe_reached());
-  rt->request_arm(ArmRequest::kArm);  // a late ARM: refused, the commands keep coming
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(eventually([&] { return rt->safe_reached(); })) << "the ramp never reached the safe voltage";
+  // A late ARM: refused, the commands keep coming. Each tick takes the pending request before it
+  // steps, so the second step counted after the request comes from a tick that saw it; two wakes
+  // of ticks later, an ARM taken would have moved u (5 V a tick).
+  rt->request_arm(ArmRequest::kArm);
+  const std::size_t steps_at_arm = record.steps.load();
+  ASSERT_TRUE(eventually([&] {
+    return record.steps.load() >= steps_at_arm + 2 * static_cast<std::size_t>(s.rt.ticks_per_wake);
+  })) << "the real-time thread stopped stepping after the late ARM";
   const SafeStopResult r = rt->stop();
   EXPECT_TRUE(r.requested);
   EXPECT_TRUE(r.reached);

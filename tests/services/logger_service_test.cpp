@@ -200,6 +200,8 @@ TEST_F(LoggerServiceTest, ACompensatorResumingAfterSilenceIsCountedApart) {
   LoggerService service(*lcm_, names_, options_);
   for (std::int64_t k = 0; k < 10; ++k) publish(*lcm_, names_.command, command_block(200 + 10 * k, 10, 10 * k + 9));
   dispatch_all();
+  // a duration: the silence itself, which the logger measures between the blocks' receive times;
+  // sleep_for waits at least this long however busy the machine (twice command_resume_s).
   std::this_thread::sleep_for(std::chrono::milliseconds(40));
   publish(*lcm_, names_.command, command_block(1000, 10, 800));
   publish(*lcm_, names_.command, sensor_block(0, 3));
