@@ -1,7 +1,9 @@
 #pragma once
-// YAML config snippets for identified parameters. Keys are the parameter structs' member names
-// (mem: {c1, c2, c3}, banning: {hysteresis: {a, b, alpha}, stage: {k, c}}, ...), values in SI
-// with full precision, so the snippet can be pasted into a hystloop config file.
+// YAML config snippets for identified parameters, written through each model's parameter table
+// (models/model_descriptors.hpp): keys are the table's names (mem: {c1, c2, c3}, banning:
+// {hysteresis: {a, b, alpha, s_max}, stage: {k, c}, order}, ...), values in SI, each the shortest
+// text that reads back to the same double, so the snippet can be pasted into a hystloop config
+// file or given to hystloop-model --params-file and reads back unchanged.
 
 #include <string>
 

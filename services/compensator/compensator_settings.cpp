@@ -7,6 +7,8 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include "models/model_descriptors.hpp"
+#include "models/param_config.hpp"
 #include "runtime/config_validation.hpp"
 #include "runtime/rig_auth_config.hpp"
 #include "runtime/stage_config.hpp"
@@ -19,34 +21,19 @@ TrajectoryShape parse_shape(const Config& config, const std::string& name) {
   config.fail("trajectory.shape", "must be " + trajectory_shape_choices() + " (got '" + name + "')");
 }
 
-ShapingFunction read_shaping(const Config& config, const std::string& prefix, const ShapingFunction& fallback) {
-  if (!config.has(prefix + ".kind")) {
-    for (const char* key : {".gain", ".offset", ".coefficients", ".amplitude", ".scale"}) {
-      if (config.has(prefix + key)) config.fail(prefix + ".kind", "required when other " + prefix + " keys are given");
-    }
-    return fallback;
-  }
-  const std::string kind = config.get<std::string>(prefix + ".kind");
-  ShapingFunction s;
-  if (kind == "linear") {
-    s = ShapingFunction::make_linear(config.get<double>(prefix + ".gain"), config.get<double>(prefix + ".offset", 0.0));
-  } else if (kind == "polynomial") {
-    const auto c = config.get<std::vector<double>>(prefix + ".coefficients");
-    if (c.empty() || c.size() > ShapingFunction::kMaxCoefficients) {
-      config.fail(prefix + ".coefficients", fmt::format("needs 1..{} values", ShapingFunction::kMaxCoefficients));
-    }
-    s.kind = ShapingKind::polynomial;
-    for (std::size_t i = 0; i < c.size(); ++i) s.coefficients[i] = c[i];
-    s.domain_min = config.get<double>(prefix + ".domain_min");
-    s.domain_max = config.get<double>(prefix + ".domain_max");
-  } else if (kind == "tanh") {
-    s = ShapingFunction::make_tanh(config.get<double>(prefix + ".amplitude"), config.get<double>(prefix + ".scale"),
-                                   config.get<double>(prefix + ".offset", 0.0));
-  } else {
-    config.fail(prefix + ".kind", "must be linear, polynomial or tanh (got '" + kind + "')");
-  }
-  validate_config_section(config, "", [&] { s.validate(prefix); });
-  return s;
+// A model's config section (mem.c1, katalenic.input_shaping.kind, ...) read through the model's
+// parameter table onto `settings`: the keys are the ones hystloop-identify writes and
+// hystloop-model reads. A refused value names the key.
+template <class D>
+typename D::Params read_model_section(const Config& config, typename D::Settings settings) {
+  const std::vector<Assignment> assignments = config_section(config, D::name, D::table());
+  typename D::Params params;
+  validate_config_section(config, std::string(D::name) + ".", [&] {
+    apply(D::table(), D::name, assignments, settings);
+    params = D::build(settings);
+    params.validate();
+  });
+  return params;
 }
 
 // compensator.plausible_gain_factor, and the models the file sets (and the one the mode starts
@@ -89,60 +76,49 @@ GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept
 }
 
 const std::vector<std::string>& compensator_config_keys() {
-  static const std::vector<std::string> keys = {"compensator.mode",
-                                                "compensator.horizon_s",
-                                                "compensator.dt_s",
-                                                "compensator.run_seconds",
-                                                "compensator.sample_queue_capacity",
-                                                "compensator.plan_slew_fraction",
-                                                "compensator.servo_slew_reserve",
-                                                "compensator.plausible_gain_factor",
-                                                "actuator.u_min_V",
-                                                "actuator.u_max_V",
-                                                "actuator.slew_V_per_s",
-                                                "stage.kind",
-                                                "stage.k",
-                                                "stage.c",
-                                                "stage.order",
-                                                "learning.enabled",
-                                                "learning.gain",
-                                                "learning.cutoff_hz",
-                                                "learning.max_correction_m",
-                                                "learning.max_period_s",
-                                                "learning.lag_compensated",
-                                                "learning.fade_s",
-                                                "learning.blend_s",
-                                                "learning.hold_params_after",
-                                                "rt.priority",
-                                                "rt.lock_memory",
-                                                "mem.c1",
-                                                "mem.c2",
-                                                "mem.c3",
-                                                "pi.count",
-                                                "pi.thresholds",
-                                                "pi.weights",
-                                                "pi.range_V",
-                                                "linear.gain",
-                                                "linear.offset",
-                                                "katalenic.k1",
-                                                "katalenic.k2",
-                                                "katalenic.k2_slope",
-                                                "katalenic.k2_domain_min",
-                                                "katalenic.k2_domain_max",
-                                                "katalenic.initial_offset",
-                                                "katalenic.input_shaping.*",
-                                                "katalenic.output_shaping.*",
-
-                                                "trajectory.shape",
-                                                "trajectory.amplitude_m",
-                                                "trajectory.offset_m",
-                                                "trajectory.frequency_hz",
-                                                "trajectory.phase_rad",
-                                                "trajectory.blend_s",
-                                                "trajectory.corner_s",
-                                                "trajectory.shape_if_infeasible",
-                                                "trajectory.points_t_s",
-                                                "trajectory.points_y_m"};
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k = {"compensator.mode",
+                                  "compensator.horizon_s",
+                                  "compensator.dt_s",
+                                  "compensator.run_seconds",
+                                  "compensator.sample_queue_capacity",
+                                  "compensator.plan_slew_fraction",
+                                  "compensator.servo_slew_reserve",
+                                  "compensator.plausible_gain_factor",
+                                  "actuator.u_min_V",
+                                  "actuator.u_max_V",
+                                  "actuator.slew_V_per_s",
+                                  "stage.kind",
+                                  "stage.k",
+                                  "stage.c",
+                                  "stage.order",
+                                  "learning.enabled",
+                                  "learning.gain",
+                                  "learning.cutoff_hz",
+                                  "learning.max_correction_m",
+                                  "learning.max_period_s",
+                                  "learning.lag_compensated",
+                                  "learning.fade_s",
+                                  "learning.blend_s",
+                                  "learning.hold_params_after",
+                                  "rt.priority",
+                                  "rt.lock_memory",
+                                  "trajectory.shape",
+                                  "trajectory.amplitude_m",
+                                  "trajectory.offset_m",
+                                  "trajectory.frequency_hz",
+                                  "trajectory.phase_rad",
+                                  "trajectory.blend_s",
+                                  "trajectory.corner_s",
+                                  "trajectory.shape_if_infeasible",
+                                  "trajectory.points_t_s",
+                                  "trajectory.points_y_m"};
+    append_config_keys(k, MemDescriptor::name, MemDescriptor::table());
+    append_config_keys(k, PiDescriptor::name, PiDescriptor::table());
+    append_config_keys(k, LinearDescriptor::name, LinearDescriptor::table());
+    append_config_keys(k, KatalenicDescriptor::name, KatalenicDescriptor::table());
+    return k;
+  }();
   return keys;
 }
 
@@ -174,50 +150,13 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
-  c.mem.c1 = config.get_positive("mem.c1", c.mem.c1);
-  c.mem.c2 = config.get_non_negative("mem.c2", c.mem.c2);
-  c.mem.c3 = config.get_positive("mem.c3", c.mem.c3);
-  validate_config_section(config, "mem.", [&] { c.mem.validate(); });
-
-  // PI: explicit plays (as identified), or the MEM-matched baseline over +-pi.range_V.
-  if (config.has("pi.thresholds") || config.has("pi.weights")) {
-    const auto r = config.get<std::vector<double>>("pi.thresholds");
-    const auto w = config.get<std::vector<double>>("pi.weights");
-    if (r.empty() || r.size() > kPiMaxOperators)
-      config.fail("pi.thresholds", fmt::format("needs 1..{} values", kPiMaxOperators));
-    if (w.size() != r.size())
-      config.fail("pi.weights", fmt::format("needs as many values as pi.thresholds ({})", r.size()));
-    const auto count = config.get_int_in_range("pi.count", static_cast<std::int64_t>(r.size()), 1,
-                                               static_cast<std::int64_t>(kPiMaxOperators));
-    if (static_cast<std::size_t>(count) != r.size()) config.fail("pi.count", "must equal the number of pi.thresholds");
-    c.pi = PiParams{};
-    c.pi.count = r.size();
-    for (std::size_t i = 0; i < r.size(); ++i) {
-      c.pi.thresholds[i] = r[i];
-      c.pi.weights[i] = w[i];
-    }
-  } else {
-    const auto count = config.get_int_in_range("pi.count", 15, 1, static_cast<std::int64_t>(kPiMaxOperators));
-    const double range = config.get_positive("pi.range_V", 250.0);
-    validate_config_section(config, "pi.",
-                            [&] { c.pi = pi_params_from_mem(c.mem, static_cast<std::size_t>(count), range); });
-  }
-  validate_config_section(config, "pi.", [&] { c.pi.validate(); });
-
-  c.linear.gain = config.get<double>("linear.gain", c.linear.gain);
-  c.linear.offset = config.get<double>("linear.offset", c.linear.offset);
-  validate_config_section(config, "linear.", [&] { c.linear.validate(); });
-
-  KatalenicParams& k = c.katalenic;
-  k.k1 = config.get_positive("katalenic.k1", k.k1);
-  k.k2 = config.get_positive("katalenic.k2", k.k2);
-  k.k2_slope = config.get<double>("katalenic.k2_slope", k.k2_slope);
-  k.k2_domain_min = config.get<double>("katalenic.k2_domain_min", k.k2_domain_min);
-  k.k2_domain_max = config.get<double>("katalenic.k2_domain_max", k.k2_domain_max);
-  k.initial_offset = config.get<double>("katalenic.initial_offset", k.initial_offset);
-  k.input_shaping = read_shaping(config, "katalenic.input_shaping", k.input_shaping);
-  k.output_shaping = read_shaping(config, "katalenic.output_shaping", k.output_shaping);
-  validate_config_section(config, "katalenic.", [&] { k.validate(); });
+  c.mem = read_model_section<MemDescriptor>(config, c.mem);
+  // PI: explicit plays (as identified), or the baseline matched to the MEM just read over +-range_V.
+  PiSettings pi;
+  pi.matched_to = c.mem;
+  c.pi = read_model_section<PiDescriptor>(config, pi);
+  c.linear = read_model_section<LinearDescriptor>(config, c.linear);
+  c.katalenic = read_model_section<KatalenicDescriptor>(config, c.katalenic);
 
   // The actuator as the bridge limits it: the plan stays inside it (keep equal to the bridge's actuator.*).
   c.u_min_V = config.get<double>("actuator.u_min_V", c.u_min_V);
@@ -299,12 +238,10 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("compensator: mode {}, plans {} ticks ({:.4g} s) ahead, dt {} s{}", to_string(c.mode),
                               c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
                               s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
-  lines.push_back(fmt::format("mem: c1 {:.6g} m/V, c2 {:.6g} m/V^(1+c3), c3 {:.6g}", c.mem.c1, c.mem.c2, c.mem.c3));
-  lines.push_back(
-      fmt::format("pi: {} plays up to {:.4g} V", c.pi.count, c.pi.count ? c.pi.thresholds[c.pi.count - 1] : 0.0));
-  lines.push_back(fmt::format("linear: gain {:.6g} m/V, offset {:.4g} m", c.linear.gain, c.linear.offset));
-  lines.push_back(fmt::format("katalenic: k1 {:.6g}, k2 {:.6g}, k2_slope {:.4g}", c.katalenic.k1, c.katalenic.k2,
-                              c.katalenic.k2_slope));
+  lines.push_back("mem: " + MemDescriptor::summary_of(c.mem));
+  lines.push_back("pi: " + PiDescriptor::summary_of(c.pi));
+  lines.push_back("linear: " + LinearDescriptor::summary_of(c.linear));
+  lines.push_back("katalenic: " + KatalenicDescriptor::summary_of(c.katalenic));
   lines.push_back(fmt::format(
       "actuator: u in [{}, {}] V, slew {:.4g} V/s (an experiment uses at most {:.0f} % of it, a trajectory {:.0f} %)",
       c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction, 100.0 * c.tracking_slew_fraction()));

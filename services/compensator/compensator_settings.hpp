@@ -1,9 +1,10 @@
 #pragma once
 // Everything hystloop-compensator is configured with, read from the YAML tree (after --set
 // overrides and --params snippets) and validated there: a refused value throws ConfigError
-// naming the file and the field. Model sections use the parameter names, the same keys
-// `hystloop-identify --out` writes (mem: {c1, c2, c3}, pi: {count, thresholds, weights},
-// linear: {gain, offset}, katalenic: {k1, k2, ..., input_shaping: {...}}).
+// naming the file and the field. Model sections are read through the models' parameter tables
+// (models/model_descriptors.hpp), the names `hystloop-identify --out` writes and hystloop-model
+// reads (mem: {c1, c2, c3}, pi: {count, range_V, thresholds, weights}, linear: {gain, offset},
+// katalenic: {k1, k2, ..., input_shaping: {...}}).
 
 #include <filesystem>
 #include <string>

@@ -1,6 +1,6 @@
 #include "csv_columns.hpp"
 
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 
 namespace hystloop::model_tool {
 namespace {

@@ -2,7 +2,7 @@
 // their own data.
 //
 //   hystloop-model --model mem --forward data.csv --out y.csv            t,u     -> t,u,y
-//   hystloop-model --model pi --param n=15 --param u_max=250 --inverse ref.csv    t,y_ref -> t,y_ref,u
+//   hystloop-model --model pi --param count=15 --param range_V=250 --inverse ref.csv  t,y_ref -> t,y_ref,u
 //   hystloop-model --params-file fitted.yaml --inverse - < ref.csv
 //
 // Exit status: 0 done, 1 the model produced a non-finite value, 2 refused (usage, parameters,
@@ -21,7 +21,7 @@
 #include "core/errors.hpp"
 #include "csv_columns.hpp"
 #include "model_registry.hpp"
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 #include "params_file.hpp"
 
 namespace {
@@ -166,7 +166,7 @@ int main(int argc, char** argv) try {
   app.footer(models_help() +
              "\nExamples:\n"
              "  hystloop-model --model mem --forward data.csv --out y.csv\n"
-             "  hystloop-model --model pi --param n=15 --param u_max=250 --inverse ref.csv\n"
+             "  hystloop-model --model pi --param count=15 --param range_V=250 --inverse ref.csv\n"
              "  hystloop-model --params-file fitted.yaml --inverse - < ref.csv   (YAML from hystloop-identify --out)\n"
              "Exit status: 0 done, 1 the model gave a non-finite value, 2 refused (usage, parameters, input).");
   Args args;

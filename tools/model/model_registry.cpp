@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "model_descriptors.hpp"
+#include "models/model_descriptors.hpp"
 #include "models/model_concepts.hpp"
 
 namespace hystloop::model_tool {

@@ -1,7 +1,8 @@
 #pragma once
-// The models hystloop-model can run, by name: each entry owns its parameter table (param_table.hpp)
-// and builds a runner for one file. The runner is virtual per file; the per-sample loop inside it
-// is a template over the model type (model_concepts.hpp), so no sample pays a virtual call.
+// The models hystloop-model can run, by name: each entry is a model's descriptor and parameter
+// table (models/model_descriptors.hpp) and builds a runner for one file. The runner is virtual
+// per file; the per-sample loop inside it is a template over the model type (model_concepts.hpp),
+// so no sample pays a virtual call.
 
 #include <memory>
 #include <span>
@@ -9,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 
 namespace hystloop::model_tool {
 

@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 
 namespace hystloop::model_tool {
 

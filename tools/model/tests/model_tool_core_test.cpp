@@ -17,7 +17,7 @@
 #include "models/katalenic.hpp"
 #include "models/mem.hpp"
 #include "models/prandtl_ishlinskii.hpp"
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 #include "params_file.hpp"
 
 namespace hystloop::model_tool {
@@ -202,16 +202,19 @@ TEST(ModelRegistry, TheModelsOwnValidationNamesTheField) {
   EXPECT_EQ(field_of("banning", {"stage.k=0"}), "stage.k");
   EXPECT_EQ(field_of("pi", {"weights=-1e-9,2e-9"}), "weights[0]");
   EXPECT_EQ(field_of("pi", {"thresholds=0,1"}), "thresholds");
-  EXPECT_EQ(field_of("pi", {"n=0"}), "n");
-  EXPECT_EQ(field_of("pi", {"n=33"}), "n");
-  EXPECT_EQ(field_of("pi", {"u_max=-5"}), "u_max");
-  EXPECT_EQ(field_of("pi", {"n=3", "weights=1e-9,1e-9"}), "n");
-  EXPECT_EQ(field_of("pi", {"weights=1e-9,1e-9", "thresholds=0,1,2"}), "thresholds");
+  // n and u_max are older spellings of count and range_V: accepted, the error names the field.
+  EXPECT_EQ(field_of("pi", {"n=0"}), "count");
+  EXPECT_EQ(field_of("pi", {"count=33"}), "count");
+  EXPECT_EQ(field_of("pi", {"u_max=-5"}), "range_V");
+  EXPECT_EQ(field_of("pi", {"range_V=0"}), "range_V");
+  EXPECT_EQ(field_of("pi", {"n=3", "weights=1e-9,1e-9"}), "count");
+  EXPECT_EQ(field_of("pi", {"weights=1e-9,1e-9", "thresholds=0,1,2"}), "weights");
   EXPECT_EQ(field_of("pi", {"count=2", "weights=1e-9,1e-9", "thresholds=0,10"}), "(accepted)");
   EXPECT_EQ(configure_error("mem", {"c3=-1"}), "c3: must be > 0 (got -1)");
 }
 
-// The PI built from n/u_max is the project's MEM-matched baseline; checked through its output.
+// The PI built from count/range_V (here by their older spellings) is the project's MEM-matched baseline; checked
+// through its output.
 TEST(ModelRegistry, PiFromSizeAndRangeIsTheMemMatchedBaseline) {
   const auto run = find_model("pi")->configure({param("n=7"), param("u_max=200")});
   const std::vector<double> u = {0.0, 120.0, 200.0, -60.0, 30.0};
@@ -255,7 +258,8 @@ TEST(ModelRegistry, HelpListsEveryModelParameterUnitAndDefault) {
     }
   }
   EXPECT_NE(help.find("default 5e-09"), std::string::npos);  // MEM c1 from MemParams{}
-  EXPECT_NE(help.find("n (or count)"), std::string::npos);
+  EXPECT_NE(help.find("count (or n)"), std::string::npos);
+  EXPECT_NE(help.find("range_V (or u_max)"), std::string::npos);
 }
 
 // ---- params file -------------------------------------------------------------------------------

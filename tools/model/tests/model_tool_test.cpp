@@ -162,7 +162,7 @@ TEST_P(ModelToolRoundTrip, ForwardThenInverseGivesTheInputBack) {
 INSTANTIATE_TEST_SUITE_P(
     Models, ModelToolRoundTrip,
     ::testing::Values(RoundTripCase{"mem", "--param c1=4.5e-9 --param c2=2e-12 --param c3=1.1", 1e-11},
-                      RoundTripCase{"pi", "--param n=12 --param u_max=260", 1e-11},
+                      RoundTripCase{"pi", "--param count=12 --param range_V=260", 1e-11},
                       RoundTripCase{"pi_weights", "--param weights=4e-9,1e-9,1e-9,5e-10,5e-10 --param u_max=250",
                                     1e-11},
                       RoundTripCase{"katalenic", "--param k1=30 --param k2=0.02", 1e-11},
@@ -297,7 +297,7 @@ TEST_F(ModelTool, EveryRefusalExitsWithTwoAndNamesWhere) {
       {"--model mem --forward --param c1 {in}", ok, "--param c1: expected NAME=VALUE"},
       {"--model mem --forward --param c3=-1 {in}", ok, "model mem: c3: must be > 0 (got -1)"},
       {"--model banning --forward --param hysteresis.b=1e-8 {in}", ok, "model banning: hysteresis.b:"},
-      {"--model pi --forward --param n=40 {in}", ok, "model pi: n: must be in [1, 32] (got 40)"},
+      {"--model pi --forward --param n=40 {in}", ok, "model pi: count: must be in [1, 32] (got 40)"},
       {"--model pi --forward --param thresholds=0,10 {in}", ok, "model pi: thresholds: given without weights"},
       {"--model pi --forward --param weights=-1e-9 {in}", ok, "model pi: weights[0]:"},
       {"--model memm --forward {in}", ok, "--model: unknown model 'memm'; did you mean 'mem'?"},
@@ -372,8 +372,8 @@ TEST_F(ModelTool, HelpListsEveryModelAndParameterWithUnitAndDefault) {
     }
   }
   for (const char* name :
-       {"c1", "c2", "c3", "hysteresis.alpha", "stage.k", "k1", "k2", "output_shaping.gain", "n (or count)", "u_max",
-        "weights", "thresholds", "gain", "offset", "--params-file", "--forward", "--inverse"}) {
+       {"c1", "c2", "c3", "hysteresis.alpha", "stage.k", "k1", "k2", "output_shaping.gain", "count (or n)",
+        "range_V (or u_max)", "weights", "thresholds", "gain", "offset", "--params-file", "--forward", "--inverse"}) {
     EXPECT_NE(r.out.find(name), std::string::npos) << name;
   }
 }

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "model_descriptors.hpp"
-#include "param_fields.hpp"
+#include "models/model_descriptors.hpp"
+#include "models/param_fields.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 namespace {
 
 using P = KatalenicParams;
@@ -25,6 +25,13 @@ constexpr ShapingNames kInputNames{"input_shaping.kind",         "input_shaping.
 constexpr ShapingNames kOutputNames{
     "output_shaping.kind",       "output_shaping.gain",       "output_shaping.offset",    "output_shaping.coefficients",
     "output_shaping.domain_min", "output_shaping.domain_max", "output_shaping.amplitude", "output_shaping.scale"};
+
+// Whether a shaping field means anything for the function's kind (the YAML written leaves the
+// others out: {kind: linear, gain: ..., offset: ...}).
+template <class Sel, ShapingKind... kinds>
+bool of_kind(const P& p) {
+  return ((Sel{}(p).kind == kinds) || ...);
+}
 
 // Sel: captureless generic lambda returning the ShapingFunction inside P.
 template <class Sel>
@@ -48,8 +55,10 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
   const std::string_view unit = map == "in" ? "x/V" : "m/x";
   rows.push_back(number<P>(
       n.gain, unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::linear>;
   rows.push_back(number<P>(
       n.offset, map == "in" ? "x" : "m", "linear, tanh: value at 0", [](auto& p) -> auto& { return Sel{}(p).offset; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::linear, ShapingKind::tanh>;
   rows.push_back(custom<P>(
       n.coefficients, "-", "polynomial: c0,c1,...,c7 (units of the map)", ValueKind::list,
       [](P& p, const ParsedValue& v) {
@@ -67,28 +76,33 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
         while (k > 1 && c[k - 1] == 0.0) --k;
         return format_list(std::span<const double>(c.data(), k));
       }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
       n.domain_min, map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
       [](auto& p) -> auto& { return Sel{}(p).domain_min; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
       n.domain_max, map == "in" ? "V" : "x", "polynomial: upper end of that domain",
       [](auto& p) -> auto& { return Sel{}(p).domain_max; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
       n.amplitude, map == "in" ? "x" : "m", "tanh: half the output range",
       [](auto& p) -> auto& { return Sel{}(p).amplitude; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::tanh>;
   rows.push_back(number<P>(
       n.scale, map == "in" ? "V" : "x", "tanh: input scale", [](auto& p) -> auto& { return Sel{}(p).scale; }));
+  rows.back().applies = &of_kind<Sel, ShapingKind::tanh>;
 }
 
 std::vector<ParamSpec<P>> make_rows() {
   std::vector<ParamSpec<P>> rows = {
-      number<P>(
-          "k1", "x", "half-width of the backlash band |z - x| <= k1", [](auto& p) -> auto& { return p.k1; }),
-      number<P>(
-          "k2", "1/x", "rate of the transition to the asymptotes", [](auto& p) -> auto& { return p.k2; }),
-      number<P>(
+      summarised(number<P>(
+          "k1", "x", "half-width of the backlash band |z - x| <= k1", [](auto& p) -> auto& { return p.k1; })),
+      summarised(number<P>(
+          "k2", "1/x", "rate of the transition to the asymptotes", [](auto& p) -> auto& { return p.k2; })),
+      summarised(number<P>(
           "k2_slope", "1/x^2", "k2(x) = k2 + k2_slope*clamp(x, k2_domain_min, k2_domain_max)",
-          [](auto& p) -> auto& { return p.k2_slope; }),
+          [](auto& p) -> auto& { return p.k2_slope; })),
       number<P>(
           "k2_domain_min", "x", "working interval of that schedule, lower end",
           [](auto& p) -> auto& { return p.k2_domain_min; }),
@@ -109,4 +123,4 @@ std::span<const ParamSpec<KatalenicParams>> KatalenicDescriptor::table() {
   return rows;
 }
 
-}  // namespace hystloop::model_tool
+}  // namespace hystloop

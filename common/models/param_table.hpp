@@ -1,8 +1,10 @@
 #pragma once
-// One table per model describes its parameters: name (and an alias, e.g. the YAML key), unit,
-// meaning, kind of value and how to store it. The same table drives --help, the parsing of
-// `--param NAME=VALUE` and of the params file, and the "did you mean" for an unknown name, so
-// the three can never disagree.
+// One table per model describes its parameters: name (and an alias, an older spelling), unit,
+// meaning, kind of value and how to store it. The same table drives hystloop-model's --help,
+// `--param NAME=VALUE` and --params-file, the YAML hystloop-identify writes (param_text.hpp), the
+// compensator's model sections and its start-up summary, and the "did you mean" for an unknown
+// name, so none of them can disagree on a name. Bounds are the model's validate(): a table only
+// stores values, the parameter struct says which sets are valid.
 //
 // Values are parsed strictly: the whole text must be the value (no trailing junk), numbers in C
 // notation and finite, lists comma separated (optionally in [brackets], as YAML writes them).
@@ -16,7 +18,7 @@
 
 #include "core/errors.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 
 enum class ValueKind { number, count, list, choice };
 
@@ -51,13 +53,17 @@ class AssignmentError : public ParameterError {
 template <class S>
 struct ParamSpec {
   std::string_view name;
-  std::string_view alias;  // accepted as well ("" if none): e.g. the key hystloop-identify writes
+  std::string_view alias;  // accepted as well ("" if none): another spelling users' files or commands hold
   std::string_view unit;   // "m/V", "-" for dimensionless
   std::string_view description;
   ValueKind kind = ValueKind::number;
   std::string_view choices;  // ValueKind::choice: "a|b|c"
   void (*set)(S&, const ParsedValue&) = nullptr;
   std::string (*show)(const S&) = nullptr;  // the current value as text (help shows S{}'s)
+  // Whether the value means anything for this set (a tanh's gain does not): nullptr = always.
+  // A value that means nothing is left out of the YAML written, so a file says only what counts.
+  bool (*applies)(const S&) = nullptr;
+  bool in_summary = false;  // one of the few values a one-line summary of the set names
 };
 
 // The table row, type-erased for help and listing.
@@ -127,4 +133,4 @@ void apply(std::span<const ParamSpec<S>> table, std::string_view model, const st
   }
 }
 
-}  // namespace hystloop::model_tool
+}  // namespace hystloop

@@ -1,10 +1,14 @@
 #pragma once
-// What the registry needs to know of each model, as types: the settings struct the parameter
-// table writes into, how it becomes the model's parameter struct, and the forward and inverse
-// classes (Inverse = void when there is none). The tables live in model_tables_*.cpp.
+// Each model's description, as types: the settings struct its parameter table writes into, how
+// that becomes the model's parameter struct and back, a one-line summary of a set, and the
+// forward and inverse classes (Inverse = void when there is none). The tables live in
+// model_tables*.cpp. hystloop-model's registry, hystloop-identify's YAML (ident/params_yaml)
+// and the compensator's model sections all go through these, so a parameter is added to a model
+// in its table alone.
 
 #include <cstddef>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -13,31 +17,42 @@
 #include "models/linear.hpp"
 #include "models/mem.hpp"
 #include "models/prandtl_ishlinskii.hpp"
-#include "param_table.hpp"
+#include "models/param_table.hpp"
+#include "models/param_text.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 
-struct MemDescriptor {
-  using Settings = MemParams;
-  using Params = MemParams;
+// A model whose table stores straight into its parameter struct (all but PI); D is the model's
+// descriptor, which declares table().
+template <class D, class P>
+struct StoresParams {
+  using Settings = P;
+  using Params = P;
+  static constexpr std::string_view notes = "";  // extra help lines
+  static Params build(const Settings& s) { return s; }
+  static Settings settings_of(const Params& p) { return p; }
+  static std::string summary_of(const Params& p) { return summary_line(D::table(), p); }  // the in_summary rows
+};
+
+struct MemDescriptor : StoresParams<MemDescriptor, MemParams> {
   using Forward = MemModel;
   using Inverse = MemInverse;
   static constexpr std::string_view name = "mem";
   static constexpr std::string_view summary =
       "memory-element (Ramberg-Osgood) hysteresis, Strijbosch-Tiels-Oomen; exact inverse (Theorem 10)";
-  static constexpr std::string_view notes = "";
   static std::span<const ParamSpec<Settings>> table();
-  static Params build(const Settings& s) { return s; }
 };
 
 // PI is given either by its operators (weights, optionally thresholds) or by a size and range,
-// with weights then matched to the default MEM (pi_params_from_mem): the project's PI baseline.
+// with weights then matched to a MEM (pi_params_from_mem): the project's PI baseline.
 struct PiSettings {
-  std::size_t n = 15;  // operators
-  bool n_given = false;
-  double u_max = 250.0;            // [V] input amplitude the even thresholds span: r_i = i u_max / n
+  std::size_t count = 15;  // operators
+  bool count_given = false;
+  double range_V = 250.0;          // [V] input amplitude the even thresholds span: r_i = i range_V / count
   std::vector<double> thresholds;  // [V]
   std::vector<double> weights;     // [m/V]
+  // The MEM the baseline's weights match: the default one, or the compensator's configured one.
+  MemParams matched_to = MemParams::paper_like();
 };
 
 struct PiDescriptor {
@@ -49,27 +64,23 @@ struct PiDescriptor {
   static constexpr std::string_view summary =
       "Prandtl-Ishlinskii, play operators (Kuhnen 2003); exact inverse PI operator";
   static constexpr std::string_view notes =
-      "without weights: n plays at r_i = i*u_max/n with weights matched to the default MEM; "
-      "weights alone: even thresholds over u_max; thresholds need weights";
+      "without weights: count plays at r_i = i*range_V/count with weights matched to the default MEM; "
+      "weights alone: even thresholds over range_V; thresholds need weights";
   static std::span<const ParamSpec<Settings>> table();
   static Params build(const Settings& s);  // throws ParameterError naming the field
+  static Settings settings_of(const Params& p);
+  static std::string summary_of(const Params& p);  // "15 plays up to 233.3 V"
 };
 
-struct LinearDescriptor {
-  using Settings = LinearParams;
-  using Params = LinearParams;
+struct LinearDescriptor : StoresParams<LinearDescriptor, LinearParams> {
   using Forward = LinearModel;
   using Inverse = LinearInverse;
   static constexpr std::string_view name = "linear";
   static constexpr std::string_view summary = "linear spring y = gain*u + offset (no hysteresis)";
-  static constexpr std::string_view notes = "";
   static std::span<const ParamSpec<Settings>> table();
-  static Params build(const Settings& s) { return s; }
 };
 
-struct KatalenicDescriptor {
-  using Settings = KatalenicParams;
-  using Params = KatalenicParams;
+struct KatalenicDescriptor : StoresParams<KatalenicDescriptor, KatalenicParams> {
   using Forward = KatalenicModel;
   using Inverse = KatalenicInverse;
   static constexpr std::string_view name = "katalenic";
@@ -80,12 +91,9 @@ struct KatalenicDescriptor {
       "shaping kinds: linear (gain, offset), polynomial (coefficients c0,c1,..., domain_min/max), "
       "tanh (amplitude, scale, offset)";
   static std::span<const ParamSpec<Settings>> table();
-  static Params build(const Settings& s) { return s; }
 };
 
-struct BanningDescriptor {
-  using Settings = BanningStageParams;
-  using Params = BanningStageParams;
+struct BanningDescriptor : StoresParams<BanningDescriptor, BanningStageParams> {
   using Forward = BanningStage;
   using Inverse = void;
   static constexpr std::string_view name = "banning";
@@ -95,7 +103,6 @@ struct BanningDescriptor {
       "dynamic: u is held from the previous row's t to this row's t (t must increase); "
       "forward only (no inverse)";
   static std::span<const ParamSpec<Settings>> table();
-  static Params build(const Settings& s) { return s; }
 };
 
-}  // namespace hystloop::model_tool
+}  // namespace hystloop

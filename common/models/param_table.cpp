@@ -1,4 +1,4 @@
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -6,7 +6,7 @@
 
 #include "core/edit_distance.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 namespace {
 
 std::string_view trim(std::string_view s) {
@@ -175,4 +175,4 @@ std::string format_list(std::span<const double> v) {
   return out;
 }
 
-}  // namespace hystloop::model_tool
+}  // namespace hystloop

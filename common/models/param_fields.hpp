@@ -10,9 +10,9 @@
 #include <string>
 #include <string_view>
 
-#include "param_table.hpp"
+#include "models/param_table.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 
 template <class S, class Ref>
 ParamSpec<S> number(std::string_view name, std::string_view unit, std::string_view description, Ref,
@@ -45,4 +45,18 @@ ParamSpec<S> custom(std::string_view name, std::string_view unit, std::string_vi
   return p;
 }
 
-}  // namespace hystloop::model_tool
+// The row, named in one-line summaries (param_text.hpp: summary_line).
+template <class S>
+ParamSpec<S> summarised(ParamSpec<S> p) {
+  p.in_summary = true;
+  return p;
+}
+
+// The row, written only where `applies` says the value means something for the set.
+template <class S>
+ParamSpec<S> only_if(ParamSpec<S> p, bool (*applies)(const S&)) {
+  p.applies = applies;
+  return p;
+}
+
+}  // namespace hystloop
