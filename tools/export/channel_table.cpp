@@ -12,7 +12,6 @@
 namespace hystloop::exporter {
 
 using report::decode_checked;
-using report::has_fingerprint_of;
 
 namespace {
 
@@ -93,31 +92,7 @@ class Row {
   std::size_t index_ = 0;
 };
 
-enum class Kind { kSensor, kCommand, kTrajectory, kParams, kModel, kStatus, kControl, kUnknown };
-
-Kind kind_of(const lcm::LogEvent& e) {
-  if (has_fingerprint_of<sensor_block_t>(e)) return Kind::kSensor;
-  if (has_fingerprint_of<command_block_t>(e)) return Kind::kCommand;
-  if (has_fingerprint_of<trajectory_t>(e)) return Kind::kTrajectory;
-  if (has_fingerprint_of<mem_params_t>(e)) return Kind::kParams;
-  if (has_fingerprint_of<model_params_t>(e)) return Kind::kModel;
-  if (has_fingerprint_of<service_status_t>(e)) return Kind::kStatus;
-  if (has_fingerprint_of<control_t>(e)) return Kind::kControl;
-  return Kind::kUnknown;
-}
-
-const char* type_name(Kind kind) {
-  switch (kind) {
-    case Kind::kSensor: return "hystloop.sensor_block_t";
-    case Kind::kCommand: return "hystloop.command_block_t";
-    case Kind::kTrajectory: return "hystloop.trajectory_t";
-    case Kind::kParams: return "hystloop.mem_params_t";
-    case Kind::kModel: return "hystloop.model_params_t";
-    case Kind::kStatus: return "hystloop.service_status_t";
-    case Kind::kControl: return "hystloop.control_t";
-    default: return "unknown";
-  }
-}
+using Kind = report::MessageKind;
 
 constexpr const char* kUtime = "sender's time [us since the UNIX epoch]";
 
@@ -293,7 +268,7 @@ const Column* ChannelTable::find(const std::string& name) const noexcept {
   return nullptr;
 }
 
-std::string type_name_of(const lcm::LogEvent& event) { return type_name(kind_of(event)); }
+std::string type_name_of(const lcm::LogEvent& event) { return report::lcm_type_name(report::message_kind(event)); }
 
 struct TableBuilder::Impl {
   std::function<bool(const std::string&)> wanted;
@@ -407,8 +382,8 @@ void TableBuilder::add(const lcm::LogEvent& event) {
   if (first && impl_->wanted(event.channel)) {  // the first event decides the channel's type and columns
     Channel c;
     c.table.channel = event.channel;
-    c.kind = kind_of(event);
-    c.table.type_name = type_name(c.kind);
+    c.kind = report::message_kind(event);
+    c.table.type_name = report::lcm_type_name(c.kind);
     Impl::define(c);
     impl_->index[event.channel] = impl_->channels.size();
     impl_->channels.push_back(std::move(c));

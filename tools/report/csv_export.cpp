@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,7 +16,7 @@ namespace hystloop::report {
 
 namespace {
 
-enum class Kind { kUndecided, kSensor, kCommand, kTrajectory, kParams, kStatus, kControl, kUnknown };
+using Kind = MessageKind;
 
 std::string num(double v) {
   char buf[32];
@@ -39,28 +40,6 @@ std::string joined(const std::vector<double>& values) {
     out += num(v);
   }
   return csv_quoted(out);
-}
-
-Kind kind_of(const lcm::LogEvent& e) {
-  if (has_fingerprint_of<sensor_block_t>(e)) return Kind::kSensor;
-  if (has_fingerprint_of<command_block_t>(e)) return Kind::kCommand;
-  if (has_fingerprint_of<trajectory_t>(e)) return Kind::kTrajectory;
-  if (has_fingerprint_of<mem_params_t>(e)) return Kind::kParams;
-  if (has_fingerprint_of<service_status_t>(e)) return Kind::kStatus;
-  if (has_fingerprint_of<control_t>(e)) return Kind::kControl;
-  return Kind::kUnknown;
-}
-
-const char* type_name(Kind kind) {
-  switch (kind) {
-    case Kind::kSensor: return "hystloop.sensor_block_t";
-    case Kind::kCommand: return "hystloop.command_block_t";
-    case Kind::kTrajectory: return "hystloop.trajectory_t";
-    case Kind::kParams: return "hystloop.mem_params_t";
-    case Kind::kStatus: return "hystloop.service_status_t";
-    case Kind::kControl: return "hystloop.control_t";
-    default: return "unknown";
-  }
 }
 
 const char* header(Kind kind) {
@@ -258,7 +237,7 @@ class RowDecoder {
 
 struct ChannelWriter {
   CsvExport result;
-  Kind kind = Kind::kUndecided;
+  std::optional<Kind> kind;  // decided by the first event
   std::ofstream out;
 };
 
@@ -325,12 +304,12 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
   for_each_event(logs, [&](const lcm::LogEvent& e) {
     for (auto& w : writers) {
       if (e.channel != w->result.channel) continue;
-      if (w->kind == Kind::kUndecided) {  // the first event decides the channel's type and header
-        w->kind = kind_of(e);
-        w->result.type_name = type_name(w->kind);
-        w->out << "t_s,recv_utime_us," << header(w->kind) << '\n';
+      if (!w->kind) {  // the first event decides the channel's type and header
+        w->kind = message_kind(e);
+        w->result.type_name = lcm_type_name(*w->kind);
+        w->out << "t_s,recv_utime_us," << header(*w->kind) << '\n';
       }
-      const bool decoded = decoder.rows(w->kind, e, t0_utime, row, [&](double row_t, const std::string& fields) {
+      const bool decoded = decoder.rows(*w->kind, e, t0_utime, row, [&](double row_t, const std::string& fields) {
         if (row_t < lower_s || row_t > upper_s) return;
         w->out << num(row_t) << ',' << e.timestamp << ',' << fields << '\n';
         ++w->result.rows;
@@ -340,13 +319,13 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
   });
   std::vector<CsvExport> results;
   for (auto& w : writers) {
-    if (w->kind == Kind::kUndecided) {  // no event at all
+    if (!w->kind) {  // no event at all
       w->out << "t_s,recv_utime_us\n";
-      w->result.type_name = type_name(Kind::kUndecided);
+      w->result.type_name = lcm_type_name(Kind::kUnknown);
     }
     w->out.close();
     if (!w->out) throw std::runtime_error(w->result.file.string() + ": write failed");
-    write_legend(w->result, w->kind == Kind::kUndecided ? std::string() : header(w->kind));
+    write_legend(w->result, w->kind ? header(*w->kind) : std::string());
     results.push_back(w->result);
   }
   return results;
