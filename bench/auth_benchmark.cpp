@@ -1,6 +1,6 @@
 // The cost of the authenticated rig per message (README "Authenticated rig"): the trailer's
-// HMAC-SHA-512-256 signed and checked for a 20-tick command block (one per sensor block, 500/s),
-// a 20-tick sensor block (the bridge signs 500 a second at the default bridge.block_ticks) and a
+// HMAC-SHA-512-256 signed and checked for a 20-tick command block (one per sensor block), a 20-tick
+// sensor block (500 a second at the former default bridge.block_ticks; 200 of 50 ticks now) and a
 // MEM parameter set, beside the LCM encode they follow. Time per message; the
 // verifier's figure includes its replay table.
 #include <benchmark/benchmark.h>

@@ -30,7 +30,7 @@ struct BridgeSettings {
   ComediSettings comedi{};       // the comedi.* keys (used when backend is comedi)
   ActuatorLimits limits{};
   FeedbackGains servo{};  // the servo on y_ref - y (all gains 0 = feedforward only)
-  int block_ticks = 20;   // ticks per HX_SENSOR block: 500 messages/s (1 = a message per tick)
+  int block_ticks = 50;   // ticks per HX_SENSOR block: 200 messages/s (1 = a message per tick)
   RtSettings rt{};
   bool auto_arm = false;                 // arm as soon as commands flow (first arm only)
   double rearm_after_trip_s = 0.0;       // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)

@@ -44,9 +44,9 @@ TEST(BridgeSettings, DefaultsWithoutAConfig) {
   EXPECT_EQ(s.stage.banning.hysteresis.a, 8.58e-9);  // Table 1
   EXPECT_EQ(s.stage.banning.stage.k, 1.17e8);        // Table 2
   EXPECT_FALSE(s.auto_arm);
-  // Blocks of 20 ticks (500 HX_SENSOR messages a second); the clock wakes every tick; LCM queues
+  // Blocks of 50 ticks (200 HX_SENSOR messages a second); the clock wakes every tick; LCM queues
   // 256 command blocks.
-  EXPECT_EQ(s.block_ticks, 20);
+  EXPECT_EQ(s.block_ticks, 50);
   EXPECT_EQ(s.rt.ticks_per_wake, 1);
   EXPECT_EQ(s.command_queue_capacity, 256);
   // Without a config the servo is off (feedforward only); its anti-windup limit is the range.
@@ -93,7 +93,7 @@ TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
   const BridgeSettings s = load_bridge_settings(c);
   EXPECT_EQ(s.limits.slew_V_per_s, 5e4);
   EXPECT_EQ(s.limits.watchdog_s, 2e-3);
-  EXPECT_EQ(s.block_ticks, 20);
+  EXPECT_EQ(s.block_ticks, 50);
   EXPECT_GE(s.rt.ticks_per_wake, 1);
   EXPECT_LE(s.rt.ticks_per_wake, s.block_ticks);
   EXPECT_EQ(s.command_queue_capacity, 256);
@@ -128,7 +128,7 @@ TEST(BridgeSettings, EveryDeployedBridgeConfigLoads) {
   EXPECT_EQ(demo.servo.kp, 0.1);
   EXPECT_EQ(demo.servo.ki, 600.0);
   EXPECT_EQ(demo.servo.nominal_gain_m_per_V, 6.3e-9);
-  EXPECT_EQ(demo.block_ticks, 20);
+  EXPECT_EQ(demo.block_ticks, 50);
   EXPECT_LE(demo.rt.ticks_per_wake, demo.block_ticks);
   EXPECT_TRUE(demo.rt.lock_memory);
   EXPECT_NO_THROW(load_bridge_settings(Config::load_file(kConfigDir + "banning/bridge.yaml")));
@@ -162,7 +162,7 @@ TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("bridge: {command_queue_capacity: 100001}"), "bridge.command_queue_capacity"));
   EXPECT_TRUE(contains(refusal("rt: {ticks_per_wake: 0}"), "bridge.yaml: rt.ticks_per_wake"));
   // A block is published when its last tick has run: a wake-up may not run past it.
-  const std::string too_many = refusal("rt: {ticks_per_wake: 21}");
+  const std::string too_many = refusal("rt: {ticks_per_wake: 51}");  // one more than the default block
   EXPECT_TRUE(contains(too_many, "bridge.yaml: rt.ticks_per_wake")) << too_many;
   EXPECT_TRUE(contains(too_many, "bridge.block_ticks")) << too_many;
   EXPECT_TRUE(contains(refusal("bridge: {block_ticks: 4}\nrt: {ticks_per_wake: 5}"), "rt.ticks_per_wake"));
