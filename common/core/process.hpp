@@ -12,6 +12,7 @@
 // from the terminal with a second Ctrl-C.
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -67,5 +68,12 @@ ResourceUsage read_resource_usage() noexcept;
 
 // The host name (for HX_STATUS), "unknown" if it cannot be read.
 std::string host_name();
+
+// Runs `exe args...` with `dir` as its working directory, its standard output silenced and its
+// standard error into `stderr_file` (relative to dir), and waits for it (the tools' gnuplot).
+// Its exit status; -1 when it could not run or did not exit. What this process has buffered is
+// flushed first: the child's freopen would write it a second time.
+int run_program_in(const std::filesystem::path& dir, const std::filesystem::path& exe,
+                   const std::vector<std::string>& args, const char* stderr_file = "/dev/null");
 
 }  // namespace hystloop

@@ -1,8 +1,5 @@
 #include "fit_plots.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -12,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/process.hpp"
 #include "plots.hpp"  // tools/report: find_executable
 
 namespace hystloop {
@@ -34,33 +32,6 @@ std::string short_num(double v) {
 }
 
 std::string model_name(ModelKind kind) { return std::string(to_string(kind)); }
-
-// Runs `exe args...` in `dir`, stdout silenced and stderr into dir/log_name; its exit status, -1
-// when it could not run.
-int run_in(const fs::path& dir, const fs::path& exe, std::vector<std::string> args, const char* log_name) {
-  std::vector<char*> argv;
-  std::string program = exe.string();
-  argv.push_back(program.data());
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  // The child's freopen would write what this process has buffered a second time.
-  std::cout.flush();
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    if (std::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(126);
-    if (std::freopen(log_name, "w", stderr) == nullptr) ::_exit(126);
-    ::execv(program.c_str(), argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 void write_curve(const fs::path& path, const SampleTable& s, const FitCurve& c, std::size_t stride) {
   std::ofstream out(path);
@@ -201,10 +172,10 @@ FitPlotFiles write_fit_plots(const SampleTable& s, const FitPlotInput& in, const
     return result;
   }
   for (const std::string terminal : {"pngcairo", "png"}) {
-    if (run_in(dir, exe, {"-e", "set terminal " + terminal}, "/dev/null") != 0) continue;  // not built in
+    if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}, "/dev/null") != 0) continue;  // not built in
     write_script(terminal);
     for (const auto& image : images) fs::remove(dir / image);
-    const int rc = run_in(dir, exe, {"plots.gp"}, "gnuplot.log");
+    const int rc = run_program_in(dir, exe, {"plots.gp"}, "gnuplot.log");
     result.terminal = terminal;
     for (const auto& image : images) {
       if (fs::exists(dir / image)) result.images.push_back(dir / image);

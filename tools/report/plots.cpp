@@ -1,6 +1,5 @@
 #include "plots.hpp"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <stdexcept>
 
 #include "convergence_plot.hpp"
+#include "core/process.hpp"
 #include "model_overlay.hpp"
 #include "plot_series.hpp"
 
@@ -31,32 +31,6 @@ std::ofstream open_for_writing(const std::filesystem::path& path) {
 void close_checked(std::ofstream& out, const std::filesystem::path& path) {
   out.close();
   if (!out) throw std::runtime_error(path.string() + ": write failed");
-}
-
-// Runs `gnuplot args...` with `dir` as working directory, output silenced; returns its exit status.
-// gnuplot's own messages go to `log_name` in dir.
-int run_in(const std::filesystem::path& dir, const std::filesystem::path& exe, const std::vector<std::string>& args,
-           const char* log_name = "/dev/null") {
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    if (std::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(126);
-    if (std::freopen(log_name, "w", stderr) == nullptr) ::_exit(126);
-    std::vector<char*> argv;
-    std::string program = exe.string();
-    argv.push_back(program.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(program.c_str(), argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 struct Histogram {
@@ -276,11 +250,11 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     return result;
   }
   for (const std::string terminal : {"pngcairo", "png"}) {
-    if (run_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // terminal not built in
+    if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // terminal not built in
     write_script(terminal);
     for (const auto& image : images) std::filesystem::remove(dir / image);
     if (options.progress) options.progress("rendering " + std::to_string(images.size()) + " plots with gnuplot");
-    const int rc = run_in(dir, exe, {"plots.gp"}, "gnuplot.log");
+    const int rc = run_program_in(dir, exe, {"plots.gp"}, "gnuplot.log");
     result.terminal = terminal;
     for (const auto& image : images) {
       if (std::filesystem::exists(dir / image)) result.images.push_back(dir / image);

@@ -1,8 +1,5 @@
 #include "scan_output.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -13,6 +10,8 @@
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
+
+#include "core/process.hpp"
 
 namespace hystloop::report {
 
@@ -86,33 +85,6 @@ std::string fmt_num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
-}
-
-// gnuplot in `dir` (its messages into log_name there), as plots.cpp runs it.
-int run_gnuplot(const std::filesystem::path& dir, const std::filesystem::path& exe,
-                const std::vector<std::string>& args, const char* log_name = "/dev/null") {
-  // The child's freopen would flush a copy of what the parent has buffered: print it once.
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    if (std::freopen("/dev/null", "w", stdout) == nullptr) ::_exit(126);
-    if (std::freopen(log_name, "w", stderr) == nullptr) ::_exit(126);
-    std::string program = exe.string();
-    std::vector<std::string> copy = args;
-    std::vector<char*> argv{program.data()};
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(program.c_str(), argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 // One segment's error for the plot: the ticks' min and max per bucket (the envelope survives
@@ -387,10 +359,10 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
     return result;
   }
   for (const std::string terminal : {"pngcairo", "png"}) {
-    if (run_gnuplot(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // not built in
+    if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // not built in
     write_script(terminal);
     for (const auto& image : images) std::filesystem::remove(dir / image);
-    const int rc = run_gnuplot(dir, exe, {"scan.gp"}, "scan_gnuplot.log");
+    const int rc = run_program_in(dir, exe, {"scan.gp"}, "scan_gnuplot.log");
     result.terminal = terminal;
     for (const auto& image : images) {
       if (std::filesystem::exists(dir / image)) result.images.push_back(dir / image);
