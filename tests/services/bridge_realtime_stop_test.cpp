@@ -150,12 +150,16 @@ TEST(BridgeRealtimeStop, GivesUpAfterTheTimeoutAndStillHoldsSafe) {
   Record record;
   auto rt = drive_to(s, record, 200.0);
   const auto t0 = std::chrono::steady_clock::now();
+  rt->begin_safe_stop();
+  // Given up while ramping: a thread starved by a busy machine may not step within the 50 ms, so
+  // the stop is waited for once the ramp has begun, not at a fixed time.
+  ASSERT_TRUE(eventually([&] { return record.last_u_V.load() < 200.0; })) << "the ramp never began";
   const SafeStopResult r = rt->stop();
   const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(r.requested);
   EXPECT_FALSE(r.reached);
   EXPECT_GE(waited_s, 0.05);
-  EXPECT_LT(waited_s, 1.0);
+  EXPECT_LT(waited_s, 10.0);  // gave up: the whole ramp takes 20 s
   EXPECT_GE(r.wall_s, 0.05);
   EXPECT_GT(r.ramp_ticks, 0);
   EXPECT_LT(record.u_V.back(), 200.0);  // it was ramping
