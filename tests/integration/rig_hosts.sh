@@ -103,11 +103,11 @@ hy() {  # host, rig file, deploy/hystloop arguments...
 }
 
 # --- phase 1: the demo's scenario across the hosts -----------------------------------------
+mkdir -p "$out/desk"  # before the recorder starts: it opens its files there at once
 nsenter -t "${holder[desk]}" -n -u -- "$probe" --url "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304" --prefix "$prefix" \
   record --dir "$out/desk" --seconds 900 --rt-priority 10 >"$out/desk-record.txt" 2>&1 &
 recorder=$!  # the probe itself (nsenter execs it): SIGTERM ends the recording
-mkdir -p "$out/desk"
-for _ in $(seq 250); do [ -e "$out/desk/recording" ] && break; sleep 0.02; done
+wait_until 20 "the desk's recorder started ($out/desk-record.txt)" test -e "$out/desk/recording"
 LOG_DIR="$out/log1" hy stage "$out/rig.yaml" up || die "up --host stage"
 hy control "$out/rig.yaml" up || die "up --host control"
 hy desk "$out/rig.yaml" status || die "status does not show every service on its host"
