@@ -18,6 +18,7 @@
 #include "core/errors.hpp"
 #include "core/periodic_timer.hpp"
 #include "models/gain_plausibility.hpp"
+#include "models/model_descriptors.hpp"
 #include "runtime/model_params_message.hpp"
 
 namespace hystloop {
@@ -116,15 +117,14 @@ void CompensatorService::on_model(const model_params_t& msg) {
 }
 
 std::string describe_model(const ModelParamSet& set) {
+  std::string summary = "?";
   switch (set.kind) {
-    case ModelKind::mem: return fmt::format("MEM c1 {:.6g}, c2 {:.6g}, c3 {:.6g}", set.mem.c1, set.mem.c2, set.mem.c3);
-    case ModelKind::pi:
-      return fmt::format("PI, {} operators to {:.4g} V, w0 {:.6g}", set.pi.count,
-                         set.pi.count > 0 ? set.pi.thresholds[set.pi.count - 1] : 0.0, set.pi.weights[0]);
-    case ModelKind::katalenic: return fmt::format("Katalenic k1 {:.6g}, k2 {:.6g}", set.katalenic.k1, set.katalenic.k2);
-    case ModelKind::linear: return fmt::format("linear gain {:.6g}, offset {:.4g}", set.linear.gain, set.linear.offset);
+    case ModelKind::mem: summary = MemDescriptor::summary_of(set.mem); break;
+    case ModelKind::pi: summary = PiDescriptor::summary_of(set.pi); break;
+    case ModelKind::katalenic: summary = KatalenicDescriptor::summary_of(set.katalenic); break;
+    case ModelKind::linear: summary = LinearDescriptor::summary_of(set.linear); break;
   }
-  return "unknown";
+  return std::string(to_string(set.kind)) + ": " + summary;
 }
 
 }  // namespace hystloop

@@ -87,7 +87,8 @@ struct CompensatorServiceCounters {
   // block) and sensor_jumps (confirmed jumps ahead).
 };
 
-// "MEM c1 .., c2 .., c3 ..", "PI, 15 operators to 247 V, w0 ..", ... for log lines and HX_STATUS.
+// "mem: c1 5.3e-09 m/V, c2 2.1e-12 m/V^(1+c3), c3 1.15", "pi: 15 plays up to 233.3 V", ...: as the
+// start-up summary names the set (its model's summary_of), for the log lines of accepted sets.
 std::string describe_model(const ModelParamSet& set);
 
 class CompensatorService {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "compensator/compensator_service.hpp"
 #include "compensator/compensator_settings.hpp"
 #include "models/model_descriptors.hpp"
 
@@ -135,6 +136,29 @@ TEST(CompensatorModelSections, ASnippetTheTablesWriteLoadsUnchanged) {
   const std::vector<std::string> lines = describe(s);
   EXPECT_NE(std::find(lines.begin(), lines.end(), "mem: c1 5.3e-09 m/V, c2 2.1e-12 m/V^(1+c3), c3 1.15"), lines.end());
   EXPECT_NE(std::find(lines.begin(), lines.end(), "pi: 3 plays up to 160 V"), lines.end());
+}
+
+// A set accepted or swapped in is logged as the start-up summary names its model: one text per
+// model, from its table, so a parameter added to a table shows in both.
+TEST(CompensatorModelSections, ASetIsLoggedAsTheStartUpSummaryNamesIt) {
+  const CompensatorSettings s = load_compensator_settings(Config::load_file(kConfig));
+  const std::vector<std::string> lines = describe(s);
+  for (int i = 0; i < kModelKindCount; ++i) {
+    ModelParamSet set;
+    set.kind = static_cast<ModelKind>(i);
+    set.mem = s.control.mem;
+    set.pi = s.control.pi;
+    set.katalenic = s.control.katalenic;
+    set.linear = s.control.linear;
+    EXPECT_NE(std::find(lines.begin(), lines.end(), describe_model(set)), lines.end()) << describe_model(set);
+  }
+  ModelParamSet mem;
+  mem.mem = MemParams{5.3e-9, 2.1e-12, 1.15};
+  EXPECT_EQ(describe_model(mem), "mem: c1 5.3e-09 m/V, c2 2.1e-12 m/V^(1+c3), c3 1.15");
+  ModelParamSet pi;
+  pi.kind = ModelKind::pi;
+  pi.pi = PiParams::with_even_thresholds(3, 240.0);
+  EXPECT_EQ(describe_model(pi), "pi: 3 plays up to 160 V");
 }
 
 }  // namespace
