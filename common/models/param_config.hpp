@@ -35,6 +35,17 @@ std::vector<Assignment> config_section(const Config& config, std::string_view mo
   return out;
 }
 
+// D's (model_descriptors.hpp) section onto `settings` (the defaults), built and validated. Throws
+// ParameterError naming the field below the section ("c1", an unknown one too): run it in
+// validate_config_section(config, "<model>.", ...) for a ConfigError naming the key.
+template <class D>
+typename D::Params params_from_config(const Config& config, typename D::Settings settings) {
+  apply(D::table(), D::name, config_section(config, D::name, D::table()), settings);
+  typename D::Params params = D::build(settings);
+  params.validate();
+  return params;
+}
+
 // "<model>.<name>" for every row and alias of the table: the keys a config may hold.
 template <class S>
 void append_config_keys(std::vector<std::string>& keys, std::string_view model, std::span<const ParamSpec<S>> table) {

@@ -11,6 +11,7 @@
 #include "core/config.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
+#include "models/model_descriptors.hpp"
 #include "reidentifier/reident_options.hpp"
 #include "reidentifier/reident_service.hpp"
 #include "runtime/service_main.hpp"
@@ -22,11 +23,11 @@ int main(int argc, char** argv) try {
       "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
       "to the online MEM estimator, refits every reidentifier.refit_period_s on a worker thread, and publishes\n"
       "on <rig>PARAMS only candidates that pass validation (signs, ranges, residual, a held-out branch\n"
-      "better than the set in use), with their held-out residual. The initial set in use is mem.c1/c2/c3\n"
+      "better than the set in use), with their held-out residual. The initial set in use is the mem section\n"
       "(the compensator's keys, version 1); a newer valid set published by anyone else on <rig>PARAMS\n"
       "replaces it, and new versions are numbered above every one seen there or applied by the\n"
       "compensator on <rig>COMMAND. Status on <rig>STATUS\n"
-      "(process \"reidentifier\") at 1 Hz. Configuration keys: mem.{c1,c2,c3}, reidentifier.{rate_hz, refit_period_s,\n"
+      "(process \"reidentifier\") at 1 Hz. Configuration keys: mem.*, reidentifier.{rate_hz, refit_period_s,\n"
       "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
       "max_solver_time_s, reversal_dead_band_V, publish_invalid, stale_after_s, degraded_after_poisoned,\n"
       "lcm_queue, models, model_margin, model_period_s, model_decimation, pin_model}\n"
@@ -58,8 +59,7 @@ int main(int argc, char** argv) try {
     const ChannelNames names(service.rig_prefix);
     const OnlineMemOptions& e = options.estimator;
     spdlog::info("lcm: url {}, rig {}", url, names.prefix);
-    spdlog::info("mem: c1 {:.9g} m/V, c2 {:.9g} m/V^(1+c3), c3 {:.9g} (initial set in use, version 1)",
-                 options.initial.c1, options.initial.c2, options.initial.c3);
+    spdlog::info("mem: {} (initial set in use, version 1)", MemDescriptor::summary_of(options.initial));
     spdlog::info(
         "reidentifier: rate_hz {}, refit_period_s {}, window_s {} ({} samples), capacity_s {} ({} samples), "
         "holdout_branches {}, min_relative_improvement {}, max_residual_rms_m {:.3g}, max_solver_time_s {}, "

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "models/model_descriptors.hpp"
+#include "models/param_config.hpp"
 #include "runtime/config_validation.hpp"
 
 namespace hystloop {
@@ -109,11 +111,8 @@ ReidentOptions read_reident_options(const Config& config) {
   config.check_no_unknown_keys(known);
 
   ReidentOptions o;
-  const MemParams d = MemParams::paper_like();
-  o.initial.c1 = config.get_positive("mem.c1", d.c1);
-  o.initial.c2 = config.get_non_negative("mem.c2", d.c2);
-  o.initial.c3 = config.get_positive("mem.c3", d.c3);
-  validate_config_section(config, "mem.", [&] { o.initial.validate(); });
+  validate_config_section(config, "mem.",
+                          [&] { o.initial = params_from_config<MemDescriptor>(config, MemParams::paper_like()); });
   read_plausibility(config, o);
 
   o.rate_hz = config.get_in_range("reidentifier.rate_hz", o.rate_hz, 1.0, 1e6);

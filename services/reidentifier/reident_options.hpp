@@ -7,9 +7,9 @@
 
 namespace hystloop {
 
-// Reads and checks mem.{c1,c2,c3}, stage.* and reidentifier.*. Unknown reidentifier.* keys (and the old section
-// reident:) are refused ("did you mean"); other sections belong to the processes sharing the file (the compensator
-// checks the rest of mem.*). Throws ConfigError naming the field.
+// Reads and checks mem.* (the MEM's parameter table: the compensator's keys), stage.* and reidentifier.*. Unknown
+// reidentifier.* and mem.* keys (and the old section reident:) are refused ("did you mean"); other sections belong
+// to the processes sharing the file. Throws ConfigError naming the field.
 ReidentOptions read_reident_options(const Config& config);
 
 }  // namespace hystloop

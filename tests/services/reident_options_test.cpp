@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "models/model_descriptors.hpp"
+
 namespace hystloop {
 namespace {
 
@@ -69,6 +71,26 @@ TEST(ReidentOptions, RefusalsNameTheField) {
   const std::string typo = refusal("reidentifier: {refit_period: 2}");
   EXPECT_NE(typo.find("reidentifier.refit_period: unknown key"), std::string::npos) << typo;
   EXPECT_NE(typo.find("reidentifier.refit_period_s"), std::string::npos) << typo;
+}
+
+// mem: is read through the MEM's parameter table, as the compensator reads it: every key (and
+// alias) of the table is taken, anything else under mem: is refused naming the key.
+TEST(ReidentOptions, TheMemSectionIsTheTables) {
+  const MemParams d = MemParams::paper_like();
+  for (const auto& row : MemDescriptor::table()) {
+    for (const std::string_view name : {row.name, row.alias}) {
+      if (name.empty()) continue;
+      const std::string yaml = "mem: {" + std::string(name) + ": " + row.show(d) + "}\n";
+      EXPECT_EQ(refusal(yaml), "accepted") << yaml;
+    }
+  }
+  const std::string unknown = refusal("mem: {c4: 1.0e-9}");
+  EXPECT_NE(unknown.find("r.yaml: mem.c4: unknown parameter 'c4' of model mem"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("(valid: c1, c2, c3)"), std::string::npos) << unknown;
+  const std::string malformed = refusal("mem: {c1: 5e-9x}");
+  EXPECT_NE(malformed.find("r.yaml: mem.c1: expected a number, got '5e-9x'"), std::string::npos) << malformed;
+  EXPECT_DOUBLE_EQ(read_reident_options(Config::from_string("mem: {c2: 3.0e-12}\n")).initial.c2, 3.0e-12);
+  EXPECT_DOUBLE_EQ(read_reident_options(Config::from_string("mem: {c2: 3.0e-12}\n")).initial.c1, d.c1);
 }
 
 TEST(ReidentOptions, TheDeployedDefaultsLoad) {
