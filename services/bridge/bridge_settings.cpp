@@ -8,6 +8,8 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "loop/command_buffer.hpp"
+#include "models/model_descriptors.hpp"
+#include "models/param_config.hpp"
 #include "runtime/config_validation.hpp"
 #include "runtime/rig_auth_config.hpp"
 
@@ -45,19 +47,13 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "rt.io_priority",
                                                 "rt.lock_memory",
                                                 "rt.cpu",
-                                                "banning.hysteresis.a",
-                                                "banning.hysteresis.b",
-                                                "banning.hysteresis.alpha",
-                                                "banning.hysteresis.s_max",
-                                                "banning.stage.k",
-                                                "banning.stage.c",
-                                                "banning.order",
                                                 "ro.c1",
                                                 "ro.c2",
                                                 "ro.c3"};
   static const std::vector<std::string> all = [] {
     std::vector<std::string> k = keys;
     k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
+    append_config_keys(k, BanningDescriptor::name, BanningDescriptor::table());  // the simulated stage
     return k;
   }();
   return all;
@@ -90,25 +86,12 @@ BridgeSettings load_bridge_settings(const Config& config) {
   st.drift_fraction = config.get_in_range("bridge.drift_fraction", st.drift_fraction, -0.5, 1.0);
   st.drift_start_s = config.get_non_negative("bridge.drift_start_s", st.drift_start_s);
   st.drift_duration_s = config.get_positive("bridge.drift_duration_s", st.drift_duration_s);
-  auto& h = st.banning.hysteresis;
-  h.a = config.get_positive("banning.hysteresis.a", h.a);
-  h.b = config.get_positive("banning.hysteresis.b", h.b);
-  h.alpha = config.get_positive("banning.hysteresis.alpha", h.alpha);
-  h.s_max = config.get_positive("banning.hysteresis.s_max", h.s_max);
-  st.banning.stage.k = config.get_positive("banning.stage.k", st.banning.stage.k);
-  st.banning.stage.c = config.get_positive("banning.stage.c", st.banning.stage.c);
-  const std::string order = config.get<std::string>("banning.order", "hysteresis_then_stage");
-  if (order == "hysteresis_then_stage") {
-    st.banning.order = BanningOrder::kHysteresisThenStage;
-  } else if (order == "stage_then_hysteresis") {
-    st.banning.order = BanningOrder::kStageThenHysteresis;
-  } else {
-    config.fail("banning.order", "must be hysteresis_then_stage or stage_then_hysteresis (got '" + order + "')");
-  }
+  // The keys hystloop-identify --model banning writes, through the same table.
+  validate_config_section(config, "banning.",
+                          [&] { st.banning = params_from_config<BanningDescriptor>(config, st.banning); });
   st.ramberg_osgood.c1 = config.get_positive("ro.c1", st.ramberg_osgood.c1);
   st.ramberg_osgood.c2 = config.get_non_negative("ro.c2", st.ramberg_osgood.c2);
   st.ramberg_osgood.c3 = config.get_positive("ro.c3", st.ramberg_osgood.c3);
-  validate_config_section(config, "banning.", [&] { st.banning.validate(); });
   validate_config_section(config, "ro.", [&] { st.ramberg_osgood.validate(); });
   validate_config_section(config, "", [&] { st.validate(); });
 
@@ -161,7 +144,6 @@ BridgeSettings load_bridge_settings(const Config& config) {
 
 std::vector<std::string> describe(const BridgeSettings& s) {
   const auto& st = s.stage;
-  const auto& h = st.banning.hysteresis;
   const auto& a = s.limits;
   std::vector<std::string> lines;
   lines.push_back(fmt::format(
@@ -177,8 +159,7 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   if (s.backend == "comedi") {
     lines.push_back(describe(s.comedi));
   } else if (s.backend == "sim") {
-    lines.push_back(fmt::format("banning: a {} m/V, b {} m/V, alpha {} 1/V, s_max {} V, k {} 1/s^2, c {} 1/s", h.a, h.b,
-                                h.alpha, h.s_max, st.banning.stage.k, st.banning.stage.c));
+    lines.push_back("banning: " + BanningDescriptor::summary_of(st.banning));
   } else {
     lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
                                 st.ramberg_osgood.c3));

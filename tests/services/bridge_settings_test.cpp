@@ -14,6 +14,7 @@
 #include "bridge/rt_report.hpp"
 #include "core/send_time_ring.hpp"
 #include "bridge/stage_backend.hpp"
+#include "models/model_descriptors.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
@@ -147,6 +148,38 @@ TEST(BridgeSettings, RefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("rt: {priority: 50, io_priority: 50}"), "rt.io_priority"));
   EXPECT_TRUE(contains(refusal("actuator: {watchdog: 0.1}"), "did you mean 'actuator.watchdog_s'"));
   EXPECT_EQ(refusal("bridge: {backend: ro, drift_fraction: 0.1}\nrt: {priority: 80, io_priority: 70}"), "accepted");
+}
+
+// The simulated stage's banning: section is read through BanningDescriptor's table, the one
+// hystloop-identify --model banning writes its YAML from: every key of the table is a config key
+// and is taken, a section the table writes loads unchanged, a refusal names the key, and the
+// start-up line is the table's summary.
+TEST(BridgeSettings, TheBanningSectionIsTheTables) {
+  const std::vector<std::string>& keys = bridge_config_keys();
+  const BanningStageParams d = load_bridge_settings(Config()).stage.banning;
+  for (const auto& row : BanningDescriptor::table()) {
+    const std::string key = "banning." + std::string(row.name);
+    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
+    Config config;
+    config.apply_override(key + "=" + row.show(d));
+    EXPECT_NO_THROW(load_bridge_settings(config)) << key;
+  }
+  BanningStageParams p = d;
+  p.hysteresis.alpha = 1.2345678901234567e-3;
+  p.stage.c = 2.5e3;
+  p.order = BanningOrder::kStageThenHysteresis;
+  const std::string yaml = yaml_section(BanningDescriptor::name, BanningDescriptor::table(), p);
+  const BridgeSettings s = load_bridge_settings(Config::from_string(yaml, "banning.yaml"));
+  EXPECT_EQ(yaml_section(BanningDescriptor::name, BanningDescriptor::table(), s.stage.banning), yaml);
+  const std::vector<std::string> lines = describe(s);
+  EXPECT_NE(std::find(lines.begin(), lines.end(), "banning: " + BanningDescriptor::summary_of(p)), lines.end());
+  EXPECT_TRUE(contains(BanningDescriptor::summary_of(p), "hysteresis.alpha 0.00123457 1/V"));
+  EXPECT_TRUE(contains(refusal("banning: {hysteresis: {a: 8.58e-9x}}"),
+                       "bridge.yaml: banning.hysteresis.a: expected a number, got '8.58e-9x'"));
+  EXPECT_TRUE(contains(refusal("banning: {order: sideways}"),
+                       "bridge.yaml: banning.order: expected one of hysteresis_then_stage|stage_then_hysteresis"));
+  EXPECT_TRUE(contains(refusal("banning: {stage: {k: -1}}"), "bridge.yaml: banning.stage.k: must be > 0"));
+  EXPECT_TRUE(contains(refusal("banning: {stage: {m: 1}}"), "banning.stage.m"));
 }
 
 TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
