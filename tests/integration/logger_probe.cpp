@@ -195,14 +195,20 @@ int check_log(const Options& o) {
     }
     std::int64_t last_eventnum = -1;
     std::int64_t last_timestamp = 0;
+    std::string last_channel;
     std::size_t events_in_file = 0;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       ++events_in_file;
       if (ev->eventnum <= last_eventnum)
         fail(file + ": event numbers not increasing at " + std::to_string(ev->eventnum));
-      if (ev->timestamp < last_timestamp) fail(file + ": timestamp goes back at event " + std::to_string(ev->eventnum));
+      if (ev->timestamp < last_timestamp) {
+        fail(file + ": timestamp goes back at event " + std::to_string(ev->eventnum) + " (" + ev->channel + ", " +
+             std::to_string(ev->timestamp) + " us after " + last_channel + " at " + std::to_string(last_timestamp) +
+             " us)");
+      }
       last_eventnum = ev->eventnum;
       last_timestamp = ev->timestamp;
+      last_channel = ev->channel;
       bool ours = false;
       for (const std::string* n : names) ours = ours || ev->channel == *n;
       if (!ours) continue;
