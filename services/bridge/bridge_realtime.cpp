@@ -116,16 +116,15 @@ void BridgeRealtime::run() noexcept {
     }
     const std::int64_t end = catch_up ? std::min(due, next + 2 * per_wake) : due;
     if (end - next > per_wake) ticks_caught_up_ += static_cast<std::uint64_t>(end - next - per_wake);
-    for (std::int64_t k = next; k < end; ++k) tick(k, k == next ? skipped : 0);
+    std::int64_t start_ns = info.wake_ns;  // the work of a wake-up's first tick counts from the wake-up
+    for (std::int64_t k = next; k < end; ++k) start_ns = tick(k, k == next ? skipped : 0, start_ns);
     next = end;
     RtReport& report = reports_.current();
     report.lateness.add(info.lateness_ns);
   }
 }
 
-void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
-  const std::int64_t start_ns = monotonic_ns();
-
+std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t start_ns) noexcept {
   if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
     stop_u_start_V_ = core_.last_applied_V();
     arming_.stop(core_);  // from this tick the core ramps to the safe voltage and is never armed again
@@ -179,7 +178,8 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
   if (reached_now) safe_reached_.store(true, std::memory_order_release);
 
   RtReport& report = reports_.current();
-  report.work.add(monotonic_ns() - start_ns);
+  const std::int64_t end_ns = monotonic_ns();
+  report.work.add(end_ns - start_ns);
   reports_.serve_request([&](RtReport& r) {
     r.core = core_.counters();
     r.ticks_skipped = ticks_skipped_;
@@ -198,6 +198,7 @@ void BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped) noexcept {
     r.armed = core_.armed();
     min_depth_period_ = -1;
   });
+  return end_ns;  // a status period's hand-over above counts in the next tick's work (once a second)
 }
 
 }  // namespace hystloop

@@ -36,7 +36,7 @@ struct RtReport {
   double gain_scale = 1.0;
   bool armed = false;
   // This report period's windows.
-  LatencyStats work;      // RT work per tick (wake to sample pushed) [ns]
+  LatencyStats work;      // RT work per tick (wake-up or the tick before's end, to sample pushed) [ns]
   LatencyStats lateness;  // timer wake-up lateness [ns]
 };
 
