@@ -42,7 +42,7 @@ struct ScanOptions {
   // deploy/hystloop scan asks (scan.yaml if_infeasible: shape); false: refused.
   bool shape_if_infeasible = true;
   double servo_slew_reserve = CompensatorConfig{}.servo_slew_reserve;  // of the slew limit, kept for the servo
-  int block_ticks = LoopSimulationConfig{}.block_ticks;  // samples per sensor block
+  int block_ticks = LoopSimulationConfig{}.block_ticks;                // samples per sensor block
   int settle_periods = 20;     // the error is measured after these whole periods ...
   int measure_periods = 10;    // ... over these
   double min_measure_s = 0.2;  // at least this long (more periods at high rates)

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <string>
 
 namespace hystloop {
@@ -17,7 +18,7 @@ TEST(LogLimiter, OneLinePerReasonPerIntervalThenSaysHowManyWereSuppressed) {
   EXPECT_TRUE(first);
   EXPECT_EQ(first.suppressed, 0u);
   EXPECT_EQ(suppressed_note(first), "");
-  for (int i = 1; i <= 999; ++i) EXPECT_FALSE(limiter.allow(0, 5 * kSecond + i * 1'000'000)) << i;
+  for (int i = 1; i <= 999; ++i) EXPECT_FALSE(limiter.allow(0, 5 * kSecond + std::int64_t{i} * 1'000'000)) << i;
   EXPECT_TRUE(limiter.allow(1, 5 * kSecond + 500'000'000));  // another reason has its own budget
   const LogLimiter::Gate resumed = limiter.allow(0, 6 * kSecond);
   ASSERT_TRUE(resumed);

@@ -209,9 +209,11 @@ int check_log(const Options& o) {
       for (const std::string* n : names) ours = ours || ev->channel == *n;
       if (!ours) continue;
       if (ev->timestamp < last_timestamp) {
-        fail(file + ": timestamp goes back at event " + std::to_string(ev->eventnum) + " (" + ev->channel + ", " +
-             std::to_string(ev->timestamp) + " us after " + last_channel + " at " + std::to_string(last_timestamp) +
-             " us)");
+        std::string what = file;
+        what += ": timestamp goes back at event " + std::to_string(ev->eventnum);
+        what += " (" + ev->channel + ", " + std::to_string(ev->timestamp) + " us after ";
+        what += last_channel + " at " + std::to_string(last_timestamp) + " us)";
+        fail(what);
       }
       last_timestamp = ev->timestamp;
       last_channel = ev->channel;

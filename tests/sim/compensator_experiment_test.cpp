@@ -236,7 +236,7 @@ TEST(CompensatorExperiment, TrackingThroughTheLoopAfterAnExperimentStartsFromWhe
   EXPECT_FALSE(sim.compensator().experiment_running());
   const TrackingStats s = sim.tracking(2.0, 5.0);
   ASSERT_GT(s.n, 20000u);
-  EXPECT_LT(s.rms_true_m, 1e-11);                // rounding; a virgin-skeleton start would be off by nanometres
+  EXPECT_LT(s.rms_true_m, 1e-11);  // rounding; a virgin-skeleton start would be off by nanometres
   // The bridge arms at the first plan (as its auto_arm does), so no tick waits on a command.
   EXPECT_EQ(sim.bridge().counters().late, 0u);
 }

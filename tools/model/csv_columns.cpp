@@ -91,9 +91,11 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
         index[c] = found;
       }
       if (!missing.empty()) {
-        throw CsvError(
-            file, line_no,
-            "header '" + std::string(line) + "' lacks column " + missing + " (expected '" + expected + "', SI units)");
+        std::string why = "header '";
+        why += line;
+        why += "' lacks column " + missing;
+        why += " (expected '" + expected + "', SI units)";
+        throw CsvError(file, line_no, why);
       }
       for (const auto& h : header) {
         bool used = false;

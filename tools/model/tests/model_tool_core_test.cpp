@@ -136,6 +136,7 @@ Assignment param(const std::string& text) { return split_assignment(text, "--par
 std::string configure_error(std::string_view model, const std::vector<std::string>& params) {
   try {
     std::vector<Assignment> a;
+    a.reserve(params.size());
     for (const auto& p : params) a.push_back(param(p));
     find_model(model)->configure(a);
   } catch (const std::exception& e) {
@@ -185,6 +186,7 @@ TEST(ModelRegistry, ParsesValuesStrictly) {
 TEST(ModelRegistry, TheModelsOwnValidationNamesTheField) {
   const auto field_of = [](std::string_view model, const std::vector<std::string>& params) {
     std::vector<Assignment> a;
+    a.reserve(params.size());
     for (const auto& p : params) a.push_back(param(p));
     try {
       find_model(model)->configure(a);
@@ -276,7 +278,7 @@ class ParamsFileTest : public ::testing::Test {
     std::filesystem::remove_all(dir_, ec);
   }
   std::string write(const std::string& name, const std::string& text) {
-    const std::string p = (dir_ / name).string();
+    std::string p = (dir_ / name).string();
     std::ofstream(p) << text;
     return p;
   }

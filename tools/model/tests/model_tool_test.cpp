@@ -74,7 +74,7 @@ class ModelTool : public ::testing::Test {
   }
 
   std::string write_text(const std::string& name, const std::string& text) const {
-    const std::string p = path(name);
+    std::string p = path(name);
     std::ofstream(p) << text;
     return p;
   }
