@@ -14,20 +14,6 @@
 
 namespace hystloop {
 
-template <class S, class Ref>
-ParamSpec<S> number(std::string_view name, std::string_view unit, std::string_view description, Ref,
-                    std::string_view alias = {}) {
-  ParamSpec<S> p;
-  p.name = name;
-  p.alias = alias;
-  p.unit = unit;
-  p.description = description;
-  p.kind = ValueKind::number;
-  p.set = [](S& s, const ParsedValue& v) { Ref{}(s) = v.number; };
-  p.show = [](const S& s) { return format_number(Ref{}(s)); };
-  return p;
-}
-
 // A row with its own set/show (lists, choices, counts, values that need a conversion).
 template <class S>
 ParamSpec<S> custom(std::string_view name, std::string_view unit, std::string_view description, ValueKind kind,
@@ -43,6 +29,15 @@ ParamSpec<S> custom(std::string_view name, std::string_view unit, std::string_vi
   p.set = set;
   p.show = show;
   return p;
+}
+
+// A number stored in the field `Ref` returns.
+template <class S, class Ref>
+ParamSpec<S> number(std::string_view name, std::string_view unit, std::string_view description, Ref,
+                    std::string_view alias = {}) {
+  return custom<S>(
+      name, unit, description, ValueKind::number, [](S& s, const ParsedValue& v) { Ref{}(s) = v.number; },
+      [](const S& s) { return format_number(Ref{}(s)); }, {}, alias);
 }
 
 // The row, named in one-line summaries (param_text.hpp: summary_line).
