@@ -17,17 +17,13 @@
 #include "models/coleman_hodgdon_theory.hpp"
 #include "models/loop_features.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/sanitized.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Sanitizer builds (Debug + ASan) run the same checks on fewer cases to stay within a few seconds.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
+using testing::kSanitized;
 
 BanningStageParams with_order(BanningOrder order) {
   BanningStageParams p;

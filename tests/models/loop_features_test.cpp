@@ -15,17 +15,13 @@
 #include "core/errors.hpp"
 #include "models/coleman_hodgdon.hpp"
 #include "models/coleman_hodgdon_theory.hpp"
+#include "support/sanitized.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Sanitizer builds (Debug + ASan) run the same checks on fewer cases to stay within a few seconds.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
+using testing::kSanitized;
 
 struct Samples {
   std::vector<double> u;

@@ -15,17 +15,13 @@
 #include "core/errors.hpp"
 #include "models/coleman_hodgdon_theory.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/sanitized.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Sanitizer builds (Debug + ASan) run the same checks on fewer cases to stay within a few seconds.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
+using testing::kSanitized;
 
 // Least-squares fit of y = p cos(wt) + q sin(wt) + r; returns hypot(p, q).
 double fitted_amplitude(const std::vector<double>& t, const std::vector<double>& y, double omega) {
