@@ -5,13 +5,7 @@
 # a control_t SHUTDOWN addressed to "logger" stops it cleanly with a summary.
 # Run inside tools/netns-run.
 #   logger_cli.sh <hystloop-logger> <logger_probe>
-set -euo pipefail
-logger="$1"; probe="$2"
-url="udpm://239.255.76.67:7667?ttl=0"
-[ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
-dir="$(mktemp -d)"; pid=""
-cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$dir"; }
-trap cleanup EXIT
+source "$(dirname "$0")/logger_common.sh" "$@"
 
 expect_exit() {  # <code> <text in stderr> args...
   local code="$1" text="$2"; shift 2

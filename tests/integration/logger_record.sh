@@ -4,13 +4,7 @@
 # intact and in order, and the summary reports exactly that gap, in ticks, and no drop. lcm-logplayer then plays the log into a
 # second logger, whose recording and summary must be the same. Run inside tools/netns-run.
 #   logger_record.sh <hystloop-logger> <logger_probe>
-set -euo pipefail
-logger="$1"; probe="$2"
-url="udpm://239.255.76.67:7667?ttl=0"
-[ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
-dir="$(mktemp -d)"; pid=""
-cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$dir"; }
-trap cleanup EXIT
+source "$(dirname "$0")/logger_common.sh" "$@"
 stream=(--blocks 5000 --block-ticks 10 --gap-at 1234 --gap-len 17 --commands 3000)
 
 check_summary() {  # <summary.json> <stop reason>

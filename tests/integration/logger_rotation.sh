@@ -4,13 +4,7 @@
 # that order is the complete stream; by age (--max-file-s 0.25) a ~1.2 s recording makes
 # several files too. Run inside tools/netns-run.
 #   logger_rotation.sh <hystloop-logger> <logger_probe>
-set -euo pipefail
-logger="$1"; probe="$2"
-url="udpm://239.255.76.67:7667?ttl=0"
-[ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
-dir="$(mktemp -d)"; pid=""
-cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; rm -rf "$dir"; }
-trap cleanup EXIT
+source "$(dirname "$0")/logger_common.sh" "$@"
 stream=(--blocks 4000 --block-ticks 10 --gap-at 100 --gap-len 3 --commands 4000)
 
 record() {  # <out dir> <rate> logger options...
