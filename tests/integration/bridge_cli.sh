@@ -2,16 +2,8 @@
 # hystloop-bridge's command line: --help, and a bad configuration value exits 2 naming the field.
 #   bridge_cli.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
-"$bridge" --help >"$dir/help.txt" || fail "--help exited with $?"
-for opt in --config --set --lcm-url --rig --backend --noise-rms-m --drift --seconds --auto-arm; do
-  grep -q -- "$opt" "$dir/help.txt" || fail "--help does not mention $opt"
-done
-refused() {  # expected-text, args...
-  local want="$1"; shift
-  set +e; "$bridge" "$@" >"$dir/out.txt" 2>"$dir/err.txt"; local rc=$?; set -e
-  [ $rc -eq 2 ] || fail "'$*' exited with $rc, expected 2 ($(cat "$dir/err.txt"))"
-  grep -q -- "$want" "$dir/err.txt" || fail "'$*': stderr does not say '$want': $(cat "$dir/err.txt")"
-}
+expect_help "$bridge" --config --set --lcm-url --rig --backend --noise-rms-m --drift --seconds --auto-arm
+refused() { expect_refused "$bridge" "$@"; }  # expected-text args...
 refused "actuator.watchdog_s" --set actuator.watchdog_s=-1
 refused "actuator.u_max_V: must be greater than actuator.u_min_V" --set actuator.u_max_V=-300
 refused "actuator.safe_u_V" --set actuator.safe_u_V=400

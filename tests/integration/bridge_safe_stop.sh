@@ -43,8 +43,7 @@ run_case() {  # name: sigterm | shutdown
   wait_until 10 "$name: the recorder had the bridge's STOPPING report (sent after its last samples)" \
     stopping_reported bridge
   stop_recording
-  "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "$name: unsafe samples"; }
-  get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
+  analyze_recording "$name: unsafe samples"
   [ "$(get samples)" -ge 10000 ] || fail "$name: only $(get samples) samples recorded"
   # sensor.csv: seq,utime,u_V,y_m,flags,... SAFE_STATE = 2.
   local last; last=$(tail -n 1 "$dir/sensor.csv")

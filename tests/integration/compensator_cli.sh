@@ -3,16 +3,8 @@
 # and a parameter snippet as hystloop-identify --out writes it is accepted (--params).
 #   compensator_cli.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
-"$compensator" --help >"$dir/help.txt" || fail "--help exited with $?"
-for opt in --config --set --lcm-url --rig --params --mode --seconds; do
-  grep -q -- "$opt" "$dir/help.txt" || fail "--help does not mention $opt"
-done
-refused() {  # expected-text, args...
-  local want="$1"; shift
-  set +e; "$compensator" "$@" >"$dir/out.txt" 2>"$dir/err.txt"; local rc=$?; set -e
-  [ $rc -eq 2 ] || fail "'$*' exited with $rc, expected 2 ($(cat "$dir/err.txt"))"
-  grep -q -- "$want" "$dir/err.txt" || fail "'$*': stderr does not say '$want': $(cat "$dir/err.txt")"
-}
+expect_help "$compensator" --config --set --lcm-url --rig --params --mode --seconds
+refused() { expect_refused "$compensator" "$@"; }  # expected-text args...
 refused "mem.c3" --set mem.c3=-1
 refused "mem.c1" --set mem.c1=abc
 refused "compensator.mode" --mode experiment

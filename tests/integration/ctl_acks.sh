@@ -81,10 +81,6 @@ expect_ctl 0 disarm
 says "'bridge' confirmed"
 expect_ctl 0 shutdown
 for p in compensator bridge reidentifier; do says "'$p' confirmed"; done
-for p in $bpid $cpid $rpid; do
-  for _ in $(seq 100); do kill -0 $p 2>/dev/null || break; sleep 0.1; done
-  kill -0 $p 2>/dev/null && fail "pid $p did not stop on SHUTDOWN"
-  wait $p || fail "pid $p exited with $?"
-done
+expect_shutdown 100 $bpid $cpid $rpid
 stop_recording
 echo "ctl_acks: ok"

@@ -41,6 +41,41 @@ wait_log() {  # file text
   fail "$1 never said '$2'"
 }
 value() { "$probe" status-value --dir "$dir" --process "$1" --key "$2"; }
+# A service's --help names each of the options given.
+expect_help() {  # executable option...
+  local exe="$1"; shift
+  "$exe" --help >"$dir/help.txt" || fail "--help exited with $?"
+  for opt in "$@"; do
+    grep -q -- "$opt" "$dir/help.txt" || fail "--help does not mention $opt"
+  done
+}
+# A command line a service refuses: it exits 2 and its stderr says the expected text.
+expect_refused() {  # executable expected-text args...
+  local exe="$1" want="$2"; shift 2
+  set +e; "$exe" "$@" >"$dir/out.txt" 2>"$dir/err.txt"; local rc=$?; set -e
+  [ $rc -eq 2 ] || fail "'$*' exited with $rc, expected 2 ($(cat "$dir/err.txt"))"
+  grep -q -- "$want" "$dir/err.txt" || fail "'$*': stderr does not say '$want': $(cat "$dir/err.txt")"
+}
+# After a SHUTDOWN request: each process stops within tenths/10 s and exits 0.
+expect_shutdown() {  # tenths-of-a-second pid...
+  local tenths="$1" p; shift
+  for p in "$@"; do
+    for _ in $(seq "$tenths"); do kill -0 $p 2>/dev/null || break; sleep 0.1; done
+    kill -0 $p 2>/dev/null && fail "pid $p did not stop on SHUTDOWN"
+    wait $p || fail "pid $p exited with $?"
+  done
+}
+# loop_probe analyze on the recording: its figures go to $dir/analysis.txt (read them with get);
+# an unsafe sample prints them and fails with the text given.
+analyze_recording() {  # failure-text
+  "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "$1"; }
+}
+get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
+# No command of the recording was planned further ahead than the horizon (ticks).
+expect_within_horizon() {
+  [ "$(get max_planned_ahead_ticks)" -le "$horizon_ticks" ] ||
+    fail "a command was planned $(get max_planned_ahead_ticks) ticks ahead (horizon $horizon_ticks)"
+}
 expect_value() {  # process key expected
   local v; v="$(value "$1" "$2")" || fail "$1 reports no $2"
   [ "$v" = "$3" ] || fail "$1 $2 = $v, expected $3"

@@ -34,7 +34,7 @@ kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
 stop_recording
-"$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
+analyze_recording "unsafe samples"
 
 # Both injections send their bad HX_CONTROL messages to everyone: 2n of each there.
 for reason in decode_failed wrong_type non_finite out_of_range; do

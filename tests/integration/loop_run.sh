@@ -13,19 +13,14 @@ wait_log "$dir/bridge.log" "started in the safe state"
 # below need), however long a loaded machine takes to get there.
 wait_until 40 "the recorder held 35000 samples" samples_recorded 35000
 "$probe" control --command shutdown
-for p in $bpid $cpid; do
-  for _ in $(seq 50); do kill -0 $p 2>/dev/null || break; sleep 0.1; done
-  kill -0 $p 2>/dev/null && fail "pid $p did not stop on SHUTDOWN"
-  wait $p || fail "pid $p exited with $?"
-done
+expect_shutdown 50 $bpid $cpid
 stop_recording
-"$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
+analyze_recording "unsafe samples"
 cat "$dir/analysis.txt"
-get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
 [ "$(get samples)" -ge 30000 ] || fail "only $(get samples) samples in ~3.5 s at 10 kHz"
 [ "$(get seq_gaps)" -eq 0 ] || fail "$(get seq_gaps) gaps in the sample ticks"
 [ "$(get applied)" -ge 25000 ] || fail "only $(get applied) commands applied"
-[ "$(get max_planned_ahead_ticks)" -le "$horizon_ticks" ] || fail "a command was planned $(get max_planned_ahead_ticks) ticks ahead (horizon $horizon_ticks)"
+expect_within_horizon
 grep -q "state=4" "$dir/status.log" || fail "no STOPPING report"
 # HEALTHY while it ran (a report may say DEGRADED when the shared machine stalled the loop for
 # tens of milliseconds; that is what DEGRADED is for), never SAFE once armed, no watchdog trip.

@@ -40,11 +40,7 @@ pin_adopted() {
 }
 wait_until 20 "the compensator reported the pinned model $pin adopted" pin_adopted
 "$probe" control --command shutdown
-for p in $bpid $cpid $rpid; do
-  for _ in $(seq 100); do kill -0 $p 2>/dev/null || break; sleep 0.1; done
-  kill -0 $p 2>/dev/null && fail "pid $p did not stop on SHUTDOWN"
-  wait $p || fail "pid $p exited with $?"
-done
+expect_shutdown 100 $bpid $cpid $rpid
 stop_recording
 grep "published model change\|model pinned" "$dir/reident.log" | sed 's/^.*info  //'
 changes="$(value reidentifier model_changes)" || fail "no model_changes from the re-identifier"

@@ -57,7 +57,7 @@ kill -TERM $bpid $cpid $rpid $lpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
 stop_recording
-"$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "unsafe samples"; }
+analyze_recording "unsafe samples"
 [ "$trips" -eq 0 ] || fail "$trips watchdog trips while the logger and the re-identifier were restarted"
 restarts=$(value compensator bridge_restarts)
 [ "$restarts" -eq 0 ] || fail "forged sensor blocks restarted the compensator's control law ($restarts)"

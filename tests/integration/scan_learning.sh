@@ -44,11 +44,7 @@ last="$(status_key compensator learning_periods)"
 expect_value compensator learning_active 1
 
 "$probe" control --command shutdown
-for p in $bpid $cpid; do
-  for _ in $(seq 100); do kill -0 $p 2>/dev/null || break; sleep 0.1; done
-  kill -0 $p 2>/dev/null && fail "pid $p did not stop on SHUTDOWN"
-  wait $p || fail "pid $p exited with $?"
-done
+expect_shutdown 100 $bpid $cpid
 stop_recording
 
 # The recorded ticks: flags bit 2 SAFE_STATE, 16 LATE_COMMAND, 1 SATURATED | 8 SLEW_LIMITED. The
