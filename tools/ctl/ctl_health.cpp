@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include <spdlog/fmt/fmt.h>
 
 namespace hystloop::ctl {
 
@@ -12,9 +13,7 @@ std::string timing(double p50, double p99, double max) {
   if (!std::isfinite(p50) && !std::isfinite(p99) && !std::isfinite(max)) return "--";
   auto one = [](double v) {
     if (!std::isfinite(v)) return std::string("--");
-    char buf[32];
-    std::snprintf(buf, sizeof buf, v < 100.0 ? "%.1f" : "%.0f", v);
-    return std::string(buf);
+    return v < 100.0 ? fmt::format("{:.1f}", v) : fmt::format("{:.0f}", v);
   };
   return one(p50) + "/" + one(p99) + "/" + one(max) + " us";
 }
@@ -69,12 +68,9 @@ HealthVerdict check_health(const StatusBoard& board, const std::vector<std::stri
 
 std::string format_status(const ProcessReport& report, bool all_counters) {
   const auto& s = report.status;
-  char head[256];
   const double up_s = static_cast<double>(s.utime - s.start_utime) * 1e-6;
-  std::snprintf(head, sizeof head, "%-12s %-9s pid %d@%s  up %.0f s  late %lld  rejected %lld", s.process.c_str(),
-                state_name(s.state).c_str(), s.pid, s.host.c_str(), up_s, static_cast<long long>(s.late),
-                static_cast<long long>(s.rejected));
-  std::string line = head;
+  std::string line = fmt::format("{:<12} {:<9} pid {}@{}  up {:.0f} s  late {}  rejected {}", s.process,
+                                 state_name(s.state), s.pid, s.host, up_s, s.late, s.rejected);
   line += "  loop p50/p99/max " + timing(s.loop_p50_us, s.loop_p99_us, s.loop_max_us);
   line += "  latency " + timing(s.latency_p50_us, s.latency_p99_us, s.latency_max_us);
   if (!s.detail.empty()) line += "  [" + s.detail + "]";

@@ -24,24 +24,35 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::chrono::microseconds until_deadline(Clock::time_point deadline) {
-  return std::max(std::chrono::microseconds(0),
-                  std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()));
+// Dispatches what LCM holds, waiting at most `slice` and never past `deadline`; false if LCM failed.
+bool receive(CtlLink& link, Clock::time_point deadline, std::chrono::microseconds slice, int max_messages = 256) {
+  const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now());
+  return handle_pending(link.lcm(), std::clamp(left, std::chrono::microseconds(0), slice), max_messages) >= 0;
+}
+
+int receive_failed(const CtlLink& link) {
+  std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
+  return 1;
 }
 
 Clock::time_point after(double seconds) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-std::string resolved_url(const LinkOptions& o) {
-  std::string url = resolve_lcm_url_for_10khz(o.lcm_url, o.allow_network);
-  return url;
+// A block channel's queue for a listening subcommand: a few seconds of blocks.
+template <class T>
+typename Subscription<T>::Options block_queue() {
+  typename Subscription<T>::Options o;
+  o.queue_capacity = 4'000;
+  return o;
 }
 
 }  // namespace
 
 CtlLink::CtlLink(const LinkOptions& options)
-    : channels_(options.rig), url_(resolved_url(options)), lcm_(open_lcm(url_, options.allow_network)) {}
+    : channels_(options.rig),
+      url_(resolve_lcm_url_for_10khz(options.lcm_url, options.allow_network)),
+      lcm_(open_lcm(url_, options.allow_network)) {}
 
 int run_status(CtlLink& link, const StatusOptions& o) {
   StatusBoard board;
@@ -51,10 +62,7 @@ int run_status(CtlLink& link, const StatusOptions& o) {
   const auto deadline = after(waiting ? o.timeout_s : o.listen_s);
   HealthVerdict verdict;
   while (Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(100'000))) < 0) {
-      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
-      return 1;
-    }
+    if (!receive(link, deadline, std::chrono::microseconds(100'000))) return receive_failed(link);
     if (waiting) {
       verdict = check_health(board, o.wait_healthy, o.accept_safe, o.accept_degraded);
       if (verdict.healthy) break;
@@ -87,8 +95,6 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   install_stop_handlers();
   WatchLine line;
   std::optional<std::int64_t> late_before_report;
-  Subscription<sensor_block_t>::Options sensor_queue;
-  sensor_queue.queue_capacity = 4'000;  // blocks: a few seconds of them
   TruthPairing truth;
   Subscription<sensor_block_t> samples(
       link.lcm(), link.channels().sensor,
@@ -96,21 +102,17 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
         line.second.add_sensor_block(b);
         truth.add_sensor_block(b, line.second);
       },
-      sensor_queue);
-  Subscription<sim_truth_t>::Options truth_queue;
-  truth_queue.queue_capacity = sensor_queue.queue_capacity;
+      block_queue<sensor_block_t>());
   Subscription<sim_truth_t> truths(
       link.lcm(), link.channels().sim_truth,
-      [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); }, truth_queue);
-  Subscription<command_block_t>::Options command_queue;
-  command_queue.queue_capacity = 4'000;
+      [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); }, block_queue<sim_truth_t>());
   Subscription<command_block_t> commands(
       link.lcm(), link.channels().command,
       [&](const command_block_t& c, std::int64_t) {
         line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
         line.params_in_use = command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
       },
-      command_queue);
+      block_queue<command_block_t>());
   Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
     if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
   });
@@ -135,10 +137,7 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   const auto end = o.seconds > 0 ? after(o.seconds) : Clock::time_point::max();
   while (!stop_requested()) {
     const auto wake = std::min(next_print, end);
-    if (handle_pending(link.lcm(), std::min(until_deadline(wake), std::chrono::microseconds(50'000)), 1024) < 0) {
-      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
-      return 1;
-    }
+    if (!receive(link, wake, std::chrono::microseconds(50'000), 1024)) return receive_failed(link);
     const auto now = Clock::now();
     if (now >= next_print) {
       line.elapsed_s = std::chrono::duration<double>(next_print - start).count();
@@ -176,10 +175,7 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
   if (!o.wait) return 0;
   const auto deadline = after(o.timeout_s);
   while (verdict.outcome == TrajectoryOutcome::kPending && Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000))) < 0) {
-      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
-      return 1;
-    }
+    if (!receive(link, deadline, std::chrono::microseconds(50'000))) return receive_failed(link);
   }
   const long long version = static_cast<long long>(msg.version);
   const char* who = o.compensator_process.c_str();
@@ -236,10 +232,7 @@ int send_control_confirmed(CtlLink& link, const control_t& msg, const std::strin
   const auto deadline = after(o.timeout_s);
   const auto gathered = after(std::min(o.gather_s, o.timeout_s));
   while (Clock::now() < deadline && !tracker.finished(Clock::now() >= gathered)) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(20'000))) < 0) {
-      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
-      return 1;
-    }
+    if (!receive(link, deadline, std::chrono::microseconds(20'000))) return receive_failed(link);
   }
   if (last != nullptr) *last = heard;
   const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
@@ -269,7 +262,7 @@ std::optional<service_status_t> listen_for_status(CtlLink& link, const std::stri
                                         });
   const auto deadline = after(timeout_s);
   while (!found && Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000))) < 0) break;
+    if (!receive(link, deadline, std::chrono::microseconds(50'000))) break;
   }
   return found;
 }
@@ -283,7 +276,7 @@ StatusWait wait_for_status(CtlLink& link, const std::string& process, const Stat
                                         });
   const auto deadline = after(timeout_s);
   while (!w.satisfied && Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(20'000))) < 0) break;
+    if (!receive(link, deadline, std::chrono::microseconds(20'000))) break;
   }
   return w;
 }
@@ -306,23 +299,19 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
       }
     });
   };
-  Subscription<command_block_t>::Options queue;
-  queue.queue_capacity = 4'000;
-  Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command, queue);
+  Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command,
+                                         block_queue<command_block_t>());
   // The plan runs a horizon ahead of the stage: the series is done when the sample of its last
   // tick has arrived, not when that tick was planned.
   std::int64_t last_sample = -1;
-  Subscription<sensor_block_t>::Options sensor_queue;
-  sensor_queue.queue_capacity = 4'000;
   Subscription<sensor_block_t> samples(
       link.lcm(), link.channels().sensor,
       [&](const sensor_block_t& b, std::int64_t) {
         if (b.n_ticks > 0) last_sample = std::max<std::int64_t>(last_sample, b.seq + b.n_ticks - 1);
       },
-      sensor_queue);
+      block_queue<sensor_block_t>());
   auto pump = [&](Clock::time_point until_time) {
-    return handle_pending(link.lcm(), std::min(until_deadline(until_time), std::chrono::microseconds(50'000)), 4096) >=
-           0;
+    return receive(link, until_time, std::chrono::microseconds(50'000), 4096);
   };
 
   // Commands must flow, and no experiment may be running: ours would queue behind it.
@@ -375,10 +364,7 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   while (!tracker.finished() && !tracker.ended_early() && !stop_requested()) {
     const auto deadline = tracker.started() ? end_deadline : start_deadline;
     if (Clock::now() >= deadline) break;
-    if (!pump(deadline)) {
-      std::fprintf(stderr, "hystloop-ctl: LCM receive failed on %s\n", link.url().c_str());
-      return 1;
-    }
+    if (!pump(deadline)) return receive_failed(link);
   }
   if (stop_requested()) {
     send_stop();
@@ -427,18 +413,15 @@ std::int32_t next_params_version(CtlLink& link, double listen_s) {
   Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
     highest = std::max(highest, p.version);
   });
-  Subscription<command_block_t>::Options queue;
-  queue.queue_capacity = 4'000;
   Subscription<command_block_t> commands(
       link.lcm(), link.channels().command,
       [&](const command_block_t& c, std::int64_t) {
         for_each_tick(c, [&](const CommandTick& t) { highest = std::max(highest, t.params_version); });
       },
-      queue);
+      block_queue<command_block_t>());
   const auto deadline = after(listen_s);
   while (Clock::now() < deadline) {
-    if (handle_pending(link.lcm(), std::min(until_deadline(deadline), std::chrono::microseconds(50'000)), 1024) < 0)
-      break;
+    if (!receive(link, deadline, std::chrono::microseconds(50'000), 1024)) break;
   }
   // Saturating: after a forged 2147483647 the set still goes out (as a new publisher it is taken anyway).
   return highest < std::numeric_limits<std::int32_t>::max() ? highest + 1 : highest;

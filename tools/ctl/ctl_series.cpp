@@ -1,18 +1,12 @@
 #include "ctl_series.hpp"
 
-#include <cstdio>
+#include <spdlog/fmt/fmt.h>
 
 #include "core/errors.hpp"
 
 namespace hystloop::ctl {
 
 namespace {
-
-std::string format(const char* fmt, double a, double b, double c, double d) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
-  return buf;
-}
 
 ExperimentRequest sine(const char* kind, double offset_V, double amplitude_V, double frequency_Hz, double periods) {
   ExperimentRequest r;
@@ -35,17 +29,17 @@ std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {
   const std::vector<BanningExperiment> experiments = plan_banning_experiments(plan);
   for (std::size_t i = 0; i < experiments.size(); ++i) {
     const BanningExperiment& e = experiments[i];
-    const std::string head = std::string(to_string(e.kind)) +
-                             format(" experiment: offset %g V, amplitude %g V", e.offset_V, e.amplitude_V, 0, 0);
+    const std::string head =
+        fmt::format("{} experiment: offset {:g} V, amplitude {:g} V", to_string(e.kind), e.offset_V, e.amplitude_V);
     if (e.settle_periods > 0) {
       steps.push_back({i,
-                       head + format(": settling, %g periods at %g Hz (%.3g s)", e.settle_periods,
-                                     e.settle_frequency_Hz, e.settle_periods / e.settle_frequency_Hz, 0),
+                       head + fmt::format(": settling, {:g} periods at {:g} Hz ({:.3g} s)", e.settle_periods,
+                                          e.settle_frequency_Hz, e.settle_periods / e.settle_frequency_Hz),
                        sine("settle", e.offset_V, e.amplitude_V, e.settle_frequency_Hz, e.settle_periods)});
     }
     steps.push_back({i,
-                     head + format(": measuring %g periods at %g Hz (%.3g s)", e.measure_periods, e.frequency_Hz,
-                                   e.measure_periods / e.frequency_Hz, 0),
+                     head + fmt::format(": measuring {:g} periods at {:g} Hz ({:.3g} s)", e.measure_periods,
+                                        e.frequency_Hz, e.measure_periods / e.frequency_Hz),
                      sine("sine", e.offset_V, e.amplitude_V, e.frequency_Hz, e.measure_periods)});
   }
   for (const auto& s : steps) s.request.validate();

@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <utility>
+
+#include <spdlog/fmt/fmt.h>
 
 #include "ctl_health.hpp"
 #include "lcm/blocks.hpp"
@@ -79,44 +80,26 @@ std::optional<double> learning_rms_nm(const service_status_t& compensator) {
 }
 
 std::string format_watch_line(const WatchLine& l) {
-  char buf[320];
-  std::string out;
-  std::snprintf(buf, sizeof buf, "%5.0f s", l.elapsed_s);
-  out += buf;
+  std::string out = fmt::format("{:5.0f} s", l.elapsed_s);
   if (const auto rms = l.second.rms_m()) {
-    std::snprintf(buf, sizeof buf, "  rms %7.1f nm  max %7.1f nm", *rms * 1e9, l.second.max_abs_m * 1e9);
+    out += fmt::format("  rms {:7.1f} nm  max {:7.1f} nm", *rms * 1e9, l.second.max_abs_m * 1e9);
   } else {
-    std::snprintf(buf, sizeof buf, "  rms %7s nm  max %7s nm", "--", "--");
+    out += fmt::format("  rms {:>7} nm  max {:>7} nm", "--", "--");
   }
-  out += buf;
   if (const auto true_rms = l.second.true_rms_m()) {
-    std::snprintf(buf, sizeof buf, "  true %.2f nm max %.1f nm", *true_rms * 1e9, l.second.true_max_abs_m * 1e9);
-    out += buf;
+    out += fmt::format("  true {:.2f} nm max {:.1f} nm", *true_rms * 1e9, l.second.true_max_abs_m * 1e9);
   }
-  std::snprintf(buf, sizeof buf, "  ticks %6llu/%llu", static_cast<unsigned long long>(l.second.tracking),
-                static_cast<unsigned long long>(l.second.samples));
-  out += buf;
+  out += fmt::format("  ticks {:6}/{}", l.second.tracking, l.second.samples);
   out += l.params_in_use ? "  params v" + std::to_string(*l.params_in_use) : std::string("  params --");
   if (l.params_latest && l.params_latest != l.params_in_use)
     out += " (v" + std::to_string(*l.params_latest) + " published)";
-  if (l.late_total) {
-    std::snprintf(buf, sizeof buf, "  late %lld (+%lld)", static_cast<long long>(*l.late_total),
-                  static_cast<long long>(l.late_delta.value_or(0)));
-    out += buf;
-  } else {
-    out += "  late --";
-  }
+  out += l.late_total ? fmt::format("  late {} (+{})", *l.late_total, l.late_delta.value_or(0)) : "  late --";
   out += l.clamped_per_s ? "  clamped " + std::to_string(*l.clamped_per_s) + "/s" : std::string("  clamped --");
   out += l.second.buffer_min_ticks ? "  buf min " + std::to_string(*l.second.buffer_min_ticks)
                                    : std::string("  buf min --");
   out += l.bridge_state.empty() ? "  bridge --" : "  bridge " + l.bridge_state;
   if (l.learning_rms_nm || l.learning_periods) {
-    if (l.learning_rms_nm) {
-      std::snprintf(buf, sizeof buf, "  learned %.1f nm", *l.learning_rms_nm);
-    } else {
-      std::snprintf(buf, sizeof buf, "  learned -- nm");
-    }
-    out += buf;
+    out += l.learning_rms_nm ? fmt::format("  learned {:.1f} nm", *l.learning_rms_nm) : "  learned -- nm";
     out += " (" + (l.learning_periods ? std::to_string(*l.learning_periods) : std::string("--")) + " periods)";
   }
   const std::int64_t refused = l.trajectories_refused.value_or(0), shaped = l.trajectories_shaped.value_or(0);

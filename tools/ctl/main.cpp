@@ -36,6 +36,8 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/fmt/fmt.h>
+
 #include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "ctl_ack.hpp"
@@ -104,19 +106,15 @@ int send_control(const Options& o, std::int8_t command, const std::string& targe
 }
 
 std::string format_gains(const ServoGainsFigures& g) {
-  char text[256];
-  std::snprintf(text, sizeof text, "kp %g, ki %g 1/s, kd %g s, %s", g.kp, g.ki_per_s, g.kd_s,
-                g.notch_hz > 0.0 ? "" : "no notch");
-  std::string out = text;
-  if (g.notch_hz > 0.0) {
-    std::snprintf(text, sizeof text, "notch at %g Hz (Q %g)", g.notch_hz, g.notch_q);
-    out += text;
-  }
-  return out;
+  return fmt::format("kp {:g}, ki {:g} 1/s, kd {:g} s, {}", g.kp, g.ki_per_s, g.kd_s,
+                     g.notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g.notch_hz, g.notch_q) : "no notch");
 }
 
-std::optional<ServoGainsFigures> gains_of(const service_status_t& s) {
-  return servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); });
+// Prints the servo gains `report` carries; false if it carries none.
+bool print_gains(const std::string& bridge, const service_status_t& report) {
+  const auto g = servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); });
+  if (g) std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
+  return g.has_value();
 }
 
 int run_gains(Options& o) {
@@ -129,23 +127,15 @@ int run_gains(Options& o) {
                    link.channels().status.c_str(), o.ack.timeout_s);
       return 1;
     }
-    const auto g = gains_of(*report);
-    if (!g) {
-      std::fprintf(stderr, "hystloop-ctl: '%s' reports no servo gains (a build that does not?)\n", bridge.c_str());
-      return 1;
-    }
-    std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
-    return 0;
+    if (print_gains(bridge, *report)) return 0;
+    std::fprintf(stderr, "hystloop-ctl: '%s' reports no servo gains (a build that does not?)\n", bridge.c_str());
+    return 1;
   }
   o.gains.validate();
   std::map<std::string, service_status_t> last;
   const int rc = send_control(
       o, control_t::SET_GAINS, bridge, "SET_GAINS", nullptr, {}, [&](control_t& msg) { apply(o.gains, msg); }, &last);
-  if (const auto it = last.find(bridge); it != last.end()) {
-    if (const auto g = gains_of(it->second)) {
-      std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
-    }
-  }
+  if (const auto it = last.find(bridge); it != last.end()) print_gains(bridge, it->second);
   return rc;
 }
 
@@ -156,14 +146,11 @@ int send_trajectory(const Options& o) {
   if (!(o.verdict.timeout_s > 0.0)) throw ParameterError("timeout", "must be > 0");
   const std::int64_t now = wall_utime();
   const trajectory_t msg = make_trajectory(request, now, now);  // version: wall time, increases per request
-  char text[256];
-  std::snprintf(text, sizeof text, "%s amplitude %g m frequency %g Hz offset %g m blend %g s", request.shape.c_str(),
-                msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s);
-  std::string description = text;
+  std::string description = fmt::format("{} amplitude {:g} m frequency {:g} Hz offset {:g} m blend {:g} s",
+                                        request.shape, msg.amplitude_m, msg.frequency_Hz, msg.offset_m, msg.blend_s);
   if (msg.n_points > 0) description += " with " + std::to_string(msg.n_points) + " points";
   if (msg.shape == trajectory_t::TRIANGLE) {
-    std::snprintf(text, sizeof text, " corner %g s", msg.corner_s);
-    description += msg.corner_s > 0.0 ? text : " corner: the shortest feasible";
+    description += msg.corner_s > 0.0 ? fmt::format(" corner {:g} s", msg.corner_s) : " corner: the shortest feasible";
   }
   if (msg.if_infeasible == trajectory_t::SHAPE) description += ", shaped if infeasible";
   CtlLink link(o.link);
