@@ -17,12 +17,7 @@
 namespace hystloop {
 namespace {
 
-using testing::BridgeRig;
-using testing::command;
-using testing::kDt;
-using testing::kGain;
-using testing::kNaN;
-using testing::servo_gains;
+using namespace testing;  // the rig (bridge_test_rig.hpp): BridgeRig, command, kDt, kNaN, ...
 
 constexpr std::int32_t kClampFlags = sample_flags::kSaturated | sample_flags::kSlewLimited;
 

@@ -20,11 +20,7 @@
 namespace hystloop {
 namespace {
 
-using testing::BridgeRig;
-using testing::command;
-using testing::kDt;
-using testing::kInf;
-using testing::kNaN;
+using namespace testing;  // the rig (bridge_test_rig.hpp): BridgeRig, command, kDt, kNaN, ...
 
 bool has(const BridgeTick& t, std::int32_t flag) { return (t.flags & flag) != 0; }
 

@@ -14,12 +14,7 @@
 namespace hystloop {
 namespace {
 
-using testing::BridgeRig;
-using testing::command;
-using testing::kDt;
-using testing::kGain;
-using testing::kNaN;
-using testing::servo_gains;
+using namespace testing;  // the rig (bridge_test_rig.hpp): BridgeRig, command, kDt, kNaN, ...
 
 constexpr double kRef = 1e-6;
 constexpr double kFeedforward = 80.0;  // the plant needs (1 um - 20 nm) / gain = 98 V
