@@ -12,6 +12,10 @@
 
 namespace hystloop::exporter {
 
+using report::ChannelTable;
+using report::Column;
+using report::ColumnType;
+
 // One fact about the run: a text, an integer or a number (units in the name: "time_zero_utime_us").
 struct RunAttribute {
   std::string name;  // a MATLAB identifier: letters, digits, '_'

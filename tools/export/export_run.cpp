@@ -164,7 +164,7 @@ ExportContent collect(const ExportOptions& o, std::FILE* progress) {
     candidates.insert(c);
     candidates.insert(names.prefix + c);
   }
-  TableBuilder builder(
+  report::TableBuilder builder(
       [&](const std::string& channel) {
         return o.channels.empty() ? channel.rfind(names.prefix, 0) == 0 : candidates.count(channel) != 0;
       },

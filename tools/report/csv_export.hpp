@@ -1,16 +1,18 @@
 #pragma once
-// CSV export of whole logged channels: one row per event (per tick for the blocks of
-// HX_SENSOR and HX_COMMAND, the block's fields repeated on each), a header naming every
-// decoded field with its unit (t_s and recv_utime_us first: the row's time on the report's
-// axis and the event's raw log timestamp). The message type is recognised from its
-// fingerprint, so any channel of any rig prefix exports; an event that does not decode is
-// skipped and counted. Beside each CSV, <channel>.legend.txt names the codes of its
-// integer-coded columns (code_legend.hpp): "mode: 0=off,1=linear,...", one column a line.
+// CSV export of whole logged channels: the channel's table (channel_table.hpp: one row per
+// event, per tick for the blocks of HX_SENSOR and HX_COMMAND) as a header line of its column
+// names (t_s and recv_utime_us first: the row's time on the report's axis and the event's raw
+// log timestamp) and one line per row. A text is quoted; a ragged column's part of a row (a
+// trajectory's points, a status's counters) is one quoted field of space-separated values. An
+// event that does not decode is skipped and counted. Beside each CSV, <channel>.legend.txt
+// names the codes of its integer-coded columns: "mode: 0=off,1=linear,...", one column a line.
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include "channel_table.hpp"
 
 namespace hystloop::report {
 
@@ -30,9 +32,8 @@ std::filesystem::path csv_path(const std::filesystem::path& dir, const std::stri
 std::filesystem::path csv_legend_path(const std::filesystem::path& dir, const std::string& channel);
 
 // The text of a channel's legend file: a comment line naming the CSV and its type, then one
-// line per integer-coded column of `csv_header` ("t_s,recv_utime_us,...") that the type's
-// legend knows, "column: codes".
-std::string csv_legend_text(const std::string& channel, const std::string& type_name, const std::string& csv_header);
+// line per column of the table that has a legend, "column: codes".
+std::string csv_legend_text(const ChannelTable& table);
 
 // One pass over the logs, writing each channel's rows with lower_s <= t_s <= upper_s
 // (t_s relative to t0_utime), and each channel's legend file. Throws std::runtime_error if a file cannot be written.

@@ -201,7 +201,13 @@ TEST(CodeLegend, CoversEveryConstantOfTheLcmTypes) {
 }
 
 TEST(CsvLegendText, UnknownTypeHasNoCodes) {
-  const std::string text = csv_legend_text("HX_X", "unknown", "size_bytes");
+  ChannelTable table;
+  table.channel = "HX_X";
+  Column size;
+  size.name = "size_bytes";
+  size.type = ColumnType::kInt64;
+  table.columns.push_back(size);
+  const std::string text = csv_legend_text(table);
   EXPECT_EQ(text.rfind("# Integer codes of the columns of HX_X.csv (unknown)", 0), 0u) << text;
   EXPECT_NE(text.find("no column of this channel is integer-coded"), std::string::npos);
 }

@@ -504,7 +504,13 @@ TEST_F(ReportToolTest, EveryFigureMatchesTheGeneratedTruth) {
             "t_s,recv_utime_us,block_utime_us,block_seq,sample_seq,seq,u_ff_V,y_ref_m,params_version,mode");
   EXPECT_EQ(static_cast<std::size_t>(std::count(command.begin(), command.end(), '\n')),
             counts.at("HX_COMMAND") * kBlock + 1);
-  EXPECT_NE(slurp(dir_ / "out" / "HX_STATUS.csv").find("rejected_nonfinite=12"), std::string::npos);
+  // A status's counters: their names in one field, their values in the next, in the same order.
+  const std::string status = slurp(dir_ / "out" / "HX_STATUS.csv");
+  EXPECT_NE(status.find(",n_counters,counter_names,counter_values\n"), std::string::npos) << status.substr(0, 300);
+  EXPECT_NE(
+      status.find(",\"ticks rejected_nonfinite stale command.rejected_out_of_range control.rejected_decode_failed "
+                  "cpu_user_us cpu_system_us\",\"12000 12 2 1 5 "),
+      std::string::npos);
 
   // Plots, when gnuplot is there; their data and script always.
   for (const char* data : {"track.dat", "per_second.dat", "run_ahead_hist.dat", "plots.gp"}) {

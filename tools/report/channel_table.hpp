@@ -1,8 +1,9 @@
 #pragma once
 // A recorded channel as columns: one column per decoded field, one row per event (per tick for
-// the blocks of HX_SENSOR and HX_COMMAND, the block's fields repeated on each, as in the CSV
-// export), each column with its unit and, for integer codes, its legend (code_legend.hpp). The
-// message type is recognised from its fingerprint, so any channel of any rig prefix exports.
+// the blocks of HX_SENSOR and HX_COMMAND, the block's fields repeated on each), each column with
+// its unit and, for integer codes, its legend (code_legend.hpp). The message type is recognised
+// from its fingerprint, so any channel of any rig prefix exports. The one decoder and column
+// naming of hystloop-report's CSV (csv_export.hpp) and hystloop-export's MAT and HDF5 files.
 //
 // Variable-length arrays of a message (a trajectory's points, a status's counters, a model's PI
 // operators) are "ragged" columns: the arrays of all rows one after the other, row r's part
@@ -18,12 +19,12 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-namespace hystloop::exporter {
+namespace hystloop::report {
 
 enum class ColumnType { kFloat64, kInt64, kText };
 
 struct Column {
-  std::string name;  // the field's name with its unit as in the CSV export: "u_V", "utime_us"
+  std::string name;  // the field's name with its unit: "u_V", "utime_us"
   std::string unit;  // SI symbol ("s", "V", "m", "m/V", "Hz"), "us", "tick", or "1" (dimensionless, counts, codes)
   std::string description;  // what it is, when the name does not say it; may be empty
   std::string legend;       // integer codes: "0=off,1=linear,..."; empty when the column is not coded
@@ -47,6 +48,8 @@ struct ChannelTable {
   std::uint64_t skipped = 0;  // events that did not decode or broke the message contract
 
   const Column* find(const std::string& name) const noexcept;
+  // Drops the rows collected so far (the columns and counts stay): for a writer that streams them.
+  void clear_rows() noexcept;
 };
 
 // Collects the rows of the channels `wanted` accepts, with lower_s <= t_s <= upper_s, t_s
@@ -59,7 +62,8 @@ class TableBuilder {
   TableBuilder(const TableBuilder&) = delete;
   TableBuilder& operator=(const TableBuilder&) = delete;
 
-  void add(const lcm::LogEvent& event);
+  // The table the event went to (its rows in the range added), nullptr if its channel is not wanted.
+  ChannelTable* add(const lcm::LogEvent& event);
   // Events of every channel seen, wanted or not.
   const std::map<std::string, std::uint64_t>& channel_counts() const noexcept;
   // The tables of the wanted channels, in the order their first events came.
@@ -70,7 +74,4 @@ class TableBuilder {
   std::unique_ptr<Impl> impl_;
 };
 
-// The type a channel's events carry, by fingerprint: "hystloop.sensor_block_t", or "unknown".
-std::string type_name_of(const lcm::LogEvent& event);
-
-}  // namespace hystloop::exporter
+}  // namespace hystloop::report

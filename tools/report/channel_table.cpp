@@ -9,9 +9,7 @@
 #include "lcm/blocks.hpp"
 #include "log_reader.hpp"
 
-namespace hystloop::exporter {
-
-using report::decode_checked;
+namespace hystloop::report {
 
 namespace {
 
@@ -79,7 +77,7 @@ class Row {
       c.unit = type == ColumnType::kText ? "" : unit;
       c.description = description;
       c.type = type;
-      if (const auto* legend = report::find_code_legend(table_.type_name, name)) c.legend = legend->text();
+      if (const auto* legend = find_code_legend(table_.type_name, name)) c.legend = legend->text();
       columns.push_back(std::move(c));
     }
     Column& c = columns[index_++];
@@ -92,7 +90,7 @@ class Row {
   std::size_t index_ = 0;
 };
 
-using Kind = report::MessageKind;
+using Kind = MessageKind;
 
 constexpr const char* kUtime = "sender's time [us since the UNIX epoch]";
 
@@ -101,7 +99,7 @@ void times(Row& r, double t_s, std::int64_t recv_utime) {
       .i("recv_utime_us", "us", recv_utime, "the event's log timestamp: its receive time [us since the UNIX epoch]");
 }
 
-void sensor_fields(Row& r, const sensor_block_t& m, const SensorTick& k) {
+void fields(Row& r, const sensor_block_t& m, const SensorTick& k) {
   r.i("block_utime_us", "us", m.utime, "time of the block's first sample")
       .i("block_seq", "1", m.seq)
       .f("dt_s", "s", m.dt_s, "tick period")
@@ -116,7 +114,7 @@ void sensor_fields(Row& r, const sensor_block_t& m, const SensorTick& k) {
       .i("flags", "1", k.flags);
 }
 
-void command_fields(Row& r, const command_block_t& m, const CommandTick& k) {
+void fields(Row& r, const command_block_t& m, const CommandTick& k) {
   r.i("block_utime_us", "us", m.utime, kUtime)
       .i("block_seq", "1", m.seq)
       .i("sample_seq", "1", m.sample_seq, "last sensor tick the compensator had; -1 = none")
@@ -127,7 +125,7 @@ void command_fields(Row& r, const command_block_t& m, const CommandTick& k) {
       .i("mode", "1", k.mode);
 }
 
-void trajectory_fields(Row& r, const trajectory_t& m) {
+void fields(Row& r, const trajectory_t& m) {
   r.i("utime_us", "us", m.utime, kUtime)
       .i("version", "1", m.version)
       .i("shape", "1", m.shape)
@@ -144,7 +142,7 @@ void trajectory_fields(Row& r, const trajectory_t& m) {
       .ragged("points_y_m", "m", m.points_y_m, "n_points");
 }
 
-void params_fields(Row& r, const mem_params_t& m) {
+void fields(Row& r, const mem_params_t& m) {
   r.i("utime_us", "us", m.utime, kUtime)
       .i("version", "1", m.version)
       .i("publisher_id", "1", m.publisher_id)
@@ -158,7 +156,7 @@ void params_fields(Row& r, const mem_params_t& m) {
       .s("source", m.source);
 }
 
-void model_fields(Row& r, const model_params_t& m) {
+void fields(Row& r, const model_params_t& m) {
   r.i("format_version", "1", m.format_version)
       .i("utime_us", "us", m.utime, kUtime)
       .i("version", "1", m.version)
@@ -206,7 +204,7 @@ void model_fields(Row& r, const model_params_t& m) {
       .s("source", m.source);
 }
 
-void status_fields(Row& r, const service_status_t& m) {
+void fields(Row& r, const service_status_t& m) {
   r.i("utime_us", "us", m.utime, kUtime)
       .s("process", m.process)
       .s("host", m.host)
@@ -227,7 +225,7 @@ void status_fields(Row& r, const service_status_t& m) {
       .ragged("counter_values", "1", m.counter_values, "n_counters");
 }
 
-void control_fields(Row& r, const control_t& m) {
+void fields(Row& r, const control_t& m) {
   r.i("utime_us", "us", m.utime, kUtime)
       .i("request_id", "1", m.request_id)
       .i("command", "1", m.command)
@@ -246,10 +244,18 @@ void control_fields(Row& r, const control_t& m) {
       .i("learning", "1", m.learning);
 }
 
-struct Channel {
-  ChannelTable table;
-  Kind kind = Kind::kUnknown;
+// A message of no known type: its size only.
+struct Undecoded {
+  std::int64_t size_bytes = 0;
 };
+
+void fields(Row& r, const Undecoded& m) { r.i("size_bytes", "byte", m.size_bytes); }
+
+// The block messages, whose rows are their ticks, and their tick types.
+template <class M>
+constexpr bool kBlock = std::is_same_v<M, sensor_block_t> || std::is_same_v<M, command_block_t>;
+template <class M>
+using TickOf = std::conditional_t<std::is_same_v<M, sensor_block_t>, SensorTick, CommandTick>;
 
 }  // namespace
 
@@ -268,13 +274,21 @@ const Column* ChannelTable::find(const std::string& name) const noexcept {
   return nullptr;
 }
 
-std::string type_name_of(const lcm::LogEvent& event) { return report::lcm_type_name(report::message_kind(event)); }
+void ChannelTable::clear_rows() noexcept {
+  for (Column& c : columns) {
+    c.f64.clear();
+    c.i64.clear();
+    c.text.clear();
+  }
+  rows = 0;
+}
 
 struct TableBuilder::Impl {
   std::function<bool(const std::string&)> wanted;
   std::map<std::string, std::uint64_t> counts;
-  std::map<std::string, std::size_t> index;  // wanted channel -> position in channels
-  std::vector<Channel> channels;
+  std::map<std::string, std::size_t> index;  // wanted channel -> position in tables and kinds
+  std::vector<ChannelTable> tables;
+  std::vector<Kind> kinds;
   std::int64_t t0_utime = 0;
   double lower_s = 0.0, upper_s = 0.0;
   sensor_block_t sensor;
@@ -284,84 +298,73 @@ struct TableBuilder::Impl {
   model_params_t model;
   service_status_t status;
   control_t control;
+  Undecoded undecoded;
 
   double t_of(std::int64_t utime) const { return static_cast<double>(utime - t0_utime) * 1e-6; }
   bool in_range(double t) const { return t >= lower_s && t <= upper_s; }
 
-  // The columns of a kind, from a message with one of each array element.
-  static void define(Channel& c) {
-    Row r(c.table, true);
-    times(r, 0.0, 0);
-    switch (c.kind) {
-      case Kind::kSensor: sensor_fields(r, sensor_block_t{}, SensorTick{}); break;
-      case Kind::kCommand: command_fields(r, command_block_t{}, CommandTick{}); break;
-      case Kind::kTrajectory: trajectory_fields(r, trajectory_t{}); break;
-      case Kind::kParams: params_fields(r, mem_params_t{}); break;
-      case Kind::kModel: model_fields(r, model_params_t{}); break;
-      case Kind::kStatus: status_fields(r, service_status_t{}); break;
-      case Kind::kControl: control_fields(r, control_t{}); break;
-      default: r.i("size_bytes", "byte", 0); break;
+  // Calls f with the message a kind decodes into (reused from event to event).
+  template <class F>
+  bool with_message(Kind kind, F&& f) {
+    switch (kind) {
+      case Kind::kSensor: return f(sensor);
+      case Kind::kCommand: return f(command);
+      case Kind::kTrajectory: return f(trajectory);
+      case Kind::kParams: return f(params);
+      case Kind::kModel: return f(model);
+      case Kind::kStatus: return f(status);
+      case Kind::kControl: return f(control);
+      default: return f(undecoded);
     }
   }
 
+  // The columns of a kind, from an empty message (the per-tick fields of a block from an empty tick).
+  void define(ChannelTable& t, Kind kind) {
+    with_message(kind, [&](auto& m) {
+      using M = std::decay_t<decltype(m)>;
+      Row r(t, true);
+      times(r, 0.0, 0);
+      if constexpr (kBlock<M>) {
+        fields(r, M{}, TickOf<M>{});
+      } else {
+        fields(r, M{});
+      }
+      return true;
+    });
+  }
+
   // false: the event did not decode.
-  bool add(Channel& c, const lcm::LogEvent& e) {
-    ChannelTable& t = c.table;
+  bool add(ChannelTable& t, Kind kind, const lcm::LogEvent& e) {
     const double event_t = t_of(e.timestamp);
-    auto one_row = [&](auto&& fields) {
-      if (!in_range(event_t)) return;
+    auto row = [&](double row_t, auto&& fields_of) {
+      if (!in_range(row_t)) return;
       Row r(t, false);
-      times(r, event_t, e.timestamp);
-      fields(r);
+      times(r, row_t, e.timestamp);
+      fields_of(r);
       ++t.rows;
     };
-    switch (c.kind) {
-      case Kind::kSensor: {
-        if (!decode_checked(e, sensor)) return false;
+    return with_message(kind, [&](auto& m) {
+      using M = std::decay_t<decltype(m)>;
+      if constexpr (std::is_same_v<M, Undecoded>) {
+        m.size_bytes = e.datalen;
+      } else if (!decode_checked(e, m)) {
+        return false;
+      }
+      if constexpr (!kBlock<M>) {
+        row(event_t, [&](Row& r) { fields(r, m); });
+      } else {
         std::size_t i = 0;
-        for_each_tick(sensor, [&](const SensorTick& k) {
-          const double tick_t = t_of(report::tick_recv_utime(e.timestamp, sensor.n_ticks, i++, sensor.dt_s));
-          if (!in_range(tick_t)) return;
-          Row r(t, false);
-          times(r, tick_t, e.timestamp);
-          sensor_fields(r, sensor, k);
-          ++t.rows;
+        for_each_tick(m, [&](const auto& k) {
+          // A sensor tick is dated as the report's time axis dates it, a command tick by its block's arrival.
+          double tick_t = event_t;
+          if constexpr (std::is_same_v<M, sensor_block_t>) {
+            tick_t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
+          }
+          row(tick_t, [&](Row& r) { fields(r, m, k); });
         });
-        return true;
       }
-      case Kind::kCommand: {
-        if (!decode_checked(e, command)) return false;
-        if (!in_range(event_t)) return true;
-        for_each_tick(command, [&](const CommandTick& k) {
-          Row r(t, false);
-          times(r, event_t, e.timestamp);
-          command_fields(r, command, k);
-          ++t.rows;
-        });
-        return true;
-      }
-      case Kind::kTrajectory:
-        if (!decode_checked(e, trajectory)) return false;
-        one_row([&](Row& r) { trajectory_fields(r, trajectory); });
-        return true;
-      case Kind::kParams:
-        if (!decode_checked(e, params)) return false;
-        one_row([&](Row& r) { params_fields(r, params); });
-        return true;
-      case Kind::kModel:
-        if (!decode_checked(e, model)) return false;
-        one_row([&](Row& r) { model_fields(r, model); });
-        return true;
-      case Kind::kStatus:
-        if (!decode_checked(e, status)) return false;
-        one_row([&](Row& r) { status_fields(r, status); });
-        return true;
-      case Kind::kControl:
-        if (!decode_checked(e, control)) return false;
-        one_row([&](Row& r) { control_fields(r, control); });
-        return true;
-      default: one_row([&](Row& r) { r.i("size_bytes", "byte", e.datalen); }); return true;
-    }
+      return true;
+    });
   }
 };
 
@@ -376,33 +379,35 @@ TableBuilder::TableBuilder(std::function<bool(const std::string&)> wanted, std::
 
 TableBuilder::~TableBuilder() = default;
 
-void TableBuilder::add(const lcm::LogEvent& event) {
+ChannelTable* TableBuilder::add(const lcm::LogEvent& event) {
   auto [count, first] = impl_->counts.try_emplace(event.channel, 0);
   ++count->second;
   if (first && impl_->wanted(event.channel)) {  // the first event decides the channel's type and columns
-    Channel c;
-    c.table.channel = event.channel;
-    c.kind = report::message_kind(event);
-    c.table.type_name = report::lcm_type_name(c.kind);
-    Impl::define(c);
-    impl_->index[event.channel] = impl_->channels.size();
-    impl_->channels.push_back(std::move(c));
+    ChannelTable t;
+    t.channel = event.channel;
+    const Kind kind = message_kind(event);
+    t.type_name = lcm_type_name(kind);
+    impl_->define(t, kind);
+    impl_->index[event.channel] = impl_->tables.size();
+    impl_->tables.push_back(std::move(t));
+    impl_->kinds.push_back(kind);
   }
   const auto it = impl_->index.find(event.channel);
-  if (it == impl_->index.end()) return;
-  Channel& c = impl_->channels[it->second];
-  ++c.table.events;
-  if (!impl_->add(c, event)) ++c.table.skipped;
+  if (it == impl_->index.end()) return nullptr;
+  ChannelTable& t = impl_->tables[it->second];
+  ++t.events;
+  if (!impl_->add(t, impl_->kinds[it->second], event)) ++t.skipped;
+  return &t;
 }
 
 const std::map<std::string, std::uint64_t>& TableBuilder::channel_counts() const noexcept { return impl_->counts; }
 
 std::vector<ChannelTable> TableBuilder::take() {
-  std::vector<ChannelTable> tables;
-  for (Channel& c : impl_->channels) tables.push_back(std::move(c.table));
-  impl_->channels.clear();
+  std::vector<ChannelTable> tables = std::move(impl_->tables);
+  impl_->tables.clear();
+  impl_->kinds.clear();
   impl_->index.clear();
   return tables;
 }
 
-}  // namespace hystloop::exporter
+}  // namespace hystloop::report
