@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "models/model_descriptors.hpp"
 
 namespace hystloop {
 namespace {
@@ -20,8 +21,6 @@ std::string num(double v) {
   return buf;
 }
 
-std::string indexed(const char* name, std::size_t i) { return std::string(name) + "[" + std::to_string(i) + "]"; }
-
 void require_normal(const std::string& field, double value) {
   if (std::fpclassify(value) == FP_SUBNORMAL) {
     throw ParameterError(field, "is " + num(value) +
@@ -30,47 +29,13 @@ void require_normal(const std::string& field, double value) {
   }
 }
 
-void require_normal_shaping(const std::string& field, const ShapingFunction& s) {
-  require_normal(field + ".gain", s.gain);
-  require_normal(field + ".offset", s.offset);
-  for (std::size_t i = 0; i < s.coefficients.size(); ++i)
-    require_normal(indexed((field + ".coefficients").c_str(), i), s.coefficients[i]);
-  require_normal(field + ".domain_min", s.domain_min);
-  require_normal(field + ".domain_max", s.domain_max);
-  require_normal(field + ".amplitude", s.amplitude);
-  require_normal(field + ".scale", s.scale);
-}
-
+// Every number of the set, through its model's table: "mem.c1", "pi.weights[3]",
+// "katalenic.input_shaping.coefficients[2]".
 void require_normal_parameters(const ModelParamSet& set) {
-  switch (set.kind) {
-    case ModelKind::mem:
-      require_normal("mem.c1", set.mem.c1);
-      require_normal("mem.c2", set.mem.c2);
-      require_normal("mem.c3", set.mem.c3);
-      return;
-    case ModelKind::pi:
-      for (std::size_t i = 0; i < set.pi.count && i < kPiMaxOperators; ++i) {
-        require_normal(indexed("pi.thresholds", i), set.pi.thresholds[i]);
-        require_normal(indexed("pi.weights", i), set.pi.weights[i]);
-      }
-      return;
-    case ModelKind::linear:
-      require_normal("linear.gain", set.linear.gain);
-      require_normal("linear.offset", set.linear.offset);
-      return;
-    case ModelKind::katalenic: {
-      const KatalenicParams& k = set.katalenic;
-      require_normal("katalenic.k1", k.k1);
-      require_normal("katalenic.k2", k.k2);
-      require_normal("katalenic.k2_slope", k.k2_slope);
-      require_normal("katalenic.k2_domain_min", k.k2_domain_min);
-      require_normal("katalenic.k2_domain_max", k.k2_domain_max);
-      require_normal("katalenic.initial_offset", k.initial_offset);
-      require_normal_shaping("katalenic.input_shaping", k.input_shaping);
-      require_normal_shaping("katalenic.output_shaping", k.output_shaping);
-      return;
-    }
-  }
+  OnlineModels::visit(set.kind, [&]<class D>() {
+    for_each_number(D::table(), D::settings_of(set.*D::in_set),
+                    [](const std::string& name, double v) { require_normal(std::string(D::name) + "." + name, v); });
+  });
 }
 
 // The smallest and largest slope of a shaping function over [lo, hi].
@@ -172,8 +137,8 @@ void require_plausible(const ModelParamSet& set, const GainPlausibility& rig) {
         cumulative += model.pi.weights[i];
         if (!(cumulative >= lo) || !(cumulative <= hi)) {
           const bool below = !(cumulative >= lo);
-          refuse(indexed("pi.weights", i), "the slope w_0 + ... + w_" + std::to_string(i) + " of a branch", cumulative,
-                 below, rig);
+          refuse("pi.weights[" + std::to_string(i) + "]",
+                 "the slope w_0 + ... + w_" + std::to_string(i) + " of a branch", cumulative, below, rig);
         }
       }
       refuse("pi.weights", "the slope of a branch", low ? g.min_m_per_V : g.max_m_per_V, low, rig);

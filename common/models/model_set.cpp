@@ -3,17 +3,20 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "models/model_descriptors.hpp"
 
 namespace hystloop {
 
 std::string_view to_string(ModelKind kind) noexcept {
-  switch (kind) {
-    case ModelKind::mem: return "mem";
-    case ModelKind::pi: return "pi";
-    case ModelKind::katalenic: return "katalenic";
-    case ModelKind::linear: return "linear";
-  }
-  return "unknown";
+  std::string_view name = "unknown";
+  OnlineModels::visit(kind, [&]<class D>() { name = D::name; });
+  return name;
+}
+
+std::string describe_model(const ModelParamSet& set) {
+  std::string summary = "?";
+  OnlineModels::visit(set.kind, [&]<class D>() { summary = D::summary_of(set.*D::in_set); });
+  return std::string(to_string(set.kind)) + ": " + summary;
 }
 
 std::optional<ModelKind> parse_model_kind(std::string_view name) noexcept {
@@ -31,7 +34,7 @@ std::optional<ModelKind> model_kind_from_int(std::int64_t value) noexcept {
 
 namespace {
 template <class Params>
-void validate_prefixed(const Params& params, const char* prefix) {
+void validate_prefixed(const Params& params, std::string_view prefix) {
   try {
     params.validate();
   } catch (const ParameterError& e) {
@@ -43,13 +46,9 @@ void validate_prefixed(const Params& params, const char* prefix) {
 
 void ModelParamSet::validate(double dt_s) const {
   if (stage) stage->validate(dt_s);
-  switch (kind) {
-    case ModelKind::mem: return validate_prefixed(mem, "mem");
-    case ModelKind::pi: return validate_prefixed(pi, "pi");
-    case ModelKind::katalenic: return validate_prefixed(katalenic, "katalenic");
-    case ModelKind::linear: return validate_prefixed(linear, "linear");
+  if (!OnlineModels::visit(kind, [&]<class D>() { validate_prefixed(this->*D::in_set, D::name); })) {
+    throw ParameterError("kind", "names no model");
   }
-  throw ParameterError("kind", "names no model");
 }
 
 }  // namespace hystloop

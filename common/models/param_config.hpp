@@ -37,10 +37,13 @@ std::vector<Assignment> config_section(const Config& config, std::string_view mo
 
 // D's (model_descriptors.hpp) section onto `settings` (the defaults), built and validated. Throws
 // ParameterError naming the field below the section ("c1", an unknown one too): run it in
-// validate_config_section(config, "<model>.", ...) for a ConfigError naming the key.
+// validate_config_section(config, "<section>.", ...) for a ConfigError naming the key. The
+// section is the model's name unless another part of the config holds the model's parameters
+// (the bridge's ro: a MEM).
 template <class D>
-typename D::Params params_from_config(const Config& config, typename D::Settings settings) {
-  apply(D::table(), D::name, config_section(config, D::name, D::table()), settings);
+typename D::Params params_from_config(const Config& config, typename D::Settings settings,
+                                      std::string_view section = D::name) {
+  apply(D::table(), D::name, config_section(config, section, D::table()), settings);
   typename D::Params params = D::build(settings);
   params.validate();
   return params;

@@ -114,6 +114,19 @@ const ParamSpec<S>* find_spec(std::span<const ParamSpec<S>> table, std::string_v
   return nullptr;
 }
 
+// f(name, value) for every number `s` holds by the table: a number row's value, a list row's
+// entries as "name[i]". Read back from show(), which is exact (format_number round-trips).
+template <class S, class F>
+void for_each_number(std::span<const ParamSpec<S>> table, const S& s, F&& f) {
+  for (const auto& p : table) {
+    const Assignment shown{std::string(p.name), p.show(s), std::string(p.name)};
+    if (p.kind == ValueKind::number) f(shown.name, parse_number(shown));
+    if (p.kind != ValueKind::list) continue;
+    const std::vector<double> values = parse_list(shown);
+    for (std::size_t i = 0; i < values.size(); ++i) f(shown.name + "[" + std::to_string(i) + "]", values[i]);
+  }
+}
+
 // Refusal of an unknown name, listing the valid ones and the likely one.
 [[noreturn]] void throw_unknown(const Assignment& a, std::string_view model, const std::vector<ParamInfo>& valid);
 

@@ -46,14 +46,12 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "rt.priority",
                                                 "rt.io_priority",
                                                 "rt.lock_memory",
-                                                "rt.cpu",
-                                                "ro.c1",
-                                                "ro.c2",
-                                                "ro.c3"};
+                                                "rt.cpu"};
   static const std::vector<std::string> all = [] {
     std::vector<std::string> k = keys;
     k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
     append_config_keys(k, BanningDescriptor::name, BanningDescriptor::table());  // the simulated stage
+    append_config_keys(k, "ro", MemDescriptor::table());                         // the Ramberg-Osgood plant
     return k;
   }();
   return all;
@@ -89,10 +87,9 @@ BridgeSettings load_bridge_settings(const Config& config) {
   // The keys hystloop-identify --model banning writes, through the same table.
   validate_config_section(config, "banning.",
                           [&] { st.banning = params_from_config<BanningDescriptor>(config, st.banning); });
-  st.ramberg_osgood.c1 = config.get_positive("ro.c1", st.ramberg_osgood.c1);
-  st.ramberg_osgood.c2 = config.get_non_negative("ro.c2", st.ramberg_osgood.c2);
-  st.ramberg_osgood.c3 = config.get_positive("ro.c3", st.ramberg_osgood.c3);
-  validate_config_section(config, "ro.", [&] { st.ramberg_osgood.validate(); });
+  // The Ramberg-Osgood plant is a MEM: its keys are the MEM's (ro.c1, ro.c2, ro.c3).
+  validate_config_section(
+      config, "ro.", [&] { st.ramberg_osgood = params_from_config<MemDescriptor>(config, st.ramberg_osgood, "ro"); });
   validate_config_section(config, "", [&] { st.validate(); });
 
   ActuatorLimits& a = s.limits;
@@ -161,8 +158,7 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   } else if (s.backend == "sim") {
     lines.push_back("banning: " + BanningDescriptor::summary_of(st.banning));
   } else {
-    lines.push_back(fmt::format("ro: c1 {} m/V, c2 {} m/V^(1+c3), c3 {}", st.ramberg_osgood.c1, st.ramberg_osgood.c2,
-                                st.ramberg_osgood.c3));
+    lines.push_back("ro: " + MemDescriptor::summary_of(st.ramberg_osgood));
   }
   lines.push_back(fmt::format("servo: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}", s.servo.kp,
                               s.servo.ki, s.servo.kd, s.servo.nominal_gain_m_per_V,

@@ -94,9 +94,8 @@ void CompensatorService::on_params(const mem_params_t& msg) {
 }
 
 void CompensatorService::on_model(const model_params_t& msg) {
-  const std::string_view what = msg.kind >= 0 && msg.kind < kModelKindCount
-                                    ? to_string(static_cast<ModelKind>(msg.kind))
-                                    : std::string_view("model");
+  const std::optional<ModelKind> kind = model_kind_from_int(msg.kind);
+  const std::string_view what = kind ? to_string(*kind) : std::string_view("model");
   const ParamsHeader h{what, msg.version, msg.publisher_id, msg.valid != 0, msg.source, msg.residual_m};
   const bool format_known = msg.format_version == model_params_t::FORMAT_VERSION;
   const std::optional<ModelParamSet> set = format_known ? model_from_message(msg) : std::nullopt;
@@ -114,17 +113,6 @@ void CompensatorService::on_model(const model_params_t& msg) {
     return;
   }
   if (admit(h)) offer(h, *set, true);
-}
-
-std::string describe_model(const ModelParamSet& set) {
-  std::string summary = "?";
-  switch (set.kind) {
-    case ModelKind::mem: summary = MemDescriptor::summary_of(set.mem); break;
-    case ModelKind::pi: summary = PiDescriptor::summary_of(set.pi); break;
-    case ModelKind::katalenic: summary = KatalenicDescriptor::summary_of(set.katalenic); break;
-    case ModelKind::linear: summary = LinearDescriptor::summary_of(set.linear); break;
-  }
-  return std::string(to_string(set.kind)) + ": " + summary;
 }
 
 }  // namespace hystloop

@@ -26,14 +26,20 @@ TrajectoryShape parse_shape(const Config& config, const std::string& name) {
 // hystloop-model reads. A refused value names the key.
 template <class D>
 typename D::Params read_model_section(const Config& config, typename D::Settings settings) {
-  const std::vector<Assignment> assignments = config_section(config, D::name, D::table());
   typename D::Params params;
-  validate_config_section(config, std::string(D::name) + ".", [&] {
-    apply(D::table(), D::name, assignments, settings);
-    params = D::build(settings);
-    params.validate();
-  });
+  validate_config_section(config, std::string(D::name) + ".",
+                          [&] { params = params_from_config<D>(config, std::move(settings)); });
   return params;
+}
+
+// Every model the compensator is configured with, as one set (of no particular kind).
+ModelParamSet configured_models(const CompensatorConfig& c) {
+  ModelParamSet set;
+  set.mem = c.mem;
+  set.pi = c.pi;
+  set.katalenic = c.katalenic;
+  set.linear = c.linear;
+  return set;
 }
 
 // compensator.plausible_gain_factor, and the models the file sets (and the one the mode starts
@@ -49,19 +55,15 @@ void read_plausibility(const Config& config, CompensatorSettings& s) {
   }
   const GainPlausibility rig = gain_plausibility(s);  // its parts were checked by their own keys
   const std::vector<std::string> keys = config.keys();
-  for (int i = 0; i < kModelKindCount; ++i) {
-    ModelParamSet set;
-    set.kind = static_cast<ModelKind>(i);
-    const std::string section = std::string(to_string(set.kind)) + ".";
+  ModelParamSet set = configured_models(c);
+  OnlineModels::for_each([&]<class D>() {
+    const std::string section = std::string(D::name) + ".";
     const bool in_file =
         std::any_of(keys.begin(), keys.end(), [&](const std::string& k) { return k.rfind(section, 0) == 0; });
-    if (!in_file && model_kind_of(c.mode) != set.kind) continue;
-    set.mem = c.mem;
-    set.pi = c.pi;
-    set.katalenic = c.katalenic;
-    set.linear = c.linear;
+    if (!in_file && model_kind_of(c.mode) != D::kind) return;
+    set.kind = D::kind;
     validate_config_section(config, "", [&] { require_plausible(set, rig); });
-  }
+  });
 }
 
 }  // namespace
@@ -113,10 +115,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "trajectory.shape_if_infeasible",
                                   "trajectory.points_t_s",
                                   "trajectory.points_y_m"};
-    append_config_keys(k, MemDescriptor::name, MemDescriptor::table());
-    append_config_keys(k, PiDescriptor::name, PiDescriptor::table());
-    append_config_keys(k, LinearDescriptor::name, LinearDescriptor::table());
-    append_config_keys(k, KatalenicDescriptor::name, KatalenicDescriptor::table());
+    OnlineModels::for_each([&]<class D>() { append_config_keys(k, D::name, D::table()); });
     return k;
   }();
   return keys;
@@ -238,10 +237,11 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("compensator: mode {}, plans {} ticks ({:.4g} s) ahead, dt {} s{}", to_string(c.mode),
                               c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
                               s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
-  lines.push_back("mem: " + MemDescriptor::summary_of(c.mem));
-  lines.push_back("pi: " + PiDescriptor::summary_of(c.pi));
-  lines.push_back("linear: " + LinearDescriptor::summary_of(c.linear));
-  lines.push_back("katalenic: " + KatalenicDescriptor::summary_of(c.katalenic));
+  ModelParamSet models = configured_models(c);
+  OnlineModels::for_each([&]<class D>() {
+    models.kind = D::kind;
+    lines.push_back(describe_model(models));
+  });
   lines.push_back(fmt::format(
       "actuator: u in [{}, {}] V, slew {:.4g} V/s (an experiment uses at most {:.0f} % of it, a trajectory {:.0f} %)",
       c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction, 100.0 * c.tracking_slew_fraction()));
