@@ -32,6 +32,7 @@
 #include "lcm/model_params_fixtures.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
+#include "integration/probe_common.hpp"
 
 namespace hystloop {
 namespace {
@@ -50,30 +51,16 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  if (argc < 2) throw std::invalid_argument("usage: lcm_probe publish|subscribe|write-log|check-log [options]");
-  o.mode = argv[1];
-  for (int i = 2; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    const std::string value = argv[i + 1];
-    if (key == "--url")
-      o.url = value;
-    else if (key == "--prefix")
-      o.prefix = value;
-    else if (key == "--file")
-      o.file = value;
-    else if (key == "--ready-file")
-      o.ready_file = value;
-    else if (key == "--ignore-prefix")
-      o.ignore_prefix = value;
-    else if (key == "--rounds")
-      o.rounds = std::stoll(value);
-    else if (key == "--rate-hz")
-      o.rate_hz = std::stod(value);
-    else if (key == "--timeout-s")
-      o.timeout_s = std::stod(value);
-    else
-      throw std::invalid_argument("unknown option " + key);
-  }
+  o.mode = probe::mode_of(argc, argv, "usage: lcm_probe publish|subscribe|write-log|check-log|echo|ping [options]");
+  probe::parse_options(argc, argv,
+                       {{"--url", &o.url},
+                        {"--prefix", &o.prefix},
+                        {"--file", &o.file},
+                        {"--ready-file", &o.ready_file},
+                        {"--ignore-prefix", &o.ignore_prefix},
+                        {"--rounds", &o.rounds},
+                        {"--rate-hz", &o.rate_hz},
+                        {"--timeout-s", &o.timeout_s}});
   return o;
 }
 
@@ -110,11 +97,16 @@ model_params_t fixture_for(const model_params_t*, std::int64_t i) { return fixtu
 service_status_t fixture_for(const service_status_t*, std::int64_t i) { return fixtures::status(i); }
 control_t fixture_for(const control_t*, std::int64_t i) { return fixtures::control(i); }
 
-// Checks what arrives on one channel against the fixtures.
+// Subscribes to one channel and checks what arrives there against the fixtures. `queue` (0: LCM's
+// default) sizes the subscription's queue.
 template <class T>
 class Expectation {
  public:
-  Expectation(std::string channel, std::int64_t expected) : channel_(std::move(channel)), expected_(expected) {}
+  Expectation(lcm::LCM& lcm, std::string channel, std::int64_t expected, int queue)
+      : channel_(std::move(channel)),
+        expected_(expected),
+        subscription_(
+            lcm, channel_, [this](const T& m, std::int64_t) { see(m); }, queued(queue)) {}
 
   void see(const T& msg) {
     const std::int64_t i = index_of(msg);
@@ -126,8 +118,15 @@ class Expectation {
       ++altered_;
     }
   }
+  // An event of a log file: true when it is on this channel (and then received as LCM would deliver it).
+  bool receive(const lcm::LogEvent& event) {
+    if (event.channel != channel_) return false;
+    subscription_.receive(event.data, static_cast<std::size_t>(event.datalen), event.timestamp);
+    return true;
+  }
   bool complete() const { return static_cast<std::int64_t>(seen_.size()) == expected_; }
-  bool report(std::uint64_t rejected) const {
+  bool report() const {
+    const std::uint64_t rejected = subscription_.counters().rejected_total();
     const bool ok = complete() && altered_ == 0 && duplicates_ == 0 && rejected == 0;
     std::printf("%-16s expected %6lld  intact %6zu  altered %4lld  duplicate %4lld  rejected %4llu  %s\n",
                 channel_.c_str(), static_cast<long long>(expected_), seen_.size(), static_cast<long long>(altered_),
@@ -141,21 +140,47 @@ class Expectation {
   std::set<std::int64_t> seen_;
   std::int64_t altered_ = 0;
   std::int64_t duplicates_ = 0;
+  Subscription<T> subscription_;
+
+  static typename Subscription<T>::Options queued(int queue) {
+    typename Subscription<T>::Options options;
+    options.queue_capacity = queue;
+    return options;
+  }
 };
 
-// All seven expectations, fed either by Subscriptions or by a log file.
+// All seven expectations, fed either by LCM or by a log file's events. `queue` sizes the queues of
+// the channels with a message every round (sensor, command).
 struct Expectations {
-  Expectations(const ChannelNames& ch, std::int64_t rounds)
-      : sensor(ch.sensor, rounds),
-        command(ch.command, rounds),
-        trajectory(ch.trajectory, rare_rounds(rounds)),
-        params(ch.params, rare_rounds(rounds)),
-        model(ch.model, rare_rounds(rounds)),
-        status(ch.status, rare_rounds(rounds)),
-        control(ch.control, rare_rounds(rounds)) {}
-  bool complete() const {
-    return sensor.complete() && command.complete() && trajectory.complete() && params.complete() && model.complete() &&
-           status.complete() && control.complete();
+  Expectations(lcm::LCM& lcm, const ChannelNames& ch, std::int64_t rounds, int queue = 0)
+      : sensor(lcm, ch.sensor, rounds, queue),
+        command(lcm, ch.command, rounds, queue),
+        trajectory(lcm, ch.trajectory, rare_rounds(rounds), 0),
+        params(lcm, ch.params, rare_rounds(rounds), 0),
+        model(lcm, ch.model, rare_rounds(rounds), 0),
+        status(lcm, ch.status, rare_rounds(rounds), 0),
+        control(lcm, ch.control, rare_rounds(rounds), 0) {}
+  // Calls f on each expectation, in the order of a round.
+  template <class F>
+  void each(F&& f) {
+    f(sensor), f(command), f(trajectory), f(params), f(model), f(status), f(control);
+  }
+  bool complete() {
+    bool all = true;
+    each([&](const auto& e) { all = all && e.complete(); });
+    return all;
+  }
+  // Prints a line a channel; true when every one is intact.
+  bool report() {
+    bool ok = true;
+    each([&](const auto& e) { ok = e.report() && ok; });
+    return ok;
+  }
+  // A log file's event: true when it is on one of the seven channels.
+  bool receive(const lcm::LogEvent& event) {
+    bool ours = false;
+    each([&](auto& e) { ours = ours || e.receive(event); });
+    return ours;
   }
   Expectation<sensor_block_t> sensor;
   Expectation<command_block_t> command;
@@ -215,22 +240,7 @@ int publish(const Options& o) {
 int subscribe(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
-  Expectations expect(ch, o.rounds);
-  const int queue = static_cast<int>(2 * o.rounds + 64);  // a slow start must not drop
-  Subscription<sensor_block_t>::Options so;
-  so.queue_capacity = queue;
-  Subscription<command_block_t>::Options co;
-  co.queue_capacity = queue;
-  Subscription<sensor_block_t> sensor(
-      *lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); }, so);
-  Subscription<command_block_t> command(
-      *lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); }, co);
-  Subscription<trajectory_t> trajectory(*lcm, ch.trajectory,
-                                        [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
-  Subscription<mem_params_t> params(*lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
-  Subscription<model_params_t> model(*lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
-  Subscription<service_status_t> status(*lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
-  Subscription<control_t> control(*lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
+  Expectations expect(*lcm, ch, o.rounds, static_cast<int>(2 * o.rounds + 64));  // a slow start must not drop
   if (!o.ready_file.empty()) std::ofstream(o.ready_file) << "ready\n";
 
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
@@ -241,14 +251,7 @@ int subscribe(const Options& o) {
     }
   }
   handle_pending(*lcm, std::chrono::milliseconds(50));  // late duplicates would show here
-  bool ok = expect.sensor.report(sensor.counters().rejected_total());
-  ok = expect.command.report(command.counters().rejected_total()) && ok;
-  ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
-  ok = expect.params.report(params.counters().rejected_total()) && ok;
-  ok = expect.model.report(model.counters().rejected_total()) && ok;
-  ok = expect.status.report(status.counters().rejected_total()) && ok;
-  ok = expect.control.report(control.counters().rejected_total()) && ok;
-  return ok ? 0 : 1;
+  return expect.report() ? 0 : 1;
 }
 
 int write_log(const Options& o) {
@@ -278,42 +281,12 @@ int check_log(const Options& o) {
   if (!log.good()) throw std::runtime_error("cannot read " + o.file);
   // A memq LCM only to host the Subscriptions: events are fed to receive() directly.
   lcm::LCM lcm("memq://");
-  Expectations expect(ch, o.rounds);
-  Subscription<sensor_block_t> sensor(lcm, ch.sensor, [&](const auto& m, std::int64_t) { expect.sensor.see(m); });
-  Subscription<command_block_t> command(lcm, ch.command, [&](const auto& m, std::int64_t) { expect.command.see(m); });
-  Subscription<trajectory_t> trajectory(lcm, ch.trajectory,
-                                        [&](const auto& m, std::int64_t) { expect.trajectory.see(m); });
-  Subscription<mem_params_t> params(lcm, ch.params, [&](const auto& m, std::int64_t) { expect.params.see(m); });
-  Subscription<model_params_t> model(lcm, ch.model, [&](const auto& m, std::int64_t) { expect.model.see(m); });
-  Subscription<service_status_t> status(lcm, ch.status, [&](const auto& m, std::int64_t) { expect.status.see(m); });
-  Subscription<control_t> control(lcm, ch.control, [&](const auto& m, std::int64_t) { expect.control.see(m); });
+  Expectations expect(lcm, ch, o.rounds);
   std::int64_t other = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
-    const auto size = static_cast<std::size_t>(event->datalen);
-    if (event->channel == ch.sensor)
-      sensor.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.command)
-      command.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.trajectory)
-      trajectory.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.params)
-      params.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.model)
-      model.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.status)
-      status.receive(event->data, size, event->timestamp);
-    else if (event->channel == ch.control)
-      control.receive(event->data, size, event->timestamp);
-    else if (o.ignore_prefix.empty() || event->channel.rfind(o.ignore_prefix, 0) != 0)
-      ++other;
+    if (!expect.receive(*event) && (o.ignore_prefix.empty() || event->channel.rfind(o.ignore_prefix, 0) != 0)) ++other;
   }
-  bool ok = expect.sensor.report(sensor.counters().rejected_total());
-  ok = expect.command.report(command.counters().rejected_total()) && ok;
-  ok = expect.trajectory.report(trajectory.counters().rejected_total()) && ok;
-  ok = expect.params.report(params.counters().rejected_total()) && ok;
-  ok = expect.model.report(model.counters().rejected_total()) && ok;
-  ok = expect.status.report(status.counters().rejected_total()) && ok;
-  ok = expect.control.report(control.counters().rejected_total()) && ok;
+  const bool ok = expect.report();
   if (other != 0) std::printf("%lld events on other channels\n", static_cast<long long>(other));
   return ok && other == 0 ? 0 : 1;
 }
@@ -387,22 +360,19 @@ int ping(const Options& o) {
   return static_cast<std::int64_t>(rtt_us.size()) == o.rounds ? 0 : 1;
 }
 
+int run(int argc, char** argv) {
+  return probe::run_mode("lcm_probe", parse(argc, argv),
+                         {{"publish", publish},
+                          {"subscribe", subscribe},
+                          {"write-log", write_log},
+                          {"check-log", check_log},
+                          {"echo", echo},
+                          {"ping", ping}});
+}
+
 }  // namespace
 }  // namespace hystloop
 
 int main(int argc, char** argv) {
-  try {
-    const auto o = hystloop::parse(argc, argv);
-    if (o.mode == "publish") return hystloop::publish(o);
-    if (o.mode == "subscribe") return hystloop::subscribe(o);
-    if (o.mode == "write-log") return hystloop::write_log(o);
-    if (o.mode == "check-log") return hystloop::check_log(o);
-    if (o.mode == "echo") return hystloop::echo(o);
-    if (o.mode == "ping") return hystloop::ping(o);
-    std::fprintf(stderr, "lcm_probe: unknown mode %s\n", o.mode.c_str());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "lcm_probe: %s\n", e.what());
-    return 2;
-  }
+  return hystloop::probe::run_probe("lcm_probe", [&] { return hystloop::run(argc, argv); });
 }

@@ -45,6 +45,7 @@
 #include "lcm/message_fixtures.hpp"
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
+#include "integration/probe_common.hpp"
 
 namespace hystloop {
 namespace {
@@ -66,39 +67,20 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  if (argc < 2) throw std::invalid_argument("usage: logger_probe publish|check-log|shutdown [options]");
-  o.mode = argv[1];
-  for (int i = 2; i < argc; ++i) {
-    const std::string key = argv[i];
-    if (key.rfind("--", 0) != 0) {
-      o.files.push_back(key);
-      continue;
-    }
-    if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
-    const std::string value = argv[++i];
-    if (key == "--url")
-      o.url = value;
-    else if (key == "--prefix")
-      o.prefix = value;
-    else if (key == "--blocks")
-      o.blocks = std::stoll(value);
-    else if (key == "--block-ticks")
-      o.block_ticks = std::stoll(value);
-    else if (key == "--gap-at")
-      o.gap_at = std::stoll(value);
-    else if (key == "--gap-len")
-      o.gap_len = std::stoll(value);
-    else if (key == "--commands")
-      o.commands = std::stoll(value);
-    else if (key == "--rate-hz")
-      o.rate_hz = std::stod(value);
-    else if (key == "--wait-logger-s")
-      o.wait_logger_s = std::stod(value);
-    else if (key == "--seconds")
-      o.seconds = std::stod(value);
-    else
-      throw std::invalid_argument("unknown option " + key);
-  }
+  o.mode = probe::mode_of(
+      argc, argv, "usage: logger_probe publish|check-log|shutdown|wait-logger|sync|read-logs|watch-status [options]");
+  probe::parse_options(argc, argv,
+                       {{"--url", &o.url},
+                        {"--prefix", &o.prefix},
+                        {"--blocks", &o.blocks},
+                        {"--block-ticks", &o.block_ticks},
+                        {"--gap-at", &o.gap_at},
+                        {"--gap-len", &o.gap_len},
+                        {"--commands", &o.commands},
+                        {"--rate-hz", &o.rate_hz},
+                        {"--wait-logger-s", &o.wait_logger_s},
+                        {"--seconds", &o.seconds}},
+                       &o.files);
   if (o.block_ticks < 1 || o.block_ticks > sensor_block_t::MAX_TICKS)
     throw std::invalid_argument("--block-ticks: 1..1000");
   return o;
@@ -368,35 +350,23 @@ int sync_logger(const Options& o) {
 int shutdown(const Options& o) {
   const ChannelNames ch(o.prefix);
   auto lcm = open_lcm(o.url);
-  control_t msg{};
-  msg.utime = fixtures::kBaseUtime;
-  msg.request_id = 4242;
-  msg.command = control_t::SHUTDOWN;
-  msg.target = "logger";
-  Publisher<control_t> publisher(*lcm, ch.control);
-  // Repeated, as senders do over UDP: the logger acts once.
-  bool ok = true;
-  for (int i = 0; i < 3; ++i) ok = publisher.publish(msg) && ok;
-  return ok ? 0 : 1;
+  return probe::send_shutdown(*lcm, ch.control, "logger", fixtures::kBaseUtime) ? 0 : 1;
+}
+
+int run(int argc, char** argv) {
+  return probe::run_mode("logger_probe", parse(argc, argv),
+                         {{"publish", publish},
+                          {"check-log", check_log},
+                          {"shutdown", shutdown},
+                          {"wait-logger", wait_logger},
+                          {"sync", sync_logger},
+                          {"read-logs", read_logs},
+                          {"watch-status", watch_status}});
 }
 
 }  // namespace
 }  // namespace hystloop
 
 int main(int argc, char** argv) {
-  try {
-    const hystloop::Options o = hystloop::parse(argc, argv);
-    if (o.mode == "publish") return hystloop::publish(o);
-    if (o.mode == "check-log") return hystloop::check_log(o);
-    if (o.mode == "shutdown") return hystloop::shutdown(o);
-    if (o.mode == "wait-logger") return hystloop::wait_logger(o);
-    if (o.mode == "sync") return hystloop::sync_logger(o);
-    if (o.mode == "read-logs") return hystloop::read_logs(o);
-    if (o.mode == "watch-status") return hystloop::watch_status(o);
-    std::fprintf(stderr, "logger_probe: unknown mode %s\n", o.mode.c_str());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "logger_probe: %s\n", e.what());
-    return 2;
-  }
+  return hystloop::probe::run_probe("logger_probe", [&] { return hystloop::run(argc, argv); });
 }

@@ -52,6 +52,7 @@
 #include "lcm/publisher.hpp"
 #include "lcm/subscription.hpp"
 #include "models/mem.hpp"
+#include "integration/probe_common.hpp"
 
 namespace hystloop {
 namespace {
@@ -77,33 +78,19 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  if (argc < 2) throw std::invalid_argument("usage: reident_stream good|garbage --url U [options]");
-  o.mode = argv[1];
+  o.mode = probe::mode_of(argc, argv, "usage: reident_stream good|garbage|shutdown|status --url U [options]");
   if (o.mode != "good" && o.mode != "garbage" && o.mode != "shutdown" && o.mode != "status") {
     throw std::invalid_argument("mode must be good, garbage, shutdown or status");
   }
-  for (int i = 2; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    const std::string value = argv[i + 1];
-    if (key == "--url")
-      o.url = value;
-    else if (key == "--prefix")
-      o.prefix = value;
-    else if (key == "--duration-s")
-      o.duration_s = std::stod(value);
-    else if (key == "--phase-s")
-      o.phase_s = std::stod(value);
-    else if (key == "--frequency-hz")
-      o.frequency_hz = std::stod(value);
-    else if (key == "--tolerance")
-      o.tolerance = std::stod(value);
-    else if (key == "--settle-s")
-      o.settle_s = std::stod(value);
-    else if (key == "--expect-invalid")
-      o.expect_invalid = value == "1";
-    else
-      throw std::invalid_argument("unknown option " + key);
-  }
+  probe::parse_options(argc, argv,
+                       {{"--url", &o.url},
+                        {"--prefix", &o.prefix},
+                        {"--duration-s", &o.duration_s},
+                        {"--phase-s", &o.phase_s},
+                        {"--frequency-hz", &o.frequency_hz},
+                        {"--tolerance", &o.tolerance},
+                        {"--settle-s", &o.settle_s},
+                        {"--expect-invalid", &o.expect_invalid}});
   return o;
 }
 
@@ -142,13 +129,7 @@ class Stream {
     }
     if (o_.mode == "status") return 0;
     if (o_.mode == "shutdown") {
-      control_t c{};
-      c.utime = 1;
-      c.request_id = 4242;
-      c.command = control_t::SHUTDOWN;
-      c.target = "reidentifier";
-      Publisher<control_t> control(*lcm_, names_.control);
-      for (int i = 0; i < 3; ++i) control.publish(c);  // repeated, as over UDP: acted on once
+      probe::send_shutdown(*lcm_, names_.control, "reidentifier", 1);  // its status is not this mode's verdict
       return 0;
     }
     return o_.mode == "good" ? run_good() : run_garbage();
@@ -244,6 +225,14 @@ class Stream {
     }
   }
 
+  // One check of a mode's verdict: a failed one is printed and counted.
+  void check(bool ok, const std::string& what) {
+    if (!ok) {
+      std::fprintf(stderr, "reident_stream: FAIL: %s\n", what.c_str());
+      ++failures_;
+    }
+  }
+
   std::int64_t counter(const std::string& name) const {
     const auto it = seen_.counters.find(name);
     return it == seen_.counters.end() ? -1 : it->second;
@@ -287,13 +276,6 @@ class Stream {
     });
     settle();
     print_figures();
-    int failures = 0;
-    auto check = [&](bool ok, const std::string& what) {
-      if (!ok) {
-        std::fprintf(stderr, "reident_stream: FAIL: %s\n", what.c_str());
-        ++failures;
-      }
-    };
     check(seen_.valid_params >= 1, "no valid HX_PARAMS from the re-identifier");
     if (seen_.valid_params >= 1) {
       const mem_params_t& b = seen_.best;
@@ -322,7 +304,7 @@ class Stream {
     check(counter("params_version_applied") == kAppliedVersion, "the applied version (HX_COMMAND) is not reported");
     check(counter("refits_accepted") >= 1, "status does not count the accepted refit");
     check(counter("seq_gaps") == 0, "samples were lost on the way");
-    return failures == 0 ? 0 : 1;
+    return failures_ == 0 ? 0 : 1;
   }
 
   int run_garbage() {
@@ -349,13 +331,6 @@ class Stream {
     });
     settle();
     print_figures();
-    int failures = 0;
-    auto check = [&](bool ok, const std::string& what) {
-      if (!ok) {
-        std::fprintf(stderr, "reident_stream: FAIL: %s\n", what.c_str());
-        ++failures;
-      }
-    };
     check(seen_.valid_params == 0, "garbage produced a valid HX_PARAMS");
     check(seen_.invalid_params == 0, "a valid = false set was published without --publish-invalid");
     check(counter("refits_accepted") == 0, "status counts an accepted refit");
@@ -369,7 +344,7 @@ class Stream {
       if (name.rfind("refits_", 0) == 0 && value > 0)
         std::printf("reident_stream: %s = %lld\n", name.c_str(), static_cast<long long>(value));
     }
-    return failures == 0 ? 0 : 1;
+    return failures_ == 0 ? 0 : 1;
   }
 
   Options o_;
@@ -385,6 +360,7 @@ class Stream {
   command_block_t commands_{};
   std::int64_t seq_ = 0;        // next sensor tick
   std::int64_t commanded_ = 0;  // next tick without a command
+  int failures_ = 0;            // of check()
   clock::time_point stream_start_ = clock::now();
 };
 
@@ -392,15 +368,11 @@ class Stream {
 }  // namespace hystloop
 
 int main(int argc, char** argv) {
-  try {
-    const hystloop::Options o = hystloop::parse(argc, argv);
-    hystloop::Stream stream(o);
-    return stream.run();
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "reident_stream: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "reident_stream: %s\n", e.what());
-    return 1;
-  }
+  return hystloop::probe::run_probe(
+      "reident_stream",
+      [&] {
+        hystloop::Stream stream(hystloop::parse(argc, argv));
+        return stream.run();
+      },
+      1);
 }
