@@ -5,25 +5,18 @@
 
 #include <gtest/gtest.h>
 
+#include "sequence_stream.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
 namespace {
 
-using V = SequenceGuard::Verdict;
-constexpr std::int64_t kStep = 500;        // ticks (the compensator's horizon)
-constexpr std::int64_t kWindow = 100'000;  // us
-constexpr std::int64_t kBlock = 20;        // ticks per block, one block every 2 ms
-constexpr std::int64_t kPeriod = 2'000;    // us
+using testing::V;
 
-struct Stream {
-  SequenceGuard guard{kStep, kWindow};
+// Every block through the discontinuities' check.
+struct Stream : testing::GuardStream {
+  Stream() { via = &d; }
   SequenceDiscontinuities d;
-  std::int64_t t_us = 0;
-  V send(std::int64_t seq) { return d.check(guard, seq, kBlock, t_us += kPeriod); }
-  void run(std::int64_t from, std::int64_t to) {
-    for (std::int64_t s = from; s < to; s += kBlock) ASSERT_EQ(send(s), V::take) << s;
-  }
 };
 
 TEST(SequenceDiscontinuities, NothingBeforeADiscontinuityIsConfirmed) {

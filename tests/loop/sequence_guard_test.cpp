@@ -8,14 +8,17 @@
 #include <limits>
 #include <random>
 
+#include "sequence_stream.hpp"
+
 namespace hystloop {
 namespace {
 
-using V = SequenceGuard::Verdict;
-constexpr std::int64_t kStep = 500;        // ticks (the compensator's horizon)
-constexpr std::int64_t kWindow = 100'000;  // us
-constexpr std::int64_t kBlock = 20;        // ticks per block, one block every 2 ms
-constexpr std::int64_t kPeriod = 2'000;    // us
+using testing::GuardStream;
+using testing::kBlock;
+using testing::kPeriod;
+using testing::kStep;
+using testing::kWindow;
+using testing::V;
 
 TEST(SequenceGuard, TheFirstBlockAndItsSuccessorsAreTaken) {
   SequenceGuard g(kStep, kWindow);
@@ -28,54 +31,50 @@ TEST(SequenceGuard, TheFirstBlockAndItsSuccessorsAreTaken) {
 }
 
 TEST(SequenceGuard, OneBlock900TicksAheadIsIgnoredAndTheRealBlocksAreTaken) {
-  SequenceGuard g(kStep, kWindow);
-  std::int64_t t = 0;
-  for (std::int64_t s = 1000; s < 2000; s += kBlock) ASSERT_EQ(g.check(s, kBlock, t += kPeriod), V::take);
-  EXPECT_EQ(g.check(2000 + 900, kBlock, t + 100), V::hold);  // forged
-  for (std::int64_t s = 2000; s < 3000; s += kBlock) ASSERT_EQ(g.check(s, kBlock, t += kPeriod), V::take) << s;
-  EXPECT_EQ(g.counters().held, 1u);
-  EXPECT_EQ(g.counters().ignored, 1u);
-  EXPECT_EQ(g.counters().jumps, 0u);
+  GuardStream s;
+  s.run(1000, 2000);
+  EXPECT_EQ(s.guard.check(2000 + 900, kBlock, s.t_us + 100), V::hold);  // forged
+  s.run(2000, 3000);
+  EXPECT_EQ(s.guard.counters().held, 1u);
+  EXPECT_EQ(s.guard.counters().ignored, 1u);
+  EXPECT_EQ(s.guard.counters().jumps, 0u);
 }
 
 TEST(SequenceGuard, OneBlock5000TicksBehindDoesNotRestart) {
-  SequenceGuard g(kStep, kWindow);
-  std::int64_t t = 0;
-  for (std::int64_t s = 50000; s < 51000; s += kBlock) ASSERT_EQ(g.check(s, kBlock, t += kPeriod), V::take);
-  EXPECT_EQ(g.check(51000 - 5000, kBlock, t + 100), V::hold);
-  EXPECT_EQ(g.check(51000 - 5000 + kBlock, kBlock, t + 200), V::hold);  // even two in a row
-  for (std::int64_t s = 51000; s < 52000; s += kBlock) ASSERT_EQ(g.check(s, kBlock, t += kPeriod), V::take);
-  EXPECT_EQ(g.counters().restarts, 0u);
-  EXPECT_EQ(g.counters().ignored, 1u);
-  EXPECT_EQ(g.counters().held, 2u);
+  GuardStream s;
+  s.run(50000, 51000);
+  EXPECT_EQ(s.guard.check(51000 - 5000, kBlock, s.t_us + 100), V::hold);
+  EXPECT_EQ(s.guard.check(51000 - 5000 + kBlock, kBlock, s.t_us + 200), V::hold);  // even two in a row
+  s.run(51000, 52000);
+  EXPECT_EQ(s.guard.counters().restarts, 0u);
+  EXPECT_EQ(s.guard.counters().ignored, 1u);
+  EXPECT_EQ(s.guard.counters().held, 2u);
 }
 
 TEST(SequenceGuard, ThreeConsecutiveBlocksConfirmARestart) {
-  SequenceGuard g(kStep, kWindow);
-  std::int64_t t = 0;
-  for (std::int64_t s = 50000; s < 51000; s += kBlock) g.check(s, kBlock, t += kPeriod);
-  t += 3'000'000;  // the bridge restarts: quiet, then its clock from 0
-  EXPECT_EQ(g.check(0, kBlock, t += kPeriod), V::hold);
-  EXPECT_EQ(g.check(kBlock, kBlock, t += kPeriod), V::hold);
-  EXPECT_EQ(g.check(3 * kBlock, kBlock, t += kPeriod), V::restart);  // one lost between: still consistent
-  EXPECT_EQ(g.check(4 * kBlock, kBlock, t += kPeriod), V::take);
-  EXPECT_EQ(g.next_expected(), 5 * kBlock);
-  EXPECT_EQ(g.counters().restarts, 1u);
-  EXPECT_EQ(g.counters().held, 2u);
-  EXPECT_EQ(g.counters().ignored, 0u);
+  GuardStream s;
+  s.run(50000, 51000);
+  s.t_us += 3'000'000;  // the bridge restarts: quiet, then its clock from 0
+  EXPECT_EQ(s.send(0), V::hold);
+  EXPECT_EQ(s.send(kBlock), V::hold);
+  EXPECT_EQ(s.send(3 * kBlock), V::restart);  // one lost between: still consistent
+  EXPECT_EQ(s.send(4 * kBlock), V::take);
+  EXPECT_EQ(s.guard.next_expected(), 5 * kBlock);
+  EXPECT_EQ(s.guard.counters().restarts, 1u);
+  EXPECT_EQ(s.guard.counters().held, 2u);
+  EXPECT_EQ(s.guard.counters().ignored, 0u);
 }
 
 TEST(SequenceGuard, ThreeConsecutiveBlocksConfirmAJumpAhead) {
-  SequenceGuard g(kStep, kWindow);
-  std::int64_t t = 0;
-  for (std::int64_t s = 0; s < 1000; s += kBlock) g.check(s, kBlock, t += kPeriod);
-  EXPECT_EQ(g.check(10000, kBlock, t += kPeriod), V::hold);
-  EXPECT_EQ(g.check(10020, kBlock, t += kPeriod), V::hold);
-  EXPECT_EQ(g.check(10040, kBlock, t += kPeriod), V::jump);
-  EXPECT_EQ(g.check(1000, kBlock, t += kPeriod), V::hold);  // the old numbering is now the discontinuity
-  EXPECT_EQ(g.check(10060, kBlock, t += kPeriod), V::take);
-  EXPECT_EQ(g.counters().jumps, 1u);
-  EXPECT_EQ(g.counters().ignored, 1u);
+  GuardStream s;
+  s.run(0, 1000);
+  EXPECT_EQ(s.send(10000), V::hold);
+  EXPECT_EQ(s.send(10020), V::hold);
+  EXPECT_EQ(s.send(10040), V::jump);
+  EXPECT_EQ(s.send(1000), V::hold);  // the old numbering is now the discontinuity
+  EXPECT_EQ(s.send(10060), V::take);
+  EXPECT_EQ(s.guard.counters().jumps, 1u);
+  EXPECT_EQ(s.guard.counters().ignored, 1u);
 }
 
 TEST(SequenceGuard, ABlockAtTheInt64CeilingIsHeldWithoutOverflow) {
@@ -139,17 +138,16 @@ TEST(SequenceGuard, RandomInterleavingsOfForgedBlocksNeverDisturbTheRealStream) 
 TEST(SequenceGuard, RandomRealRestartsAreConfirmedAfterThreeBlocks) {
   for (std::uint32_t seed = 1; seed <= 100; ++seed) {
     std::mt19937 rng(seed);
-    SequenceGuard g(kStep, kWindow);
-    std::int64_t t = 0;
-    std::int64_t s = 200'000;
-    for (int i = 0; i < 50; ++i, s += kBlock) g.check(s, kBlock, t += kPeriod);
-    if (rng() % 2 == 0) g.check(s + 50'000, kBlock, t += 10);  // a forged one before
+    GuardStream g;
+    std::int64_t s = 200'000 + 50 * kBlock;
+    g.run(200'000, s);
+    if (rng() % 2 == 0) g.guard.check(s + 50'000, kBlock, g.t_us += 10);  // a forged one before
     const bool back = rng() % 2 == 0;
     s = back ? static_cast<std::int64_t>(rng() % 1000) : s + 20'000;
-    EXPECT_EQ(g.check(s, kBlock, t += kPeriod), V::hold);
-    EXPECT_EQ(g.check(s + kBlock, kBlock, t += kPeriod), V::hold);
-    EXPECT_EQ(g.check(s + 2 * kBlock, kBlock, t += kPeriod), back ? V::restart : V::jump) << "seed " << seed;
-    for (int i = 3; i < 50; ++i) ASSERT_EQ(g.check(s + i * kBlock, kBlock, t += kPeriod), V::take);
+    EXPECT_EQ(g.send(s), V::hold);
+    EXPECT_EQ(g.send(s + kBlock), V::hold);
+    EXPECT_EQ(g.send(s + 2 * kBlock), back ? V::restart : V::jump) << "seed " << seed;
+    for (int i = 3; i < 50; ++i) ASSERT_EQ(g.send(s + i * kBlock), V::take);
   }
 }
 
