@@ -66,13 +66,15 @@ void BridgeService::on_command(const command_block_t& msg) noexcept {
   }
 }
 
-void BridgeService::act(const control_t& msg) noexcept {
+void BridgeService::act(const control_t& msg, const char* what) {
   ++control_acted_;
   acks_.acted(msg.request_id);
+  if (what != nullptr) spdlog::info("{} (request {})", what, msg.request_id);
 }
 
-void BridgeService::refuse(const control_t& msg, std::string why) {
+void BridgeService::refuse(const control_t& msg, const std::string& what, std::string why) {
   ++control_refused_;
+  spdlog::warn("{} (request {}) refused: {}", what, msg.request_id, why);
   acks_.refused(msg.request_id, std::move(why), wall_utime());
 }
 
@@ -80,38 +82,27 @@ void BridgeService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   switch (msg.command) {
     case control_t::ARM:
-      if (stopping_) {  // the real-time thread would not arm either
-        refuse(msg, "the bridge is stopping (ramping to the safe voltage)");
-        spdlog::warn("ARM (request {}) refused: the bridge is stopping (ramping to the safe voltage)", msg.request_id);
-        return;
-      }
-      act(msg);
+      // The real-time thread would not arm either.
+      if (stopping_) return refuse(msg, "ARM", "the bridge is stopping (ramping to the safe voltage)");
+      act(msg, "ARM");
       rt_.request_arm(ArmRequest::kArm);
-      spdlog::info("ARM (request {})", msg.request_id);
       return;
     case control_t::DISARM:
-      act(msg);
+      act(msg, "DISARM");
       rt_.request_arm(ArmRequest::kDisarm);
       safe_reason_ = "disarmed via HX_CONTROL";
-      spdlog::info("DISARM (request {})", msg.request_id);
       return;
     case control_t::SET_GAINS: {
       FeedbackGains g;
       try {
         g = requested_gains(gains_, msg);
       } catch (const std::exception& e) {
-        refuse(msg, e.what());
-        spdlog::warn("SET_GAINS (request {}) refused, the gains in force (kp {}, ki {} 1/s, kd {} s) stay: {}",
-                     msg.request_id, gains_.kp, gains_.ki, gains_.kd, e.what());
-        return;
+        return refuse(msg, "SET_GAINS", e.what());  // the gains in force stay
       }
       if (!rt_.push_gains(g)) {
-        refuse(msg, "the real-time thread has not taken the last gains yet: send again");
-        spdlog::warn("SET_GAINS (request {}) refused: the real-time thread has not taken the last ones yet",
-                     msg.request_id);
-        return;
+        return refuse(msg, "SET_GAINS", "the real-time thread has not taken the last gains yet: send again");
       }
-      act(msg);
+      act(msg, nullptr);
       gains_ = g;
       spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s, {} (request {})", g.kp, g.ki, g.kd,
                    g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
@@ -119,27 +110,24 @@ void BridgeService::on_control(const control_t& msg) {
       return;
     }
     case control_t::RESET_COUNTERS:
-      act(msg);
+      act(msg, "RESET_COUNTERS");
       // All counters from the next report on (asked for at once, so at most a tick of the
       // real-time thread's events is not counted).
       counters_.rebase("command", commands_.counters());
       counters_.rebase("control", control_.counters());
       counters_.rebase("sensor", sensor_pub_.counters());
       reset_pending_ = true;
-      spdlog::info("RESET_COUNTERS (request {})", msg.request_id);
       return;
     case control_t::SHUTDOWN:
-      act(msg);
-      spdlog::info("SHUTDOWN (request {})", msg.request_id);
+      act(msg, "SHUTDOWN");
       request_stop();
       return;
     default:
       // Meant for the compensator; refused only when addressed to the bridge by name.
       if (msg.target == "bridge") {
-        refuse(msg, "command " + std::to_string(msg.command) +
-                        " is not the bridge's (arm, disarm, gains, reset-counters, shutdown)");
-        spdlog::warn("control command {} (request {}) is not one the bridge knows; ignored", msg.command,
-                     msg.request_id);
+        refuse(msg, "control command " + std::to_string(msg.command),
+               "command " + std::to_string(msg.command) +
+                   " is not the bridge's (arm, disarm, gains, reset-counters, shutdown)");
       }
       return;
   }

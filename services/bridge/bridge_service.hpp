@@ -49,8 +49,9 @@ class BridgeService {
  private:
   void on_command(const command_block_t& msg) noexcept;
   void on_control(const control_t& msg);
-  void act(const control_t& msg) noexcept;  // counts it and tells its sender
-  void refuse(const control_t& msg, std::string why);
+  // Count the request, tell its sender and log "<what> (request <id>)" (act: unless `what` is null).
+  void act(const control_t& msg, const char* what);
+  void refuse(const control_t& msg, const std::string& what, std::string why);
   void publish_samples(bool flush) noexcept;
   void publish_block() noexcept;
   void append_truth(const OutgoingTick& t) noexcept;

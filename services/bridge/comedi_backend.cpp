@@ -56,6 +56,17 @@ void install_emergency_handlers() {
 
 std::string comedi_error() { return comedi_strerror(comedi_errno()); }
 
+// One write or read of `data` on a channel.
+comedi_insn instruction(unsigned insn, lsampl_t* data, unsigned subdevice, const ComediChannelSettings& c) {
+  comedi_insn i{};
+  i.insn = insn;
+  i.n = 1;
+  i.data = data;
+  i.subdev = subdevice;
+  i.chanspec = CR_PACK(c.channel, c.range, c.aref);
+  return i;
+}
+
 int find_subdevice(comedi_t* device, int configured, int type) {
   if (configured >= 0) return configured;
   for (int s = 0, n = comedi_get_n_subdevices(device); s < n; ++s) {
@@ -139,16 +150,8 @@ ComediHandle::~ComediHandle() {
 ComediBackend::ComediBackend(const ComediSettings& settings, const ActuatorLimits& limits)
     : settings_(settings), limits_(limits), handle_(settings.device, settings.calibration, settings.source) {
   check_against_card();  // writes the safe voltage first when the output is usable, then throws
-  tick_insns_[0].insn = INSN_WRITE;
-  tick_insns_[0].n = 1;
-  tick_insns_[0].data = &dac_word_;
-  tick_insns_[0].subdev = ao_subdevice_;
-  tick_insns_[0].chanspec = CR_PACK(settings_.ao.channel, settings_.ao.range, settings_.ao.aref);
-  tick_insns_[1].insn = INSN_READ;
-  tick_insns_[1].n = 1;
-  tick_insns_[1].data = &adc_word_;
-  tick_insns_[1].subdev = ai_subdevice_;
-  tick_insns_[1].chanspec = CR_PACK(settings_.ai.channel, settings_.ai.range, settings_.ai.aref);
+  tick_insns_[0] = instruction(INSN_WRITE, &dac_word_, ao_subdevice_, settings_.ao);
+  tick_insns_[1] = instruction(INSN_READ, &adc_word_, ai_subdevice_, settings_.ai);
   tick_list_.n_insns = 2;
   tick_list_.insns = tick_insns_;
   hold_safe(limits_.safe_u_V);  // before anything can arm
@@ -198,11 +201,7 @@ void ComediBackend::check_against_card() {
     fail("comedi.ao.range", e.what());
   }
   // From here the output is usable: a refusal below leaves it at the safe voltage.
-  safe_insn_.insn = INSN_WRITE;
-  safe_insn_.n = 1;
-  safe_insn_.data = &safe_data_;
-  safe_insn_.subdev = ao_subdevice_;
-  safe_insn_.chanspec = CR_PACK(settings_.ao.channel, settings_.ao.range, settings_.ao.aref);
+  safe_insn_ = instruction(INSN_WRITE, &safe_data_, ao_subdevice_, settings_.ao);
   safe_list_.n_insns = 1;
   safe_list_.insns = &safe_insn_;
   const auto refuse = [&](const std::string& field, const std::string& reason) {
