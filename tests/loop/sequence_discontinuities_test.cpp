@@ -29,9 +29,7 @@ TEST(SequenceDiscontinuities, NothingBeforeADiscontinuityIsConfirmed) {
 TEST(SequenceDiscontinuities, AJumpIsFromTheExpectedTickToTheNewNumberingsFirst) {
   Stream s;
   s.run(0, 1000);
-  EXPECT_EQ(s.send(5000), V::hold);
-  EXPECT_EQ(s.send(5020), V::hold);
-  EXPECT_EQ(s.send(5040), V::jump);
+  s.confirm({5000, 5020, 5040}, V::jump);
   EXPECT_EQ(s.d.last_jump().expected_tick, 1000);  // not 999, the last tick used
   EXPECT_EQ(s.d.last_jump().resumed_tick, 5000);   // not 5040, the confirming block's
   EXPECT_EQ(s.d.last_restart().expected_tick, -1);
@@ -40,10 +38,8 @@ TEST(SequenceDiscontinuities, AJumpIsFromTheExpectedTickToTheNewNumberingsFirst)
 TEST(SequenceDiscontinuities, ARestartIsFromTheExpectedTickToTheNewClocksFirst) {
   Stream s;
   s.run(50000, 51000);
-  s.t_us += 3'000'000;  // the bridge restarts: quiet, then its clock from 0
-  EXPECT_EQ(s.send(0), V::hold);
-  EXPECT_EQ(s.send(20), V::hold);
-  EXPECT_EQ(s.send(60), V::restart);  // one lost between: still consistent
+  s.t_us += 3'000'000;                 // the bridge restarts: quiet, then its clock from 0
+  s.confirm({0, 20, 60}, V::restart);  // one lost between: still consistent
   EXPECT_EQ(s.d.last_restart().expected_tick, 51000);
   EXPECT_EQ(s.d.last_restart().resumed_tick, 0);
 }
@@ -52,10 +48,8 @@ TEST(SequenceDiscontinuities, ARestartIsFromTheExpectedTickToTheNewClocksFirst) 
 TEST(SequenceDiscontinuities, AnIgnoredCandidateDoesNotLendItsFirstTick) {
   Stream s;
   s.run(0, 1000);
-  EXPECT_EQ(s.send(900'000), V::hold);  // forged, far ahead
-  EXPECT_EQ(s.send(8000), V::hold);     // far from both: a new candidate, the forged one ignored
-  EXPECT_EQ(s.send(8020), V::hold);
-  EXPECT_EQ(s.send(8040), V::jump);
+  EXPECT_EQ(s.send(900'000), V::hold);     // forged, far ahead
+  s.confirm({8000, 8020, 8040}, V::jump);  // far from both: a new candidate, the forged one ignored
   EXPECT_EQ(s.guard.counters().ignored, 1u);
   EXPECT_EQ(s.d.last_jump().expected_tick, 1000);
   EXPECT_EQ(s.d.last_jump().resumed_tick, 8000);
@@ -67,9 +61,7 @@ TEST(SequenceDiscontinuities, AJumpAndARestartKeepTheirOwnTicks) {
   Stream s;
   s.run(0, 1000);
   for (const std::int64_t seq : {5000, 5020, 5040}) s.send(seq);
-  EXPECT_EQ(s.send(1000), V::hold);
-  EXPECT_EQ(s.send(1020), V::hold);
-  EXPECT_EQ(s.send(1040), V::restart);
+  s.confirm({1000, 1020, 1040}, V::restart);
   EXPECT_EQ(s.d.last_jump().expected_tick, 1000);
   EXPECT_EQ(s.d.last_jump().resumed_tick, 5000);
   EXPECT_EQ(s.d.last_restart().expected_tick, 5060);

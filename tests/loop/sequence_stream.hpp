@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 
 #include "loop/sequence_discontinuities.hpp"
 #include "loop/sequence_guard.hpp"
@@ -30,6 +32,14 @@ struct GuardStream {
     t_us += kPeriod;
     return via != nullptr ? via->check(guard, seq, kBlock, t_us) : guard.check(seq, kBlock, t_us);
   }
+  // Blocks that continue a new numbering: each one held but the last, whose verdict is `confirmed`.
+  void confirm(std::initializer_list<std::int64_t> seqs, V confirmed) {
+    std::size_t i = 0;
+    for (const std::int64_t seq : seqs) EXPECT_EQ(send(seq), ++i == seqs.size() ? confirmed : V::hold) << seq;
+  }
+  // A block `after_us` after the last one, the clock left where it was (a forged block between two
+  // real ones).
+  V send_between(std::int64_t seq, std::int64_t after_us) { return guard.check(seq, kBlock, t_us + after_us); }
   // The blocks from `from` up to `to` (excluded), each one taken.
   void run(std::int64_t from, std::int64_t to) {
     for (std::int64_t s = from; s < to; s += kBlock) ASSERT_EQ(send(s), V::take) << s;
