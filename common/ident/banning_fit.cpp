@@ -52,9 +52,23 @@ SineFit sine_fit(std::span<const double> x, double f, double fs) {
   return {c[0], std::hypot(c[1], c[2]), xx - c.dot(r), std::atan2(c[2], c[1])};
 }
 
-// (21): the loop's peak-to-peak slope at amplitude amp [V].
-double ch_slope_closed(double a, double b, double alpha, double amp) {
-  return a + (b - a) / alpha * std::tanh(alpha * amp) / amp;
+// (21) and (24) of Theorem 3: the loop's peak-to-peak slope and its area at amplitude amp [V]
+// (T: a double, or Ceres' Jet where b and alpha are fitted).
+template <class T>
+T ch_slope(T a, T b, T alpha, T amp) {
+  using std::tanh;
+  return a + (b - a) / alpha * tanh(alpha * amp) / amp;
+}
+template <class T>
+T ch_area(T a, T b, T alpha, T amp) {
+  using std::tanh;
+  return T(4.0) * (a - b) / alpha * (amp - tanh(alpha * amp) / alpha);
+}
+
+// The sine at frequency f fitted to u: its offset and amplitude.
+SineEstimate sine_at(std::span<const double> u, double f, double fs) {
+  const SineFit fit = sine_fit(u, f, fs);
+  return {fit.offset, fit.amplitude, f, std::isfinite(fit.amplitude) && fit.amplitude > 0.0};
 }
 
 }  // namespace
@@ -81,21 +95,11 @@ SineEstimate estimate_sine(std::span<const double> u, double fs, bool refine_fre
   // Linear interpolation of the crossings is biased at a few samples per period: refine the
   // frequency by minimising the least-squares residual of the sine fit around it.
   const double f0 = static_cast<double>(count - 1) / (2.0 * (last - first));
-  if (!refine_frequency) {
-    const SineFit fit = sine_fit(u, f0, fs);
-    e.frequency_Hz = f0, e.offset = fit.offset, e.amplitude = fit.amplitude;
-    e.ok = std::isfinite(e.amplitude) && e.amplitude > 0.0;
-    return e;
-  }
+  if (!refine_frequency) return sine_at(u, f0, fs);
   std::uintmax_t iterations = 60;
   const auto best = boost::math::tools::brent_find_minima([&](double f) { return sine_fit(u, f, fs).rss; },
                                                           f0 * (1.0 - 2e-3), f0 * (1.0 + 2e-3), 40, iterations);
-  const SineFit fit = sine_fit(u, best.first, fs);
-  e.frequency_Hz = best.first;
-  e.offset = fit.offset;
-  e.amplitude = fit.amplitude;
-  e.ok = std::isfinite(e.amplitude) && e.amplitude > 0.0;
-  return e;
+  return sine_at(u, best.first, fs);
 }
 
 double first_harmonic_amplitude(std::span<const double> y, double f, double fs) { return sine_fit(y, f, fs).amplitude; }
@@ -129,7 +133,7 @@ double loop_lag_area_per_rad(const ColemanHodgdonParams& h, double offset_V, dou
   constexpr int kSteps = 4096;
   const double dth = 2.0 * std::numbers::pi / kSteps;
   ColemanHodgdon ch(h);
-  const double slope = ch_slope_closed(h.a, h.b, h.alpha, amplitude_V);
+  const double slope = ch_slope(h.a, h.b, h.alpha, amplitude_V);
   ch.reset(offset_V - amplitude_V, h.a * offset_V - slope * amplitude_V);
   double integral = 0.0;
   double w_prev = ch.output(), u_prev = offset_V - amplitude_V;
@@ -144,29 +148,15 @@ double loop_lag_area_per_rad(const ColemanHodgdonParams& h, double offset_V, dou
 
 namespace {
 
-// (21) and (24) of Theorem 3 with b in nm/V (x[0]) and alpha in 1/V (x[1]); a fixed.
-struct SlopeResidual {
-  double a_nm, amplitude, slope_nm;
+// A loop's slope (21) or area (24), relative to the measured one, with b in nm/V (x[0]) and alpha
+// in 1/V (x[1]); a fixed.
+struct LoopResidual {
+  double a_nm, amplitude, measured;  // [nm/V] or [nm V]
+  bool area;
   template <class T>
   bool operator()(const T* x, T* r) const {
-    using std::tanh;
-    const T& b = x[0];
-    const T& al = x[1];
-    const T zeta = T(a_nm) + (b - T(a_nm)) / al * tanh(al * T(amplitude)) / T(amplitude);
-    r[0] = (zeta - T(slope_nm)) / T(slope_nm);
-    return true;
-  }
-};
-
-struct AreaResidual {
-  double a_nm, amplitude, area_nmV;
-  template <class T>
-  bool operator()(const T* x, T* r) const {
-    using std::tanh;
-    const T& b = x[0];
-    const T& al = x[1];
-    const T eps = T(4.0) * (T(a_nm) - b) / al * (T(amplitude) - tanh(al * T(amplitude)) / al);
-    r[0] = (eps - T(area_nmV)) / T(area_nmV);
+    const T model = area ? ch_area(T(a_nm), x[0], x[1], T(amplitude)) : ch_slope(T(a_nm), x[0], x[1], T(amplitude));
+    r[0] = (model - T(measured)) / T(measured);
     return true;
   }
 };
@@ -179,8 +169,8 @@ struct MagnitudeResidual {
   }
 };
 
-// The time budget is attached per solve (CeresTimeBudget), read from the fit's clock.
-ceres::Solver::Options solver_options() {
+// Every solve of the fit: these tolerances, the time budget read from the fit's clock.
+ceres::Solver::Summary solve(ceres::Problem& problem, const FitClock& clock, double budget_s) {
   ceres::Solver::Options o;
   o.linear_solver_type = ceres::DENSE_QR;
   o.max_num_iterations = 200;
@@ -188,7 +178,11 @@ ceres::Solver::Options solver_options() {
   o.function_tolerance = 1e-14;
   o.parameter_tolerance = 1e-12;
   o.gradient_tolerance = 1e-16;
-  return o;
+  detail::CeresTimeBudget budget(clock, budget_s);
+  budget.attach(o);
+  ceres::Solver::Summary summary;
+  ceres::Solve(o, &problem, &summary);
+  return summary;
 }
 
 // Inverts (25) for h (paper order): ptp = 2 a h A + 2 (b - a)/alpha tanh(alpha A h), increasing in h.
@@ -204,8 +198,6 @@ double invert_peak_to_peak(const ColemanHodgdonParams& p, double ptp, double amp
   }
   return 0.5 * (lo + hi);
 }
-
-FitCheck refusal(FitStatus status, std::string reason) { return {status, std::move(reason)}; }
 
 using PointRefs = std::vector<BanningPoint*>;
 
@@ -227,12 +219,11 @@ FitCheck measure_experiments(std::span<const BanningExperimentData> experiments,
     const auto& ex = experiments[i];
     BanningPoint pt;
     if (FitCheck c = check_fit_samples(ex.u, ex.y); !c.ok()) {
-      return refusal(c.status, "experiment " + std::to_string(i) + ": " + c.reason);
+      return FitCheck{c.status, "experiment " + std::to_string(i) + ": " + c.reason};
     }
     SineEstimate se;
     if (ex.frequency_Hz > 0.0) {
-      const SineFit fit = sine_fit(ex.u, ex.frequency_Hz, ex.sample_rate_Hz);
-      se = {fit.offset, fit.amplitude, ex.frequency_Hz, std::isfinite(fit.amplitude) && fit.amplitude > 0.0};
+      se = sine_at(ex.u, ex.frequency_Hz, ex.sample_rate_Hz);
     } else {
       se = estimate_sine(ex.u, ex.sample_rate_Hz, false);
       if (se.ok && se.frequency_Hz >= o.frequency_threshold_Hz) se = estimate_sine(ex.u, ex.sample_rate_Hz, true);
@@ -272,7 +263,7 @@ FitCheck fit_centre_line(const PointRefs& loops, const BanningFitOptions& o, Ban
     std::ostringstream s;
     s << loops.size() << " usable loop experiments whose centres span " << (loops.empty() ? 0.0 : umax - umin)
       << " V; need two or more offsets spanning >= " << o.min_offset_span_V << " V to identify a";
-    return refusal(FitStatus::too_few_samples, s.str());
+    return FitCheck{FitStatus::too_few_samples, s.str()};
   }
   Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
   Eigen::Vector2d r = Eigen::Vector2d::Zero();
@@ -307,7 +298,7 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
   if (!(a > 0.0) || !(b0 > 0.0) || !(b0 < a)) {
     std::ostringstream s;
     s << "a = " << a << " m/V, small-loop slope b = " << b0 << " m/V: need 0 < b < a (a loop with area)";
-    return refusal(FitStatus::out_of_range, s.str());
+    return FitCheck{FitStatus::out_of_range, s.str()};
   }
   std::vector<double> alphas;
   for (const auto* p : loops) {
@@ -316,8 +307,8 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
     }
   }
   if (alphas.empty()) {
-    return refusal(FitStatus::too_few_samples,
-                   "no loop above small_amplitude_max_V with a positive area: alpha cannot be identified");
+    return FitCheck{FitStatus::too_few_samples,
+                    "no loop above small_amplitude_max_V with a positive area: alpha cannot be identified"};
   }
   std::nth_element(alphas.begin(), alphas.begin() + static_cast<std::ptrdiff_t>(alphas.size() / 2), alphas.end());
   x[0] = b0 * 1e9, x[1] = alphas[alphas.size() / 2];
@@ -330,46 +321,37 @@ FitCheck refine_b_alpha(const PointRefs& loops, const BanningFitOptions& o, cons
   const double a = res.hysteresis.a;
   ceres::Problem problem;
   for (const auto* p : loops) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SlopeResidual, 1, 2>(
-                                 new SlopeResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9}),
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LoopResidual, 1, 2>(
+                                 new LoopResidual{a * 1e9, p->amplitude_V, p->features.slope * 1e9, false}),
                              nullptr, x);
     if (p->area_fitted) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AreaResidual, 1, 2>(
-                                   new AreaResidual{a * 1e9, p->amplitude_V, (p->features.area + p->lag_area) * 1e9}),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LoopResidual, 1, 2>(new LoopResidual{
+                                   a * 1e9, p->amplitude_V, (p->features.area + p->lag_area) * 1e9, true}),
                                nullptr, x);
     }
   }
   problem.SetParameterLowerBound(x, 0, 1e-6);
   problem.SetParameterLowerBound(x, 1, 1e-9);
-  ceres::Solver::Options so = solver_options();
-  detail::CeresTimeBudget budget(clock, o.max_solver_time_s);
-  budget.attach(so);
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
-  if (!summary.IsSolutionUsable()) return refusal(FitStatus::solver_failure, "Ceres (b, alpha): " + summary.message);
+  const ceres::Solver::Summary summary = solve(problem, clock, o.max_solver_time_s);
+  if (!summary.IsSolutionUsable()) return FitCheck{FitStatus::solver_failure, "Ceres (b, alpha): " + summary.message};
   res.hysteresis.b = x[0] * 1e-9;
   res.hysteresis.alpha = x[1];
-  try {
-    res.hysteresis.validate();
-  } catch (const ParameterError& e) {
-    return refusal(FitStatus::out_of_range, std::string("hysteresis: ") + e.what());
-  }
+  if (FitCheck c = check_valid(res.hysteresis, "hysteresis: "); !c.ok()) return c;
   const double b = res.hysteresis.b, al = res.hysteresis.alpha;
   double ss = 0.0, sa = 0.0;
   std::size_t na = 0;
   for (const auto* p : loops) {
     const double A = p->amplitude_V;
-    ss += std::pow((ch_slope_closed(a, b, al, A) - p->features.slope) / p->features.slope, 2);
+    ss += std::pow((ch_slope(a, b, al, A) - p->features.slope) / p->features.slope, 2);
     if (p->area_fitted) {
-      const double eps = 4.0 * (a - b) / al * (A - std::tanh(al * A) / al);
       const double area = p->features.area + p->lag_area;
-      sa += std::pow((eps - area) / area, 2), ++na;
+      sa += std::pow((ch_area(a, b, al, A) - area) / area, 2), ++na;
     }
   }
   res.slope_rel_rms = std::sqrt(ss / static_cast<double>(loops.size()));
   res.area_rel_rms = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
   if (!std::isfinite(res.slope_rel_rms) || !std::isfinite(res.area_rel_rms)) {
-    return refusal(FitStatus::solver_failure, "the slope or area residual is not finite: no usable solution");
+    return FitCheck{FitStatus::solver_failure, "the slope or area residual is not finite: no usable solution"};
   }
   return {};
 }
@@ -385,7 +367,7 @@ FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFi
     if (o.order == BanningOrder::kStageThenHysteresis) {
       p->magnitude = invert_peak_to_peak(h, ptp, p->amplitude_V);
     } else {  // hysteresis first: the stage sees a loop of slope (21) at the drive amplitude
-      p->magnitude = ptp / (2.0 * ch_slope_closed(h.a, h.b, h.alpha, p->amplitude_V) * p->amplitude_V);
+      p->magnitude = ptp / (2.0 * ch_slope(h.a, h.b, h.alpha, p->amplitude_V) * p->amplitude_V);
     }
     if (p->magnitude > peak_h) peak_h = p->magnitude, peak_f = p->frequency_Hz;
   }
@@ -399,22 +381,14 @@ FitCheck fit_stage(const PointRefs& mags, double sample_rate_Hz, const BanningFi
             2.0 * std::numbers::pi * p->frequency_Hz, p->magnitude, o.zoh_magnitude ? 1.0 / sample_rate_Hz : 0.0}),
         nullptr, kc);
   }
-  ceres::Solver::Options so = solver_options();
-  detail::CeresTimeBudget budget(clock, o.max_solver_time_s);
-  budget.attach(so);
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
-  if (!summary.IsSolutionUsable()) return refusal(FitStatus::solver_failure, "Ceres (k, c): " + summary.message);
+  const ceres::Solver::Summary summary = solve(problem, clock, o.max_solver_time_s);
+  if (!summary.IsSolutionUsable()) return FitCheck{FitStatus::solver_failure, "Ceres (k, c): " + summary.message};
   res.stage.k = std::exp(kc[0]);
   res.stage.c = std::exp(kc[1]);
-  try {
-    res.stage.validate();
-  } catch (const ParameterError& e) {
-    return refusal(FitStatus::out_of_range, std::string("stage: ") + e.what());
-  }
+  if (FitCheck c = check_valid(res.stage, "stage: "); !c.ok()) return c;
   res.magnitude_rel_rms = std::sqrt(2.0 * summary.final_cost / static_cast<double>(mags.size()));
   if (!std::isfinite(res.magnitude_rel_rms)) {
-    return refusal(FitStatus::solver_failure, "the magnitude residual is not finite: no usable solution");
+    return FitCheck{FitStatus::solver_failure, "the magnitude residual is not finite: no usable solution"};
   }
   return {};
 }
