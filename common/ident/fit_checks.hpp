@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 
+#include "core/errors.hpp"
 #include "ident/fit_status.hpp"
 #include "models/katalenic.hpp"
 #include "models/mem.hpp"
@@ -46,8 +47,17 @@ FitCheck check_after_second_reversal(std::span<const double> u_V, std::size_t mi
 // solver_failure if the residual is not finite or negative; out_of_range if it exceeds y_span_m.
 FitCheck check_fit_residual(double residual_rms_m, double y_span_m);
 
-// MemParams::validate() (finite, c1 > 0, c2 >= 0, c3 > 0) as out_of_range with its message.
-FitCheck check_mem_params(const MemParams& params);
+// params.validate() (MemParams: finite, c1 > 0, c2 >= 0, c3 > 0; ...) as out_of_range, its
+// message after `what` ("MEM parameters outside their domain: ").
+template <class P>
+FitCheck check_valid(const P& params, const std::string& what) {
+  try {
+    params.validate();
+  } catch (const ParameterError& e) {
+    return {FitStatus::out_of_range, what + e.what()};
+  }
+  return {};
+}
 
 // KatalenicParams::validate(), and the band the data can determine: 0 < k1 <= u_span_V (a wider
 // backlash band never lets the operator leave its initial state), 1e-6 <= k2 u_span_V <= 1e6 (a

@@ -185,12 +185,7 @@ std::string range_problem(const MemParams& p, const MemFitOptions& o) {
     s << "c3 = " << p.c3 << " sits on the search bound [" << o.c3_min << ", " << o.c3_max
       << "]: the data do not determine it";
   if (!s.str().empty()) return s.str();
-  try {
-    p.validate();
-  } catch (const ParameterError& e) {
-    return e.what();
-  }
-  return {};
+  return check_valid(p, "").reason;
 }
 
 template <class Data>
@@ -307,7 +302,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
   }
   if (result.ok()) {
     // A fit that is not a fit (NaN residual, c2 collapsed by overflow, ...) is a refusal.
-    FitCheck c = check_mem_params(result.params);
+    FitCheck c = check_valid(result.params, "MEM parameters outside their domain: ");
     if (c.ok()) c = check_fit_residual(result.residual_rms_m, sc.y_span);
     if (!c.ok()) result = refuse(std::move(result), c.status, std::move(c.reason));
   }

@@ -44,15 +44,15 @@ TEST(FitChecks, ResidualMustBeFiniteAndSmallerThanTheData) {
 }
 
 TEST(FitChecks, MemParamsOutsideTheirDomainAreRefused) {
-  EXPECT_TRUE(check_mem_params(MemParams::paper_like()).ok());
+  EXPECT_TRUE(check_valid(MemParams::paper_like(), "MEM: ").ok());
   MemParams p;
   p.c2 = std::numeric_limits<double>::quiet_NaN();
-  const FitCheck c = check_mem_params(p);
+  const FitCheck c = check_valid(p, "MEM: ");
   EXPECT_EQ(c.status, FitStatus::out_of_range);
   EXPECT_NE(c.reason.find("c2"), std::string::npos) << c.reason;
   p = MemParams::paper_like();
   p.c1 = 0.0;
-  EXPECT_EQ(check_mem_params(p).status, FitStatus::out_of_range);
+  EXPECT_EQ(check_valid(p, "MEM: ").status, FitStatus::out_of_range);
 }
 
 TEST(FitChecks, KatalenicBandMustBeDeterminedByTheData) {
