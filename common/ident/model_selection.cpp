@@ -53,6 +53,52 @@ double holdout_rms(std::span<const double> y, const std::vector<double>& pred, s
   return std::sqrt(ss / static_cast<double>(std::max<std::size_t>(y.size() - split, 1)));
 }
 
+namespace {
+
+template <class Result>
+ModelScore score_of(ModelKind kind, const Result& r) {
+  ModelScore s{kind, r.status, r.reason, r.residual_rms_m, 0.0, 0.0, r.samples_used};
+  if constexpr (requires { r.solve_time_s; }) s.fit_time_s = r.solve_time_s;
+  return s;
+}
+
+}  // namespace
+
+ModelScore fit_candidate(ModelKind kind, std::span<const double> u, std::span<const double> y,
+                         const ModelSelectionOptions& o, ModelSelection& sel) {
+  switch (kind) {
+    case ModelKind::mem: return score_of(kind, sel.mem = fit_mem(u, y, o.mem));
+    case ModelKind::pi: return score_of(kind, sel.pi = fit_pi(u, y, o.pi));
+    case ModelKind::katalenic: return score_of(kind, sel.katalenic = fit_katalenic(u, y, o.katalenic));
+    case ModelKind::linear: return score_of(kind, sel.linear = fit_linear(u, y, o.mem.min_input_range_V));
+  }
+  return {};
+}
+
+ModelParamSet fitted_set(const ModelSelection& sel, ModelKind kind, ModelParamSet base) {
+  base.kind = kind;
+  switch (kind) {
+    case ModelKind::mem: base.mem = sel.mem.params; break;
+    case ModelKind::pi: base.pi = to_pi_params(sel.pi); break;
+    case ModelKind::katalenic: base.katalenic = sel.katalenic.params; break;
+    case ModelKind::linear: base.linear = to_linear_params(sel.linear); break;
+  }
+  return base;
+}
+
+std::vector<double> fitted_prediction(const ModelSelection& sel, ModelKind kind, std::span<const double> u,
+                                      std::span<const double> y) {
+  switch (kind) {
+    case ModelKind::mem: return predict_mem(sel.mem.params, u, y);
+    case ModelKind::pi: return predict_pi(sel.pi, u);
+    case ModelKind::katalenic: return predict_katalenic(sel.katalenic.params, u);
+    case ModelKind::linear: break;
+  }
+  std::vector<double> pred(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) pred[k] = sel.linear.gain_m_per_V * u[k] + sel.linear.offset_m;
+  return pred;
+}
+
 ModelSelection select_model(std::span<const double> u, std::span<const double> y, const ModelSelectionOptions& o) {
   o.validate();
   ModelSelection sel;
@@ -76,40 +122,10 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
   const std::size_t split = sel.split_index, train_begin = rev[1];
   const auto ut = u.first(split + 1), yt = y.first(split + 1);
   for (ModelKind kind : o.candidates) {
-    ModelScore score;
-    score.kind = kind;
-    std::vector<double> pred;
-    switch (kind) {
-      case ModelKind::mem:
-        sel.mem = fit_mem(ut, yt, o.mem);
-        score.status = sel.mem.status, score.reason = sel.mem.reason, score.train_rms_m = sel.mem.residual_rms_m;
-        score.fit_time_s = sel.mem.solve_time_s;
-        if (sel.mem.ok()) pred = predict_mem(sel.mem.params, u, y);
-        break;
-      case ModelKind::pi:
-        sel.pi = fit_pi(ut, yt, o.pi);
-        score.status = sel.pi.status, score.reason = sel.pi.reason, score.train_rms_m = sel.pi.residual_rms_m;
-        score.fit_time_s = sel.pi.solve_time_s;
-        if (sel.pi.ok()) pred = predict_pi(sel.pi, u);
-        break;
-      case ModelKind::katalenic:
-        sel.katalenic = fit_katalenic(ut, yt, o.katalenic);
-        score.status = sel.katalenic.status, score.reason = sel.katalenic.reason;
-        score.train_rms_m = sel.katalenic.residual_rms_m;
-        score.fit_time_s = sel.katalenic.solve_time_s;
-        if (sel.katalenic.ok()) pred = predict_katalenic(sel.katalenic.params, u);
-        break;
-      case ModelKind::linear:
-        sel.linear = fit_linear(ut, yt, o.mem.min_input_range_V);
-        score.status = sel.linear.status, score.reason = sel.linear.reason,
-        score.train_rms_m = sel.linear.residual_rms_m;
-        if (sel.linear.ok()) {
-          pred.resize(u.size());
-          for (std::size_t k = 0; k < u.size(); ++k) pred[k] = sel.linear.gain_m_per_V * u[k] + sel.linear.offset_m;
-        }
-        break;
+    ModelScore score = fit_candidate(kind, ut, yt, o, sel);
+    if (score.status == FitStatus::ok) {
+      score.holdout_rms_m = holdout_rms(y, fitted_prediction(sel, kind, u, y), train_begin, split);
     }
-    if (!pred.empty()) score.holdout_rms_m = holdout_rms(y, pred, train_begin, split);
     sel.ranking.push_back(score);
   }
   std::stable_sort(sel.ranking.begin(), sel.ranking.end(), [](const ModelScore& a, const ModelScore& b) {

@@ -34,9 +34,10 @@ struct ModelScore {
   ModelKind kind = ModelKind::mem;
   FitStatus status = FitStatus::solver_failure;
   std::string reason;
-  double train_rms_m = 0.0;    // fit residual as the fitter reports it
-  double holdout_rms_m = 0.0;  // prediction error on the held-out part
-  double fit_time_s = 0.0;     // the fitter's solve_time_s (its options' clock); linear: 0, closed form
+  double train_rms_m = 0.0;      // fit residual as the fitter reports it
+  double holdout_rms_m = 0.0;    // prediction error on the held-out part
+  double fit_time_s = 0.0;       // the fitter's solve_time_s (its options' clock); linear: 0, closed form
+  std::size_t samples_used = 0;  // as the fitter counts them
 };
 
 struct ModelSelection {
@@ -53,6 +54,20 @@ struct ModelSelection {
 
 ModelSelection select_model(std::span<const double> u_V, std::span<const double> y_m,
                             const ModelSelectionOptions& options = {});
+
+// One model fitted on all of (u, y) with its options from `options` (which validates only that
+// model's), the result stored in its member of `sel` (sel.mem, sel.pi, ...). The score is the
+// fitter's status, reason, residual, sample count and time; holdout_rms_m stays 0.
+ModelScore fit_candidate(ModelKind kind, std::span<const double> u_V, std::span<const double> y_m,
+                         const ModelSelectionOptions& options, ModelSelection& sel);
+
+// `base` with kind and the parameters of `sel`'s fit of `kind` (the other members and the stage
+// as in base). Throws ParameterError when the fit makes no valid parameter struct (PI: w_0 = 0).
+ModelParamSet fitted_set(const ModelSelection& sel, ModelKind kind, ModelParamSet base = {});
+
+// What `sel`'s fit of `kind` predicts for every u sample, as select_model scores it.
+std::vector<double> fitted_prediction(const ModelSelection& sel, ModelKind kind, std::span<const double> u_V,
+                                      std::span<const double> y_m);
 
 // Simulations used for the scores (y [m] for every u sample).
 std::vector<double> predict_mem(const MemParams& params, std::span<const double> u_V, std::span<const double> y_m);

@@ -49,34 +49,16 @@ std::vector<double> predict_model(const ModelParamSet& p, std::span<const double
 
 namespace {
 
-// The refitted set of `kind` from a selection, if that fit succeeded and makes a valid set.
+// The refitted set of `kind` from a selection (called for the fits that succeeded), if it makes a
+// valid set.
 std::optional<ModelParamSet> refitted(const ModelSelection& sel, ModelKind kind, const ModelParamSet& base) {
-  ModelParamSet set = base;
-  set.kind = kind;
   try {
-    switch (kind) {
-      case ModelKind::mem:
-        if (!sel.mem.ok()) return std::nullopt;
-        set.mem = sel.mem.params;
-        break;
-      case ModelKind::pi:
-        if (!sel.pi.ok()) return std::nullopt;
-        set.pi = to_pi_params(sel.pi);
-        break;
-      case ModelKind::katalenic:
-        if (!sel.katalenic.ok()) return std::nullopt;
-        set.katalenic = sel.katalenic.params;
-        break;
-      case ModelKind::linear:
-        if (!sel.linear.ok()) return std::nullopt;
-        set.linear = to_linear_params(sel.linear);
-        break;
-    }
+    ModelParamSet set = fitted_set(sel, kind, base);
     set.validate();
+    return set;
   } catch (const ParameterError&) {
     return std::nullopt;
   }
-  return set;
 }
 
 const ModelScore* score_of(const ModelSelection& sel, ModelKind kind) {
