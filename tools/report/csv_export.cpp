@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "log_reader.hpp"
+#include "plot_series.hpp"
 
 namespace hystloop::report {
 
@@ -149,10 +150,7 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
     w.result.skipped = t.skipped;
     w.out.close();
     if (!w.out) throw std::runtime_error(w.result.file.string() + ": write failed");
-    std::ofstream legend(w.result.legend_file);
-    legend << csv_legend_text(t);
-    legend.close();
-    if (!legend) throw std::runtime_error(w.result.legend_file.string() + ": cannot write");
+    write_text_file(w.result.legend_file, csv_legend_text(t));
     results.push_back(w.result);
   }
   return results;

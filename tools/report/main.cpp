@@ -20,7 +20,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +30,7 @@
 #include "csv_export.hpp"
 #include "lcm/channels.hpp"
 #include "log_reader.hpp"
+#include "plot_series.hpp"
 #include "plots.hpp"
 #include "report_metrics.hpp"
 #include "report_table.hpp"
@@ -94,13 +94,6 @@ class Progress {
   bool enabled_ = false;
 };
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
-}
-
 int run(const Options& o) {
   const ChannelNames channels(o.rig);
   ReportOptions ro;
@@ -145,7 +138,7 @@ int run(const Options& o) {
     std::fprintf(stderr, "hystloop-report: warning: no %s ticks in the log; most figures are null\n",
                  channels.sensor.c_str());
   }
-  write_text(o.out / "summary.json", summary_json(metrics, ro, o.logs));
+  write_text_file(o.out / "summary.json", summary_json(metrics, ro, o.logs));
 
   std::vector<CsvExport> exports;
   if (!csv_channels.empty()) {

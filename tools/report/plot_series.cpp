@@ -88,6 +88,12 @@ void append_number(std::string& out, double v) {
 }
 }  // namespace
 
+void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  DataFile out(path);
+  out.text(text);
+  out.close();
+}
+
 std::string plot_number(double v) {
   std::string out;
   append_number(out, v);

@@ -52,6 +52,9 @@ class DataFile {
   bool failed_ = false;
 };
 
+// Writes a whole text file (a script, summary.json, scan.md, a legend) as DataFile does.
+void write_text_file(const std::filesystem::path& path, std::string_view text);
+
 // A number as the data files and scripts write it ("%.9g"-like; "NaN" when not finite).
 std::string plot_number(double v);
 

@@ -5,13 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <set>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
-#include <stdexcept>
 
 #include "convergence_plot.hpp"
 #include "core/process.hpp"
@@ -21,17 +18,6 @@
 namespace hystloop::report {
 
 namespace {
-
-std::ofstream open_for_writing(const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
-  return out;
-}
-
-void close_checked(std::ofstream& out, const std::filesystem::path& path) {
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": write failed");
-}
 
 struct Histogram {
   double lo = 0.0;
@@ -227,46 +213,51 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
   }
   gp << "\nunset output\n";
 
-  result.script = dir / "plots.gp";
+  render_script({"plots.gp", gp.str(), images, "gnuplot.log", "plots", "no data to plot"}, dir, options, result);
+  return result;
+}
+
+void render_script(const GnuplotScript& script, const std::filesystem::path& dir, const PlotOptions& options,
+                   PlotResult& result) {
+  result.script = dir / script.name;
   auto write_script = [&](const std::string& terminal) {
-    std::string text = gp.str();
+    std::string text = script.text;
     for (auto at = text.find("@TERMINAL@"); at != std::string::npos; at = text.find("@TERMINAL@", at)) {
       text.replace(at, 10, terminal);
     }
-    auto out = open_for_writing(result.script);
-    out << text;
-    close_checked(out, result.script);
+    write_text_file(result.script, text);
   };
   write_script("pngcairo");
 
   const auto exe = find_executable(options.gnuplot);
   if (exe.empty()) {
-    result.warning =
-        "gnuplot not found ('" + options.gnuplot + "'): plots skipped (data and plots.gp are in " + dir.string() + ")";
-    return result;
+    result.warning = "gnuplot not found ('" + options.gnuplot + "'): " + script.what + " skipped (data and " +
+                     script.name + " are in " + dir.string() + ")";
+    return;
   }
+  const auto& images = script.images;
   if (images.empty()) {
-    result.warning = "no data to plot";
-    return result;
+    result.warning = script.nothing;
+    return;
   }
   for (const std::string terminal : {"pngcairo", "png"}) {
     if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // terminal not built in
     write_script(terminal);
     for (const auto& image : images) std::filesystem::remove(dir / image);
     if (options.progress) options.progress("rendering " + std::to_string(images.size()) + " plots with gnuplot");
-    const int rc = run_program_in(dir, exe, {"plots.gp"}, "gnuplot.log");
+    const int rc = run_program_in(dir, exe, {script.name}, script.log.c_str());
     result.terminal = terminal;
     for (const auto& image : images) {
       if (std::filesystem::exists(dir / image)) result.images.push_back(dir / image);
     }
     if (rc != 0 || result.images.size() != images.size()) {
-      result.warning = "gnuplot failed (exit " + std::to_string(rc) + "): " + std::to_string(result.images.size()) +
-                       " of " + std::to_string(images.size()) + " plots written; see " + (dir / "gnuplot.log").string();
+      result.warning = "gnuplot failed on " + script.name + " (exit " + std::to_string(rc) +
+                       "): " + std::to_string(result.images.size()) + " of " + std::to_string(images.size()) + " " +
+                       script.what + " written; see " + (dir / script.log).string();
     }
-    return result;
+    return;
   }
-  result.warning = "gnuplot has neither the pngcairo nor the png terminal: plots skipped";
-  return result;
+  result.warning = "gnuplot has neither the pngcairo nor the png terminal: " + script.what + " skipped";
 }
 
 }  // namespace hystloop::report

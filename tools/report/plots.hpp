@@ -40,6 +40,22 @@ struct PlotResult {
   std::string warning;                            // why images are missing, empty when all went well
 };
 
+// A gnuplot script of the report and what it draws.
+struct GnuplotScript {
+  std::string name;                 // "plots.gp", written into the output folder
+  std::string text;                 // "@TERMINAL@" stands for the PNG terminal
+  std::vector<std::string> images;  // the PNGs it draws
+  std::string log;                  // gnuplot's output, in the output folder: "gnuplot.log"
+  std::string what;                 // the plots, in the warnings: "plots", "scan plots"
+  std::string nothing;              // the warning when there is no image: "no data to plot"
+};
+
+// Writes the script into `dir` for pngcairo, then renders its images with gnuplot there, with
+// pngcairo or, where cairo is missing, libgd's png (the script rewritten for it). Sets result's
+// script, images, terminal and warning. Throws std::runtime_error if the script cannot be written.
+void render_script(const GnuplotScript& script, const std::filesystem::path& dir, const PlotOptions& options,
+                   PlotResult& result);
+
 // Writes the data and the script into `dir` and runs gnuplot there.
 // Throws std::runtime_error if a file cannot be written.
 PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics& metrics,

@@ -1,17 +1,14 @@
 #include "scan_output.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <sstream>
-#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
-#include "core/process.hpp"
+#include "plot_series.hpp"
 
 namespace hystloop::report {
 
@@ -69,30 +66,12 @@ std::string cell(std::string text) {
   return text;
 }
 
-std::ofstream open_for_writing(const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
-  return out;
-}
-
-void close_checked(std::ofstream& out, const std::filesystem::path& path) {
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": write failed");
-}
-
-std::string fmt_num(double v) {
-  if (!std::isfinite(v)) return "NaN";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 // One segment's error for the plot: the ticks' min and max per bucket (the envelope survives
 // the decimation), time since origin_s (the reference's first segment: off, then on, follow).
-void write_error_block(std::ostream& out, const RunData& run, const std::optional<SegmentFigures>& s, double origin_s,
+void write_error_block(DataFile& out, const RunData& run, const std::optional<SegmentFigures>& s, double origin_s,
                        std::size_t max_points) {
   if (!s) {
-    out << "NaN NaN\n\n\n";  // keeps the block numbering: two blocks per reference
+    out.text("NaN NaN\n\n\n");  // keeps the block numbering: two blocks per reference
     return;
   }
   const std::int64_t zero = run.time_zero_utime();
@@ -111,11 +90,11 @@ void write_error_block(std::ostream& out, const RunData& run, const std::optiona
                                               [](const auto& a, const auto& b) { return a.second < b.second; });
     const auto& first = lo->first <= hi->first ? *lo : *hi;
     const auto& second = lo->first <= hi->first ? *hi : *lo;
-    out << fmt_num(first.first) << ' ' << fmt_num(first.second) << '\n';
-    if (bucket > 1) out << fmt_num(second.first) << ' ' << fmt_num(second.second) << '\n';
+    out.num(first.first).num(first.second).end_row();
+    if (bucket > 1) out.num(second.first).num(second.second).end_row();
   }
-  if (ticks.empty()) out << "NaN NaN\n";
-  out << "\n\n";
+  if (ticks.empty()) out.text("NaN NaN\n");
+  out.text("\n\n");
 }
 
 }  // namespace
@@ -216,58 +195,56 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
   const std::size_t per_segment =
       std::clamp<std::size_t>(options.max_points / std::max<std::size_t>(1, 2 * n), 200, 6000);
   {
-    const auto path = dir / "scan_error.dat";
-    auto out = open_for_writing(path);
-    out << "# t_s e_nm   (t since the reference's first segment; e = y_ref - y; two blocks per reference: learning "
-           "off, learning on; min and "
-           "max per bucket)\n";
+    DataFile out(dir / "scan_error.dat");
+    out.text(
+        "# t_s e_nm   (t since the reference's first segment; e = y_ref - y; two blocks per reference: learning "
+        "off, learning on; min and "
+        "max per bucket)\n");
     for (const auto& r : scan.references) {
       const double origin_s = r.off ? r.off->start_s : (r.on ? r.on->start_s : 0.0);
       write_error_block(out, run, r.off, origin_s, per_segment);
       write_error_block(out, run, r.on, origin_s, per_segment);
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
   std::map<std::string, std::vector<const ReferenceFigures*>> by_shape;
   for (const auto& r : scan.references) by_shape[r.trajectory.shape].push_back(&r);
   {
-    const auto path = dir / "scan_rates.dat";
-    auto out = open_for_writing(path);
-    out << "# frequency_hz rms_last_off_nm rms_last_on_nm rms_off_nm rms_on_nm   (one block per shape)\n";
+    DataFile out(dir / "scan_rates.dat");
+    out.text("# frequency_hz rms_last_off_nm rms_last_on_nm rms_off_nm rms_on_nm   (one block per shape)\n");
     for (auto& [shape, refs] : by_shape) {
-      out << "# " << shape << '\n';
+      out.text("# ").text(shape).text("\n");
       std::sort(refs.begin(), refs.end(),
                 [](const auto* a, const auto* b) { return a->trajectory.frequency_hz < b->trajectory.frequency_hz; });
       for (const auto* r : refs) {
         auto v = [](const std::optional<SegmentFigures>& s, bool last_s) {
           const std::optional<double> m = !s ? std::nullopt : (last_s ? s->rms_last_m : s->rms_m);
-          return fmt_num(m ? *m * 1e9 : std::nan(""));
+          return m ? *m * 1e9 : std::nan("");
         };
-        out << fmt_num(r->trajectory.frequency_hz) << ' ' << v(r->off, true) << ' ' << v(r->on, true) << ' '
-            << v(r->off, false) << ' ' << v(r->on, false) << '\n';
+        out.num(r->trajectory.frequency_hz).num(v(r->off, true)).num(v(r->on, true));
+        out.num(v(r->off, false)).num(v(r->on, false)).end_row();
       }
-      out << "\n\n";
+      out.text("\n\n");
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
   {
-    const auto path = dir / "scan_periods.dat";
-    auto out = open_for_writing(path);
-    out << "# period rms_nm   (learning on; one block per reference)\n";
+    DataFile out(dir / "scan_periods.dat");
+    out.text("# period rms_nm   (learning on; one block per reference)\n");
     for (const auto& r : scan.references) {
       if (r.on && !r.on->period_rms_m.empty()) {
         for (std::size_t i = 0; i < r.on->period_rms_m.size(); ++i) {
-          out << i << ' ' << fmt_num(r.on->period_rms_m[i] * 1e9) << '\n';
+          out.integer(static_cast<long long>(i)).num(r.on->period_rms_m[i] * 1e9).end_row();
         }
       } else {
-        out << "NaN NaN\n";
+        out.text("NaN NaN\n");
       }
-      out << "\n\n";
+      out.text("\n\n");
     }
-    close_checked(out, path);
-    result.data_files.push_back(path);
+    out.close();
+    result.data_files.push_back(out.path());
   }
 
   std::ostringstream gp;
@@ -295,7 +272,7 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
            << "' at graph 0.45, graph 0.6\nplot [0:1] [-1:1] 0 with lines lc rgb 'gray' notitle\nunset label 1\n";
         continue;
       }
-      gp << "set yrange [" << fmt_num(-range) << ":" << fmt_num(range) << "]\n"
+      gp << "set yrange [" << plot_number(-range) << ":" << plot_number(range) << "]\n"
          << "plot 'scan_error.dat' index " << 2 * i << " using 1:2 with lines lw 1 lc rgb '#c04040' title "
          << "'learning off', '' index " << 2 * i + 1 << " using 1:2 with lines lw 1 lc rgb '#2060c0' title "
          << "'learning on'\n";
@@ -339,42 +316,8 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
   }
   gp << "\nunset output\n";
 
-  result.script = dir / "scan.gp";
-  auto write_script = [&](const std::string& terminal) {
-    std::string text = gp.str();
-    for (std::size_t at; (at = text.find("@TERMINAL@")) != std::string::npos;) text.replace(at, 10, terminal);
-    auto out = open_for_writing(result.script);
-    out << text;
-    close_checked(out, result.script);
-  };
-  write_script("pngcairo");
-  const auto exe = find_executable(options.gnuplot);
-  if (exe.empty()) {
-    result.warning = "gnuplot not found ('" + options.gnuplot + "'): scan plots skipped (data and scan.gp are in " +
-                     dir.string() + ")";
-    return result;
-  }
-  if (images.empty()) {
-    result.warning = "no reference to plot";
-    return result;
-  }
-  for (const std::string terminal : {"pngcairo", "png"}) {
-    if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}) != 0) continue;  // not built in
-    write_script(terminal);
-    for (const auto& image : images) std::filesystem::remove(dir / image);
-    const int rc = run_program_in(dir, exe, {"scan.gp"}, "scan_gnuplot.log");
-    result.terminal = terminal;
-    for (const auto& image : images) {
-      if (std::filesystem::exists(dir / image)) result.images.push_back(dir / image);
-    }
-    if (rc != 0 || result.images.size() != images.size()) {
-      result.warning = "gnuplot failed on scan.gp (exit " + std::to_string(rc) +
-                       "): " + std::to_string(result.images.size()) + " of " + std::to_string(images.size()) +
-                       " scan plots written; see " + (dir / "scan_gnuplot.log").string();
-    }
-    return result;
-  }
-  result.warning = "gnuplot has neither the pngcairo nor the png terminal: scan plots skipped";
+  render_script({"scan.gp", gp.str(), images, "scan_gnuplot.log", "scan plots", "no reference to plot"}, dir, options,
+                result);
   return result;
 }
 

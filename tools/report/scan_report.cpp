@@ -1,24 +1,12 @@
 #include "scan_report.hpp"
 
 #include <cstdio>
-#include <fstream>
-#include <stdexcept>
 
+#include "plot_series.hpp"
 #include "scan_log.hpp"
 #include "scan_output.hpp"
 
 namespace hystloop::report {
-
-namespace {
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
-}
-
-}  // namespace
 
 int write_scan_report(const std::vector<std::filesystem::path>& logs, const RunData& data, const ChannelNames& channels,
                       const std::filesystem::path& dir, const ScanReportOptions& o) {
@@ -45,7 +33,7 @@ int write_scan_report(const std::vector<std::filesystem::path>& logs, const RunD
                  clamped.c_str());
   }
   const std::string table = scan_table(scan);
-  write_text(dir / "scan.json", scan_json(scan, logs));
+  write_text_file(dir / "scan.json", scan_json(scan, logs));
   std::string md = "# Scan: tracking error per line-rate reference, learning off and on\n\n" + table;
   char rule[160];
   std::snprintf(rule, sizeof rule, "stays within %g x the median of the last %zu", o.figures.converge_factor,
@@ -67,7 +55,7 @@ int write_scan_report(const std::vector<std::filesystem::path>& logs, const RunD
     }
     md += "\n";
   }
-  write_text(dir / "scan.md", md);
+  write_text_file(dir / "scan.md", md);
   PlotResult plots;
   if (!o.no_plots) {
     plots = write_scan_plots(data, scan, dir, o.plots);
