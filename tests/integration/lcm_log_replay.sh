@@ -3,21 +3,15 @@
 # endpoints, then lcm-logplayer plays it into a project subscriber: every message must
 # arrive intact, once. Run inside tools/netns-run.
 #   lcm_log_replay.sh <lcm_probe> [rounds]
-set -euo pipefail
-probe="$1"; rounds="${2:-300}"
-url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"  # 10 kHz survives a busy CPU (see url.hpp)
-[ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
-source "$(dirname "$0")/wait_common.sh"
-dir="$(mktemp -d)"; logger=""
-cleanup() { [ -n "$logger" ] && kill "$logger" 2>/dev/null; rm -rf "$dir"; }
-trap cleanup EXIT
+source "$(dirname "$0")/lcm_common.sh" "$@"
+rounds="${2:-300}"
 
 echo "== record with lcm-logger"
 # lcm-logger's subscription queue is LCM's default (30 messages): descheduled for ~15 ms by a busy
 # machine it drops. As root it runs at a low SCHED_FIFO priority, as the project's own logger does.
 rt=(); [ "$(id -u)" -eq 0 ] && command -v chrt >/dev/null && rt=(chrt -f 10)
 "${rt[@]}" lcm-logger --quiet --force --flush-interval=20 --lcm-url="$url" --channel='HX_.*|WARMUP_.*' "$dir/run.lcmlog" &
-logger=$!
+logger=$!; pids+=("$logger")
 # Warm-up sensor messages in the file so far (channel names are plain text in the log; none yet is
 # 0, not a failure: grep's status would end the script under pipefail).
 marks() { { grep -a -o 'WARMUP_SENSOR' "$dir/run.lcmlog" 2>/dev/null || true; } | wc -l; }
@@ -35,15 +29,12 @@ wait_until 20 "lcm-logger recorded a warm-up round" warmup_recorded 0
 # The same at the end: the logger handles its socket in order, so once a round sent after them
 # is in the file, so is every HX_ message.
 wait_until 20 "lcm-logger recorded the closing warm-up round" warmup_recorded "$(marks)"
-kill -INT "$logger"; wait "$logger" || true; logger=""
+kill -INT "$logger"; wait "$logger" || true
 
 echo "== read the log back"
 "$probe" check-log --file "$dir/run.lcmlog" --prefix HX_ --rounds "$rounds" --ignore-prefix WARMUP_
 
 echo "== play it with lcm-logplayer into a subscriber"
-"$probe" subscribe --url "$url" --prefix HX_ --rounds "$rounds" --timeout-s 8 --ready-file "$dir/ready" &
-sub=$!
-for _ in $(seq 100); do [ -e "$dir/ready" ] && break; sleep 0.05; done
-[ -e "$dir/ready" ] || { echo "subscriber never became ready" >&2; kill "$sub"; exit 1; }
+start_peer subscribe --url "$url" --prefix HX_ --rounds "$rounds" --timeout-s 8
 lcm-logplayer --lcm-url="$url" --speed=1.0 "$dir/run.lcmlog"
-wait "$sub"
+wait "$peer"
