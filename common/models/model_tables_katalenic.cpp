@@ -2,6 +2,7 @@
 // initial offset, and the two shaping functions field by field ("input_shaping.gain", ...), the
 // flattened form of the YAML hystloop-identify writes (input_shaping: {kind: linear, gain: ...}).
 #include <array>
+#include <deque>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -15,16 +16,11 @@ namespace {
 
 using P = KatalenicParams;
 
-struct ShapingNames {
-  std::string_view kind, gain, offset, coefficients, domain_min, domain_max, amplitude, scale;
-};
-
-constexpr ShapingNames kInputNames{"input_shaping.kind",         "input_shaping.gain",       "input_shaping.offset",
-                                   "input_shaping.coefficients", "input_shaping.domain_min", "input_shaping.domain_max",
-                                   "input_shaping.amplitude",    "input_shaping.scale"};
-constexpr ShapingNames kOutputNames{
-    "output_shaping.kind",       "output_shaping.gain",       "output_shaping.offset",    "output_shaping.coefficients",
-    "output_shaping.domain_min", "output_shaping.domain_max", "output_shaping.amplitude", "output_shaping.scale"};
+// The rows' names outlive make_rows(): a deque never moves what it holds.
+std::string_view stored(std::string name) {
+  static std::deque<std::string> names;
+  return names.emplace_back(std::move(name));
+}
 
 // Whether a shaping field means anything for the function's kind (the YAML written leaves the
 // others out: {kind: linear, gain: ..., offset: ...}).
@@ -35,9 +31,11 @@ bool of_kind(const P& p) {
 
 // Sel: captureless generic lambda returning the ShapingFunction inside P.
 template <class Sel>
-void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, std::string_view map) {
+void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const std::string& prefix, std::string_view map) {
+  const auto n = [&](const char* field) { return stored(prefix + "." + field); };
   rows.push_back(custom<P>(
-      n.kind, "-", map == "in" ? "input map V -> operator units" : "output map operator units -> m", ValueKind::choice,
+      n("kind"), "-", map == "in" ? "input map V -> operator units" : "output map operator units -> m",
+      ValueKind::choice,
       [](P& p, const ParsedValue& v) {
         Sel{}(p).kind = v.choice == "tanh"         ? ShapingKind::tanh
                         : v.choice == "polynomial" ? ShapingKind::polynomial
@@ -54,13 +52,14 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
       "linear|polynomial|tanh"));
   const std::string_view unit = map == "in" ? "x/V" : "m/x";
   rows.push_back(number<P>(
-      n.gain, unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
+      n("gain"), unit, "linear: slope", [](auto& p) -> auto& { return Sel{}(p).gain; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::linear>;
   rows.push_back(number<P>(
-      n.offset, map == "in" ? "x" : "m", "linear, tanh: value at 0", [](auto& p) -> auto& { return Sel{}(p).offset; }));
+      n("offset"), map == "in" ? "x" : "m", "linear, tanh: value at 0",
+      [](auto& p) -> auto& { return Sel{}(p).offset; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::linear, ShapingKind::tanh>;
   rows.push_back(custom<P>(
-      n.coefficients, "-", "polynomial: c0,c1,...,c7 (units of the map)", ValueKind::list,
+      n("coefficients"), "-", "polynomial: c0,c1,...,c7 (units of the map)", ValueKind::list,
       [](P& p, const ParsedValue& v) {
         auto& c = Sel{}(p).coefficients;
         if (v.list.size() > c.size()) {
@@ -78,19 +77,19 @@ void add_shaping_rows(std::vector<ParamSpec<P>>& rows, const ShapingNames& n, st
       }));
   rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
-      n.domain_min, map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
+      n("domain_min"), map == "in" ? "V" : "x", "polynomial: lower end of the proven-monotone domain",
       [](auto& p) -> auto& { return Sel{}(p).domain_min; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
-      n.domain_max, map == "in" ? "V" : "x", "polynomial: upper end of that domain",
+      n("domain_max"), map == "in" ? "V" : "x", "polynomial: upper end of that domain",
       [](auto& p) -> auto& { return Sel{}(p).domain_max; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::polynomial>;
   rows.push_back(number<P>(
-      n.amplitude, map == "in" ? "x" : "m", "tanh: half the output range",
+      n("amplitude"), map == "in" ? "x" : "m", "tanh: half the output range",
       [](auto& p) -> auto& { return Sel{}(p).amplitude; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::tanh>;
   rows.push_back(number<P>(
-      n.scale, map == "in" ? "V" : "x", "tanh: input scale", [](auto& p) -> auto& { return Sel{}(p).scale; }));
+      n("scale"), map == "in" ? "V" : "x", "tanh: input scale", [](auto& p) -> auto& { return Sel{}(p).scale; }));
   rows.back().applies = &of_kind<Sel, ShapingKind::tanh>;
 }
 
@@ -111,8 +110,8 @@ std::vector<ParamSpec<P>> make_rows() {
       number<P>(
           "initial_offset", "x", "z - x at reset, |.| <= k1", [](auto& p) -> auto& { return p.initial_offset; }),
   };
-  add_shaping_rows<decltype([](auto& p) -> auto& { return p.input_shaping; })>(rows, kInputNames, "in");
-  add_shaping_rows<decltype([](auto& p) -> auto& { return p.output_shaping; })>(rows, kOutputNames, "out");
+  add_shaping_rows<decltype([](auto& p) -> auto& { return p.input_shaping; })>(rows, "input_shaping", "in");
+  add_shaping_rows<decltype([](auto& p) -> auto& { return p.output_shaping; })>(rows, "output_shaping", "out");
   return rows;
 }
 

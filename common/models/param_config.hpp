@@ -7,6 +7,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/config.hpp"
@@ -43,10 +44,7 @@ std::vector<Assignment> config_section(const Config& config, std::string_view mo
 template <class D>
 typename D::Params params_from_config(const Config& config, typename D::Settings settings,
                                       std::string_view section = D::name) {
-  apply(D::table(), D::name, config_section(config, section, D::table()), settings);
-  typename D::Params params = D::build(settings);
-  params.validate();
-  return params;
+  return params_from<D>(config_section(config, section, D::table()), std::move(settings));
 }
 
 // "<model>.<name>" for every row and alias of the table: the keys a config may hold.

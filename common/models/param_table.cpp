@@ -7,15 +7,12 @@
 #include "core/edit_distance.hpp"
 
 namespace hystloop {
-namespace {
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
   return s;
 }
-
-}  // namespace
 
 AssignmentError::AssignmentError(const Assignment& a, const std::string& reason)
     : ParameterError(a.name, reason), message_(a.origin + ": " + reason) {}

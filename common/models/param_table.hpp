@@ -80,6 +80,9 @@ std::vector<double> parse_list(const Assignment& a);
 std::string parse_choice(const Assignment& a, std::string_view choices);
 ParsedValue parse_value(const Assignment& a, ValueKind kind, std::string_view choices);
 
+// `s` without the spaces and tabs around it.
+std::string_view trim(std::string_view s);
+
 // Strict C-locale number: the whole of `text` (surrounding spaces aside) must be one finite
 // double. Returns false otherwise; `why` says "expected a number" or "expected a finite number".
 bool parse_finite_double(std::string_view text, double& out, std::string* why = nullptr);
@@ -112,6 +115,16 @@ const ParamSpec<S>* find_spec(std::span<const ParamSpec<S>> table, std::string_v
     if (p.name == name || (!p.alias.empty() && p.alias == name)) return &p;
   }
   return nullptr;
+}
+
+// D's (models/model_descriptors.hpp) parameters: the assignments over `settings` (the defaults),
+// built and validated. Throws AssignmentError or ParameterError naming the field.
+template <class D>
+typename D::Params params_from(const std::vector<Assignment>& assignments, typename D::Settings settings = {}) {
+  apply(D::table(), D::name, assignments, settings);
+  typename D::Params params = D::build(settings);
+  params.validate();
+  return params;
 }
 
 // f(name, value) for every number `s` holds by the table: a number row's value, a list row's

@@ -219,10 +219,7 @@ void merge_params_file(Config& config, const std::filesystem::path& snippet) {
     try {
       value = params.get<std::string>(key);
     } catch (const ConfigError&) {  // a list: thresholds, weights, coefficients
-      const auto list = params.get<std::vector<double>>(key);
-      value.assign(1, '[');
-      for (std::size_t i = 0; i < list.size(); ++i) value += fmt::format("{}{:.17g}", i ? ", " : "", list[i]);
-      value.push_back(']');
+      value = "[" + format_list(params.get<std::vector<double>>(key)) + "]";
     }
     std::string assignment = key;  // (appended, not key + "=" + value: GCC 12 warns falsely on that)
     assignment.append(1, '=').append(value);

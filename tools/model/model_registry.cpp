@@ -23,12 +23,6 @@ concept SteppedStage = requires(M& m, const M& cm, double u, double dt) {
 template <class D>
 constexpr bool kHasInverse = !std::is_void_v<typename D::Inverse>;
 
-static_assert(HysteresisForward<MemModel> && HysteresisInverse<MemInverse>);
-static_assert(HysteresisForward<PiModel> && HysteresisInverse<PiInverse>);
-static_assert(HysteresisForward<LinearModel> && HysteresisInverse<LinearInverse>);
-static_assert(HysteresisForward<KatalenicModel> && HysteresisInverse<KatalenicInverse>);
-static_assert(SteppedStage<BanningStage>);
-
 template <class D>
 class RunFor final : public ModelRun {
  public:
@@ -83,11 +77,7 @@ class EntryFor final : public ModelEntry {
   std::vector<ParamInfo> parameters() const override { return describe(D::table()); }
 
   std::unique_ptr<ModelRun> configure(const std::vector<Assignment>& assignments) const override {
-    typename D::Settings settings{};
-    apply(D::table(), D::name, assignments, settings);
-    const typename D::Params params = D::build(settings);
-    params.validate();
-    return std::make_unique<RunFor<D>>(params);
+    return std::make_unique<RunFor<D>>(params_from<D>(assignments));
   }
 };
 

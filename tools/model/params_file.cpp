@@ -55,14 +55,11 @@ ParamsFile read_params_file(const std::string& path, std::string_view model) {
     const std::string key = kv.first.as<std::string>();
     if (find_model(key) != nullptr) sections.push_back(key);
   }
+  std::string found;
+  for (const auto& s : sections) found += (found.empty() ? "" : ", ") + s;
   ParamsFile result;
   if (model.empty()) {
     if (sections.size() != 1) {
-      std::string found;
-      for (const auto& s : sections) {
-        if (!found.empty()) found += ", ";
-        found += s;
-      }
       throw ParamsFileError(path + ": " +
                             (sections.empty() ? "no model section (expected one of " + model_names() + ")"
                                               : "several model sections (" + found + "): choose one with --model"));
@@ -71,11 +68,6 @@ ParamsFile read_params_file(const std::string& path, std::string_view model) {
   } else {
     result.model = std::string(model);
     if (!doc[result.model]) {
-      std::string found;
-      for (const auto& s : sections) {
-        if (!found.empty()) found += ", ";
-        found += s;
-      }
       throw ParamsFileError(path + ": no '" + result.model + "' section" +
                             (found.empty() ? std::string() : " (it has: " + found + ")"));
     }
