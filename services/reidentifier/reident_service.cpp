@@ -27,9 +27,7 @@ ModelParamSet initial_model(const ReidentOptions& options) {
   set.mem = options.initial;
   return set;
 }
-}  // namespace
 
-namespace {
 // Logs refusals on the worker thread, right after evaluate: the I/O thread never formats one.
 // A steady plant is refused every period (no_improvement): a reason is logged at info when it
 // differs from the previous refusal's, or once a minute while it repeats; at debug otherwise.
@@ -110,30 +108,22 @@ void ReidentService::on_params(const mem_params_t& msg) {
   const ParamsOffer offer = core_->on_params(p, msg.version, msg.publisher_id, msg.valid, msg.source);
   // Counted by the core (params_adopted, _stale, _invalid, _implausible); logged at most once a second per kind.
   const auto id = static_cast<std::uint64_t>(msg.publisher_id);
-  if (core_->counters().get(ReidentCounter::params_implausible) != implausible_before) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, monotonic_ns())) {
-      spdlog::warn("params version {} from '{}' (publisher {:x}) not adopted: {}{}", msg.version,
-                   escape_wire(msg.source), id, core_->implausible_reason(), suppressed_note(g));
+  const auto log = [&](LogReason reason, spdlog::level::level_enum level, const std::string& what) {
+    if (const LogLimiter::Gate g = log_limiter_.allow(reason, monotonic_ns())) {
+      spdlog::log(level, "params version {} from '{}' (publisher {:x}) {}{}", msg.version, escape_wire(msg.source), id,
+                  what, suppressed_note(g));
     }
-    return;
+  };
+  if (core_->counters().get(ReidentCounter::params_implausible) != implausible_before) {
+    return log(kLogInvalid, spdlog::level::warn, "not adopted: " + core_->implausible_reason());
   }
   if (offer == ParamsOffer::adopted) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogAdopted, monotonic_ns())) {
-      spdlog::info("params in use now version {} from '{}' (publisher {:x}): c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}{}",
-                   msg.version, escape_wire(msg.source), id, msg.c1, msg.c2, msg.c3, suppressed_note(g));
-    }
+    log(kLogAdopted, spdlog::level::info,
+        fmt::format("in use now: c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", msg.c1, msg.c2, msg.c3));
   } else if (offer == ParamsOffer::stale) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogStale, monotonic_ns())) {
-      spdlog::debug("params version {} from '{}' (publisher {:x}) ignored: not newer than the last from it{}",
-                    msg.version, escape_wire(msg.source), id, suppressed_note(g));
-    }
+    log(kLogStale, spdlog::level::debug, "ignored: not newer than the last from it");
   } else if (offer == ParamsOffer::invalid) {
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogInvalid, monotonic_ns())) {
-      spdlog::info(
-          "params version {} from '{}' (publisher {:x}) not used: marked invalid or outside the model's "
-          "domain{}",
-          msg.version, escape_wire(msg.source), id, suppressed_note(g));
-    }
+    log(kLogInvalid, spdlog::level::info, "not used: marked invalid or outside the model's domain");
   } else if (offer == ParamsOffer::forged) {
     forged_seen_us_ = steady_us();
     if (!forged_logged_) {  // once: the rest are counted (params_forged) and in the status detail
@@ -363,24 +353,18 @@ int ReidentService::run() {
   const int lcm_errors = run_io_loop(lcm_, loop, [this](std::int64_t wall_us) { on_tick(wall_us); });
   const std::int64_t now = steady_us();
   publish_status(now, true);
-  const ReidentCounters& c = core_->counters();
   const LatencyStats& refit = core_->refit_time();
+  const ParamsInUse& in_use = core_->in_use();
+  std::string counts;  // under their HX_STATUS names
+  for (const auto& [name, value] : counter_entries()) counts += fmt::format(", {} {}", name, value);
   spdlog::info(
-      "stopping: {} samples fed, {} skipped (safe state {}, sensor fault {}), {} gaps, {} non-finite, {} dropouts; "
-      "refits {} attempted, {} accepted, {} rejected, {} superseded; refit p50 {:.1f} ms max {:.1f} ms; "
-      "params version {} c1 {:.6g} c2 {:.6g} c3 {:.6g} (compensator applied {}); {} LCM errors",
-      c.get(ReidentCounter::samples_fed),
-      c.get(ReidentCounter::skipped_safe_state) + c.get(ReidentCounter::skipped_sensor_fault),
-      c.get(ReidentCounter::skipped_safe_state), c.get(ReidentCounter::skipped_sensor_fault),
-      c.get(ReidentCounter::seq_gaps), c.get(ReidentCounter::non_finite), c.get(ReidentCounter::dropouts),
-      c.get(ReidentCounter::refits_attempted), c.get(ReidentCounter::refits_accepted), c.rejected_total(),
-      c.get(ReidentCounter::refits_superseded), refit.count() ? refit.percentile(0.5) * 1e-6 : 0.0,
-      static_cast<double>(refit.max_ns()) * 1e-6, core_->in_use().version(), core_->in_use().params().c1,
-      core_->in_use().params().c2, core_->in_use().params().c3,
-      core_->in_use().applied_version() == ParamsInUse::kUnknownVersion
-          ? std::string("unknown")
-          : std::to_string(core_->in_use().applied_version()),
-      lcm_errors);
+      "stopping: refit p50 {:.1f} ms max {:.1f} ms; params version {} c1 {:.6g} c2 {:.6g} c3 {:.6g} (compensator "
+      "applied {}); {} LCM errors{}",
+      refit.count() ? refit.percentile(0.5) * 1e-6 : 0.0, static_cast<double>(refit.max_ns()) * 1e-6, in_use.version(),
+      in_use.params().c1, in_use.params().c2, in_use.params().c3,
+      in_use.applied_version() == ParamsInUse::kUnknownVersion ? std::string("unknown")
+                                                               : std::to_string(in_use.applied_version()),
+      lcm_errors, counts);
   return 0;
 }
 
