@@ -143,12 +143,19 @@ TEST(BridgeServo, GainChangeIsBumpless) {
 }
 
 // kp = 0 below makes the integrator's state visible: with no error, u_fb = ki * integral / gain.
-TEST(BridgeServo, HeldWhileSafeAndResumedOnArm) {
-  BridgeRig rig(patient_limits(), servo_gains(0.0, 300.0));
+// Runs on target until the integral holds the plant, then disarms: the feedback of the last armed
+// tick.
+double feedback_then_disarm(BridgeRig& rig) {
   run(rig, 5000, kFeedforward, kRef);
   const double held = rig.step(kFeedforward, kRef).u_fb_V;
-  ASSERT_GT(held, 10.0);
   rig.bridge->disarm();
+  return held;
+}
+
+TEST(BridgeServo, HeldWhileSafeAndResumedOnArm) {
+  BridgeRig rig(patient_limits(), servo_gains(0.0, 300.0));
+  const double held = feedback_then_disarm(rig);
+  ASSERT_GT(held, 10.0);
   for (int i = 0; i < 500; ++i) {  // the plant sinks with the ramp: large errors, ignored
     const BridgeTick t = rig.step(kFeedforward, kRef);
     ASSERT_TRUE(t.flags & sample_flags::kSafeState);
@@ -168,10 +175,8 @@ TEST(BridgeServo, HeldWhileSafeAndResumedOnArm) {
 // commands are back): a late tick holds the servo, it does not mean "no reference".
 TEST(BridgeServo, HeldWhileSafeAndResumedOnArmEvenIfTheFirstArmedTickIsLate) {
   BridgeRig rig(patient_limits(), servo_gains(0.0, 300.0));
-  run(rig, 5000, kFeedforward, kRef);
-  const double held = rig.step(kFeedforward, kRef).u_fb_V;
+  const double held = feedback_then_disarm(rig);
   ASSERT_GT(held, 10.0);
-  rig.bridge->disarm();
   for (int i = 0; i < 500; ++i) rig.step_without_command();
   BridgeCore& b = *rig.bridge;
   b.arm(rig.k);

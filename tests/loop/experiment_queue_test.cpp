@@ -100,9 +100,7 @@ TEST(ExperimentQueue, RunsASeriesBackToBack) {
 
 TEST(ExperimentQueue, ASeriesSteppedPastItsEndEndsOnce) {
   ExperimentQueue q;
-  q.add(sine(1.0, 100.0, 0.01));
-  q.add(sine(1.0, 100.0, 0.01));
-  q.add(sine(1.0, 100.0, 0.01));
+  for (int i = 0; i < 3; ++i) q.add(sine(1.0, 100.0, 0.01));
   ASSERT_TRUE(q.step(0.0).active);
   const ExperimentQueue::Step s = q.step(10.0);
   EXPECT_FALSE(s.active);
@@ -113,9 +111,7 @@ TEST(ExperimentQueue, ASeriesSteppedPastItsEndEndsOnce) {
 
 TEST(ExperimentQueue, StopEndsTheRunningOneAndDropsTheWaitingOnes) {
   ExperimentQueue q;
-  q.add(sine(10.0, 10.0, 1.0));
-  q.add(sine(10.0, 10.0, 1.0));
-  q.add(sine(10.0, 10.0, 1.0));
+  for (int i = 0; i < 3; ++i) q.add(sine(10.0, 10.0, 1.0));
   ASSERT_TRUE(q.step(2.0).active);
   q.stop(2.05);  // mid-period: a stop is a stop
   EXPECT_EQ(q.queued(), 0u);

@@ -6,27 +6,23 @@
 #include <complex>
 #include <numbers>
 
+#include "bridge_test_rig.hpp"
 #include "loop/notch_filter.hpp"
 #include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
 
+using testing::servo_gains;  // kp, ki in the rig's normalisation: 1 um per 100 V
+
 TEST(Feedback, ProportionalAndIntegralInNormalisedUnits) {
-  FeedbackGains g;
-  g.kp = 0.5;
-  g.ki = 100.0;
-  g.nominal_gain_m_per_V = 1e-8;
-  FeedbackController c(g);
+  FeedbackController c(servo_gains(0.5, 100.0));
   // e = 1 nm for one 100 us step: u = (0.5*1e-9 + 100*1e-9*1e-4) / 1e-8 V
   EXPECT_NEAR(c.update(1e-9, 0.0, 1e-4), (0.5e-9 + 1e-11) / 1e-8, 1e-12);
 }
 
 TEST(Feedback, IntegratorRemovesAConstantDisturbanceOnAUnitPlant) {
-  FeedbackGains g;
-  g.ki = 200.0;
-  g.nominal_gain_m_per_V = 1e-8;
-  FeedbackController c(g);
+  FeedbackController c(servo_gains(0.0, 200.0));
   // Plant y = gain * u + d, reference 0: the integrator must cancel d.
   const double d = 50e-9;
   double y = d;
@@ -38,9 +34,7 @@ TEST(Feedback, IntegratorRemovesAConstantDisturbanceOnAUnitPlant) {
 }
 
 TEST(Feedback, AntiWindupStopsIntegratingIntoSaturation) {
-  FeedbackGains g;
-  g.ki = 1000.0;
-  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackGains g = servo_gains(0.0, 1000.0);
   g.u_min_V = -250.0;
   g.u_max_V = 250.0;
   FeedbackController c(g);
@@ -69,10 +63,7 @@ TEST(Feedback, RefusesNegativeGains) {
 // The edge of the interval the caller allows, not only the actuator's range: the integral goes
 // up to the edge (a nanovolt short of it) and no further.
 TEST(Feedback, TheIntegratorStopsAtTheEdgeOfTheAllowedInterval) {
-  FeedbackGains g;
-  g.ki = 1000.0;
-  g.nominal_gain_m_per_V = 1e-8;
-  FeedbackController c(g);
+  FeedbackController c(servo_gains(0.0, 1000.0));
   double u = 0.0;
   for (int i = 0; i < 1000; ++i) u = c.update(1e-6, 10.0, 1e-4, -5.0, 12.0);  // +10 V per tick, 2 V allowed
   EXPECT_NEAR(10.0 + u, 12.0, 1e-7);
@@ -89,11 +80,7 @@ TEST(Feedback, TheIntegratorStopsAtTheEdgeOfTheAllowedInterval) {
 // A command the proportional part alone takes beyond the edge: the integral holds (it does not
 // grow toward the clamp, nor unwind: that is the error's business).
 TEST(Feedback, BeyondTheEdgeAlreadyTheIntegralHolds) {
-  FeedbackGains g;
-  g.kp = 1.0;
-  g.ki = 100.0;
-  g.nominal_gain_m_per_V = 1e-8;
-  FeedbackController c(g);
+  FeedbackController c(servo_gains(1.0, 100.0));
   for (int i = 0; i < 10; ++i) c.update(1e-9, 0.0, 1e-4);
   const double held = c.integral_m_s();
   for (int i = 0; i < 100; ++i) c.update(1e-6, 0.0, 1e-4, -1.0, 1.0);  // kp e / gain = 100 V > 1 V
@@ -143,9 +130,7 @@ TEST(Notch, StopsASineAtItsCentreAndPassesASlowOne) {
 }
 
 TEST(Notch, ServoOutputIsThePidThroughTheNotch) {
-  FeedbackGains g;
-  g.kp = 0.5;
-  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackGains g = servo_gains(0.5, 0.0);
   g.notch_hz = 1720.0;
   g.notch_q = 0.7;
   FeedbackController c(g);
@@ -158,9 +143,7 @@ TEST(Notch, ServoOutputIsThePidThroughTheNotch) {
 
 // Switching the notch in, retuning it or out on a servo at rest changes nothing in its output.
 TEST(Notch, ANotchChangeIsBumpless) {
-  FeedbackGains g;
-  g.ki = 300.0;
-  g.nominal_gain_m_per_V = 1e-8;
+  FeedbackGains g = servo_gains(0.0, 300.0);
   FeedbackController c(g);
   for (int i = 0; i < 1000; ++i) c.update(1e-8, 0.0, 1e-4);
   const double before = c.update(0.0, 0.0, 1e-4);
