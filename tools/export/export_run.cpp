@@ -41,12 +41,6 @@ std::int64_t time_zero_utime(const std::vector<fs::path>& logs, const std::strin
   return first_event.value_or(0);
 }
 
-std::string channel_list(const std::map<std::string, std::uint64_t>& counts) {
-  std::string out;
-  for (const auto& [channel, n] : counts) out += (out.empty() ? "" : ", ") + channel;
-  return out.empty() ? "none" : out;
-}
-
 // Reports how far reading got, at most every two seconds.
 class Progress {
  public:
@@ -183,17 +177,14 @@ ExportContent collect(const ExportOptions& o, std::FILE* progress) {
   ExportContent content;
   if (o.channels.empty()) {
     if (found.empty()) {
-      throw std::runtime_error("no channel of the rig " + names.prefix +
-                               " in the log (channels: " + channel_list(counts) + "); --rig PREFIX for another rig");
+      throw std::runtime_error("no channel of the rig " + names.prefix + " in the log (channels: " +
+                               report::channel_list(counts) + "); --rig PREFIX for another rig");
     }
     content.tables = std::move(found);
   } else {
     std::set<std::string> taken;
     for (const auto& c : o.channels) {
-      const std::string channel = counts.count(c) != 0 ? c : names.prefix + c;
-      if (counts.count(channel) == 0) {
-        throw ParameterError("--channel", "no channel '" + c + "' in the log (channels: " + channel_list(counts) + ")");
-      }
+      const std::string channel = report::resolve_channel(c, counts, names.prefix, "--channel");
       if (!taken.insert(channel).second) continue;  // asked for twice
       for (auto& t : found) {
         if (t.channel == channel) content.tables.push_back(std::move(t));

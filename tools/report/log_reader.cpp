@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "decode.hpp"
 #include "event_file.hpp"
 #include "lcm/blocks.hpp"
@@ -27,6 +28,19 @@ std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>
     scans.push_back(reader.scan());
   }
   return scans;
+}
+
+std::string channel_list(const std::map<std::string, std::uint64_t>& counts) {
+  std::string out;
+  for (const auto& [channel, n] : counts) out += (out.empty() ? "" : ", ") + channel;
+  return out.empty() ? "none" : out;
+}
+
+std::string resolve_channel(const std::string& name, const std::map<std::string, std::uint64_t>& counts,
+                            const std::string& prefix, const char* option) {
+  if (counts.count(name) != 0) return name;
+  if (counts.count(prefix + name) != 0) return prefix + name;
+  throw ParameterError(option, "no channel '" + name + "' in the log (channels: " + channel_list(counts) + ")");
 }
 
 std::vector<std::string> describe_scan_problems(const std::vector<LogFileScan>& scans) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,15 @@ std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks
 // std::runtime_error naming the file if one cannot be opened.
 std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>& files,
                                         const std::function<void(const lcm::LogEvent&)>& visit);
+
+// The channels of a log's event counts, comma-separated ("HX_COMMAND, HX_SENSOR"), or "none".
+std::string channel_list(const std::map<std::string, std::uint64_t>& counts);
+
+// A channel named by `option` as logged ("HX_SENSOR") or by its suffix after the rig's prefix
+// ("SENSOR"). Throws ParameterError(option, "no channel 'X' in the log (channels: ...)") when the
+// log has neither.
+std::string resolve_channel(const std::string& name, const std::map<std::string, std::uint64_t>& counts,
+                            const std::string& prefix, const char* option);
 
 // One warning per file that was not read cleanly ("run.lcmlog: the last 17 bytes are not a
 // complete event (truncated?)"); empty when every byte of every file was an event.

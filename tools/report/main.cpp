@@ -58,16 +58,6 @@ struct Options {
   ScanReportOptions scan;  // --scan, --no-scan, --scan-settle, --compensator-process
 };
 
-// A --csv argument names a channel as logged ("HX_SENSOR") or by its suffix ("SENSOR").
-std::string resolve_channel(const std::string& name, const RunData& run, const std::string& prefix) {
-  if (run.channel_counts.count(name) != 0) return name;
-  if (run.channel_counts.count(prefix + name) != 0) return prefix + name;
-  std::string known;
-  for (const auto& [channel, count] : run.channel_counts) known += (known.empty() ? "" : ", ") + channel;
-  throw ParameterError("--csv",
-                       "no channel '" + name + "' in the log (channels: " + (known.empty() ? "none" : known) + ")");
-}
-
 // A line on stderr as each phase of a long log starts (a 30 s run at 10 kHz is some 25 MB and
 // takes seconds), so that a slow report is seen working; nothing for a short log or with --quiet.
 class Progress {
@@ -126,7 +116,8 @@ int run(const Options& o) {
     return 1;
   }
   std::vector<std::string> csv_channels;
-  for (const auto& name : o.csv) csv_channels.push_back(resolve_channel(name, data, channels.prefix));
+  for (const auto& name : o.csv)
+    csv_channels.push_back(resolve_channel(name, data.channel_counts, channels.prefix, "--csv"));
 
   std::error_code ec;
   fs::create_directories(o.out, ec);
