@@ -17,35 +17,23 @@ FitCurve curve(ModelKind kind, std::vector<double> prediction) {
   return c;
 }
 
-// predict_mem copies the measured y before the first reversal (the state is unknown there): a
-// plot must not show that as the model agreeing perfectly.
-std::vector<double> mem_prediction(const MemParams& params, std::span<const double> u, std::span<const double> y) {
-  std::vector<double> out = predict_mem(params, u, y);
+// fitted_prediction, but for MEM NaN before the first reversal: predict_mem copies the measured
+// y there (the state is unknown), and a plot must not show that as the model agreeing perfectly.
+std::vector<double> prediction(const ModelSelection& sel, ModelKind kind, std::span<const double> u,
+                               std::span<const double> y) {
+  std::vector<double> out = fitted_prediction(sel, kind, u, y);
+  if (kind != ModelKind::mem) return out;
   const std::vector<std::size_t> rev = find_reversals(u);
   const std::size_t start = rev.empty() ? 0 : rev.front();
   for (std::size_t k = 0; k < start && k < out.size(); ++k) out[k] = kNaN;
   return out;
 }
 
-std::vector<double> linear_prediction(const LinearFitResult& fit, std::span<const double> u) {
-  std::vector<double> out(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) out[k] = fit.gain_m_per_V * u[k] + fit.offset_m;
-  return out;
-}
-
 }  // namespace
 
-FitCurve whole_record_curve(const MemFitResult& fit, std::span<const double> u_V, std::span<const double> y_m) {
-  return curve(ModelKind::mem, mem_prediction(fit.params, u_V, y_m));
-}
-FitCurve whole_record_curve(const PiFitResult& fit, std::span<const double> u_V) {
-  return curve(ModelKind::pi, predict_pi(fit, u_V));
-}
-FitCurve whole_record_curve(const KatalenicFitResult& fit, std::span<const double> u_V) {
-  return curve(ModelKind::katalenic, predict_katalenic(fit.params, u_V));
-}
-FitCurve whole_record_curve(const LinearFitResult& fit, std::span<const double> u_V) {
-  return curve(ModelKind::linear, linear_prediction(fit, u_V));
+FitCurve whole_record_curve(const ModelSelection& fit, ModelKind kind, std::span<const double> u_V,
+                            std::span<const double> y_m) {
+  return curve(kind, prediction(fit, kind, u_V, y_m));
 }
 
 std::vector<FitCurve> ranked_curves(const ModelSelection& sel, std::span<const double> u, std::span<const double> y) {
@@ -56,13 +44,7 @@ std::vector<FitCurve> ranked_curves(const ModelSelection& sel, std::span<const d
   const std::size_t train_begin = rev.size() > 1 ? rev[1] : 0;  // as select_model scores
   for (const ModelScore& score : sel.ranking) {
     if (score.status != FitStatus::ok) continue;
-    std::vector<double> pred;
-    switch (score.kind) {
-      case ModelKind::mem: pred = mem_prediction(sel.mem.params, u, y); break;
-      case ModelKind::pi: pred = predict_pi(sel.pi, u); break;
-      case ModelKind::katalenic: pred = predict_katalenic(sel.katalenic.params, u); break;
-      case ModelKind::linear: pred = linear_prediction(sel.linear, u); break;
-    }
+    std::vector<double> pred = prediction(sel, score.kind, u, y);
     double offset = 0.0;
     std::size_t n = 0;
     for (std::size_t k = train_begin; k < split && k < pred.size(); ++k, ++n) offset += y[k] - pred[k];

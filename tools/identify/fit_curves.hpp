@@ -26,11 +26,9 @@ struct FitCurve {
   double heldout_rms_m = std::numeric_limits<double>::quiet_NaN();  // NaN: nothing held out
 };
 
-// A model fitted on the whole record (heldout_begin = size, no offset).
-FitCurve whole_record_curve(const MemFitResult& fit, std::span<const double> u_V, std::span<const double> y_m);
-FitCurve whole_record_curve(const PiFitResult& fit, std::span<const double> u_V);
-FitCurve whole_record_curve(const KatalenicFitResult& fit, std::span<const double> u_V);
-FitCurve whole_record_curve(const LinearFitResult& fit, std::span<const double> u_V);
+// The model `fit` holds for `kind` (fit_candidate on the whole record): heldout_begin = size, no offset.
+FitCurve whole_record_curve(const ModelSelection& fit, ModelKind kind, std::span<const double> u_V,
+                            std::span<const double> y_m);
 
 // One curve per candidate select_model fitted and scored (refused ones left out), in its
 // ranking's order: each fitted on [0, split_index], the rest held out.

@@ -23,6 +23,7 @@
 #include "ident/fit_checks.hpp"
 #include "ident/model_selection.hpp"
 #include "ident/params_yaml.hpp"
+#include "models/model_descriptors.hpp"
 #include "ident/sample_csv.hpp"
 #include "identify_output.hpp"
 #include "lcm/message_checks.hpp"
@@ -122,100 +123,53 @@ FitPlotInput single_model_plots(const Run& run, ModelKind kind, const SampleTabl
   return in;
 }
 
-int fit_mem_model(const Run& run, const SampleTable& s, Fitted& out) {
-  const IdentifyArgs& args = run.args;
-  MemFitOptions o = selection_options(args).mem;
-  MemFitResult r;
-  {
-    const ProgressStage stage(on_samples("fitting mem", s.u.size()));
-    r = fit_mem(s.u, s.y, o);
-  }
-  if (!r.ok()) return refuse(r.status, r.reason);
-  std::printf("MEM (%s form): c1 = %.6g m/V, c2 = %.6g m/V^(1+c3), c3 = %.6g\n", args.form.c_str(), r.params.c1,
-              r.params.c2, r.params.c3);
-  std::printf("fit: residual %.4g nm RMS, noise %.4g nm, %zu samples, %zu branches, %.1f ms\n", r.residual_rms_m * 1e9,
-              r.noise_rms_m * 1e9, r.samples_used, r.branches_used, r.solve_time_s * 1e3);
-  out.yaml = to_yaml(r.params);
-  out.set = ModelParamSet{};
-  out.set->kind = ModelKind::mem;
-  out.set->mem = r.params;
-  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
-  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::mem, s, whole_record_curve(r, s.u, s.y));
-  out.mem = std::move(r);
-  return 0;
+// Prints the set by its model's table ("mem: c1 5.3e-09 m/V, ...", as the services log a set) and
+// keeps its YAML section.
+template <class D>
+void take_params(const typename D::Params& p, Fitted& out) {
+  std::printf("%s: %s\n", std::string(D::name).c_str(), D::summary_of(p).c_str());
+  out.yaml = to_yaml(p);
 }
 
-int fit_pi_model(const Run& run, const SampleTable& s, Fitted& out) {
-  PiFitOptions o;
-  o.operators = run.args.operators;
-  PiFitResult r;
-  {
-    const ProgressStage stage(on_samples("fitting pi", s.u.size()));
-    r = fit_pi(s.u, s.y, o);
-  }
-  if (!r.ok()) return refuse(r.status, r.reason);
-  std::printf("Prandtl-Ishlinskii: %zu plays, offset %.6g m\n", r.weights.size(), r.offset_m);
-  for (std::size_t i = 0; i < r.weights.size(); ++i)
-    std::printf("  r = %8.3f V  w = %.6g m/V\n", r.thresholds_V[i], r.weights[i]);
-  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
-              r.solve_time_s * 1e3);
+// The set `fit` holds for `kind`, printed and kept; 1 when its values make no valid set.
+int take_set(const ModelSelection& fit, ModelKind kind, Fitted& out) {
   try {
-    out.set = ModelParamSet{};
-    out.set->kind = ModelKind::pi;
-    out.set->pi = to_pi_params(r);
+    out.set = fitted_set(fit, kind);
   } catch (const ParameterError& e) {
     return refuse(FitStatus::out_of_range, e.what());
   }
-  out.yaml = to_yaml(out.set->pi);
-  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
-  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::pi, s, whole_record_curve(r, s.u));
-  return 0;
-}
-
-int fit_katalenic_model(const Run& run, const SampleTable& s, Fitted& out) {
-  KatalenicFitOptions o;
-  o.output_polynomial_degree = run.args.katalenic_degree;
-  KatalenicFitResult r;
-  {
-    const ProgressStage stage(on_samples("fitting katalenic", s.u.size()));
-    r = fit_katalenic(s.u, s.y, o);
-  }
-  if (!r.ok()) return refuse(r.status, r.reason);
-  std::printf("Katalenic: k1 = %.6g V, k2 = %.6g 1/V, output gain %.6g m/V\n", r.params.k1, r.params.k2,
-              r.params.output_shaping.gain);
-  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms\n", r.residual_rms_m * 1e9, r.samples_used,
-              r.solve_time_s * 1e3);
-  out.yaml = to_yaml(r.params);
-  out.set = ModelParamSet{};
-  out.set->kind = ModelKind::katalenic;
-  out.set->katalenic = r.params;
-  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
-  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::katalenic, s, whole_record_curve(r, s.u));
-  return 0;
-}
-
-int fit_linear_model(const Run& run, const SampleTable& s, Fitted& out) {
-  const LinearFitResult r = fit_linear(s.u, s.y);
-  if (!r.ok()) return refuse(r.status, r.reason);
-  std::printf("linear: gain = %.6g m/V, offset = %.6g m\n", r.gain_m_per_V, r.offset_m);
-  std::printf("fit: residual %.4g nm RMS, %zu samples\n", r.residual_rms_m * 1e9, r.samples_used);
-  out.set = ModelParamSet{};
-  out.set->kind = ModelKind::linear;
-  out.set->linear = to_linear_params(r);
-  out.yaml = to_yaml(out.set->linear);
-  out.figures = {r.residual_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
-  if (run.out.plots_dir) out.plots = single_model_plots(run, ModelKind::linear, s, whole_record_curve(r, s.u));
-  return 0;
-}
-
-int fit_single(const Run& run, ModelKind kind, const SampleTable& s, Fitted& out) {
   switch (kind) {
-    case ModelKind::mem: return fit_mem_model(run, s, out);
-    case ModelKind::pi: return fit_pi_model(run, s, out);
-    case ModelKind::katalenic: return fit_katalenic_model(run, s, out);
-    case ModelKind::linear: return fit_linear_model(run, s, out);
+    case ModelKind::mem: take_params<MemDescriptor>(out.set->mem, out); break;
+    case ModelKind::pi: take_params<PiDescriptor>(out.set->pi, out); break;
+    case ModelKind::katalenic: take_params<KatalenicDescriptor>(out.set->katalenic, out); break;
+    case ModelKind::linear: take_params<LinearDescriptor>(out.set->linear, out); break;
   }
-  return kExitFailure;
+  return 0;
+}
+
+// One model fitted on the whole record.
+int fit_single(const Run& run, ModelKind kind, const SampleTable& s, Fitted& out) {
+  ModelSelection fit;
+  ModelScore r;
+  {
+    const ProgressStage stage(on_samples("fitting " + std::string(to_string(kind)), s.u.size()));
+    r = fit_candidate(kind, s.u, s.y, selection_options(run.args), fit);
+  }
+  if (r.status != FitStatus::ok) return refuse(r.status, r.reason);
+  if (const int rc = take_set(fit, kind, out)) return rc;
+  std::printf("fit: residual %.4g nm RMS, %zu samples, %.1f ms", r.train_rms_m * 1e9, r.samples_used,
+              r.fit_time_s * 1e3);
+  if (kind == ModelKind::mem) {
+    std::printf(", %s form, noise %.4g nm, %zu branches", run.args.form.c_str(), fit.mem.noise_rms_m * 1e9,
+                fit.mem.branches_used);
+    out.mem = fit.mem;
+  } else if (kind == ModelKind::pi) {
+    std::printf(", offset %.6g m", fit.pi.offset_m);  // PiParams has no offset: a PI model starts at 0
+  }
+  std::printf("\n");
+  out.figures = {r.train_rms_m, std::nan(""), r.samples_used, window_of(s, s.t.size())};
+  if (run.out.plots_dir) out.plots = single_model_plots(run, kind, s, whole_record_curve(fit, kind, s.u, s.y));
+  return 0;
 }
 
 // Every model of the set fitted and ranked on held-out data; the best one emitted.
@@ -237,33 +191,8 @@ int fit_auto(const Run& run, const SampleTable& s, Fitted& out) {
   const ModelScore& best = sel.ranking.front();
   std::printf("held out from sample %zu of %zu; best: %s\n", sel.split_index, s.u.size(),
               std::string(to_string(best.kind)).c_str());
-  ModelParamSet set;
-  set.kind = best.kind;
-  std::size_t samples_used = 0;
-  try {
-    switch (best.kind) {
-      case ModelKind::mem:
-        set.mem = sel.mem.params, samples_used = sel.mem.samples_used;
-        out.yaml = to_yaml(set.mem);
-        break;
-      case ModelKind::pi:
-        set.pi = to_pi_params(sel.pi), samples_used = sel.pi.samples_used;
-        out.yaml = to_yaml(set.pi);
-        break;
-      case ModelKind::katalenic:
-        set.katalenic = sel.katalenic.params, samples_used = sel.katalenic.samples_used;
-        out.yaml = to_yaml(set.katalenic);
-        break;
-      case ModelKind::linear:
-        set.linear = to_linear_params(sel.linear), samples_used = sel.linear.samples_used;
-        out.yaml = to_yaml(set.linear);
-        break;
-    }
-  } catch (const ParameterError& e) {
-    return refuse(FitStatus::out_of_range, e.what());
-  }
-  out.set = set;
-  out.figures = {best.train_rms_m, best.holdout_rms_m, samples_used, window_of(s, sel.split_index + 1)};
+  if (const int rc = take_set(sel, best.kind, out)) return rc;
+  out.figures = {best.train_rms_m, best.holdout_rms_m, best.samples_used, window_of(s, sel.split_index + 1)};
   if (run.out.plots_dir) {
     FitPlotInput in;
     in.heading = run.heading;
@@ -441,22 +370,27 @@ struct SeveralExperiments : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-void throw_if_several_experiments(const IdentifyArgs& args) {
+// The experiments the loop ran that the log lists, when it holds at least `min_requests` requests
+// (the cheap look first) and one of them ran; none otherwise (the record is fitted as it is).
+LoggedExperiments experiments_in_log(const IdentifyArgs& args, std::size_t min_requests) {
   const ExperimentLogOptions o = experiment_options(args);
-  if (count_experiment_requests(args.files, o) < 2) return;  // the cheap look: one experiment at most
-  LoggedExperiments logged;
+  if (count_experiment_requests(args.files, o) < min_requests) return {};
   try {
-    logged = read_logged_experiments(args.files, o);
+    return read_logged_experiments(args.files, o);
   } catch (const SampleLogError&) {
-    return;  // requests but no experiment ran: the record is fitted as it is
+    return {};
   }
+}
+
+void throw_if_several_experiments(const IdentifyArgs& args) {
+  const LoggedExperiments logged = experiments_in_log(args, 2);
   const std::size_t n = logged.experiments.size();
   if (n < 2) return;
   const std::string where = args.files.size() == 1 ? args.files.front() : "the log";
   throw SeveralExperiments(where + " holds " + std::to_string(n) +
                            " experiments the loop ran; fit one with --experiment N (N as listed), or a time range "
                            "with --from S --to S (--model banning fits a series of them):\n" +
-                           list_experiments(logged, o));
+                           list_experiments(logged, experiment_options(args)));
 }
 
 // A fit of a whole log that holds an experiment the loop ran (several are refused before the
@@ -465,20 +399,13 @@ void throw_if_several_experiments(const IdentifyArgs& args) {
 // then tracking, fails on MEM's c3 bound). Says so after the fit, failed or not, and lists it.
 void note_experiments_in_whole_log(const IdentifyArgs& args) {
   if (!args.from_logs || args.experiment || args.from_s || args.to_s) return;
-  const ExperimentLogOptions o = experiment_options(args);
-  if (count_experiment_requests(args.files, o) == 0) return;
-  LoggedExperiments logged;
-  try {
-    logged = read_logged_experiments(args.files, o);
-  } catch (const SampleLogError&) {
-    return;
-  }
+  const LoggedExperiments logged = experiments_in_log(args, 1);
   if (logged.experiments.empty()) return;
   std::cerr << "hystloop-identify: note: this fit is over the whole record, and the log holds "
             << logged.experiments.size()
             << " experiment(s) the loop ran; fit one alone with --experiment N (N as listed), or a time range with "
                "--from S --to S:\n"
-            << list_experiments(logged, o);
+            << list_experiments(logged, experiment_options(args));
 }
 
 // Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
@@ -613,17 +540,9 @@ int run_identify(const IdentifyArgs& args) {
   } reset;
   try {
     return fit_inputs(args);
-  } catch (const CsvError& e) {
-    return usage_error(e.what());
-  } catch (const SampleLogError& e) {
-    return usage_error(e.what());
-  } catch (const SampleBudgetError& e) {
-    return usage_error(e.what());
-  } catch (const SeveralExperiments& e) {
+  } catch (const std::runtime_error& e) {  // CsvError, SampleLogError, the budget, several experiments, LCM
     return usage_error(e.what());
   } catch (const ParameterError& e) {
-    return usage_error(e.what());
-  } catch (const std::runtime_error& e) {  // LCM could not start
     return usage_error(e.what());
   }
 }

@@ -52,7 +52,7 @@ TEST_F(IdentifyTool, FitsMemAndWritesTheYamlSnippet) {
   write_csv(path("mem.csv"), u, y, 1e4);
   const ToolRun r = run_tool(path("mem.csv") + " --model mem --out " + path("params.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("c1 = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("mem: c1 "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("residual"), std::string::npos) << r.output;
   const YAML::Node doc = YAML::LoadFile(path("params.yaml"));
   EXPECT_NEAR(doc["mem"]["c1"].as<double>(), truth.c1, 0.01 * truth.c1);
@@ -173,7 +173,7 @@ TEST_F(IdentifyTool, MoreSamplesThanTheBoundAreRefusedWithAHint) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("20000 samples exceed --max-samples 5000"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--decimate 4"), std::string::npos) << r.output;
-  EXPECT_EQ(r.output.find("c1 = "), std::string::npos) << r.output;  // refused before any fit
+  EXPECT_EQ(r.output.find("mem: c1 "), std::string::npos) << r.output;  // refused before any fit
   // Decimated to the bound, the rate-independent MEM still fits.
   const ToolRun d =
       run_tool(path("mem.csv") + " --model mem --max-samples 5000 --decimate 4 --out " + path("params.yaml"));

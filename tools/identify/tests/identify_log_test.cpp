@@ -253,7 +253,7 @@ double yaml_value(const std::string& file, const char* key) { return YAML::LoadF
 
 std::size_t fit_samples(const std::string& output) {
   std::smatch m;
-  if (!std::regex_search(output, m, std::regex(R"(nm, (\d+) samples, )"))) return 0;
+  if (!std::regex_search(output, m, std::regex(R"(RMS, (\d+) samples, )"))) return 0;
   return std::stoul(m[1].str());
 }
 
@@ -313,7 +313,7 @@ TEST_F(IdentifyLog, ToolRefusesMoreSamplesThanTheBoundAndARangeFits) {
   EXPECT_EQ(big.exit_code, 2) << big.output;
   EXPECT_NE(big.output.find("exceed --max-samples 15000"), std::string::npos) << big.output;
   EXPECT_NE(big.output.find("--from/--to"), std::string::npos) << big.output;
-  EXPECT_EQ(big.output.find("c1 = "), std::string::npos) << big.output;
+  EXPECT_EQ(big.output.find("mem: c1 "), std::string::npos) << big.output;
   const ToolRun part = run_tool(path("run.lcmlog") + " --model mem --max-samples 15000 --from 0.5 --to 1.5");
   EXPECT_EQ(part.exit_code, 0) << part.output;
   // A folder where a log was expected: a usage error, not CLI11's 105.

@@ -354,8 +354,8 @@ TEST_F(IdentifySeries, ToolFitsOneListedExperimentWithAnyModel) {
   EXPECT_NE(r.output.find("fitting experiment 3: " + std::to_string(ticks) + " samples"), std::string::npos)
       << r.output;
   double gain = 0.0, offset = 0.0;
-  ASSERT_EQ(std::sscanf(r.output.substr(r.output.find("linear: gain = ")).c_str(),
-                        "linear: gain = %lf m/V, offset = %lf m", &gain, &offset),
+  ASSERT_EQ(std::sscanf(r.output.substr(r.output.find("linear: gain ")).c_str(), "linear: gain %lf m/V, offset %lf m",
+                        &gain, &offset),
             2)
       << r.output;
   const double a = BanningStageParams{}.hysteresis.a;
