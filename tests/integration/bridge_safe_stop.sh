@@ -42,8 +42,7 @@ run_case() {  # name: sigterm | shutdown
   wait $cpid || true
   wait_until 10 "$name: the recorder had the bridge's STOPPING report (sent after its last samples)" \
     stopping_reported bridge
-  stop_recording
-  analyze_recording "$name: unsafe samples"
+  stop_and_analyze "$name: unsafe samples"
   [ "$(get samples)" -ge 10000 ] || fail "$name: only $(get samples) samples recorded"
   # sensor.csv: seq,utime,u_V,y_m,flags,... SAFE_STATE = 2.
   local last; last=$(tail -n 1 "$dir/sensor.csv")

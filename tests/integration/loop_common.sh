@@ -65,10 +65,12 @@ expect_shutdown() {  # tenths-of-a-second pid...
     wait $p || fail "pid $p exited with $?"
   done
 }
-# loop_probe analyze on the recording: its figures go to $dir/analysis.txt (read them with get);
-# an unsafe sample prints them and fails with the text given.
-analyze_recording() {  # failure-text
+# Stops the recorder and runs loop_probe analyze on its recording: the figures go to
+# $dir/analysis.txt (read them with get) and are printed; an unsafe sample fails with the text given.
+stop_and_analyze() {  # failure-text
+  stop_recording
   "$probe" analyze --dir "$dir" --watchdog $watchdog_s >"$dir/analysis.txt" || { cat "$dir/analysis.txt"; fail "$1"; }
+  cat "$dir/analysis.txt"
 }
 get() { sed -n "s/^$1=//p" "$dir/analysis.txt"; }
 # No command of the recording was planned further ahead than the horizon (ticks).

@@ -33,8 +33,7 @@ wait_until 20 "both services reported every bad message" counted
 kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
-stop_recording
-analyze_recording "unsafe samples"
+stop_and_analyze "unsafe samples"
 
 # Both injections send their bad HX_CONTROL messages to everyone: 2n of each there.
 for reason in decode_failed wrong_type non_finite out_of_range; do

@@ -14,9 +14,7 @@ wait_log "$dir/bridge.log" "started in the safe state"
 wait_until 40 "the recorder held 35000 samples" samples_recorded 35000
 "$probe" control --command shutdown
 expect_shutdown 50 $bpid $cpid
-stop_recording
-analyze_recording "unsafe samples"
-cat "$dir/analysis.txt"
+stop_and_analyze "unsafe samples"
 [ "$(get samples)" -ge 30000 ] || fail "only $(get samples) samples in ~3.5 s at 10 kHz"
 [ "$(get seq_gaps)" -eq 0 ] || fail "$(get seq_gaps) gaps in the sample ticks"
 [ "$(get applied)" -ge 25000 ] || fail "only $(get applied) commands applied"

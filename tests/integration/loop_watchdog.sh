@@ -51,9 +51,7 @@ sleep 2.2   # a duration: tracking after the re-arm (the analysis wants >= 15000
 kill -TERM $bpid $c2
 wait $bpid || fail "the bridge exited with $? on SIGTERM"
 wait $c2 || fail "the compensator exited with $? on SIGTERM"
-stop_recording
-analyze_recording "unsafe samples or a slow trip"
-cat "$dir/analysis.txt"
+stop_and_analyze "unsafe samples or a slow trip"
 [ "$late_after_stop" -eq 0 ] || fail "a ${stop_s} s stop of the compensator or a 0.3 s stop of the bridge cost $late_after_stop late ticks (horizon $horizon_s s)"
 [ "$trips_after_stop" -eq 0 ] || fail "the watchdog tripped during a stop shorter than the horizon"
 [ "$(get safe_entries)" -ge 1 ] || fail "the bridge never entered the safe state after the kill"

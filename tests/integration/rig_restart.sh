@@ -56,8 +56,7 @@ wait_log "$dir/bridge.log" "DISARM (request"
 kill -TERM $bpid $cpid $rpid $lpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
-stop_recording
-analyze_recording "unsafe samples"
+stop_and_analyze "unsafe samples"
 [ "$trips" -eq 0 ] || fail "$trips watchdog trips while the logger and the re-identifier were restarted"
 restarts=$(value compensator bridge_restarts)
 [ "$restarts" -eq 0 ] || fail "forged sensor blocks restarted the compensator's control law ($restarts)"
