@@ -256,21 +256,14 @@ bool LogFileSet::write(const char* channel, std::size_t channel_length, const vo
     if (too_big || too_old) close_current();
   }
   // After a fault, nothing for kRetryInterval_s (each refused event is counted), then a new file.
-  if (fd_ < 0 && (now_s < retry_at_s_ || !open_next(now_s))) {
+  // An event larger than the buffer is written on its own, after what the buffer holds.
+  const bool direct = bytes > kBufferBytes;
+  const bool full = direct || buffer_used_ + bytes > kBufferBytes || buffered_count_ == kMaxBufferedEvents;
+  if ((fd_ < 0 && (now_s < retry_at_s_ || !open_next(now_s))) || (full && !flush_buffer())) {
     lose(tag);
     return false;
   }
-  if (bytes > kBufferBytes) {
-    if (!flush_buffer()) {
-      lose(tag);
-      return false;
-    }
-    return write_direct(channel, channel_length, data, size, utime, tag);
-  }
-  if ((buffer_used_ + bytes > kBufferBytes || buffered_count_ == kMaxBufferedEvents) && !flush_buffer()) {
-    lose(tag);
-    return false;
-  }
+  if (direct) return write_direct(channel, channel_length, data, size, utime, tag);
   std::uint8_t* at = buffer_.get() + buffer_used_;
   frame(at, channel_length, size, utime);
   std::memcpy(at + kEventHeaderBytes, channel, channel_length);

@@ -116,19 +116,14 @@ void LoggerService::receive(const char* channel, const void* data, std::size_t s
 
 void LoggerService::check_sequence(ChannelSlot& slot, const void* data, std::size_t size,
                                    std::int64_t recv_utime) noexcept {
-  std::int64_t first = 0;
-  std::int64_t n_ticks = 0;
+  const auto observe = [&](const auto& block) { slot.sequence.observe(block.seq, block.n_ticks, recv_utime); };
   if (slot.kind == SequenceKind::kSensor && decode_block(sensor_block_, data, size)) {
-    first = sensor_block_.seq;
-    n_ticks = sensor_block_.n_ticks;
+    observe(sensor_block_);
   } else if (slot.kind == SequenceKind::kCommand && decode_block(command_block_, data, size)) {
-    first = command_block_.seq;
-    n_ticks = command_block_.n_ticks;
+    observe(command_block_);
   } else {
     ++slot.undecodable;
-    return;
   }
-  slot.sequence.observe(first, n_ticks, recv_utime);
 }
 
 void LoggerService::on_control(const control_t& msg) {
@@ -328,7 +323,9 @@ int LoggerService::run() {
   if (lcm_errors > 0) spdlog::warn("LCM reported {} errors while receiving", lcm_errors);
 
   const RecordingSummary summary = finish();
-  for (const std::string& line : summary_lines(summary, *channels_)) spdlog::info("{}", line);
+  // After a disk fault (its line "DISK FAULT: ..." among them) they are errors: the exit status is 1.
+  const auto level = summary.disk.errors > 0 ? spdlog::level::err : spdlog::level::info;
+  for (const std::string& line : summary_lines(summary, *channels_)) spdlog::log(level, "{}", line);
   const std::filesystem::path path = options_.summary_file.empty()
                                          ? std::filesystem::path(files_->base_path().string() + ".summary.json")
                                          : options_.summary_file;
@@ -341,14 +338,7 @@ int LoggerService::run() {
     spdlog::error("summary not written: {}", e.what());
     rc = 1;
   }
-  if (summary.disk.errors > 0) {
-    spdlog::error(
-        "disk faults during the recording: {} failed call(s), last {}; {} events not written, {} unconfirmed "
-        "(fsync/close failed), {} file(s) cut back to their last complete event, {} empty file(s) removed",
-        summary.disk.errors, summary.disk.reason(), summary.disk.events_lost, summary.disk.unconfirmed_events,
-        summary.disk.files_truncated, summary.disk.files_removed);
-    rc = 1;
-  }
+  if (summary.disk.errors > 0) rc = 1;
   report(wall_utime(), service_status_t::STOPPING);
   return rc;
 }

@@ -1,10 +1,6 @@
 #include "logger/logger_summary.hpp"
 
-#include <cstdio>
-#include <fstream>
-#include <sstream>
-#include <stdexcept>
-#include <system_error>
+#include <spdlog/fmt/fmt.h>
 
 #include "core/escape.hpp"
 #include "runtime/summary_file.hpp"
@@ -139,56 +135,49 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
 std::vector<std::string> summary_lines(const RecordingSummary& s, const ChannelTable& channels) {
   const Totals t = totals_of(channels);
   std::vector<std::string> lines;
-  std::ostringstream head;
-  head.precision(1);
-  head << std::fixed << "recorded " << t.written << " of " << t.received << " messages (" << t.bytes_written
-       << " payload bytes) in " << s.files.size() << " file(s) over " << s.duration_s << " s, stopped by "
-       << s.stop_reason << "; dropped " << saturating_add(t.dropped, s.unrecorded_channel) << " (queue full "
-       << t.queue_full << ", oversize " << t.oversize << ", write failed " << t.write_failed << ", no channel slot "
-       << s.unrecorded_channel << ")";
-  lines.push_back(head.str());
+  lines.push_back(fmt::format(
+      "recorded {} of {} messages ({} payload bytes) in {} file(s) over {:.1f} s, stopped by {}; dropped {} (queue "
+      "full {}, oversize {}, write failed {}, no channel slot {})",
+      t.written, t.received, t.bytes_written, s.files.size(), s.duration_s, s.stop_reason,
+      saturating_add(t.dropped, s.unrecorded_channel), t.queue_full, t.oversize, t.write_failed, s.unrecorded_channel));
   if (s.disk.errors > 0) {
-    lines.push_back("  DISK FAULT: " + std::to_string(s.disk.errors) + " failed call(s), last " + s.disk.reason() +
-                    "; " + std::to_string(s.disk.events_lost) + " events not written, " +
-                    std::to_string(s.disk.files_truncated) + " file(s) cut back to their last complete event, " +
-                    std::to_string(s.disk.files_removed) + " empty file(s) removed, " +
-                    std::to_string(s.disk.unconfirmed_events) + " events unconfirmed (fsync/close failed)");
+    lines.push_back(fmt::format(
+        "  DISK FAULT: {} failed call(s), last {}; {} events not written, {} file(s) cut back to their last complete "
+        "event, {} empty file(s) removed, {} events unconfirmed (fsync/close failed)",
+        s.disk.errors, s.disk.reason(), s.disk.events_lost, s.disk.files_truncated, s.disk.files_removed,
+        s.disk.unconfirmed_events));
   }
-  if (channels.unknown().messages() > 0) {
-    const UnknownChannels& u = channels.unknown();
+  if (const UnknownChannels& u = channels.unknown(); u.messages() > 0) {
     std::string names;
     for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escape_wire(u.kept_name(i)) + "'";
-    lines.push_back("  not recorded: " + std::to_string(u.messages()) + " message(s) on " +
-                    (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct()) +
-                    " channel(s) without a slot (first: " + names + ")");
+    lines.push_back(fmt::format("  not recorded: {} message(s) on {}{} channel(s) without a slot (first: {})",
+                                u.messages(), u.distinct_is_lower_bound() ? ">= " : "", u.distinct(), names));
   }
   for (std::size_t i = 0; i < channels.size(); ++i) {
     const ChannelSlot& c = channels[i];
-    std::ostringstream line;
-    line << "  " << escape_wire(c.name_view()) << ": received " << c.received << ", written " << c.written.load()
-         << ", dropped " << c.dropped();
+    std::string line = fmt::format("  {}: received {}, written {}, dropped {}", escape_wire(c.name_view()), c.received,
+                                   c.written.load(), c.dropped());
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
-      line << ", ticks " << q.first_seq() << ".." << q.last_seq() << ", gaps " << q.gap_events() << " (missing "
-           << q.missing() << " ticks), overlaps " << q.overlaps() << ", duplicates " << q.duplicates()
-           << ", out of order " << q.out_of_order();
-      if (q.resumes() > 0) line << ", resumes " << q.resumes() << " (skipped " << q.skipped() << " ticks)";
-      if (q.restarts() > 0) line << ", restarts " << q.restarts();
-      if (c.undecodable > 0) line << ", undecodable " << c.undecodable;
+      line += fmt::format(", ticks {}..{}, gaps {} (missing {} ticks), overlaps {}, duplicates {}, out of order {}",
+                          q.first_seq(), q.last_seq(), q.gap_events(), q.missing(), q.overlaps(), q.duplicates(),
+                          q.out_of_order());
+      if (q.resumes() > 0) line += fmt::format(", resumes {} (skipped {} ticks)", q.resumes(), q.skipped());
+      if (q.restarts() > 0) line += fmt::format(", restarts {}", q.restarts());
+      if (c.undecodable > 0) line += fmt::format(", undecodable {}", c.undecodable);
       if (q.violations() > 0) {
-        line << ", contract violations " << q.violations() << " (not checked for gaps:";
+        line += fmt::format(", contract violations {} (not checked for gaps:", q.violations());
         for (std::size_t v = 0; v < SequenceGapDetector::kViolationKinds; ++v) {
           const auto reason = static_cast<SequenceGapDetector::Violation>(v);
-          line << " " << SequenceGapDetector::to_string(reason) << " " << q.violations(reason);
+          line += fmt::format(" {} {}", SequenceGapDetector::to_string(reason), q.violations(reason));
         }
-        line << ")";
+        line += ")";
       }
     }
-    lines.push_back(line.str());
+    lines.push_back(line);
   }
   for (const LogFileInfo& f : s.files) {
-    lines.push_back("  file " + f.path.string() + ": " + std::to_string(f.events) + " events, " +
-                    std::to_string(f.bytes) + " bytes");
+    lines.push_back(fmt::format("  file {}: {} events, {} bytes", f.path.string(), f.events, f.bytes));
   }
   return lines;
 }
