@@ -1,6 +1,5 @@
 #include "ctl_requests.hpp"
 
-#include <array>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -17,24 +16,6 @@
 namespace hystloop::ctl {
 
 namespace {
-
-constexpr std::array<std::pair<std::string_view, std::int8_t>, 3> kLearning{{
-    {"on", control_t::LEARNING_ON},
-    {"off", control_t::LEARNING_OFF},
-    {"reset", control_t::LEARNING_RESET},
-}};
-
-template <std::size_t N>
-std::int8_t lookup(const std::array<std::pair<std::string_view, std::int8_t>, N>& table, std::string_view field,
-                   std::string_view name) {
-  std::string names;
-  for (const auto& [key, value] : table) {
-    if (key == name) return value;
-    if (!names.empty()) names += '|';
-    names += key;
-  }
-  throw ParameterError(std::string(field), "must be one of " + names + " (got '" + std::string(name) + "')");
-}
 
 std::int8_t shape_on_wire(std::string_view name) {
   if (const auto shape = trajectory_shape_named(name)) return to_wire(*shape);
@@ -84,11 +65,16 @@ void GainsRequest::validate() const {
   if (notch_hz) require_in_range("notch-hz", *notch_hz, 0.0, kMaxNotch_hz);
   if (notch_q) {
     if (notch_hz && *notch_hz == 0.0) throw ParameterError("notch-q", "only with a notch (--notch-hz > 0)");
-    require_in_range("notch-q", *notch_q, kMinNotchQ, kMaxNotchQ);
+    require_in_range("notch-q", *notch_q, kNotchMinQ, kNotchMaxQ);
   }
 }
 
-std::int8_t parse_learning(std::string_view name) { return lookup(kLearning, "learning", name); }
+std::int8_t parse_learning(std::string_view name) {
+  if (name == "on") return control_t::LEARNING_ON;
+  if (name == "off") return control_t::LEARNING_OFF;
+  if (name == "reset") return control_t::LEARNING_RESET;
+  throw ParameterError("learning", "must be one of on|off|reset (got '" + std::string(name) + "')");
+}
 
 void ExperimentRequest::validate() const {
   if (kind.empty()) throw ParameterError("kind", "must not be empty");

@@ -32,12 +32,10 @@ struct GainsRequest {
   std::optional<double> ki;  // [1/s]
   std::optional<double> kd;  // [s]
   // The servo's notch at the stage's resonance: centre [Hz], 0 = remove it, else in
-  // (0, kMaxNotch_hz]; and its quality factor, in [kMinNotchQ, kMaxNotchQ].
+  // (0, kMaxNotch_hz]; and its quality factor, in [kNotchMinQ, kNotchMaxQ] (loop/feedback.hpp).
   std::optional<double> notch_hz;
   std::optional<double> notch_q;
   static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
-  static constexpr double kMinNotchQ = 0.1;
-  static constexpr double kMaxNotchQ = 50.0;
   // Nothing given: the request is a question (print the gains in force).
   bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q; }
   // Given gains finite, >= 0 and within the servo's plausibility bounds at 10 kHz (kp <= 2, ki <= 1e4 1/s,

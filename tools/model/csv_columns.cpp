@@ -1,5 +1,7 @@
 #include "csv_columns.hpp"
 
+#include <algorithm>
+
 #include "models/param_table.hpp"
 
 namespace hystloop::model_tool {
@@ -66,35 +68,20 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
                        "missing header row: expected column names '" + expected + "', got '" + std::string(line) + "'");
       }
       for (const auto f : fields) header.push_back(unquote(f));
-      for (std::size_t i = 0; i < header.size(); ++i) {
-        for (std::size_t j = 0; j < i; ++j) {
-          if (header[i] == header[j]) throw CsvError(file, line_no, "header names column '" + header[i] + "' twice");
-        }
+      for (auto h = header.begin(); h != header.end(); ++h) {
+        if (std::find(header.begin(), h, *h) != h)
+          throw CsvError(file, line_no, "header names column '" + *h + "' twice");
+        if (std::find(required.begin(), required.end(), *h) == required.end()) table.ignored.push_back(*h);
       }
       std::string missing;
       for (std::size_t c = 0; c < required.size(); ++c) {
-        std::size_t found = header.size();
-        for (std::size_t i = 0; i < header.size(); ++i) {
-          if (header[i] == required[c]) found = i;
-        }
-        if (found == header.size()) {
-          missing += missing.empty() ? "'" : ", '";
-          missing += required[c];
-          missing += '\'';
-        }
-        index[c] = found;
+        index[c] = static_cast<std::size_t>(std::find(header.begin(), header.end(), required[c]) - header.begin());
+        if (index[c] == header.size()) missing += (missing.empty() ? "'" : ", '") + std::string(required[c]) + "'";
       }
       if (!missing.empty()) {
-        std::string why = "header '";
-        why += line;
-        why += "' lacks column " + missing;
-        why += " (expected '" + expected + "', SI units)";
-        throw CsvError(file, line_no, why);
-      }
-      for (const auto& h : header) {
-        bool used = false;
-        for (const auto r : required) used = used || h == r;
-        if (!used) table.ignored.push_back(h);
+        throw CsvError(
+            file, line_no,
+            "header '" + std::string(line) + "' lacks column " + missing + " (expected '" + expected + "', SI units)");
       }
       table.header_line = line_no;
       continue;

@@ -117,11 +117,7 @@ int run(Args& args) {
   }
   if (!table.ignored.empty()) {
     std::string list;
-    for (const auto& c : table.ignored) {
-      list += list.empty() ? "'" : ", '";
-      list += c;
-      list += '\'';
-    }
+    for (const auto& c : table.ignored) list += (list.empty() ? "'" : ", '") + c + "'";
     std::cerr << kTool << ": " << name << ":" << table.header_line << ": ignoring column"
               << (table.ignored.size() > 1 ? "s " : " ") << list << " (reads '" << columns[0] << "," << columns[1]
               << "')\n";
