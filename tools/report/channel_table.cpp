@@ -3,6 +3,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <type_traits>
+#include <variant>
 
 #include "code_legend.hpp"
 #include "decode.hpp"
@@ -89,8 +90,6 @@ class Row {
   bool define_only_;
   std::size_t index_ = 0;
 };
-
-using Kind = MessageKind;
 
 constexpr const char* kUtime = "sender's time [us since the UNIX epoch]";
 
@@ -257,6 +256,21 @@ constexpr bool kBlock = std::is_same_v<M, sensor_block_t> || std::is_same_v<M, c
 template <class M>
 using TickOf = std::conditional_t<std::is_same_v<M, sensor_block_t>, SensorTick, CommandTick>;
 
+// The message a channel's events decode into, of the type its first event's fingerprint names
+// (any channel name, any rig prefix); Undecoded when it is none of the contract's types.
+using Message = std::variant<Undecoded, sensor_block_t, command_block_t, trajectory_t, mem_params_t, model_params_t,
+                             service_status_t, control_t>;
+
+template <std::size_t I = 1>
+Message message_of(const lcm::LogEvent& event) {
+  if constexpr (I == std::variant_size_v<Message>) {
+    return Undecoded{};
+  } else {
+    if (has_fingerprint_of<std::variant_alternative_t<I, Message>>(event)) return Message(std::in_place_index<I>);
+    return message_of<I + 1>(event);
+  }
+}
+
 }  // namespace
 
 std::size_t Column::size() const noexcept {
@@ -288,53 +302,32 @@ struct TableBuilder::Impl {
   std::map<std::string, std::uint64_t> counts;
   std::map<std::string, std::size_t> index;  // wanted channel -> position in tables and kinds
   std::vector<ChannelTable> tables;
-  std::vector<Kind> kinds;
+  std::vector<Message> messages;  // each table's, reused from event to event
   std::int64_t t0_utime = 0;
   double lower_s = 0.0, upper_s = 0.0;
-  sensor_block_t sensor;
-  command_block_t command;
-  trajectory_t trajectory;
-  mem_params_t params;
-  model_params_t model;
-  service_status_t status;
-  control_t control;
-  Undecoded undecoded;
 
   double t_of(std::int64_t utime) const { return static_cast<double>(utime - t0_utime) * 1e-6; }
   bool in_range(double t) const { return t >= lower_s && t <= upper_s; }
 
-  // Calls f with the message a kind decodes into (reused from event to event).
-  template <class F>
-  bool with_message(Kind kind, F&& f) {
-    switch (kind) {
-      case Kind::kSensor: return f(sensor);
-      case Kind::kCommand: return f(command);
-      case Kind::kTrajectory: return f(trajectory);
-      case Kind::kParams: return f(params);
-      case Kind::kModel: return f(model);
-      case Kind::kStatus: return f(status);
-      case Kind::kControl: return f(control);
-      default: return f(undecoded);
-    }
-  }
-
-  // The columns of a kind, from an empty message (the per-tick fields of a block from an empty tick).
-  void define(ChannelTable& t, Kind kind) {
-    with_message(kind, [&](auto& m) {
-      using M = std::decay_t<decltype(m)>;
-      Row r(t, true);
-      times(r, 0.0, 0);
-      if constexpr (kBlock<M>) {
-        fields(r, M{}, TickOf<M>{});
-      } else {
-        fields(r, M{});
-      }
-      return true;
-    });
+  // The type name and columns of a channel, from an empty message (a block's per-tick fields from an empty tick).
+  static void define(ChannelTable& t, const Message& message) {
+    std::visit(
+        [&](const auto& m) {
+          using M = std::decay_t<decltype(m)>;
+          if constexpr (!std::is_same_v<M, Undecoded>) t.type_name = std::string("hystloop.") + M::getTypeName();
+          Row r(t, true);
+          times(r, 0.0, 0);
+          if constexpr (kBlock<M>) {
+            fields(r, M{}, TickOf<M>{});
+          } else {
+            fields(r, M{});
+          }
+        },
+        message);
   }
 
   // false: the event did not decode.
-  bool add(ChannelTable& t, Kind kind, const lcm::LogEvent& e) {
+  bool add(ChannelTable& t, Message& message, const lcm::LogEvent& e) {
     const double event_t = t_of(e.timestamp);
     auto row = [&](double row_t, auto&& fields_of) {
       if (!in_range(row_t)) return;
@@ -343,28 +336,30 @@ struct TableBuilder::Impl {
       fields_of(r);
       ++t.rows;
     };
-    return with_message(kind, [&](auto& m) {
-      using M = std::decay_t<decltype(m)>;
-      if constexpr (std::is_same_v<M, Undecoded>) {
-        m.size_bytes = e.datalen;
-      } else if (!decode_checked(e, m)) {
-        return false;
-      }
-      if constexpr (!kBlock<M>) {
-        row(event_t, [&](Row& r) { fields(r, m); });
-      } else {
-        std::size_t i = 0;
-        for_each_tick(m, [&](const auto& k) {
-          // A sensor tick is dated as the report's time axis dates it, a command tick by its block's arrival.
-          double tick_t = event_t;
-          if constexpr (std::is_same_v<M, sensor_block_t>) {
-            tick_t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
+    return std::visit(
+        [&](auto& m) {
+          using M = std::decay_t<decltype(m)>;
+          if constexpr (std::is_same_v<M, Undecoded>) {
+            m.size_bytes = e.datalen;
+          } else if (!decode_checked(e, m)) {
+            return false;
           }
-          row(tick_t, [&](Row& r) { fields(r, m, k); });
-        });
-      }
-      return true;
-    });
+          if constexpr (!kBlock<M>) {
+            row(event_t, [&](Row& r) { fields(r, m); });
+          } else {
+            std::size_t i = 0;
+            for_each_tick(m, [&](const auto& k) {
+              // A sensor tick is dated as the report's time axis dates it, a command tick by its block's arrival.
+              double tick_t = event_t;
+              if constexpr (std::is_same_v<M, sensor_block_t>) {
+                tick_t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
+              }
+              row(tick_t, [&](Row& r) { fields(r, m, k); });
+            });
+          }
+          return true;
+        },
+        message);
   }
 };
 
@@ -385,18 +380,16 @@ ChannelTable* TableBuilder::add(const lcm::LogEvent& event) {
   if (first && impl_->wanted(event.channel)) {  // the first event decides the channel's type and columns
     ChannelTable t;
     t.channel = event.channel;
-    const Kind kind = message_kind(event);
-    t.type_name = lcm_type_name(kind);
-    impl_->define(t, kind);
+    impl_->messages.push_back(message_of(event));
+    Impl::define(t, impl_->messages.back());
     impl_->index[event.channel] = impl_->tables.size();
     impl_->tables.push_back(std::move(t));
-    impl_->kinds.push_back(kind);
   }
   const auto it = impl_->index.find(event.channel);
   if (it == impl_->index.end()) return nullptr;
   ChannelTable& t = impl_->tables[it->second];
   ++t.events;
-  if (!impl_->add(t, impl_->kinds[it->second], event)) ++t.skipped;
+  if (!impl_->add(t, impl_->messages[it->second], event)) ++t.skipped;
   return &t;
 }
 
@@ -405,7 +398,7 @@ const std::map<std::string, std::uint64_t>& TableBuilder::channel_counts() const
 std::vector<ChannelTable> TableBuilder::take() {
   std::vector<ChannelTable> tables = std::move(impl_->tables);
   impl_->tables.clear();
-  impl_->kinds.clear();
+  impl_->messages.clear();
   impl_->index.clear();
   return tables;
 }

@@ -23,12 +23,6 @@ bool has_fingerprint_of(const lcm::LogEvent& event) noexcept {
   return wire_fingerprint(event.data, size) == T::getHash();
 }
 
-// The contract's message types a log may hold, told apart by their fingerprint (a channel's name
-// is the rig's to choose).
-enum class MessageKind { kSensor, kCommand, kTrajectory, kParams, kModel, kStatus, kControl, kUnknown };
-MessageKind message_kind(const lcm::LogEvent& event) noexcept;
-const char* lcm_type_name(MessageKind kind) noexcept;  // "hystloop.sensor_block_t", ...; "unknown"
-
 template <class T>
 bool decode_checked(const lcm::LogEvent& event, T& msg) noexcept {
   if (!has_fingerprint_of<T>(event)) return false;
