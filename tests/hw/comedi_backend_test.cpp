@@ -13,6 +13,7 @@
 #include "bridge/bridge_settings.hpp"
 #include "fake_comedi.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
@@ -52,12 +53,7 @@ class ComediBackendTest : public ::testing::Test {
 };
 
 std::string refusal(const std::string& yaml) {
-  try {
-    load_bridge_settings(Config::from_string(yaml, "bridge.yaml"));
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "accepted";
+  return testing::config_refusal([&] { load_bridge_settings(Config::from_string(yaml, "bridge.yaml")); });
 }
 
 TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {

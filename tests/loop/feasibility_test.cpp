@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
@@ -18,15 +19,7 @@ constexpr double kGain = 6.4e-9;  // [m/V]: 1 um takes 156.25 V
 LinearPlant static_gain() { return {kGain, std::nullopt}; }
 LinearPlant with_stage() { return {kGain, SecondOrderStageParams{}}; }  // Banning's Table 2: k 1.17e8, c 2.03e3
 
-template <class F>
-std::string field_of(F&& f) {
-  try {
-    f();
-  } catch (const ParameterError& e) {
-    return e.field();
-  }
-  return "<no error>";
-}
+using testing::refused_field;
 
 TEST(Feasibility, SineOfAStaticGainByHand) {
   // 1 um at 100 Hz: 2 pi 100 1e-6 / 6.4e-9 = 9.817e4 V/s, twice the 5e4 V/s slew limit.
@@ -122,14 +115,14 @@ TEST(Feasibility, UsableLimitsShrinkAboutTheCentre) {
   EXPECT_EQ(exceeded_limit({-30.1, 0.0, 0.0}, l), Limit::kRange);
   EXPECT_EQ(exceeded_limit({0.0, 0.0, 3.21e4}, l), Limit::kSlew);
   EXPECT_EQ(exceeded_limit({0.0, 200.0, 1e9}, l), Limit::kRange);  // range is named first
-  EXPECT_EQ(field_of([] { FeedforwardLimits{10.0, 10.0, 1.0, 1.0}.validate(); }), "limits.u_max_V");
-  EXPECT_EQ(field_of([] { FeedforwardLimits{-1.0, 1.0, 0.0, 1.0}.validate(); }), "limits.slew_V_per_s");
-  EXPECT_EQ(field_of([] { FeedforwardLimits{-1.0, 1.0, 1.0, 0.0}.validate(); }), "limits.fraction");
-  EXPECT_EQ(field_of([] { FeedforwardLimits{-1.0, 1.0, 1.0, 1.5}.validate(); }), "limits.fraction");
-  EXPECT_EQ(field_of([] { LinearPlant{0.0, std::nullopt}.validate(); }), "plant.gain_m_per_V");
-  EXPECT_EQ(field_of([] { LinearPlant{1e-8, SecondOrderStageParams{1e8, -1.0}}.validate(); }), "plant.stage.c");
-  EXPECT_EQ(field_of([] { triangle_need(static_gain(), 1e-6, 10.0, 0.05, 0.0); }), "corner_s");
-  EXPECT_EQ(field_of([] { sine_need(static_gain(), 1e-6, 0.0, 0.0); }), "frequency_hz");
+  EXPECT_EQ(refused_field([] { FeedforwardLimits{10.0, 10.0, 1.0, 1.0}.validate(); }), "limits.u_max_V");
+  EXPECT_EQ(refused_field([] { FeedforwardLimits{-1.0, 1.0, 0.0, 1.0}.validate(); }), "limits.slew_V_per_s");
+  EXPECT_EQ(refused_field([] { FeedforwardLimits{-1.0, 1.0, 1.0, 0.0}.validate(); }), "limits.fraction");
+  EXPECT_EQ(refused_field([] { FeedforwardLimits{-1.0, 1.0, 1.0, 1.5}.validate(); }), "limits.fraction");
+  EXPECT_EQ(refused_field([] { LinearPlant{0.0, std::nullopt}.validate(); }), "plant.gain_m_per_V");
+  EXPECT_EQ(refused_field([] { LinearPlant{1e-8, SecondOrderStageParams{1e8, -1.0}}.validate(); }), "plant.stage.c");
+  EXPECT_EQ(refused_field([] { triangle_need(static_gain(), 1e-6, 10.0, 0.05, 0.0); }), "corner_s");
+  EXPECT_EQ(refused_field([] { sine_need(static_gain(), 1e-6, 0.0, 0.0); }), "frequency_hz");
 }
 
 TEST(Feasibility, LargestSineAmplitudeByHand) {
