@@ -1,16 +1,11 @@
 #include "fit_plots.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <iostream>
 #include <sstream>
-#include <stdexcept>
 
-#include "core/process.hpp"
-#include "plots.hpp"  // tools/report: find_executable
+#include "plot_series.hpp"  // tools/report: write_text_file
 
 namespace hystloop {
 namespace {
@@ -34,8 +29,7 @@ std::string short_num(double v) {
 std::string model_name(ModelKind kind) { return std::string(to_string(kind)); }
 
 void write_curve(const fs::path& path, const SampleTable& s, const FitCurve& c, std::size_t stride) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+  std::ostringstream out;
   out << "# hystloop-identify: model " << model_name(c.kind) << " over the record, SI units\n";
   if (c.heldout_begin < s.t.size()) {
     out << "# fitted on samples [0, " << c.heldout_begin << "), held out from t = " << num(s.t[c.heldout_begin])
@@ -51,8 +45,7 @@ void write_curve(const fs::path& path, const SampleTable& s, const FitCurve& c, 
     out << num(s.t[k]) << ' ' << num(s.u[k]) << ' ' << num(s.y[k]) << ' ' << num(model) << ' ' << num(s.y[k] - model)
         << ' ' << (k >= c.heldout_begin ? 1 : 0) << '\n';
   }
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": write failed");
+  report::write_text_file(path, out.str());
 }
 
 std::string curve_file(const FitCurve& c, const char* prefix) { return prefix + model_name(c.kind) + ".dat"; }
@@ -152,43 +145,10 @@ FitPlotFiles write_fit_plots(const SampleTable& s, const FitPlotInput& in, const
   }
   gp << "set output\n";
 
-  result.script = dir / "plots.gp";
-  auto write_script = [&](const std::string& terminal) {
-    std::string text = gp.str();
-    for (std::size_t at = text.find("@TERMINAL@"); at != std::string::npos; at = text.find("@TERMINAL@", at)) {
-      text.replace(at, 10, terminal);
-    }
-    std::ofstream out(result.script);
-    out << text;
-    out.close();
-    if (!out) throw std::runtime_error(result.script.string() + ": cannot write");
-  };
-  write_script("pngcairo");
-
-  const fs::path exe = report::find_executable(options.gnuplot);
-  if (exe.empty()) {
-    result.warning = "gnuplot not found ('" + options.gnuplot + "'): plots skipped (the data and plots.gp are in " +
-                     dir.string() + ")";
-    return result;
-  }
-  for (const std::string terminal : {"pngcairo", "png"}) {
-    if (run_program_in(dir, exe, {"-e", "set terminal " + terminal}, "/dev/null") != 0) continue;  // not built in
-    write_script(terminal);
-    for (const auto& image : images) fs::remove(dir / image);
-    const int rc = run_program_in(dir, exe, {"plots.gp"}, "gnuplot.log");
-    result.terminal = terminal;
-    for (const auto& image : images) {
-      if (fs::exists(dir / image)) result.images.push_back(dir / image);
-    }
-    if (rc != 0 || result.images.size() != images.size()) {
-      result.warning = "gnuplot failed (exit " + std::to_string(rc) + "): see " + (dir / "gnuplot.log").string();
-    } else {
-      fs::remove(dir / "gnuplot.log");
-    }
-    return result;
-  }
-  result.warning = "gnuplot has neither the pngcairo nor the png terminal: plots skipped (data and plots.gp are in " +
-                   dir.string() + ")";
+  report::PlotOptions render;
+  render.gnuplot = options.gnuplot;
+  report::render_script({"plots.gp", gp.str(), images, "gnuplot.log", "plots", ""}, dir, render, result);
+  if (result.warning.empty()) fs::remove(dir / "gnuplot.log");  // kept only to say why gnuplot failed
   return result;
 }
 

@@ -20,6 +20,7 @@
 
 #include "fit_curves.hpp"
 #include "ident/sample_csv.hpp"
+#include "plots.hpp"  // tools/report: PlotResult
 
 namespace hystloop {
 
@@ -35,13 +36,9 @@ struct FitPlotOptions {
   std::size_t max_points = 200'000;  // rows per data file at most (every K-th sample beyond)
 };
 
-struct FitPlotFiles {
-  std::vector<std::filesystem::path> data_files;  // always written
-  std::filesystem::path script;                   // always written
-  std::vector<std::filesystem::path> images;      // rendered PNGs (empty without gnuplot)
-  std::string terminal;                           // "pngcairo", "png" or empty
-  std::string warning;                            // why images are missing; empty when all went well
-};
+// The data files and the script, always written; the PNGs gnuplot rendered, its terminal, and why
+// images are missing (empty when all went well).
+using FitPlotFiles = report::PlotResult;
 
 // Writes the data and the script into `dir` (which must exist) and runs gnuplot there.
 // Throws std::runtime_error naming the file that cannot be written.
