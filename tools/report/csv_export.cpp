@@ -75,27 +75,20 @@ struct ChannelWriter {
   bool has_header = false;
 };
 
-std::string safe_file_name(std::string name) {
-  for (char& c : name) {
+// DIR/<channel><suffix>, the channel's characters outside [A-Za-z0-9_.-] replaced by '_'.
+std::filesystem::path channel_file(const std::filesystem::path& dir, std::string channel, const char* suffix) {
+  for (char& c : channel) {
     const bool ok =
         (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
     if (!ok) c = '_';
   }
-  return name;
+  return dir / (channel + suffix);
 }
 
 }  // namespace
 
-std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel) {
-  return dir / (safe_file_name(channel) + ".csv");
-}
-
-std::filesystem::path csv_legend_path(const std::filesystem::path& dir, const std::string& channel) {
-  return dir / (safe_file_name(channel) + ".legend.txt");
-}
-
 std::string csv_legend_text(const ChannelTable& table) {
-  std::string out = "# Integer codes of the columns of " + csv_path("", table.channel).string() + " (" +
+  std::string out = "# Integer codes of the columns of " + channel_file("", table.channel, ".csv").string() + " (" +
                     table.type_name + "), from the constants of lcmtypes/*.lcm\n";
   bool any = false;
   for (const Column& c : table.columns) {
@@ -119,8 +112,8 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
     if (writer_of(channel) != writers.end()) continue;  // asked for twice
     ChannelWriter& w = writers.emplace_back();
     w.result.channel = channel;
-    w.result.file = csv_path(dir, channel);
-    w.result.legend_file = csv_legend_path(dir, channel);
+    w.result.file = channel_file(dir, channel, ".csv");
+    w.result.legend_file = channel_file(dir, channel, ".legend.txt");
     w.out.open(w.result.file);
     if (!w.out) throw std::runtime_error(w.result.file.string() + ": cannot write");
   }

@@ -18,18 +18,12 @@ namespace hystloop::report {
 
 struct CsvExport {
   std::string channel;
-  std::filesystem::path file;
-  std::filesystem::path legend_file;  // DIR/<channel>.legend.txt
+  std::filesystem::path file;         // DIR/<channel>.csv, characters outside [A-Za-z0-9_.-] replaced by '_'
+  std::filesystem::path legend_file;  // DIR/<channel>.legend.txt, the name made safe alike
   std::string type_name;              // "hystloop.sensor_block_t", or "unknown" (rows carry only times and size)
   std::size_t rows = 0;               // rows written (ticks of a block channel)
   std::size_t skipped = 0;            // events that did not decode
 };
-
-// File name for a channel: DIR/<channel>.csv, characters outside [A-Za-z0-9_.-] replaced by '_'.
-std::filesystem::path csv_path(const std::filesystem::path& dir, const std::string& channel);
-
-// DIR/<channel>.legend.txt, the channel's name made safe as for csv_path.
-std::filesystem::path csv_legend_path(const std::filesystem::path& dir, const std::string& channel);
 
 // The text of a channel's legend file: a comment line naming the CSV and its type, then one
 // line per column of the table that has a legend, "column: codes".
