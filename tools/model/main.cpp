@@ -82,12 +82,12 @@ int run(Args& args) {
   const ModelEntry* entry = find_model(args.model);
   if (entry == nullptr) {
     std::vector<std::string> names;
-    for (const ModelEntry* m : model_registry()) names.emplace_back(m->name());
+    for (const ModelEntry* m : model_registry()) names.emplace_back(m->name);
     const std::string guess = closest_name(args.model, names);
     return refuse("--model: unknown model '" + args.model + "'" +
                   (guess.empty() ? "" : "; did you mean '" + guess + "'?") + " (models: " + model_names() + ")");
   }
-  if (args.inverse && !entry->has_inverse()) {
+  if (args.inverse && !entry->has_inverse) {
     return refuse("--inverse: model " + args.model +
                   " has no inverse (a dynamic stage, not a static hysteresis map); run it --forward, or use an "
                   "invertible model (mem, katalenic, pi, linear) for feedforward");
@@ -109,7 +109,7 @@ int run(Args& args) {
   CsvColumns table;
   try {
     table = read_input(args, name, columns);
-    if (entry->uses_time()) require_increasing(table, 0, name);
+    if (entry->uses_time) require_increasing(table, 0, name);
   } catch (const CsvError& e) {
     return refuse(e.what());
   } catch (const OpenError& e) {

@@ -67,26 +67,17 @@ class RunFor final : public ModelRun {
 };
 
 template <class D>
-class EntryFor final : public ModelEntry {
- public:
-  std::string_view name() const noexcept override { return D::name; }
-  std::string_view summary() const noexcept override { return D::summary; }
-  std::string_view notes() const noexcept override { return D::notes; }
-  bool has_inverse() const noexcept override { return kHasInverse<D>; }
-  bool uses_time() const noexcept override { return !HysteresisForward<typename D::Forward>; }
-  std::vector<ParamInfo> parameters() const override { return describe(D::table()); }
-
-  std::unique_ptr<ModelRun> configure(const std::vector<Assignment>& assignments) const override {
-    return std::make_unique<RunFor<D>>(params_from<D>(assignments));
-  }
-};
-
-const EntryFor<MemDescriptor> kMem;
-const EntryFor<BanningDescriptor> kBanning;
-const EntryFor<KatalenicDescriptor> kKatalenic;
-const EntryFor<PiDescriptor> kPi;
-const EntryFor<LinearDescriptor> kLinear;
-const ModelEntry* const kRegistry[] = {&kMem, &kBanning, &kKatalenic, &kPi, &kLinear};
+const ModelEntry kEntry{D::name,
+                        D::summary,
+                        D::notes,
+                        kHasInverse<D>,
+                        !HysteresisForward<typename D::Forward>,
+                        [] { return describe(D::table()); },
+                        [](const std::vector<Assignment>& assignments) -> std::unique_ptr<ModelRun> {
+                          return std::make_unique<RunFor<D>>(params_from<D>(assignments));
+                        }};
+const ModelEntry* const kRegistry[] = {&kEntry<MemDescriptor>, &kEntry<BanningDescriptor>, &kEntry<KatalenicDescriptor>,
+                                       &kEntry<PiDescriptor>, &kEntry<LinearDescriptor>};
 
 }  // namespace
 
@@ -94,7 +85,7 @@ std::span<const ModelEntry* const> model_registry() { return kRegistry; }
 
 const ModelEntry* find_model(std::string_view name) {
   for (const ModelEntry* m : kRegistry) {
-    if (m->name() == name) return m;
+    if (m->name == name) return m;
   }
   return nullptr;
 }
@@ -103,7 +94,7 @@ std::string model_names(std::string_view separator) {
   std::string out;
   for (const ModelEntry* m : kRegistry) {
     if (!out.empty()) out += separator;
-    out += m->name();
+    out += m->name;
   }
   return out;
 }
@@ -113,8 +104,8 @@ std::string models_help() {
       "Models and their parameters (--param NAME=VALUE, repeatable; SI units, 'x' = the Katalenic operator's units):\n";
   char line[512];
   for (const ModelEntry* m : kRegistry) {
-    out += "\n  " + std::string(m->name()) + ": " + std::string(m->summary()) + "\n";
-    if (!m->notes().empty()) out += "    (" + std::string(m->notes()) + ")\n";
+    out += "\n  " + std::string(m->name) + ": " + std::string(m->summary) + "\n";
+    if (!m->notes.empty()) out += "    (" + std::string(m->notes) + ")\n";
     for (const ParamInfo& p : m->parameters()) {
       const std::string name = p.alias.empty() ? p.name : p.name + " (or " + p.alias + ")";
       const std::string unit = "[" + p.unit + "]";

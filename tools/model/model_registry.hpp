@@ -27,18 +27,16 @@ class ModelRun {
   virtual std::vector<double> inverse(const std::vector<double>& t, const std::vector<double>& y_ref) const = 0;
 };
 
-class ModelEntry {
- public:
-  virtual ~ModelEntry() = default;
-  virtual std::string_view name() const noexcept = 0;
-  virtual std::string_view summary() const noexcept = 0;  // one line for --help
-  virtual std::string_view notes() const noexcept = 0;    // extra help lines ("" if none)
-  virtual bool has_inverse() const noexcept = 0;
-  virtual bool uses_time() const noexcept = 0;  // dynamics: dt from the t column
-  virtual std::vector<ParamInfo> parameters() const = 0;
+struct ModelEntry {
+  std::string_view name;
+  std::string_view summary;  // one line for --help
+  std::string_view notes;    // extra help lines ("" if none)
+  bool has_inverse = false;
+  bool uses_time = false;  // dynamics: dt from the t column
+  std::vector<ParamInfo> (*parameters)() = nullptr;
   // Defaults, then each assignment in order, then the model's validate(). Throws AssignmentError
   // for an unknown name or malformed value, ParameterError (naming the field) for an invalid set.
-  virtual std::unique_ptr<ModelRun> configure(const std::vector<Assignment>& assignments) const = 0;
+  std::unique_ptr<ModelRun> (*configure)(const std::vector<Assignment>& assignments) = nullptr;
 };
 
 // Every model, in the order --help lists them.

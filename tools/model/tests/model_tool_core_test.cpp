@@ -149,11 +149,11 @@ TEST(ModelRegistry, HasEveryModelWithDefaultsThatValidate) {
   for (const char* name : {"mem", "banning", "katalenic", "pi", "linear"}) {
     const ModelEntry* m = find_model(name);
     ASSERT_NE(m, nullptr) << name;
-    EXPECT_EQ(m->name(), name);
+    EXPECT_EQ(m->name, name);
     EXPECT_FALSE(m->parameters().empty()) << name;
     EXPECT_NO_THROW(m->configure({})) << name;
-    EXPECT_EQ(m->has_inverse(), std::string(name) != "banning") << name;
-    EXPECT_EQ(m->uses_time(), std::string(name) == "banning") << name;
+    EXPECT_EQ(m->has_inverse, std::string(name) != "banning") << name;
+    EXPECT_EQ(m->uses_time, std::string(name) == "banning") << name;
   }
   EXPECT_EQ(find_model("Mem"), nullptr);
   EXPECT_EQ(model_registry().size(), 5u);
@@ -252,7 +252,7 @@ TEST(ModelRegistry, BanningRefusesInverseInProcessToo) {
 TEST(ModelRegistry, HelpListsEveryModelParameterUnitAndDefault) {
   const std::string help = models_help();
   for (const ModelEntry* m : model_registry()) {
-    EXPECT_NE(help.find("  " + std::string(m->name()) + ": "), std::string::npos) << m->name();
+    EXPECT_NE(help.find("  " + std::string(m->name) + ": "), std::string::npos) << m->name;
     for (const ParamInfo& p : m->parameters()) {
       EXPECT_NE(help.find("    " + p.name + " "), std::string::npos) << p.name;
       EXPECT_NE(help.find("[" + p.unit + "]"), std::string::npos) << p.name;

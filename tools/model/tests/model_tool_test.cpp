@@ -362,10 +362,10 @@ TEST_F(ModelTool, HelpListsEveryModelAndParameterWithUnitAndDefault) {
   const ToolRun r = run("--help");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const ModelEntry* m : model_registry()) {
-    EXPECT_NE(r.out.find("  " + std::string(m->name()) + ": "), std::string::npos) << m->name();
+    EXPECT_NE(r.out.find("  " + std::string(m->name) + ": "), std::string::npos) << m->name;
     for (const ParamInfo& p : m->parameters()) {
       const std::size_t at = r.out.find("    " + p.name + " ");
-      ASSERT_NE(at, std::string::npos) << m->name() << " " << p.name;
+      ASSERT_NE(at, std::string::npos) << m->name << " " << p.name;
       const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
       EXPECT_NE(line.find("[" + p.unit + "]"), std::string::npos) << line;
       EXPECT_NE(line.find("default " + p.default_text), std::string::npos) << line;
