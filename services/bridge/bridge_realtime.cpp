@@ -186,7 +186,6 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;
-    r.auto_arms = arming_.auto_arms();
     r.last_tick = last_tick_;
     r.last_trip_tick = arming_.last_trip_tick();
     r.min_depth_period = min_depth_period_;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iterator>
 #include <thread>
 #include <vector>
 
@@ -16,22 +17,12 @@ namespace hystloop {
 namespace {
 
 const char* subdevice_type_name(int type) {
-  switch (type) {
-    case COMEDI_SUBD_UNUSED: return "unused";
-    case COMEDI_SUBD_AI: return "analog input";
-    case COMEDI_SUBD_AO: return "analog output";
-    case COMEDI_SUBD_DI: return "digital input";
-    case COMEDI_SUBD_DO: return "digital output";
-    case COMEDI_SUBD_DIO: return "digital I/O";
-    case COMEDI_SUBD_COUNTER: return "counter";
-    case COMEDI_SUBD_TIMER: return "timer";
-    case COMEDI_SUBD_MEMORY: return "memory";
-    case COMEDI_SUBD_CALIB: return "calibration DACs";
-    case COMEDI_SUBD_PROC: return "processor";
-    case COMEDI_SUBD_SERIAL: return "serial";
-    case COMEDI_SUBD_PWM: return "pwm";
-    default: return "other";
-  }
+  // By COMEDI_SUBD_*, from COMEDI_SUBD_UNUSED = 0.
+  static constexpr const char* kNames[] = {
+      "unused", "analog input", "analog output",    "digital input", "digital output", "digital I/O", "counter",
+      "timer",  "memory",       "calibration DACs", "processor",     "serial",         "pwm"};
+  static_assert(COMEDI_SUBD_UNUSED == 0 && static_cast<std::size_t>(COMEDI_SUBD_PWM) == std::size(kNames) - 1);
+  return type >= 0 && type < static_cast<int>(std::size(kNames)) ? kNames[type] : "other";
 }
 
 std::string flag_names(int flags) {

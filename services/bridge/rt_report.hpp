@@ -25,7 +25,6 @@ struct RtReport {
   std::uint64_t ticks_caught_up = 0;     // ticks run late, back to back, after an overrun (a simulator)
   std::uint64_t samples_dropped = 0;     // outgoing queue full: the I/O thread fell behind
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue
-  std::uint64_t auto_arms = 0;
   std::int64_t last_tick = -1;
   std::int64_t last_trip_tick = -1;    // tick of the last watchdog trip
   std::int64_t min_depth_period = -1;  // lowest buffer depth at an armed tick this period (-1: none)
