@@ -5,7 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+
+#include "support/refusal.hpp"
 
 namespace hystloop {
 namespace {
@@ -13,11 +16,7 @@ namespace {
 // Runs `f`, expects a ConfigError, returns its message.
 template <class F>
 std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
+  if (const std::optional<ConfigError> e = testing::thrown<ConfigError>(f)) return e->what();
   ADD_FAILURE() << "expected ConfigError";
   return {};
 }
