@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "models/coleman_hodgdon_theory.hpp"
 #include "models/loop_features.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
 #include "support/sanitized.hpp"
 
 namespace hystloop {
@@ -46,22 +48,16 @@ TEST(BanningStageParams, DefaultsAreTables1And2) {
 TEST(BanningStageParams, ValidationNamesTheFieldWithItsPrefix) {
   BanningStageParams p;
   p.hysteresis.b = 2.0 * p.hysteresis.a;
-  try {
-    BanningStage s(p);
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "hysteresis.b");
-    EXPECT_EQ(std::string(e.what()).rfind("hysteresis.b: must be in [", 0), 0u) << e.what();
-  }
+  const std::optional<ParameterError> e = testing::thrown<ParameterError>([&] { BanningStage s(p); });
+  ASSERT_TRUE(e) << "no throw";
+  EXPECT_EQ(e->field(), "hysteresis.b");
+  EXPECT_EQ(std::string(e->what()).rfind("hysteresis.b: must be in [", 0), 0u) << e->what();
   p = {};
   p.stage.c = -3.0;
-  try {
-    p.validate();
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "stage.c");
-    EXPECT_STREQ(e.what(), "stage.c: must be > 0 (got -3)");
-  }
+  const std::optional<ParameterError> c = testing::thrown<ParameterError>([&] { p.validate(); });
+  ASSERT_TRUE(c) << "no throw";
+  EXPECT_EQ(c->field(), "stage.c");
+  EXPECT_STREQ(c->what(), "stage.c: must be > 0 (got -3)");
 }
 
 // At the paper's 2 Hz (Fig. 7) with dt = 100 us, both orders trace the CH loop of Theorem 3:

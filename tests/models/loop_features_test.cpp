@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "models/coleman_hodgdon.hpp"
 #include "models/coleman_hodgdon_theory.hpp"
+#include "support/refusal.hpp"
 #include "support/sanitized.hpp"
 
 namespace hystloop {
@@ -183,28 +184,13 @@ TEST(LoopFeatures, RefusesWhatIsNotALoop) {
 TEST(LoopFeatures, ArgumentErrorsNameTheField) {
   const std::vector<double> u(10, 0.0);
   const std::vector<double> y(9, 0.0);
-  try {
-    extract_loop_features(u, y);
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "y");
-  }
+  EXPECT_EQ(testing::refused_field([&] { extract_loop_features(u, y); }), "y");
   LoopFeatureOptions o;
   o.branch_degree = 0;
-  try {
-    extract_loop_features(u, u, o);
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "branch_degree");
-  }
+  EXPECT_EQ(testing::refused_field([&] { extract_loop_features(u, u, o); }), "branch_degree");
   o = {};
   o.reversal_fraction = 0.7;
-  try {
-    extract_loop_features(u, u, o);
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "reversal_fraction");
-  }
+  EXPECT_EQ(testing::refused_field([&] { extract_loop_features(u, u, o); }), "reversal_fraction");
 }
 
 }  // namespace

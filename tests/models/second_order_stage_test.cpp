@@ -10,11 +10,13 @@
 #include <complex>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include "core/errors.hpp"
 #include "models/coleman_hodgdon_theory.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
 #include "support/sanitized.hpp"
 
 namespace hystloop {
@@ -84,21 +86,13 @@ TEST(SecondOrderStageParams, DefaultsAreTable2) {
 TEST(SecondOrderStageParams, ValidationNamesTheField) {
   SecondOrderStageParams p;
   p.k = -1.0;
-  try {
-    p.validate();
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "k");
-    EXPECT_NE(std::string(e.what()).find("k: must be > 0 (got -1)"), std::string::npos) << e.what();
-  }
+  const std::optional<ParameterError> e = testing::thrown<ParameterError>([&] { p.validate(); });
+  ASSERT_TRUE(e) << "no throw";
+  EXPECT_EQ(e->field(), "k");
+  EXPECT_NE(std::string(e->what()).find("k: must be > 0 (got -1)"), std::string::npos) << e->what();
   p = {};
   p.c = std::nan("");
-  try {
-    p.validate();
-    FAIL() << "no throw";
-  } catch (const ParameterError& e) {
-    EXPECT_EQ(e.field(), "c");
-  }
+  EXPECT_EQ(testing::refused_field([&] { p.validate(); }), "c");
   EXPECT_THROW(SecondOrderStage{p}, ParameterError);
 }
 
