@@ -40,6 +40,14 @@ struct GuardStream {
   // A block `after_us` after the last one, the clock left where it was (a forged block between two
   // real ones).
   V send_between(std::int64_t seq, std::int64_t after_us) { return guard.check(seq, kBlock, t_us + after_us); }
+  // All four of the guard's counters.
+  void expect_counters(const SequenceGuard::Counters& want) const {
+    const SequenceGuard::Counters& c = guard.counters();
+    EXPECT_EQ(c.held, want.held) << "held";
+    EXPECT_EQ(c.ignored, want.ignored) << "ignored";
+    EXPECT_EQ(c.jumps, want.jumps) << "jumps";
+    EXPECT_EQ(c.restarts, want.restarts) << "restarts";
+  }
   // The blocks from `from` up to `to` (excluded), each one taken.
   void run(std::int64_t from, std::int64_t to) {
     for (std::int64_t s = from; s < to; s += kBlock) ASSERT_EQ(send(s), V::take) << s;
