@@ -70,8 +70,10 @@ MemFitResult refuse(MemFitResult r, FitStatus status, std::string reason) {
 }
 
 IntegratedData build_integrated(std::span<const double> u, std::span<const double> y,
-                                const std::vector<BranchSegment>& branches, const Scales& sc, std::size_t stride = 1) {
+                                const std::vector<BranchSegment>& branches, const Scales& sc, const MemFitOptions& o,
+                                std::size_t stride = 1) {
   IntegratedData d;
+  d.c1_floor_fraction = o.min_c1_fraction;
   std::size_t n = 0;
   for (const auto& b : branches) n += b.size();
   d.p.reserve(n), d.log_p.reserve(n), d.s.reserve(n), d.y.reserve(n);
@@ -92,8 +94,10 @@ IntegratedData build_integrated(std::span<const double> u, std::span<const doubl
 
 DerivativeData build_derivative(std::span<const double> u, std::span<const double> y,
                                 const std::vector<BranchSegment>& branches, const Scales& sc, double min_du_V,
-                                std::size_t lag, std::size_t stride = 1) {
+                                const MemFitOptions& o, std::size_t stride = 1) {
+  const auto lag = static_cast<std::size_t>(o.derivative_lag);
   DerivativeData d;
+  d.c1_floor_fraction = o.min_c1_fraction;
   std::size_t count = 0;
   for (const auto& b : branches) {
     for (std::size_t k = b.begin + lag; k < b.end; ++k) {
@@ -217,12 +221,7 @@ MemFitResult solve(const Data& coarse, const Data& data, const Scales& sc, const
   if (o.refine_with_ceres && !lin.constrained) {
     const double sigma = robust_sigma(residuals(data, m));
     const double scale = std::max(o.robust_scale_sigmas * sigma, 1e-12);
-    detail::RefineOutcome refined;
-    if constexpr (std::is_same_v<Data, IntegratedData>) {
-      refined = detail::refine_integrated(data, m, o, scale);
-    } else {
-      refined = detail::refine_derivative(data, m, o, scale);
-    }
+    const detail::RefineOutcome refined = detail::refine(data, m, o, scale);
     if (!refined.usable) {
       return refuse(std::move(result), FitStatus::solver_failure, "Ceres: " + refined.message);
     }
@@ -268,23 +267,19 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
   result.noise_rms_m = o.noise_rms_m > 0.0 ? o.noise_rms_m : estimate_noise_rms(y);
 
   if (o.form == MemFitForm::integrated) {
-    IntegratedData data = build_integrated(u, y, branches, sc);
-    data.c1_floor_fraction = o.min_c1_fraction;
+    const IntegratedData data = build_integrated(u, y, branches, sc, o);
     result.samples_used = data.y.size();
     if (result.samples_used < o.min_samples) {
       std::ostringstream s;
       s << result.samples_used << " samples on branches (need " << o.min_samples << ")";
       return timer.finish(result, FitStatus::too_few_samples, s.str());
     }
-    IntegratedData coarse = build_integrated(u, y, branches, sc, kGridStride);
-    coarse.c1_floor_fraction = o.min_c1_fraction;
-    result = solve(coarse, data, sc, o, std::move(result));
+    result = solve(build_integrated(u, y, branches, sc, o, kGridStride), data, sc, o, std::move(result));
   } else {
     // SNR of z = dy/du: |du| * slope / (sqrt(2) sigma_y); the slope is the loop's mean slope.
     const double slope = (ymax - ymin) / (umax - umin);
     const double min_du = slope > 0.0 ? o.min_snr * std::sqrt(2.0) * result.noise_rms_m / slope : 0.0;
-    DerivativeData data = build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag));
-    data.c1_floor_fraction = o.min_c1_fraction;
+    const DerivativeData data = build_derivative(u, y, branches, sc, min_du, o);
     result.samples_used = data.z.size();
     if (result.samples_used < o.min_samples) {
       std::ostringstream s;
@@ -292,10 +287,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
         << "; |du| must be >= " << min_du << " V per " << o.derivative_lag << " samples)";
       return timer.finish(result, FitStatus::too_few_samples, s.str());
     }
-    DerivativeData coarse =
-        build_derivative(u, y, branches, sc, min_du, static_cast<std::size_t>(o.derivative_lag), kGridStride);
-    coarse.c1_floor_fraction = o.min_c1_fraction;
-    result = solve(coarse, data, sc, o, std::move(result));
+    result = solve(build_derivative(u, y, branches, sc, min_du, o, kGridStride), data, sc, o, std::move(result));
   }
   if (result.status == FitStatus::ok || result.status == FitStatus::out_of_range) {
     result.residual_rms_m = mem_branch_rms(u, y, branches, result.params);

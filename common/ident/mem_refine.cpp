@@ -157,13 +157,13 @@ RefineOutcome irls(const Data& data, std::size_t n, const ScaledMem& start, cons
 
 }  // namespace
 
-RefineOutcome refine_integrated(const IntegratedData& data, const ScaledMem& start, const MemFitOptions& options,
-                                double loss_scale) {
+RefineOutcome refine(const IntegratedData& data, const ScaledMem& start, const MemFitOptions& options,
+                     double loss_scale) {
   return irls<IntegratedData, IntegratedCost>(data, data.y.size(), start, options, loss_scale);
 }
 
-RefineOutcome refine_derivative(const DerivativeData& data, const ScaledMem& start, const MemFitOptions& options,
-                                double loss_scale) {
+RefineOutcome refine(const DerivativeData& data, const ScaledMem& start, const MemFitOptions& options,
+                     double loss_scale) {
   return irls<DerivativeData, DerivativeCost>(data, data.z.size(), start, options, loss_scale);
 }
 

@@ -30,10 +30,10 @@ struct RefineOutcome {
   int ceres_solves = 0;
 };
 
-// loss_scale is in scaled residual units.
-RefineOutcome refine_integrated(const IntegratedData& data, const ScaledMem& start, const MemFitOptions& options,
-                                double loss_scale);
-RefineOutcome refine_derivative(const DerivativeData& data, const ScaledMem& start, const MemFitOptions& options,
-                                double loss_scale);
+// The joint refinement of either form; loss_scale is in scaled residual units.
+RefineOutcome refine(const IntegratedData& data, const ScaledMem& start, const MemFitOptions& options,
+                     double loss_scale);
+RefineOutcome refine(const DerivativeData& data, const ScaledMem& start, const MemFitOptions& options,
+                     double loss_scale);
 
 }  // namespace hystloop::detail

@@ -28,8 +28,6 @@ Eigen::VectorXd solve_passive(const Eigen::MatrixXd& g, const Eigen::VectorXd& h
   return z;
 }
 
-}  // namespace
-
 NnlsResult nnls_normal(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, int max_iterations) {
   const Eigen::Index n = h.size();
   if (max_iterations <= 0) max_iterations = static_cast<int>(3 * n + 10);
@@ -76,6 +74,8 @@ NnlsResult nnls_normal(const Eigen::MatrixXd& g, const Eigen::VectorXd& h, int m
   }
   return res;
 }
+
+}  // namespace
 
 NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, int max_iterations) {
   const Eigen::MatrixXd g = a.transpose() * a;

@@ -17,7 +17,5 @@ struct NnlsResult {
 };
 
 NnlsResult nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, int max_iterations = 0);
-// Same, from the normal equations directly.
-NnlsResult nnls_normal(const Eigen::MatrixXd& gram, const Eigen::VectorXd& atb, int max_iterations = 0);
 
 }  // namespace hystloop
