@@ -89,14 +89,11 @@ TEST(MessageChecks, SensorBlockRangesAndFlags) {
 TEST(MessageChecks, SensorBlockTickCountAndArraySizesMustAgree) {
   auto m = fixtures::sensor_ticks(0, sensor_block_t::MAX_TICKS);
   EXPECT_EQ(check_message(m), Verdict::kOk);
-  const SensorTick extra = sensor_tick(m, 0);  // append_tick refuses a tick past MAX_TICKS: add it by hand
-  m.u_V.push_back(extra.u_V);
-  m.u_ff_V.push_back(extra.u_ff_V);
-  m.u_fb_V.push_back(extra.u_fb_V);
-  m.y_ref_m.push_back(extra.y_ref_m);
-  m.y_m.push_back(extra.y_m);
-  m.flags.push_back(extra.flags);
+  // append_tick refuses a tick past MAX_TICKS: told one fewer it appends one, then the count is set back.
+  --m.n_ticks;
+  ASSERT_TRUE(append_tick(m, sensor_tick(m, 0)));
   m.n_ticks += 1;
+  ASSERT_EQ(m.u_V.size(), static_cast<std::size_t>(sensor_block_t::MAX_TICKS) + 1);
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
   m = fixtures::sensor_ticks(0, 0);  // a block of no tick
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
@@ -180,12 +177,10 @@ TEST(MessageChecks, CommandBlockModesVersionsAndSequence) {
 TEST(MessageChecks, CommandBlockTickCountAndArraySizesMustAgree) {
   auto m = fixtures::command_ticks(0, command_block_t::MAX_TICKS, 0);
   EXPECT_EQ(check_message(m), Verdict::kOk);
-  const CommandTick extra = command_tick(m, 0);
-  m.u_ff_V.push_back(extra.u_ff_V);
-  m.y_ref_m.push_back(extra.y_ref_m);
-  m.params_version.push_back(extra.params_version);
-  m.mode.push_back(extra.mode);
+  --m.n_ticks;  // as above: one tick past MAX_TICKS
+  ASSERT_TRUE(append_tick(m, command_tick(m, 0)));
   m.n_ticks += 1;
+  ASSERT_EQ(m.u_ff_V.size(), static_cast<std::size_t>(command_block_t::MAX_TICKS) + 1);
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
   m = fixtures::command_ticks(0, 0, 0);
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
