@@ -8,9 +8,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include "core/errors.hpp"
+#include "support/refusal.hpp"
+#include "support/tool_run.hpp"
 
 namespace hystloop {
 namespace {
@@ -19,23 +22,14 @@ namespace fs = std::filesystem;
 
 class RigKeyTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("hystloop_rig_key_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   static std::string refusal(const fs::path& path) {
-    try {
-      load_rig_key(path);
-    } catch (const ParameterError& e) {
-      EXPECT_EQ(e.field(), "auth.key_file");
-      return e.what();
+    const std::optional<ParameterError> e = testing::thrown<ParameterError>([&] { load_rig_key(path); });
+    if (!e) {
+      ADD_FAILURE() << "loaded " << path;
+      return {};
     }
-    ADD_FAILURE() << "loaded " << path;
-    return {};
+    EXPECT_EQ(e->field(), "auth.key_file");
+    return e->what();
   }
   fs::path write(const std::string& name, const std::string& text, fs::perms perms) {
     fs::path p = dir_ / name;
@@ -44,7 +38,8 @@ class RigKeyTest : public ::testing::Test {
     return p;
   }
 
-  fs::path dir_;
+  testing::ScratchDir scratch_{"hystloop_rig_key"};  // removed after the test
+  fs::path dir_ = scratch_.dir();
 };
 
 TEST_F(RigKeyTest, KeygenWritesAnOwnerOnlyFileThatLoadsBack) {
