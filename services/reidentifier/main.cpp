@@ -42,16 +42,13 @@ int main(int argc, char** argv) try {
       "--publish-invalid", publish_invalid,
       "Also publish refused candidates, with valid = false, for diagnosis (= --set reidentifier.publish_invalid=true)");
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
+  if (publish_invalid) service.overrides.push_back("reidentifier.publish_invalid=true");
 
   ReidentOptions options;
   std::string url;
   const auto refused = configure_or_refuse("hystloop-reidentifier", [&] {
     url = set_up_service(ReidentService::kProcessName, service,
-                         {.adjust =
-                              [&](Config& config) {
-                                if (publish_invalid) config.apply_override("reidentifier.publish_invalid=true");
-                              },
-                          .read = [&](const Config& config) { options = read_reident_options(config); }});
+                         {.adjust = {}, .read = [&](const Config& config) { options = read_reident_options(config); }});
   });
   if (refused) return *refused;
 

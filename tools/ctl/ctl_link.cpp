@@ -7,6 +7,8 @@
 #include <limits>
 #include <string>
 
+#include <spdlog/fmt/fmt.h>
+
 #include "core/process.hpp"
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
@@ -74,13 +76,8 @@ int run_status(CtlLink& link, const StatusOptions& o) {
   if (waiting) {
     verdict = check_health(board, o.wait_healthy, o.accept_safe, o.accept_degraded);
     if (verdict.healthy) return 0;
-    std::string problems;
-    for (const auto& p : verdict.problems) {
-      if (!problems.empty()) problems += "; ";
-      problems += p;
-    }
     std::fprintf(stderr, "hystloop-ctl: not healthy after %g s on %s: %s\n", o.timeout_s,
-                 link.channels().status.c_str(), problems.c_str());
+                 link.channels().status.c_str(), fmt::format("{}", fmt::join(verdict.problems, "; ")).c_str());
     return 1;
   }
   if (board.processes().empty()) {

@@ -84,13 +84,6 @@ struct Options {
   AckOptions ack;
 };
 
-// Who answers a request: the target named, else the process whose command it is ("" = all heard).
-std::vector<std::string> answering(const std::string& target, const char* owner) {
-  if (!target.empty()) return {target};
-  if (owner != nullptr) return {owner};
-  return {};
-}
-
 int send_control(const Options& o, std::int8_t command, const std::string& target, const std::string& what,
                  const char* owner, StateCheck state = {}, const std::function<void(control_t&)>& fill = {},
                  std::map<std::string, service_status_t>* last = nullptr) {
@@ -99,7 +92,8 @@ int send_control(const Options& o, std::int8_t command, const std::string& targe
   if (fill) fill(msg);
   if (check_message(msg) != Verdict::kOk) throw ParameterError(what, "refused by the message contract");
   AckOptions ack = o.ack;
-  ack.expected = answering(target, owner);
+  // Who answers: the target named, else the process whose command it is (none: every process heard).
+  if (!target.empty() || owner != nullptr) ack.expected = {target.empty() ? std::string(owner) : target};
   ack.state = std::move(state);
   CtlLink link(o.link);
   return send_control_confirmed(link, msg, what, ack, last);
