@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <initializer_list>
 #include <string>
 
 namespace {
@@ -25,6 +26,10 @@ struct BridgeRun {
 };
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+// Each of the texts is in the bridge's output (shown in full when one is not).
+void expect_says(const BridgeRun& r, std::initializer_list<const char*> texts) {
+  for (const char* text : texts) EXPECT_TRUE(contains(r.out, text)) << "no '" << text << "' in:\n" << r.out;
+}
 
 BridgeRun run(const std::string& fake, const std::string& args, const std::string& wrap = "") {
   const std::string log =
@@ -51,12 +56,10 @@ BridgeRun run(const std::string& fake, const std::string& args, const std::strin
 TEST(ComediProbe, ListsTheCardAndDrivesNothingWithoutYes) {
   const BridgeRun r = run("", "--probe-hardware");
   EXPECT_EQ(r.rc, 0) << r.out;
-  EXPECT_TRUE(contains(r.out, "card: driver fake_driver, board fake_board, 3 subdevices")) << r.out;
-  EXPECT_TRUE(contains(r.out, "subdevice 0: analog input, 16 channels, maxdata 65535")) << r.out;
-  EXPECT_TRUE(contains(r.out, "subdevice 1: analog output, 2 channels")) << r.out;
-  EXPECT_TRUE(contains(r.out, "    range 1: [0, 10] V")) << r.out;
-  EXPECT_TRUE(contains(r.out, "calibration: none found (conversions use the range tables)")) << r.out;
-  EXPECT_TRUE(contains(r.out, "not driving the output. With --yes")) << r.out;
+  expect_says(r, {"card: driver fake_driver, board fake_board, 3 subdevices",
+                  "subdevice 0: analog input, 16 channels, maxdata 65535", "subdevice 1: analog output, 2 channels",
+                  "    range 1: [0, 10] V", "calibration: none found (conversions use the range tables)",
+                  "not driving the output. With --yes"});
   EXPECT_FALSE(contains(r.out, "measured"));
   EXPECT_TRUE(contains(r.log, "writes 0 ")) << r.log;
 }
@@ -64,16 +67,14 @@ TEST(ComediProbe, ListsTheCardAndDrivesNothingWithoutYes) {
 TEST(ComediProbe, WithYesReportsTheSensorsGainAndSign) {
   BridgeRun r = run("mirror_gain=0.5,calibration=1", "--probe-hardware --yes --duration-s 0.2");
   EXPECT_EQ(r.rc, 0) << r.out;
-  EXPECT_TRUE(contains(r.out, "calibration: softcal file /var/lib/comedi/calibrations/fake_board_comedi0")) << r.out;
-  EXPECT_TRUE(contains(r.out, "triangle 0 V -> 1 V -> -1 V -> 0 V at the card (x25: -25..25 V at the piezo)")) << r.out;
-  EXPECT_TRUE(contains(r.out, "measured: sensor +0.5")) << r.out;
-  EXPECT_TRUE(contains(r.out, "verdict: sign OK")) << r.out;
+  expect_says(r, {"calibration: softcal file /var/lib/comedi/calibrations/fake_board_comedi0",
+                  "triangle 0 V -> 1 V -> -1 V -> 0 V at the card (x25: -25..25 V at the piezo)",
+                  "measured: sensor +0.5", "verdict: sign OK"});
   // The softcal code for 0 V (the fake's output is 2 mV high and 1 % steep): first and last.
   EXPECT_TRUE(contains(r.log, "first 32761 ") && contains(r.log, "last 32761 ")) << r.log;
   r = run("mirror_gain=-0.8", "--probe-hardware --yes --duration-s 0.2 --amplitude-V 2");
   EXPECT_EQ(r.rc, 1) << r.out;
-  EXPECT_TRUE(contains(r.out, "measured: sensor -0.8")) << r.out;
-  EXPECT_TRUE(contains(r.out, "SIGN REVERSED")) << r.out;
+  expect_says(r, {"measured: sensor -0.8", "SIGN REVERSED"});
   EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
   // Clamped to the actuator's range: +-2 V at the card asked, +-50 V / 25 allowed.
   r = run("mirror_gain=1",
@@ -100,8 +101,7 @@ TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
   const BridgeRun r = run("", "--set rt.priority=0 --set rt.io_priority=0 --set rt.lock_memory=false --set rt.cpu=-1",
                           netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
   EXPECT_EQ(r.rc, 0) << r.out;
-  EXPECT_TRUE(contains(r.out, "the safe 0 V written (DAC code 32768)")) << r.out;
-  EXPECT_TRUE(contains(r.out, "stopping on signal 15")) << r.out;
+  expect_says(r, {"the safe 0 V written (DAC code 32768)", "stopping on signal 15"});
   EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
 }
 

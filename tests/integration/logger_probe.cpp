@@ -86,13 +86,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-template <class T>
-std::vector<std::uint8_t> encoded(const T& msg) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
 struct Event {
   const std::string* channel;
   std::vector<std::uint8_t> bytes;
@@ -104,15 +97,15 @@ std::vector<Event> expected_stream(const Options& o, const ChannelNames& ch) {
   for (std::int64_t k = 0; k < o.blocks; ++k) {
     const std::int64_t seq = o.block_ticks * k;
     if (!(k >= o.gap_at && k < o.gap_at + o.gap_len)) {
-      events.push_back({&ch.sensor, encoded(fixtures::sensor_ticks(seq, o.block_ticks))});
+      events.push_back({&ch.sensor, fixtures::encode(fixtures::sensor_ticks(seq, o.block_ticks))});
     }
     if (k < o.commands) {
-      events.push_back({&ch.command, encoded(fixtures::command_ticks(seq + fixtures::kCommandLead, o.block_ticks,
-                                                                     seq + o.block_ticks - 1))});
+      events.push_back({&ch.command, fixtures::encode(fixtures::command_ticks(
+                                         seq + fixtures::kCommandLead, o.block_ticks, seq + o.block_ticks - 1))});
     }
     if (k % 100 == 0) {
-      events.push_back({&ch.trajectory, encoded(fixtures::trajectory(k / 100))});
-      events.push_back({&ch.params, encoded(fixtures::params(k / 100))});
+      events.push_back({&ch.trajectory, fixtures::encode(fixtures::trajectory(k / 100))});
+      events.push_back({&ch.params, fixtures::encode(fixtures::params(k / 100))});
     }
   }
   return events;
