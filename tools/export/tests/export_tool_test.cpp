@@ -26,9 +26,11 @@
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "log_test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystloop;
+using namespace hystloop::test;
 
 namespace {
 
@@ -48,18 +50,6 @@ std::int32_t flags_of(std::int64_t k) {
 std::int64_t block_recv(std::int64_t b) { return kT0 + ((b + 1) * kTicks - 1) * 100; }
 
 std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
-
-template <class T>
-void write(lcm::LogFile& log, std::int64_t t, const std::string& channel, const T& msg) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, msg.getEncodedSize());
-  lcm::LogEvent e{};
-  e.timestamp = t;
-  e.channel = channel;
-  e.datalen = static_cast<std::int32_t>(bytes.size());
-  e.data = bytes.data();
-  ASSERT_EQ(log.writeEvent(&e), 0);
-}
 
 void write_log(const fs::path& file) {
   lcm::LogFile log(file.string(), "w");
@@ -136,23 +126,8 @@ void write_log(const fs::path& file) {
   write(log, kT0 + 1300, "OTHER_RIG_SENSOR", k);  // another rig's channel: not exported by default
 }
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct ToolRun {
-  int exit_code;
-  std::string out, err;
-};
-
 ToolRun run_tool(const std::string& args, const fs::path& scratch) {
-  const std::string cmd = std::string(HYSTLOOP_EXPORT_EXE) + " " + args + " >" + (scratch / "stdout").string() + " 2>" +
-                          (scratch / "stderr").string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(scratch / "stdout"), slurp(scratch / "stderr")};
+  return test::run_tool(HYSTLOOP_EXPORT_EXE, args, scratch);
 }
 
 // Reading HDF5 back through the C API, nothing of the exporter's own code.

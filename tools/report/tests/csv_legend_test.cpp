@@ -21,33 +21,16 @@
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "log_test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystloop;
 using namespace hystloop::report;
+using namespace hystloop::test;
 
 namespace {
 
 constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // [us]
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-template <class T>
-void write(lcm::LogFile& log, std::int64_t t, const std::string& channel, const T& msg) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, msg.getEncodedSize());
-  lcm::LogEvent e{};
-  e.timestamp = t;
-  e.channel = channel;
-  e.datalen = static_cast<std::int32_t>(bytes.size());
-  e.data = bytes.data();
-  ASSERT_EQ(log.writeEvent(&e), 0);
-}
 
 class CsvLegendTest : public ::testing::Test {
  protected:

@@ -29,10 +29,12 @@
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/message_storage.hpp"
+#include "log_test_support.hpp"
 #include "models/mem.hpp"
 
 namespace fs = std::filesystem;
 using namespace hystloop;
+using namespace hystloop::test;
 
 namespace {
 
@@ -62,19 +64,6 @@ MemParams set_of(std::int32_t version) {
 
 double ref_at(std::int64_t k) { return -1.6e-6 * std::cos(2.0 * M_PI * static_cast<double>(k) * kDt); }
 
-struct Event {
-  std::int64_t t;
-  std::string channel;
-  std::vector<std::uint8_t> bytes;
-};
-
-template <class T>
-Event event(std::int64_t t, const std::string& channel, const T& msg) {
-  Event e{t, channel, std::vector<std::uint8_t>(static_cast<std::size_t>(msg.getEncodedSize()))};
-  msg.encode(e.bytes.data(), 0, msg.getEncodedSize());
-  return e;
-}
-
 mem_params_t published(std::int32_t version) {
   const MemParams p = set_of(version);
   mem_params_t m{};
@@ -93,7 +82,7 @@ service_status_t status(const std::string& process, std::int64_t t) {
   service_status_t s{};
   s.utime = t;
   s.process = process;
-  s.host = "h";
+  s.host = std::string(1, 'h');  // (a literal trips GCC 12's -Wrestrict once inlined)
   s.pid = 42;
   s.state = service_status_t::HEALTHY;
   s.start_utime = kT0;
@@ -162,40 +151,11 @@ void write_demo_log(const fs::path& file, const Timeline& tl) {
   traj.frequency_Hz = 1.0;
   events.push_back(event(at_tick(tl.experiment_end), "HX_TRAJECTORY", traj));
 
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
-  lcm::LogFile log(file.string(), "w");
-  ASSERT_TRUE(log.good());
-  for (auto& e : events) {
-    lcm::LogEvent le{};
-    le.timestamp = e.t;
-    le.channel = e.channel;
-    le.datalen = static_cast<std::int32_t>(e.bytes.size());
-    le.data = e.bytes.data();
-    ASSERT_EQ(log.writeEvent(&le), 0);
-  }
+  write_events(file, events);
 }
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct ToolRun {
-  int exit_code = -1;
-  std::string out, err;
-  double seconds = 0.0;
-};
 
 ToolRun run_tool(const std::string& args, const fs::path& scratch) {
-  const std::string cmd = std::string(HYSTLOOP_REPORT_EXE) + " " + args + " >" + (scratch / "stdout").string() + " 2>" +
-                          (scratch / "stderr").string();
-  const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(cmd.c_str());
-  const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(scratch / "stdout"), slurp(scratch / "stderr"),
-          took.count()};
+  return test::run_tool(HYSTLOOP_REPORT_EXE, args, scratch);
 }
 
 // What plots.gp draws: per output file, each plot command with the title in force for it, and
@@ -257,7 +217,6 @@ std::vector<std::vector<double>> rows_of(const fs::path& file, std::size_t* blan
   return rows;
 }
 
-bool is_png(const fs::path& path) { return slurp(path).substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8); }
 bool have_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
 
 double tick_t(std::int64_t k) { return static_cast<double>(k) * kDt; }

@@ -26,10 +26,12 @@
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/message_storage.hpp"
+#include "log_test_support.hpp"
 #include <nlohmann/json.hpp>
 
 namespace fs = std::filesystem;
 using namespace hystloop;
+using namespace hystloop::test;
 
 namespace {
 
@@ -85,19 +87,6 @@ std::int64_t cpu_user(const std::string& process, std::int64_t s) {
 }
 std::int64_t cpu_system(const std::string& process, std::int64_t s) {
   return s * (process == "bridge" ? 50'000 : 40'000);
-}
-
-struct Event {
-  std::int64_t t;
-  std::string channel;
-  std::vector<std::uint8_t> bytes;
-};
-
-template <class T>
-Event event(std::int64_t t, const std::string& channel, const T& msg) {
-  Event e{t, channel, std::vector<std::uint8_t>(static_cast<std::size_t>(msg.getEncodedSize()))};
-  msg.encode(e.bytes.data(), 0, msg.getEncodedSize());
-  return e;
 }
 
 mem_params_t params(std::int32_t version, double c1, bool valid) {
@@ -234,45 +223,17 @@ LogTruth write_log(const fs::path& file, const LogOptions& o = {}) {
   traj.frequency_Hz = 0.5;
   events.push_back(event(kT0 + 900'000, "HX_TRAJECTORY", traj));
 
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
-  lcm::LogFile log(file.string(), "w");
-  EXPECT_TRUE(log.good());
+  write_events(file, events);
   LogTruth truth;
-  for (auto& e : events) {
-    lcm::LogEvent le{};
-    le.timestamp = e.t;
-    le.channel = e.channel;
-    le.datalen = static_cast<std::int32_t>(e.bytes.size());
-    le.data = e.bytes.data();
-    EXPECT_EQ(log.writeEvent(&le), 0);
+  for (const auto& e : events) {
     ++truth.counts[e.channel];
     truth.times[e.channel].push_back(e.t);
   }
   return truth;
 }
 
-struct ToolRun {
-  int exit_code;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 ToolRun run_tool(const std::string& args, const fs::path& scratch) {
-  const std::string cmd = std::string(HYSTLOOP_REPORT_EXE) + " " + args + " >" + (scratch / "stdout").string() + " 2>" +
-                          (scratch / "stderr").string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(scratch / "stdout"), slurp(scratch / "stderr")};
-}
-
-bool is_png(const fs::path& path) {
-  const std::string head = slurp(path).substr(0, 8);
-  return head == std::string("\x89PNG\r\n\x1a\n", 8);
+  return test::run_tool(HYSTLOOP_REPORT_EXE, args, scratch);
 }
 
 // The expected figures for ticks with lo <= t <= hi, computed from the generator's truth.

@@ -39,6 +39,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/message_storage.hpp"
 #include "log_reader.hpp"
+#include "log_test_support.hpp"
 #include "scan_figures.hpp"
 #include "scan_log.hpp"
 #include "scan_output.hpp"
@@ -46,6 +47,7 @@
 namespace fs = std::filesystem;
 using namespace hystloop;
 using namespace hystloop::report;
+using namespace hystloop::test;
 
 namespace {
 
@@ -82,19 +84,9 @@ std::int32_t flags(std::int64_t k) {
   return f;
 }
 
-struct Event {
-  std::int64_t t;
-  std::string channel;
-  std::vector<std::uint8_t> bytes;
-};
 template <class T>
 void add(std::vector<Event>& events, std::int64_t t, const std::string& channel, const T& msg, int copies = 1) {
-  for (int i = 0; i < copies; ++i) {
-    Event e{t + std::int64_t{2000} * i, channel,
-            std::vector<std::uint8_t>(static_cast<std::size_t>(msg.getEncodedSize()))};
-    msg.encode(e.bytes.data(), 0, msg.getEncodedSize());
-    events.push_back(std::move(e));
-  }
+  for (int i = 0; i < copies; ++i) events.push_back(event(t + std::int64_t{2000} * i, channel, msg));
 }
 
 control_t control(std::int64_t id, std::int8_t command, std::int8_t learning = 0) {
@@ -191,17 +183,7 @@ void write_log(const fs::path& file, TruthBlocks truth = {}) {
   for (const double t : {0.5, 1.01, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 6.99, 7.01, 7.5, 8.5, 9.5}) {
     add(events, at(t), "HX_STATUS", compensator_status(t));
   }
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
-  lcm::LogFile log(file.string(), "w");
-  ASSERT_TRUE(log.good());
-  for (auto& e : events) {
-    lcm::LogEvent le{};
-    le.timestamp = e.t;
-    le.channel = e.channel;
-    le.datalen = static_cast<std::int32_t>(e.bytes.size());
-    le.data = e.bytes.data();
-    ASSERT_EQ(log.writeEvent(&le), 0);
-  }
+  write_events(file, events);
 }
 
 struct Truth {  // figures of ticks [from, to) computed from the generator
@@ -404,16 +386,9 @@ TEST_F(ScanLog, InfersTheLearningStateWithoutRequests) {
 
 TEST_F(ScanLog, ReportWritesTheScanTable) {
   const fs::path out = dir_ / "out";
-  const std::string cmd = std::string(HYSTLOOP_REPORT_EXE) + " " + log().string() + " --out " + out.string() +
-                          " --no-plots >" + (dir_ / "stdout").string() + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  std::ifstream printed(dir_ / "stdout");
-  std::stringstream ss;
-  ss << printed.rdbuf();
-  ASSERT_EQ(WEXITSTATUS(status), 0) << ss.str();
-  EXPECT_NE(ss.str().find("scan, 2 reference(s), 1 refused"), std::string::npos)
-      << ss.str();  // two periodic: automatic
+  const ToolRun r = run_tool(HYSTLOOP_REPORT_EXE, log().string() + " --out " + out.string() + " --no-plots", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("scan, 2 reference(s), 1 refused"), std::string::npos) << r.out;  // two periodic: automatic
   ASSERT_TRUE(fs::exists(out / "scan.md"));
   std::ifstream in(out / "scan.json");
   const auto j = nlohmann::json::parse(in);
