@@ -26,24 +26,13 @@
 #include "runtime/summary_file.hpp"
 
 namespace hystloop {
-namespace {
-
-Subscription<command_block_t>::Options command_options(int capacity) {
-  Subscription<command_block_t>::Options o;
-  o.queue_capacity = capacity;
-  return o;
-}
-
-}  // namespace
-
 BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, const ChannelNames& channels)
     : settings_(settings),
       lcm_(lcm),
       rt_(settings, make_stage_backend(settings)),
       sensor_pub_(lcm, channels.sensor),
-      commands_(
-          lcm, channels.command, [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
-          command_options(settings.command_queue_capacity)),
+      commands_(lcm, channels.command, [this](const command_block_t& msg, std::int64_t) { on_command(msg); },
+                {.queue_capacity = settings.command_queue_capacity, .on_reject = {}}),
       control_(lcm, channels.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }),
       status_(lcm, channels.status, "bridge"),
       gains_(settings.servo) {

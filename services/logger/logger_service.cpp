@@ -78,10 +78,9 @@ LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const Log
     writer_ = std::make_unique<LogWriter>(*ring_, *channels_, *files_, options.flush_interval_s);
     writer_->start();
 
-    Subscription<control_t>::Options control_options;
-    control_options.queue_capacity = 64;
     control_ = std::make_unique<Subscription<control_t>>(
-        lcm_, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }, control_options);
+        lcm_, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); },
+        Subscription<control_t>::Options{.queue_capacity = 64, .on_reject = {}});
   } catch (...) {
     unsubscribe();
     if (writer_) writer_->stop();

@@ -83,11 +83,9 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
   };
   sensor_ = std::make_unique<Subscription<sensor_block_t>>(
       lcm, names.sensor, [this](const sensor_block_t& msg, std::int64_t) { on_sensor_block(msg); }, sensor_options);
-  Subscription<command_block_t>::Options command_options;
-  command_options.queue_capacity = static_cast<int>(options.lcm_queue);
   command_ = std::make_unique<Subscription<command_block_t>>(
       lcm, names.command, [this](const command_block_t& msg, std::int64_t) { core_->on_command_block(msg); },
-      command_options);
+      Subscription<command_block_t>::Options{.queue_capacity = sensor_options.queue_capacity, .on_reject = {}});
   params_in_ = std::make_unique<Subscription<mem_params_t>>(
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
   control_ = std::make_unique<Subscription<control_t>>(lcm, names.control,

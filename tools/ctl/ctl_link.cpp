@@ -41,13 +41,8 @@ Clock::time_point after(double seconds) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-// A block channel's queue for a listening subcommand: a few seconds of blocks.
-template <class T>
-typename Subscription<T>::Options block_queue() {
-  typename Subscription<T>::Options o;
-  o.queue_capacity = 4'000;
-  return o;
-}
+// A listening subcommand's queue on a block channel: a few seconds of blocks.
+constexpr int kBlockQueue = 4'000;
 
 }  // namespace
 
@@ -93,23 +88,22 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   WatchLine line;
   std::optional<std::int64_t> late_before_report;
   TruthPairing truth;
-  Subscription<sensor_block_t> samples(
-      link.lcm(), link.channels().sensor,
-      [&](const sensor_block_t& b, std::int64_t) {
-        line.second.add_sensor_block(b);
-        truth.add_sensor_block(b, line.second);
-      },
-      block_queue<sensor_block_t>());
-  Subscription<sim_truth_t> truths(
-      link.lcm(), link.channels().sim_truth,
-      [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); }, block_queue<sim_truth_t>());
-  Subscription<command_block_t> commands(
-      link.lcm(), link.channels().command,
-      [&](const command_block_t& c, std::int64_t) {
-        line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
-        line.params_in_use = command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
-      },
-      block_queue<command_block_t>());
+  Subscription<sensor_block_t> samples(link.lcm(), link.channels().sensor,
+                                       [&](const sensor_block_t& b, std::int64_t) {
+                                         line.second.add_sensor_block(b);
+                                         truth.add_sensor_block(b, line.second);
+                                       },
+                                       {.queue_capacity = kBlockQueue, .on_reject = {}});
+  Subscription<sim_truth_t> truths(link.lcm(), link.channels().sim_truth,
+                                   [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); },
+                                   {.queue_capacity = kBlockQueue, .on_reject = {}});
+  Subscription<command_block_t> commands(link.lcm(), link.channels().command,
+                                         [&](const command_block_t& c, std::int64_t) {
+                                           line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
+                                           line.params_in_use =
+                                               command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
+                                         },
+                                         {.queue_capacity = kBlockQueue, .on_reject = {}});
   Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
     if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
   });
@@ -252,16 +246,10 @@ int send_control_confirmed(CtlLink& link, const control_t& msg, const std::strin
 }
 
 std::optional<service_status_t> listen_for_status(CtlLink& link, const std::string& process, double timeout_s) {
-  std::optional<service_status_t> found;
-  Subscription<service_status_t> status(link.lcm(), link.channels().status,
-                                        [&](const service_status_t& s, std::int64_t) {
-                                          if (s.process == process) found = s;
-                                        });
-  const auto deadline = after(timeout_s);
-  while (!found && Clock::now() < deadline) {
-    if (!receive(link, deadline, std::chrono::microseconds(50'000))) break;
-  }
-  return found;
+  StatusWait w = wait_for_status(
+      link, process, [](const service_status_t&) { return true; }, timeout_s);
+  if (!w.satisfied) return std::nullopt;
+  return w.last.at(process);
 }
 
 StatusWait wait_for_status(CtlLink& link, const std::string& process, const StateCheck& until, double timeout_s) {
@@ -297,16 +285,16 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
     });
   };
   Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command,
-                                         block_queue<command_block_t>());
+                                         {.queue_capacity = kBlockQueue, .on_reject = {}});
   // The plan runs a horizon ahead of the stage: the series is done when the sample of its last
   // tick has arrived, not when that tick was planned.
   std::int64_t last_sample = -1;
-  Subscription<sensor_block_t> samples(
-      link.lcm(), link.channels().sensor,
-      [&](const sensor_block_t& b, std::int64_t) {
-        if (b.n_ticks > 0) last_sample = std::max<std::int64_t>(last_sample, b.seq + b.n_ticks - 1);
-      },
-      block_queue<sensor_block_t>());
+  Subscription<sensor_block_t> samples(link.lcm(), link.channels().sensor,
+                                       [&](const sensor_block_t& b, std::int64_t) {
+                                         if (b.n_ticks > 0)
+                                           last_sample = std::max<std::int64_t>(last_sample, b.seq + b.n_ticks - 1);
+                                       },
+                                       {.queue_capacity = kBlockQueue, .on_reject = {}});
   auto pump = [&](Clock::time_point until_time) {
     return receive(link, until_time, std::chrono::microseconds(50'000), 4096);
   };
@@ -415,7 +403,7 @@ std::int32_t next_params_version(CtlLink& link, double listen_s) {
       [&](const command_block_t& c, std::int64_t) {
         for_each_tick(c, [&](const CommandTick& t) { highest = std::max(highest, t.params_version); });
       },
-      block_queue<command_block_t>());
+      {.queue_capacity = kBlockQueue, .on_reject = {}});
   const auto deadline = after(listen_s);
   while (Clock::now() < deadline) {
     if (!receive(link, deadline, std::chrono::microseconds(50'000), 1024)) break;
