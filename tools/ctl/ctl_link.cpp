@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <spdlog/fmt/fmt.h>
@@ -243,13 +244,6 @@ int send_control_confirmed(CtlLink& link, const control_t& msg, const std::strin
                  o.timeout_s);
   }
   return ok ? 0 : 1;
-}
-
-std::optional<service_status_t> listen_for_status(CtlLink& link, const std::string& process, double timeout_s) {
-  StatusWait w = wait_for_status(
-      link, process, [](const service_status_t&) { return true; }, timeout_s);
-  if (!w.satisfied) return std::nullopt;
-  return w.last.at(process);
 }
 
 StatusWait wait_for_status(CtlLink& link, const std::string& process, const StateCheck& until, double timeout_s) {

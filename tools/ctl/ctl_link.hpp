@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
-#include <optional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -119,9 +118,6 @@ struct AckOptions {
 // it could not be published.
 int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& options,
                            std::map<std::string, service_status_t>* last = nullptr);
-
-// The latest report of `process` within timeout_s (it reports once a second), or nullopt.
-std::optional<service_status_t> listen_for_status(CtlLink& link, const std::string& process, double timeout_s);
 
 struct StatusWait {
   bool satisfied = false;

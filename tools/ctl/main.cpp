@@ -115,13 +115,14 @@ int run_gains(Options& o) {
   const std::string bridge = o.gains_target;
   if (o.gains.empty()) {  // a question: the gains in force
     CtlLink link(o.link);
-    const auto report = listen_for_status(link, bridge, o.ack.timeout_s);
-    if (!report) {
+    const StatusWait w = wait_for_status(
+        link, bridge, [](const service_status_t&) { return true; }, o.ack.timeout_s);
+    if (!w.satisfied) {
       std::fprintf(stderr, "hystloop-ctl: no status from '%s' on %s within %g s: is a rig running?\n", bridge.c_str(),
                    link.channels().status.c_str(), o.ack.timeout_s);
       return 1;
     }
-    if (print_gains(bridge, *report)) return 0;
+    if (print_gains(bridge, w.last.at(bridge))) return 0;
     std::fprintf(stderr, "hystloop-ctl: '%s' reports no servo gains (a build that does not?)\n", bridge.c_str());
     return 1;
   }
