@@ -3,6 +3,8 @@
 // `reason`; only `ok` means the parameters may be used. Options a fitter cannot run with are not
 // a status: their validate() throws ParameterError where they enter, before any data is looked at.
 
+#include <cstddef>
+#include <string>
 #include <string_view>
 
 namespace hystloop {
@@ -21,5 +23,15 @@ enum class FitStatus {
 };
 
 std::string_view to_string(FitStatus status) noexcept;
+
+// What the result of each model's fit (MEM, PI, Katalenic, linear) holds beside its parameters.
+struct FitOutcome {
+  double residual_rms_m = 0.0;  // [m] on the samples scored
+  std::size_t samples_used = 0;
+  FitStatus status = FitStatus::solver_failure;
+  std::string reason;
+  double solve_time_s = 0.0;  // the fit's time by its options' clock (instrumentation only); linear: 0
+  bool ok() const noexcept { return status == FitStatus::ok; }
+};
 
 }  // namespace hystloop

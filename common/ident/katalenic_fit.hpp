@@ -27,14 +27,8 @@ struct KatalenicFitOptions {
   void validate() const;  // throws ParameterError naming the field
 };
 
-struct KatalenicFitResult {
+struct KatalenicFitResult : FitOutcome {
   KatalenicParams params{};
-  double residual_rms_m = 0.0;
-  std::size_t samples_used = 0;
-  FitStatus status = FitStatus::solver_failure;
-  std::string reason;
-  double solve_time_s = 0.0;
-  bool ok() const noexcept { return status == FitStatus::ok; }
 };
 
 KatalenicFitResult fit_katalenic(std::span<const double> u_V, std::span<const double> y_m,

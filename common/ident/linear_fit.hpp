@@ -10,14 +10,9 @@
 
 namespace hystloop {
 
-struct LinearFitResult {
+struct LinearFitResult : FitOutcome {
   double gain_m_per_V = 0.0;
   double offset_m = 0.0;
-  double residual_rms_m = 0.0;
-  std::size_t samples_used = 0;
-  FitStatus status = FitStatus::solver_failure;
-  std::string reason;
-  bool ok() const noexcept { return status == FitStatus::ok; }
 };
 
 LinearParams to_linear_params(const LinearFitResult& fit);  // validates

@@ -57,20 +57,16 @@ struct MemFitOptions {
   void validate() const;
 };
 
-struct MemFitResult {
+// residual_rms_m: the integrated-branch residual (per-branch offsets fitted), in both forms;
+// samples_used: samples (integrated) or difference points (derivative).
+struct MemFitResult : FitOutcome {
   MemParams params{};
-  double residual_rms_m = 0.0;   // integrated-branch residual (per-branch offsets fitted), both forms
-  std::size_t samples_used = 0;  // samples (integrated) or difference points (derivative)
   std::size_t branches_used = 0;
-  FitStatus status = FitStatus::solver_failure;
-  std::string reason;
-  double solve_time_s = 0.0;  // time of the whole fit by options.clock (instrumentation only)
   // The best MEM element lies on the domain's edge (c1 at its floor, or c2 = 0): the data are
   // not exactly MEM-shaped. The parameters are usable; expect a larger model error.
   bool constrained = false;
   double noise_rms_m = 0.0;   // noise level used (given or estimated)
   double projected_c3 = 0.0;  // c3 from the variable-projection search, before Ceres
-  bool ok() const noexcept { return status == FitStatus::ok; }
 };
 
 // Fits (c1, c2, c3) to the samples. Never throws for bad data: the status says why it refused;

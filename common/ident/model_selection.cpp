@@ -55,11 +55,8 @@ double holdout_rms(std::span<const double> y, const std::vector<double>& pred, s
 
 namespace {
 
-template <class Result>
-ModelScore score_of(ModelKind kind, const Result& r) {
-  ModelScore s{kind, r.status, r.reason, r.residual_rms_m, 0.0, 0.0, r.samples_used};
-  if constexpr (requires { r.solve_time_s; }) s.fit_time_s = r.solve_time_s;
-  return s;
+ModelScore score_of(ModelKind kind, const FitOutcome& r) {
+  return {kind, r.status, r.reason, r.residual_rms_m, 0.0, r.solve_time_s, r.samples_used};
 }
 
 }  // namespace

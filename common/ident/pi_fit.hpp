@@ -24,16 +24,10 @@ struct PiFitOptions {
   void validate() const;  // throws ParameterError naming the field
 };
 
-struct PiFitResult {
+struct PiFitResult : FitOutcome {
   std::vector<double> thresholds_V;  // r_i [V]
   std::vector<double> weights;       // w_i [m/V], >= 0
   double offset_m = 0.0;
-  double residual_rms_m = 0.0;
-  std::size_t samples_used = 0;
-  FitStatus status = FitStatus::solver_failure;
-  std::string reason;
-  double solve_time_s = 0.0;
-  bool ok() const noexcept { return status == FitStatus::ok; }
 };
 
 PiFitResult fit_pi(std::span<const double> u_V, std::span<const double> y_m, const PiFitOptions& options = {});
