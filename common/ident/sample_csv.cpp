@@ -53,15 +53,8 @@ SampleTable parse_sample_csv(std::istream& in, const std::string& name) {
       header = fields;
       for (std::size_t i = 0; i < header.size(); ++i) {
         const std::string h = lower(header[i]);
-        const int idx = static_cast<int>(i);
-        if (h == "t")
-          ct = idx;
-        else if (h == "u")
-          cu = idx;
-        else if (h == "y")
-          cy = idx;
-        else if (h == "experiment")
-          ce = idx;
+        int* column = h == "t" ? &ct : h == "u" ? &cu : h == "y" ? &cy : h == "experiment" ? &ce : nullptr;
+        if (column != nullptr) *column = static_cast<int>(i);
       }
       std::string missing;
       if (ct < 0) missing += " t";
