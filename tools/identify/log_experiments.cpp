@@ -72,42 +72,34 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   control_t control{};
   command_block_t command{};
   sensor_block_t sensor{};
-  for (const auto& file : files) {
-    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
-    lcm::LogFile log(file, "r");
-    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
-    ++out.files;
-    while (const lcm::LogEvent* event = log.readNextEvent()) {
-      if (event->channel == o.sensor_channel) {
-        if (decode_logged(*event, sensor) && check_message(sensor) == Verdict::kOk) {
-          for_each_tick(sensor, [&](const SensorTick& t) { r.samples.push_back({t.seq, t.u_V, t.y_m, t.flags}); });
-        }
-      } else if (event->channel == o.command_channel) {
-        if (decode_logged(*event, command) && check_message(command) == Verdict::kOk) {
-          for_each_tick(command, [&](const CommandTick& t) {
-            r.commands.push_back({t.seq, event->timestamp, t.u_ff_V, t.mode == command_block_t::MODE_EXPERIMENT});
-          });
-        }
-      } else if (event->channel == o.control_channel) {
-        if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
-        if (!for_compensator(control, o)) continue;
-        if (control.command == control_t::STOP_EXPERIMENT) {
-          r.stops.push_back(event->timestamp);
-          continue;
-        }
-        if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) continue;
-        try {  // what the compensator accepts (CompensatorService::on_control)
-          r.starts.push_back(
-              {event->timestamp, control.request_id,
-               make_experiment_spec(control.experiment, control.experiment_amplitude_V, control.experiment_offset_V,
-                                    control.experiment_frequency_Hz, control.experiment_duration_s)});
-        } catch (const ParameterError& e) {
-          out.notes.push_back("request " + std::to_string(control.request_id) +
-                              ": refused by the compensator's rules: " + e.what());
-        }
+  for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
+    if (event.channel == o.sensor_channel) {
+      if (decode_logged(event, sensor) && check_message(sensor) == Verdict::kOk) {
+        for_each_tick(sensor, [&](const SensorTick& t) { r.samples.push_back({t.seq, t.u_V, t.y_m, t.flags}); });
+      }
+    } else if (event.channel == o.command_channel) {
+      if (decode_logged(event, command) && check_message(command) == Verdict::kOk) {
+        for_each_tick(command, [&](const CommandTick& t) {
+          r.commands.push_back({t.seq, event.timestamp, t.u_ff_V, t.mode == command_block_t::MODE_EXPERIMENT});
+        });
+      }
+    } else if (event.channel == o.control_channel) {
+      if (!decode_logged(event, control) || check_message(control) != Verdict::kOk) return;
+      if (!for_compensator(control, o)) return;
+      if (control.command == control_t::STOP_EXPERIMENT) return r.stops.push_back(event.timestamp);
+      if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) return;
+      try {  // what the compensator accepts (CompensatorService::on_control)
+        r.starts.push_back(
+            {event.timestamp, control.request_id,
+             make_experiment_spec(control.experiment, control.experiment_amplitude_V, control.experiment_offset_V,
+                                  control.experiment_frequency_Hz, control.experiment_duration_s)});
+      } catch (const ParameterError& e) {
+        out.notes.push_back("request " + std::to_string(control.request_id) +
+                            ": refused by the compensator's rules: " + e.what());
       }
     }
-  }
+  });
+  out.files = files.size();
   out.requests = r.starts.size();
   auto by_seq = [](const auto& a, const auto& b) { return a.seq < b.seq; };
   auto same_seq = [](const auto& a, const auto& b) { return a.seq == b.seq; };
@@ -320,15 +312,14 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
 std::size_t count_experiment_requests(const std::vector<std::string>& files, const ExperimentLogOptions& o) {
   std::set<std::int64_t> ids;
   control_t control{};
-  for (const auto& file : files) {
-    if (!std::filesystem::is_regular_file(file)) return 0;
-    lcm::LogFile log(file, "r");
-    if (!log.good()) return 0;
-    while (const lcm::LogEvent* event = log.readNextEvent()) {
-      if (event->channel != o.control_channel) continue;
-      if (!decode_logged(*event, control) || check_message(control) != Verdict::kOk) continue;
+  try {
+    for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
+      if (event.channel != o.control_channel) return;
+      if (!decode_logged(event, control) || check_message(control) != Verdict::kOk) return;
       if (for_compensator(control, o) && control.command == control_t::START_EXPERIMENT) ids.insert(control.request_id);
-    }
+    });
+  } catch (const SampleLogError&) {
+    return 0;  // the reader then says why
   }
   return ids.size();
 }

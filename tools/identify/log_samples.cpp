@@ -115,30 +115,32 @@ void LogReadOptions::validate() const {
   }
 }
 
+void for_each_log_event(const std::vector<std::string>& files,
+                        const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
+  for (const auto& file : files) {
+    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
+    lcm::LogFile log(file, "r");
+    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
+    while (const lcm::LogEvent* event = log.readNextEvent()) on_event(file, *event);
+  }
+}
+
 bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
 
 LogSamples read_sample_logs(const std::vector<std::string>& files, const LogReadOptions& options) {
   options.validate();
   if (files.empty()) throw SampleLogError("no log file given");
   RecordBuilder record(options);
-  sensor_block_t block{};
-  for (const auto& file : files) {
-    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
-    lcm::LogFile log(file, "r");
-    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
-    ++record.result().files;
-    while (const lcm::LogEvent* event = log.readNextEvent()) {
-      ++record.result().events;
-      if (event->channel != options.sensor_channel) continue;
-      ++record.result().sensor_events;
-      if (!decode_logged(*event, block)) {
-        ++record.result().undecodable;
-        continue;
-      }
-      record.add(file, event->eventnum, block);
-    }
-  }
   LogSamples& out = record.result();
+  sensor_block_t block{};
+  for_each_log_event(files, [&](const std::string& file, const lcm::LogEvent& event) {
+    ++out.events;
+    if (event.channel != options.sensor_channel) return;
+    ++out.sensor_events;
+    if (!decode_logged(event, block)) return void(++out.undecodable);
+    record.add(file, event.eventnum, block);
+  });
+  out.files = files.size();
   if (out.table.t.empty()) {
     std::ostringstream s;
     s << (files.size() == 1 ? files.front() : files.front() + " ... " + files.back()) << ": no usable "

@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -99,6 +100,11 @@ bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
     return false;
   }
 }
+
+// Calls on_event(file, event) for every event of the files, in order. Throws SampleLogError for
+// a file that is not there or does not open as an LCM event log.
+void for_each_log_event(const std::vector<std::string>& files,
+                        const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event);
 
 // True for a path that names an LCM event log by its ending (".lcmlog").
 bool looks_like_lcm_log(const std::string& path);
