@@ -218,14 +218,18 @@ int run_banning_series(Options& o) {
   return run_series(link, steps, o.series);
 }
 
+// An option whose default --help shows.
+template <class T>
+CLI::Option* with_default(CLI::App* sub, const std::string& name, T& value, const std::string& help) {
+  return sub->add_option(name, value, help)->capture_default_str();
+}
+
 // Every request that changes state waits for its answer on the status channel.
 void add_wait_options(CLI::App* sub, Options& o) {
   auto* no_wait = sub->add_flag(
       "--no-wait", [&o](std::int64_t) { o.ack.wait = false; },
       "Send and return at once, without waiting for the process to confirm on the status channel");
-  sub->add_option("--timeout", o.ack.timeout_s, "How long to wait for the confirmation [s]")
-      ->capture_default_str()
-      ->excludes(no_wait);
+  with_default(sub, "--timeout", o.ack.timeout_s, "How long to wait for the confirmation [s]")->excludes(no_wait);
 }
 
 CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, Options& o, bool wait_options = true) {
@@ -261,9 +265,8 @@ int run(int argc, char** argv) {
                      "Also accept SAFE from this process (e.g. an unarmed bridge)");
   status->add_flag("--accept-degraded", o.status.accept_degraded,
                    "Also accept DEGRADED (serving, with a complaint the status detail names)");
-  status->add_option("--timeout", o.status.timeout_s, "How long --wait-healthy waits [s]")->capture_default_str();
-  status->add_option("--listen", o.status.listen_s, "Without --wait-healthy: how long to collect reports [s]")
-      ->capture_default_str();
+  with_default(status, "--timeout", o.status.timeout_s, "How long --wait-healthy waits [s]");
+  with_default(status, "--listen", o.status.listen_s, "Without --wait-healthy: how long to collect reports [s]");
   status->add_flag("--counters", o.status.all_counters, "Also print every named counter");
 
   ConfigGetOptions config_get_options;
@@ -303,7 +306,7 @@ int run(int argc, char** argv) {
       "gains",
       "Bridge: change the servo's gains given (the others stay as in force), or print the gains in force "
       "(no gain given); normalised PID, all >= 0; kp <= 2, ki dt <= 1, kd bounded alike");
-  gains->add_option("--target", o.gains_target, "Process of the servo (the bridge)")->capture_default_str();
+  with_default(gains, "--target", o.gains_target, "Process of the servo (the bridge)");
   gains->add_option("--kp", o.gains.kp, "Proportional gain [-]");
   gains->add_option("--ki", o.gains.ki, "Integral gain [1/s]");
   gains->add_option("--kd", o.gains.kd, "Derivative gain [s]");
@@ -315,7 +318,7 @@ int run(int argc, char** argv) {
   CLI::App* learn = app.add_subcommand("learn", "Compensator: learning of the feedforward for periodic references");
   learn->add_option("what", o.learning, "on, off (drops the correction, ramped out) or reset (starts again)")
       ->required();
-  learn->add_option("--target", o.learn_target, "Process that learns (the compensator)")->capture_default_str();
+  with_default(learn, "--target", o.learn_target, "Process that learns (the compensator)");
   add_wait_options(learn, o);
 
   CLI::App* experiment = control_subcommand(
@@ -327,7 +330,7 @@ int run(int argc, char** argv) {
   auto* frequency = experiment->add_option("--frequency", o.experiment.frequency_Hz, "Excitation frequency [Hz], > 0");
   auto* duration = experiment->add_option("--duration", o.experiment.duration_s,
                                           "Duration [s], > 0, rounded up to whole periods (--mem-paper: default 2)");
-  auto* offset = experiment->add_option("--offset", o.experiment.offset_V, "Offset [V]")->capture_default_str();
+  auto* offset = with_default(experiment, "--offset", o.experiment.offset_V, "Offset [V]");
   auto* kind = experiment
                    ->add_option("--kind", o.experiment.kind,
                                 "sine, or settle (the same sine, marked for identification to skip)")
@@ -343,7 +346,7 @@ int run(int argc, char** argv) {
                                 "frequency response; fit the log with hystloop-identify --model banning")
                      ->excludes(amplitude, frequency, duration, offset, kind, mem_paper_exp);
   auto plan_option = [&](const char* name, auto& value, const char* help) {
-    experiment->add_option(name, value, help)->capture_default_str()->needs(series);
+    with_default(experiment, name, value, help)->needs(series);
   };
   plan_option("--offsets", o.plan.offsets_V, "series: offsets of the centre experiments [V]");
   plan_option("--offset-amplitude", o.plan.offset_amplitude_V, "series: their amplitude [V]");
@@ -366,20 +369,15 @@ int run(int argc, char** argv) {
         o.ack.wait = false;
       },
       "Send and return at once (without it: wait for the compensator to confirm; a series is followed to its end)");
-  experiment->add_option("--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")
-      ->capture_default_str()
-      ->needs(series);
+  with_default(experiment, "--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")->needs(series);
 
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
   trajectory->add_option("--shape", o.trajectory.shape, trajectory_shape_choices());
-  trajectory->add_option("--amplitude", o.trajectory.amplitude_m, "Peak amplitude [m] (may be negative)")
-      ->capture_default_str();
-  trajectory->add_option("--frequency", o.trajectory.frequency_Hz, "Frequency [Hz] of the periodic shapes")
-      ->capture_default_str();
-  trajectory->add_option("--offset", o.trajectory.offset_m, "Offset [m]")->capture_default_str();
-  trajectory->add_option("--phase", o.trajectory.phase_rad, "Phase [rad]")->capture_default_str();
-  trajectory->add_option("--blend", o.trajectory.blend_s, "Fade-in from the current reference [s]")
-      ->capture_default_str();
+  with_default(trajectory, "--amplitude", o.trajectory.amplitude_m, "Peak amplitude [m] (may be negative)");
+  with_default(trajectory, "--frequency", o.trajectory.frequency_Hz, "Frequency [Hz] of the periodic shapes");
+  with_default(trajectory, "--offset", o.trajectory.offset_m, "Offset [m]");
+  with_default(trajectory, "--phase", o.trajectory.phase_rad, "Phase [rad]");
+  with_default(trajectory, "--blend", o.trajectory.blend_s, "Fade-in from the current reference [s]");
   trajectory->add_option("--points-csv", o.points_csv,
                          "points: CSV of t_s,y_m rows (times from the start, increasing)");
   trajectory->add_flag("--mem-paper", o.mem_paper, "The MEM paper's y_d = -1.6 um cos(2 pi t) (with --blend)")
@@ -395,34 +393,29 @@ int run(int argc, char** argv) {
   auto* no_wait = trajectory->add_flag(
       "--no-wait", [&](std::int64_t) { o.verdict.wait = false; },
       "Send and return at once, without waiting for the compensator's verdict");
-  trajectory->add_option("--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
-      ->capture_default_str()
+  with_default(trajectory, "--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
       ->excludes(no_wait);
-  trajectory->add_option("--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS")
-      ->capture_default_str();
+  with_default(trajectory, "--compensator", o.verdict.compensator_process,
+               "Process name of the compensator in HX_STATUS");
 
   CLI::App* params = app.add_subcommand("params", "Send a MEM parameter set (HX_PARAMS, valid, source hystloop-ctl)");
   params->add_option("--c1", o.params.c1, "Slope at a branch point [m/V], > 0")->required();
   params->add_option("--c2", o.params.c2, "Growth of the slope [m/V^(1+c3)], >= 0")->required();
   params->add_option("--c3", o.params.c3, "Exponent [-], in (0, 50]")->required();
-  params->add_option("--residual", o.params.residual_m, "Fit residual to report [m], >= 0")->capture_default_str();
+  with_default(params, "--residual", o.params.residual_m, "Fit residual to report [m], >= 0");
   params->add_option("--version", o.params_version,
                      "Version (default: 1 + the highest seen on HX_PARAMS/HX_COMMAND within --listen); each run "
                      "publishes with a new publisher id, so the compensator takes it whatever others sent");
-  params->add_option("--listen", o.params_listen_s, "How long to look for the version in use [s]")
-      ->capture_default_str();
-  params->add_option("--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS")
-      ->capture_default_str();
+  with_default(params, "--listen", o.params_listen_s, "How long to look for the version in use [s]");
+  with_default(params, "--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS");
   add_wait_options(params, o);
 
   CLI::App* watch = app.add_subcommand("watch",
                                        "Print the tracking error (from HX_SENSOR), params version, late "
                                        "commands and the bridge's lowest buffer depth once a second");
   watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
-  watch->add_option("--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS")
-      ->capture_default_str();
-  watch->add_option("--compensator", o.watch.compensator_process, "Process name of the compensator in HX_STATUS")
-      ->capture_default_str();
+  with_default(watch, "--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS");
+  with_default(watch, "--compensator", o.watch.compensator_process, "Process name of the compensator in HX_STATUS");
 
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
 
