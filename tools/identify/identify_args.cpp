@@ -54,7 +54,7 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   auto* logs = app.add_option_group("LCM logs", "reading HX_SENSOR from LCM event logs");
   logs->add_flag("--log", args.log,
                  "read the files as LCM event logs whatever their names (default: by the .lcmlog ending)");
-  logs->add_option("--rig", args.rig,
+  logs->add_option("--rig", args.link.rig,
                    "rig channel prefix: samples from <rig>SENSOR; --publish to <rig>MODEL or <rig>PARAMS")
       ->capture_default_str();
   logs->add_option("--dt", args.dt_s, "tick period [s]: t = (seq - first seq) * dt")->capture_default_str();
@@ -67,7 +67,7 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "fit only this experiment the loop ran (numbered from 0 as listed; e.g. the one hystloop-ctl "
                    "experiment --mem-paper ran). A log with several experiments needs it (or --from/--to): "
                    "without, they are listed and the exit status is 2");
-  logs->add_option("--compensator", args.compensator,
+  logs->add_option("--compensator", args.link.compensator,
                    "process name of the compensator: whose HX_CONTROL experiment requests count, and whose "
                    "HX_STATUS says whether a published set was adopted")
       ->capture_default_str();
@@ -95,11 +95,12 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                   "set's version in use [s] (default 5); exit 1 if it does not")
       ->check(CLI::Range(0.0, 600.0));
   pub->add_flag("--no-wait", args.no_wait, "publish and exit 0 without waiting for the set to be adopted");
-  pub->add_option("--version", args.version,
+  pub->add_option("--version", args.link.version,
                   "parameter set version (default: 1 + the highest heard on <rig>PARAMS / <rig>COMMAND, at least 2)");
-  pub->add_option("--listen-s", args.listen_s, "how long to listen for the version in use [s]")->capture_default_str();
-  pub->add_option("--lcm-url", args.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
-  pub->add_flag("--allow-network", args.allow_network,
+  pub->add_option("--listen-s", args.link.listen_s, "how long to listen for the version in use [s]")
+      ->capture_default_str();
+  pub->add_option("--lcm-url", args.link.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
+  pub->add_flag("--allow-network", args.link.allow_network,
                 "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
   pub->add_option("--key-file", args.key_file, "the rig key (auth.key_file of the services): sign the published set");
   auto* bounds = app.add_option_group("bounds", "memory and progress of long fits");

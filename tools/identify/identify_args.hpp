@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "models/model_set.hpp"
+#include "params_publish.hpp"
 #include "sample_budget.hpp"
 
 namespace hystloop {
@@ -40,24 +41,19 @@ struct IdentifyArgs {
   // LCM logs
   bool log = false;
   bool from_logs = false;  // by check_identify_args: --log, or every file named *.lcmlog
-  std::string rig = "HX_";
   double dt_s = 1e-4;
   std::string time_from = "seq";
   std::optional<double> from_s, to_s;
-  std::string compensator = "compensator";
   std::optional<std::size_t> experiment;
   double max_late = 0.02;
   double max_missing = 0.01;
-  // --publish
+  // --publish; its rig prefix and compensator name also say whose channels a log is read from
   bool publish = false;
-  std::optional<std::int32_t> version;
-  double listen_s = 0.5;
-  std::string lcm_url;
-  bool allow_network = false;
-  std::string key_file;            // the rig key: sign the set (README "Authenticated rig")
-  std::string publish_on;          // "params" (MEM on HX_PARAMS) or "model" (HX_MODEL); empty: by the model
-  bool publish_on_params = false;  // by check_identify_args
-  std::optional<double> timeout_s;
+  PublishOptions link{};
+  std::string key_file;             // the rig key: sign the set (README "Authenticated rig")
+  std::string publish_on;           // "params" (MEM on HX_PARAMS) or "model" (HX_MODEL); empty: by the model
+  bool publish_on_params = false;   // by check_identify_args
+  std::optional<double> timeout_s;  // link.timeout_s when given
   bool no_wait = false;
   // bounds
   std::size_t max_samples = kDefaultMaxSamples;

@@ -204,13 +204,13 @@ int fit_auto(const Run& run, const SampleTable& s, Fitted& out) {
 }
 
 std::int32_t version_to_publish(ParamsLink& link, const IdentifyArgs& args) {
-  if (args.version) return *args.version;
+  if (args.link.version) return *args.link.version;
   const std::int32_t heard = link.highest_version_heard();
   if (heard > 0) {
     std::printf("version in use on %s: %d\n", link.channels().prefix.c_str(), heard);
   } else {
     std::printf("no parameter version heard on %s/%s/%s in %.2g s\n", link.channels().params.c_str(),
-                link.channels().model.c_str(), link.channels().command.c_str(), args.listen_s);
+                link.channels().model.c_str(), link.channels().command.c_str(), args.link.listen_s);
   }
   return next_params_version(heard);
 }
@@ -292,21 +292,19 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
     const auto& p = r.points[i];
     if (!p.used) {
       std::printf("%10zu  skipped: %s\n", i, p.note.c_str());
-    } else if (p.magnitude_experiment) {
-      if (r.stage_identified) {
-        std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  h = %.5g\n", i, p.offset_V, p.amplitude_V,
-                    p.frequency_Hz, p.magnitude);
-      } else {  // h needs the stage fit: the first harmonic of y as measured
-        std::printf("%10zu  %10.3f  %13.3f  %14.3f  magnitude  y1 = %.5g nm\n", i, p.offset_V, p.amplitude_V,
-                    p.frequency_Hz, p.response_m * 1e9);
-      }
-    } else {
-      std::printf("%10zu  %10.3f  %13.3f  %14.3f  loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V", i,
-                  p.offset_V, p.amplitude_V, p.frequency_Hz, p.features.y_centre * 1e9, p.features.slope * 1e9,
-                  p.features.area * 1e9);
-      if (p.area_fitted && p.lag_area != 0.0) std::printf(" %+.3g for the lag", p.lag_area * 1e9);
-      std::printf("\n");
+      continue;
     }
+    std::printf("%10zu  %10.3f  %13.3f  %14.3f  ", i, p.offset_V, p.amplitude_V, p.frequency_Hz);
+    if (p.magnitude_experiment && r.stage_identified) {
+      std::printf("magnitude  h = %.5g", p.magnitude);
+    } else if (p.magnitude_experiment) {  // h needs the stage fit: the first harmonic of y as measured
+      std::printf("magnitude  y1 = %.5g nm", p.response_m * 1e9);
+    } else {
+      std::printf("loop       centre %.5g nm, slope %.5g nm/V, area %.5g nm V", p.features.y_centre * 1e9,
+                  p.features.slope * 1e9, p.features.area * 1e9);
+      if (p.area_fitted && p.lag_area != 0.0) std::printf(" %+.3g for the lag", p.lag_area * 1e9);
+    }
+    std::printf("\n");
   }
   if (!r.ok()) return refuse(r.status, r.reason);
   std::printf("Banning: a = %.6g m/V, b = %.6g m/V, alpha = %.6g 1/V\n", r.hysteresis.a, r.hysteresis.b,
@@ -342,10 +340,10 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
 
 ExperimentLogOptions experiment_options(const IdentifyArgs& args) {
   ExperimentLogOptions o;
-  o.control_channel = channel_name(args.rig, kControlSuffix);
-  o.command_channel = channel_name(args.rig, kCommandSuffix);
-  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
-  o.compensator_process = args.compensator;
+  o.control_channel = channel_name(args.link.rig, kControlSuffix);
+  o.command_channel = channel_name(args.link.rig, kCommandSuffix);
+  o.sensor_channel = channel_name(args.link.rig, kSensorSuffix);
+  o.compensator_process = args.link.compensator;
   o.dt_s = args.dt_s;
   o.max_not_as_commanded = args.max_late;
   o.max_missing = args.max_missing;
@@ -424,7 +422,7 @@ std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
     return tables;
   }
   LogReadOptions o;
-  o.sensor_channel = channel_name(args.rig, kSensorSuffix);
+  o.sensor_channel = channel_name(args.link.rig, kSensorSuffix);
   o.time_base = args.time_from == "utime" ? LogTimeBase::utime : LogTimeBase::seq;
   o.dt_s = args.dt_s;
   o.from_s = args.from_s;
@@ -492,17 +490,11 @@ int fit_inputs(const IdentifyArgs& args) {
   std::unique_ptr<ParamsLink> link;
   if (args.publish) {
     if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));
-    PublishOptions p;
-    p.lcm_url = args.lcm_url;
-    p.allow_network = args.allow_network;
-    p.rig = args.rig;
-    p.version = args.version;
-    p.listen_s = args.listen_s;
-    p.compensator = args.compensator;
+    PublishOptions p = args.link;
     if (args.timeout_s) p.timeout_s = *args.timeout_s;
     link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
   } else {
-    validate_rig_prefix(args.rig);
+    validate_rig_prefix(args.link.rig);
   }
   if (args.from_logs && args.choice.mode == ModelChoice::Mode::banning) return fit_banning_logs(args);
   std::vector<SampleTable> tables = read_inputs(args, args.from_logs);
