@@ -265,8 +265,7 @@ int BridgeService::run() {
   if (last == nullptr) last = rt_.reports().take();
   if (last != nullptr) {
     report(*last, wall_utime(), true);
-    log_summary(*last, safe);
-    if (!summary_json_path_.empty()) write_summary_json(*last, safe);
+    summarize(*last, safe);
   }
   return lcm_errors_ > 0 || !safe.reached ? 1 : 0;
 }
@@ -364,9 +363,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   previous_repaired_ = sensor_ticks_repaired_;
   previous_unpublished_ = sensor_ticks_unpublished_;
   health.clamped_last_second = rt.clamped_last_second;
-  const BridgeHealth assessed = assess_bridge_health(health);
-  const std::int8_t state = assessed.state;
-  std::string detail = assessed.detail;
+  auto [state, detail] = assess_bridge_health(health);
   if (rt.armed) safe_reason_ = "not armed";  // the next safe state says its own reason
   detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
                         detail.empty() ? "" : "; ", rt_.backend().name(), rt.u_applied_V, rt.gain_scale,
@@ -407,14 +404,16 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   latency_.reset();
 }
 
-void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) const {
+// The run's figures at exit: the log's summary lines and, with --summary-json, the file.
+void BridgeService::summarize(const RtReport& rt, const SafeStopResult& safe) const {
   const BridgeCounters& c = rt.core;
   const double armed_ticks = static_cast<double>(c.applied + c.late);
+  const double late_fraction = armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0;
+  const CounterSet::Entries entries = counter_entries(rt);
   std::string counts;  // under their HX_STATUS names
-  for (const auto& [name, value] : counter_entries(rt)) counts += fmt::format(", {} {}", name, value);
+  for (const auto& [name, value] : entries) counts += fmt::format(", {} {}", name, value);
   spdlog::info("summary: late {:.3g} % of armed ticks, lowest buffer depth {} ticks, {} command blocks rejected{}",
-               armed_ticks > 0 ? 100.0 * static_cast<double>(c.late) / armed_ticks : 0.0, rt.min_depth_total,
-               commands_.counters().rejected_total(), counts);
+               100.0 * late_fraction, rt.min_depth_total, commands_.counters().rejected_total(), counts);
   if (latency_total_.count() > 0) {
     spdlog::info(
         "summary: sensor block sent -> its answer received p50 {:.1f} us, p99 {:.1f} us, max {:.1f} us over {} "
@@ -427,20 +426,17 @@ void BridgeService::log_summary(const RtReport& rt, const SafeStopResult& safe) 
       "bound {} s)",
       safe.reached ? "ramped" : "ramp NOT finished", safe.u_start_V, settings_.limits.safe_u_V, safe.ramp_ticks,
       safe.ramp_s, safe.wall_s, settings_.stop_ramp_timeout_s);
-}
+  if (summary_json_path_.empty()) return;
 
-void BridgeService::write_summary_json(const RtReport& rt, const SafeStopResult& safe) const {
-  const BridgeCounters& c = rt.core;
-  const double armed_ticks = static_cast<double>(c.applied + c.late);
   const double wall_s = monotonic_s() - started_s_;
   const ResourceUsage usage = read_resource_usage();
   const double cpu_s = usage.user_cpu_s + usage.system_cpu_s;
   // Every HX_STATUS counter under its name (counter_entries()), then the figures derived from them.
   nlohmann::ordered_json json;
-  for (const auto& [name, value] : counter_entries(rt)) json[name] = value;
+  for (const auto& [name, value] : entries) json[name] = value;
   json["armed_ticks"] = static_cast<std::uint64_t>(armed_ticks);
   json["late_ticks"] = c.late;
-  json["late_tick_fraction"] = armed_ticks > 0 ? static_cast<double>(c.late) / armed_ticks : 0.0;
+  json["late_tick_fraction"] = late_fraction;
   json["buffer_min_depth_ticks"] = rt.min_depth_total;
   json["rejected"] = c.rejected_nonfinite + c.rejected_future;
   json["block_to_answer_us"] = latency_summary_us(latency_total_);

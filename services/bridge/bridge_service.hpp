@@ -60,8 +60,7 @@ class BridgeService {
   CounterSet::Entries counter_entries(const RtReport& rt) const;
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
   void log_safe_stop(const SafeStopResult& safe) const;
-  void log_summary(const RtReport& rt, const SafeStopResult& safe) const;
-  void write_summary_json(const RtReport& rt, const SafeStopResult& safe) const;
+  void summarize(const RtReport& rt, const SafeStopResult& safe) const;
 
   BridgeSettings settings_;
   lcm::LCM& lcm_;
