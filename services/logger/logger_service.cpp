@@ -160,12 +160,11 @@ std::string LoggerService::fault_detail(const DiskFaults& f) {
   std::string detail;
   const std::string file = escape_wire(files_->current_file().filename().string());
   if (!f.writing || f.errors > seen_faults_.errors) {
-    detail = "FAULT: " + f.reason() + "; " + std::to_string(f.events_lost) + " events not written so far";
-    if (!f.writing)
-      detail += ", retrying in a new file every " + fmt::format("{}", LogFileSet::kRetryInterval_s) + " s";
+    detail = fmt::format("FAULT: {}; {} events not written so far", f.reason(), f.events_lost);
+    if (!f.writing) detail += fmt::format(", retrying in a new file every {} s", LogFileSet::kRetryInterval_s);
   } else if (!seen_faults_.writing) {
-    detail = "recovered from the disk fault: writing again to " + file + " after " + std::to_string(f.events_lost) +
-             " events not written";
+    detail = fmt::format("recovered from the disk fault: writing again to {} after {} events not written", file,
+                         f.events_lost);
   }
   if (!seen_faults_.writing && f.writing && f.recoveries > seen_faults_.recoveries) {
     spdlog::warn("disk: writing again to {} ({} events not written during the fault)", file, f.events_lost);
@@ -185,10 +184,9 @@ std::string LoggerService::unknown_channels_detail() {
   if (u.messages() <= seen_unrecorded_) return {};
   std::string names;
   for (std::size_t i = 0; i < u.kept_count(); ++i) names += (i ? ", '" : "'") + escape_wire(u.kept_name(i)) + "'";
-  const std::string distinct = (u.distinct_is_lower_bound() ? ">= " : "") + std::to_string(u.distinct());
-  std::string detail = "not recorded: " + std::to_string(u.messages() - seen_unrecorded_) + " message(s) on " +
-                       distinct + " channel(s) beyond the table's " + std::to_string(ChannelTable::kMaxChannels) +
-                       " (first: " + names + ")";
+  std::string detail = fmt::format("not recorded: {} message(s) on {}{} channel(s) beyond the table's {} (first: {})",
+                                   u.messages() - seen_unrecorded_, u.distinct_is_lower_bound() ? ">= " : "",
+                                   u.distinct(), ChannelTable::kMaxChannels, names);
   if (u.distinct() > seen_unknown_names_) {
     if (const LogLimiter::Gate g = slow_log_.allow(kLogUnknownChannels, monotonic_ns())) {
       spdlog::warn("{}{}", detail, suppressed_note(g));
