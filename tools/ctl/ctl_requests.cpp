@@ -12,6 +12,7 @@
 #include "loop/compensator.hpp"
 #include "loop/feedback.hpp"
 #include "loop/params_admission.hpp"
+#include "models/mem.hpp"
 
 namespace hystloop::ctl {
 
@@ -205,10 +206,8 @@ trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t vers
 }
 
 void ParamsRequest::validate() const {
-  require_positive("c1", c1);
-  require_in_range("c1", c1, 0.0, 1.0);
-  require_non_negative("c2", c2);
-  require_positive("c3", c3);
+  MemParams{c1, c2, c3}.validate();      // the MEM's own domain, naming c1, c2, c3
+  require_in_range("c1", c1, 0.0, 1.0);  // and the contract's sanity bounds
   require_in_range("c3", c3, 0.0, 50.0);
   require_in_range("residual", residual_m, 0.0, kMaxAbsPosition_m);
   if (version < 1) throw ParameterError("version", "must be >= 1 (got " + std::to_string(version) + ")");
