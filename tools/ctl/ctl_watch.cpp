@@ -11,43 +11,32 @@
 
 namespace hystloop::ctl {
 
-void WatchSecond::add_error(double e_m) noexcept {
-  ++tracking;
+void ErrorStats::add(double e_m) noexcept {
+  ++count;
   sum_sq_m2 += e_m * e_m;
   max_abs_m = std::max(max_abs_m, std::abs(e_m));
+}
+
+std::optional<double> ErrorStats::rms_m() const noexcept {
+  if (count == 0) return std::nullopt;
+  return std::sqrt(sum_sq_m2 / static_cast<double>(count));
 }
 
 void WatchSecond::add_sensor_block(const sensor_block_t& block) noexcept {
   bool armed = true;
   for_each_tick(block, [&](const SensorTick& t) {
     ++samples;
-    if (std::isfinite(t.y_ref_m)) add_error(t.y_ref_m - t.y_m);
+    if (std::isfinite(t.y_ref_m)) error.add(t.y_ref_m - t.y_m);
     armed = armed && (t.flags & sensor_block_t::SAFE_STATE) == 0;
   });
   if (armed) buffer_min_ticks = std::min(buffer_min_ticks.value_or(block.buffer_depth_ticks), block.buffer_depth_ticks);
-}
-
-void WatchSecond::add_true_error(double e_m) noexcept {
-  ++true_tracking;
-  true_sum_sq_m2 += e_m * e_m;
-  true_max_abs_m = std::max(true_max_abs_m, std::abs(e_m));
-}
-
-std::optional<double> WatchSecond::rms_m() const noexcept {
-  if (tracking == 0) return std::nullopt;
-  return std::sqrt(sum_sq_m2 / static_cast<double>(tracking));
-}
-
-std::optional<double> WatchSecond::true_rms_m() const noexcept {
-  if (true_tracking == 0) return std::nullopt;
-  return std::sqrt(true_sum_sq_m2 / static_cast<double>(true_tracking));
 }
 
 void TruthPairing::pair(const std::vector<double>& y_ref, const std::vector<double>& y_true,
                         WatchSecond& into) noexcept {
   if (y_ref.size() != y_true.size()) return;  // not the same block after all
   for (std::size_t i = 0; i < y_ref.size(); ++i) {
-    if (std::isfinite(y_ref[i]) && std::isfinite(y_true[i])) into.add_true_error(y_ref[i] - y_true[i]);
+    if (std::isfinite(y_ref[i]) && std::isfinite(y_true[i])) into.true_error.add(y_ref[i] - y_true[i]);
   }
 }
 
@@ -81,15 +70,15 @@ std::optional<double> learning_rms_nm(const service_status_t& compensator) {
 
 std::string format_watch_line(const WatchLine& l) {
   std::string out = fmt::format("{:5.0f} s", l.elapsed_s);
-  if (const auto rms = l.second.rms_m()) {
-    out += fmt::format("  rms {:7.1f} nm  max {:7.1f} nm", *rms * 1e9, l.second.max_abs_m * 1e9);
+  if (const auto rms = l.second.error.rms_m()) {
+    out += fmt::format("  rms {:7.1f} nm  max {:7.1f} nm", *rms * 1e9, l.second.error.max_abs_m * 1e9);
   } else {
     out += fmt::format("  rms {:>7} nm  max {:>7} nm", "--", "--");
   }
-  if (const auto true_rms = l.second.true_rms_m()) {
-    out += fmt::format("  true {:.2f} nm max {:.1f} nm", *true_rms * 1e9, l.second.true_max_abs_m * 1e9);
+  if (const auto true_rms = l.second.true_error.rms_m()) {
+    out += fmt::format("  true {:.2f} nm max {:.1f} nm", *true_rms * 1e9, l.second.true_error.max_abs_m * 1e9);
   }
-  out += fmt::format("  ticks {:6}/{}", l.second.tracking, l.second.samples);
+  out += fmt::format("  ticks {:6}/{}", l.second.error.count, l.second.samples);
   out += l.params_in_use ? "  params v" + std::to_string(*l.params_in_use) : std::string("  params --");
   if (l.params_latest && l.params_latest != l.params_in_use)
     out += " (v" + std::to_string(*l.params_latest) + " published)";

@@ -17,25 +17,27 @@
 
 namespace hystloop::ctl {
 
-// What one second of watching saw.
-struct WatchSecond {
-  std::uint64_t samples = 0;   // sensor ticks
-  std::uint64_t commands = 0;  // command ticks
-  std::uint64_t tracking = 0;  // sensor ticks with a reference
+// Tracking errors: how many, the sum of their squares, the largest magnitude.
+struct ErrorStats {
+  std::uint64_t count = 0;
   double sum_sq_m2 = 0.0;
   double max_abs_m = 0.0;
-  std::optional<std::int32_t> buffer_min_ticks;  // lowest buffer depth of an armed sensor block
-  std::uint64_t true_tracking = 0;               // ticks with a reference and their true position
-  double true_sum_sq_m2 = 0.0;
-  double true_max_abs_m = 0.0;
 
-  void add_error(double e_m) noexcept;
-  void add_true_error(double e_m) noexcept;
+  void add(double e_m) noexcept;
+  std::optional<double> rms_m() const noexcept;  // none without an error
+};
+
+// What one second of watching saw.
+struct WatchSecond {
+  std::uint64_t samples = 0;                     // sensor ticks
+  std::uint64_t commands = 0;                    // command ticks
+  ErrorStats error;                              // y_ref - y of the sensor ticks with a reference
+  ErrorStats true_error;                         // y_ref - y_true of those with their true position too
+  std::optional<std::int32_t> buffer_min_ticks;  // lowest buffer depth of an armed sensor block
+
   // Every tick of the block (its error where it has a reference), and its buffer depth when no
   // tick is SAFE_STATE. Allocation-free.
   void add_sensor_block(const sensor_block_t& block) noexcept;
-  std::optional<double> rms_m() const noexcept;
-  std::optional<double> true_rms_m() const noexcept;
 };
 
 // Pairs each HX_SIM_TRUTH block with the HX_SENSOR block of the same seq, in either arrival

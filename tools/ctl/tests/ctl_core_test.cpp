@@ -329,11 +329,11 @@ TEST(CtlWatch, SensorBlocksGiveTheExactRmsAndTheLowestArmedBufferDepth) {
     second.add_sensor_block(b);
   }
   EXPECT_EQ(second.samples, static_cast<std::uint64_t>(kBlocks * kBlockTicks));
-  ASSERT_EQ(second.tracking, tracking);
-  EXPECT_NEAR(*second.rms_m(), std::sqrt(sum / static_cast<double>(tracking)), 1e-15);
-  EXPECT_NEAR(second.max_abs_m, max_abs, 1e-18);
+  ASSERT_EQ(second.error.count, tracking);
+  EXPECT_NEAR(*second.error.rms_m(), std::sqrt(sum / static_cast<double>(tracking)), 1e-15);
+  EXPECT_NEAR(second.error.max_abs_m, max_abs, 1e-18);
   EXPECT_EQ(*second.buffer_min_ticks, 100);  // block 3's 0 was in the safe state
-  EXPECT_FALSE(WatchSecond{}.rms_m());
+  EXPECT_FALSE(WatchSecond{}.error.rms_m());
   EXPECT_FALSE(WatchSecond{}.buffer_min_ticks);
 }
 
@@ -365,33 +365,33 @@ TEST(CtlWatch, TruthBlocksPairWithTheirSensorBlocksInEitherOrder) {
   pairing.add_sensor_block(sensor(0), second);
   pairing.add_truth_block(truth(0, 1e-9), second);  // after its sensor block
   pairing.add_truth_block(truth(4, 3e-9), second);  // before it
-  EXPECT_EQ(second.true_tracking, 3u);
+  EXPECT_EQ(second.true_error.count, 3u);
   pairing.add_sensor_block(sensor(4), second);
   pairing.add_sensor_block(sensor(8), second);       // its truth was lost
   pairing.add_truth_block(truth(12, 1e-9), second);  // its sensor block was lost
-  ASSERT_EQ(second.true_tracking, 6u);
-  EXPECT_NEAR(*second.true_rms_m(), std::sqrt((3 * 1e-18 + 3 * 9e-18) / 6), 1e-18);
-  EXPECT_NEAR(second.true_max_abs_m, 3e-9, 1e-21);
+  ASSERT_EQ(second.true_error.count, 6u);
+  EXPECT_NEAR(*second.true_error.rms_m(), std::sqrt((3 * 1e-18 + 3 * 9e-18) / 6), 1e-18);
+  EXPECT_NEAR(second.true_error.max_abs_m, 3e-9, 1e-21);
   sim_truth_t short_block = truth(16, 1e-9);
   short_block.y_true_m.pop_back();
   short_block.n_ticks = kBlockTicks - 1;
   pairing.add_sensor_block(sensor(16), second);
   pairing.add_truth_block(short_block, second);  // not the same ticks: not paired
-  EXPECT_EQ(second.true_tracking, 6u);
+  EXPECT_EQ(second.true_error.count, 6u);
   // Far more unpaired blocks than it keeps: the oldest go, the newest still pair.
   for (std::int64_t n = 0; n < 1000; ++n) pairing.add_sensor_block(sensor(100 + n * kBlockTicks), second);
   pairing.add_truth_block(truth(100 + 999 * kBlockTicks, 1e-9), second);
   pairing.add_truth_block(truth(100, 1e-9), second);
-  EXPECT_EQ(second.true_tracking, 9u);
-  EXPECT_FALSE(WatchSecond{}.true_rms_m());
+  EXPECT_EQ(second.true_error.count, 9u);
+  EXPECT_FALSE(WatchSecond{}.true_error.rms_m());
 }
 
 TEST(CtlWatch, LineIsTidy) {
   WatchLine l;
   l.elapsed_s = 12;
   l.second.samples = 10000;
-  l.second.add_error(27.9e-9);
-  l.second.add_error(-27.9e-9);
+  l.second.error.add(27.9e-9);
+  l.second.error.add(-27.9e-9);
   l.params_in_use = 3;
   l.params_latest = 4;
   l.late_total = 5;
@@ -403,8 +403,8 @@ TEST(CtlWatch, LineIsTidy) {
             "   12 s  rms    27.9 nm  max    27.9 nm  ticks      2/10000  params v3 (v4 published)  late 5 (+1)  "
             "clamped 14/s  buf min 212  bridge HEALTHY");
   WatchLine with_truth = l;
-  with_truth.second.add_true_error(0.55e-9);
-  with_truth.second.add_true_error(-3.1e-9);
+  with_truth.second.true_error.add(0.55e-9);
+  with_truth.second.true_error.add(-3.1e-9);
   EXPECT_NE(format_watch_line(with_truth).find("max    27.9 nm  true 2.23 nm max 3.1 nm  ticks      2/10000"),
             std::string::npos)
       << format_watch_line(with_truth);
