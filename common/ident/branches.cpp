@@ -3,32 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "models/reversal_detector.hpp"
+
 namespace hystloop {
 
 std::vector<std::size_t> find_reversals(std::span<const double> u, double dead_band_V) {
   std::vector<std::size_t> reversals;
   if (u.empty()) return reversals;
-  const double band = std::max(dead_band_V, 0.0);
-  int direction = 0;
-  std::size_t extremum = 0;
+  ReversalDetector detector(std::max(dead_band_V, 0.0));
+  detector.reset(u[0]);
+  std::size_t extremum = 0;  // the sample at detector.extremum()
   for (std::size_t k = 1; k < u.size(); ++k) {
-    const double x = u[k];
-    if (direction == 0) {
-      if (x - u[extremum] > band)
-        direction = +1, extremum = k;
-      else if (u[extremum] - x > band)
-        direction = -1, extremum = k;
-    } else if (direction > 0) {
-      if (x > u[extremum])
-        extremum = k;
-      else if (u[extremum] - x > band)
-        reversals.push_back(extremum), direction = -1, extremum = k;
-    } else {
-      if (x < u[extremum])
-        extremum = k;
-      else if (x - u[extremum] > band)
-        reversals.push_back(extremum), direction = +1, extremum = k;
-    }
+    const ReversalDetector::Event event = detector.update(u[k]);
+    if (event == ReversalDetector::Event::kReversal) reversals.push_back(extremum);
+    if (event != ReversalDetector::Event::kNone) extremum = k;
   }
   return reversals;
 }

@@ -21,7 +21,7 @@ struct BranchSegment {
   std::size_t size() const noexcept { return end - begin; }
 };
 
-// Reversal indices (extrema) of u in order.
+// Reversal indices (extrema) of u in order, by ReversalDetector's rule (models/reversal_detector.hpp).
 std::vector<std::size_t> find_reversals(std::span<const double> u, double dead_band_V = 0.0);
 
 // Branches [reversal_i, reversal_{i+1}) and the last one [reversal_last, n); the skeleton is dropped.
