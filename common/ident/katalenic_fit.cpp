@@ -40,11 +40,7 @@ struct Problem {
     p.k2_domain_min = -1e300;  // k2 constant: no schedule
     p.k2_domain_max = 1e300;
     p.output_shaping = ShapingFunction::make_linear(1.0);
-    KatalenicModel m(p);
-    m.reset(u[0]);
-    std::vector<double> z(u.size());
-    for (std::size_t k = 0; k < u.size(); ++k) z[k] = m.forward(u[k]);
-    return z;
+    return predict_katalenic(p, u);
   }
   // Least-squares shaping coefficients (in scaled columns) and the residual vector.
   Eigen::VectorXd project(const std::vector<double>& z, double* residuals) const {
@@ -85,6 +81,15 @@ double cost(const Problem& p, double k1, double k2) {
 }
 
 }  // namespace
+
+std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<const double> u) {
+  KatalenicModel m(params);
+  std::vector<double> out(u.size());
+  if (u.empty()) return out;
+  m.reset(u[0]);
+  for (std::size_t k = 0; k < u.size(); ++k) out[k] = m.forward(u[k]);
+  return out;
+}
 
 KatalenicFitResult fit_katalenic(std::span<const double> u, std::span<const double> y, const KatalenicFitOptions& o) {
   o.validate();

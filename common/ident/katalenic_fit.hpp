@@ -10,6 +10,7 @@
 
 #include <span>
 #include <string>
+#include <vector>
 
 #include "ident/fit_clock.hpp"
 #include "ident/fit_status.hpp"
@@ -33,5 +34,8 @@ struct KatalenicFitResult : FitOutcome {
 
 KatalenicFitResult fit_katalenic(std::span<const double> u_V, std::span<const double> y_m,
                                  const KatalenicFitOptions& options = {});
+
+// y [m] the operator with `params` gives for u, reset at u[0] (as the fit simulates it).
+std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<const double> u_V);
 
 }  // namespace hystloop

@@ -33,15 +33,6 @@ std::vector<double> predict_mem(const MemParams& params, std::span<const double>
   return out;
 }
 
-std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<const double> u) {
-  KatalenicModel m(params);
-  std::vector<double> out(u.size());
-  if (u.empty()) return out;
-  m.reset(u[0]);
-  for (std::size_t k = 0; k < u.size(); ++k) out[k] = m.forward(u[k]);
-  return out;
-}
-
 // Held-out RMS after removing the offset estimated on [train_begin, split).
 double holdout_rms(std::span<const double> y, const std::vector<double>& pred, std::size_t train_begin,
                    std::size_t split) {

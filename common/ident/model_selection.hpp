@@ -69,9 +69,8 @@ ModelParamSet fitted_set(const ModelSelection& sel, ModelKind kind, ModelParamSe
 std::vector<double> fitted_prediction(const ModelSelection& sel, ModelKind kind, std::span<const double> u_V,
                                       std::span<const double> y_m);
 
-// Simulations used for the scores (y [m] for every u sample).
+// MEM's simulation for the scores, y [m] for every u sample (PI's and Katalenic's are beside their fits).
 std::vector<double> predict_mem(const MemParams& params, std::span<const double> u_V, std::span<const double> y_m);
-std::vector<double> predict_katalenic(const KatalenicParams& params, std::span<const double> u_V);
 // The score: RMS of y - pred over [split, end) after removing their mean difference over
 // [train_begin, split) (select_model uses train_begin = the second reversal, split = split_index).
 double holdout_rms(std::span<const double> y_m, const std::vector<double>& pred, std::size_t train_begin,
