@@ -357,17 +357,6 @@ LoggedExperiments read_experiments(const IdentifyArgs& args) {
   return logged;
 }
 
-struct SampleBudgetError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// A log whose record holds several experiments, none chosen: one fit over all of them mixes
-// loops of different amplitudes and offsets (and the settling between) into a model that fits
-// none (on the demo's log MEM's c3 lands on its search bound). Lists them and says how to pick.
-struct SeveralExperiments : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 // The experiments the loop ran that the log lists, when it holds at least `min_requests` requests
 // (the cheap look first) and one of them ran; none otherwise (the record is fitted as it is).
 LoggedExperiments experiments_in_log(const IdentifyArgs& args, std::size_t min_requests) {
@@ -380,12 +369,15 @@ LoggedExperiments experiments_in_log(const IdentifyArgs& args, std::size_t min_r
   }
 }
 
+// A log whose record holds several experiments, none chosen: one fit over all of them mixes
+// loops of different amplitudes and offsets (and the settling between) into a model that fits
+// none (on the demo's log MEM's c3 lands on its search bound). Lists them and says how to pick.
 void throw_if_several_experiments(const IdentifyArgs& args) {
   const LoggedExperiments logged = experiments_in_log(args, 2);
   const std::size_t n = logged.experiments.size();
   if (n < 2) return;
   const std::string where = args.files.size() == 1 ? args.files.front() : "the log";
-  throw SeveralExperiments(where + " holds " + std::to_string(n) +
+  throw std::runtime_error(where + " holds " + std::to_string(n) +
                            " experiments the loop ran; fit one with --experiment N (N as listed), or a time range "
                            "with --from S --to S (--model banning fits a series of them):\n" +
                            list_experiments(logged, experiment_options(args)));
@@ -407,7 +399,7 @@ void note_experiments_in_whole_log(const IdentifyArgs& args) {
 }
 
 // Reads every input file: all CSV, or all LCM logs (one record). Throws CsvError /
-// SampleLogError / SampleBudgetError.
+// SampleLogError, or std::runtime_error for a CSV over the sample budget.
 std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
   const ProgressStage stage("reading " + std::to_string(args.files.size()) + " file(s)");
   std::vector<SampleTable> tables;
@@ -416,7 +408,7 @@ std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
     std::size_t rows = 0;
     for (const auto& f : args.files) rows += count_csv_rows(f);
     if (auto why = over_sample_budget((rows + args.decimate - 1) / args.decimate, args.max_samples, args.decimate)) {
-      throw SampleBudgetError(*why);
+      throw std::runtime_error(*why);
     }
     for (const auto& f : args.files) tables.push_back(read_sample_csv(f));
     return tables;
@@ -532,7 +524,7 @@ int run_identify(const IdentifyArgs& args) {
   } reset;
   try {
     return fit_inputs(args);
-  } catch (const std::runtime_error& e) {  // CsvError, SampleLogError, the budget, several experiments, LCM
+  } catch (const std::runtime_error& e) {  // CsvError, SampleLogError, the budget, several experiments, LCM setup
     return usage_error(e.what());
   } catch (const ParameterError& e) {
     return usage_error(e.what());
