@@ -79,20 +79,14 @@ SafeStopResult BridgeRealtime::stop() {
 
 void BridgeRealtime::run() noexcept {
   // Set-up (may log through spdlog when refused; the loop below never does).
-  if (settings_.rt.cpu >= 0) {
-    try {
-      affinity_status_ = set_cpu_affinity({settings_.rt.cpu});
-    } catch (const std::exception& e) {
-      affinity_status_ = {false, e.what()};
-    }
-  } else {
-    affinity_status_ = {true, "not pinned"};
+  affinity_status_ = {true, "not pinned"};
+  try {
+    if (settings_.rt.cpu >= 0) affinity_status_ = set_cpu_affinity({settings_.rt.cpu});
+  } catch (const std::exception& e) {
+    affinity_status_ = {false, e.what()};
   }
-  if (settings_.rt.priority > 0) {
-    priority_status_ = set_realtime_priority(settings_.rt.priority);
-  } else {
-    priority_status_ = {true, "normal scheduling"};
-  }
+  priority_status_ =
+      settings_.rt.priority > 0 ? set_realtime_priority(settings_.rt.priority) : SetupStatus{true, "normal scheduling"};
   const std::int64_t per_wake = settings_.rt.ticks_per_wake;
   PeriodicTimer timer(period_ns_from_rate_hz(settings_.rate_hz) * per_wake);
   started_.store(true, std::memory_order_release);

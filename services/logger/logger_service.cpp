@@ -221,26 +221,20 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     const Seen now{c.dropped(), q.gap_events(), q.missing(), overlaps, q.resumes(), q.skipped(), q.violations()};
     Seen& before = seen_[i];
     const std::string_view name = c.name_view();
-    if (now.dropped > before.dropped) {
-      detail = append(detail, fmt::format("dropped {} on {}", now.dropped - before.dropped, name));
-    }
-    if (now.gap_events > before.gap_events) {
-      detail = append(detail, fmt::format("{} gap(s), {} ticks missing on {}", now.gap_events - before.gap_events,
-                                          now.missing - before.missing, name));
-    }
-    if (now.overlaps > before.overlaps) {
-      detail =
-          append(detail, fmt::format("{} overlapping/duplicate block(s) on {}", now.overlaps - before.overlaps, name));
-    }
-    if (now.resumes > before.resumes) {
-      detail = append(detail, fmt::format("{} resume(s) after silence, {} ticks skipped on {}",
-                                          now.resumes - before.resumes, now.skipped - before.skipped, name));
-    }
-    if (now.violations > before.violations) {
-      detail = append(detail, fmt::format("{} block(s) breaking the channel contract (seq or n_ticks out of range; "
-                                          "not checked for gaps) on {}",
-                                          now.violations - before.violations, name));
-    }
+    // What went wrong on the channel since the last report: "<what> on <channel>".
+    const auto say = [&](bool news, const std::string& what) {
+      if (news) detail = append(detail, what + " on " + std::string(name));
+    };
+    say(now.dropped > before.dropped, fmt::format("dropped {}", now.dropped - before.dropped));
+    say(now.gap_events > before.gap_events,
+        fmt::format("{} gap(s), {} ticks missing", now.gap_events - before.gap_events, now.missing - before.missing));
+    say(now.overlaps > before.overlaps,
+        fmt::format("{} overlapping/duplicate block(s)", now.overlaps - before.overlaps));
+    say(now.resumes > before.resumes, fmt::format("{} resume(s) after silence, {} ticks skipped",
+                                                  now.resumes - before.resumes, now.skipped - before.skipped));
+    say(now.violations > before.violations,
+        fmt::format("{} block(s) breaking the channel contract (seq or n_ticks out of range; not checked for gaps)",
+                    now.violations - before.violations));
     before = now;
   }
   if (other_dropped > seen_other_dropped_) {
