@@ -265,22 +265,6 @@ int finish(const Run& run, const SampleTable& s, const Fitted& f) {
   return publish_fitted(*run.link, run.args, f);
 }
 
-int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExperimentData>& data);
-
-int fit_banning_files(const IdentifyArgs& args, const std::vector<SampleTable>& tables) {
-  std::vector<SampleTable> groups;
-  for (const auto& t : tables) {
-    for (auto& g : split_experiments(t)) groups.push_back(std::move(g));
-  }
-  std::vector<BanningExperimentData> data;
-  for (const auto& g : groups) {
-    const double fs = sample_rate_Hz(g.t);
-    if (!(fs > 0.0)) return refuse(FitStatus::size_mismatch, "an experiment's t does not increase: no sample rate");
-    data.push_back({g.u, g.y, fs});
-  }
-  return fit_banning_and_emit(args, data);
-}
-
 int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExperimentData>& data) {
   BanningFitResult r;
   {
@@ -336,6 +320,20 @@ int fit_banning_and_emit(const IdentifyArgs& args, const std::vector<BanningExpe
     std::printf("plots: none for banning (its fit is on loop features of several experiments, not one record)\n");
   }
   return write_yaml(out, to_yaml(r.hysteresis, r.stage_identified ? &r.stage : nullptr));
+}
+
+int fit_banning_files(const IdentifyArgs& args, const std::vector<SampleTable>& tables) {
+  std::vector<SampleTable> groups;
+  for (const auto& t : tables) {
+    for (auto& g : split_experiments(t)) groups.push_back(std::move(g));
+  }
+  std::vector<BanningExperimentData> data;
+  for (const auto& g : groups) {
+    const double fs = sample_rate_Hz(g.t);
+    if (!(fs > 0.0)) return refuse(FitStatus::size_mismatch, "an experiment's t does not increase: no sample rate");
+    data.push_back({g.u, g.y, fs});
+  }
+  return fit_banning_and_emit(args, data);
 }
 
 ExperimentLogOptions experiment_options(const IdentifyArgs& args) {

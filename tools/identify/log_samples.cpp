@@ -22,12 +22,6 @@ std::string where(const std::string& file, std::int64_t eventnum) {
   return file + ": event " + std::to_string(eventnum);
 }
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // Folds the samples of a record into LogSamples, one at a time, in log order.
 class RecordBuilder {
  public:
@@ -39,8 +33,8 @@ class RecordBuilder {
     for_each_tick(block, [&](const SensorTick& s) {
       if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
       throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) +
-                           "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") + " is not finite (u_V = " + number(s.u_V) +
-                           ", y_m = " + number(s.y_m) + ")");
+                           "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") +
+                           " is not finite (u_V = " + short_number(s.u_V) + ", y_m = " + short_number(s.y_m) + ")");
     });
     if (check_message(block) != Verdict::kOk) return void(++out_.undecodable);
     out_.sensor_ticks += static_cast<std::size_t>(block.n_ticks);
@@ -110,7 +104,8 @@ void LogReadOptions::validate() const {
   if (to_s) {
     require_positive("to", *to_s);
     if (from_s && !(*to_s > *from_s)) {
-      throw ParameterError("to", "must be > from (got from " + number(*from_s) + ", to " + number(*to_s) + ")");
+      throw ParameterError("to",
+                           "must be > from (got from " + short_number(*from_s) + ", to " + short_number(*to_s) + ")");
     }
   }
 }
@@ -123,6 +118,12 @@ void for_each_log_event(const std::vector<std::string>& files,
     if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
     while (const lcm::LogEvent* event = log.readNextEvent()) on_event(file, *event);
   }
+}
+
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
@@ -157,8 +158,8 @@ std::string describe(const LogSamples& s, const LogReadOptions& options) {
   o << "log: " << s.files << " file(s), " << s.events << " events, " << s.sensor_events << " blocks on "
     << options.sensor_channel << " (" << s.sensor_ticks << " ticks)\n";
   o << "samples: " << s.table.t.size() << " kept (seq " << s.first_seq.value_or(0) << " .. " << s.last_seq.value_or(0)
-    << ", t " << number(s.table.t.front()) << " .. " << number(s.table.t.back()) << " s), " << s.outside_range
-    << " outside the time range\n";
+    << ", t " << short_number(s.table.t.front()) << " .. " << short_number(s.table.t.back()) << " s), "
+    << s.outside_range << " outside the time range\n";
   o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
     << " repeated seq, " << s.undecodable << " block(s) undecodable or out of contract\n";
   o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";
