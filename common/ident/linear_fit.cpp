@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "ident/fit_checks.hpp"
+#include "ident/fit_clock.hpp"
 
 namespace hystloop {
 
@@ -17,11 +18,7 @@ LinearParams to_linear_params(const LinearFitResult& fit) {
 LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y, double min_range) {
   LinearFitResult r;
   // (A moving u has at least 2 samples.)
-  if (FitCheck c = check_fit_input(u, y, min_range); !c.ok()) {
-    r.status = c.status;
-    r.reason = std::move(c.reason);
-    return r;
-  }
+  if (FitCheck c = check_fit_input(u, y, min_range); !c.ok()) return with_status(std::move(r), c.status, c.reason);
   double su = 0.0, sy = 0.0;
   for (std::size_t k = 0; k < u.size(); ++k) su += u[k], sy += y[k];
   const double n = static_cast<double>(u.size()), mu = su / n, my = sy / n;
@@ -34,12 +31,10 @@ LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y,
   r.residual_rms_m = std::sqrt(ss / n);
   r.samples_used = u.size();
   if (!(r.gain_m_per_V > 0.0)) {
-    r.status = FitStatus::out_of_range;
-    r.reason = "gain " + std::to_string(r.gain_m_per_V) + " m/V: must be > 0";
-    return r;
+    return with_status(std::move(r), FitStatus::out_of_range,
+                       "gain " + std::to_string(r.gain_m_per_V) + " m/V: must be > 0");
   }
-  r.status = FitStatus::ok;
-  return r;
+  return with_status(std::move(r), FitStatus::ok);
 }
 
 }  // namespace hystloop

@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
+#include "ident/fit_clock.hpp"
 
 namespace hystloop {
 
@@ -91,20 +92,16 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
   o.validate();
   ModelSelection sel;
   if (u.size() != y.size() || u.empty()) {
-    sel.status = FitStatus::size_mismatch;
-    sel.reason = "u and y differ in length or are empty";
-    return sel;
+    return with_status(std::move(sel), FitStatus::size_mismatch, "u and y differ in length or are empty");
   }
   const std::vector<std::size_t> rev = find_reversals(u);
   const auto target = static_cast<std::size_t>((1.0 - o.holdout_fraction) * static_cast<double>(u.size()));
   const auto it = std::lower_bound(rev.begin(), rev.end(), target);
   if (rev.size() < 4 || it == rev.end() || static_cast<std::size_t>(it - rev.begin()) < 3) {
-    sel.status = FitStatus::too_few_branches;
     std::ostringstream s;
     s << rev.size() << " reversals: need >= 3 before and 1 after " << (1.0 - o.holdout_fraction) * 100.0
       << " % of the record to fit and hold out";
-    sel.reason = s.str();
-    return sel;
+    return with_status(std::move(sel), FitStatus::too_few_branches, s.str());
   }
   sel.split_index = *it;
   const std::size_t split = sel.split_index, train_begin = rev[1];
@@ -121,13 +118,9 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
     if (ao != bo) return ao;
     return ao && a.holdout_rms_m < b.holdout_rms_m;
   });
-  if (sel.ranking.front().status == FitStatus::ok) {
-    sel.status = FitStatus::ok;
-  } else {
-    sel.status = sel.ranking.front().status;
-    sel.reason = "no model could be fitted: " + sel.ranking.front().reason;
-  }
-  return sel;
+  const FitStatus best = sel.ranking.front().status;
+  const std::string why = best == FitStatus::ok ? "" : "no model could be fitted: " + sel.ranking.front().reason;
+  return with_status(std::move(sel), best, why);
 }
 
 }  // namespace hystloop
