@@ -347,22 +347,21 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     spdlog::warn("{}", safe_reason_);
   }
 
-  BridgeHealthInput health;
-  health.stopping = stopping;
-  health.armed = rt.armed;
-  health.at_safe_voltage = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed;
-  health.safe_u_V = settings_.limits.safe_u_V;
-  health.safe_reason = safe_reason_;
-  health.late_fraction = late_fraction;
-  health.degraded_late_fraction = settings_.degraded_late_fraction;
-  health.samples_dropped = dropped;
-  health.commands_too_far_ahead = too_far_ahead;
-  health.max_lead_s = settings_.max_lead_s;
-  health.samples_repaired = sensor_ticks_repaired_ - previous_repaired_;
-  health.samples_unpublished = sensor_ticks_unpublished_ - previous_unpublished_;
+  const BridgeHealthInput health{.stopping = stopping,
+                                 .armed = rt.armed,
+                                 .at_safe_voltage = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed,
+                                 .safe_u_V = settings_.limits.safe_u_V,
+                                 .safe_reason = safe_reason_,
+                                 .late_fraction = late_fraction,
+                                 .degraded_late_fraction = settings_.degraded_late_fraction,
+                                 .samples_dropped = dropped,
+                                 .samples_repaired = sensor_ticks_repaired_ - previous_repaired_,
+                                 .samples_unpublished = sensor_ticks_unpublished_ - previous_unpublished_,
+                                 .commands_too_far_ahead = too_far_ahead,
+                                 .max_lead_s = settings_.max_lead_s,
+                                 .clamped_last_second = rt.clamped_last_second};
   previous_repaired_ = sensor_ticks_repaired_;
   previous_unpublished_ = sensor_ticks_unpublished_;
-  health.clamped_last_second = rt.clamped_last_second;
   auto [state, detail] = assess_bridge_health(health);
   if (rt.armed) safe_reason_ = "not armed";  // the next safe state says its own reason
   detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",

@@ -38,13 +38,6 @@ std::optional<std::int64_t> find_counter(const service_status_t& status, std::st
   return std::nullopt;
 }
 
-void StatusBoard::update(const service_status_t& status, std::int64_t recv_utime) {
-  ProcessReport& report = processes_[status.process];
-  report.status = status;
-  report.recv_utime = recv_utime;
-  ++report.reports;
-}
-
 HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
                            const std::vector<std::string>& accept_safe, bool accept_degraded) {
   HealthVerdict verdict;
@@ -54,7 +47,7 @@ HealthVerdict check_health(const StatusBoard& board, const std::vector<std::stri
       verdict.problems.push_back(name + ": no status received");
       continue;
     }
-    const auto& s = it->second.status;
+    const service_status_t& s = it->second;
     const bool safe_ok = std::find(accept_safe.begin(), accept_safe.end(), name) != accept_safe.end();
     if (s.state == service_status_t::HEALTHY || (safe_ok && s.state == service_status_t::SAFE) ||
         (accept_degraded && s.state == service_status_t::DEGRADED)) {
@@ -66,8 +59,7 @@ HealthVerdict check_health(const StatusBoard& board, const std::vector<std::stri
   return verdict;
 }
 
-std::string format_status(const ProcessReport& report, bool all_counters) {
-  const auto& s = report.status;
+std::string format_status(const service_status_t& s, bool all_counters) {
   const double up_s = static_cast<double>(s.utime - s.start_utime) * 1e-6;
   std::string line = fmt::format("{:<12} {:<9} pid {}@{}  up {:.0f} s  late {}  rejected {}", s.process,
                                  state_name(s.state), s.pid, s.host, up_s, s.late, s.rejected);

@@ -19,19 +19,14 @@ std::string state_name(std::int8_t state);
 // The value of the named counter in a report; nullopt when the process does not report it.
 std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name);
 
-struct ProcessReport {
-  service_status_t status;
-  std::int64_t recv_utime = 0;
-  std::uint64_t reports = 0;
-};
-
+// The latest report of each process heard.
 class StatusBoard {
  public:
-  void update(const service_status_t& status, std::int64_t recv_utime);
-  const std::map<std::string, ProcessReport>& processes() const noexcept { return processes_; }
+  void update(const service_status_t& status) { processes_[status.process] = status; }
+  const std::map<std::string, service_status_t>& processes() const noexcept { return processes_; }
 
  private:
-  std::map<std::string, ProcessReport> processes_;
+  std::map<std::string, service_status_t> processes_;
 };
 
 struct HealthVerdict {
@@ -47,6 +42,6 @@ HealthVerdict check_health(const StatusBoard& board, const std::vector<std::stri
 
 // One line: process, state, pid@host, uptime, late/rejected, loop and latency timing, detail.
 // With all_counters, the named counters follow, one per indented line.
-std::string format_status(const ProcessReport& report, bool all_counters);
+std::string format_status(const service_status_t& status, bool all_counters);
 
 }  // namespace hystloop::ctl

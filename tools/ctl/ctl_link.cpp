@@ -55,7 +55,7 @@ CtlLink::CtlLink(const LinkOptions& options)
 int run_status(CtlLink& link, const StatusOptions& o) {
   StatusBoard board;
   Subscription<service_status_t> sub(link.lcm(), link.channels().status,
-                                     [&](const service_status_t& s, std::int64_t t) { board.update(s, t); });
+                                     [&](const service_status_t& s, std::int64_t) { board.update(s); });
   const bool waiting = !o.wait_healthy.empty();
   const auto deadline = after(waiting ? o.timeout_s : o.listen_s);
   HealthVerdict verdict;

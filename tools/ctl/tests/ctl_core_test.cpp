@@ -274,13 +274,13 @@ TEST(CtlHealth, VerdictNamesWhoIsMissingOrUnhealthy) {
   EXPECT_FALSE(v.healthy);
   ASSERT_EQ(v.problems.size(), 2u);
   EXPECT_EQ(v.problems[0], "bridge: no status received");
-  board.update(report("bridge", service_status_t::SAFE, "not armed"), 1);
-  board.update(report("compensator", service_status_t::HEALTHY), 1);
+  board.update(report("bridge", service_status_t::SAFE, "not armed"));
+  board.update(report("compensator", service_status_t::HEALTHY));
   v = check_health(board, {"bridge", "compensator"}, {});
   ASSERT_EQ(v.problems.size(), 1u);
   EXPECT_EQ(v.problems[0], "bridge: SAFE (not armed)");
   EXPECT_TRUE(check_health(board, {"bridge", "compensator"}, {"bridge"}).healthy);
-  board.update(report("compensator", service_status_t::DEGRADED, "late commands"), 2);  // the latest report counts
+  board.update(report("compensator", service_status_t::DEGRADED, "late commands"));  // the latest report counts
   EXPECT_FALSE(check_health(board, {"bridge", "compensator"}, {"bridge"}).healthy);
 }
 
@@ -291,7 +291,7 @@ TEST(CtlHealth, StatusLine) {
   s.counter_names = {"ticks"};
   s.counter_values = {100};
   s.n_counters = 1;
-  board.update(s, 1);
+  board.update(s);
   const std::string line = format_status(board.processes().at("bridge"), true);
   EXPECT_NE(line.find("DEGRADED"), std::string::npos) << line;
   EXPECT_NE(line.find("late 12"), std::string::npos) << line;
