@@ -84,13 +84,8 @@ FitPlotFiles write_fit_plots(const SampleTable& s, const FitPlotInput& in, const
   }
   // The branch held out: the chosen curve's own (auto), or a fit on the first part (one model).
   const FitCurve* held = in.heldout ? &*in.heldout : (in.chosen.heldout_begin < n ? &in.chosen : nullptr);
-  std::string held_file;
-  if (in.heldout) {
-    held_file = curve_file(*in.heldout, "heldout_");
-    write(held_file, *in.heldout);
-  } else if (held != nullptr) {
-    held_file = chosen_file;
-  }
+  const std::string held_file = in.heldout ? curve_file(*in.heldout, "heldout_") : chosen_file;
+  if (in.heldout) write(held_file, *in.heldout);
 
   const std::string chosen_name = model_name(in.chosen.kind);
   std::ostringstream gp;
