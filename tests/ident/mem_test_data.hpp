@@ -49,6 +49,16 @@ inline std::vector<double> mem_branches(const std::vector<double>& u, const MemP
   return y;
 }
 
+// The project's forward MEM (common/models/mem.hpp, not the independent generator above) from
+// rest at 0 V: y for every u.
+inline std::vector<double> model_output(const MemParams& truth, const std::vector<double>& u) {
+  MemModel model(truth);
+  model.reset(0.0);
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  return y;
+}
+
 inline void add_noise(std::vector<double>& y, double rms_m, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n(0.0, rms_m);

@@ -13,11 +13,8 @@ namespace {
 
 TEST(ModelSelection, MemDataRanksMemFirstAndLinearLast) {
   const MemParams truth = MemParams::paper_like();
-  MemModel model(truth);
-  model.reset(0.0);
   const auto u = testdata::paper_identification_input();
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  std::vector<double> y = testdata::model_output(truth, u);
   testdata::add_noise(y, 1e-9, 17);
   const ModelSelection sel = select_model(u, y);
   ASSERT_TRUE(sel.ok()) << sel.reason;

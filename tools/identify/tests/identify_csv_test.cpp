@@ -43,11 +43,8 @@ void write_csv(const std::string& file, const std::vector<double>& u, const std:
 
 TEST_F(IdentifyTool, FitsMemAndWritesTheYamlSnippet) {
   const MemParams truth = MemParams::paper_like();
-  MemModel model(truth);
-  model.reset(0.0);
   const auto u = testdata::paper_identification_input();
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  std::vector<double> y = testdata::model_output(truth, u);
   testdata::add_noise(y, 1e-9, 5);
   write_csv(path("mem.csv"), u, y, 1e4);
   const ToolRun r = run_tool(path("mem.csv") + " --model mem --out " + path("params.yaml"));
@@ -163,11 +160,8 @@ TEST_F(IdentifyTool, AFolderInsteadOfAFileIsAUsageError) {
 
 TEST_F(IdentifyTool, MoreSamplesThanTheBoundAreRefusedWithAHint) {
   const MemParams truth = MemParams::paper_like();
-  MemModel model(truth);
-  model.reset(0.0);
   const auto u = testdata::paper_identification_input();  // 20000 samples
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  std::vector<double> y = testdata::model_output(truth, u);
   write_csv(path("mem.csv"), u, y, 1e4);
   const ToolRun r = run_tool(path("mem.csv") + " --model mem --max-samples 5000");
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -217,11 +211,7 @@ TEST(IdentifyDecimate, KeepsEveryKthSampleAndTheTurnsBetweenThem) {
 TEST_F(IdentifyTool, ProgressOfALongFitOnStderr) {
   auto u = testdata::paper_identification_input();
   u.resize(6000);  // three periods
-  MemModel model(MemParams::paper_like());
-  model.reset(0.0);
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
-  write_csv(path("mem.csv"), u, y, 1e4);
+  write_csv(path("mem.csv"), u, testdata::model_output(MemParams::paper_like(), u), 1e4);
   // Katalenic simulates its operator per evaluation: ~30 ms here, 30 periods of the shortest
   // --progress-period-s (a 20 ms period once let a quick run finish before its first line).
   // Only stderr is collected: { tool 2>&1 >/dev/null; }.
@@ -255,11 +245,8 @@ TEST_F(IdentifyTool, HelpDescribesTheModels) {
 
 TEST_F(IdentifyTool, PublishOnHxParamsIsOnlyForMem) {
   const MemParams truth = MemParams::paper_like();
-  MemModel model(truth);
-  model.reset(0.0);
   const auto u = testdata::paper_identification_input();
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
+  std::vector<double> y = testdata::model_output(truth, u);
   write_csv(path("mem.csv"), u, y, 1e4);
   // Refused before any LCM is opened (any model on HX_MODEL: identify_publish_test.cpp, in a namespace).
   const ToolRun pi = run_tool(path("mem.csv") + " --model pi --publish --publish-on params");
