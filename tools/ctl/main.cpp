@@ -99,16 +99,14 @@ int send_control(const Options& o, std::int8_t command, const std::string& targe
   return send_control_confirmed(link, msg, what, ack, last);
 }
 
-std::string format_gains(const ServoGainsFigures& g) {
-  return fmt::format("kp {:g}, ki {:g} 1/s, kd {:g} s, {}", g.kp, g.ki_per_s, g.kd_s,
-                     g.notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g.notch_hz, g.notch_q) : "no notch");
-}
-
 // Prints the servo gains `report` carries; false if it carries none.
 bool print_gains(const std::string& bridge, const service_status_t& report) {
   const auto g = servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); });
-  if (g) std::printf("hystloop-ctl: '%s' servo gains in force: %s\n", bridge.c_str(), format_gains(*g).c_str());
-  return g.has_value();
+  if (!g) return false;
+  fmt::print("hystloop-ctl: '{}' servo gains in force: kp {:g}, ki {:g} 1/s, kd {:g} s, {}\n", bridge, g->kp,
+             g->ki_per_s, g->kd_s,
+             g->notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g->notch_hz, g->notch_q) : "no notch");
+  return true;
 }
 
 int run_gains(Options& o) {
