@@ -5,7 +5,6 @@
 
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <chrono>
 #include <ctime>
 #include <exception>
@@ -16,13 +15,11 @@
 #include "bridge/bridge_health.hpp"
 #include "bridge/servo_request.hpp"
 #include "core/clock.hpp"
-#include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/servo_gains_status.hpp"
-#include "runtime/counter_baseline.hpp"
 #include "runtime/summary_file.hpp"
 
 namespace hystloop {

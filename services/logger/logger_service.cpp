@@ -17,7 +17,6 @@
 #include "lcm/connection.hpp"
 #include "runtime/summary_file.hpp"
 #include "lcm/message_storage.hpp"
-#include "lcm/rig_auth.hpp"
 #include "lcm/wire_layout.hpp"
 #include "runtime/io_loop.hpp"
 
