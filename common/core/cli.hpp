@@ -17,6 +17,8 @@
 #include <optional>
 #include <string>
 
+#include "core/errors.hpp"
+
 namespace hystloop {
 
 inline constexpr int kExitOk = 0;
@@ -59,6 +61,21 @@ inline int exit_on_escaped_exception(const char* program) noexcept {
     std::fprintf(stderr, "%s: unknown error\n", program);
   }
   return kExitFailure;
+}
+
+// A tool's whole main: run() parses its command line and does the work; what it throws keeps
+// the contract above, printed as "<program>: <what>": a ParameterError (refused input) exits 2,
+// anything else 1.
+template <class Run>
+int run_tool(const char* program, Run&& run) noexcept {
+  try {
+    return run();
+  } catch (const ParameterError& e) {
+    std::fprintf(stderr, "%s: %s\n", program, e.what());
+    return kExitUsage;
+  } catch (...) {
+    return exit_on_escaped_exception(program);
+  }
 }
 
 }  // namespace hystloop

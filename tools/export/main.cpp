@@ -55,24 +55,11 @@ int export_main(int argc, char** argv) {
   app.add_flag("--quiet", o.quiet, "No progress on stderr and no summary on stdout (warnings and errors still)");
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   o.mat_version = mat_version == "7.3" ? MatVersion::kV73 : MatVersion::kV5;
-  try {
-    return run_export(o, stderr, stdout);
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-export: %s\n", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-export: %s\n", e.what());
-    return kExitFailure;
-  }
+  return run_export(o, stderr, stdout);
 }
 
 }  // namespace
 
-// Setting the options up can throw too (CLI11 refuses a malformed definition): nothing escapes.
 int main(int argc, char** argv) {
-  try {
-    return export_main(argc, argv);
-  } catch (...) {  // what the program's own handlers did not take
-    return hystloop::exit_on_escaped_exception("hystloop-export");
-  }
+  return hystloop::run_tool("hystloop-export", [&] { return export_main(argc, argv); });
 }

@@ -199,24 +199,11 @@ int report_main(int argc, char** argv) {
   app.add_option("--compensator-process", o.scan.compensator_process, "Process name of the compensator in HX_STATUS")
       ->capture_default_str();
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
-  try {
-    return run(o);
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-report: %s\n", e.what());
-    return 1;
-  }
+  return run(o);
 }
 
 }  // namespace
 
-// Setting the options up can throw too (CLI11 refuses a malformed definition): nothing escapes.
 int main(int argc, char** argv) {
-  try {
-    return report_main(argc, argv);
-  } catch (...) {  // what the program's own handlers did not take
-    return hystloop::exit_on_escaped_exception("hystloop-report");
-  }
+  return hystloop::run_tool("hystloop-report", [&] { return report_main(argc, argv); });
 }
