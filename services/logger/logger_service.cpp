@@ -222,7 +222,7 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     const std::string_view name = c.name_view();
     // What went wrong on the channel since the last report: "<what> on <channel>".
     const auto say = [&](bool news, const std::string& what) {
-      if (news) detail = append(detail, what + " on " + std::string(name));
+      if (news) detail = append(detail, fmt::format("{} on {}", what, name));
     };
     say(now.dropped > before.dropped, fmt::format("dropped {}", now.dropped - before.dropped));
     say(now.gap_events > before.gap_events,
