@@ -1,11 +1,14 @@
 #include "logger/log_file_set.hpp"
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <system_error>
+
+#include <spdlog/fmt/chrono.h>
+#include <spdlog/fmt/fmt.h>
 
 namespace hystloop {
 
@@ -15,15 +18,11 @@ constexpr std::uint32_t kEventMagic = 0xEDA1DA01u;  // LCM's event log framing (
 std::string recording_name(const std::string& file_prefix, std::time_t start_time) {
   std::tm local{};
   localtime_r(&start_time, &local);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
-  return file_prefix + "hystloop-" + stamp;
+  return fmt::format("{}hystloop-{:%Y%m%d-%H%M%S}", file_prefix, local);
 }
 
 std::filesystem::path numbered(const std::filesystem::path& base, std::size_t index) {
-  char suffix[32];
-  std::snprintf(suffix, sizeof suffix, ".%03zu.lcmlog", index);
-  return base.string() + suffix;
+  return fmt::format("{}.{:03}.lcmlog", base.string(), index);
 }
 
 std::uint8_t* put_be(std::uint8_t* at, std::uint64_t value, int bytes) noexcept {
@@ -34,15 +33,9 @@ std::uint8_t* put_be(std::uint8_t* at, std::uint64_t value, int bytes) noexcept 
 std::string error_text(int error) { return std::error_code(error, std::generic_category()).message(); }
 
 const char* op_name(DiskOp op) noexcept {
-  switch (op) {
-    case DiskOp::kCreate: return "create";
-    case DiskOp::kWrite: return "write";
-    case DiskOp::kTruncate: return "truncate";
-    case DiskOp::kFsync: return "fsync";
-    case DiskOp::kClose: return "close";
-    case DiskOp::kNone: break;
-  }
-  return "none";
+  constexpr const char* kNames[] = {"none", "create", "write", "truncate", "fsync", "close"};  // by DiskOp
+  static_assert(std::size(kNames) == static_cast<std::size_t>(DiskOp::kClose) + 1);
+  return kNames[static_cast<std::size_t>(op)];
 }
 }  // namespace
 
