@@ -237,13 +237,13 @@ int send_control_confirmed(CtlLink& link, const control_t& msg, const std::strin
   for (const std::string& line : describe_answers(tracker, true)) {
     std::fprintf(ok ? stdout : stderr, "hystloop-ctl: %s\n", line.c_str());
   }
-  if (ok) {
-    std::printf("hystloop-ctl: %s confirmed in %.0f ms\n", what.c_str(), waited_s * 1e3);
-  } else {
+  if (!ok) {
     std::fprintf(stderr, "hystloop-ctl: %s not confirmed (waited %.1f s of --timeout %g s)\n", what.c_str(), waited_s,
                  o.timeout_s);
+    return 1;
   }
-  return ok ? 0 : 1;
+  std::printf("hystloop-ctl: %s confirmed in %.0f ms\n", what.c_str(), waited_s * 1e3);
+  return 0;
 }
 
 StatusWait wait_for_status(CtlLink& link, const std::string& process, const StateCheck& until, double timeout_s) {

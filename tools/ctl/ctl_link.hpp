@@ -42,15 +42,14 @@ class CtlLink {
   std::unique_ptr<lcm::LCM> lcm_;
 };
 
-// Publishes `msg` `repeats` times, `gap` apart (UDP may drop one; receivers dedupe by
-// request id / version). Returns false if the message was refused or never sent.
+// Publishes `msg` 3 times, 5 ms apart (UDP may drop one; receivers dedupe by request id /
+// version). Returns false if the message was refused or never sent.
 template <class T>
-bool publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg, int repeats = 3,
-                      std::chrono::milliseconds gap = std::chrono::milliseconds(5)) {
+bool publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg) {
   Publisher<T> publisher(lcm, channel);
   bool all = true;
-  for (int i = 0; i < repeats; ++i) {
-    if (i > 0) std::this_thread::sleep_for(gap);
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     all = publisher.publish(msg) && all;
   }
   return all;

@@ -44,11 +44,9 @@ std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {
   }
   for (const auto& s : steps) s.request.validate();
   if (steps.size() > ExperimentQueue::kCapacity + 1) {
-    throw ParameterError("banning-series", std::to_string(steps.size()) +
-                                               " experiments (settling included) exceed what "
-                                               "the compensator queues (" +
-                                               std::to_string(ExperimentQueue::kCapacity + 1) +
-                                               "): give fewer offsets, amplitudes or frequencies");
+    throw ParameterError("banning-series", fmt::format("{} experiments (settling included) exceed what the compensator "
+                                                       "queues ({}): give fewer offsets, amplitudes or frequencies",
+                                                       steps.size(), ExperimentQueue::kCapacity + 1));
   }
   return steps;
 }
