@@ -132,20 +132,12 @@ T convert_value(const Config& cfg, const YAML::Node& node, const std::string& fi
   }
 }
 
-// ParameterError's what() is "field: reason"; ConfigError wants the reason alone.
-std::string reason_of(const ParameterError& e) {
-  const std::string what = e.what();
-  const std::string prefix = e.field() + ": ";
-  return what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what;
-}
-
 }  // namespace
 
 ConfigError::ConfigError(std::string source, std::string field, const std::string& reason)
     : ParameterError(std::move(field), reason),
       source_(std::move(source)),
-      reason_(reason),
-      message_(compose(source_, this->field(), reason_)) {}
+      message_(compose(source_, this->field(), reason)) {}
 
 const std::string& Config::Impl::source_for(std::string_view path) const {
   for (const auto& key : overridden) {
@@ -264,7 +256,7 @@ double Config::get_positive(std::string_view path, double default_value) const {
   try {
     require_positive(path, v);
   } catch (const ParameterError& e) {
-    fail(path, reason_of(e));
+    fail(path, e.reason());
   }
   return v;
 }
@@ -274,7 +266,7 @@ double Config::get_non_negative(std::string_view path, double default_value) con
   try {
     require_non_negative(path, v);
   } catch (const ParameterError& e) {
-    fail(path, reason_of(e));
+    fail(path, e.reason());
   }
   return v;
 }

@@ -37,11 +37,9 @@ class ConfigError : public ParameterError {
   ConfigError(std::string source, std::string field, const std::string& reason);
   const char* what() const noexcept override { return message_.c_str(); }
   const std::string& source() const noexcept { return source_; }
-  const std::string& reason() const noexcept { return reason_; }
 
  private:
   std::string source_;
-  std::string reason_;
   std::string message_;
 };
 

@@ -15,12 +15,25 @@ namespace hystloop {
 class ParameterError : public std::invalid_argument {
  public:
   ParameterError(std::string field, const std::string& reason)
-      : std::invalid_argument(field + ": " + reason), field_(std::move(field)) {}
+      : std::invalid_argument(field + ": " + reason), field_(std::move(field)), reason_(reason) {}
   const std::string& field() const noexcept { return field_; }
+  const std::string& reason() const noexcept { return reason_; }  // what() without "field: "
 
  private:
   std::string field_;
+  std::string reason_;
 };
+
+// Runs validate(); a ParameterError from it is thrown again with `prefix` before its field
+// ("c3" -> "mem.c3"), so a nested set's refusal names the field as the file spells it.
+template <class Validate>
+void validate_within(std::string_view prefix, Validate&& validate) {
+  try {
+    validate();
+  } catch (const ParameterError& e) {
+    throw ParameterError(std::string(prefix) + e.field(), e.reason());
+  }
+}
 
 // Throws ParameterError unless `value` is finite.
 void require_finite(std::string_view field, double value);

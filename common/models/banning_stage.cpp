@@ -8,16 +8,8 @@
 namespace hystloop {
 
 void BanningStageParams::validate() const {
-  try {
-    hysteresis.validate();
-  } catch (const ParameterError& e) {
-    throw ParameterError("hysteresis." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
-  }
-  try {
-    stage.validate();
-  } catch (const ParameterError& e) {
-    throw ParameterError("stage." + e.field(), std::string(e.what()).substr(e.field().size() + 2));
-  }
+  validate_within("hysteresis.", [&] { hysteresis.validate(); });
+  validate_within("stage.", [&] { stage.validate(); });
 }
 
 namespace {

@@ -35,12 +35,7 @@ std::optional<ModelKind> model_kind_from_int(std::int64_t value) noexcept {
 namespace {
 template <class Params>
 void validate_prefixed(const Params& params, std::string_view prefix) {
-  try {
-    params.validate();
-  } catch (const ParameterError& e) {
-    const std::string what = e.what();  // "field: reason"
-    throw ParameterError(std::string(prefix) + "." + e.field(), what.substr(e.field().size() + 2));
-  }
+  validate_within(std::string(prefix) + ".", [&] { params.validate(); });
 }
 }  // namespace
 

@@ -34,12 +34,7 @@ DiscreteStage discretise_zoh(const SecondOrderStageParams& stage, double dt_s) {
 void StageModel::validate(double dt_s) const {
   if (kind == Kind::kNone) return;
   if (kind != Kind::kSecondOrder) throw ParameterError("stage.kind", "must be none or second_order");
-  try {
-    second_order.validate();
-  } catch (const ParameterError& e) {
-    const std::string what = e.what();  // "k: must be > 0 (got -1)"
-    throw ParameterError("stage." + e.field(), what.substr(e.field().size() + 2));
-  }
+  validate_within("stage.", [&] { second_order.validate(); });
   const StageInverse check(second_order, dt_s);
 }
 

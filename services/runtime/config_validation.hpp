@@ -19,9 +19,7 @@ void validate_config_section(const Config& config, std::string_view prefix, F&& 
   } catch (const ConfigError&) {
     throw;
   } catch (const ParameterError& e) {
-    std::string reason = e.what();
-    if (reason.rfind(e.field() + ": ", 0) == 0) reason.erase(0, e.field().size() + 2);
-    config.fail(std::string(prefix) + e.field(), reason);
+    config.fail(std::string(prefix) + e.field(), e.reason());
   }
 }
 
