@@ -48,8 +48,6 @@ struct PublisherCounters {
   std::uint64_t invalid = 0;           // refused by the value check before encoding: never sent
   std::uint64_t encode_failed = 0;     // encode < 0, or the buffer could not grow
   std::uint64_t transport_failed = 0;  // lcm publish returned an error
-
-  std::uint64_t failed_total() const noexcept { return invalid + encode_failed + transport_failed; }
 };
 
 }  // namespace hystloop

@@ -97,7 +97,6 @@ class MemModel {
   double input() const noexcept { return u_; }                   // last u [V]
   double output() const noexcept { return y_; }                  // last y [m]
   double branch_origin_u() const noexcept { return u_origin_; }  // [V]
-  double branch_origin_y() const noexcept { return y_origin_; }  // [m]
   bool on_skeleton() const noexcept { return scale_ != 1.0; }
   int direction() const noexcept { return detector_.direction(); }
   std::uint64_t reversals() const noexcept { return reversals_; }  // since construction/reset
@@ -150,7 +149,6 @@ class MemInverse {
   double reference() const noexcept { return y_ref_; }  // last y_ref [m]
   double output() const noexcept { return u_; }         // last u [V]
   double branch_origin_u() const noexcept { return u_origin_; }
-  double branch_origin_y() const noexcept { return y_origin_; }
   bool on_skeleton() const noexcept { return scale_ != 1.0; }
   int direction() const noexcept { return direction_; }
   std::uint64_t reversals() const noexcept { return reversals_; }

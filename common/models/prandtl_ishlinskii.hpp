@@ -66,7 +66,6 @@ class PiModel {
 
   double input() const noexcept { return u_; }
   double output() const noexcept { return y_; }
-  const std::array<double, kPiMaxOperators>& play_states() const noexcept { return z_; }
 
  private:
   double sum() const noexcept;
@@ -89,7 +88,6 @@ class PiInverse {
 
   void set_params(const PiParams& params);  // validates; u does not jump
   const PiParams& params() const noexcept { return params_; }
-  const PiParams& inverse_params() const noexcept { return inverse_.params(); }
 
   double output() const noexcept { return inverse_.output(); }
 

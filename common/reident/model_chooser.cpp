@@ -81,7 +81,6 @@ ModelParamSet start_of(ModelKind kind, const MemParams& mem) {
 ModelDecision ModelChooser::collect(ReidentCore& core) {
   ModelDecision d;
   const ModelProposal& p = result_;
-  last_duration_s_ = duration_s_;
   last_reason_ = p.reason;  // the I/O thread's copy (allocates only while it grows; 0.2 Hz)
   if (job_poisoned_) {
     ++counters_[poisoned];

@@ -98,7 +98,6 @@ class ModelChooser {
   const ModelParamSet& in_use() const noexcept { return in_use_; }
   bool enabled() const noexcept { return options_.enabled; }
   std::uint64_t count(Counter c) const noexcept { return counters_[c]; }
-  double last_selection_s() const noexcept { return last_duration_s_; }
   const std::string& last_reason() const noexcept { return last_reason_; }  // the last selection's decision
 
   bool run_pending() { return slot_.run_pending(); }  // no thread: runs a submitted job here
@@ -123,7 +122,6 @@ class ModelChooser {
 
   std::int64_t next_us_ = INT64_MIN;
   std::uint64_t fed_at_last_ = 0;
-  double last_duration_s_ = 0.0;
   std::string last_reason_;
   std::uint64_t counters_[kCounters]{};
   std::array<double, kRecentFits> recent_best_m_{};  // a ring of the last selections' best held-out RMS

@@ -15,6 +15,7 @@
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/feedforward_mode.hpp"
+#include "models/model_descriptors.hpp"
 #include "runtime/counter_baseline.hpp"
 #include "runtime/io_loop.hpp"
 

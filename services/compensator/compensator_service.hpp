@@ -87,10 +87,6 @@ struct CompensatorServiceCounters {
   // block) and sensor_jumps (confirmed jumps ahead).
 };
 
-// "mem: c1 5.3e-09 m/V, c2 2.1e-12 m/V^(1+c3), c3 1.15", "pi: 15 plays up to 233.3 V", ...: as the
-// start-up summary names the set (its model's summary_of), for the log lines of accepted sets.
-std::string describe_model(const ModelParamSet& set);
-
 class CompensatorService {
  public:
   CompensatorService(const CompensatorSettings& settings, lcm::LCM& lcm, const ChannelNames& channels);
@@ -116,8 +112,6 @@ class CompensatorService {
   const Compensator& compensator() const noexcept { return *compensator_; }
   const CompensatorServiceCounters& counters() const noexcept { return counters_; }
   const SequenceGuard::Counters& sequence_counters() const noexcept { return guard_.counters(); }
-  // The last command block published (tests look at it).
-  const command_block_t& last_command() const noexcept { return command_; }
 
  private:
   void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version);
