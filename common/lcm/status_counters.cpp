@@ -56,4 +56,11 @@ bool add_publisher_counters(service_status_t& status, std::string_view endpoint,
   return ok;
 }
 
+std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name) {
+  for (std::size_t i = 0; i < status.counter_names.size() && i < status.counter_values.size(); ++i) {
+    if (status.counter_names[i] == name) return status.counter_values[i];
+  }
+  return std::nullopt;
+}
+
 }  // namespace hystloop

@@ -3,6 +3,7 @@
 // per-sample path: these build strings).
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "hystloop/service_status_t.hpp"
@@ -23,5 +24,9 @@ bool add_endpoint_counters(service_status_t& status, std::string_view endpoint, 
 
 // "<endpoint>.published", ".invalid", ".encode_failed", ".transport_failed".
 bool add_publisher_counters(service_status_t& status, std::string_view endpoint, const PublisherCounters& counters);
+
+// The value of the named counter of a status message (as received: the arrays are trusted only
+// as far as both reach); nullopt when it has none by that name.
+std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name);
 
 }  // namespace hystloop

@@ -13,6 +13,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -23,6 +24,7 @@
 #include "hystloop/service_status_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
+#include "lcm/status_counters.hpp"
 
 namespace hystloop {
 namespace {
@@ -79,11 +81,9 @@ struct Harness {
 };
 
 std::int64_t counter(const service_status_t& s, const std::string& name) {
-  for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  }
-  ADD_FAILURE() << name << " not reported";
-  return -1;
+  const std::optional<std::int64_t> value = find_counter(s, name);
+  if (!value) ADD_FAILURE() << name << " not reported";
+  return value.value_or(-1);
 }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }

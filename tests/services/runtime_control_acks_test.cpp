@@ -9,16 +9,14 @@
 #include <optional>
 #include <string>
 
+#include "lcm/status_counters.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
 namespace {
 
 std::optional<std::int64_t> counter(const service_status_t& s, const std::string& name) {
-  for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  }
-  return std::nullopt;
+  return find_counter(s, name);
 }
 
 TEST(ControlAcks, TheIdsOfTheLastRequestsActedOnAndRefusedAreReportedAndAReportIsOwedAtOnce) {

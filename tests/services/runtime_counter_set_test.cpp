@@ -5,15 +5,17 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <optional>
+
+#include "lcm/status_counters.hpp"
+
 namespace hystloop {
 namespace {
 
 std::uint64_t value_of(const service_status_t& s, const std::string& name) {
-  for (std::size_t i = 0; i < s.counter_names.size(); ++i) {
-    if (s.counter_names[i] == name) return static_cast<std::uint64_t>(s.counter_values[i]);
-  }
-  ADD_FAILURE() << "no counter " << name;
-  return 0;
+  const std::optional<std::int64_t> value = find_counter(s, name);
+  if (!value) ADD_FAILURE() << "no counter " << name;
+  return static_cast<std::uint64_t>(value.value_or(0));
 }
 
 TEST(CounterSet, ReportsSinceTheLastRebaseForCountersAndEndpoints) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdio>
 
+#include "lcm/status_counters.hpp"
+
 namespace hystloop {
 namespace {
 
@@ -19,14 +21,6 @@ std::string seconds(double s) {
 
 }  // namespace
 
-std::optional<std::int64_t> status_counter(const service_status_t& status, const std::string& name) {
-  const auto n = static_cast<std::size_t>(std::max(status.n_counters, 0));
-  for (std::size_t i = 0; i < n && i < status.counter_names.size() && i < status.counter_values.size(); ++i) {
-    if (status.counter_names[i] == name) return status.counter_values[i];
-  }
-  return std::nullopt;
-}
-
 AdoptionWatch::AdoptionWatch(std::string compensator_process, std::int32_t published_version)
     : compensator_(std::move(compensator_process)), version_(published_version) {}
 
@@ -34,9 +28,9 @@ void AdoptionWatch::on_status(const service_status_t& status) {
   heard_.insert(status.process);
   if (status.process != compensator_) return;
   compensator_heard_ = true;
-  if (const auto v = status_counter(status, "params_version")) status_version_ = *v;
+  if (const auto v = find_counter(status, "params_version")) status_version_ = *v;
   for (const char* name : kRefusalCounters) {
-    if (const auto v = status_counter(status, name)) {
+    if (const auto v = find_counter(status, name)) {
       refusals_first_.try_emplace(name, *v);
       refusals_last_[name] = *v;
     }

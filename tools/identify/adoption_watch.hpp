@@ -45,7 +45,4 @@ class AdoptionWatch {
   std::map<std::string, std::int64_t> refusals_first_, refusals_last_;  // the compensator's refusal counters
 };
 
-// The value of the named counter of a status message; nullopt when it has none by that name.
-std::optional<std::int64_t> status_counter(const service_status_t& status, const std::string& name);
-
 }  // namespace hystloop

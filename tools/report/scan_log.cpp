@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "decode.hpp"
+#include "lcm/status_counters.hpp"
 #include "lcm/trajectory_shape.hpp"
 #include "log_reader.hpp"
 #include "models/model_set.hpp"
@@ -36,13 +37,6 @@ std::optional<ScanControl::Kind> control_kind(const control_t& c) noexcept {
     case control_t::SHUTDOWN: return ScanControl::Kind::kStop;
     default: return std::nullopt;
   }
-}
-
-std::optional<std::int64_t> counter_of(const service_status_t& s, const char* name) {
-  for (std::size_t i = 0; i < s.counter_names.size() && i < s.counter_values.size(); ++i) {
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  }
-  return std::nullopt;
 }
 
 }  // namespace
@@ -79,16 +73,16 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
       ScanCompensatorStatus s;
       s.recv_utime = t;
       s.detail = status.detail;
-      s.trajectory_version = counter_of(status, "trajectory_version");
-      s.trajectory_refused_version = counter_of(status, "trajectory_refused_version");
-      s.trajectory_shaped_version = counter_of(status, "trajectory_shaped_version");
-      s.learning_active = counter_of(status, "learning_active");
-      s.learning_periods = counter_of(status, "learning_periods");
-      s.learning_rms_pm = counter_of(status, "learning_rms_pm");
-      s.model_switches = counter_of(status, "model_switches");
-      s.params_swapped = counter_of(status, "params_swapped");
-      s.u_clamped = counter_of(status, "u_clamped");
-      s.u_slew_clamped = counter_of(status, "u_slew_clamped");
+      s.trajectory_version = find_counter(status, "trajectory_version");
+      s.trajectory_refused_version = find_counter(status, "trajectory_refused_version");
+      s.trajectory_shaped_version = find_counter(status, "trajectory_shaped_version");
+      s.learning_active = find_counter(status, "learning_active");
+      s.learning_periods = find_counter(status, "learning_periods");
+      s.learning_rms_pm = find_counter(status, "learning_rms_pm");
+      s.model_switches = find_counter(status, "model_switches");
+      s.params_swapped = find_counter(status, "params_swapped");
+      s.u_clamped = find_counter(status, "u_clamped");
+      s.u_slew_clamped = find_counter(status, "u_slew_clamped");
       out.compensator.push_back(std::move(s));
     } else if (event.channel == channels.model) {
       if (!decode_checked(event, model)) return;
