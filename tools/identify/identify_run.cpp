@@ -138,12 +138,7 @@ int take_set(const ModelSelection& fit, ModelKind kind, Fitted& out) {
   } catch (const ParameterError& e) {
     return refuse(FitStatus::out_of_range, e.what());
   }
-  switch (kind) {
-    case ModelKind::mem: take_params<MemDescriptor>(out.set->mem, out); break;
-    case ModelKind::pi: take_params<PiDescriptor>(out.set->pi, out); break;
-    case ModelKind::katalenic: take_params<KatalenicDescriptor>(out.set->katalenic, out); break;
-    case ModelKind::linear: take_params<LinearDescriptor>(out.set->linear, out); break;
-  }
+  OnlineModels::visit(kind, [&]<class D>() { take_params<D>((*out.set).*D::in_set, out); });
   return 0;
 }
 
