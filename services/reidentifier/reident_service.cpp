@@ -92,8 +92,6 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
                                                        [this](const control_t& msg, std::int64_t) { on_control(msg); });
 }
 
-ReidentService::~ReidentService() = default;
-
 void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
   const std::int64_t t0 = monotonic_ns();
   core_->on_sensor_block(msg, t0 / 1000);

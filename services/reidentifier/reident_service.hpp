@@ -52,7 +52,6 @@ class ReidentService {
   static constexpr const char* kProcessName = "reidentifier";
 
   ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options);
-  ~ReidentService();
 
   // Serves until SIGINT/SIGTERM or a SHUTDOWN request; returns the exit code (0).
   int run();
