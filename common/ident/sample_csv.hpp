@@ -1,8 +1,9 @@
 #pragma once
-// Reading recorded samples from CSV: a header row naming the columns (t, u, y required, SI:
-// seconds, volts, metres; an optional `experiment` column groups rows into experiments), then one
-// sample per row. Blank lines and lines starting with '#' are skipped; other columns are ignored.
-// A malformed file is refused with a message naming the file, line and column.
+// Reading recorded samples from CSV (models/csv_columns.hpp: the one reader): a header row naming
+// the columns in any case (t, u, y required, SI: seconds, volts, metres; an optional `experiment`
+// column groups rows into experiments), then one sample per row. Blank lines and lines starting
+// with '#' are skipped; other columns are ignored. A malformed file, or a u or y beyond the
+// sanity bounds (fit_checks.hpp), is refused with a message naming the file, line and column.
 
 #include <istream>
 #include <string>

@@ -19,7 +19,7 @@
 
 #include "core/cli.hpp"
 #include "core/errors.hpp"
-#include "csv_columns.hpp"
+#include "models/csv_columns.hpp"
 #include "model_registry.hpp"
 #include "models/param_table.hpp"
 #include "params_file.hpp"

@@ -146,7 +146,7 @@ TEST_F(IdentifyTool, DataBeyondPhysicalSanityIsRefusedNamingLineAndColumn) {
     const ToolRun r = run_tool(path("huge.csv") + " --model " + m);
     EXPECT_EQ(r.exit_code, 2) << m << ": " << r.output;
     EXPECT_EQ(r.output.find("nan"), std::string::npos) << m << ": " << r.output;
-    EXPECT_NE(r.output.find("huge.csv:3: column 'u' (2)"), std::string::npos) << m << ": " << r.output;
+    EXPECT_NE(r.output.find("huge.csv:3: column 'u': "), std::string::npos) << m << ": " << r.output;
     EXPECT_NE(r.output.find("sanity bound"), std::string::npos) << m << ": " << r.output;
   }
 }

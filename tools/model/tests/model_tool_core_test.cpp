@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "csv_columns.hpp"
+#include "models/csv_columns.hpp"
 #include "model_registry.hpp"
 #include "models/katalenic.hpp"
 #include "models/mem.hpp"

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "csv_columns.hpp"
+#include "models/csv_columns.hpp"
 #include "ident/params_yaml.hpp"
 #include "model_registry.hpp"
 #include "models/banning_stage.hpp"

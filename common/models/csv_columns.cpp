@@ -1,10 +1,12 @@
-#include "csv_columns.hpp"
+#include "models/csv_columns.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 
 #include "models/param_table.hpp"
 
-namespace hystloop::model_tool {
+namespace hystloop {
 namespace {
 
 std::vector<std::string_view> split_fields(std::string_view line) {
@@ -31,6 +33,11 @@ std::string unquote(std::string_view s) {
   return std::string(s);
 }
 
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
 bool all_numbers(const std::vector<std::string_view>& fields) {
   for (const auto f : fields) {
     double v = 0.0;
@@ -41,14 +48,17 @@ bool all_numbers(const std::vector<std::string_view>& fields) {
 
 }  // namespace
 
-CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span<const std::string_view> required) {
+CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span<const std::string_view> required,
+                            const CsvReadOptions& options) {
   CsvColumns table;
   for (const auto r : required) table.names.emplace_back(r);
   table.values.resize(required.size());
   const std::string expected = join(required);
+  auto key = [&](std::string_view name) { return options.any_case ? lower(std::string(name)) : std::string(name); };
 
-  std::vector<std::string> header;
+  std::vector<std::string> header;                  // as matched: lower case with any_case
   std::vector<std::size_t> index(required.size());  // field of each requested column
+  std::size_t text_index = 0;                       // field of the text column; header.size() when none
   std::string raw;
   std::size_t line_no = 0;
   bool saw_any = false;
@@ -67,15 +77,22 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
         throw CsvError(file, line_no,
                        "missing header row: expected column names '" + expected + "', got '" + std::string(line) + "'");
       }
-      for (const auto f : fields) header.push_back(unquote(f));
+      for (const auto f : fields) header.push_back(key(unquote(f)));
+      auto field_of = [&](std::string_view name) {
+        return static_cast<std::size_t>(std::find(header.begin(), header.end(), key(name)) - header.begin());
+      };
+      text_index = options.text_column.empty() ? header.size() : field_of(options.text_column);
       for (auto h = header.begin(); h != header.end(); ++h) {
+        const auto at = static_cast<std::size_t>(h - header.begin());
         if (std::find(header.begin(), h, *h) != h)
-          throw CsvError(file, line_no, "header names column '" + *h + "' twice");
-        if (std::find(required.begin(), required.end(), *h) == required.end()) table.ignored.push_back(*h);
+          throw CsvError(file, line_no, "header names column '" + unquote(fields[at]) + "' twice");
+        const bool requested =
+            std::any_of(required.begin(), required.end(), [&](std::string_view r) { return key(r) == *h; });
+        if (!requested && at != text_index) table.ignored.push_back(unquote(fields[at]));
       }
       std::string missing;
       for (std::size_t c = 0; c < required.size(); ++c) {
-        index[c] = static_cast<std::size_t>(std::find(header.begin(), header.end(), required[c]) - header.begin());
+        index[c] = field_of(required[c]);
         if (index[c] == header.size()) missing += (missing.empty() ? "'" : ", '") + std::string(required[c]) + "'";
       }
       if (!missing.empty()) {
@@ -101,6 +118,7 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
       }
       table.values[c].push_back(v);
     }
+    if (text_index < header.size()) table.text.emplace_back(fields[text_index]);
     table.lines.push_back(line_no);
   }
   if (in.bad()) throw CsvError(file, line_no, "read error");
@@ -124,6 +142,18 @@ void require_increasing(const CsvColumns& table, std::size_t column, const std::
   }
 }
 
+void require_within(const CsvColumns& table, std::size_t column, double bound, const char* unit,
+                    const std::string& file) {
+  const std::vector<double>& v = table.values[column];
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (std::abs(v[k]) > bound) {
+      throw CsvError(file, table.lines[k],
+                     "column '" + table.names[column] + "': " + format_number(v[k]) + " " + unit +
+                         " is beyond the sanity bound +-" + format_number(bound) + " " + unit);
+    }
+  }
+}
+
 void write_csv_columns(std::ostream& out, std::span<const std::string_view> names,
                        std::span<const std::vector<double>* const> columns) {
   out << join(names) << '\n';
@@ -140,4 +170,4 @@ void write_csv_columns(std::ostream& out, std::span<const std::string_view> name
   }
 }
 
-}  // namespace hystloop::model_tool
+}  // namespace hystloop
