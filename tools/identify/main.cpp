@@ -26,7 +26,6 @@
 // malformed, beyond the sanity bounds, too many samples), or an LCM setup error.
 #include <CLI/CLI.hpp>
 
-#include <exception>
 #include <iostream>
 
 #include "core/cli.hpp"
@@ -56,9 +55,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (...) {  // what the program's own handlers did not take
-    return hystloop::exit_on_escaped_exception("hystloop-identify");
-  }
+  return hystloop::run_tool("hystloop-identify", [&] { return run(argc, argv); });
 }
