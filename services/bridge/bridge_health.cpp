@@ -11,8 +11,7 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
   h.state = service_status_t::HEALTHY;
   if (in.stopping) {
     h.state = service_status_t::STOPPING;
-    h.detail = in.at_safe_voltage ? fmt::format("stopping: at the safe {} V", in.safe_u_V)
-                                  : fmt::format("stopping: ramping to the safe {} V", in.safe_u_V);
+    h.detail = fmt::format("stopping: {} the safe {} V", in.at_safe_voltage ? "at" : "ramping to", in.safe_u_V);
     return h;
   }
   if (!in.armed) {

@@ -41,11 +41,6 @@ void LogWriter::stop() {
   files_.close();
 }
 
-void LogWriter::write_record(const RecordRing::Record& record, double now_s) noexcept {
-  const ChannelSlot& slot = channels_[record.channel];
-  files_.write(slot.name.data(), slot.name_length, record.data, record.size, record.recv_utime, now_s, record.channel);
-}
-
 void LogWriter::run() noexcept {
   // The writer wakes on a timer, not per record: the loop's channels bring ~1,000 messages a
   // second, so waking per record (a notify from the receive thread) costs as many wake-ups as a
@@ -67,7 +62,8 @@ void LogWriter::run() noexcept {
       n = ring_.drain(
           [&](const RecordRing::Record& r) noexcept {
             bytes += r.size;
-            write_record(r, now_s);
+            const ChannelSlot& slot = channels_[r.channel];  // the tag: the channel's index
+            files_.write(slot.name.data(), slot.name_length, r.data, r.size, r.recv_utime, now_s, r.channel);
           },
           kBatch);
     } while (n > 0 && last_round);

@@ -46,7 +46,6 @@ class LogWriter {
 
  private:
   void run() noexcept;
-  void write_record(const RecordRing::Record& record, double now_s) noexcept;
 
   RecordRing& ring_;
   const ChannelTable& channels_;
