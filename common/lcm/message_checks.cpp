@@ -29,6 +29,12 @@ class Findings {
     finite_or_nan(v);
     require(!std::isfinite(v) || (v >= lo && v <= hi));
   }
+  // An element count in [lo, max] that every array holds (`consistent`): true when the arrays may be read.
+  bool count(std::int32_t n, std::int32_t lo, std::int32_t max, bool consistent) noexcept {
+    const bool ok = n >= lo && n <= max && consistent;
+    require(ok);
+    return ok;
+  }
   Verdict verdict() const noexcept {
     if (non_finite_) return Verdict::kNonFinite;
     return out_of_range_ ? Verdict::kOutOfRange : Verdict::kOk;
@@ -53,9 +59,7 @@ Verdict check_message(const sensor_block_t& msg) noexcept {
   f.tick(msg.seq);
   f.within(msg.dt_s, 1e-7, 1.0);
   f.require(msg.dt_s > 0.0);
-  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= sensor_block_t::MAX_TICKS && arrays_consistent(msg);
-  f.require(count_ok);
-  if (count_ok) {
+  if (f.count(msg.n_ticks, 1, sensor_block_t::MAX_TICKS, arrays_consistent(msg))) {
     for (std::size_t i = 0; i < msg.u_V.size(); ++i) {
       f.within(msg.u_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
       f.within(msg.u_ff_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
@@ -72,9 +76,7 @@ Verdict check_message(const sim_truth_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0);
   f.tick(msg.seq);
-  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= sim_truth_t::MAX_TICKS && arrays_consistent(msg);
-  f.require(count_ok);
-  if (count_ok) {
+  if (f.count(msg.n_ticks, 1, sim_truth_t::MAX_TICKS, arrays_consistent(msg))) {
     for (const double y : msg.y_true_m) f.within(y, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   }
   return f.verdict();
@@ -84,9 +86,7 @@ Verdict check_message(const command_block_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.sample_seq >= -1 && msg.sample_seq <= kMaxTick);
   f.tick(msg.seq);
-  const bool count_ok = msg.n_ticks >= 1 && msg.n_ticks <= command_block_t::MAX_TICKS && arrays_consistent(msg);
-  f.require(count_ok);
-  if (count_ok) {
+  if (f.count(msg.n_ticks, 1, command_block_t::MAX_TICKS, arrays_consistent(msg))) {
     for (std::size_t i = 0; i < msg.u_ff_V.size(); ++i) {
       f.within(msg.u_ff_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
       f.nan_or_within(msg.y_ref_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
@@ -110,12 +110,8 @@ Verdict check_message(const trajectory_t& msg) noexcept {
   f.within(msg.frequency_Hz, 0.0, kMaxAbsFrequency_Hz);
   f.require(!periodic || msg.frequency_Hz > 0.0);
 
-  const bool count_ok = msg.n_points >= 0 && msg.n_points <= trajectory_t::MAX_POINTS &&
-                        msg.points_t_s.size() == static_cast<std::size_t>(msg.n_points) &&
-                        msg.points_y_m.size() == static_cast<std::size_t>(msg.n_points);
-  f.require(count_ok);
   f.require(msg.shape != trajectory_t::POINTS || msg.n_points >= 1);
-  if (count_ok) {
+  if (f.count(msg.n_points, 0, trajectory_t::MAX_POINTS, arrays_consistent(msg))) {
     for (std::size_t i = 0; i < msg.points_t_s.size(); ++i) {
       f.within(msg.points_t_s[i], 0.0, kMaxDuration_s);
       f.within(msg.points_y_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
@@ -195,10 +191,7 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
   for (const double v : out) f.finite(v);
   for (const double v : msg.kat_in_coefficients) f.finite(v);
   for (const double v : msg.kat_out_coefficients) f.finite(v);
-  const bool count_ok =
-      msg.n_operators >= 0 && msg.n_operators <= model_params_t::MAX_OPERATORS && arrays_consistent(msg);
-  f.require(count_ok);
-  if (count_ok) {
+  if (f.count(msg.n_operators, 0, model_params_t::MAX_OPERATORS, arrays_consistent(msg))) {
     for (const double v : msg.pi_thresholds_V) f.finite(v);
     for (const double v : msg.pi_weights) f.finite(v);
   }
@@ -225,11 +218,7 @@ Verdict check_message(const service_status_t& msg) noexcept {
   f.text(msg.detail);
   for (const std::string& name : msg.counter_names) f.text(name);
   f.require(msg.state >= service_status_t::STARTING && msg.state <= service_status_t::STOPPING);
-  const bool count_ok = msg.n_counters >= 0 && msg.n_counters <= service_status_t::MAX_COUNTERS &&
-                        msg.counter_names.size() == static_cast<std::size_t>(msg.n_counters) &&
-                        msg.counter_values.size() == static_cast<std::size_t>(msg.n_counters);
-  f.require(count_ok);
-  if (count_ok) {
+  if (f.count(msg.n_counters, 0, service_status_t::MAX_COUNTERS, arrays_consistent(msg))) {
     for (const std::int64_t value : msg.counter_values) f.require(value >= 0);
   }
   for (const double t : {msg.loop_p50_us, msg.loop_p99_us, msg.loop_max_us, msg.latency_p50_us, msg.latency_p99_us,

@@ -8,6 +8,10 @@ void reserve_all(std::size_t n, V&... vectors) {
   (vectors.reserve(n), ...);
 }
 template <class... V>
+void clear_all(V&... vectors) noexcept {
+  (vectors.clear(), ...);
+}
+template <class... V>
 bool all_sized(std::int32_t n, const V&... vectors) noexcept {
   return n >= 0 && ((vectors.size() == static_cast<std::size_t>(n)) && ...);
 }
@@ -23,21 +27,9 @@ void reserve_storage(command_block_t& m) {
 
 void reserve_storage(sim_truth_t& m) { m.y_true_m.reserve(sim_truth_t::MAX_TICKS); }
 
-void clear_arrays(sensor_block_t& m) noexcept {
-  m.u_V.clear();
-  m.u_ff_V.clear();
-  m.u_fb_V.clear();
-  m.y_ref_m.clear();
-  m.y_m.clear();
-  m.flags.clear();
-}
+void clear_arrays(sensor_block_t& m) noexcept { clear_all(m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags); }
 
-void clear_arrays(command_block_t& m) noexcept {
-  m.u_ff_V.clear();
-  m.y_ref_m.clear();
-  m.params_version.clear();
-  m.mode.clear();
-}
+void clear_arrays(command_block_t& m) noexcept { clear_all(m.u_ff_V, m.y_ref_m, m.params_version, m.mode); }
 
 void clear_arrays(sim_truth_t& m) noexcept { m.y_true_m.clear(); }
 
@@ -51,60 +43,39 @@ bool arrays_consistent(const command_block_t& m) noexcept {
 
 bool arrays_consistent(const sim_truth_t& m) noexcept { return all_sized(m.n_ticks, m.y_true_m); }
 
-void reserve_storage(trajectory_t& msg) {
-  msg.points_t_s.reserve(trajectory_t::MAX_POINTS);
-  msg.points_y_m.reserve(trajectory_t::MAX_POINTS);
-}
+void reserve_storage(trajectory_t& msg) { reserve_all(trajectory_t::MAX_POINTS, msg.points_t_s, msg.points_y_m); }
 
 void reserve_storage(mem_params_t& msg) { msg.source.reserve(kReservedStringChars); }
 
 void reserve_storage(model_params_t& msg) {
   msg.source.reserve(kReservedStringChars);
-  msg.pi_thresholds_V.reserve(model_params_t::MAX_OPERATORS);
-  msg.pi_weights.reserve(model_params_t::MAX_OPERATORS);
+  reserve_all(model_params_t::MAX_OPERATORS, msg.pi_thresholds_V, msg.pi_weights);
 }
 
-void clear_arrays(model_params_t& msg) noexcept {
-  msg.pi_thresholds_V.clear();
-  msg.pi_weights.clear();
-}
+void clear_arrays(model_params_t& msg) noexcept { clear_all(msg.pi_thresholds_V, msg.pi_weights); }
 
 bool arrays_consistent(const model_params_t& msg) noexcept {
-  const auto n = static_cast<std::size_t>(msg.n_operators);
-  return msg.n_operators >= 0 && msg.pi_thresholds_V.size() == n && msg.pi_weights.size() == n;
+  return all_sized(msg.n_operators, msg.pi_thresholds_V, msg.pi_weights);
 }
 
 void reserve_storage(service_status_t& msg) {
-  msg.process.reserve(kReservedStringChars);
-  msg.host.reserve(kReservedStringChars);
-  msg.detail.reserve(kReservedStringChars);
-  msg.counter_names.reserve(service_status_t::MAX_COUNTERS);
-  msg.counter_values.reserve(service_status_t::MAX_COUNTERS);
+  reserve_all(kReservedStringChars, msg.process, msg.host, msg.detail);
+  reserve_all(service_status_t::MAX_COUNTERS, msg.counter_names, msg.counter_values);
 }
 
-void reserve_storage(control_t& msg) {
-  msg.target.reserve(kReservedStringChars);
-  msg.experiment.reserve(kReservedStringChars);
-}
+void reserve_storage(control_t& msg) { reserve_all(kReservedStringChars, msg.target, msg.experiment); }
 
-void clear_arrays(trajectory_t& msg) noexcept {
-  msg.points_t_s.clear();
-  msg.points_y_m.clear();
-}
+void clear_arrays(trajectory_t& msg) noexcept { clear_all(msg.points_t_s, msg.points_y_m); }
 
-void clear_arrays(service_status_t& msg) noexcept {
-  msg.counter_names.clear();  // destroys the strings; their heap buffers, if any, go with them
-  msg.counter_values.clear();
-}
+// Clearing counter_names destroys the strings; their heap buffers, if any, go with them.
+void clear_arrays(service_status_t& msg) noexcept { clear_all(msg.counter_names, msg.counter_values); }
 
 bool arrays_consistent(const trajectory_t& msg) noexcept {
-  return msg.n_points >= 0 && msg.points_t_s.size() == static_cast<std::size_t>(msg.n_points) &&
-         msg.points_y_m.size() == static_cast<std::size_t>(msg.n_points);
+  return all_sized(msg.n_points, msg.points_t_s, msg.points_y_m);
 }
 
 bool arrays_consistent(const service_status_t& msg) noexcept {
-  return msg.n_counters >= 0 && msg.counter_names.size() == static_cast<std::size_t>(msg.n_counters) &&
-         msg.counter_values.size() == static_cast<std::size_t>(msg.n_counters);
+  return all_sized(msg.n_counters, msg.counter_names, msg.counter_values);
 }
 
 }  // namespace hystloop
