@@ -415,27 +415,24 @@ void Compensator::check_running_line(const ModelParamSet& candidate, bool switch
 void Compensator::offer_mem_params(const MemParams& params, std::int32_t version) {
   ModelParamSet set;
   set.mem = params;
-  try {
-    params.validate();
-    check_running_line(set, false);
-  } catch (const ParameterError&) {
-    ++counters_.params_rejected;
-    throw;
-  }
-  pending_ = Pending{set, false};
-  pending_version_ = version;
-  ++counters_.params_accepted;
+  offer(set, false, version);
 }
 
-void Compensator::offer_model(const ModelParamSet& params, std::int32_t version) {
+void Compensator::offer_model(const ModelParamSet& params, std::int32_t version) { offer(params, true, version); }
+
+void Compensator::offer(const ModelParamSet& set, bool switch_model, std::int32_t version) {
   try {
-    params.validate(config_.dt_s);
-    check_running_line(params, true);
+    if (switch_model) {
+      set.validate(config_.dt_s);
+    } else {
+      set.mem.validate();  // MEM's parameters only: the rest of the set is not offered
+    }
+    check_running_line(set, switch_model);
   } catch (const ParameterError&) {
     ++counters_.params_rejected;
     throw;
   }
-  pending_ = Pending{params, true};
+  pending_ = Pending{set, switch_model};
   pending_version_ = version;
   ++counters_.params_accepted;
 }
@@ -598,31 +595,27 @@ double Compensator::servo_share_m(const CompensatorInput& sample) noexcept {
   return servo_share_stage_->step(w, config_.dt_s);
 }
 
-void Compensator::take_params_from(const Compensator& old) noexcept {
-  inverses_.take_params_from(old.inverses_);
-  params_version_ = old.params_version_;
-  const std::uint64_t swaps = counters_.stage_swaps;
-  set_stage(old.stage_model_);
-  counters_.stage_swaps = swaps;
-  learner_.set_enabled(old.learner_.enabled());
-  pending_ = old.pending_;
-  pending_version_ = old.pending_version_;
-}
-
 Compensator Compensator::restarted(CompensatorConfig config, std::string& refusal) const {
   config.mem = mem_params();
   config.mode = mode();
   TrajectorySpec reference = trajectory();
   reference.hold_m = 0.0;
   Compensator next(config);
-  next.take_params_from(*this);
+  // The parameter sets given here: the one in use with its version, and one waiting for a reversal.
+  next.inverses_.take_params_from(inverses_);
+  next.params_version_ = params_version_;
+  next.set_stage(stage_model_);
+  next.counters_.stage_swaps = 0;  // the same stage: no swap
+  next.learner_.set_enabled(learner_.enabled());
+  next.pending_ = pending_;
+  next.pending_version_ = pending_version_;
   refusal.clear();
   try {
-    next.set_trajectory(reference, std::numeric_limits<double>::quiet_NaN());
+    next.set_trajectory(reference, kNaN);
   } catch (const ParameterError& e) {
     // Taken before, infeasible now (the sets in use changed since): hold where the new law starts
     // rather than clamp; the operator sends it again, or a feasible one.
-    next.set_trajectory(TrajectorySpec{}, std::numeric_limits<double>::quiet_NaN());
+    next.set_trajectory(TrajectorySpec{}, kNaN);
     refusal = e.what();
   }
   return next;

@@ -259,9 +259,6 @@ class Compensator {
   // First tick not yet planned (-1 before the first sample).
   std::int64_t next_tick() const noexcept { return next_tick_; }
   const CompensatorConfig& config() const noexcept { return config_; }
-  // A restarted control law keeps the parameter sets `old` was given: the one in use with its
-  // version, and one waiting for a reversal.
-  void take_params_from(const Compensator& old) noexcept;
   // The control law for a bridge that restarted (its tick numbering went back): a new one from
   // `config` with what is in force here — the parameter sets, the tracking mode (an experiment is
   // not one), the reference from its start. A reference the sets now in force make infeasible is
@@ -280,6 +277,8 @@ class Compensator {
   // Throws ParameterError when `candidate` swapped in would take the periodic line in force
   // beyond the plan's share of the slew (a dry run in a copy; nothing to check without a line).
   void check_running_line(const ModelParamSet& candidate, bool switch_model) const;
+  // offer_model (switch_model) and offer_mem_params: validated, checked, counted, then pending.
+  void offer(const ModelParamSet& set, bool switch_model, std::int32_t version);
   double feasible_amplitude(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const;
   void restart_learning(std::int64_t k) noexcept;
   void set_stage(const StageModel& stage) noexcept;

@@ -455,23 +455,19 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
       if (n == name) semantic_rejects += reported_.since(n, value);
     }
   }
-  status_.counter("trajectory_version",
-                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_version)));
-  status_.counter("trajectory_refused_version",
-                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_refused_version)));
-  status_.counter("trajectory_shaped_version",
-                  static_cast<std::uint64_t>(std::max<std::int64_t>(0, counters_.trajectory_shaped_version)));
+  // Versions and tick distances below 0 (none yet) are reported as 0: the counters are unsigned.
+  const auto at_least_0 = [](std::int64_t v) { return static_cast<std::uint64_t>(std::max<std::int64_t>(0, v)); };
+  status_.counter("trajectory_version", at_least_0(counters_.trajectory_version));
+  status_.counter("trajectory_refused_version", at_least_0(counters_.trajectory_refused_version));
+  status_.counter("trajectory_shaped_version", at_least_0(counters_.trajectory_shaped_version));
   acks_.report(status_);
   status_.counter("mode", static_cast<std::uint64_t>(c.mode()));  // the tracking mode (command_block_t.MODE_*)
-  status_.counter("params_version", static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.params_version())));
+  status_.counter("params_version", at_least_0(c.params_version()));
   status_.counter("learning_active", learner.active ? 1u : 0u);
   status_.counter("learning_periods", learner.periods_learned);
   status_.counter("params_held_by_learning", c.params_held_by_learning() ? 1u : 0u);
   status_.counter("learning_rms_pm", static_cast<std::uint64_t>(std::llround(learner.last_error_rms_m * 1e12)));
-  if (c.next_tick() >= 0) {
-    status_.counter("plan_ahead_ticks",
-                    static_cast<std::uint64_t>(std::max<std::int64_t>(0, c.next_tick() - 1 - c.last_seq())));
-  }
+  if (c.next_tick() >= 0) status_.counter("plan_ahead_ticks", at_least_0(c.next_tick() - 1 - c.last_seq()));
   reported_.report(status_, "sensor", samples_.counters());
   reported_.report(status_, "trajectory", trajectories_.counters());
   reported_.report(status_, "params", params_.counters());
