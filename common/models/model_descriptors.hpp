@@ -140,9 +140,9 @@ struct KatalenicDescriptor : StoresParams<KatalenicDescriptor, KatalenicParams> 
 
  private:
   template <class F, class S, class K, class D, class C>
-  static void shaping_on_wire(F& f, S& s, K& kind, D& gain, D& offset, C& coefficients, D& domain_min, D& domain_max,
-                              D& amplitude, D& scale) {
-    f(kind, s.kind);
+  static void shaping_on_wire(F& f, S& s, K& shaping_kind, D& gain, D& offset, C& coefficients, D& domain_min,
+                              D& domain_max, D& amplitude, D& scale) {
+    f(shaping_kind, s.kind);
     f(gain, s.gain);
     f(offset, s.offset);
     f(coefficients, s.coefficients);
