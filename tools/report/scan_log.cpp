@@ -9,7 +9,6 @@
 #include "lcm/status_counters.hpp"
 #include "lcm/trajectory_shape.hpp"
 #include "log_reader.hpp"
-#include "models/model_set.hpp"
 
 namespace hystloop::report {
 
@@ -52,7 +51,6 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
   trajectory_t trajectory;
   control_t control;
   service_status_t status;
-  model_params_t model;
   for_each_event(files, [&](const lcm::LogEvent& event) {
     const std::int64_t t = event.timestamp;
     if (event.channel == channels.trajectory) {
@@ -81,13 +79,7 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
       s.learning_rms_pm = find_counter(status, "learning_rms_pm");
       s.model_switches = find_counter(status, "model_switches");
       s.params_swapped = find_counter(status, "params_swapped");
-      s.u_clamped = find_counter(status, "u_clamped");
-      s.u_slew_clamped = find_counter(status, "u_slew_clamped");
       out.compensator.push_back(std::move(s));
-    } else if (event.channel == channels.model) {
-      if (!decode_checked(event, model)) return;
-      const auto kind = model_kind_from_int(model.kind);
-      out.models.push_back({t, kind ? std::string(to_string(*kind)) : "unknown", model.valid != 0});
     }
   });
   return out;

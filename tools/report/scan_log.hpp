@@ -1,9 +1,9 @@
 #pragma once
 // What the scan table needs from a log beyond RunData (run_data.hpp): the trajectories sent on
 // HX_TRAJECTORY, the requests on HX_CONTROL that change what the loop does (SET_LEARNING,
-// SET_MODE, START_EXPERIMENT, DISARM, SHUTDOWN), HX_MODEL publications and the compensator's HX_STATUS
-// reports (its verdict on each trajectory, its learning figures, the model it runs). Times are
-// the log's receive timestamps, the same clock as RunData's samples.
+// SET_MODE, START_EXPERIMENT, DISARM, SHUTDOWN) and the compensator's HX_STATUS reports (its
+// verdict on each trajectory, its learning figures, the model it runs). Times are the log's
+// receive timestamps, the same clock as RunData's samples.
 //
 // Senders repeat a request over UDP with the same id (hystloop-ctl: 3 times) and a trajectory
 // with the same version: each is kept once, at its first receipt.
@@ -44,21 +44,13 @@ struct ScanCompensatorStatus {
   std::string detail;
   std::optional<std::int64_t> trajectory_version, trajectory_refused_version, trajectory_shaped_version;
   std::optional<std::int64_t> learning_active, learning_periods, learning_rms_pm;
-  std::optional<std::int64_t> model_switches, params_swapped, u_clamped, u_slew_clamped;
-};
-
-// An HX_MODEL publication (a model change or refit by the re-identifier).
-struct ScanModelEvent {
-  std::int64_t recv_utime = 0;
-  std::string model;  // ModelKind's name
-  bool valid = false;
+  std::optional<std::int64_t> model_switches, params_swapped;
 };
 
 struct ScanEvents {
   std::vector<ScanTrajectory> trajectories;  // in log order, one per version
   std::vector<ScanControl> controls;         // in log order, one per request id
   std::vector<ScanCompensatorStatus> compensator;
-  std::vector<ScanModelEvent> models;
 };
 
 // Reads `files` in order (as read_logs does). Events that do not decode are skipped here: the
