@@ -20,7 +20,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,14 +46,11 @@ struct Options {
   std::vector<fs::path> logs;
   fs::path out;
   std::vector<std::string> csv;
-  std::optional<double> from_s, to_s;
-  double skip_initial_s = 0.0;
+  ReportOptions range;  // --from, --to, --skip-initial, --bridge-process, --logger-process
   std::string rig = std::string(kDefaultRigPrefix);
   bool quiet = false;
   bool no_plots = false;
   PlotOptions plots;
-  std::string bridge_process = "bridge";
-  std::string logger_process = "logger";
   ScanReportOptions scan;  // --scan, --no-scan, --scan-settle, --compensator-process
 };
 
@@ -86,13 +82,7 @@ class Progress {
 
 int run(const Options& o) {
   const ChannelNames channels(o.rig);
-  ReportOptions ro;
-  ro.from_s = o.from_s;
-  ro.to_s = o.to_s;
-  ro.skip_initial_s = o.skip_initial_s;
-  ro.bridge_process = o.bridge_process;
-  ro.logger_process = o.logger_process;
-  ro.validate();
+  o.range.validate();
   o.scan.figures.validate();
   if (o.plots.max_points == 0) throw ParameterError("--plot-max-points", "must be > 0 (got 0)");
 
@@ -124,24 +114,24 @@ int run(const Options& o) {
   if (ec || !fs::is_directory(o.out)) throw std::runtime_error(o.out.string() + ": cannot create the folder");
 
   progress.phase("computing the figures of " + std::to_string(data.samples.size()) + " ticks");
-  const ReportMetrics metrics = compute_metrics(data, ro);
+  const ReportMetrics metrics = compute_metrics(data, o.range);
   if (data.samples.empty()) {
     std::fprintf(stderr, "hystloop-report: warning: no %s ticks in the log; most figures are null\n",
                  channels.sensor.c_str());
   }
-  write_text_file(o.out / "summary.json", summary_json(metrics, ro, o.logs));
+  write_text_file(o.out / "summary.json", summary_json(metrics, o.range, o.logs));
 
   std::vector<CsvExport> exports;
   if (!csv_channels.empty()) {
     progress.phase("exporting CSV");
-    exports = export_csv(o.logs, csv_channels, data.time_zero_utime(), ro.lower_s(), ro.upper_s(), o.out);
+    exports = export_csv(o.logs, csv_channels, data.time_zero_utime(), o.range.lower_s(), o.range.upper_s(), o.out);
   }
   PlotResult plots;
   if (!o.no_plots) {
     progress.phase("writing the plots' data");
     PlotOptions plot_options = o.plots;
     plot_options.progress = [&progress](const std::string& step) { progress.phase(step); };
-    plots = write_plots(track_points(data, ro), metrics, o.out, plot_options);
+    plots = write_plots(track_points(data, o.range), metrics, o.out, plot_options);
     if (!plots.warning.empty()) std::fprintf(stderr, "hystloop-report: warning: %s\n", plots.warning.c_str());
   }
 
@@ -174,14 +164,14 @@ int report_main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--out", o.out, "Output folder (created if missing)")->required();
   app.add_option("--csv", o.csv, "Export a channel to DIR/<channel>.csv, e.g. HX_SENSOR or SENSOR (repeatable)");
-  app.add_option("--from", o.from_s, "Start of the analysed range [s after the first sensor tick]");
-  app.add_option("--to", o.to_s, "End of the analysed range [s after the first sensor tick]");
-  app.add_option("--skip-initial", o.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
+  app.add_option("--from", o.range.from_s, "Start of the analysed range [s after the first sensor tick]");
+  app.add_option("--to", o.range.to_s, "End of the analysed range [s after the first sensor tick]");
+  app.add_option("--skip-initial", o.range.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
       ->capture_default_str();
   app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();
-  app.add_option("--bridge-process", o.bridge_process, "Process name of the bridge in HX_STATUS")
+  app.add_option("--bridge-process", o.range.bridge_process, "Process name of the bridge in HX_STATUS")
       ->capture_default_str();
-  app.add_option("--logger-process", o.logger_process, "Process name of the logger in HX_STATUS")
+  app.add_option("--logger-process", o.range.logger_process, "Process name of the logger in HX_STATUS")
       ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "Print nothing but warnings and errors");
   app.add_flag("--no-plots", o.no_plots, "Write no plots");
