@@ -107,7 +107,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
             {tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m, k.flags});
         armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
       });
-      run.sensor_blocks.push_back({t, sensor.seq, sensor.n_ticks, sensor.dt_s, sensor.buffer_depth_ticks, armed});
+      run.sensor_blocks.push_back({t, sensor.dt_s, sensor.buffer_depth_ticks, armed});
       const auto n = static_cast<std::size_t>(sensor.n_ticks);
       const BlockSamples block{run.samples.size() - n, n};
       sensor_blocks[sensor.seq] = block;
@@ -124,7 +124,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
       }
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
-      run.command_blocks.push_back({t, command.seq, command.sample_seq, command.n_ticks});
+      run.command_blocks.push_back({t, command.seq, command.sample_seq});
       for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version, k.mode); });
     } else if (event.channel == channels.params) {
       if (!decode_checked(event, params)) return void(++run.undecodable);
@@ -139,8 +139,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
                             kind ? std::string(to_string(*kind)) : "unknown", model.heldout_rms_m, true});
     } else if (event.channel == channels.status) {
       if (!decode_checked(event, status)) return void(++run.undecodable);
-      StatusRecord record{t,  status.process, status.state,      status.late, status.rejected,
-                          {}, status.utime,   status.start_utime};
+      StatusRecord record{t, status.process, status.rejected, {}, status.utime, status.start_utime};
       for (std::size_t i = 0; i < status.counter_names.size(); ++i) {
         record.counters.emplace_back(status.counter_names[i], status.counter_values[i]);
       }

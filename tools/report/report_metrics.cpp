@@ -11,19 +11,13 @@ namespace hystloop::report {
 
 namespace {
 
-constexpr std::int32_t kSafeStateFlag = sensor_block_t::SAFE_STATE;
-constexpr std::int32_t kLateCommandFlag = sensor_block_t::LATE_COMMAND;
-constexpr std::int32_t kSaturatedFlag = sensor_block_t::SATURATED;
-constexpr std::int32_t kSlewLimitedFlag = sensor_block_t::SLEW_LIMITED;
 // A SAFE_STATE transition up to this long after a DISARM/SHUTDOWN request for the bridge is its
 // answer, not a watchdog trip (a tick is dated no earlier than it was sampled, but allow for the
 // request reaching the logger after the bridge).
 constexpr std::int64_t kRequestBefore_us = 200'000;
 constexpr std::int64_t kRequestAfter_us = 50'000;
 
-double rms(double sum_sq, std::size_t n) { return std::sqrt(sum_sq / static_cast<double>(n)); }
-
-bool armed(const SampleRecord& s) { return (s.flags & kSafeStateFlag) == 0; }
+bool armed(const SampleRecord& s) { return (s.flags & sensor_block_t::SAFE_STATE) == 0; }
 
 // True when a DISARM or SHUTDOWN request for the bridge explains a safe state entered at utime.
 bool requested_safe(const RunData& run, const std::string& bridge, std::int64_t utime) {
@@ -33,12 +27,11 @@ bool requested_safe(const RunData& run, const std::string& bridge, std::int64_t 
   });
 }
 
-void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, ReportMetrics& m) {
-  auto t_of = [t0](std::int64_t utime) { return static_cast<double>(utime - t0) * 1e-6; };
+void fill_params(const RunData& run, double lo, double hi, ReportMetrics& m) {
   const double start = m.first_sample_t_s.value_or(lo);
   const ParamsRecord* initial = nullptr;
   for (const auto& p : run.params) {
-    const double t = t_of(p.recv_utime);
+    const double t = run.t_s(p.recv_utime);
     if (t > hi) continue;
     if (t >= lo) {
       const bool seen = std::any_of(m.params_history.begin(), m.params_history.end(),
@@ -53,7 +46,7 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
   }
   if (initial == nullptr) {
     for (const auto& p : run.params) {
-      const double t = t_of(p.recv_utime);
+      const double t = run.t_s(p.recv_utime);
       if (p.valid && p.model == "mem" && t >= lo && t <= hi) {
         initial = &p;
         break;
@@ -64,7 +57,7 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
   m.params_initial = MemParams{initial->version, initial->c1, initial->c2, initial->c3};
   MemParams current = *m.params_initial;
   for (const auto& p : run.params) {
-    const double t = t_of(p.recv_utime);
+    const double t = run.t_s(p.recv_utime);
     if (!p.valid || p.model != "mem" || &p == initial || t <= start || t < lo || t > hi) continue;
     if (p.version != current.version) ++m.params_updates;
     current = MemParams{p.version, p.c1, p.c2, p.c3};
@@ -73,9 +66,9 @@ void fill_params(const RunData& run, double lo, double hi, std::int64_t t0, Repo
 }
 
 // Buffer depth of the armed sensor blocks, and the tick period.
-void fill_blocks(const RunData& run, double lo, double hi, std::int64_t t0, ReportMetrics& m) {
+void fill_blocks(const RunData& run, double lo, double hi, ReportMetrics& m) {
   for (const auto& b : run.sensor_blocks) {
-    const double t = static_cast<double>(b.recv_utime - t0) * 1e-6;
+    const double t = run.t_s(b.recv_utime);
     if (t < lo || t > hi) continue;
     ++m.sensor_blocks;
     if (!m.tick_period_s) m.tick_period_s = b.dt_s;
@@ -84,7 +77,7 @@ void fill_blocks(const RunData& run, double lo, double hi, std::int64_t t0, Repo
     m.buffer_min_depth_ticks = std::min(m.buffer_min_depth_ticks.value_or(b.buffer_depth_ticks), b.buffer_depth_ticks);
   }
   for (const auto& c : run.command_blocks) {
-    const double t = static_cast<double>(c.recv_utime - t0) * 1e-6;
+    const double t = run.t_s(c.recv_utime);
     if (t < lo || t > hi || c.sample_seq < 0) continue;
     m.run_ahead_ticks.push_back(static_cast<double>(c.seq - c.sample_seq));
   }
@@ -96,7 +89,7 @@ void fill_blocks(const RunData& run, double lo, double hi, std::int64_t t0, Repo
 }
 
 // Events of each channel received within the sampled span, per second of it.
-void fill_message_rates(const RunData& run, std::int64_t t0, ReportMetrics& m) {
+void fill_message_rates(const RunData& run, ReportMetrics& m) {
   for (const auto& [channel, times] : run.event_times) {
     if (!m.first_sample_t_s || !(m.duration_s > 0.0)) {
       m.messages_per_s[channel] = std::nullopt;
@@ -104,7 +97,7 @@ void fill_message_rates(const RunData& run, std::int64_t t0, ReportMetrics& m) {
     }
     const double first = *m.first_sample_t_s, last = *m.last_sample_t_s;
     const auto n = std::count_if(times.begin(), times.end(), [&](std::int64_t utime) {
-      const double t = static_cast<double>(utime - t0) * 1e-6;
+      const double t = run.t_s(utime);
       return t >= first && t <= last;
     });
     m.messages_per_s[channel] = static_cast<double>(n) / m.duration_s;
@@ -139,12 +132,11 @@ std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) 
 }
 
 std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& options) {
-  const std::int64_t t0 = run.time_zero_utime();
   const double lo = options.lower_s(), hi = options.upper_s();
   std::vector<TrackPoint> points;
   points.reserve(run.samples.size());
   for (const auto& s : run.samples) {
-    const double t = static_cast<double>(s.recv_utime - t0) * 1e-6;
+    const double t = run.t_s(s.recv_utime);
     if (t < lo || t > hi) continue;
     const VersionRun* command = run.command_versions.run_at(s.seq);
     points.push_back({t, s.u_V, s.y_m, s.y_ref_m, command != nullptr ? command->mode : VersionRun::kUnknownMode,
@@ -160,24 +152,22 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   m.undecodable = run.undecodable;
 
   const std::int64_t t0 = run.time_zero_utime();
-  auto t_of = [t0](std::int64_t utime) { return static_cast<double>(utime - t0) * 1e-6; };
   const double lo = options.lower_s(), hi = options.upper_s();
 
   struct BinSum {
-    double sum_sq = 0.0;
-    std::size_t n = 0;
+    RmsSum error;
     std::optional<std::int32_t> version;
     std::size_t clamped = 0;
   };
   std::map<std::int64_t, BinSum> bins;
   std::vector<std::pair<double, double>> track;  // (t_s, e_m)
-  double sum_sq = 0.0;
+  RmsSum all;
   const SampleRecord* prev = nullptr;
   std::int64_t safe_transitions = 0;
   std::optional<std::int32_t> applied;  // the version of the last tick with a logged command
 
   for (const auto& s : run.samples) {
-    const double t = t_of(s.recv_utime);
+    const double t = run.t_s(s.recv_utime);
     if (t < lo || t > hi) continue;
     ++m.samples;
     if (!m.first_sample_t_s) m.first_sample_t_s = t;
@@ -188,7 +178,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     }
     if (armed(s)) {
       ++m.armed_samples;
-      if ((s.flags & kLateCommandFlag) != 0) ++m.late_samples;
+      if ((s.flags & sensor_block_t::LATE_COMMAND) != 0) ++m.late_samples;
     } else if (prev != nullptr && armed(*prev) && !requested_safe(run, options.bridge_process, s.recv_utime)) {
       ++safe_transitions;
     }
@@ -199,7 +189,8 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
       if (applied && *applied != *version) m.swaps.push_back({t, s.seq, *applied, *version});
       applied = version;
     }
-    const bool range_clamped = (s.flags & kSaturatedFlag) != 0, slew_clamped = (s.flags & kSlewLimitedFlag) != 0;
+    const bool range_clamped = (s.flags & sensor_block_t::SATURATED) != 0;
+    const bool slew_clamped = (s.flags & sensor_block_t::SLEW_LIMITED) != 0;
     m.clamped_range_samples += range_clamped ? 1 : 0;
     m.clamped_slew_samples += slew_clamped ? 1 : 0;
     if (range_clamped || slew_clamped) {
@@ -208,9 +199,8 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
     }
     if (!std::isfinite(s.y_ref_m)) continue;
     const double e = s.y_ref_m - s.y_m;
-    bin.sum_sq += e * e;
-    ++bin.n;
-    sum_sq += e * e;
+    bin.error.add(e);
+    all.add(e);
     track.emplace_back(t, e);
   }
   if (m.first_sample_t_s) m.duration_s = *m.last_sample_t_s - *m.first_sample_t_s;
@@ -218,7 +208,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   // Tracking figures.
   m.tracking_samples = track.size();
   if (!track.empty()) {
-    m.rms_error_m = rms(sum_sq, track.size());
+    m.rms_error_m = all.rms();
     double max_abs = 0.0, t_first = track.front().first, t_last = track.front().first;
     for (const auto& [t, e] : track) {
       max_abs = std::max(max_abs, std::abs(e));
@@ -226,14 +216,13 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
       t_last = std::max(t_last, t);
     }
     m.max_abs_error_m = max_abs;
-    double first_sq = 0.0, last_sq = 0.0;
-    std::size_t first_n = 0, last_n = 0;
+    RmsSum first, last;
     for (const auto& [t, e] : track) {
-      if (t < t_first + 5.0) first_sq += e * e, ++first_n;
-      if (t > t_last - 5.0) last_sq += e * e, ++last_n;
+      if (t < t_first + 5.0) first.add(e);
+      if (t > t_last - 5.0) last.add(e);
     }
-    m.rms_error_first_5s_m = rms(first_sq, first_n);
-    m.rms_error_last_5s_m = rms(last_sq, last_n);
+    m.rms_error_first_5s_m = first.rms();
+    m.rms_error_last_5s_m = last.rms();
   }
 
   // One line per second, empty seconds included, the version carried forward.
@@ -244,9 +233,9 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
       out.t_s = static_cast<double>(second);
       if (const auto it = bins.find(second); it != bins.end()) {
         if (it->second.version) version = *it->second.version;
-        out.tracking_samples = it->second.n;
+        out.tracking_samples = it->second.error.n;
         out.clamped_samples = it->second.clamped;
-        if (it->second.n > 0) out.rms_error_m = rms(it->second.sum_sq, it->second.n);
+        out.rms_error_m = it->second.error.rms();
       }
       out.params_version = version;
       m.per_second.push_back(out);
@@ -256,8 +245,8 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   if (m.armed_samples > 0) {
     m.late_command_fraction = static_cast<double>(m.late_samples) / static_cast<double>(m.armed_samples);
   }
-  fill_blocks(run, lo, hi, t0, m);
-  fill_message_rates(run, t0, m);
+  fill_blocks(run, lo, hi, m);
+  fill_message_rates(run, m);
 
   const std::int64_t upper_utime = std::isfinite(hi) ? t0 + static_cast<std::int64_t>(std::floor(hi * 1e6))
                                                      : std::numeric_limits<std::int64_t>::max();
@@ -267,7 +256,7 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   fill_logger_gaps(run, options, upper_utime, m);
   fill_watchdog_trips(run, options, upper_utime, safe_transitions, m);
   fill_cpu_fraction(run, lower_utime, upper_utime, m);
-  fill_params(run, lo, hi, t0, m);
+  fill_params(run, lo, hi, m);
   return m;
 }
 

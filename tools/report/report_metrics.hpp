@@ -12,6 +12,7 @@
 // Armed: a tick without SAFE_STATE; a sensor block with no SAFE_STATE tick.
 // Percentiles are nearest-rank: the ceil(q*n)-th smallest value.
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -127,6 +128,19 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options);
 
 // Nearest-rank percentile of an ascending vector, q in [0, 1]; nullopt when empty.
 std::optional<double> nearest_rank(const std::vector<double>& sorted, double q) noexcept;
+
+// The RMS of the errors added; nullopt when none was.
+struct RmsSum {
+  double sum_sq = 0.0;
+  std::size_t n = 0;
+  void add(double e) noexcept {
+    sum_sq += e * e;
+    ++n;
+  }
+  std::optional<double> rms() const noexcept {
+    return n == 0 ? std::nullopt : std::optional<double>(std::sqrt(sum_sq / static_cast<double>(n)));
+  }
+};
 
 // One tick (for plots): time, applied voltage, measured and reference position, and what the
 // compensator commanded it with.

@@ -36,8 +36,6 @@ struct SampleRecord {
 // One HX_SENSOR block (its ticks are in RunData::samples).
 struct SensorBlockRecord {
   std::int64_t recv_utime = 0;
-  std::int64_t seq = 0;
-  std::int32_t n_ticks = 0;
   double dt_s = 0.0;
   std::int32_t buffer_depth_ticks = 0;
   bool armed = false;  // no tick of the block is SAFE_STATE
@@ -48,7 +46,6 @@ struct CommandBlockRecord {
   std::int64_t recv_utime = 0;
   std::int64_t seq = 0;          // first tick it plans
   std::int64_t sample_seq = -1;  // last sensor tick the compensator had (-1: none)
-  std::int32_t n_ticks = 0;
 };
 
 // params_version and mode of the command ticks [first_seq, end_seq): consecutive ticks with one
@@ -93,8 +90,6 @@ struct ParamsRecord {
 struct StatusRecord {
   std::int64_t recv_utime = 0;
   std::string process;
-  std::int8_t state = 0;
-  std::int64_t late = 0;
   std::int64_t rejected = 0;
   std::vector<std::pair<std::string, std::int64_t>> counters;
   std::int64_t utime = 0;        // the sender's time of the report [us]
@@ -145,6 +140,8 @@ struct RunData {
     if (!samples.empty()) return samples.front().recv_utime;
     return first_event_utime.value_or(0);
   }
+  // The report's time axis: seconds of a receive time after time_zero_utime().
+  double t_s(std::int64_t utime) const noexcept { return static_cast<double>(utime - time_zero_utime()) * 1e-6; }
 };
 
 }  // namespace hystloop::report

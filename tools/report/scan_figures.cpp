@@ -6,28 +6,14 @@
 #include <limits>
 
 #include "core/errors.hpp"
+#include "report_metrics.hpp"
 #include "hystloop/sensor_block_t.hpp"
 
 namespace hystloop::report {
 
 namespace {
 
-constexpr std::int32_t kSaturated = sensor_block_t::SATURATED;
-constexpr std::int32_t kClampFlags = kSaturated | sensor_block_t::SLEW_LIMITED;
-
-double seconds(std::int64_t utime, std::int64_t zero) { return static_cast<double>(utime - zero) * 1e-6; }
-
-struct RmsSum {
-  double sum_sq = 0.0;
-  std::size_t n = 0;
-  void add(double e) {
-    sum_sq += e * e;
-    ++n;
-  }
-  std::optional<double> rms() const {
-    return n == 0 ? std::nullopt : std::optional<double>(std::sqrt(sum_sq / static_cast<double>(n)));
-  }
-};
+constexpr std::int32_t kClampFlags = std::int32_t{sensor_block_t::SATURATED} | sensor_block_t::SLEW_LIMITED;
 
 // The compensator's verdict on trajectory `t`: its first report that decides this version.
 void find_verdict(const ScanEvents& events, const ScanTrajectory& t, ReferenceFigures& r) {
@@ -120,11 +106,10 @@ void add_compensator_figures(const ScanEvents& events, const Segment& seg, Segme
 
 SegmentFigures measure(const RunData& run, const ScanEvents& events, const ScanTrajectory& t, const Segment& seg,
                        double dt_s, const ScanOptions& o) {
-  const std::int64_t zero = run.time_zero_utime();
   SegmentFigures f;
   f.learning = seg.learning;
-  f.start_s = seconds(seg.start_utime, zero);
-  f.end_s = seconds(seg.end_utime, zero);
+  f.start_s = run.t_s(seg.start_utime);
+  f.end_s = run.t_s(seg.end_utime);
   f.analysed_from_s = std::min(f.end_s, f.start_s + seg.skip_s);
   f.period_ticks = std::max<std::int64_t>(1, std::llround(1.0 / (t.frequency_hz * dt_s)));
   const double last_from_s = std::max(f.analysed_from_s, f.end_s - o.last_s);
@@ -147,7 +132,7 @@ SegmentFigures measure(const RunData& run, const ScanEvents& events, const ScanT
     if ((s.flags & sensor_block_t::SLEW_LIMITED) != 0) ++f.slew_limited_ticks;
     if ((s.flags & sensor_block_t::LATE_COMMAND) != 0) ++f.late_ticks;
     if ((s.flags & sensor_block_t::SAFE_STATE) != 0) ++f.safe_ticks;
-    const double t_s = seconds(s.recv_utime, zero);
+    const double t_s = run.t_s(s.recv_utime);
     if (!std::isfinite(s.y_ref_m) || t_s < f.analysed_from_s) continue;
     const double e = s.y_ref_m - s.y_m;
     all.add(e);
@@ -269,7 +254,6 @@ ScanResult compute_scan(const RunData& run, const ScanEvents& events, const Scan
   ScanResult result;
   result.options = o;
   if (!run.sensor_blocks.empty()) result.dt_s = run.sensor_blocks.front().dt_s;
-  const std::int64_t zero = run.time_zero_utime();
 
   // One row per periodic trajectory, in the order sent.
   std::vector<std::optional<std::size_t>> row_of(events.trajectories.size());
@@ -278,7 +262,7 @@ ScanResult compute_scan(const RunData& run, const ScanEvents& events, const Scan
     if (!t.periodic()) continue;
     ReferenceFigures r;
     r.trajectory = t;
-    r.sent_s = seconds(t.recv_utime, zero);
+    r.sent_s = run.t_s(t.recv_utime);
     find_verdict(events, t, r);
     row_of[i] = result.references.size();
     result.references.push_back(std::move(r));

@@ -33,7 +33,7 @@ RunData ramp_run(std::int64_t ticks, std::int64_t tick_us) {
 
 StatusRecord status(std::int64_t t, const std::string& process, std::vector<std::pair<std::string, std::int64_t>> c,
                     std::int64_t start_utime = 0) {
-  StatusRecord s{t, process, 1, 0, 0, std::move(c)};
+  StatusRecord s{t, process, 0, std::move(c)};
   s.utime = t;
   s.start_utime = start_utime;
   return s;
@@ -86,7 +86,7 @@ TEST(ComputeMetrics, RandomErrorsGiveTheirRms) {
     run.command_versions.add(k, 3);
   }
   for (std::int64_t b = 0; b < 500; ++b)
-    run.command_blocks.push_back({kT0 + b * 1000, b * 10 + 305, b * 10 + 4 - b % 7, 10});
+    run.command_blocks.push_back({kT0 + b * 1000, b * 10 + 305, b * 10 + 4 - b % 7});
   const auto m = compute_metrics(run, {});
   EXPECT_NEAR(*m.rms_error_m, std::sqrt(sum / 5000.0), 1e-18);
   EXPECT_NEAR(*m.rms_error_m, 30e-9, 2e-9);
@@ -145,7 +145,7 @@ TEST(CommandVersions, FirstLoggedCommandForATickWinsAndRunsCoalesce) {
 TEST(ComputeMetrics, NothingArmedGivesNoLateFraction) {
   RunData run = ramp_run(10, 100);
   for (auto& s : run.samples) s.flags = 2 | 16;  // SAFE_STATE | LATE_COMMAND
-  run.sensor_blocks.push_back({kT0 + 900, 0, 10, 1e-4, 0, false});
+  run.sensor_blocks.push_back({kT0 + 900, 1e-4, 0, false});
   const auto m = compute_metrics(run, {});
   EXPECT_EQ(m.armed_samples, 0u);
   EXPECT_FALSE(m.late_command_fraction);
@@ -162,8 +162,7 @@ TEST(ComputeMetrics, LateFractionAndBufferDepthCountArmedTicksAndBlocksOnly) {
     if (k % 10 == 3) s.flags |= 16;  // LATE_COMMAND: ticks 3, 13 safe; 23 .. 93 armed
   }
   for (std::int64_t b = 0; b < 10; ++b) {
-    run.sensor_blocks.push_back(
-        {kT0 + b * 1000 + 900, b * 10, 10, 1e-4, static_cast<std::int32_t>(b == 1 ? 0 : 40 - b), b >= 2});
+    run.sensor_blocks.push_back({kT0 + b * 1000 + 900, 1e-4, static_cast<std::int32_t>(b == 1 ? 0 : 40 - b), b >= 2});
   }
   const auto m = compute_metrics(run, {});
   EXPECT_EQ(m.armed_samples, 80u);
@@ -250,11 +249,10 @@ TEST(ComputeMetrics, RejectedCommandsFallBackToTheStatusField) {
   RunData run = ramp_run(10, 100);
   auto m = compute_metrics(run, {});
   EXPECT_FALSE(m.commands_rejected);
-  run.statuses.push_back({kT0, "bridge", 1, 0, 9, {{"ticks", 10}, {"control.rejected_out_of_range", 4}}, kT0, 0});
+  run.statuses.push_back({kT0, "bridge", 9, {{"ticks", 10}, {"control.rejected_out_of_range", 4}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 9);  // no command reject counter: the 'rejected' field
-  run.statuses.push_back(
-      {kT0 + 10, "bridge", 1, 0, 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}, kT0, 0});
+  run.statuses.push_back({kT0 + 10, "bridge", 9, {{"cmd.rejected_non_finite", 2}, {"rejected_future", 1}}, kT0, 0});
   m = compute_metrics(run, {});
   EXPECT_EQ(*m.commands_rejected, 3);
   EXPECT_EQ(m.commands_rejected_counters.size(), 2u);
