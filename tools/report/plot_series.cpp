@@ -46,8 +46,7 @@ std::array<SeriesFile, kGroups> write_groups(const std::vector<TrackPoint>& tick
   }
   for (std::size_t g = 0; g < kGroups; ++g) {
     if (!files[g]) continue;
-    files[g]->close();
-    out[g].file = paths[g];
+    out[g].file = files[g]->close();
   }
   return out;
 }
@@ -127,13 +126,14 @@ void DataFile::blank_line() {
   end_row();
 }
 
-void DataFile::close() {
-  if (file_ == nullptr) return;
+const std::filesystem::path& DataFile::close() {
+  if (file_ == nullptr) return path_;
   failed_ = failed_ || (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size());
   buffer_.clear();
   failed_ = std::fclose(file_) != 0 || failed_;
   file_ = nullptr;
   if (failed_) throw std::runtime_error(path_.string() + ": write failed");
+  return path_;
 }
 
 std::size_t decimation_step(std::size_t n, std::size_t max_points) noexcept {

@@ -39,8 +39,7 @@ class DataFile {
   DataFile& integer(long long v);
   void end_row();
   void blank_line();
-  void close();  // flushes; throws when a write failed
-  const std::filesystem::path& path() const noexcept { return path_; }
+  const std::filesystem::path& close();  // flushes; throws when a write failed; returns the file's path
 
  private:
   void flush_if_full();

@@ -100,8 +100,7 @@ std::string yref_y_script(const std::array<SeriesFile, 3>& yref_y) {
   return gp.str();
 }
 
-}  // namespace
-
+// Full path of an executable (PATH search unless `name` contains '/'), empty if none.
 std::filesystem::path find_executable(const std::string& name) {
   if (name.empty()) return {};
   if (name.find('/') != std::string::npos) return ::access(name.c_str(), X_OK) == 0 ? std::filesystem::path(name) : "";
@@ -114,6 +113,8 @@ std::filesystem::path find_executable(const std::string& name) {
   }
   return {};
 }
+
+}  // namespace
 
 PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics& m, const std::filesystem::path& dir,
                        const PlotOptions& options) {
@@ -134,8 +135,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
       out.integer(p.mode).integer(p.params_version.value_or(-1));
       out.end_row();
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   {
     DataFile out(dir / "per_second.dat");
@@ -144,8 +144,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
       out.num(bin.t_s).num(bin.rms_error_m ? *bin.rms_error_m * 1e9 : std::nan("")).integer(bin.params_version);
       out.end_row();
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   if (!m.params_history.empty()) {
     DataFile out(dir / "params.dat");
@@ -157,8 +156,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
       out.num(p.heldout_rms_m * 1e9).integer(p.valid ? 1 : 0).integer(p.model_change ? 1 : 0);
       out.text(" ").text(p.model).end_row();
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   const Histogram hist = run_ahead_histogram(m);
   {
@@ -169,8 +167,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
       out.num(lo).num(lo + hist.width).integer(static_cast<long long>(hist.counts[i]));
       out.end_row();
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   const std::vector<double> model_y = mem_model_y(ticks, m);
   const auto u_y = write_u_y_series(ticks, model_y, dir, options.max_points);

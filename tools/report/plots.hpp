@@ -61,7 +61,4 @@ void render_script(const GnuplotScript& script, const std::filesystem::path& dir
 PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics& metrics,
                        const std::filesystem::path& dir, const PlotOptions& options);
 
-// Full path of an executable (PATH search unless `name` contains '/'), empty if none.
-std::filesystem::path find_executable(const std::string& name);
-
 }  // namespace hystloop::report

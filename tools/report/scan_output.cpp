@@ -74,10 +74,9 @@ void write_error_block(DataFile& out, const RunData& run, const std::optional<Se
     out.text("NaN NaN\n\n\n");  // keeps the block numbering: two blocks per reference
     return;
   }
-  const std::int64_t zero = run.time_zero_utime();
   std::vector<std::pair<double, double>> ticks;
   for (const auto& k : run.samples) {
-    const double t = static_cast<double>(k.recv_utime - zero) * 1e-6;
+    const double t = run.t_s(k.recv_utime);
     if (t < s->start_s || t >= s->end_s || !std::isfinite(k.y_ref_m)) continue;
     ticks.emplace_back(t - origin_s, (k.y_ref_m - k.y_m) * 1e9);
   }
@@ -205,8 +204,7 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
       write_error_block(out, run, r.off, origin_s, per_segment);
       write_error_block(out, run, r.on, origin_s, per_segment);
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   std::map<std::string, std::vector<const ReferenceFigures*>> by_shape;
   for (const auto& r : scan.references) by_shape[r.trajectory.shape].push_back(&r);
@@ -227,8 +225,7 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
       }
       out.text("\n\n");
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
   {
     DataFile out(dir / "scan_periods.dat");
@@ -243,8 +240,7 @@ PlotResult write_scan_plots(const RunData& run, const ScanResult& scan, const st
       }
       out.text("\n\n");
     }
-    out.close();
-    result.data_files.push_back(out.path());
+    result.data_files.push_back(out.close());
   }
 
   std::ostringstream gp;
