@@ -24,6 +24,11 @@ std::string nm(const std::optional<double>& metres) {
 
 std::string ticks(const std::optional<double>& n) { return n ? fmt("%.0f", *n) : std::string("--"); }
 
+// A count with where it came from: "3  (last bridge status: watchdog_trips)"; "--  (...)" without one.
+std::string sourced(const std::optional<std::int64_t>& n, const std::string& source) {
+  return (n ? fmt("%lld", static_cast<long long>(*n)) : std::string("--")) + "  (" + source + ")";
+}
+
 std::string params(const std::optional<MemParams>& p) {
   return p ? fmt("v%d (c1 %.4g, c2 %.4g, c3 %.4g)", p->version, p->c1, p->c2, p->c3) : std::string("--");
 }
@@ -52,24 +57,19 @@ std::string format_table(const ReportMetrics& m) {
   row("run-ahead min/p1/p50", ticks(m.run_ahead_min_ticks) + " / " + ticks(m.run_ahead_p01_ticks) + " / " +
                                   ticks(m.run_ahead_p50_ticks) +
                                   fmt(" ticks  (n = %zu command blocks)", m.run_ahead_ticks.size()));
-  row("watchdog trips",
-      (m.watchdog_trips ? fmt("%lld", static_cast<long long>(*m.watchdog_trips)) : std::string("--")) + "  (" +
-          m.watchdog_trips_source + ")");
+  row("watchdog trips", sourced(m.watchdog_trips, m.watchdog_trips_source));
   std::string cpu;
   for (const auto& [process, fraction] : m.cpu_fraction) {
     cpu +=
         (cpu.empty() ? "" : ", ") + process + " " + (fraction ? fmt("%.1f %%", *fraction * 100.0) : std::string("--"));
   }
   row("cpu", cpu.empty() ? std::string("--  (no status)") : cpu);
-  row("commands rejected", m.commands_rejected ? fmt("%lld", static_cast<long long>(*m.commands_rejected)) + "  (" +
-                                                     m.commands_rejected_source + ")"
-                                               : "--  (" + m.commands_rejected_source + ")");
+  row("commands rejected", sourced(m.commands_rejected, m.commands_rejected_source));
   row("params initial", params(m.params_initial));
   row("params final", params(m.params_final) + fmt("  (%zu updates)", m.params_updates));
-  row("logger gaps", (m.logger_gaps ? fmt("%lld", static_cast<long long>(*m.logger_gaps)) : std::string("--")) + "  (" +
-                         m.logger_gaps_source + ")" +
-                         fmt("; sensor seq: %lld gaps, %lld missing", static_cast<long long>(m.seq_gaps),
-                             static_cast<long long>(m.missing_samples)));
+  row("logger gaps", sourced(m.logger_gaps, m.logger_gaps_source) + fmt("; sensor seq: %lld gaps, %lld missing",
+                                                                        static_cast<long long>(m.seq_gaps),
+                                                                        static_cast<long long>(m.missing_samples)));
   if (m.undecodable > 0) row("undecodable events", fmt("%llu", static_cast<unsigned long long>(m.undecodable)));
   return out;
 }

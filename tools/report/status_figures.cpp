@@ -37,8 +37,7 @@ std::optional<std::int64_t> report_cpu_us(const StatusRecord& s) {
   return *user + *system;
 }
 
-}  // namespace
-
+// The last status of `process` received at or before upper_utime; nullptr if none.
 const StatusRecord* last_status(const RunData& run, const std::string& process, std::int64_t upper_utime) {
   const StatusRecord* last = nullptr;
   for (const auto& status : run.statuses) {
@@ -46,6 +45,8 @@ const StatusRecord* last_status(const RunData& run, const std::string& process, 
   }
   return last;
 }
+
+}  // namespace
 
 void fill_commands_rejected(const RunData& run, const ReportOptions& options, std::int64_t upper_utime,
                             ReportMetrics& m) {

@@ -3,15 +3,11 @@
 // computed from the ticks when a report lacks them). Part of compute_metrics.
 
 #include <cstdint>
-#include <string>
 
 #include "report_metrics.hpp"
 #include "run_data.hpp"
 
 namespace hystloop::report {
-
-// The last status of `process` received at or before upper_utime; nullptr if none.
-const StatusRecord* last_status(const RunData& run, const std::string& process, std::int64_t upper_utime);
 
 // commands_rejected: the bridge's command reject counters (leaf "rejected*" or "stale" of no
 // other endpoint), else its 'rejected' field.

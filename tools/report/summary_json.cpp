@@ -52,6 +52,7 @@ Json params_history_json(const std::vector<ParamsPoint>& history) {
   return out;
 }
 
+// Name -> value pairs (a map, or a vector of pairs) as an object.
 template <class Map>
 Json map_json(const Map& map) {
   Json out = Json::object();
@@ -127,8 +128,7 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
 
   j["commands_rejected"] = number_or_null(m.commands_rejected);
   j["commands_rejected_source"] = m.commands_rejected_source;
-  j["commands_rejected_counters"] = Json::object();
-  for (const auto& [name, value] : m.commands_rejected_counters) j["commands_rejected_counters"][name] = value;
+  j["commands_rejected_counters"] = map_json(m.commands_rejected_counters);
 
   j["params_history"] = params_history_json(m.params_history);
   j["params_initial"] = params_json(m.params_initial);
