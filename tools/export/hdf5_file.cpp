@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -54,21 +55,17 @@ class Writer {
     check(attr.ok() && H5Awrite(attr.get(), type.get(), &data) >= 0, "attribute " + name);
   }
 
+  // An int64 or a double.
   template <class T>
-  void attribute(hid_t object, const std::string& name, T value, hid_t type) const {
+  void attribute(hid_t object, const std::string& name, T value) const {
+    const hid_t type = std::is_floating_point_v<T> ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT64;
     const Handle space(H5Screate(H5S_SCALAR), H5Sclose);
     const Handle attr(H5Acreate2(object, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     check(attr.ok() && H5Awrite(attr.get(), type, &value) >= 0, "attribute " + name);
   }
 
   void attribute(hid_t object, const RunAttribute& a) const {
-    if (const auto* text = std::get_if<std::string>(&a.value)) {
-      attribute(object, a.name, *text);
-    } else if (const auto* integer = std::get_if<std::int64_t>(&a.value)) {
-      attribute(object, a.name, *integer, H5T_NATIVE_INT64);
-    } else {
-      attribute(object, a.name, std::get<double>(a.value), H5T_NATIVE_DOUBLE);
-    }
+    std::visit([&](const auto& value) { attribute(object, a.name, value); }, a.value);
   }
 
   // A 1-D dataset of n elements of `type`, chunked and compressed when it holds anything.
@@ -115,7 +112,7 @@ class Writer {
     if (!c.description.empty()) attribute(set, "description", c.description);
     if (!c.legend.empty()) attribute(set, "legend", c.legend);
     if (!c.count_column.empty()) attribute(set, "count_column", c.count_column);
-    if (c.per_row > 0) attribute(set, "per_row", static_cast<std::int64_t>(c.per_row), H5T_NATIVE_INT64);
+    if (c.per_row > 0) attribute(set, "per_row", static_cast<std::int64_t>(c.per_row));
   }
 
   void table(hid_t file, const ChannelTable& t) const {
@@ -127,9 +124,9 @@ class Writer {
     check(group.ok(), "group " + name);
     attribute(group.get(), "channel", t.channel);
     attribute(group.get(), "lcm_type", t.type_name);
-    attribute(group.get(), "rows", static_cast<std::int64_t>(t.rows), H5T_NATIVE_INT64);
-    attribute(group.get(), "events", static_cast<std::int64_t>(t.events), H5T_NATIVE_INT64);
-    attribute(group.get(), "skipped_events", static_cast<std::int64_t>(t.skipped), H5T_NATIVE_INT64);
+    attribute(group.get(), "rows", static_cast<std::int64_t>(t.rows));
+    attribute(group.get(), "events", static_cast<std::int64_t>(t.events));
+    attribute(group.get(), "skipped_events", static_cast<std::int64_t>(t.skipped));
     for (const Column& c : t.columns) column(group.get(), c);
   }
 

@@ -27,37 +27,39 @@ Var checked(matvar_t* v, const std::string& what) {
   return Var(v);
 }
 
-Var text(const std::string& s) {
+// A char array of the text.
+Var var(const std::string& s) {
   size_t dims[2] = {s.empty() ? 0U : 1U, s.size()};
   return checked(Mat_VarCreate(nullptr, MAT_C_CHAR, MAT_T_UTF8, 2, dims, s.empty() ? nullptr : data_of(s.data()),
                                MAT_F_DONT_COPY_DATA),
                  "text");
 }
 
+// A rows-by-1 double or int64 array of the values at `data`, copied unless flags is MAT_F_DONT_COPY_DATA.
 template <class T>
-Var scalar(T value) {
-  size_t dims[2] = {1, 1};
+Var numbers(const T* data, std::size_t rows, int flags, const std::string& what) {
   constexpr bool f64 = std::is_floating_point_v<T>;
-  return checked(
-      Mat_VarCreate(nullptr, f64 ? MAT_C_DOUBLE : MAT_C_INT64, f64 ? MAT_T_DOUBLE : MAT_T_INT64, 2, dims, &value, 0),
-      "number");
+  size_t dims[2] = {rows, 1};
+  return checked(Mat_VarCreate(nullptr, f64 ? MAT_C_DOUBLE : MAT_C_INT64, f64 ? MAT_T_DOUBLE : MAT_T_INT64, 2, dims,
+                               rows == 0 ? nullptr : data_of(data), flags),
+                 what);
+}
+
+// A 1x1 double or int64.
+template <class T>
+Var var(T value) {
+  return numbers(&value, 1, 0, "number");
 }
 
 Var column(const Column& c) {
-  size_t dims[2] = {c.size(), 1};
   switch (c.type) {
-    case ColumnType::kFloat64:
-      return checked(Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims,
-                                   c.f64.empty() ? nullptr : data_of(c.f64.data()), MAT_F_DONT_COPY_DATA),
-                     c.name);
-    case ColumnType::kInt64:
-      return checked(Mat_VarCreate(nullptr, MAT_C_INT64, MAT_T_INT64, 2, dims,
-                                   c.i64.empty() ? nullptr : data_of(c.i64.data()), MAT_F_DONT_COPY_DATA),
-                     c.name);
+    case ColumnType::kFloat64: return numbers(c.f64.data(), c.size(), MAT_F_DONT_COPY_DATA, c.name);
+    case ColumnType::kInt64: return numbers(c.i64.data(), c.size(), MAT_F_DONT_COPY_DATA, c.name);
     default: {
+      size_t dims[2] = {c.size(), 1};
       Var cell = checked(Mat_VarCreate(nullptr, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), c.name);
       for (std::size_t i = 0; i < c.text.size(); ++i) {
-        Mat_VarSetCell(cell.get(), static_cast<int>(i), text(c.text[i]).release());  // owned by the cell now
+        Mat_VarSetCell(cell.get(), static_cast<int>(i), var(c.text[i]).release());  // owned by the cell now
       }
       return cell;
     }
@@ -88,18 +90,18 @@ Var channel_data(const std::string& name, const ChannelTable& t) {
 Var channel_meta(const std::string& name, const ChannelTable& t) {
   std::vector<std::pair<std::string, Var>> units, descriptions, legends, ragged;
   for (const Column& c : t.columns) {
-    units.emplace_back(c.name, text(c.unit));
-    descriptions.emplace_back(c.name, text(c.description));
-    if (!c.legend.empty()) legends.emplace_back(c.name, text(c.legend));
-    if (!c.count_column.empty()) ragged.emplace_back(c.name, text(c.count_column));
-    if (c.per_row > 0) ragged.emplace_back(c.name, text(std::to_string(c.per_row) + " per row"));
+    units.emplace_back(c.name, var(c.unit));
+    descriptions.emplace_back(c.name, var(c.description));
+    if (!c.legend.empty()) legends.emplace_back(c.name, var(c.legend));
+    if (!c.count_column.empty()) ragged.emplace_back(c.name, var(c.count_column));
+    if (c.per_row > 0) ragged.emplace_back(c.name, var(std::to_string(c.per_row) + " per row"));
   }
   std::vector<std::pair<std::string, Var>> fields;
-  fields.emplace_back("channel", text(t.channel));
-  fields.emplace_back("lcm_type", text(t.type_name));
-  fields.emplace_back("rows", scalar(static_cast<double>(t.rows)));
-  fields.emplace_back("events", scalar(static_cast<double>(t.events)));
-  fields.emplace_back("skipped_events", scalar(static_cast<double>(t.skipped)));
+  fields.emplace_back("channel", var(t.channel));
+  fields.emplace_back("lcm_type", var(t.type_name));
+  fields.emplace_back("rows", var(static_cast<double>(t.rows)));
+  fields.emplace_back("events", var(static_cast<double>(t.events)));
+  fields.emplace_back("skipped_events", var(static_cast<double>(t.skipped)));
   fields.emplace_back("units", structure(nullptr, std::move(units)));
   fields.emplace_back("description", structure(nullptr, std::move(descriptions)));
   fields.emplace_back("legend", structure(nullptr, std::move(legends)));
@@ -111,20 +113,14 @@ Var run_info(const ExportContent& content) {
   std::vector<std::pair<std::string, Var>> fields;
   for (const RunAttribute& a : content.run) {
     if (a.name == "config_files") continue;  // the cell of paths below
-    if (const auto* s = std::get_if<std::string>(&a.value)) {
-      fields.emplace_back(a.name, text(*s));
-    } else if (const auto* i = std::get_if<std::int64_t>(&a.value)) {
-      fields.emplace_back(a.name, scalar(*i));
-    } else {
-      fields.emplace_back(a.name, scalar(std::get<double>(a.value)));
-    }
+    fields.emplace_back(a.name, std::visit([](const auto& value) { return var(value); }, a.value));
   }
   std::vector<std::pair<std::string, Var>> configs;
   size_t dims[2] = {content.configs.size(), 1};
   Var paths = checked(Mat_VarCreate(nullptr, MAT_C_CELL, MAT_T_CELL, 2, dims, nullptr, 0), "config_files");
   for (std::size_t i = 0; i < content.configs.size(); ++i) {
-    configs.emplace_back(content.configs[i].name, text(content.configs[i].text));
-    Mat_VarSetCell(paths.get(), static_cast<int>(i), text(content.configs[i].path.native()).release());
+    configs.emplace_back(content.configs[i].name, var(content.configs[i].text));
+    Mat_VarSetCell(paths.get(), static_cast<int>(i), var(content.configs[i].path.native()).release());
   }
   fields.emplace_back("config", structure(nullptr, std::move(configs)));
   fields.emplace_back("config_files", std::move(paths));
