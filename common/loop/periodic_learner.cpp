@@ -58,11 +58,6 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
       gain_(config.gain),
       applied_weight_(config.lag_compensated ? config.gain : 1.0),
       max_correction_m_(config.max_correction_m),
-      max_period_(0),
-      window_(2),
-      fade_ticks_(1),
-      blend_ticks_(0),
-      filter_cutoff_hz_(0.0),
       lag_compensated_(config.lag_compensated),
       enabled_(config.enabled) {
   config.validate(dt_s);

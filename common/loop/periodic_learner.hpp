@@ -213,8 +213,9 @@ class PeriodicLearner {
   double dt_s_, gain_;
   double applied_weight_;  // of c_applied in acc_: 1 (plain), gain (lag-compensated)
   double max_correction_m_;
-  std::int64_t max_period_, window_, fade_ticks_, blend_ticks_;
-  double filter_cutoff_hz_;
+  // Derived from the config in the constructor's body.
+  std::int64_t max_period_ = 0, window_ = 2, fade_ticks_ = 1, blend_ticks_ = 0;
+  double filter_cutoff_hz_ = 0.0;
   bool lag_compensated_;
 
   // The periodic reference asked for (target) and whether learning is on.

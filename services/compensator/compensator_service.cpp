@@ -16,7 +16,6 @@
 #include "lcm/blocks.hpp"
 #include "lcm/feedforward_mode.hpp"
 #include "models/model_descriptors.hpp"
-#include "runtime/counter_baseline.hpp"
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
