@@ -51,10 +51,8 @@ extern "C" void on_stop_signal(int sig) {
   errno = saved_errno;
 }
 
-std::string errno_text(int err) { return std::strerror(err); }
-
 SetupStatus refused(const std::string& what, int err) {
-  SetupStatus s{false, what + " refused: " + errno_text(err)};
+  SetupStatus s{false, what + " refused: " + std::strerror(err)};
   spdlog::warn("{} (continuing without it)", s.detail);
   return s;
 }

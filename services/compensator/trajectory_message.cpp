@@ -1,8 +1,10 @@
 #include "compensator/trajectory_message.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "core/errors.hpp"
+#include "lcm/message_storage.hpp"
 #include "lcm/trajectory_shape.hpp"
 
 namespace hystloop {
@@ -27,17 +29,13 @@ TrajectorySpec trajectory_from_message(const trajectory_t& msg) {
       throw ParameterError("trajectory.if_infeasible",
                            "must be REFUSE (0) or SHAPE (1) (got " + std::to_string(msg.if_infeasible) + ")");
   }
-  if (msg.n_points < 0 || static_cast<std::size_t>(msg.n_points) > TrajectorySpec::kMaxPoints ||
-      msg.points_t_s.size() != static_cast<std::size_t>(msg.n_points) ||
-      msg.points_y_m.size() != static_cast<std::size_t>(msg.n_points)) {
+  if (!arrays_consistent(msg) || static_cast<std::size_t>(msg.n_points) > TrajectorySpec::kMaxPoints) {
     throw ParameterError("trajectory.n_points",
                          "must be 0.." + std::to_string(TrajectorySpec::kMaxPoints) + " and match the point arrays");
   }
   spec.n_points = static_cast<std::size_t>(msg.n_points);
-  for (std::size_t i = 0; i < spec.n_points; ++i) {
-    spec.points_t_s[i] = msg.points_t_s[i];
-    spec.points_y_m[i] = msg.points_y_m[i];
-  }
+  std::copy_n(msg.points_t_s.begin(), spec.n_points, spec.points_t_s.begin());
+  std::copy_n(msg.points_y_m.begin(), spec.n_points, spec.points_y_m.begin());
   spec.validate();
   return spec;
 }
