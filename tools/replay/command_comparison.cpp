@@ -133,15 +133,14 @@ CompareReport compare_commands(const CommandLog& expected, const CommandLog& act
 std::string format_report(const CompareReport& r, const CompareTolerance& tolerance) {
   std::string out;
   char line[512];
-  auto add = [&](const char* text) { out += text; };
   if (tolerance.voltage_V == 0.0 && tolerance.position_m == 0.0) {
-    add("comparison: exact (doubles bitwise equal; mode and params_version equal)\n");
+    out += "comparison: exact (doubles bitwise equal; mode and params_version equal)\n";
   } else {
     std::snprintf(
         line, sizeof line,
         "comparison: |expected - got| <= %.6g V (u_ff_V), <= %.6g m (y_ref_m); mode and params_version equal\n",
         tolerance.voltage_V, tolerance.position_m);
-    add(line);
+    out += line;
   }
   if (r.first_divergence) {
     const Divergence& d = *r.first_divergence;
@@ -150,23 +149,23 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
                   "%.3g; %d of %d fields differ at this tick)\n",
                   static_cast<long long>(d.seq), static_cast<long long>(d.sample_seq), d.field.c_str(), d.expected,
                   d.got, d.got - d.expected, d.fields_differing, kComparedFields);
-    add(line);
+    out += line;
   }
   if (r.first_missing_seq) {
     std::snprintf(
         line, sizeof line,
         "FIRST MISSING: tick %lld was commanded by the original, not by the replay (its sample was not played)\n",
         static_cast<long long>(*r.first_missing_seq));
-    add(line);
+    out += line;
   }
   if (r.lost_in_transport > 0) {
     std::snprintf(line, sizeof line,
                   "replay transport lost %llu commanded ticks (first planned at sample %lld): the sample was played, "
                   "the command never logged; not counted as divergence\n",
                   static_cast<unsigned long long>(r.lost_in_transport), static_cast<long long>(*r.first_lost_sample));
-    add(line);
+    out += line;
     if (r.divergence_after_loss)
-      add("the first divergence comes after the first lost sample and may be its consequence: replay again\n");
+      out += "the first divergence comes after the first lost sample and may be its consequence: replay again\n";
   }
   std::snprintf(line, sizeof line,
                 "summary: original commanded %llu ticks; compared %llu (ticks %lld..%lld): %llu equal, %llu differing; "
@@ -177,10 +176,10 @@ std::string format_report(const CompareReport& r, const CompareTolerance& tolera
                 static_cast<unsigned long long>(r.missing_in_actual),
                 static_cast<unsigned long long>(r.lost_in_transport),
                 static_cast<unsigned long long>(r.missing_in_expected));
-  add(line);
-  if (r.compared == 0) add("nothing was compared: the replay answered none of the original's ticks\n");
+  out += line;
+  if (r.compared == 0) out += "nothing was compared: the replay answered none of the original's ticks\n";
   std::snprintf(line, sizeof line, "verdict: %s\n", to_string(r.verdict()));
-  add(line);
+  out += line;
   return out;
 }
 

@@ -7,8 +7,8 @@
 // the original commanded; compares u_ff_V, y_ref_m, mode, params_version (exact by default:
 // bitwise equal doubles).
 // Prints the first divergence (tick, field, expected, got) and a summary.
-// Exit 0: equal; 1: diverged (or nothing compared); 2: bad arguments or unreadable log;
-// 3: the replay lost samples in transport and no divergence precedes the first loss.
+// Exit 0: equal; 1: diverged, nothing compared, or the replay lost samples in transport with no
+// divergence before the first loss (the verdict line tells which); 2: bad arguments or unreadable log.
 
 #include <CLI/CLI.hpp>
 

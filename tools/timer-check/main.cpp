@@ -37,9 +37,8 @@ struct Result {
   hystloop::LatencyStats::Summary lateness;
 };
 
-Result run(const Options& opt) {
-  const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
-  const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
+// Ticks of `period` [ns] until `wanted` deadlines came due (or a stop signal).
+Result run(std::int64_t period, std::uint64_t wanted) {
   hystloop::PeriodicTimer timer(period);
   const std::int64_t start = hystloop::monotonic_ns();
   Result r;
@@ -87,7 +86,7 @@ int main(int argc, char** argv) try {
 
     const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
     const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
-    const Result r = run(opt);
+    const Result r = run(period, wanted);
     const auto& l = r.lateness;
     const auto usage = hystloop::read_resource_usage();
 
