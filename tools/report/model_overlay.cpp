@@ -21,10 +21,7 @@ struct PublishedSet {
 };
 
 std::optional<hystloop::MemParams> usable(double c1, double c2, double c3) {
-  hystloop::MemParams p;
-  p.c1 = c1;
-  p.c2 = c2;
-  p.c3 = c3;
+  const hystloop::MemParams p{c1, c2, c3};
   try {
     p.validate();
   } catch (const ParameterError&) {

@@ -119,10 +119,6 @@ std::filesystem::path find_executable(const std::string& name) {
 PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics& m, const std::filesystem::path& dir,
                        const PlotOptions& options) {
   PlotResult result;
-  const bool have_ticks = !ticks.empty();
-  const bool have_tracking = m.tracking_samples > 0;
-  const bool have_run_ahead = !m.run_ahead_ticks.empty();
-
   const std::size_t step = decimation_step(ticks.size(), options.max_points);
   {  // track.dat: every step-th tick.
     DataFile out(dir / "track.dat");
@@ -183,11 +179,11 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
   gp << "# Re-plot with: cd <this folder> && gnuplot plots.gp   (terminal: edit the first line)\n"
      << "set terminal @TERMINAL@ size 1000,700 noenhanced\n"
      << "set encoding utf8\nset grid\nset key top left\n";
-  if (have_ticks) {
+  if (!ticks.empty()) {
     images.push_back("hysteresis_u_y.png");
     gp << u_y_script(u_y, !model_y.empty());
   }
-  if (have_tracking) {
+  if (m.tracking_samples > 0) {
     images.push_back("hysteresis_yref_y.png");
     gp << yref_y_script(yref_y);
     images.push_back("tracking_error.png");
@@ -200,7 +196,7 @@ PlotResult write_plots(const std::vector<TrackPoint>& ticks, const ReportMetrics
     images.push_back("convergence.png");
     gp << convergence;
   }
-  if (have_run_ahead) {
+  if (!m.run_ahead_ticks.empty()) {
     images.push_back("run_ahead_histogram.png");
     gp << "\nset output 'run_ahead_histogram.png'\n"
        << "set title 'Run-ahead margin of the command blocks (seq - sample_seq), n = " << m.run_ahead_ticks.size()

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <optional>
-#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -13,21 +12,15 @@ namespace {
 // Keys in the order they are set (readers and diffs see the layout the tool always wrote).
 using Json = nlohmann::ordered_json;
 
-template <class T>
-struct IsOptional : std::false_type {};
-template <class T>
-struct IsOptional<std::optional<T>> : std::true_type {};
-
 // A missing or non-finite number is null; integers stay integers.
 template <class T>
 Json number_or_null(const T& v) {
-  if constexpr (IsOptional<T>::value) {
-    return v ? number_or_null(*v) : Json(nullptr);
-  } else if constexpr (std::is_floating_point_v<T>) {
-    return std::isfinite(v) ? Json(v) : Json(nullptr);
-  } else {
-    return Json(v);
-  }
+  return Json(v);
+}
+Json number_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+template <class T>
+Json number_or_null(const std::optional<T>& v) {
+  return v ? number_or_null(*v) : Json(nullptr);
 }
 
 Json params_json(const std::optional<MemParams>& p) {
