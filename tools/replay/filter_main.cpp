@@ -39,7 +39,6 @@ int main(int argc, char** argv) try {
       ->capture_default_str();
 
   hystloop::replay::CommandAlteration alteration;
-  std::optional<double> delta_V;
   CLI::App* alter = app.add_subcommand("alter", "Copy a log with one tick's u_ff_V changed");
   alter->add_option("log", log, "Recorded LCM event log")->required();
   alter->add_option("out", out, "Altered log to write")->required();
@@ -48,7 +47,8 @@ int main(int argc, char** argv) try {
   alter->add_option("--nth", alteration.nth, "Change the nth tick commanded in the log instead (1 = first)")
       ->check(CLI::PositiveNumber)
       ->excludes(seq_opt);
-  alter->add_option("--delta-V", delta_V, "Add this to u_ff_V [V] (default: flip its least significant bit)");
+  alter->add_option("--delta-V", alteration.delta_V,
+                    "Add this to u_ff_V [V] (default: flip its least significant bit)");
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
   try {
@@ -60,7 +60,6 @@ int main(int argc, char** argv) try {
     } else {
       if (!seq && !alteration.nth) throw std::runtime_error("alter: --seq or --nth is required");
       alteration.seq = seq.value_or(0);
-      alteration.delta_V = delta_V;
       const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
       std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V,
                   r.new_u_ff_V);

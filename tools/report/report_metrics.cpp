@@ -29,7 +29,8 @@ bool requested_safe(const RunData& run, const std::string& bridge, std::int64_t 
 
 void fill_params(const RunData& run, double lo, double hi, ReportMetrics& m) {
   const double start = m.first_sample_t_s.value_or(lo);
-  const ParamsRecord* initial = nullptr;
+  const ParamsRecord* initial = nullptr;         // the last valid set at or before the first tick
+  const ParamsRecord* first_in_range = nullptr;  // else the first valid set of the range
   for (const auto& p : run.params) {
     const double t = run.t_s(p.recv_utime);
     if (t > hi) continue;
@@ -43,16 +44,9 @@ void fill_params(const RunData& run, double lo, double hi, ReportMetrics& m) {
     }
     if (p.model != "mem") continue;  // params_initial/final are MEM sets
     if (p.valid && t <= start) initial = &p;
+    if (p.valid && t >= lo && first_in_range == nullptr) first_in_range = &p;
   }
-  if (initial == nullptr) {
-    for (const auto& p : run.params) {
-      const double t = run.t_s(p.recv_utime);
-      if (p.valid && p.model == "mem" && t >= lo && t <= hi) {
-        initial = &p;
-        break;
-      }
-    }
-  }
+  if (initial == nullptr) initial = first_in_range;
   if (initial == nullptr) return;
   m.params_initial = MemParams{initial->version, initial->c1, initial->c2, initial->c3};
   MemParams current = *m.params_initial;
