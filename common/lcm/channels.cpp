@@ -19,9 +19,7 @@ void validate_rig_prefix(std::string_view prefix) {
 
 std::string channel_name(std::string_view rig_prefix, std::string_view suffix) {
   validate_rig_prefix(rig_prefix);
-  std::string name(rig_prefix);
-  name += suffix;
-  return name;
+  return std::string(rig_prefix).append(suffix);
 }
 
 ChannelNames::ChannelNames(std::string_view rig_prefix)

@@ -48,26 +48,11 @@ class Publisher {
       ++counters_.invalid;
       return false;
     }
-    if (!arrays_consistent(msg)) {
-      ++counters_.encode_failed;
-      return false;
-    }
-    const int size = msg.getEncodedSize();
-    if (size <= 0) {
-      ++counters_.encode_failed;
-      return false;
-    }
+    // An inconsistent message would be encoded from its counts, reading past its arrays.
+    const int size = arrays_consistent(msg) ? msg.getEncodedSize() : 0;
     const std::size_t total = static_cast<std::size_t>(size) + trailer_size();
-    if (total > buffer_.size() || total > static_cast<std::size_t>(INT_MAX)) {
-      try {
-        if (total > static_cast<std::size_t>(INT_MAX)) throw std::length_error("message too long");
-        buffer_.resize(total);
-      } catch (...) {
-        ++counters_.encode_failed;
-        return false;
-      }
-    }
-    if (msg.encode(buffer_.data(), 0, size) != size) {
+    if (size <= 0 || total > static_cast<std::size_t>(INT_MAX) || !fits(total) ||
+        msg.encode(buffer_.data(), 0, size) != size) {
       ++counters_.encode_failed;
       return false;
     }
@@ -89,6 +74,16 @@ class Publisher {
 
  private:
   std::size_t trailer_size() const noexcept { return signer_ ? kAuthTrailerBytes : 0; }
+  // Grows the buffer for a message beyond the size reserved; false when that fails.
+  bool fits(std::size_t total) noexcept {
+    if (total <= buffer_.size()) return true;
+    try {
+      buffer_.resize(total);
+    } catch (...) {
+      return false;
+    }
+    return true;
+  }
 
   lcm::LCM& lcm_;
   std::string channel_;
