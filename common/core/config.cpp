@@ -48,7 +48,7 @@ void refuse_duplicate_keys(const YAML::Node& node, const std::string& source, co
   std::map<std::string, int> first_line;  // key -> its line (1-based)
   for (auto it = node.begin(); it != node.end(); ++it) {
     const std::string key = it->first.IsScalar() ? it->first.Scalar() : describe(it->first);
-    const std::string path = prefix.empty() ? key : prefix + "." + key;
+    const std::string path = prefix.empty() ? key : std::string(prefix).append(".").append(key);
     const int line = it->first.Mark().line + 1;
     const auto [seen, inserted] = first_line.emplace(key, line);
     if (!inserted) {

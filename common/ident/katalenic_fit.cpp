@@ -53,7 +53,7 @@ struct Problem {
       for (int d = 0; d <= degree; ++d) phi(i, d) = pw, pw *= zz;
       target[i] = y[score_begin + static_cast<std::size_t>(i)] / y_scale;
     }
-    const Eigen::VectorXd c = phi.colPivHouseholderQr().solve(target);
+    Eigen::VectorXd c = phi.colPivHouseholderQr().solve(target);
     if (residuals != nullptr) {
       const Eigen::VectorXd r = target - phi * c;
       std::copy(r.data(), r.data() + n, residuals);

@@ -31,8 +31,8 @@ LinearFitResult fit_linear(std::span<const double> u, std::span<const double> y,
   r.residual_rms_m = std::sqrt(ss / n);
   r.samples_used = u.size();
   if (!(r.gain_m_per_V > 0.0)) {
-    return with_status(std::move(r), FitStatus::out_of_range,
-                       "gain " + std::to_string(r.gain_m_per_V) + " m/V: must be > 0");
+    const std::string reason = "gain " + std::to_string(r.gain_m_per_V) + " m/V: must be > 0";
+    return with_status(std::move(r), FitStatus::out_of_range, reason);
   }
   return with_status(std::move(r), FitStatus::ok);
 }

@@ -65,8 +65,8 @@ struct Scales {
   double y_span = 0.0;  // [m] output range on the branches
 };
 
-MemFitResult refuse(MemFitResult r, FitStatus status, std::string reason) {
-  return with_status(std::move(r), status, std::move(reason));
+MemFitResult refuse(MemFitResult r, FitStatus status, const std::string& reason) {
+  return with_status(std::move(r), status, reason);
 }
 
 IntegratedData build_integrated(std::span<const double> u, std::span<const double> y,
@@ -296,7 +296,7 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     // A fit that is not a fit (NaN residual, c2 collapsed by overflow, ...) is a refusal.
     FitCheck c = check_valid(result.params, "MEM parameters outside their domain: ");
     if (c.ok()) c = check_fit_residual(result.residual_rms_m, sc.y_span);
-    if (!c.ok()) result = refuse(std::move(result), c.status, std::move(c.reason));
+    if (!c.ok()) result = refuse(std::move(result), c.status, c.reason);
   }
   return timer.stamp(std::move(result));
 }

@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "models/param_table.hpp"
 
 namespace hystloop {
@@ -96,9 +98,8 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
         if (index[c] == header.size()) missing += (missing.empty() ? "'" : ", '") + std::string(required[c]) + "'";
       }
       if (!missing.empty()) {
-        throw CsvError(
-            file, line_no,
-            "header '" + std::string(line) + "' lacks column " + missing + " (expected '" + expected + "', SI units)");
+        throw CsvError(file, line_no,
+                       fmt::format("header '{}' lacks column {} (expected '{}', SI units)", line, missing, expected));
       }
       table.header_line = line_no;
       continue;

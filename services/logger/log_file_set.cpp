@@ -49,7 +49,7 @@ std::string DiskFaults::reason() const {
   return kind + " (" + op_name(last_op) + ": " + text + ")";
 }
 
-LogFileSet::LogFileSet(std::filesystem::path dir, std::string file_prefix, RotationPolicy policy,
+LogFileSet::LogFileSet(const std::filesystem::path& dir, const std::string& file_prefix, RotationPolicy policy,
                        std::time_t start_time, double now_s, Listener* listener, LogFileIo& io)
     : io_(io),
       listener_(listener),

@@ -84,8 +84,8 @@ class LogFileSet {
   // Creates `dir` if needed, picks the recording's base name from `start_time` and opens
   // the first file. Throws std::runtime_error naming the path if it cannot. `listener` may
   // be null; `io` must outlive the set.
-  LogFileSet(std::filesystem::path dir, std::string file_prefix, RotationPolicy policy, std::time_t start_time,
-             double now_s, Listener* listener = nullptr, LogFileIo& io = posix_log_file_io());
+  LogFileSet(const std::filesystem::path& dir, const std::string& file_prefix, RotationPolicy policy,
+             std::time_t start_time, double now_s, Listener* listener = nullptr, LogFileIo& io = posix_log_file_io());
   ~LogFileSet();
   LogFileSet(const LogFileSet&) = delete;
   LogFileSet& operator=(const LogFileSet&) = delete;

@@ -110,12 +110,11 @@ class Expectation {
 
   void see(const T& msg) {
     const std::int64_t i = index_of(msg);
-    if (i < 0 || i >= expected_) {
-      ++altered_;
-    } else if (!seen_.insert(i).second) {
+    const bool known = i >= 0 && i < expected_;
+    if (known && !seen_.insert(i).second) {
       ++duplicates_;
-    } else if (fixtures::encode(msg) != fixtures::encode(fixture_for(static_cast<const T*>(nullptr), i))) {
-      ++altered_;
+    } else if (!known || fixtures::encode(msg) != fixtures::encode(fixture_for(static_cast<const T*>(nullptr), i))) {
+      ++altered_;  // an index never sent, or a first copy that differs from what was
     }
   }
   // An event of a log file: true when it is on this channel (and then received as LCM would deliver it).

@@ -106,8 +106,8 @@ double stationary_peak_to_peak(BanningOrder order, double& f, double amplitude) 
   const double f_exact = 1.0 / (per * dt);
   f = f_exact;
   const int periods = std::max(60, static_cast<int>(0.05 * f_exact));  // >= 50 ms: e^{-50} settled
-  double lo = INFINITY;
-  double hi = -INFINITY;
+  double lo = HUGE_VAL;
+  double hi = -HUGE_VAL;
   for (int k = 0; k < periods; ++k) {
     for (int i = 0; i < per; ++i) {
       const double y = stage.step(amplitude * std::sin(2.0 * kPi * f_exact * i * dt), dt);
@@ -198,7 +198,7 @@ TEST(BanningStage, GainScaleMultipliesTheOutputAndRejectsNonsense) {
   EXPECT_FALSE(warm.set_gain_scale(0.0));
   EXPECT_FALSE(warm.set_gain_scale(-1.0));
   EXPECT_FALSE(warm.set_gain_scale(std::nan("")));
-  EXPECT_FALSE(warm.set_gain_scale(INFINITY));
+  EXPECT_FALSE(warm.set_gain_scale(HUGE_VAL));
   EXPECT_DOUBLE_EQ(warm.gain_scale(), 1.1);
   // A warming ramp of +10 % over a minute at 10 kHz is 600000 small changes: state is untouched.
   BanningStage ramped;

@@ -468,7 +468,8 @@ TEST(MemTheorem10, PaperReference24) {
   inv.reset_to_branch(-1.6e-6, 0.0);
   model.reset_to_branch(0.0, -1.6e-6);
   double worst = 0.0, u_min = 0.0, u_max = 0.0;
-  for (k = 0; k < n;) {
+  k = 0;  // y_d counts the samples
+  for (std::size_t i = 0; i < n; ++i) {
     const double y = y_d();
     const double u = inv.inverse(y);
     u_min = std::min(u_min, u);

@@ -179,7 +179,7 @@ TEST(SecondOrderStage, BadInputOrDtReturnsNanAndKeepsState) {
   EXPECT_TRUE(std::isnan(stage.step(std::nan(""), 1e-4)));
   EXPECT_TRUE(std::isnan(stage.step(1.0, 0.0)));
   EXPECT_TRUE(std::isnan(stage.step(1.0, -1e-4)));
-  EXPECT_TRUE(std::isnan(stage.step(1.0, INFINITY)));
+  EXPECT_TRUE(std::isnan(stage.step(1.0, HUGE_VAL)));
   EXPECT_EQ(stage.output(), y);
   stage.reset(0.25);
   EXPECT_NEAR(stage.step(0.25, 1e-4), 0.25, 1e-15);  // at rest

@@ -28,7 +28,7 @@ void flatten(const YAML::Node& node, const std::string& key, const std::string& 
     case YAML::NodeType::Map:
       for (const auto& kv : node) {
         const std::string sub = kv.first.as<std::string>();
-        flatten(kv.second, key.empty() ? sub : key + "." + sub, path, model, out);
+        flatten(kv.second, key.empty() ? sub : std::string(key).append(".").append(sub), path, model, out);
       }
       return;
     case YAML::NodeType::Null:

@@ -83,12 +83,8 @@ CompareVerdict CompareReport::verdict() const noexcept {
 }
 
 int CompareReport::exit_code() const noexcept {
-  switch (verdict()) {
-    case CompareVerdict::kEqual: return 0;
-    case CompareVerdict::kDiverged: return 1;
-    case CompareVerdict::kTransportLoss: return 1;  // no verdict on the law: a runtime failure (0/1/2 contract)
-  }
-  return 1;
+  // A divergence, or a transport loss (no verdict on the law), is a runtime failure (0/1/2 contract).
+  return verdict() == CompareVerdict::kEqual ? 0 : 1;
 }
 
 CompareReport compare_commands(const CommandLog& expected, const CommandLog& actual,
