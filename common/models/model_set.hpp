@@ -26,13 +26,19 @@ std::optional<ModelKind> parse_model_kind(std::string_view name) noexcept;
 // The wire's number; nullopt when it names no model.
 std::optional<ModelKind> model_kind_from_int(std::int64_t value) noexcept;
 
-struct ModelParamSet {
-  ModelKind kind = ModelKind::mem;
-  // Only the member that `kind` names is meaningful; the others keep their defaults.
+// One parameter struct of every online model: the one list of their members (a model added
+// here, in ModelKind and in OnlineModels is known to the message, the compensator's config and
+// inverses, validation and summaries).
+struct ModelParams {
   MemParams mem{};
   PiParams pi{};
   KatalenicParams katalenic{};
   LinearParams linear{};
+};
+
+struct ModelParamSet : ModelParams {
+  ModelKind kind = ModelKind::mem;
+  // Only the member that `kind` names is meaningful; the others keep their defaults.
   // The stage in series with the hysteresis, when the set says (nullopt: the receiver keeps the
   // stage it has; a hysteresis refit says nothing of the stage).
   std::optional<StageModel> stage;
