@@ -108,7 +108,8 @@ void CompensatorConfig::validate() const {
 Compensator::Compensator(const CompensatorConfig& config)
     : config_((config.validate(), config)),
       mode_(config.mode),
-      inverses_(config.mem, config.pi, config.katalenic, config.linear),
+      inverses_(
+          ModelParams{.mem = config.mem, .pi = config.pi, .katalenic = config.katalenic, .linear = config.linear}),
       anchor_offset_(config.reanchor_ticks, config.reanchor_ramp_ticks,
                      config.slew_fraction * config.slew_V_per_s * config.dt_s,
                      config.reanchor_u_rate_V_per_s * config.dt_s),

@@ -11,7 +11,7 @@ namespace {
 
 HysteresisInverses make() {
   const MemParams mem = MemParams::paper_like();
-  return HysteresisInverses(mem, pi_params_from_mem(mem, 15, 250.0), KatalenicParams{}, LinearParams{});
+  return HysteresisInverses(ModelParams{.mem = mem, .pi = pi_params_from_mem(mem, 15, 250.0)});
 }
 
 constexpr ModelKind kKinds[] = {ModelKind::mem, ModelKind::pi, ModelKind::katalenic, ModelKind::linear};
