@@ -82,10 +82,10 @@ Tracked track(const TrackingExperiment& e, const IdentifiedModels& id, Feedforwa
               const FeedbackGains* servo) {
   LoopSimulationConfig c = tracking_loop_config(e);
   c.compensator.mode = mode;
-  c.compensator.mem = start_mem;
-  c.compensator.pi = id.pi;
-  c.compensator.katalenic = id.katalenic;
-  c.compensator.linear = id.linear;
+  c.compensator.models.mem = start_mem;
+  c.compensator.models.pi = id.pi;
+  c.compensator.models.katalenic = id.katalenic;
+  c.compensator.models.linear = id.linear;
   c.compensator.u_min_V = c.limits.u_min_V;
   c.compensator.u_max_V = c.limits.u_max_V;
   c.compensator.slew_V_per_s = c.limits.slew_V_per_s;

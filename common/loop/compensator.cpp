@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "models/model_descriptors.hpp"
 
 namespace hystloop {
 
@@ -82,10 +83,7 @@ void CompensatorConfig::validate() const {
   if (mode == FeedforwardMode::kExperiment) {
     throw ParameterError("compensator.mode", "'experiment' is started through HX_CONTROL, not selected as a mode");
   }
-  mem.validate();
-  pi.validate();
-  katalenic.validate();
-  linear.validate();
+  OnlineModels::for_each([&]<class D>() { (models.*D::in_set).validate(); });
   require_in_range("compensator.dt_s", dt_s, 1e-6, 1.0);
   require_finite("compensator.u_min_V", u_min_V);
   require_finite("compensator.u_max_V", u_max_V);
@@ -108,8 +106,7 @@ void CompensatorConfig::validate() const {
 Compensator::Compensator(const CompensatorConfig& config)
     : config_((config.validate(), config)),
       mode_(config.mode),
-      inverses_(
-          ModelParams{.mem = config.mem, .pi = config.pi, .katalenic = config.katalenic, .linear = config.linear}),
+      inverses_(config.models),
       anchor_offset_(config.reanchor_ticks, config.reanchor_ramp_ticks,
                      config.slew_fraction * config.slew_V_per_s * config.dt_s,
                      config.reanchor_u_rate_V_per_s * config.dt_s),
@@ -597,7 +594,7 @@ double Compensator::servo_share_m(const CompensatorInput& sample) noexcept {
 }
 
 Compensator Compensator::restarted(CompensatorConfig config, std::string& refusal) const {
-  config.mem = mem_params();
+  config.models.mem = mem_params();
   config.mode = mode();
   TrajectorySpec reference = trajectory();
   reference.hold_m = 0.0;

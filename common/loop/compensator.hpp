@@ -90,10 +90,8 @@ inline LearningConfig default_learning() {
 
 struct CompensatorConfig {
   FeedforwardMode mode = FeedforwardMode::kMem;
-  MemParams mem{};
-  PiParams pi = pi_params_from_mem(MemParams::paper_like(), 15, 250.0);  // the MEM paper's 15 plays
-  KatalenicParams katalenic{};
-  LinearParams linear{};
+  // Every online model's parameters; PI's are the MEM paper's 15 plays.
+  ModelParams models{.pi = pi_params_from_mem(MemParams::paper_like(), 15, 250.0)};
   std::int64_t horizon_ticks = 500;  // plan this many ticks ahead of the last sample (50 ms at 10 kHz)
   double dt_s = 1e-4;                // the bridge's tick
   // The actuator as the bridge limits it (ActuatorLimits' defaults): the feedforward is kept in

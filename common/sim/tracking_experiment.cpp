@@ -25,10 +25,10 @@ LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e) {
 }
 
 void use_models(LoopSimulationConfig& c, const IdentifiedModels& models, const MemParams& mem) {
-  c.compensator.mem = mem;
-  c.compensator.pi = models.pi;
-  c.compensator.katalenic = models.katalenic;
-  c.compensator.linear = models.linear;
+  c.compensator.models.mem = mem;
+  c.compensator.models.pi = models.pi;
+  c.compensator.models.katalenic = models.katalenic;
+  c.compensator.models.linear = models.linear;
   c.compensator.u_min_V = c.limits.u_min_V;
   c.compensator.u_max_V = c.limits.u_max_V;
   c.compensator.slew_V_per_s = c.limits.slew_V_per_s;
@@ -117,7 +117,7 @@ TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& mo
   OnlineMemOptions opt;
   opt.window_samples = static_cast<std::size_t>(std::llround(o.window_s / c.compensator.dt_s));
   opt.fit.reversal_dead_band_V = 1.0;  // feedback jitter on u is not a branch
-  OnlineMemEstimator estimator(opt, c.compensator.mem);
+  OnlineMemEstimator estimator(opt, c.compensator.models.mem);
   MemWindow window = estimator.make_window();
   OnlineSelectorOptions selector = o.selector;
   selector.selection.mem.reversal_dead_band_V = opt.fit.reversal_dead_band_V;

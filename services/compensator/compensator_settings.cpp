@@ -35,10 +35,7 @@ typename D::Params read_model_section(const Config& config, typename D::Settings
 // Every model the compensator is configured with, as one set (of no particular kind).
 ModelParamSet configured_models(const CompensatorConfig& c) {
   ModelParamSet set;
-  set.mem = c.mem;
-  set.pi = c.pi;
-  set.katalenic = c.katalenic;
-  set.linear = c.linear;
+  static_cast<ModelParams&>(set) = c.models;
   return set;
 }
 
@@ -48,7 +45,7 @@ void read_plausibility(const Config& config, CompensatorSettings& s) {
   s.plausible_gain_factor = config.get_in_range("compensator.plausible_gain_factor", s.plausible_gain_factor,
                                                 GainPlausibility::kMinFactor, GainPlausibility::kMaxFactor);
   const CompensatorConfig& c = s.control;
-  if (!(c.linear.gain > 0.0)) {
+  if (!(c.models.linear.gain > 0.0)) {
     config.fail("linear.gain",
                 "must be > 0: it is the stage's nominal gain, the one every parameter set is checked "
                 "against (compensator.plausible_gain_factor)");
@@ -70,7 +67,7 @@ void read_plausibility(const Config& config, CompensatorSettings& s) {
 
 GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept {
   GainPlausibility rig;
-  rig.nominal_gain_m_per_V = settings.control.linear.gain;
+  rig.nominal_gain_m_per_V = settings.control.models.linear.gain;
   rig.factor = settings.plausible_gain_factor;
   rig.u_min_V = settings.control.u_min_V;
   rig.u_max_V = settings.control.u_max_V;
@@ -149,13 +146,13 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
-  c.mem = read_model_section<MemDescriptor>(config, c.mem);
+  c.models.mem = read_model_section<MemDescriptor>(config, c.models.mem);
   // PI: explicit plays (as identified), or the baseline matched to the MEM just read over +-range_V.
   PiSettings pi;
-  pi.matched_to = c.mem;
-  c.pi = read_model_section<PiDescriptor>(config, pi);
-  c.linear = read_model_section<LinearDescriptor>(config, c.linear);
-  c.katalenic = read_model_section<KatalenicDescriptor>(config, c.katalenic);
+  pi.matched_to = c.models.mem;
+  c.models.pi = read_model_section<PiDescriptor>(config, pi);
+  c.models.linear = read_model_section<LinearDescriptor>(config, c.models.linear);
+  c.models.katalenic = read_model_section<KatalenicDescriptor>(config, c.models.katalenic);
 
   // The actuator as the bridge limits it: the plan stays inside it (keep equal to the bridge's actuator.*).
   c.u_min_V = config.get<double>("actuator.u_min_V", c.u_min_V);

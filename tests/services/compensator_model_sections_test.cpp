@@ -34,8 +34,8 @@ std::string section(const typename D::Params& p) {
 
 std::string sections(const CompensatorSettings& s) {
   const CompensatorConfig& c = s.control;
-  return section<MemDescriptor>(c.mem) + section<PiDescriptor>(c.pi) + section<LinearDescriptor>(c.linear) +
-         section<KatalenicDescriptor>(c.katalenic);
+  return section<MemDescriptor>(c.models.mem) + section<PiDescriptor>(c.models.pi) +
+         section<LinearDescriptor>(c.models.linear) + section<KatalenicDescriptor>(c.models.katalenic);
 }
 
 // Each key and alias of D's table, set to the value the deployed config already has: accepted,
@@ -65,10 +65,10 @@ void expect_every_key_accepted(const typename D::Params& deployed, const std::st
 TEST(CompensatorModelSections, EveryKeyOfEveryTableIsAccepted) {
   const CompensatorSettings s = load_compensator_settings(Config::load_file(kConfig));
   const std::string expected = sections(s);
-  expect_every_key_accepted<MemDescriptor>(s.control.mem, expected);
-  expect_every_key_accepted<PiDescriptor>(s.control.pi, expected);
-  expect_every_key_accepted<LinearDescriptor>(s.control.linear, expected);
-  expect_every_key_accepted<KatalenicDescriptor>(s.control.katalenic, expected);
+  expect_every_key_accepted<MemDescriptor>(s.control.models.mem, expected);
+  expect_every_key_accepted<PiDescriptor>(s.control.models.pi, expected);
+  expect_every_key_accepted<LinearDescriptor>(s.control.models.linear, expected);
+  expect_every_key_accepted<KatalenicDescriptor>(s.control.models.katalenic, expected);
 }
 
 TEST(CompensatorModelSections, AnUnknownKeyIsRefusedNamingIt) {
@@ -102,16 +102,16 @@ TEST(CompensatorModelSections, PiBySizeAndRangeIsMatchedToTheConfiguredMemUnderE
   for (const char* pi : {"pi: {count: 7, range_V: 200}", "pi: {n: 7, u_max: 200}"}) {
     const CompensatorSettings s = load_compensator_settings(
         Config::from_string(std::string("mem: {c1: 4e-9, c2: 1e-12, c3: 1.1}\n") + pi, "compensator.yaml"));
-    ASSERT_EQ(s.control.pi.count, 7u) << pi;
+    ASSERT_EQ(s.control.models.pi.count, 7u) << pi;
     for (std::size_t i = 0; i < 7; ++i) {
-      EXPECT_EQ(s.control.pi.thresholds[i], expected.thresholds[i]) << pi << " " << i;
-      EXPECT_EQ(s.control.pi.weights[i], expected.weights[i]) << pi << " " << i;
+      EXPECT_EQ(s.control.models.pi.thresholds[i], expected.thresholds[i]) << pi << " " << i;
+      EXPECT_EQ(s.control.models.pi.weights[i], expected.weights[i]) << pi << " " << i;
     }
   }
   // Without a pi section: the 15-play baseline over +-250 V, as before the tables.
   const CompensatorSettings none = load_compensator_settings(Config::from_string("{}", "compensator.yaml"));
-  EXPECT_EQ(section<PiDescriptor>(none.control.pi),
-            section<PiDescriptor>(pi_params_from_mem(none.control.mem, 15, 250.0)));
+  EXPECT_EQ(section<PiDescriptor>(none.control.models.pi),
+            section<PiDescriptor>(pi_params_from_mem(none.control.models.mem, 15, 250.0)));
 }
 
 TEST(CompensatorModelSections, ASnippetTheTablesWriteLoadsUnchanged) {
@@ -129,9 +129,9 @@ TEST(CompensatorModelSections, ASnippetTheTablesWriteLoadsUnchanged) {
   merge_params_file(config, path);
   std::filesystem::remove(path);
   const CompensatorSettings s = load_compensator_settings(config);
-  EXPECT_EQ(section<MemDescriptor>(s.control.mem), section<MemDescriptor>(mem));
-  EXPECT_EQ(section<PiDescriptor>(s.control.pi), section<PiDescriptor>(pi));
-  EXPECT_EQ(section<KatalenicDescriptor>(s.control.katalenic), section<KatalenicDescriptor>(kat));
+  EXPECT_EQ(section<MemDescriptor>(s.control.models.mem), section<MemDescriptor>(mem));
+  EXPECT_EQ(section<PiDescriptor>(s.control.models.pi), section<PiDescriptor>(pi));
+  EXPECT_EQ(section<KatalenicDescriptor>(s.control.models.katalenic), section<KatalenicDescriptor>(kat));
   // The start-up summary says so, in the words the integration test looks for.
   const std::vector<std::string> lines = describe(s);
   EXPECT_NE(std::find(lines.begin(), lines.end(), "mem: c1 5.3e-09 m/V, c2 2.1e-12 m/V^(1+c3), c3 1.15"), lines.end());
@@ -146,10 +146,7 @@ TEST(CompensatorModelSections, ASetIsLoggedAsTheStartUpSummaryNamesIt) {
   for (int i = 0; i < kModelKindCount; ++i) {
     ModelParamSet set;
     set.kind = static_cast<ModelKind>(i);
-    set.mem = s.control.mem;
-    set.pi = s.control.pi;
-    set.katalenic = s.control.katalenic;
-    set.linear = s.control.linear;
+    static_cast<ModelParams&>(set) = s.control.models;
     EXPECT_NE(std::find(lines.begin(), lines.end(), describe_model(set)), lines.end()) << describe_model(set);
   }
   ModelParamSet mem;

@@ -94,18 +94,18 @@ TEST(CompensatorPlausibility, EveryModelWithAGain1000xTooLargeIsRefusedOnTheMode
   const CompensatorConfig& c = r.settings.control;
   ModelParamSet linear;
   linear.kind = ModelKind::linear;
-  linear.linear = c.linear;
+  linear.linear = c.models.linear;
   linear.linear.gain *= 1e3;
   ModelParamSet pi;
   pi.kind = ModelKind::pi;
-  pi.pi = c.pi;
+  pi.pi = c.models.pi;
   for (std::size_t i = 0; i < pi.pi.count; ++i) pi.pi.weights[i] *= 1e3;
   ModelParamSet katalenic;
   katalenic.kind = ModelKind::katalenic;
-  katalenic.katalenic = c.katalenic;
+  katalenic.katalenic = c.models.katalenic;
   katalenic.katalenic.output_shaping.gain *= 1e3;
   ModelParamSet mem;
-  mem.mem = c.mem;
+  mem.mem = c.models.mem;
   mem.mem.c1 *= 1e3;
   mem.mem.c2 *= 1e3;
   std::int32_t version = 2;
@@ -113,7 +113,7 @@ TEST(CompensatorPlausibility, EveryModelWithAGain1000xTooLargeIsRefusedOnTheMode
   EXPECT_EQ(r.refused(), 4u);
   EXPECT_EQ(r.accepted(), 0u);
   // The deployed PI as it is: taken.
-  pi.pi = c.pi;
+  pi.pi = c.models.pi;
   r.service.on_model(model_message(pi, version++));
   EXPECT_EQ(r.refused(), 4u);
   EXPECT_EQ(r.accepted(), 1u);
@@ -122,7 +122,7 @@ TEST(CompensatorPlausibility, EveryModelWithAGain1000xTooLargeIsRefusedOnTheMode
 TEST(CompensatorPlausibility, TheBandIsTheConfiguredLinearGainOverTheActuatorsRange) {
   const CompensatorSettings s = deployed();
   const GainPlausibility band = gain_plausibility(s);
-  EXPECT_EQ(band.nominal_gain_m_per_V, s.control.linear.gain);
+  EXPECT_EQ(band.nominal_gain_m_per_V, s.control.models.linear.gain);
   EXPECT_EQ(band.factor, 10.0);
   EXPECT_EQ(band.u_min_V, -250.0);
   EXPECT_EQ(band.u_max_V, 250.0);

@@ -29,7 +29,7 @@ LoopSimulationConfig ro_loop(const MemParams& start) {
   c.stage.ramberg_osgood = kTruth;
   c.stage.noise_rms_m = 0.0;
   c.compensator.mode = FeedforwardMode::kMem;
-  c.compensator.mem = start;
+  c.compensator.models.mem = start;
   return c;
 }
 
