@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <cstdio>
+#include <type_traits>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -30,6 +31,19 @@ typename D::Params read_model_section(const Config& config, typename D::Settings
   validate_config_section(config, std::string(D::name) + ".",
                           [&] { params = params_from_config<D>(config, std::move(settings)); });
   return params;
+}
+
+// What model D's section is read onto: D's parameters as configured so far; for PI, whose section
+// gives its plays (as identified) or a size and range, the baseline matched to the MEM just read.
+template <class D>
+typename D::Settings section_settings(const ModelParams& read) {
+  if constexpr (std::is_same_v<typename D::Settings, PiSettings>) {
+    PiSettings pi;
+    pi.matched_to = read.mem;
+    return pi;
+  } else {
+    return D::settings_of(read.*D::in_set);
+  }
 }
 
 // Every model the compensator is configured with, as one set (of no particular kind).
@@ -146,13 +160,13 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
+  // Every model's section. MEM's first: PI's baseline is matched to the MEM this file configures.
   c.models.mem = read_model_section<MemDescriptor>(config, c.models.mem);
-  // PI: explicit plays (as identified), or the baseline matched to the MEM just read over +-range_V.
-  PiSettings pi;
-  pi.matched_to = c.models.mem;
-  c.models.pi = read_model_section<PiDescriptor>(config, pi);
-  c.models.linear = read_model_section<LinearDescriptor>(config, c.models.linear);
-  c.models.katalenic = read_model_section<KatalenicDescriptor>(config, c.models.katalenic);
+  OnlineModels::for_each([&]<class D>() {
+    if constexpr (D::kind != ModelKind::mem) {
+      c.models.*D::in_set = read_model_section<D>(config, section_settings<D>(c.models));
+    }
+  });
 
   // The actuator as the bridge limits it: the plan stays inside it (keep equal to the bridge's actuator.*).
   c.u_min_V = config.get<double>("actuator.u_min_V", c.u_min_V);
