@@ -14,7 +14,7 @@
 // 0.19-2.2 x the nominal gain; 10 leaves room for a different stage and still refuses a
 // factor-1000 units error by two decades.
 //
-// Per model, the gain range over p in [0, R], R = u_max_V - u_min_V:
+// Each model's descriptor gives its gain range over p in [0, R], R = u_max_V - u_min_V:
 //   MEM        c1 .. c1 + c2 R^c3 (M(p) = c1 + c2 p^c3 grows with p)
 //   PI         the cumulative weights w_0 + ... + w_i of the plays a branch or the initial loading
 //              curve can engage within the range (r_i < R; the last one is the sum of the weights)
@@ -25,31 +25,11 @@
 // Every parameter must also be 0 or a normal double: no physical quantity is below 2.2e-308 in
 // SI units, and arithmetic on subnormals is slow enough to cost a 100 us tick.
 
+#include "models/gain_band.hpp"
 #include "models/model_set.hpp"
 
 namespace hystloop {
 
-struct GainPlausibility {
-  double nominal_gain_m_per_V = LinearParams{}.gain;  // the stage's mean slope dy/du
-  double factor = 10.0;                               // [-] gains within [nominal / factor, nominal * factor]
-  double u_min_V = -250.0;                            // the actuator's range: where a model is used
-  double u_max_V = 250.0;
-
-  // Throws ParameterError: nominal_gain_m_per_V > 0, factor in [kMinFactor, kMaxFactor],
-  // u_max_V > u_min_V, all finite.
-  void validate() const;
-  double min_gain_m_per_V() const noexcept { return nominal_gain_m_per_V / factor; }
-  double max_gain_m_per_V() const noexcept { return nominal_gain_m_per_V * factor; }
-
-  static constexpr double kMinFactor = 2.0;  // below, hysteresis alone leaves the band
-  static constexpr double kMaxFactor = 1e4;
-};
-
-// The smallest and largest small-signal gain of a valid set over the actuator's range [m/V].
-struct GainRange {
-  double min_m_per_V = 0.0;
-  double max_m_per_V = 0.0;
-};
 GainRange small_signal_gain(const ModelParamSet& set, const GainPlausibility& rig) noexcept;
 
 // Validates the set's model (ModelParamSet::validate, the stage left out: it has no gain), then

@@ -3,7 +3,6 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "models/model_descriptors.hpp"
 
 namespace hystloop {
 

@@ -54,4 +54,16 @@ std::string summary_line(std::span<const ParamSpec<S>> table, const S& s) {
   return out;
 }
 
+// A model whose table stores straight into its parameter struct (all but PI); D is the model's
+// descriptor, which declares table().
+template <class D, class P>
+struct StoresParams {
+  using Settings = P;
+  using Params = P;
+  static constexpr std::string_view notes = "";  // extra help lines
+  static Params build(const Settings& s) { return s; }
+  static Settings settings_of(const Params& p) { return p; }
+  static std::string summary_of(const Params& p) { return summary_line(D::table(), p); }  // the in_summary rows
+};
+
 }  // namespace hystloop

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
 #include "models/model_descriptors.hpp"
 #include "models/model_concepts.hpp"
@@ -76,8 +77,11 @@ const ModelEntry kEntry{D::name,
                         [](const std::vector<Assignment>& assignments) -> std::unique_ptr<ModelRun> {
                           return std::make_unique<RunFor<D>>(params_from<D>(assignments));
                         }};
-const ModelEntry* const kRegistry[] = {&kEntry<MemDescriptor>, &kEntry<BanningDescriptor>, &kEntry<KatalenicDescriptor>,
-                                       &kEntry<PiDescriptor>, &kEntry<LinearDescriptor>};
+const std::vector<const ModelEntry*> kRegistry = [] {
+  std::vector<const ModelEntry*> entries;
+  AllModels::for_each([&]<class D>() { entries.push_back(&kEntry<D>); });
+  return entries;
+}();
 
 }  // namespace
 

@@ -43,7 +43,7 @@ struct ModelEntry {
 std::span<const ModelEntry* const> model_registry();
 // nullptr if unknown.
 const ModelEntry* find_model(std::string_view name);
-// "mem, banning, katalenic, pi, linear"
+// "mem, pi, katalenic, linear, banning"
 std::string model_names(std::string_view separator = ", ");
 
 // The --help section: every model, its parameters with unit, default and meaning.

@@ -319,7 +319,7 @@ TEST_F(ParamsFileTest, RefusesWithTheFileAndKey) {
   EXPECT_EQ(read_params_file(two, "pi").model, "pi");
   EXPECT_EQ(error(two, "linear"), two + ": no 'linear' section (it has: mem, pi)");
   const std::string none = write("none.yaml", "bridge: {u_max_V: 250}\n");
-  EXPECT_EQ(error(none, ""), none + ": no model section (expected one of mem, banning, katalenic, pi, linear)");
+  EXPECT_EQ(error(none, ""), none + ": no model section (expected one of mem, pi, katalenic, linear, banning)");
   const std::string broken = write("broken.yaml", "mem:\n  c1: [1, 2\n");
   EXPECT_EQ(error(broken, "mem").rfind(broken + ":", 0), 0u);
   EXPECT_NE(error(broken, "mem").find("not valid YAML"), std::string::npos);

@@ -1,45 +1,15 @@
-// Parameter tables of mem, pi, linear and banning (katalenic's is in model_tables_katalenic.cpp).
-// Names are the parameter structs' member names, which are also the keys hystloop-identify writes
-// in its YAML (ident/params_yaml.cpp) and the compensator's config keys, so a fitted file reads
-// back unchanged everywhere.
+// PI's parameter table (its operators, or a size and a range with weights matched to a MEM), how
+// the settings become PiParams, and its gain band.
+#include "models/pi_descriptor.hpp"
+
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
 #include "core/errors.hpp"
-#include "models/model_descriptors.hpp"
 #include "models/param_fields.hpp"
 
 namespace hystloop {
-
-// ---- mem ----------------------------------------------------------------------------------------
-
-std::span<const ParamSpec<MemParams>> MemDescriptor::table() {
-  static const ParamSpec<MemParams> rows[] = {
-      summarised(number<MemParams>(
-          "c1", "m/V", "slope right after a reversal, M(0) = c1", [](auto& p) -> auto& { return p.c1; })),
-      summarised(number<MemParams>(
-          "c2", "m/V^(1+c3)", "growth of the slope with the distance p from the reversal",
-          [](auto& p) -> auto& { return p.c2; })),
-      summarised(number<MemParams>(
-          "c3", "-", "exponent of that growth, M(p) = c1 + c2 p^c3", [](auto& p) -> auto& { return p.c3; })),
-  };
-  return rows;
-}
-
-// ---- linear -------------------------------------------------------------------------------------
-
-std::span<const ParamSpec<LinearParams>> LinearDescriptor::table() {
-  static const ParamSpec<LinearParams> rows[] = {
-      summarised(number<LinearParams>(
-          "gain", "m/V", "slope (default: chord of the default MEM's +-250 V loop)",
-          [](auto& p) -> auto& { return p.gain; })),
-      summarised(number<LinearParams>(
-          "offset", "m", "output at u = 0", [](auto& p) -> auto& { return p.offset; })),
-  };
-  return rows;
-}
-
-// ---- pi -----------------------------------------------------------------------------------------
 
 static_assert(kPiMaxOperators == 32, "the help text of count says 1..32");
 
@@ -138,39 +108,46 @@ PiParams PiDescriptor::build(const PiSettings& s) {
   return p;
 }
 
-// ---- banning ------------------------------------------------------------------------------------
+namespace {
 
-std::span<const ParamSpec<BanningStageParams>> BanningDescriptor::table() {
-  using P = BanningStageParams;
-  static const ParamSpec<P> rows[] = {
-      summarised(number<P>(
-          "hysteresis.a", "m/V", "slope of f: loop centres lie on w = a u",
-          [](auto& p) -> auto& { return p.hysteresis.a; })),
-      summarised(number<P>(
-          "hysteresis.b", "m/V", "slope of small loops, a/2 <= b <= a",
-          [](auto& p) -> auto& { return p.hysteresis.b; })),
-      summarised(number<P>(
-          "hysteresis.alpha", "1/V", "relaxation rate onto f after a reversal",
-          [](auto& p) -> auto& { return p.hysteresis.alpha; })),
-      summarised(number<P>(
-          "hysteresis.s_max", "V", "saturation of f and g", [](auto& p) -> auto& { return p.hysteresis.s_max; })),
-      summarised(number<P>(
-          "stage.k", "1/s^2", "stiffness, omega_n^2", [](auto& p) -> auto& { return p.stage.k; })),
-      summarised(number<P>(
-          "stage.c", "1/s", "damping, 2 zeta omega_n", [](auto& p) -> auto& { return p.stage.c; })),
-      custom<P>(
-          "order", "-", "which comes first: hysteresis (the bridge's) or the stage (the paper's)", ValueKind::choice,
-          [](P& p, const ParsedValue& v) {
-            p.order = v.choice == "stage_then_hysteresis" ? BanningOrder::kStageThenHysteresis
-                                                          : BanningOrder::kHysteresisThenStage;
-          },
-          [](const P& p) {
-            return std::string(p.order == BanningOrder::kStageThenHysteresis ? "stage_then_hysteresis"
-                                                                             : "hysteresis_then_stage");
-          },
-          "hysteresis_then_stage|stage_then_hysteresis"),
-  };
-  return rows;
+// The plays a branch or the initial loading curve can engage within a range of R volts.
+std::size_t engaged_plays(const PiParams& pi, double range_V) noexcept {
+  std::size_t n = 0;
+  while (n < pi.count && n < kPiMaxOperators && pi.thresholds[n] < range_V) ++n;
+  return std::max<std::size_t>(n, 1);  // r_0 = 0: the identity always is
+}
+
+}  // namespace
+
+// The cumulative weights w_0 + ... + w_i of the plays a branch or the initial loading curve can
+// engage within the range (r_i < R; the last one is the sum of the weights).
+GainRange PiDescriptor::gain_range(const PiParams& p, const GainPlausibility& rig) noexcept {
+  const std::size_t n = engaged_plays(p, rig.u_max_V - rig.u_min_V);
+  GainRange r{p.weights[0], p.weights[0]};
+  double cumulative = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    cumulative += p.weights[i];
+    r.min_m_per_V = std::min(r.min_m_per_V, cumulative);
+    r.max_m_per_V = std::max(r.max_m_per_V, cumulative);
+  }
+  return r;
+}
+
+// Names the first play whose cumulative weight leaves the band.
+void PiDescriptor::refuse_gain(const PiParams& p, const GainRange& g, const GainPlausibility& rig) {
+  const double lo = rig.min_gain_m_per_V(), hi = rig.max_gain_m_per_V();
+  const std::size_t n = engaged_plays(p, rig.u_max_V - rig.u_min_V);
+  double cumulative = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    cumulative += p.weights[i];
+    if (!(cumulative >= lo) || !(cumulative <= hi)) {
+      refuse_implausible_gain("weights[" + std::to_string(i) + "]",
+                              "the slope w_0 + ... + w_" + std::to_string(i) + " of a branch", cumulative,
+                              !(cumulative >= lo), rig);
+    }
+  }
+  const bool low = !(g.min_m_per_V >= lo);
+  refuse_implausible_gain("weights", "the slope of a branch", low ? g.min_m_per_V : g.max_m_per_V, low, rig);
 }
 
 }  // namespace hystloop

@@ -1,6 +1,7 @@
-// Parameter table of katalenic: the operator's k1, k2 (and its input-dependent schedule), the
+// Parameter table of katalenic, and its gain band: the operator's k1, k2 (and its input-dependent schedule), the
 // initial offset, and the two shaping functions field by field ("input_shaping.gain", ...), the
 // flattened form of the YAML hystloop-identify writes (input_shaping: {kind: linear, gain: ...}).
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <span>
@@ -8,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "models/model_descriptors.hpp"
+#include "models/katalenic_descriptor.hpp"
 #include "models/param_fields.hpp"
 
 namespace hystloop {
@@ -120,6 +121,51 @@ std::vector<ParamSpec<P>> make_rows() {
 std::span<const ParamSpec<KatalenicParams>> KatalenicDescriptor::table() {
   static const std::vector<ParamSpec<P>> rows = make_rows();
   return rows;
+}
+
+namespace {
+
+// Sample points of a shaping function's slope over an interval (its ends included): enough to
+// see a tanh or a degree-7 polynomial bend, cheap at the rate parameter sets arrive.
+constexpr int kShapingSamples = 65;
+
+// The smallest and largest slope of a shaping function over [lo, hi].
+GainRange shaping_slope(const ShapingFunction& s, double lo, double hi) noexcept {
+  if (s.kind == ShapingKind::linear) return {s.gain, s.gain};
+  GainRange r{s.derivative(lo), s.derivative(lo)};
+  for (int i = 1; i < kShapingSamples; ++i) {
+    const double x = lo + (hi - lo) * static_cast<double>(i) / (kShapingSamples - 1);
+    const double d = s.derivative(x);
+    r.min_m_per_V = std::min(r.min_m_per_V, d);
+    r.max_m_per_V = std::max(r.max_m_per_V, d);
+  }
+  return r;
+}
+
+// The range of the operator's own slope dz/dx: the inverse operator's dv/du = 1 + M* k2 e^(-k2 u)
+// with M* in [0, 2 k1] puts it in [1 / (1 + 2 k1 k2_max), 1].
+GainRange operator_slope(const KatalenicParams& k) noexcept { return {1.0 / (1.0 + 2.0 * k.k1 * k.k2_max()), 1.0}; }
+
+}  // namespace
+
+// psi_out' x H' x psi_in', the shaping slopes sampled over the input range and the output band it
+// maps to (+- k1).
+GainRange KatalenicDescriptor::gain_range(const KatalenicParams& k, const GainPlausibility& rig) noexcept {
+  const GainRange in = shaping_slope(k.input_shaping, rig.u_min_V, rig.u_max_V);
+  const double x_lo = k.input_shaping.apply(rig.u_min_V), x_hi = k.input_shaping.apply(rig.u_max_V);
+  const GainRange out = shaping_slope(k.output_shaping, x_lo - k.k1, x_hi + k.k1);
+  const GainRange op = operator_slope(k);
+  return {in.min_m_per_V * op.min_m_per_V * out.min_m_per_V, in.max_m_per_V * op.max_m_per_V * out.max_m_per_V};
+}
+
+// The operator's own slope right after a reversal is the factor 1 / (1 + 2 k1 k2); when it alone
+// leaves the band the transition is the fault, otherwise the output's scale.
+void KatalenicDescriptor::refuse_gain(const KatalenicParams& k, const GainRange& g, const GainPlausibility& rig) {
+  const bool low = !(g.min_m_per_V >= rig.min_gain_m_per_V());
+  const bool operator_fault = low && operator_slope(k).min_m_per_V < 1.0 / rig.factor;
+  refuse_implausible_gain(operator_fault ? "k2" : "output_shaping",
+                          low ? "the slope right after a reversal" : "the largest slope of a branch",
+                          low ? g.min_m_per_V : g.max_m_per_V, low, rig);
 }
 
 }  // namespace hystloop
