@@ -20,8 +20,9 @@ static_assert(command_block_t::MODE_EXPERIMENT == static_cast<std::int8_t>(Feedf
 // Any MODE_* (MODE_EXPERIMENT too: whether a mode is selectable is the caller's question); empty
 // for a number that names none.
 inline std::optional<FeedforwardMode> feedforward_mode_from_wire(std::int8_t mode) noexcept {
-  if (mode < command_block_t::MODE_OFF || mode > command_block_t::MODE_EXPERIMENT) return std::nullopt;
-  return static_cast<FeedforwardMode>(mode);
+  const auto m = static_cast<FeedforwardMode>(mode);
+  if (m == FeedforwardMode::kOff || m == FeedforwardMode::kExperiment || model_kind_of(m)) return m;
+  return std::nullopt;
 }
 
 inline std::int8_t to_wire(FeedforwardMode mode) noexcept { return static_cast<std::int8_t>(mode); }

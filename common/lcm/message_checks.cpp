@@ -1,10 +1,12 @@
 #include "lcm/message_checks.hpp"
 
 #include "lcm/message_storage.hpp"
+#include "models/model_set.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace hystloop {
 namespace {
@@ -47,8 +49,11 @@ class Findings {
 
 constexpr double kHuge = 1.0e300;  // "any finite value"
 
+// Off, an experiment, or an online model's mode (its number in models/model_set.hpp's registry).
 bool is_command_mode(std::int8_t mode) noexcept {
-  return mode >= command_block_t::MODE_OFF && mode <= command_block_t::MODE_EXPERIMENT;
+  bool model = false;
+  OnlineModels::for_each([&]<class D>() { model = model || D::mode == mode; });
+  return mode == command_block_t::MODE_OFF || mode == command_block_t::MODE_EXPERIMENT || model;
 }
 
 }  // namespace
@@ -137,32 +142,42 @@ Verdict check_message(const mem_params_t& msg) noexcept {
 
 namespace {
 
-void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
-  switch (msg.kind) {
-    case model_params_t::KIND_MEM:
-      f.require(msg.mem_c1 > 0.0 && msg.mem_c1 <= 1.0);  // [m/V]
-      f.require(msg.mem_c2 >= 0.0);
-      f.require(msg.mem_c3 > 0.0 && msg.mem_c3 <= 50.0);  // as mem_params_t
-      break;
-    case model_params_t::KIND_PI:
-      f.require(msg.n_operators >= 1);
-      if (msg.n_operators >= 1 && arrays_consistent(msg)) {
-        f.require(msg.pi_thresholds_V[0] == 0.0 && msg.pi_weights[0] > 0.0);
-        for (std::size_t i = 1; i < msg.pi_thresholds_V.size(); ++i) {
-          f.require(msg.pi_thresholds_V[i] > msg.pi_thresholds_V[i - 1] && msg.pi_thresholds_V[i] <= kMaxAbsVoltage_V);
-        }
-      }
-      break;
-    case model_params_t::KIND_LINEAR: f.require(msg.linear_gain != 0.0 && std::fabs(msg.linear_gain) <= 1.0); break;
-    case model_params_t::KIND_KATALENIC:
-      f.require(msg.kat_k1 > 0.0 && msg.kat_k2 > 0.0 && msg.kat_k2_domain_min < msg.kat_k2_domain_max);
-      f.require(msg.kat_in_shaping >= model_params_t::SHAPING_LINEAR &&
-                msg.kat_in_shaping <= model_params_t::SHAPING_TANH);
-      f.require(msg.kat_out_shaping >= model_params_t::SHAPING_LINEAR &&
-                msg.kat_out_shaping <= model_params_t::SHAPING_TANH);
-      break;
-    default: break;  // unknown: the receiver's own reason (check_message refuses it)
+// Every online model's wire fields (its descriptor's on_wire), whatever the message's kind: numbers
+// finite, PI's arrays as long as their count says (and read only then).
+class FiniteWireFields {
+ public:
+  FiniteWireFields(Findings& f, const model_params_t& msg) noexcept : f_(f), msg_(msg) {}
+  void operator()(const double& wire, const auto&) noexcept { f_.finite(wire); }
+  void operator()(const std::int8_t&, const auto&) noexcept {}  // an enumeration: the kind's own check
+  void operator()(const double (&wire)[8], const auto&) noexcept {
+    for (const double v : wire) f_.finite(v);
   }
+  void operator()(const std::int32_t& n, const auto&) noexcept {
+    arrays_ok_ = f_.count(n, 0, model_params_t::MAX_OPERATORS, arrays_consistent(msg_));
+  }
+  void operator()(const std::vector<double>& wire, const auto&, std::size_t) noexcept {
+    if (!arrays_ok_) return;
+    for (const double v : wire) f_.finite(v);
+  }
+
+ private:
+  Findings& f_;
+  const model_params_t& msg_;
+  bool arrays_ok_ = true;
+};
+
+void check_model_fields_finite(Findings& f, const model_params_t& msg) noexcept {
+  OnlineModels::for_each([&]<class D>() {
+    typename D::Params unused{};  // on_wire pairs each wire field with a parameter; only the wire is read here
+    D::on_wire(msg, unused, FiniteWireFields(f, msg));
+  });
+}
+
+// The kind's own sanity bounds (its descriptor's check_wire) and the stage's.
+void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
+  if (const auto kind = model_kind_from_int(msg.kind)) {
+    OnlineModels::visit(*kind, [&]<class D>() { D::check_wire(msg, [&](bool ok) { f.require(ok); }); });
+  }  // unknown: the receiver's own reason (check_message refuses it)
   f.require(msg.stage_kind >= model_params_t::STAGE_UNCHANGED && msg.stage_kind <= model_params_t::STAGE_SECOND_ORDER);
   f.require(msg.stage_order == model_params_t::ORDER_HYSTERESIS_THEN_STAGE ||
             msg.stage_order == model_params_t::ORDER_STAGE_THEN_HYSTERESIS);
@@ -178,23 +193,9 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
   f.text(msg.source);
-  for (const double v : {msg.mem_c1, msg.mem_c2, msg.mem_c3, msg.linear_gain, msg.linear_offset_m, msg.kat_k1,
-                         msg.kat_k2, msg.kat_k2_slope, msg.kat_k2_domain_min, msg.kat_k2_domain_max,
-                         msg.kat_initial_offset, msg.stage_k, msg.stage_c}) {
-    f.finite(v);
-  }
-  const double in[] = {msg.kat_in_gain,       msg.kat_in_offset,    msg.kat_in_domain_min,
-                       msg.kat_in_domain_max, msg.kat_in_amplitude, msg.kat_in_scale};
-  const double out[] = {msg.kat_out_gain,       msg.kat_out_offset,    msg.kat_out_domain_min,
-                        msg.kat_out_domain_max, msg.kat_out_amplitude, msg.kat_out_scale};
-  for (const double v : in) f.finite(v);
-  for (const double v : out) f.finite(v);
-  for (const double v : msg.kat_in_coefficients) f.finite(v);
-  for (const double v : msg.kat_out_coefficients) f.finite(v);
-  if (f.count(msg.n_operators, 0, model_params_t::MAX_OPERATORS, arrays_consistent(msg))) {
-    for (const double v : msg.pi_thresholds_V) f.finite(v);
-    for (const double v : msg.pi_weights) f.finite(v);
-  }
+  f.finite(msg.stage_k);
+  f.finite(msg.stage_c);
+  check_model_fields_finite(f, msg);
   f.within(msg.residual_m, 0.0, kMaxAbsPosition_m);
   f.nan_or_within(msg.heldout_rms_m, 0.0, kMaxAbsPosition_m);
   f.within(msg.window_s, 0.0, kMaxDuration_s);
@@ -205,8 +206,7 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
 Verdict check_message(const model_params_t& msg) noexcept {
   const Verdict envelope = check_model_params_envelope(msg);
   if (envelope != Verdict::kOk) return envelope;
-  const bool known = msg.format_version == model_params_t::FORMAT_VERSION && msg.kind >= model_params_t::KIND_MEM &&
-                     msg.kind <= model_params_t::KIND_LINEAR;
+  const bool known = msg.format_version == model_params_t::FORMAT_VERSION && model_kind_from_int(msg.kind);
   return known ? Verdict::kOk : Verdict::kOutOfRange;
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -34,26 +35,19 @@ std::string si(double value, const char* unit) {
 }
 }  // namespace
 
+// Each online model's mode number is its registry entry's (models/model_set.hpp).
 FeedforwardMode mode_of(ModelKind kind) noexcept {
-  switch (kind) {
-    case ModelKind::mem: return FeedforwardMode::kMem;
-    case ModelKind::pi: return FeedforwardMode::kPi;
-    case ModelKind::katalenic: return FeedforwardMode::kKatalenic;
-    case ModelKind::linear: return FeedforwardMode::kLinear;
-  }
-  return FeedforwardMode::kOff;
+  FeedforwardMode mode = FeedforwardMode::kOff;
+  OnlineModels::visit(kind, [&]<class D>() { mode = static_cast<FeedforwardMode>(D::mode); });
+  return mode;
 }
 
 std::optional<ModelKind> model_kind_of(FeedforwardMode mode) noexcept {
-  switch (mode) {
-    case FeedforwardMode::kMem: return ModelKind::mem;
-    case FeedforwardMode::kPi: return ModelKind::pi;
-    case FeedforwardMode::kKatalenic: return ModelKind::katalenic;
-    case FeedforwardMode::kLinear: return ModelKind::linear;
-    case FeedforwardMode::kOff:
-    case FeedforwardMode::kExperiment: return std::nullopt;
-  }
-  return std::nullopt;
+  std::optional<ModelKind> kind;
+  OnlineModels::for_each([&]<class D>() {
+    if (static_cast<FeedforwardMode>(D::mode) == mode) kind = D::kind;
+  });
+  return kind;
 }
 
 // The models' names are ModelKind's (models/model_set.cpp): one table for the compensator's
@@ -65,10 +59,11 @@ FeedforwardMode parse_feedforward_mode(const std::string& name, const std::strin
 }
 
 std::string selectable_mode_choices() {
+  std::vector<std::pair<std::int8_t, std::string_view>> modes{{static_cast<std::int8_t>(FeedforwardMode::kOff), "off"}};
+  OnlineModels::for_each([&]<class D>() { modes.emplace_back(D::mode, D::name); });
+  std::sort(modes.begin(), modes.end());
   std::vector<std::string_view> names;
-  for (auto m = static_cast<int>(FeedforwardMode::kOff); m <= static_cast<int>(FeedforwardMode::kKatalenic); ++m) {
-    names.emplace_back(to_string(static_cast<FeedforwardMode>(m)));
-  }
+  for (const auto& [number, name] : modes) names.push_back(name);
   return choice_list(names);
 }
 

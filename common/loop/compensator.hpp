@@ -59,7 +59,9 @@
 
 namespace hystloop {
 
-// Which feedforward; numbering shared with command_block_t.mode / control_t.mode.
+// Which feedforward; numbering shared with command_block_t.mode / control_t.mode. A model's mode
+// is the number its entry in OnlineModels (models/model_set.hpp) gives it: one added there takes
+// the next free one (6, ...) and needs no enumerator here.
 enum class FeedforwardMode : std::int8_t {
   kOff = 0,        // no feedforward: u_ff = 0 (the bridge's servo alone)
   kLinear = 1,     // static gain: the MEM paper's "linear feedforward"
