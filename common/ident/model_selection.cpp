@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
@@ -10,9 +11,16 @@
 
 namespace hystloop {
 
+bool has_fitter(ModelKind kind) noexcept {
+  return kind == ModelKind::mem || kind == ModelKind::pi || kind == ModelKind::katalenic || kind == ModelKind::linear;
+}
+
 void ModelSelectionOptions::validate() const {
   require_in_range("holdout_fraction", holdout_fraction, 0.05, 0.8);
   if (candidates.empty()) throw ParameterError("candidates", "must name at least one model");
+  for (const ModelKind kind : candidates) {
+    if (!has_fitter(kind)) throw ParameterError("candidates", std::string(to_string(kind)) + " has no fitter");
+  }
   mem.validate();
   pi.validate();
   katalenic.validate();
@@ -60,8 +68,9 @@ ModelScore fit_candidate(ModelKind kind, std::span<const double> u, std::span<co
     case ModelKind::pi: return score_of(kind, sel.pi = fit_pi(u, y, o.pi));
     case ModelKind::katalenic: return score_of(kind, sel.katalenic = fit_katalenic(u, y, o.katalenic));
     case ModelKind::linear: return score_of(kind, sel.linear = fit_linear(u, y, o.mem.min_input_range_V));
+    default: break;  // a model the loop runs but nothing here fits (options.validate() refuses it)
   }
-  return {};
+  return {kind, FitStatus::solver_failure, std::string(to_string(kind)) + " has no fitter", 0.0, 0.0, 0.0, 0};
 }
 
 ModelParamSet fitted_set(const ModelSelection& sel, ModelKind kind, ModelParamSet base) {
@@ -71,6 +80,7 @@ ModelParamSet fitted_set(const ModelSelection& sel, ModelKind kind, ModelParamSe
     case ModelKind::pi: base.pi = to_pi_params(sel.pi); break;
     case ModelKind::katalenic: base.katalenic = sel.katalenic.params; break;
     case ModelKind::linear: base.linear = to_linear_params(sel.linear); break;
+    default: throw ParameterError("kind", std::string(to_string(kind)) + " has no fitter");
   }
   return base;
 }
@@ -82,6 +92,7 @@ std::vector<double> fitted_prediction(const ModelSelection& sel, ModelKind kind,
     case ModelKind::pi: return predict_pi(sel.pi, u);
     case ModelKind::katalenic: return predict_katalenic(sel.katalenic.params, u);
     case ModelKind::linear: break;
+    default: return std::vector<double>(u.size(), 0.0);  // no fitter, no fit (as fit_candidate says)
   }
   std::vector<double> pred(u.size());
   for (std::size_t k = 0; k < u.size(); ++k) pred[k] = sel.linear.gain_m_per_V * u[k] + sel.linear.offset_m;

@@ -21,6 +21,9 @@
 
 namespace hystloop {
 
+// Whether identification fits `kind` (fit_candidate): a model the loop runs may be fitted elsewhere.
+bool has_fitter(ModelKind kind) noexcept;
+
 struct ModelSelectionOptions {
   double holdout_fraction = 0.3;  // the held-out part starts at the first reversal after 1 - this
   std::vector<ModelKind> candidates{ModelKind::mem, ModelKind::pi, ModelKind::katalenic, ModelKind::linear};

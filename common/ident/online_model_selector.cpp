@@ -37,14 +37,16 @@ std::vector<double> predict_model(const ModelParamSet& p, std::span<const double
       fit.weights.assign(p.pi.weights.begin(), p.pi.weights.begin() + static_cast<long>(p.pi.count));
       return predict_pi(fit, u);
     }
-    case ModelKind::katalenic: return predict_katalenic(p.katalenic, u);
-    case ModelKind::linear: {
-      std::vector<double> out(u.size());
-      for (std::size_t k = 0; k < u.size(); ++k) out[k] = p.linear.gain * u[k] + p.linear.offset;
-      return out;
-    }
+    default: break;
   }
-  return std::vector<double>(u.size(), 0.0);
+  // Every other model: its forward model from a virgin state at the first sample.
+  std::vector<double> out(u.size(), 0.0);
+  OnlineModels::visit(p.kind, [&]<class D>() {
+    typename D::Forward model(p.*D::in_set);
+    if (!u.empty()) model.reset(u[0]);
+    for (std::size_t k = 0; k < u.size(); ++k) out[k] = model.forward(u[k]);
+  });
+  return out;
 }
 
 namespace {
