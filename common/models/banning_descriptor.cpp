@@ -1,5 +1,5 @@
 // Banning et al.'s stage's parameter table.
-#include "models/banning_descriptor.hpp"
+#include "models/model_descriptors.hpp"
 
 #include <string>
 

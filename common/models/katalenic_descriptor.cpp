@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "models/katalenic_descriptor.hpp"
+#include "models/model_set.hpp"
 #include "models/param_fields.hpp"
 
 namespace hystloop {

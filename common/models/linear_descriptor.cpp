@@ -1,5 +1,5 @@
 // The linear model's parameter table and its gain band.
-#include "models/linear_descriptor.hpp"
+#include "models/model_set.hpp"
 
 #include "models/param_fields.hpp"
 

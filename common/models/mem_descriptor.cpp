@@ -1,6 +1,6 @@
 // MEM's parameter table (names are MemParams' members: the YAML keys hystloop-identify writes and
 // the compensator's config keys) and its gain band.
-#include "models/mem_descriptor.hpp"
+#include "models/model_set.hpp"
 
 #include "models/param_fields.hpp"
 

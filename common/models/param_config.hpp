@@ -36,7 +36,7 @@ std::vector<Assignment> config_section(const Config& config, std::string_view mo
   return out;
 }
 
-// D's (models/<model>_descriptor.hpp) section onto `settings` (the defaults), built and validated. Throws
+// D's (models/model_descriptors.hpp) section onto `settings` (the defaults), built and validated. Throws
 // ParameterError naming the field below the section ("c1", an unknown one too): run it in
 // validate_config_section(config, "<section>.", ...) for a ConfigError naming the key. The
 // section is the model's name unless another part of the config holds the model's parameters

@@ -117,7 +117,7 @@ const ParamSpec<S>* find_spec(std::span<const ParamSpec<S>> table, std::string_v
   return nullptr;
 }
 
-// D's (models/<model>_descriptor.hpp) parameters: the assignments over `settings` (the defaults),
+// D's (models/model_descriptors.hpp) parameters: the assignments over `settings` (the defaults),
 // built and validated. Throws AssignmentError or ParameterError naming the field.
 template <class D>
 typename D::Params params_from(const std::vector<Assignment>& assignments, typename D::Settings settings = {}) {

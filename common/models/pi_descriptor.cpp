@@ -1,6 +1,6 @@
 // PI's parameter table (its operators, or a size and a range with weights matched to a MEM), how
 // the settings become PiParams, and its gain band.
-#include "models/pi_descriptor.hpp"
+#include "models/model_set.hpp"
 
 #include <algorithm>
 #include <cstdio>

@@ -39,6 +39,7 @@
 
 #include "ident/online_mem_estimator.hpp"
 #include "models/gain_plausibility.hpp"
+#include "models/model_set.hpp"
 #include "models/mem.hpp"
 #include "models/stage_inverse.hpp"
 #include "reident/model_chooser.hpp"

@@ -20,6 +20,7 @@
 
 #include "ident/online_mem_estimator.hpp"
 #include "models/gain_plausibility.hpp"
+#include "models/model_set.hpp"
 #include "reident/job_slot.hpp"
 
 namespace hystloop {

@@ -14,6 +14,7 @@
 #include "loop/compensator.hpp"
 #include "loop/trajectory.hpp"
 #include "models/gain_plausibility.hpp"
+#include "models/model_set.hpp"
 
 namespace hystloop {
 

@@ -18,7 +18,7 @@ static_assert(kPiMaxOperators == model_params_t::MAX_OPERATORS, "model_params_t 
 using Coefficients = std::array<double, ShapingFunction::kMaxCoefficients>;
 using Plays = std::array<double, kPiMaxOperators>;
 
-// The visitors of the descriptors' on_wire (models/<model>_descriptor.hpp): a parameter onto its
+// The visitors of the descriptors' on_wire (models/model_set.hpp): a parameter onto its
 // wire field, a wire field back, a wire field to 0.
 struct Write {
   void operator()(double& wire, double p) const { wire = p; }

@@ -22,6 +22,7 @@
 #include "lcm/message_storage.hpp"
 #include "lcm/wire_layout.hpp"
 #include "models/gain_plausibility.hpp"
+#include "models/model_set.hpp"
 
 namespace {
 

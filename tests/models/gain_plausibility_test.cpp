@@ -3,6 +3,7 @@
 // absurd values an outside probe sent (MEM c2 = 1e300, c1 = 2.9e-322, every gain x1000), and the
 // sets the rig is deployed with inside it.
 #include "models/gain_plausibility.hpp"
+#include "models/model_set.hpp"
 
 #include <gtest/gtest.h>
 
