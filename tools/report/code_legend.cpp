@@ -1,6 +1,9 @@
 #include "code_legend.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <string>
+#include <utility>
 
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
@@ -8,6 +11,7 @@
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "models/model_set.hpp"
 
 namespace hystloop::report {
 
@@ -24,10 +28,26 @@ Code code(std::int64_t value, std::string_view constant, std::string_view prefix
 // The value comes from the generated constant, the name from the constant's own spelling.
 #define HX_CODE(type, constant, prefix) code(type::constant, #constant, prefix)
 
+// The online models' numbers and names are the registry's (models/model_set.hpp), whether or not
+// the .lcm names them too; in the order of their numbers.
+std::vector<Code> by_value(std::vector<Code> codes) {
+  std::sort(codes.begin(), codes.end(), [](const Code& a, const Code& b) { return a.value < b.value; });
+  return codes;
+}
+
 std::vector<Code> modes() {
-  return {HX_CODE(command_block_t, MODE_OFF, "MODE_"),       HX_CODE(command_block_t, MODE_LINEAR, "MODE_"),
-          HX_CODE(command_block_t, MODE_MEM, "MODE_"),       HX_CODE(command_block_t, MODE_PI, "MODE_"),
-          HX_CODE(command_block_t, MODE_KATALENIC, "MODE_"), HX_CODE(command_block_t, MODE_EXPERIMENT, "MODE_")};
+  std::vector<Code> codes{HX_CODE(command_block_t, MODE_OFF, "MODE_"),
+                          HX_CODE(command_block_t, MODE_EXPERIMENT, "MODE_")};
+  OnlineModels::for_each([&]<class D>() { codes.push_back({D::mode, std::string(D::name)}); });
+  return by_value(std::move(codes));
+}
+
+std::vector<Code> model_kinds() {
+  std::vector<Code> codes;
+  OnlineModels::for_each([&]<class D>() {
+    codes.push_back({static_cast<std::int64_t>(D::kind), std::string(D::name)});
+  });
+  return by_value(std::move(codes));
 }
 
 std::vector<Code> shapings() {
@@ -76,11 +96,7 @@ std::vector<CodeLegend> make_legends() {
        {HX_CODE(service_status_t, STARTING, ""), HX_CODE(service_status_t, HEALTHY, ""),
         HX_CODE(service_status_t, DEGRADED, ""), HX_CODE(service_status_t, SAFE, ""),
         HX_CODE(service_status_t, STOPPING, "")}},
-      {model,
-       "kind",
-       false,
-       {HX_CODE(model_params_t, KIND_MEM, "KIND_"), HX_CODE(model_params_t, KIND_PI, "KIND_"),
-        HX_CODE(model_params_t, KIND_KATALENIC, "KIND_"), HX_CODE(model_params_t, KIND_LINEAR, "KIND_")}},
+      {model, "kind", false, model_kinds()},
       {model,
        "stage_kind",
        false,
