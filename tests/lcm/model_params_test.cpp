@@ -14,6 +14,7 @@
 #include "lcm/subscription.hpp"
 #include "lcm/wire_layout.hpp"
 #include "model_params_fixtures.hpp"
+#include "models/model_set.hpp"
 
 namespace hystloop {
 namespace {
@@ -188,7 +189,7 @@ TEST(ModelParamsMessage, KindSpecificRanges) {
 }
 
 TEST(ModelParamsMessage, AnUnknownKindOrFormatPassesTheEnvelopeOnly) {
-  for (const std::int8_t kind : {std::int8_t{4}, std::int8_t{-1}, std::int8_t{127}}) {
+  for (const std::int8_t kind : {std::int8_t{kModelKindCount}, std::int8_t{-1}, std::int8_t{127}}) {
     auto m = fixtures::model_params(0);
     m.kind = kind;
     EXPECT_EQ(check_model_params_envelope(m), Verdict::kOk) << int{kind};
