@@ -63,6 +63,7 @@ std::string selectable_mode_choices() {
   OnlineModels::for_each([&]<class D>() { modes.emplace_back(D::mode, D::name); });
   std::sort(modes.begin(), modes.end());
   std::vector<std::string_view> names;
+  names.reserve(modes.size());
   for (const auto& [number, name] : modes) names.push_back(name);
   return choice_list(names);
 }
