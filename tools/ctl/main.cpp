@@ -416,78 +416,70 @@ int run(int argc, char** argv) {
 
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
 
-  try {
-    if (*config_get) return run_config_get(config_get_options);
-    if (*keygen) {
-      write_rig_key(keygen_out, generate_rig_key(), keygen_force);
-      std::printf(
-          "wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
-          "auth.key_file in every service's config\n",
-          keygen_out.c_str());
-      return 0;
+  if (*config_get) return run_config_get(config_get_options);
+  if (*keygen) {
+    write_rig_key(keygen_out, generate_rig_key(), keygen_force);
+    std::printf(
+        "wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
+        "auth.key_file in every service's config\n",
+        keygen_out.c_str());
+    return 0;
+  }
+  if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
+  if (*status) {
+    if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
+    CtlLink link(o.link);
+    return run_status(link, o.status);
+  }
+  if (*arm) return send_control(o, control_t::ARM, o.target, "ARM", "bridge", counter_is("armed", 1));
+  if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM", "bridge", counter_is("armed", 0));
+  if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT", "compensator");
+  if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN", nullptr);
+  if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
+  if (*pin) {
+    const std::int8_t m = ctl::pin_model_mode(pin_model);
+    return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, "PIN_MODEL " + pin_model, nullptr, {},
+                        [m](control_t& msg) { msg.mode = m; });
+  }
+  if (*hold) {
+    const bool on = hold_what == "on";
+    return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, ctl::kPinModelTarget,
+                        on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr, counter_is("params_held", on ? 1 : 0));
+  }
+  if (*mode) {
+    const std::int8_t m = parse_mode(o.mode);
+    return send_control(o, control_t::SET_MODE, o.target, "SET_MODE " + o.mode, "compensator", counter_is("mode", m),
+                        [m](control_t& msg) { msg.mode = m; });
+  }
+  if (*gains) {
+    if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
+    return run_gains(o);
+  }
+  if (*learn) {
+    const std::int8_t l = parse_learning(o.learning);
+    if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
+    return send_control(o, control_t::SET_LEARNING, o.learn_target, "SET_LEARNING " + o.learning, nullptr, {},
+                        [l](control_t& msg) { msg.learning = l; });
+  }
+  if (*experiment) {
+    if (o.banning_series) return run_banning_series(o);
+    if (o.experiment_mem_paper) {
+      o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
+    } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
+      throw ParameterError("experiment",
+                           "give --amplitude, --frequency and --duration, or --mem-paper, or "
+                           "--banning-series");
     }
-    if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
-    if (*status) {
-      if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
-      CtlLink link(o.link);
-      return run_status(link, o.status);
-    }
-    if (*arm) return send_control(o, control_t::ARM, o.target, "ARM", "bridge", counter_is("armed", 1));
-    if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM", "bridge", counter_is("armed", 0));
-    if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT", "compensator");
-    if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN", nullptr);
-    if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
-    if (*pin) {
-      const std::int8_t m = ctl::pin_model_mode(pin_model);
-      return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, "PIN_MODEL " + pin_model, nullptr, {},
-                          [m](control_t& msg) { msg.mode = m; });
-    }
-    if (*hold) {
-      const bool on = hold_what == "on";
-      return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, ctl::kPinModelTarget,
-                          on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr, counter_is("params_held", on ? 1 : 0));
-    }
-    if (*mode) {
-      const std::int8_t m = parse_mode(o.mode);
-      return send_control(o, control_t::SET_MODE, o.target, "SET_MODE " + o.mode, "compensator", counter_is("mode", m),
-                          [m](control_t& msg) { msg.mode = m; });
-    }
-    if (*gains) {
-      if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
-      return run_gains(o);
-    }
-    if (*learn) {
-      const std::int8_t l = parse_learning(o.learning);
-      if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
-      return send_control(o, control_t::SET_LEARNING, o.learn_target, "SET_LEARNING " + o.learning, nullptr, {},
-                          [l](control_t& msg) { msg.learning = l; });
-    }
-    if (*experiment) {
-      if (o.banning_series) return run_banning_series(o);
-      if (o.experiment_mem_paper) {
-        o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
-      } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
-        throw ParameterError("experiment",
-                             "give --amplitude, --frequency and --duration, or --mem-paper, or "
-                             "--banning-series");
-      }
-      o.experiment.validate();
-      return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
-                          [&](control_t& msg) { apply(o.experiment, msg); });
-    }
-    if (*trajectory) return send_trajectory(o);
-    if (*params) return send_params(o);
-    if (*watch) {
-      require_non_negative("seconds", o.watch.seconds);
-      CtlLink link(o.link);
-      return run_watch(link, o.watch);
-    }
-  } catch (const ParameterError& e) {
-    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-ctl: %s\n", e.what());
-    return 1;
+    o.experiment.validate();
+    return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
+                        [&](control_t& msg) { apply(o.experiment, msg); });
+  }
+  if (*trajectory) return send_trajectory(o);
+  if (*params) return send_params(o);
+  if (*watch) {
+    require_non_negative("seconds", o.watch.seconds);
+    CtlLink link(o.link);
+    return run_watch(link, o.watch);
   }
   return kExitUsage;
 }
@@ -496,9 +488,5 @@ int run(int argc, char** argv) {
 
 // Setting the options up can throw too (CLI11 refuses a malformed definition): nothing escapes.
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (...) {  // what the program's own handlers did not take
-    return hystloop::exit_on_escaped_exception("hystloop-ctl");
-  }
+  return hystloop::run_tool("hystloop-ctl", [&] { return run(argc, argv); });
 }
