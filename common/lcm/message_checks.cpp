@@ -147,15 +147,15 @@ namespace {
 class FiniteWireFields {
  public:
   FiniteWireFields(Findings& f, const model_params_t& msg) noexcept : f_(f), msg_(msg) {}
-  void operator()(const double& wire, const auto&) noexcept { f_.finite(wire); }
-  void operator()(const std::int8_t&, const auto&) noexcept {}  // an enumeration: the kind's own check
-  void operator()(const double (&wire)[8], const auto&) noexcept {
+  void operator()(WireName, const double& wire, const auto&) noexcept { f_.finite(wire); }
+  void operator()(WireName, const std::int8_t&, const auto&) noexcept {}  // an enumeration: the kind's own check
+  void operator()(WireName, const double (&wire)[8], const auto&) noexcept {
     for (const double v : wire) f_.finite(v);
   }
-  void operator()(const std::int32_t& n, const auto&) noexcept {
+  void operator()(WireName, const std::int32_t& n, const auto&) noexcept {
     arrays_ok_ = f_.count(n, 0, model_params_t::MAX_OPERATORS, arrays_consistent(msg_));
   }
-  void operator()(const std::vector<double>& wire, const auto&, std::size_t) noexcept {
+  void operator()(WireName, const std::vector<double>& wire, const auto&, std::size_t) noexcept {
     if (!arrays_ok_) return;
     for (const double v : wire) f_.finite(v);
   }

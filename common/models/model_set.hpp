@@ -28,9 +28,16 @@
 
 namespace hystloop {
 
+// A field of model_params_t as the exports name it: its name on the wire, its unit, a note.
+struct WireName {
+  const char* name;
+  const char* unit;
+  const char* note = "";
+};
+
 // Each model's descriptor, as types: the settings struct its parameter table writes into, how that
 // becomes the model's parameter struct and back, a one-line summary of a set, the forward and
-// inverse classes. on_wire(msg, params, f) calls f(wire field, parameter field) for every field the
+// inverse classes. on_wire(msg, params, f) calls f(its WireName, wire field, parameter field) for every field the
 // model has on the wire (model_params_t, whose fields carry the model's prefix): one list for
 // writing, reading, clearing and checking a message; check_wire the wire's sanity bounds for a
 // message of its kind (a sender's units or corruption; the model's domain is validate()'s);
@@ -46,20 +53,16 @@ struct MemDescriptor : StoresParams<MemDescriptor, MemParams> {
   static std::span<const ParamSpec<Settings>> table();
   template <class M, class P, class F>
   static void on_wire(M& m, P& p, F&& f) {
-    f(m.mem_c1, p.c1);
-    f(m.mem_c2, p.c2);
-    f(m.mem_c3, p.c3);
+    f(WireName{"mem_c1", "m/V"}, m.mem_c1, p.c1);
+    f(WireName{"mem_c2", "m/V^(1+c3)"}, m.mem_c2, p.c2);
+    f(WireName{"mem_c3", "1"}, m.mem_c3, p.c3);
   }
-  // The wire's sanity bounds on a message of this kind (lcm/message_checks: a sender's units or
-  // corruption, not the model's domain, which validate() checks): require(bool) for each.
   template <class M, class R>
   static void check_wire(const M& m, R&& require) {
     require(m.mem_c1 > 0.0 && m.mem_c1 <= 1.0);  // [m/V]
     require(m.mem_c2 >= 0.0);
     require(m.mem_c3 > 0.0 && m.mem_c3 <= 50.0);  // beyond ~50, p^c3 overflows for p of 100s of volts
   }
-  // The smallest and largest small-signal gain dy/du [m/V] anywhere on a branch the actuator can
-  // run (gain_plausibility.hpp), and the refusal naming the parameter that leaves the band.
   static GainRange gain_range(const Params& p, const GainPlausibility& rig) noexcept;
   [[noreturn]] static void refuse_gain(const Params& p, const GainRange& g, const GainPlausibility& rig);
 };
@@ -91,15 +94,14 @@ struct PiDescriptor {
   // The arrays' first `count` entries are the wire's; reading, count shrinks to the shortest.
   template <class M, class P, class F>
   static void on_wire(M& m, P& p, F&& f) {
-    f(m.n_operators, p.count);
-    f(m.pi_thresholds_V, p.thresholds, p.count);
-    f(m.pi_weights, p.weights, p.count);
+    f(WireName{"n_operators", "1"}, m.n_operators, p.count);
+    f(WireName{"pi_thresholds_V", "V"}, m.pi_thresholds_V, p.thresholds, p.count);
+    f(WireName{"pi_weights", "m/V"}, m.pi_weights, p.weights, p.count);
   }
   static Params build(const Settings& s);  // throws ParameterError naming the field
   static Settings settings_of(const Params& p);
   static std::string summary_of(const Params& p);  // "15 plays up to 233.3 V"
-  // The wire's sanity bounds on a message of this kind (lcm/message_checks, which has checked the
-  // arrays hold n_operators entries): require(bool) for each.
+  // lcm/message_checks has checked that the arrays hold n_operators entries.
   template <class M, class R>
   static void check_wire(const M& m, R&& require) {
     require(m.n_operators >= 1);
@@ -109,8 +111,6 @@ struct PiDescriptor {
       require(m.pi_thresholds_V[i] > m.pi_thresholds_V[i - 1] && m.pi_thresholds_V[i] <= 1.0e4);  // [V]
     }
   }
-  // The smallest and largest small-signal gain dy/du [m/V] anywhere on a branch the actuator can
-  // run (gain_plausibility.hpp), and the refusal naming the parameter that leaves the band.
   static GainRange gain_range(const Params& p, const GainPlausibility& rig) noexcept;
   [[noreturn]] static void refuse_gain(const Params& p, const GainRange& g, const GainPlausibility& rig);
 };
@@ -123,16 +123,13 @@ struct LinearDescriptor : StoresParams<LinearDescriptor, LinearParams> {
   static std::span<const ParamSpec<Settings>> table();
   template <class M, class P, class F>
   static void on_wire(M& m, P& p, F&& f) {
-    f(m.linear_gain, p.gain);
-    f(m.linear_offset_m, p.offset);
+    f(WireName{"linear_gain", "m/V"}, m.linear_gain, p.gain);
+    f(WireName{"linear_offset_m", "m"}, m.linear_offset_m, p.offset);
   }
-  // The wire's sanity bounds on a message of this kind (lcm/message_checks): require(bool).
   template <class M, class R>
   static void check_wire(const M& m, R&& require) {
     require(m.linear_gain != 0.0 && std::fabs(m.linear_gain) <= 1.0);  // [m/V]
   }
-  // The smallest and largest small-signal gain dy/du [m/V] anywhere on a branch the actuator can
-  // run (gain_plausibility.hpp), and the refusal naming the parameter that leaves the band.
   static GainRange gain_range(const Params& p, const GainPlausibility& rig) noexcept;
   [[noreturn]] static void refuse_gain(const Params& p, const GainRange& g, const GainPlausibility& rig);
 };
@@ -150,43 +147,37 @@ struct KatalenicDescriptor : StoresParams<KatalenicDescriptor, KatalenicParams> 
   static std::span<const ParamSpec<Settings>> table();
   template <class M, class P, class F>
   static void on_wire(M& m, P& p, F&& f) {
-    f(m.kat_k1, p.k1);
-    f(m.kat_k2, p.k2);
-    f(m.kat_k2_slope, p.k2_slope);
-    f(m.kat_k2_domain_min, p.k2_domain_min);
-    f(m.kat_k2_domain_max, p.k2_domain_max);
-    f(m.kat_initial_offset, p.initial_offset);
-    shaping_on_wire(f, p.input_shaping, m.kat_in_shaping, m.kat_in_gain, m.kat_in_offset, m.kat_in_coefficients,
-                    m.kat_in_domain_min, m.kat_in_domain_max, m.kat_in_amplitude, m.kat_in_scale);
-    shaping_on_wire(f, p.output_shaping, m.kat_out_shaping, m.kat_out_gain, m.kat_out_offset, m.kat_out_coefficients,
-                    m.kat_out_domain_min, m.kat_out_domain_max, m.kat_out_amplitude, m.kat_out_scale);
+    f(WireName{"kat_k1", "1", "operator units"}, m.kat_k1, p.k1);
+    f(WireName{"kat_k2", "1"}, m.kat_k2, p.k2);
+    f(WireName{"kat_k2_slope", "1"}, m.kat_k2_slope, p.k2_slope);
+    f(WireName{"kat_k2_domain_min", "1"}, m.kat_k2_domain_min, p.k2_domain_min);
+    f(WireName{"kat_k2_domain_max", "1"}, m.kat_k2_domain_max, p.k2_domain_max);
+    f(WireName{"kat_initial_offset", "1"}, m.kat_initial_offset, p.initial_offset);
+    f(WireName{"kat_in_shaping", "1"}, m.kat_in_shaping, p.input_shaping.kind);
+    f(WireName{"kat_in_gain", "1", "V -> operator units"}, m.kat_in_gain, p.input_shaping.gain);
+    f(WireName{"kat_in_offset", "1"}, m.kat_in_offset, p.input_shaping.offset);
+    f(WireName{"kat_in_coefficients", "1"}, m.kat_in_coefficients, p.input_shaping.coefficients);
+    f(WireName{"kat_in_domain_min", "1"}, m.kat_in_domain_min, p.input_shaping.domain_min);
+    f(WireName{"kat_in_domain_max", "1"}, m.kat_in_domain_max, p.input_shaping.domain_max);
+    f(WireName{"kat_in_amplitude", "1"}, m.kat_in_amplitude, p.input_shaping.amplitude);
+    f(WireName{"kat_in_scale", "1"}, m.kat_in_scale, p.input_shaping.scale);
+    f(WireName{"kat_out_shaping", "1"}, m.kat_out_shaping, p.output_shaping.kind);
+    f(WireName{"kat_out_gain", "1", "operator units -> m"}, m.kat_out_gain, p.output_shaping.gain);
+    f(WireName{"kat_out_offset", "1"}, m.kat_out_offset, p.output_shaping.offset);
+    f(WireName{"kat_out_coefficients", "1"}, m.kat_out_coefficients, p.output_shaping.coefficients);
+    f(WireName{"kat_out_domain_min", "1"}, m.kat_out_domain_min, p.output_shaping.domain_min);
+    f(WireName{"kat_out_domain_max", "1"}, m.kat_out_domain_max, p.output_shaping.domain_max);
+    f(WireName{"kat_out_amplitude", "1"}, m.kat_out_amplitude, p.output_shaping.amplitude);
+    f(WireName{"kat_out_scale", "1"}, m.kat_out_scale, p.output_shaping.scale);
   }
-
-  // The wire's sanity bounds on a message of this kind (lcm/message_checks): require(bool) for each.
   template <class M, class R>
   static void check_wire(const M& m, R&& require) {
     require(m.kat_k1 > 0.0 && m.kat_k2 > 0.0 && m.kat_k2_domain_min < m.kat_k2_domain_max);
     require(m.kat_in_shaping >= M::SHAPING_LINEAR && m.kat_in_shaping <= M::SHAPING_TANH);
     require(m.kat_out_shaping >= M::SHAPING_LINEAR && m.kat_out_shaping <= M::SHAPING_TANH);
   }
-  // The smallest and largest small-signal gain dy/du [m/V] anywhere on a branch the actuator can
-  // run (gain_plausibility.hpp), and the refusal naming the parameter that leaves the band.
   static GainRange gain_range(const Params& p, const GainPlausibility& rig) noexcept;
   [[noreturn]] static void refuse_gain(const Params& p, const GainRange& g, const GainPlausibility& rig);
-
- private:
-  template <class F, class S, class K, class D, class C>
-  static void shaping_on_wire(F& f, S& s, K& shaping_kind, D& gain, D& offset, C& coefficients, D& domain_min,
-                              D& domain_max, D& amplitude, D& scale) {
-    f(shaping_kind, s.kind);
-    f(gain, s.gain);
-    f(offset, s.offset);
-    f(coefficients, s.coefficients);
-    f(domain_min, s.domain_min);
-    f(domain_max, s.domain_max);
-    f(amplitude, s.amplitude);
-    f(scale, s.scale);
-  }
 };
 
 // Numbering shared with model_params_t.kind on the wire; never renumber.

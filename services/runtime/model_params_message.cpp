@@ -21,31 +21,31 @@ using Plays = std::array<double, kPiMaxOperators>;
 // The visitors of the descriptors' on_wire (models/model_set.hpp): a parameter onto its
 // wire field, a wire field back, a wire field to 0.
 struct Write {
-  void operator()(double& wire, double p) const { wire = p; }
-  void operator()(std::int8_t& wire, ShapingKind p) const { wire = static_cast<std::int8_t>(p); }
-  void operator()(double (&wire)[8], const Coefficients& p) const { std::copy(p.begin(), p.end(), wire); }
-  void operator()(std::int32_t& wire, std::size_t count) const {
+  void operator()(WireName, double& wire, double p) const { wire = p; }
+  void operator()(WireName, std::int8_t& wire, ShapingKind p) const { wire = static_cast<std::int8_t>(p); }
+  void operator()(WireName, double (&wire)[8], const Coefficients& p) const { std::copy(p.begin(), p.end(), wire); }
+  void operator()(WireName, std::int32_t& wire, std::size_t count) const {
     wire = static_cast<std::int32_t>(std::min(count, kPiMaxOperators));
   }
-  void operator()(std::vector<double>& wire, const Plays& p, std::size_t count) const {
+  void operator()(WireName, std::vector<double>& wire, const Plays& p, std::size_t count) const {
     wire.assign(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(std::min(count, kPiMaxOperators)));
   }
 };
 
 struct Read {
   bool known = true;  // false: a shaping kind this build does not know
-  void operator()(double wire, double& p) const { p = wire; }
-  void operator()(std::int8_t wire, ShapingKind& p) {
+  void operator()(WireName, double wire, double& p) const { p = wire; }
+  void operator()(WireName, std::int8_t wire, ShapingKind& p) {
     known = known && wire >= model_params_t::SHAPING_LINEAR && wire <= model_params_t::SHAPING_TANH;
     p = static_cast<ShapingKind>(wire);
   }
-  void operator()(const double (&wire)[8], Coefficients& p) const {
+  void operator()(WireName, const double (&wire)[8], Coefficients& p) const {
     std::copy(std::begin(wire), std::end(wire), p.begin());
   }
-  void operator()(std::int32_t wire, std::size_t& count) const {
+  void operator()(WireName, std::int32_t wire, std::size_t& count) const {
     count = std::min(static_cast<std::size_t>(std::max(wire, 0)), kPiMaxOperators);
   }
-  void operator()(const std::vector<double>& wire, Plays& p, std::size_t& count) const {
+  void operator()(WireName, const std::vector<double>& wire, Plays& p, std::size_t& count) const {
     count = std::min(count, wire.size());
     std::copy_n(wire.begin(), count, p.begin());
   }
@@ -53,7 +53,7 @@ struct Read {
 
 struct Clear {
   template <class W, class... P>
-  void operator()(W& wire, const P&...) const {
+  void operator()(WireName, W& wire, const P&...) const {
     if constexpr (std::is_arithmetic_v<W>) {
       wire = 0;
     } else if constexpr (std::is_array_v<W>) {

@@ -9,6 +9,7 @@
 #include "decode.hpp"
 #include "lcm/blocks.hpp"
 #include "log_reader.hpp"
+#include "models/model_set.hpp"
 
 namespace hystloop::report {
 
@@ -155,43 +156,38 @@ void fields(Row& r, const mem_params_t& m) {
       .s("source", m.source);
 }
 
+// Every online model's fields as its descriptor's on_wire names them (models/model_set.hpp), so a
+// model or a parameter added there is exported without a line here.
+class ModelColumns {
+ public:
+  explicit ModelColumns(Row& r) : r_(r) {}
+  void operator()(WireName w, double v, const auto&) { r_.f(w.name, w.unit, v, w.note); }
+  void operator()(WireName w, std::int8_t v, const auto&) { r_.i(w.name, w.unit, v, w.note); }
+  void operator()(WireName w, const double (&v)[8], const auto&) { r_.fixed(w.name, w.unit, v); }
+  void operator()(WireName w, std::int32_t count, const auto&) {
+    r_.i(w.name, w.unit, count, w.note);
+    count_name_ = w.name;
+  }
+  void operator()(WireName w, const std::vector<double>& v, const auto&, std::size_t) {
+    r_.ragged(w.name, w.unit, v, count_name_);
+  }
+
+ private:
+  Row& r_;
+  const char* count_name_ = "";
+};
+
 void fields(Row& r, const model_params_t& m) {
   r.i("format_version", "1", m.format_version)
       .i("utime_us", "us", m.utime, kUtime)
       .i("version", "1", m.version)
       .i("publisher_id", "1", m.publisher_id)
-      .i("kind", "1", m.kind)
-      .f("mem_c1", "m/V", m.mem_c1)
-      .f("mem_c2", "m/V^(1+c3)", m.mem_c2)
-      .f("mem_c3", "1", m.mem_c3)
-      .f("linear_gain", "m/V", m.linear_gain)
-      .f("linear_offset_m", "m", m.linear_offset_m)
-      .i("n_operators", "1", m.n_operators)
-      .ragged("pi_thresholds_V", "V", m.pi_thresholds_V, "n_operators")
-      .ragged("pi_weights", "m/V", m.pi_weights, "n_operators")
-      .f("kat_k1", "1", m.kat_k1, "operator units")
-      .f("kat_k2", "1", m.kat_k2)
-      .f("kat_k2_slope", "1", m.kat_k2_slope)
-      .f("kat_k2_domain_min", "1", m.kat_k2_domain_min)
-      .f("kat_k2_domain_max", "1", m.kat_k2_domain_max)
-      .f("kat_initial_offset", "1", m.kat_initial_offset)
-      .i("kat_in_shaping", "1", m.kat_in_shaping)
-      .f("kat_in_gain", "1", m.kat_in_gain, "V -> operator units")
-      .f("kat_in_offset", "1", m.kat_in_offset)
-      .fixed("kat_in_coefficients", "1", m.kat_in_coefficients)
-      .f("kat_in_domain_min", "1", m.kat_in_domain_min)
-      .f("kat_in_domain_max", "1", m.kat_in_domain_max)
-      .f("kat_in_amplitude", "1", m.kat_in_amplitude)
-      .f("kat_in_scale", "1", m.kat_in_scale)
-      .i("kat_out_shaping", "1", m.kat_out_shaping)
-      .f("kat_out_gain", "1", m.kat_out_gain, "operator units -> m")
-      .f("kat_out_offset", "1", m.kat_out_offset)
-      .fixed("kat_out_coefficients", "1", m.kat_out_coefficients)
-      .f("kat_out_domain_min", "1", m.kat_out_domain_min)
-      .f("kat_out_domain_max", "1", m.kat_out_domain_max)
-      .f("kat_out_amplitude", "1", m.kat_out_amplitude)
-      .f("kat_out_scale", "1", m.kat_out_scale)
-      .f("residual_m", "m", m.residual_m)
+      .i("kind", "1", m.kind);
+  OnlineModels::for_each([&]<class D>() {
+    const typename D::Params unused{};  // on_wire pairs each wire field with a parameter; only the wire is read
+    D::on_wire(m, unused, ModelColumns(r));
+  });
+  r.f("residual_m", "m", m.residual_m)
       .f("heldout_rms_m", "m", m.heldout_rms_m, "NaN = not ranked")
       .i("samples_used", "1", m.samples_used)
       .f("window_s", "s", m.window_s)
