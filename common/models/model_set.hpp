@@ -153,22 +153,19 @@ struct KatalenicDescriptor : StoresParams<KatalenicDescriptor, KatalenicParams> 
     f(WireName{"kat_k2_domain_min", "1"}, m.kat_k2_domain_min, p.k2_domain_min);
     f(WireName{"kat_k2_domain_max", "1"}, m.kat_k2_domain_max, p.k2_domain_max);
     f(WireName{"kat_initial_offset", "1"}, m.kat_initial_offset, p.initial_offset);
-    f(WireName{"kat_in_shaping", "1"}, m.kat_in_shaping, p.input_shaping.kind);
-    f(WireName{"kat_in_gain", "1", "V -> operator units"}, m.kat_in_gain, p.input_shaping.gain);
-    f(WireName{"kat_in_offset", "1"}, m.kat_in_offset, p.input_shaping.offset);
-    f(WireName{"kat_in_coefficients", "1"}, m.kat_in_coefficients, p.input_shaping.coefficients);
-    f(WireName{"kat_in_domain_min", "1"}, m.kat_in_domain_min, p.input_shaping.domain_min);
-    f(WireName{"kat_in_domain_max", "1"}, m.kat_in_domain_max, p.input_shaping.domain_max);
-    f(WireName{"kat_in_amplitude", "1"}, m.kat_in_amplitude, p.input_shaping.amplitude);
-    f(WireName{"kat_in_scale", "1"}, m.kat_in_scale, p.input_shaping.scale);
-    f(WireName{"kat_out_shaping", "1"}, m.kat_out_shaping, p.output_shaping.kind);
-    f(WireName{"kat_out_gain", "1", "operator units -> m"}, m.kat_out_gain, p.output_shaping.gain);
-    f(WireName{"kat_out_offset", "1"}, m.kat_out_offset, p.output_shaping.offset);
-    f(WireName{"kat_out_coefficients", "1"}, m.kat_out_coefficients, p.output_shaping.coefficients);
-    f(WireName{"kat_out_domain_min", "1"}, m.kat_out_domain_min, p.output_shaping.domain_min);
-    f(WireName{"kat_out_domain_max", "1"}, m.kat_out_domain_max, p.output_shaping.domain_max);
-    f(WireName{"kat_out_amplitude", "1"}, m.kat_out_amplitude, p.output_shaping.amplitude);
-    f(WireName{"kat_out_scale", "1"}, m.kat_out_scale, p.output_shaping.scale);
+    static constexpr WireName in[] = {{"kat_in_shaping", "1"},    {"kat_in_gain", "1", "V -> operator units"},
+                                      {"kat_in_offset", "1"},     {"kat_in_coefficients", "1"},
+                                      {"kat_in_domain_min", "1"}, {"kat_in_domain_max", "1"},
+                                      {"kat_in_amplitude", "1"},  {"kat_in_scale", "1"}};
+    static constexpr WireName out[] = {{"kat_out_shaping", "1"},    {"kat_out_gain", "1", "operator units -> m"},
+                                       {"kat_out_offset", "1"},     {"kat_out_coefficients", "1"},
+                                       {"kat_out_domain_min", "1"}, {"kat_out_domain_max", "1"},
+                                       {"kat_out_amplitude", "1"},  {"kat_out_scale", "1"}};
+    shaping_on_wire(f, in, p.input_shaping, m.kat_in_shaping, m.kat_in_gain, m.kat_in_offset, m.kat_in_coefficients,
+                    m.kat_in_domain_min, m.kat_in_domain_max, m.kat_in_amplitude, m.kat_in_scale);
+    shaping_on_wire(f, out, p.output_shaping, m.kat_out_shaping, m.kat_out_gain, m.kat_out_offset,
+                    m.kat_out_coefficients, m.kat_out_domain_min, m.kat_out_domain_max, m.kat_out_amplitude,
+                    m.kat_out_scale);
   }
   template <class M, class R>
   static void check_wire(const M& m, R&& require) {
@@ -178,6 +175,20 @@ struct KatalenicDescriptor : StoresParams<KatalenicDescriptor, KatalenicParams> 
   }
   static GainRange gain_range(const Params& p, const GainPlausibility& rig) noexcept;
   [[noreturn]] static void refuse_gain(const Params& p, const GainRange& g, const GainPlausibility& rig);
+
+ private:
+  template <class F, class S, class K, class D, class C>
+  static void shaping_on_wire(F& f, const WireName (&n)[8], S& s, K& kind, D& gain, D& offset, C& coefficients,
+                              D& domain_min, D& domain_max, D& amplitude, D& scale) {
+    f(n[0], kind, s.kind);
+    f(n[1], gain, s.gain);
+    f(n[2], offset, s.offset);
+    f(n[3], coefficients, s.coefficients);
+    f(n[4], domain_min, s.domain_min);
+    f(n[5], domain_max, s.domain_max);
+    f(n[6], amplitude, s.amplitude);
+    f(n[7], scale, s.scale);
+  }
 };
 
 // Numbering shared with model_params_t.kind on the wire; never renumber.
