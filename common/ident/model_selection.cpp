@@ -11,9 +11,7 @@
 
 namespace hystloop {
 
-bool has_fitter(ModelKind kind) noexcept {
-  return kind == ModelKind::mem || kind == ModelKind::pi || kind == ModelKind::katalenic || kind == ModelKind::linear;
-}
+bool has_fitter(ModelKind kind) noexcept { return std::ranges::find(kFittedModels, kind) != kFittedModels.end(); }
 
 void ModelSelectionOptions::validate() const {
   require_in_range("holdout_fraction", holdout_fraction, 0.05, 0.8);

@@ -6,6 +6,7 @@
 // A constant offset, estimated on the training part (after its second reversal), is removed
 // before scoring, so a model is judged on the shape it predicts, not on where y started.
 
+#include <array>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -21,12 +22,14 @@
 
 namespace hystloop {
 
-// Whether identification fits `kind` (fit_candidate): a model the loop runs may be fitted elsewhere.
+// The models identification fits (fit_candidate), in ranking order: a model the loop runs may be
+// fitted elsewhere.
+inline constexpr std::array kFittedModels{ModelKind::mem, ModelKind::pi, ModelKind::katalenic, ModelKind::linear};
 bool has_fitter(ModelKind kind) noexcept;
 
 struct ModelSelectionOptions {
   double holdout_fraction = 0.3;  // the held-out part starts at the first reversal after 1 - this
-  std::vector<ModelKind> candidates{ModelKind::mem, ModelKind::pi, ModelKind::katalenic, ModelKind::linear};
+  std::vector<ModelKind> candidates{kFittedModels.begin(), kFittedModels.end()};
   MemFitOptions mem{};
   PiFitOptions pi{};
   KatalenicFitOptions katalenic{};
