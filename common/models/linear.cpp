@@ -24,44 +24,30 @@ LinearParams linear_params_from_mem(const MemParams& mem, double u_amplitude) {
   return p;
 }
 
-LinearModel::LinearModel(const LinearParams& params) : params_(params) { params_.validate(); }
-
-void LinearModel::reset(double u0) noexcept {
-  u_ = u0;
-  shift_ = 0.0;
-}
-
 double LinearModel::forward(double u) noexcept {
   if (!std::isfinite(u)) return std::numeric_limits<double>::quiet_NaN();
-  u_ = u;
+  x_ = u;
   return params_.gain * u + params_.offset + shift_;
 }
 
 void LinearModel::set_params(const LinearParams& params) {
   params.validate();
-  const double y = params_.gain * u_ + params_.offset + shift_;
+  const double y = params_.gain * x_ + params_.offset + shift_;
   params_ = params;
-  shift_ = y - (params_.gain * u_ + params_.offset);
-}
-
-LinearInverse::LinearInverse(const LinearParams& params) : params_(params) { params_.validate(); }
-
-void LinearInverse::reset(double y0) noexcept {
-  y_ = y0;
-  shift_ = 0.0;
+  shift_ = y - (params_.gain * x_ + params_.offset);
 }
 
 double LinearInverse::inverse(double y_ref) noexcept {
   if (!std::isfinite(y_ref)) return std::numeric_limits<double>::quiet_NaN();
-  y_ = y_ref;
+  x_ = y_ref;
   return (y_ref - params_.offset - shift_) / params_.gain;
 }
 
 void LinearInverse::set_params(const LinearParams& params) {
   params.validate();
-  const double u = (y_ - params_.offset - shift_) / params_.gain;
+  const double u = (x_ - params_.offset - shift_) / params_.gain;
   params_ = params;
-  shift_ = y_ - params_.offset - params_.gain * u;
+  shift_ = x_ - params_.offset - params_.gain * u;
 }
 
 }  // namespace hystloop

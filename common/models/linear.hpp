@@ -17,34 +17,38 @@ struct LinearParams {
 // The linear spring through the ends of a MEM model's major loop for inputs within +-u_amplitude [V].
 LinearParams linear_params_from_mem(const MemParams& mem, double u_amplitude);
 
-// u [V] -> y [m].
-class LinearModel {
+// What the model and its inverse share: the parameters and, to keep the output continuous across
+// set_params, the last input and the shift applied to the offset.
+class LinearState {
  public:
-  explicit LinearModel(const LinearParams& params = {});
-  void reset(double u0 = 0.0) noexcept;
-  double forward(double u) noexcept;
-  void set_params(const LinearParams& params);  // validates; y does not jump
+  void reset(double x0 = 0.0) noexcept {  // x0: u0 [V] for the model, y0 [m] for the inverse
+    x_ = x0;
+    shift_ = 0.0;
+  }
   const LinearParams& params() const noexcept { return params_; }
 
- private:
+ protected:
+  explicit LinearState(const LinearParams& params) : params_(params) { params_.validate(); }
+
   LinearParams params_;
-  double u_ = 0.0;
-  double shift_ = 0.0;  // [m]
+  double x_ = 0.0;      // last u [V] (model) or y_ref [m] (inverse)
+  double shift_ = 0.0;  // [m] added to the offset
+};
+
+// u [V] -> y [m].
+class LinearModel : public LinearState {
+ public:
+  explicit LinearModel(const LinearParams& params = {}) : LinearState(params) {}
+  double forward(double u) noexcept;
+  void set_params(const LinearParams& params);  // validates; y does not jump
 };
 
 // y_ref [m] -> u [V].
-class LinearInverse {
+class LinearInverse : public LinearState {
  public:
-  explicit LinearInverse(const LinearParams& params = {});
-  void reset(double y0 = 0.0) noexcept;
+  explicit LinearInverse(const LinearParams& params = {}) : LinearState(params) {}
   double inverse(double y_ref) noexcept;
   void set_params(const LinearParams& params);  // validates; u does not jump
-  const LinearParams& params() const noexcept { return params_; }
-
- private:
-  LinearParams params_;
-  double y_ = 0.0;
-  double shift_ = 0.0;  // [m] subtracted from y_ref
 };
 
 }  // namespace hystloop
