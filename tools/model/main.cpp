@@ -13,7 +13,6 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -41,10 +40,6 @@ struct Args {
   std::string out;
 };
 
-struct OpenError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 int refuse(const std::string& message) {
   std::cerr << kTool << ": " << message << "\n";
   return kExitUsage;
@@ -65,19 +60,14 @@ std::vector<Assignment> collect_assignments(Args& args) {
 CsvColumns read_input(const Args& args, const std::string& name, std::span<const std::string_view> columns) {
   if (args.input == "-") return read_csv_columns(std::cin, name, columns);
   std::ifstream in(args.input);
-  if (!in) throw OpenError(name + ": cannot open the input file");
+  if (!in) throw ParameterError(name, "cannot open the input file");
   return read_csv_columns(in, name, columns);
 }
 
-int run(Args& args) {
-  std::vector<Assignment> assignments;
-  try {
-    assignments = collect_assignments(args);
-  } catch (const ParamsFileError& e) {
-    return refuse(e.what());
-  } catch (const AssignmentError& e) {
-    return refuse(e.what());
-  }
+// Refused input exits 2: a ParameterError (an AssignmentError, an input that cannot be opened)
+// through run_tool, a params file's or a CSV's error here; anything else run_tool exits 1 on.
+int transform(Args& args) try {
+  std::vector<Assignment> assignments = collect_assignments(args);
   if (args.model.empty()) return refuse("give --model (one of " + model_names() + ") or --params-file");
   const ModelEntry* entry = find_model(args.model);
   if (entry == nullptr) {
@@ -106,15 +96,8 @@ int run(Args& args) {
   const std::string_view forward_in[] = {"t", "u"};
   const std::string_view inverse_in[] = {"t", "y_ref"};
   const std::span<const std::string_view> columns = args.forward ? forward_in : inverse_in;
-  CsvColumns table;
-  try {
-    table = read_input(args, name, columns);
-    if (entry->uses_time) require_increasing(table, 0, name);
-  } catch (const CsvError& e) {
-    return refuse(e.what());
-  } catch (const OpenError& e) {
-    return refuse(e.what());
-  }
+  CsvColumns table = read_input(args, name, columns);
+  if (entry->uses_time) require_increasing(table, 0, name);
   if (!table.ignored.empty()) {
     std::string list;
     for (const auto& c : table.ignored) list += (list.empty() ? "'" : ", '") + c + "'";
@@ -149,11 +132,13 @@ int run(Args& args) {
   out.close();
   if (!out) return refuse(args.out + ": cannot write the output file");
   return 0;
+} catch (const ParamsFileError& e) {
+  return refuse(e.what());
+} catch (const CsvError& e) {
+  return refuse(e.what());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) try {
+int run(int argc, char** argv) {
   CLI::App app{
       "Run a hysteresis model over a CSV file (header row, comma separated, SI units).\n"
       "--forward reads columns t,u [s, V] and writes t,u,y [m]; --inverse reads t,y_ref [s, m] and writes t,y_ref,u "
@@ -176,7 +161,11 @@ int main(int argc, char** argv) try {
   app.add_option("--out", args.out, "output CSV file (default: standard output)");
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   if (!args.forward && !args.inverse) return refuse("choose --forward (t,u -> y) or --inverse (t,y_ref -> u)");
-  return run(args);
-} catch (...) {  // CLI11's set-up and what run() lets through: nothing escapes main
-  return hystloop::exit_on_escaped_exception(kTool);
+  return transform(args);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hystloop::run_tool(kTool, [&] { return run(argc, argv); });
 }
