@@ -92,15 +92,10 @@ double KatalenicModel::forward(double u) noexcept {
 void KatalenicModel::set_params(const KatalenicParams& params) {
   params.validate();
   params_ = params;
-  anchor(u_, y_);
-}
-
-void KatalenicModel::anchor(double u, double y) noexcept {
-  const double x = params_.input_shaping.apply(u);
-  double z = params_.output_shaping.invert(y, op_.memory().last_beta());
+  const double x = params_.input_shaping.apply(u_);
+  double z = params_.output_shaping.invert(y_, op_.memory().last_beta());
   z = std::clamp(z, x - params_.k1, x + params_.k1);
   op_.reset(x, z, op_.memory().direction());
-  u_ = u;
   y_ = params_.output_shaping.apply(z);
 }
 
@@ -155,14 +150,9 @@ KatalenicRates KatalenicInverse::inverse_with_rates(double y_ref, double y_ref_d
 void KatalenicInverse::set_params(const KatalenicParams& params) {
   params.validate();
   params_ = params;
-  anchor(y_, u_);
-}
-
-void KatalenicInverse::anchor(double y, double u) noexcept {
-  z_ = params_.output_shaping.invert(y, z_);
-  x_ = std::clamp(params_.input_shaping.apply(u), z_ - params_.k1, z_ + params_.k1);
+  z_ = params_.output_shaping.invert(y_, z_);
+  x_ = std::clamp(params_.input_shaping.apply(u_), z_ - params_.k1, z_ + params_.k1);
   op_.reset(z_, x_, op_.memory().direction());
-  y_ = y;
   u_ = params_.input_shaping.invert(x_, u_);
 }
 

@@ -66,8 +66,6 @@ class KatalenicModel {
   const KatalenicDirectOperator& core() const noexcept { return op_; }  // operator-unit state
 
  private:
-  void anchor(double u, double y) noexcept;
-
   KatalenicParams params_;
   KatalenicDirectOperator op_;
   double u_ = 0.0;
@@ -101,8 +99,6 @@ class KatalenicInverse {
   const KatalenicInverseOperator& core() const noexcept { return op_; }
 
  private:
-  void anchor(double y, double u) noexcept;
-
   KatalenicParams params_;
   KatalenicInverseOperator op_;
   double y_ = 0.0;
