@@ -100,40 +100,37 @@ double ch_area_small(const ColemanHodgdonParams& p, double amplitude) noexcept {
 }
 
 namespace {
-LoopFeatures common_features(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept {
-  LoopFeatures f;
-  f.u_min = u_offset - amplitude;
-  f.u_max = u_offset + amplitude;
-  f.y_left = ch_left_turning_point(p, u_offset, amplitude);
-  f.y_right = ch_right_turning_point(p, u_offset, amplitude);
-  f.u_centre = u_offset;
-  f.y_centre = in_domain(p, u_offset, amplitude) ? p.a * u_offset : kNaN;  // Theorem 3
-  return f;
+// The loop of Theorem 3: turning points and centre in closed form, the shape (slope, delta, eta,
+// area) from the flavour asked for.
+LoopFeatures theorem3_loop(const ColemanHodgdonParams& p, double u_offset, double amplitude, double slope, double delta,
+                           double eta, double area) noexcept {
+  return {.u_min = u_offset - amplitude,
+          .u_max = u_offset + amplitude,
+          .y_left = ch_left_turning_point(p, u_offset, amplitude),
+          .y_right = ch_right_turning_point(p, u_offset, amplitude),
+          .u_centre = u_offset,
+          .y_centre = in_domain(p, u_offset, amplitude) ? p.a * u_offset : kNaN,
+          .slope = slope,
+          .delta = delta,
+          .eta = eta,
+          .area = area};
 }
 }  // namespace
 
 LoopFeatures theorem3_features(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept {
-  LoopFeatures f = common_features(p, u_offset, amplitude);
-  f.slope = ch_slope(p, amplitude);
-  f.delta = ch_horizontal_aperture(p, amplitude);
-  f.eta = ch_vertical_aperture(p, amplitude);
-  f.area = ch_area(p, amplitude);
-  return f;
+  return theorem3_loop(p, u_offset, amplitude, ch_slope(p, amplitude), ch_horizontal_aperture(p, amplitude),
+                       ch_vertical_aperture(p, amplitude), ch_area(p, amplitude));
 }
 
 LoopFeatures theorem3_small_amplitude(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept {
-  LoopFeatures f = common_features(p, u_offset, amplitude);
-  f.slope = in_domain(p, u_offset, amplitude) ? ch_slope_small(p) : kNaN;
-  f.delta = ch_horizontal_aperture_small(p, amplitude);
-  f.eta = ch_vertical_aperture_small(p, amplitude);
-  f.area = ch_area_small(p, amplitude);
-  return f;
+  const double slope = in_domain(p, u_offset, amplitude) ? ch_slope_small(p) : kNaN;
+  return theorem3_loop(p, u_offset, amplitude, slope, ch_horizontal_aperture_small(p, amplitude),
+                       ch_vertical_aperture_small(p, amplitude), ch_area_small(p, amplitude));
 }
 
 LoopFeatures exact_loop_features(const ColemanHodgdonParams& p, double u_offset, double amplitude) noexcept {
-  LoopFeatures f = theorem3_features(p, u_offset, amplitude);
-  f.delta = ch_horizontal_aperture_exact(p, amplitude);
-  return f;
+  return theorem3_loop(p, u_offset, amplitude, ch_slope(p, amplitude), ch_horizontal_aperture_exact(p, amplitude),
+                       ch_vertical_aperture(p, amplitude), ch_area(p, amplitude));
 }
 
 double stage_magnitude(const SecondOrderStageParams& p, double omega) noexcept {
