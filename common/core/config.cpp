@@ -18,12 +18,6 @@ std::string compose(const std::string& source, const std::string& field, const s
   return field.empty() ? source + ": " + reason : source + ": " + field + ": " + reason;
 }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // How a node that was not what we wanted looks, for "expected X, got Y".
 std::string describe(const YAML::Node& node) {
   switch (node.Type()) {
@@ -246,7 +240,7 @@ T Config::get(std::string_view path) const {
 double Config::get_in_range(std::string_view path, double default_value, double lo, double hi) const {
   const double v = get<double>(path, default_value);
   if (!(v >= lo && v <= hi)) {
-    fail(path, "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")");
+    fail(path, "must be in [" + refusal_number(lo) + ", " + refusal_number(hi) + "] (got " + refusal_number(v) + ")");
   }
   return v;
 }

@@ -35,6 +35,9 @@ void validate_within(std::string_view prefix, Validate&& validate) {
   }
 }
 
+// A number as refusals print it ("%.6g": 8.58e-09, 250, inf).
+std::string refusal_number(double v);
+
 // Throws ParameterError unless `value` is finite.
 void require_finite(std::string_view field, double value);
 // Throws ParameterError unless `value` is finite and > 0.

@@ -9,11 +9,7 @@ namespace hystloop {
 void MultiAxisStageConfig::validate() const {
   coupling.validate();
   for (int i = 0; i < axes(); ++i) {
-    try {
-      axis[static_cast<std::size_t>(i)].validate();
-    } catch (const ParameterError& e) {
-      throw ParameterError("axis[" + std::to_string(i) + "]." + e.field(), e.reason());
-    }
+    validate_within("axis[" + std::to_string(i) + "].", [&] { axis[static_cast<std::size_t>(i)].validate(); });
   }
 }
 

@@ -17,12 +17,6 @@ using Block = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMa
 
 std::string entry_field(int j, int i) { return "coupling[" + std::to_string(j) + "][" + std::to_string(i) + "]"; }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // Sum over the n x n block of m(i, j) v(j), skipping exact zeros so that a non-finite v(j) reaches
 // only the axes actually coupled to j (0 * NaN would be NaN). Entries >= n pass through.
 AxisVector apply(const AxisMatrix& m, int n, const AxisVector& v) noexcept {
@@ -73,7 +67,7 @@ void AxisCoupling::validate() const {
   }
   for (int i = 0; i < n_; ++i) {
     if (c_(i, i) != 1.0) {
-      throw ParameterError(entry_field(i, i), "must be exactly 1 (got " + num(c_(i, i)) + "): axis " +
+      throw ParameterError(entry_field(i, i), "must be exactly 1 (got " + refusal_number(c_(i, i)) + "): axis " +
                                                   std::string(axis_name(i)) +
                                                   "'s own gain belongs to its own model, C holds only the coupling");
     }
@@ -81,16 +75,17 @@ void AxisCoupling::validate() const {
   for (int j = 0; j < n_; ++j) {
     for (int i = 0; i < n_; ++i) {
       if (i != j && std::abs(c_(j, i)) > kMaxCoupling) {
-        throw ParameterError(entry_field(j, i), "|" + num(c_(j, i)) + "| exceeds " + num(kMaxCoupling) + ": moving " +
-                                                    std::string(axis_name(i)) + " would move " +
-                                                    std::string(axis_name(j)) +
-                                                    " by more than half as much (a mislabelled axis or sensor?)");
+        throw ParameterError(entry_field(j, i),
+                             "|" + refusal_number(c_(j, i)) + "| exceeds " + refusal_number(kMaxCoupling) +
+                                 ": moving " + std::string(axis_name(i)) + " would move " + std::string(axis_name(j)) +
+                                 " by more than half as much (a mislabelled axis or sensor?)");
       }
     }
   }
   const double cond = condition_number();
   if (!(cond <= kMaxCouplingCondition)) {
-    throw ParameterError("coupling", "condition number " + num(cond) + " exceeds " + num(kMaxCouplingCondition) +
+    throw ParameterError("coupling", "condition number " + refusal_number(cond) + " exceeds " +
+                                         refusal_number(kMaxCouplingCondition) +
                                          ": the axes are nearly dependent, so decoupling would multiply reference "
                                          "and model errors up to that many times (a few per cent coupling gives ~1.1)");
   }

@@ -1,7 +1,6 @@
 #include "models/gain_plausibility.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "core/errors.hpp"
@@ -34,12 +33,6 @@ std::string band(const GainPlausibility& rig) {
 }
 
 }  // namespace
-
-std::string refusal_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
 void refuse_implausible_gain(std::string_view field, const std::string& what, double gain_m_per_V, bool low,
                              const GainPlausibility& rig) {

@@ -57,8 +57,6 @@ struct GainRange {
 // plausible [lo, hi] m/V ...").
 [[noreturn]] void refuse_implausible_gain(std::string_view field, const std::string& what, double gain_m_per_V,
                                           bool low, const GainPlausibility& rig);
-// A number as the refusals print it ("%.6g").
-std::string refusal_number(double v);
 
 struct ModelParamSet;  // models/model_set.hpp, which includes this header
 GainRange small_signal_gain(const ModelParamSet& set, const GainPlausibility& rig) noexcept;

@@ -1,6 +1,6 @@
 #include "models/param_text.hpp"
 
-#include <cstdio>
+#include "core/errors.hpp"
 
 namespace hystloop {
 
@@ -33,9 +33,7 @@ std::string summary_item(std::string_view name, ValueKind kind, const std::strin
   std::string out = std::string(name) + " ";
   double v = 0.0;
   if (kind == ValueKind::number && parse_finite_double(text, v)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    out += buf;
+    out += refusal_number(v);
   } else {
     out += text;
   }
