@@ -53,6 +53,12 @@ Json map_json(const Map& map) {
   return out;
 }
 
+// A count that has more than one possible origin, then "<key>_source": which one it came from.
+void counted(Json& j, const std::string& key, const std::optional<std::int64_t>& count, const std::string& source) {
+  j[key] = number_or_null(count);
+  j[key + "_source"] = source;
+}
+
 }  // namespace
 
 std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
@@ -116,11 +122,8 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   j["run_ahead_p50_ticks"] = number_or_null(m.run_ahead_p50_ticks);
   j["run_ahead_max_ticks"] = number_or_null(m.run_ahead_max_ticks);
 
-  j["watchdog_trips"] = number_or_null(m.watchdog_trips);
-  j["watchdog_trips_source"] = m.watchdog_trips_source;
-
-  j["commands_rejected"] = number_or_null(m.commands_rejected);
-  j["commands_rejected_source"] = m.commands_rejected_source;
+  counted(j, "watchdog_trips", m.watchdog_trips, m.watchdog_trips_source);
+  counted(j, "commands_rejected", m.commands_rejected, m.commands_rejected_source);
   j["commands_rejected_counters"] = map_json(m.commands_rejected_counters);
 
   j["params_history"] = params_history_json(m.params_history);
@@ -128,8 +131,7 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   j["params_final"] = params_json(m.params_final);
   j["params_updates"] = m.params_updates;
 
-  j["logger_gaps"] = number_or_null(m.logger_gaps);
-  j["logger_gaps_source"] = m.logger_gaps_source;
+  counted(j, "logger_gaps", m.logger_gaps, m.logger_gaps_source);
   j["seq_gaps"] = m.seq_gaps;
   j["missing_samples"] = m.missing_samples;
 
