@@ -25,8 +25,19 @@ Code code(std::int64_t value, std::string_view constant, std::string_view prefix
   return {value, name};
 }
 
-// The value comes from the generated constant, the name from the constant's own spelling.
-#define HX_CODE(type, constant, prefix) code(type::constant, #constant, prefix)
+// HX_CODES(type, prefix, A, B, ...): code(type::A, "A", prefix), code(type::B, "B", prefix), ...:
+// each value from the generated constant, its name from the constant's own spelling, the type and
+// prefix written once for a field. A recursion through __VA_OPT__, one constant per rescan of
+// HX_EXPAND: up to 41 constants (a longer list fails to compile, naming HX_CODES_AGAIN).
+#define HX_EXPAND(...) HX_EXPAND3(HX_EXPAND3(HX_EXPAND3(__VA_ARGS__)))
+#define HX_EXPAND3(...) HX_EXPAND2(HX_EXPAND2(HX_EXPAND2(__VA_ARGS__)))
+#define HX_EXPAND2(...) HX_EXPAND1(HX_EXPAND1(HX_EXPAND1(__VA_ARGS__)))
+#define HX_EXPAND1(...) __VA_ARGS__
+#define HX_CODES(type, prefix, ...) HX_EXPAND(HX_CODES_FROM(type, prefix, __VA_ARGS__))
+#define HX_CODES_FROM(type, prefix, constant, ...) \
+  code(type::constant, #constant, prefix) __VA_OPT__(, HX_CODES_AGAIN HX_PARENS(type, prefix, __VA_ARGS__))
+#define HX_CODES_AGAIN() HX_CODES_FROM
+#define HX_PARENS ()
 
 // The online models' numbers and names are the registry's (models/model_set.hpp), whether or not
 // the .lcm names them too; in the order of their numbers.
@@ -36,8 +47,7 @@ std::vector<Code> by_value(std::vector<Code> codes) {
 }
 
 std::vector<Code> modes() {
-  std::vector<Code> codes{HX_CODE(command_block_t, MODE_OFF, "MODE_"),
-                          HX_CODE(command_block_t, MODE_EXPERIMENT, "MODE_")};
+  std::vector<Code> codes{HX_CODES(command_block_t, "MODE_", MODE_OFF, MODE_EXPERIMENT)};
   OnlineModels::for_each([&]<class D>() { codes.push_back({D::mode, std::string(D::name)}); });
   return by_value(std::move(codes));
 }
@@ -51,8 +61,7 @@ std::vector<Code> model_kinds() {
 }
 
 std::vector<Code> shapings() {
-  return {HX_CODE(model_params_t, SHAPING_LINEAR, "SHAPING_"), HX_CODE(model_params_t, SHAPING_POLYNOMIAL, "SHAPING_"),
-          HX_CODE(model_params_t, SHAPING_TANH, "SHAPING_")};
+  return {HX_CODES(model_params_t, "SHAPING_", SHAPING_LINEAR, SHAPING_POLYNOMIAL, SHAPING_TANH)};
 }
 
 std::vector<CodeLegend> make_legends() {
@@ -65,54 +74,36 @@ std::vector<CodeLegend> make_legends() {
   return {
       {sensor,
        "flags",
-       true,
-       {HX_CODE(sensor_block_t, SATURATED, ""), HX_CODE(sensor_block_t, SAFE_STATE, ""),
-        HX_CODE(sensor_block_t, SIMULATED, ""), HX_CODE(sensor_block_t, SLEW_LIMITED, ""),
-        HX_CODE(sensor_block_t, LATE_COMMAND, ""), HX_CODE(sensor_block_t, SENSOR_FAULT, "")}},
-      {command, "mode", false, modes()},
+       {HX_CODES(sensor_block_t, "", SATURATED, SAFE_STATE, SIMULATED, SLEW_LIMITED, LATE_COMMAND, SENSOR_FAULT)},
+       true},
+      {command, "mode", modes()},
       {control,
        "command",
-       false,
-       {HX_CODE(control_t, SET_MODE, ""), HX_CODE(control_t, SET_GAINS, ""), HX_CODE(control_t, ARM, ""),
-        HX_CODE(control_t, DISARM, ""), HX_CODE(control_t, START_EXPERIMENT, ""),
-        HX_CODE(control_t, STOP_EXPERIMENT, ""), HX_CODE(control_t, RESET_COUNTERS, ""),
-        HX_CODE(control_t, SHUTDOWN, ""), HX_CODE(control_t, SET_LEARNING, ""), HX_CODE(control_t, HOLD_PARAMS, ""),
-        HX_CODE(control_t, RELEASE_PARAMS, "")}},
-      {control, "mode", false, modes()},
-      {control,
-       "learning",
-       false,
-       {HX_CODE(control_t, LEARNING_OFF, "LEARNING_"), HX_CODE(control_t, LEARNING_ON, "LEARNING_"),
-        HX_CODE(control_t, LEARNING_RESET, "LEARNING_")}},
-      {trajectory,
-       "shape",
-       false,
-       {HX_CODE(trajectory_t, HOLD, ""), HX_CODE(trajectory_t, SINE, ""), HX_CODE(trajectory_t, COSINE, ""),
-        HX_CODE(trajectory_t, TRIANGLE, ""), HX_CODE(trajectory_t, POINTS, "")}},
-      {trajectory, "if_infeasible", false, {HX_CODE(trajectory_t, REFUSE, ""), HX_CODE(trajectory_t, SHAPE, "")}},
-      {status,
-       "state",
-       false,
-       {HX_CODE(service_status_t, STARTING, ""), HX_CODE(service_status_t, HEALTHY, ""),
-        HX_CODE(service_status_t, DEGRADED, ""), HX_CODE(service_status_t, SAFE, ""),
-        HX_CODE(service_status_t, STOPPING, "")}},
-      {model, "kind", false, model_kinds()},
-      {model,
-       "stage_kind",
-       false,
-       {HX_CODE(model_params_t, STAGE_UNCHANGED, "STAGE_"), HX_CODE(model_params_t, STAGE_NONE, "STAGE_"),
-        HX_CODE(model_params_t, STAGE_SECOND_ORDER, "STAGE_")}},
+       {HX_CODES(control_t, "", SET_MODE, SET_GAINS, ARM, DISARM, START_EXPERIMENT, STOP_EXPERIMENT, RESET_COUNTERS,
+                 SHUTDOWN, SET_LEARNING, HOLD_PARAMS, RELEASE_PARAMS)}},
+      {control, "mode", modes()},
+      {control, "learning", {HX_CODES(control_t, "LEARNING_", LEARNING_OFF, LEARNING_ON, LEARNING_RESET)}},
+      {trajectory, "shape", {HX_CODES(trajectory_t, "", HOLD, SINE, COSINE, TRIANGLE, POINTS)}},
+      {trajectory, "if_infeasible", {HX_CODES(trajectory_t, "", REFUSE, SHAPE)}},
+      {status, "state", {HX_CODES(service_status_t, "", STARTING, HEALTHY, DEGRADED, SAFE, STOPPING)}},
+      {model, "kind", model_kinds()},
+      {model, "stage_kind", {HX_CODES(model_params_t, "STAGE_", STAGE_UNCHANGED, STAGE_NONE, STAGE_SECOND_ORDER)}},
       {model,
        "stage_order",
-       false,
-       {HX_CODE(model_params_t, ORDER_HYSTERESIS_THEN_STAGE, "ORDER_"),
-        HX_CODE(model_params_t, ORDER_STAGE_THEN_HYSTERESIS, "ORDER_")}},
-      {model, "kat_in_shaping", false, shapings()},
-      {model, "kat_out_shaping", false, shapings()},
+       {HX_CODES(model_params_t, "ORDER_", ORDER_HYSTERESIS_THEN_STAGE, ORDER_STAGE_THEN_HYSTERESIS)}},
+      {model, "kat_in_shaping", shapings()},
+      {model, "kat_out_shaping", shapings()},
   };
 }
 
-#undef HX_CODE
+#undef HX_EXPAND
+#undef HX_EXPAND3
+#undef HX_EXPAND2
+#undef HX_EXPAND1
+#undef HX_CODES
+#undef HX_CODES_FROM
+#undef HX_CODES_AGAIN
+#undef HX_PARENS
 
 }  // namespace
 

@@ -20,8 +20,8 @@ struct Code {
 struct CodeLegend {
   std::string_view type_name;  // "hystloop.command_block_t"
   std::string_view field;      // "mode", as the field is called in the .lcm and in the exports
-  bool bits = false;           // the field ORs the codes (flags) instead of holding one of them
   std::vector<Code> codes;
+  bool bits = false;  // the field ORs the codes (flags) instead of holding one of them
 
   // "0=off,1=linear,2=mem"; for bits "bits: 1=saturated,2=safe_state (0=none)".
   std::string text() const;
