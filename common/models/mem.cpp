@@ -134,34 +134,48 @@ double RambergOsgoodParams::branch(double u, double u_i, double y_i) const noexc
   return y_i + 2.0 * y_star * x * (1.0 + alpha * std::pow(std::abs(x), gamma - 1.0));
 }
 
-// ---- MemModel ------------------------------------------------------------------------------------
+// ---- MemBranchState ------------------------------------------------------------------------------
 
-MemModel::MemModel(const MemParams& params, double reversal_deadband) : params_(params), detector_(reversal_deadband) {
+MemBranchState::MemBranchState(const MemParams& params, double reversal_deadband) : params_(params) {
   params_.validate();
   validate_deadband(reversal_deadband);
+}
+
+void MemBranchState::restart(double u_origin, double y_origin, double scale) noexcept {
+  u_origin_ = u_origin;
+  y_origin_ = y_origin;
+  scale_ = scale;
+  reversals_ = 0;
+}
+
+void MemBranchState::reverse_at(double u, double y) noexcept {
+  u_origin_ = u;
+  y_origin_ = y;
+  scale_ = 1.0;
+  ++reversals_;
+}
+
+// ---- MemModel ------------------------------------------------------------------------------------
+
+MemModel::MemModel(const MemParams& params, double reversal_deadband)
+    : MemBranchState(params, reversal_deadband), detector_(reversal_deadband) {
   reset(0.0);
 }
 
 void MemModel::reset(double u0) noexcept {
   detector_.reset(u0, u0 > 0.0 ? 1 : (u0 < 0.0 ? -1 : 0));  // virgin loading from 0 went that way
-  u_origin_ = 0.0;
-  y_origin_ = 0.0;
-  scale_ = 2.0;
+  restart(0.0, 0.0, 2.0);
   u_ = u0;
   y_ = curve(u0);
   y_extremum_ = y_;
-  reversals_ = 0;
 }
 
 void MemModel::reset_to_branch(double u_origin, double y_origin) noexcept {
   detector_.reset(u_origin, 0);
-  u_origin_ = u_origin;
-  y_origin_ = y_origin;
-  scale_ = 1.0;
+  restart(u_origin, y_origin, 1.0);
   u_ = u_origin;
   y_ = y_origin;
   y_extremum_ = y_origin;
-  reversals_ = 0;
 }
 
 double MemModel::curve(double u) const noexcept { return y_origin_ + odd_rise(params_, u - u_origin_, scale_); }
@@ -169,17 +183,11 @@ double MemModel::curve(double u) const noexcept { return y_origin_ + odd_rise(pa
 double MemModel::forward(double u) noexcept {
   if (!std::isfinite(u)) return nan();
   const ReversalDetector::Event event = detector_.update(u);
-  if (event == ReversalDetector::Event::kReversal) {
-    u_origin_ = detector_.turning_point();
-    y_origin_ = y_extremum_;
-    scale_ = 1.0;
-    ++reversals_;
-  }
-  const double y = curve(u);
-  if (event != ReversalDetector::Event::kNone) y_extremum_ = y;
+  if (event == ReversalDetector::Event::kReversal) reverse_at(detector_.turning_point(), y_extremum_);
   u_ = u;
-  y_ = y;
-  return y;
+  y_ = curve(u);
+  if (event != ReversalDetector::Event::kNone) y_extremum_ = y_;
+  return y_;
 }
 
 void MemModel::set_params(const MemParams& params) {
@@ -192,34 +200,26 @@ void MemModel::set_params(const MemParams& params) {
 // ---- MemInverse ----------------------------------------------------------------------------------
 
 MemInverse::MemInverse(const MemParams& params, double reversal_deadband)
-    : params_(params), deadband_(reversal_deadband) {
-  params_.validate();
-  validate_deadband(reversal_deadband);
+    : MemBranchState(params, reversal_deadband), deadband_(reversal_deadband) {
   reset(0.0);
 }
 
 void MemInverse::reset(double y0) noexcept {
-  u_origin_ = 0.0;
-  y_origin_ = 0.0;
-  scale_ = 2.0;
+  restart(0.0, 0.0, 2.0);
   warm_ = false;
   u_ = curve_inverse(y0);
   y_at_u_ = y0;
   y_ref_ = y0;
   direction_ = y0 > 0.0 ? 1 : (y0 < 0.0 ? -1 : 0);  // as MemModel::reset(u0): same sign
-  reversals_ = 0;
 }
 
 void MemInverse::reset_to_branch(double y_origin, double u_origin) noexcept {
-  u_origin_ = u_origin;
-  y_origin_ = y_origin;
-  scale_ = 1.0;
+  restart(u_origin, y_origin, 1.0);
   warm_ = false;
   u_ = u_origin;
   y_at_u_ = y_origin;
   y_ref_ = y_origin;
   direction_ = 0;
-  reversals_ = 0;
 }
 
 void MemInverse::continue_branch(double u_origin, double u_now, double y_now) noexcept {
@@ -293,11 +293,8 @@ double MemInverse::inverse(double y_ref) noexcept {
   const double p = solve_run(-ahead);
   const double u = u_ - s * p;
   if (u == u_) return u_;
-  u_origin_ = u_;
-  y_origin_ = y_at_u_;
-  scale_ = 1.0;
+  reverse_at(u_, y_at_u_);
   direction_ = -direction_;
-  ++reversals_;
   u_ = u;
   y_at_u_ = y_ref;
   return u;

@@ -74,8 +74,31 @@ struct RambergOsgoodParams {
   double branch(double u, double u_i, double y_i) const noexcept;  // (3) [m]
 };
 
+// What the model and its inverse share, so that they agree branch for branch: the parameters,
+// and the branch they are on, which starts at (u_origin_, y_origin_) and is the skeleton until the
+// first reversal.
+class MemBranchState {
+ public:
+  const MemParams& params() const noexcept { return params_; }
+  double branch_origin_u() const noexcept { return u_origin_; }  // [V]
+  bool on_skeleton() const noexcept { return scale_ != 1.0; }
+  std::uint64_t reversals() const noexcept { return reversals_; }  // since construction/reset
+
+ protected:
+  MemBranchState(const MemParams& params, double reversal_deadband);  // validates both
+  // Onto the skeleton (scale 2, origin (0, 0)) or a branch (scale 1), counting no reversal.
+  void restart(double u_origin, double y_origin, double scale) noexcept;
+  void reverse_at(double u, double y) noexcept;  // a reversal at (u, y): the branch from there
+
+  MemParams params_;
+  double u_origin_ = 0.0;
+  double y_origin_ = 0.0;
+  double scale_ = 2.0;  // 2 on the skeleton (Masing: half-scale branch about the origin), 1 on a branch
+  std::uint64_t reversals_ = 0;
+};
+
 // u [V] -> y [m].
-class MemModel {
+class MemModel : public MemBranchState {
  public:
   // reversal_deadband [V] >= 0, see ReversalDetector; 0 (default) is the paper's model.
   explicit MemModel(const MemParams& params = {}, double reversal_deadband = 0.0);
@@ -92,27 +115,18 @@ class MemModel {
   // output so the new curve passes through (u, y): no jump. At a reversal (p = 0) this is a pure
   // slope change.
   void set_params(const MemParams& params);
-  const MemParams& params() const noexcept { return params_; }
 
-  double input() const noexcept { return u_; }                   // last u [V]
-  double output() const noexcept { return y_; }                  // last y [m]
-  double branch_origin_u() const noexcept { return u_origin_; }  // [V]
-  bool on_skeleton() const noexcept { return scale_ != 1.0; }
+  double input() const noexcept { return u_; }   // last u [V]
+  double output() const noexcept { return y_; }  // last y [m]
   int direction() const noexcept { return detector_.direction(); }
-  std::uint64_t reversals() const noexcept { return reversals_; }  // since construction/reset
 
  private:
   double curve(double u) const noexcept;  // y on the current branch (or skeleton) at u
 
-  MemParams params_;
   ReversalDetector detector_;
-  double u_origin_ = 0.0;
-  double y_origin_ = 0.0;
-  double scale_ = 2.0;  // 2 on the skeleton (Masing: half-scale branch about the origin), 1 on a branch
   double u_ = 0.0;
   double y_ = 0.0;
   double y_extremum_ = 0.0;  // y at detector_.extremum(): the next branching point's output
-  std::uint64_t reversals_ = 0;
 };
 
 // y_ref [m] -> u [V]: the exact feedforward of Theorem 10.
@@ -121,7 +135,7 @@ class MemModel {
 // starts a new branch at the last (u, y) only if the new u actually moves back; a turn too small to
 // move u (rounding) is answered by holding u. So the model driven by this u has the same branch
 // origins, sample for sample, and MemModel(MemInverse(y_ref)) == y_ref to rounding.
-class MemInverse {
+class MemInverse : public MemBranchState {
  public:
   // reversal_deadband [m] >= 0: a retreat of y_ref by no more than this from its extremum is
   // answered by holding u (tracking error <= deadband meanwhile) instead of starting a branch.
@@ -144,29 +158,20 @@ class MemInverse {
   // output so the new curve passes through the current point, as MemModel::set_params does: a
   // model and its inverse swapped at the same sample stay exact inverses, and u does not jump.
   void set_params(const MemParams& params);
-  const MemParams& params() const noexcept { return params_; }
 
   double reference() const noexcept { return y_ref_; }  // last y_ref [m]
   double output() const noexcept { return u_; }         // last u [V]
-  double branch_origin_u() const noexcept { return u_origin_; }
-  bool on_skeleton() const noexcept { return scale_ != 1.0; }
   int direction() const noexcept { return direction_; }
-  std::uint64_t reversals() const noexcept { return reversals_; }
 
  private:
   double curve_inverse(double y) noexcept;  // u on the current branch (or skeleton) at y
   double solve_run(double rise) noexcept;   // F^-1 with a warm start from the previous solve
 
-  MemParams params_;
   double deadband_;
-  double u_origin_ = 0.0;
-  double y_origin_ = 0.0;
-  double scale_ = 2.0;
   double u_ = 0.0;
   double y_at_u_ = 0.0;  // the model's output at u_ (the y_ref that produced it): next branching point
   double y_ref_ = 0.0;
   int direction_ = 0;  // of u (= of y along a branch): +1, -1, 0 = not yet known
-  std::uint64_t reversals_ = 0;
   // Warm start: the last point where F, M and p^c3 were evaluated (see solve_run).
   bool warm_ = false;
   double warm_p_ = 0.0, warm_f_ = 0.0, warm_m_ = 0.0, warm_pc3_ = 0.0;
