@@ -1,7 +1,6 @@
 #include "core/config.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -240,7 +239,7 @@ T Config::get(std::string_view path) const {
 double Config::get_in_range(std::string_view path, double default_value, double lo, double hi) const {
   const double v = get<double>(path, default_value);
   if (!(v >= lo && v <= hi)) {
-    fail(path, "must be in [" + refusal_number(lo) + ", " + refusal_number(hi) + "] (got " + refusal_number(v) + ")");
+    fail(path, "must be in [" + number_text(lo) + ", " + number_text(hi) + "] (got " + number_text(v) + ")");
   }
   return v;
 }

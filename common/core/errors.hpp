@@ -35,8 +35,9 @@ void validate_within(std::string_view prefix, Validate&& validate) {
   }
 }
 
-// A number as refusals print it ("%.6g": 8.58e-09, 250, inf).
-std::string refusal_number(double v);
+// A number for a message, a table or a file: printf's "%.<significant>g" (8.58e-09, 250, inf), which
+// keeps SI values such as 8.58e-09 m/V readable where std::to_string would print 0.000000.
+std::string number_text(double v, int significant = 6);
 
 // Throws ParameterError unless `value` is finite.
 void require_finite(std::string_view field, double value);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string_view>
@@ -28,11 +27,7 @@ constexpr double kLearningSlewShare = 0.97;
 constexpr double kDryRunPeriods = 1.25;
 constexpr std::int64_t kDryRunMaxTicks = 200'000;
 
-std::string si(double value, const char* unit) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3g %s", value, unit);
-  return buf;
-}
+std::string si(double value, const char* unit) { return number_text(value, 3) + " " + unit; }
 }  // namespace
 
 // Each online model's mode number is its registry entry's (models/model_set.hpp).

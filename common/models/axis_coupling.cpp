@@ -67,7 +67,7 @@ void AxisCoupling::validate() const {
   }
   for (int i = 0; i < n_; ++i) {
     if (c_(i, i) != 1.0) {
-      throw ParameterError(entry_field(i, i), "must be exactly 1 (got " + refusal_number(c_(i, i)) + "): axis " +
+      throw ParameterError(entry_field(i, i), "must be exactly 1 (got " + number_text(c_(i, i)) + "): axis " +
                                                   std::string(axis_name(i)) +
                                                   "'s own gain belongs to its own model, C holds only the coupling");
     }
@@ -75,17 +75,17 @@ void AxisCoupling::validate() const {
   for (int j = 0; j < n_; ++j) {
     for (int i = 0; i < n_; ++i) {
       if (i != j && std::abs(c_(j, i)) > kMaxCoupling) {
-        throw ParameterError(entry_field(j, i),
-                             "|" + refusal_number(c_(j, i)) + "| exceeds " + refusal_number(kMaxCoupling) +
-                                 ": moving " + std::string(axis_name(i)) + " would move " + std::string(axis_name(j)) +
-                                 " by more than half as much (a mislabelled axis or sensor?)");
+        throw ParameterError(entry_field(j, i), "|" + number_text(c_(j, i)) + "| exceeds " + number_text(kMaxCoupling) +
+                                                    ": moving " + std::string(axis_name(i)) + " would move " +
+                                                    std::string(axis_name(j)) +
+                                                    " by more than half as much (a mislabelled axis or sensor?)");
       }
     }
   }
   const double cond = condition_number();
   if (!(cond <= kMaxCouplingCondition)) {
-    throw ParameterError("coupling", "condition number " + refusal_number(cond) + " exceeds " +
-                                         refusal_number(kMaxCouplingCondition) +
+    throw ParameterError("coupling", "condition number " + number_text(cond) + " exceeds " +
+                                         number_text(kMaxCouplingCondition) +
                                          ": the axes are nearly dependent, so decoupling would multiply reference "
                                          "and model errors up to that many times (a few per cent coupling gives ~1.1)");
   }

@@ -11,7 +11,7 @@ namespace {
 
 void require_normal(const std::string& field, double value) {
   if (std::fpclassify(value) == FP_SUBNORMAL) {
-    throw ParameterError(field, "is " + refusal_number(value) +
+    throw ParameterError(field, "is " + number_text(value) +
                                     ", a subnormal number (below 2.2e-308): no parameter of a stage is that "
                                     "small, and arithmetic on it is slow enough to cost a tick; 0 or a normal value");
   }
@@ -27,16 +27,16 @@ void require_normal_parameters(const ModelParamSet& set) {
 }
 
 std::string band(const GainPlausibility& rig) {
-  return "[" + refusal_number(rig.min_gain_m_per_V()) + ", " + refusal_number(rig.max_gain_m_per_V()) +
-         "] m/V (the nominal gain " + refusal_number(rig.nominal_gain_m_per_V) + " m/V within a factor " +
-         refusal_number(rig.factor) + ")";
+  return "[" + number_text(rig.min_gain_m_per_V()) + ", " + number_text(rig.max_gain_m_per_V()) +
+         "] m/V (the nominal gain " + number_text(rig.nominal_gain_m_per_V) + " m/V within a factor " +
+         number_text(rig.factor) + ")";
 }
 
 }  // namespace
 
 void refuse_implausible_gain(std::string_view field, const std::string& what, double gain_m_per_V, bool low,
                              const GainPlausibility& rig) {
-  throw ParameterError(std::string(field), what + " is " + refusal_number(gain_m_per_V) + " m/V, " +
+  throw ParameterError(std::string(field), what + " is " + number_text(gain_m_per_V) + " m/V, " +
                                                (low ? "below" : "above") + " the plausible " + band(rig) +
                                                ": not this stage's gain (a units error, or a corrupted set)");
 }

@@ -30,7 +30,7 @@ void MemDescriptor::refuse_gain(const MemParams& p, const GainRange& g, const Ga
   if (p.c1 > rig.max_gain_m_per_V()) refuse_implausible_gain("c1", c1_what, p.c1, false, rig);
   refuse_implausible_gain(
       "c2",
-      "the slope c1 + c2 p^c3 at p = " + refusal_number(rig.u_max_V - rig.u_min_V) + " V (the actuator's whole range)",
+      "the slope c1 + c2 p^c3 at p = " + number_text(rig.u_max_V - rig.u_min_V) + " V (the actuator's whole range)",
       g.max_m_per_V, false, rig);
 }
 

@@ -33,7 +33,7 @@ std::string summary_item(std::string_view name, ValueKind kind, const std::strin
   std::string out = std::string(name) + " ";
   double v = 0.0;
   if (kind == ValueKind::number && parse_finite_double(text, v)) {
-    out += refusal_number(v);
+    out += number_text(v);
   } else {
     out += text;
   }

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
 
+#include "core/errors.hpp"
 #include "lcm/status_counters.hpp"
 
 namespace hystloop {
@@ -12,12 +12,6 @@ namespace {
 // The compensator's counters of sets it did not take (services/compensator: admit, offer, on_model).
 constexpr std::array<const char*, 5> kRefusalCounters{"params_rejected", "params_invalid", "params_stale",
                                                       "model_unknown_kind", "model_unknown_format"};
-
-std::string seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", s);
-  return buf;
-}
 
 }  // namespace
 
@@ -49,9 +43,9 @@ std::string AdoptionWatch::verdict(double waited_s, const std::string& status_ch
   const std::string who = "'" + compensator_ + "'";
   if (adopted()) return "adopted by " + who + " (version " + std::to_string(*version_in_use()) + ")";
   if (heard_.empty() && !command_version_) {
-    return "no rig is running (nothing reported on " + status_channel + " within " + seconds(waited_s) + " s)";
+    return "no rig is running (nothing reported on " + status_channel + " within " + number_text(waited_s, 3) + " s)";
   }
-  std::string why = "not adopted within " + seconds(waited_s) + " s (";
+  std::string why = "not adopted within " + number_text(waited_s, 3) + " s (";
   if (const auto v = version_in_use()) {
     why += who + " in use: version " + std::to_string(*v);
   } else if (compensator_heard_) {

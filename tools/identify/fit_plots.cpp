@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/errors.hpp"
 #include "plot_series.hpp"  // tools/report: write_text_file
 
 namespace hystloop {
@@ -13,18 +14,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // 12 digits: a residual of 1e-12 of y stays visible in the file, and y - model can be checked.
-std::string num(double v) {
-  if (!std::isfinite(v)) return "NaN";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return buf;
-}
-
-std::string short_num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string num(double v) { return std::isfinite(v) ? number_text(v, 12) : "NaN"; }
 
 std::string model_name(ModelKind kind) { return std::string(to_string(kind)); }
 
@@ -52,7 +42,7 @@ std::string curve_file(const FitCurve& c, const char* prefix) { return prefix + 
 
 std::string heldout_title(const FitCurve& c) {
   if (!std::isfinite(c.heldout_rms_m)) return model_name(c.kind);
-  return model_name(c.kind) + ": held-out " + short_num(c.heldout_rms_m * 1e9) + " nm RMS";
+  return model_name(c.kind) + ": held-out " + number_text(c.heldout_rms_m * 1e9, 3) + " nm RMS";
 }
 
 // A u -> y plot of `file`: measured and model, every sample or only the held-out ones.
@@ -117,7 +107,7 @@ FitPlotFiles write_fit_plots(const SampleTable& s, const FitPlotInput& in, const
     images.emplace_back("heldout_u_y.png");
     gp << "\nset output 'heldout_u_y.png'\n"
        << "set title \"" << in.heading << "\\n"
-       << heldout_title(*held) << " (fitted on the record before t = " << short_num(s.t[held->heldout_begin])
+       << heldout_title(*held) << " (fitted on the record before t = " << number_text(s.t[held->heldout_begin], 3)
        << " s)\"\n"
        << "set xlabel 'u [V]'\nset ylabel 'y [µm]'\n"
        << loop_plot(held_file, "predicted (" + chosen_name + ")", true);

@@ -50,8 +50,8 @@ struct Record {
 };
 
 std::string label(const LoggedExperiment& e) {
-  return std::string(e.spec.settle ? "settle" : "sine") + " " + short_number(e.spec.offset_V) + " V + " +
-         short_number(e.spec.amplitude_V) + " V at " + short_number(e.spec.frequency_hz) + " Hz (request " +
+  return std::string(e.spec.settle ? "settle" : "sine") + " " + number_text(e.spec.offset_V) + " V + " +
+         number_text(e.spec.amplitude_V) + " V at " + number_text(e.spec.frequency_hz) + " Hz (request " +
          std::to_string(e.request_id) + ")";
 }
 
@@ -194,7 +194,7 @@ void collect_samples(const std::vector<Sample>& samples, const ExperimentLogOpti
   const bool loop = e.spec.frequency_hz < o.rate_independent_below_Hz;
   if (e.missing > 0 && (!loop || static_cast<double>(e.missing) > o.max_missing * ticks)) {
     e.problem = std::to_string(e.missing) + " tick(s) without a sample in the log" +
-                (loop ? ", more than " + short_number(o.max_missing * 100.0) + " %" : " (its time base matters)");
+                (loop ? ", more than " + number_text(o.max_missing * 100.0) + " %" : " (its time base matters)");
   } else if (e.safe_state > 0) {
     e.problem = std::to_string(e.safe_state) + " sample(s) in the safe state (watchdog trip or disarmed)";
   } else if (e.sensor_fault > 0) {
@@ -203,7 +203,7 @@ void collect_samples(const std::vector<Sample>& samples, const ExperimentLogOpti
     e.problem = std::to_string(e.not_as_commanded) +
                 " sample(s) not applied as commanded (late, saturated or "
                 "slew-limited), more than " +
-                short_number(o.max_not_as_commanded * 100.0) + " %";
+                number_text(o.max_not_as_commanded * 100.0) + " %";
   }
 }
 
@@ -263,7 +263,7 @@ LoggedExperiments read_logged_experiments(const std::vector<std::string>& files,
       } else if (const auto m = first_mismatch(r.commands, command_index, e.spec, start_s, e.begin_tick,
                                                std::min(e.end_tick, b.end_max), o.dt_s)) {
         mismatch = "the commands differ from the requested sines from tick " + std::to_string(m->tick) + " (expected " +
-                   short_number(m->expected_V) + " V, commanded " + short_number(m->commanded_V) +
+                   number_text(m->expected_V) + " V, commanded " + number_text(m->commanded_V) +
                    " V): a request is missing from the log";
         e.problem = mismatch;
       } else if (!e.complete) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -34,7 +33,7 @@ class RecordBuilder {
       if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
       throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) +
                            "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") +
-                           " is not finite (u_V = " + short_number(s.u_V) + ", y_m = " + short_number(s.y_m) + ")");
+                           " is not finite (u_V = " + number_text(s.u_V) + ", y_m = " + number_text(s.y_m) + ")");
     });
     if (check_message(block) != Verdict::kOk) return void(++out_.undecodable);
     out_.sensor_ticks += static_cast<std::size_t>(block.n_ticks);
@@ -105,7 +104,7 @@ void LogReadOptions::validate() const {
     require_positive("to", *to_s);
     if (from_s && !(*to_s > *from_s)) {
       throw ParameterError("to",
-                           "must be > from (got from " + short_number(*from_s) + ", to " + short_number(*to_s) + ")");
+                           "must be > from (got from " + number_text(*from_s) + ", to " + number_text(*to_s) + ")");
     }
   }
 }
@@ -118,12 +117,6 @@ void for_each_log_event(const std::vector<std::string>& files,
     if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
     while (const lcm::LogEvent* event = log.readNextEvent()) on_event(file, *event);
   }
-}
-
-std::string short_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
@@ -158,8 +151,8 @@ std::string describe(const LogSamples& s, const LogReadOptions& options) {
   o << "log: " << s.files << " file(s), " << s.events << " events, " << s.sensor_events << " blocks on "
     << options.sensor_channel << " (" << s.sensor_ticks << " ticks)\n";
   o << "samples: " << s.table.t.size() << " kept (seq " << s.first_seq.value_or(0) << " .. " << s.last_seq.value_or(0)
-    << ", t " << short_number(s.table.t.front()) << " .. " << short_number(s.table.t.back()) << " s), "
-    << s.outside_range << " outside the time range\n";
+    << ", t " << number_text(s.table.t.front()) << " .. " << number_text(s.table.t.back()) << " s), " << s.outside_range
+    << " outside the time range\n";
   o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
     << " repeated seq, " << s.undecodable << " block(s) undecodable or out of contract\n";
   o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";

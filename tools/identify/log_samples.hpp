@@ -106,9 +106,6 @@ bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
 void for_each_log_event(const std::vector<std::string>& files,
                         const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event);
 
-// v at 6 significant digits (%g), for the logs' messages and reports.
-std::string short_number(double v);
-
 // True for a path that names an LCM event log by its ending (".lcmlog").
 bool looks_like_lcm_log(const std::string& path);
 

@@ -1,22 +1,16 @@
 #include "csv_export.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <fstream>
 #include <stdexcept>
 
+#include "core/errors.hpp"
 #include "log_reader.hpp"
 #include "plot_series.hpp"
 
 namespace hystloop::report {
 
 namespace {
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return buf;
-}
 
 std::string csv_quoted(const std::string& text) {
   std::string out = "\"";
@@ -30,7 +24,7 @@ std::string csv_quoted(const std::string& text) {
 // Value k of a column, unquoted.
 std::string value(const Column& c, std::size_t k) {
   switch (c.type) {
-    case ColumnType::kFloat64: return num(c.f64[k]);
+    case ColumnType::kFloat64: return number_text(c.f64[k], 12);
     case ColumnType::kInt64: return std::to_string(c.i64[k]);
     default: return c.text[k];
   }
