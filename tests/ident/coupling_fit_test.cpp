@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "support/refusal.hpp"
+#include "support/typical_coupling.hpp"
 
 namespace hystloop {
 namespace {
@@ -25,14 +27,7 @@ constexpr double kAmplitude_m = 0.5e-6;  // the excited axis's triangle: +-0.5 u
 constexpr std::size_t kSamples = 4000;   // per experiment: 4 periods of 1000
 constexpr std::size_t kPeriod = 1000;
 
-// x->y 3 %, y->x -1 %, x->z 0.5 %, y->z 1.5 %, z->x 0.8 %, z->y -2 % (C(j, i) = i->j).
-AxisMatrix truth() {
-  AxisMatrix c;
-  c << 1.0, -0.01, 0.008,  //
-      0.03, 1.0, -0.02,    //
-      0.005, 0.015, 1.0;
-  return c;
-}
+AxisMatrix truth() { return testing::typical_coupling(); }
 
 // Where the held axes sit: not at 0, so a fit without an offset would be biased.
 constexpr double kHeld_m[kMaxAxes] = {0.2e-6, -0.1e-6, 0.35e-6};
@@ -274,12 +269,8 @@ TEST(CouplingFit, RefusesAFittedMatrixAxisCouplingRefuses) {
 
 TEST(CouplingFit, OptionsNameTheField) {
   auto field_of = [](const CouplingFitOptions& o) {
-    try {
-      o.validate();
-    } catch (const ParameterError& e) {
-      return e.field();
-    }
-    return std::string("accepted");
+    const auto e = testing::thrown<ParameterError>([&] { o.validate(); });
+    return e ? e->field() : std::string("accepted");
   };
   CouplingFitOptions o;
   EXPECT_EQ(field_of(o), "accepted");

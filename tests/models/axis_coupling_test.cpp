@@ -7,44 +7,27 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 
 #include "core/errors.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
+#include "support/typical_coupling.hpp"
 
 namespace hystloop {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// A 3-axis stage coupled by a few per cent: x->y 3 %, y->x -1 %, x->z 0.5 %, y->z 1.5 %,
-// z->x 0.8 %, z->y -2 % (C(j, i) = i->j).
-AxisMatrix typical() {
-  AxisMatrix c;
-  c << 1.0, -0.01, 0.008,  //
-      0.03, 1.0, -0.02,    //
-      0.005, 0.015, 1.0;
-  return c;
-}
+AxisMatrix typical() { return testing::typical_coupling(); }
 
-std::string field_of(int n, const AxisMatrix& c) {
-  try {
-    AxisCoupling coupling(n, c);
-  } catch (const ParameterError& e) {
-    return e.field();
-  }
-  return "accepted";
+std::optional<ParameterError> refusal(int n, const AxisMatrix& c) {
+  return testing::thrown<ParameterError>([&] { AxisCoupling coupling(n, c); });
 }
-
-std::string reason_of(int n, const AxisMatrix& c) {
-  try {
-    AxisCoupling coupling(n, c);
-  } catch (const ParameterError& e) {
-    return e.reason();
-  }
-  return "accepted";
-}
+std::string field_of(int n, const AxisMatrix& c) { return refusal(n, c) ? refusal(n, c)->field() : "accepted"; }
+std::string reason_of(int n, const AxisMatrix& c) { return refusal(n, c) ? refusal(n, c)->reason() : "accepted"; }
 
 TEST(AxisCoupling, DecoupleUndoesCouple) {
   const AxisCoupling coupling(3, typical());
