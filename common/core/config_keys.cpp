@@ -1,6 +1,5 @@
 // Config: listing the keys of the tree and refusing the unknown ones.
 #include <algorithm>
-#include <cctype>
 
 #include "core/config.hpp"
 #include "core/config_impl.hpp"
@@ -38,13 +37,6 @@ bool is_known(std::string_view key, const std::vector<std::string>& known) {
   return false;
 }
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
-
 std::string_view last_part(std::string_view key) {
   const auto dot = key.rfind('.');
   return dot == std::string_view::npos ? key : key.substr(dot + 1);
@@ -57,7 +49,7 @@ std::string suggestion(std::string_view key, const std::vector<std::string>& kno
   std::size_t best_distance = std::max<std::size_t>(2, key.size() / 5) + 1;
   for (std::string_view k : known) {
     if (k.size() >= 2 && k.substr(k.size() - 2) == ".*") continue;
-    const std::size_t d = edit_distance(lower(key), lower(k));
+    const std::size_t d = edit_distance(ascii_lower(key), ascii_lower(k));
     if (d < best_distance) {
       best_distance = d;
       best = std::string(k);
@@ -65,7 +57,7 @@ std::string suggestion(std::string_view key, const std::vector<std::string>& kno
   }
   if (!best.empty()) return best;
   for (std::string_view k : known) {
-    if (lower(last_part(k)) == lower(last_part(key))) return std::string(k);
+    if (ascii_lower(last_part(k)) == ascii_lower(last_part(key))) return std::string(k);
   }
   return {};
 }

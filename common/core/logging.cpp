@@ -3,19 +3,16 @@
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
-#include <algorithm>
-#include <cctype>
 #include <string>
 #include <vector>
 
+#include "core/edit_distance.hpp"
 #include "core/errors.hpp"
 
 namespace hystloop {
 
 spdlog::level::level_enum parse_log_level(std::string_view text) {
-  std::string lower(text);
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string lower = ascii_lower(text);
   using spdlog::level::level_enum;
   static constexpr std::pair<const char*, level_enum> kLevels[] = {
       {"trace", level_enum::trace},       {"debug", level_enum::debug},  {"info", level_enum::info},

@@ -1,11 +1,11 @@
 #include "models/csv_columns.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 
 #include <fmt/format.h>
 
+#include "core/edit_distance.hpp"
 #include "models/param_table.hpp"
 
 namespace hystloop {
@@ -35,11 +35,6 @@ std::string unquote(std::string_view s) {
   return std::string(s);
 }
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 bool all_numbers(const std::vector<std::string_view>& fields) {
   for (const auto f : fields) {
     double v = 0.0;
@@ -56,7 +51,7 @@ CsvColumns read_csv_columns(std::istream& in, const std::string& file, std::span
   for (const auto r : required) table.names.emplace_back(r);
   table.values.resize(required.size());
   const std::string expected = join(required);
-  auto key = [&](std::string_view name) { return options.any_case ? lower(std::string(name)) : std::string(name); };
+  auto key = [&](std::string_view name) { return options.any_case ? ascii_lower(name) : std::string(name); };
 
   std::vector<std::string> header;                  // as matched: lower case with any_case
   std::vector<std::size_t> index(required.size());  // field of each requested column

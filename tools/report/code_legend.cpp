@@ -1,10 +1,10 @@
 #include "code_legend.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <string>
 #include <utility>
 
+#include "core/edit_distance.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/model_params_t.hpp"
@@ -20,9 +20,7 @@ namespace {
 // "MODE_LINEAR" without "MODE_", in lower case: "linear".
 Code code(std::int64_t value, std::string_view constant, std::string_view prefix) {
   if (constant.substr(0, prefix.size()) == prefix) constant.remove_prefix(prefix.size());
-  std::string name(constant);
-  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return {value, name};
+  return {value, ascii_lower(constant)};
 }
 
 // HX_CODES(type, prefix, A, B, ...): code(type::A, "A", prefix), code(type::B, "B", prefix), ...:
