@@ -31,13 +31,6 @@ std::string state_name(std::int8_t state) {
   }
 }
 
-std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name) {
-  for (std::size_t i = 0; i < status.counter_names.size() && i < status.counter_values.size(); ++i) {
-    if (status.counter_names[i] == name) return status.counter_values[i];
-  }
-  return std::nullopt;
-}
-
 HealthVerdict check_health(const StatusBoard& board, const std::vector<std::string>& required,
                            const std::vector<std::string>& accept_safe, bool accept_degraded) {
   HealthVerdict verdict;

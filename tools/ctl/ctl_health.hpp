@@ -4,20 +4,16 @@
 
 #include <cstdint>
 #include <map>
-#include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "hystloop/service_status_t.hpp"
+#include "lcm/status_counters.hpp"  // find_counter
 
 namespace hystloop::ctl {
 
 // "STARTING", "HEALTHY", "DEGRADED", "SAFE", "STOPPING", or "state <n>".
 std::string state_name(std::int8_t state);
-
-// The value of the named counter in a report; nullopt when the process does not report it.
-std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name);
 
 // The latest report of each process heard.
 class StatusBoard {
