@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -34,10 +33,8 @@ void FeedbackGains::validate() const {
   if (has_notch()) {
     const double max_hz = kNotchMaxFractionOfRate * tick_rate_hz;
     if (!(notch_hz < max_hz)) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "must be 0 (no notch) or below 0.45 x the tick rate (%g Hz) (got %g)", max_hz,
-                    notch_hz);
-      throw ParameterError("servo.notch_hz", buf);
+      throw ParameterError("servo.notch_hz", "must be 0 (no notch) or below 0.45 x the tick rate (" +
+                                                 number_text(max_hz) + " Hz) (got " + number_text(notch_hz) + ")");
     }
     require_in_range("servo.notch_q", notch_q, kNotchMinQ, kNotchMaxQ);
   }
@@ -50,9 +47,8 @@ double FeedbackGains::max_kd_s() const noexcept {
 void FeedbackGains::check_bounds(std::string_view prefix) const {
   validate();
   const auto refuse = [&](const char* name, double value, double bound, const char* unit, const char* why) {
-    char buf[384];
-    std::snprintf(buf, sizeof buf, "must be <= %.6g%s (got %.6g): %s", bound, unit, value, why);
-    throw ParameterError(std::string(prefix) + name, buf);
+    throw ParameterError(std::string(prefix) + name,
+                         "must be <= " + number_text(bound) + unit + " (got " + number_text(value) + "): " + why);
   };
   if (!(kp <= max_kp())) {
     refuse("kp", kp, max_kp(), "",

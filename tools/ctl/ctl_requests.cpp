@@ -23,12 +23,6 @@ std::int8_t shape_on_wire(std::string_view name) {
   throw ParameterError("shape", "must be " + trajectory_shape_choices() + " (got '" + std::string(name) + "')");
 }
 
-std::string str(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
 }  // namespace
 
 std::int64_t new_request_id(std::int64_t utime, int pid) noexcept {
@@ -128,7 +122,8 @@ void TrajectoryRequest::validate() const {
       require_in_range("points-csv", points_y_m[i], -kMaxAbsPosition_m, kMaxAbsPosition_m);
       if (i > 0 && !(points_t_s[i] > points_t_s[i - 1])) {
         throw ParameterError("points-csv", "times must increase strictly (point " + std::to_string(i + 1) + ": " +
-                                               str(points_t_s[i]) + " after " + str(points_t_s[i - 1]) + ")");
+                                               number_text(points_t_s[i]) + " after " + number_text(points_t_s[i - 1]) +
+                                               ")");
       }
     }
   } else if (!points_t_s.empty()) {
@@ -136,8 +131,8 @@ void TrajectoryRequest::validate() const {
   }
   require_non_negative("corner", corner_s);
   if (s == trajectory_t::TRIANGLE && !(corner_s < 0.5 / frequency_Hz)) {
-    throw ParameterError("corner", "must be below half the period (" + str(0.5 / frequency_Hz) + " s at " +
-                                       str(frequency_Hz) + " Hz; got " + str(corner_s) + " s)");
+    throw ParameterError("corner", "must be below half the period (" + number_text(0.5 / frequency_Hz) + " s at " +
+                                       number_text(frequency_Hz) + " Hz; got " + number_text(corner_s) + " s)");
   }
   if (s != trajectory_t::TRIANGLE && corner_s != 0.0) throw ParameterError("corner", "only for --shape triangle");
 }
