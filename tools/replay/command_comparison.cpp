@@ -2,8 +2,9 @@
 
 #include <bit>
 #include <cmath>
-#include <cstdio>
 #include <iterator>
+
+#include <spdlog/fmt/fmt.h>
 
 #include "core/errors.hpp"
 
@@ -128,54 +129,40 @@ CompareReport compare_commands(const CommandLog& expected, const CommandLog& act
 
 std::string format_report(const CompareReport& r, const CompareTolerance& tolerance) {
   std::string out;
-  char line[512];
   if (tolerance.voltage_V == 0.0 && tolerance.position_m == 0.0) {
     out += "comparison: exact (doubles bitwise equal; mode and params_version equal)\n";
   } else {
-    std::snprintf(
-        line, sizeof line,
-        "comparison: |expected - got| <= %.6g V (u_ff_V), <= %.6g m (y_ref_m); mode and params_version equal\n",
+    out += fmt::format(
+        "comparison: |expected - got| <= {:.6g} V (u_ff_V), <= {:.6g} m (y_ref_m); mode and params_version equal\n",
         tolerance.voltage_V, tolerance.position_m);
-    out += line;
   }
   if (r.first_divergence) {
     const Divergence& d = *r.first_divergence;
-    std::snprintf(line, sizeof line,
-                  "FIRST DIVERGENCE at tick %lld (answering sample %lld): %s expected %.17g got %.17g (difference "
-                  "%.3g; %d of %d fields differ at this tick)\n",
-                  static_cast<long long>(d.seq), static_cast<long long>(d.sample_seq), d.field.c_str(), d.expected,
-                  d.got, d.got - d.expected, d.fields_differing, kComparedFields);
-    out += line;
+    out += fmt::format(
+        "FIRST DIVERGENCE at tick {} (answering sample {}): {} expected {:.17g} got {:.17g} (difference "
+        "{:.3g}; {} of {} fields differ at this tick)\n",
+        d.seq, d.sample_seq, d.field, d.expected, d.got, d.got - d.expected, d.fields_differing, kComparedFields);
   }
   if (r.first_missing_seq) {
-    std::snprintf(
-        line, sizeof line,
-        "FIRST MISSING: tick %lld was commanded by the original, not by the replay (its sample was not played)\n",
-        static_cast<long long>(*r.first_missing_seq));
-    out += line;
+    out += fmt::format(
+        "FIRST MISSING: tick {} was commanded by the original, not by the replay (its sample was not played)\n",
+        *r.first_missing_seq);
   }
   if (r.lost_in_transport > 0) {
-    std::snprintf(line, sizeof line,
-                  "replay transport lost %llu commanded ticks (first planned at sample %lld): the sample was played, "
-                  "the command never logged; not counted as divergence\n",
-                  static_cast<unsigned long long>(r.lost_in_transport), static_cast<long long>(*r.first_lost_sample));
-    out += line;
+    out += fmt::format(
+        "replay transport lost {} commanded ticks (first planned at sample {}): the sample was played, "
+        "the command never logged; not counted as divergence\n",
+        r.lost_in_transport, *r.first_lost_sample);
     if (r.divergence_after_loss)
       out += "the first divergence comes after the first lost sample and may be its consequence: replay again\n";
   }
-  std::snprintf(line, sizeof line,
-                "summary: original commanded %llu ticks; compared %llu (ticks %lld..%lld): %llu equal, %llu differing; "
-                "missing in replay %llu (+ %llu lost in transport); replay-only ticks (not compared) %llu\n",
-                static_cast<unsigned long long>(r.expected_ticks), static_cast<unsigned long long>(r.compared),
-                static_cast<long long>(r.first_seq.value_or(-1)), static_cast<long long>(r.last_seq.value_or(-1)),
-                static_cast<unsigned long long>(r.equal), static_cast<unsigned long long>(r.differing),
-                static_cast<unsigned long long>(r.missing_in_actual),
-                static_cast<unsigned long long>(r.lost_in_transport),
-                static_cast<unsigned long long>(r.missing_in_expected));
-  out += line;
+  out += fmt::format(
+      "summary: original commanded {} ticks; compared {} (ticks {}..{}): {} equal, {} differing; "
+      "missing in replay {} (+ {} lost in transport); replay-only ticks (not compared) {}\n",
+      r.expected_ticks, r.compared, r.first_seq.value_or(-1), r.last_seq.value_or(-1), r.equal, r.differing,
+      r.missing_in_actual, r.lost_in_transport, r.missing_in_expected);
   if (r.compared == 0) out += "nothing was compared: the replay answered none of the original's ticks\n";
-  std::snprintf(line, sizeof line, "verdict: %s\n", to_string(r.verdict()));
-  out += line;
+  out += fmt::format("verdict: {}\n", to_string(r.verdict()));
   return out;
 }
 

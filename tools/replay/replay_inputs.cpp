@@ -1,8 +1,9 @@
 #include "replay_inputs.hpp"
 
-#include <cstdio>
 #include <set>
 #include <stdexcept>
+
+#include <spdlog/fmt/fmt.h>
 
 #include "decode.hpp"
 #include "lcm/blocks.hpp"
@@ -99,40 +100,28 @@ ReplayInputSelection write_replay_inputs(const std::filesystem::path& log, const
 }
 
 std::string describe(const ReplayInputSelection& s) {
-  std::string out;
-  char line[256];
-  const auto ll = [](std::optional<std::int64_t> v) { return static_cast<long long>(v.value_or(-1)); };
-  const auto ull = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
-  std::snprintf(line, sizeof line, "log's first sample: %lld; first sample the recorded compensator answered: %lld\n",
-                ll(s.first_log_sample), ll(s.first_answered_sample));
-  out += line;
+  std::string out = fmt::format("log's first sample: {}; first sample the recorded compensator answered: {}\n",
+                                s.first_log_sample.value_or(-1), s.first_answered_sample.value_or(-1));
   if (s.blocks_before_start > 0) {
-    std::snprintf(line, sizeof line,
-                  "warm-up: the recorded compensator started after the log did; the replay starts with the block of "
-                  "sample %lld (%llu earlier sensor blocks left out)\n",
-                  ll(s.first_answered_sample), ull(s.blocks_before_start));
-    out += line;
+    out += fmt::format(
+        "warm-up: the recorded compensator started after the log did; the replay starts with the block of "
+        "sample {} ({} earlier sensor blocks left out)\n",
+        s.first_answered_sample.value_or(-1), s.blocks_before_start);
   }
   if (s.log_starts_after_compensator) {
     out +=
         "warning: the log begins after the recorded compensator started: inputs it received before are not in the log, "
         "the replay may diverge\n";
   }
-  std::snprintf(line, sizeof line,
-                "replay inputs: %llu sensor blocks (%llu ticks), %llu trajectory/params/control messages (%llu logged "
-                "before the compensator ran, left out)\n",
-                ull(s.blocks_written), ull(s.ticks_written), ull(s.other_inputs_written), ull(s.other_inputs_skipped));
-  out += line;
+  out += fmt::format(
+      "replay inputs: {} sensor blocks ({} ticks), {} trajectory/params/control messages ({} logged "
+      "before the compensator ran, left out)\n",
+      s.blocks_written, s.ticks_written, s.other_inputs_written, s.other_inputs_skipped);
   if (s.blocks_unanswered > 0) {
-    std::snprintf(line, sizeof line,
-                  "the recorded compensator did not answer %llu sensor blocks after its first (%llu left out)\n",
-                  ull(s.blocks_unanswered), ull(s.blocks_unanswered_dropped));
-    out += line;
+    out += fmt::format("the recorded compensator did not answer {} sensor blocks after its first ({} left out)\n",
+                       s.blocks_unanswered, s.blocks_unanswered_dropped);
   }
-  if (s.undecodable > 0) {
-    std::snprintf(line, sizeof line, "%llu input events did not decode and were left out\n", ull(s.undecodable));
-    out += line;
-  }
+  if (s.undecodable > 0) out += fmt::format("{} input events did not decode and were left out\n", s.undecodable);
   return out;
 }
 
