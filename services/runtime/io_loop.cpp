@@ -1,5 +1,7 @@
 #include "runtime/io_loop.hpp"
 
+#include <algorithm>
+
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
 #include "runtime/status_reporter.hpp"
@@ -12,11 +14,8 @@ int run_io_loop(lcm::LCM& lcm, const IoLoopOptions& options, const std::function
   int errors = 0;
   auto next = clock::now() + options.period;
   while (!stop_requested()) {
-    const auto now = clock::now();
-    auto budget = std::chrono::duration_cast<std::chrono::microseconds>(next - now);
-    if (budget > options.poll_timeout) budget = options.poll_timeout;
-    if (budget.count() < 0) budget = std::chrono::microseconds(0);
-    const int n = handle_pending(lcm, budget);
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(next - clock::now());
+    const int n = handle_pending(lcm, std::clamp(left, std::chrono::microseconds(0), options.poll_timeout));
     if (n < 0) ++errors;
     if (n > 0 && after_dispatch) after_dispatch();
     if (clock::now() >= next) {
