@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
-#include <sstream>
+#include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "ident/ceres_budget.hpp"
@@ -260,10 +260,10 @@ FitCheck fit_centre_line(const PointRefs& loops, const BanningFitOptions& o, Ban
   double umin = 1e300, umax = -1e300;
   for (const auto* p : loops) umin = std::min(umin, p->features.u_centre), umax = std::max(umax, p->features.u_centre);
   if (loops.size() < 2 || umax - umin < o.min_offset_span_V) {
-    std::ostringstream s;
-    s << loops.size() << " usable loop experiments whose centres span " << (loops.empty() ? 0.0 : umax - umin)
-      << " V; need two or more offsets spanning >= " << o.min_offset_span_V << " V to identify a";
-    return FitCheck{FitStatus::too_few_samples, s.str()};
+    return FitCheck{FitStatus::too_few_samples,
+                    fmt::format("{} usable loop experiments whose centres span {:g} V; need two or more offsets "
+                                "spanning >= {:g} V to identify a",
+                                loops.size(), loops.empty() ? 0.0 : umax - umin, o.min_offset_span_V)};
   }
   Eigen::Matrix2d g = Eigen::Matrix2d::Zero();
   Eigen::Vector2d r = Eigen::Vector2d::Zero();
@@ -296,9 +296,9 @@ FitCheck seed_b_alpha(const PointRefs& loops, double a, const BanningFitOptions&
   }
   b0 /= static_cast<double>(n);
   if (!(a > 0.0) || !(b0 > 0.0) || !(b0 < a)) {
-    std::ostringstream s;
-    s << "a = " << a << " m/V, small-loop slope b = " << b0 << " m/V: need 0 < b < a (a loop with area)";
-    return FitCheck{FitStatus::out_of_range, s.str()};
+    return FitCheck{
+        FitStatus::out_of_range,
+        fmt::format("a = {:g} m/V, small-loop slope b = {:g} m/V: need 0 < b < a (a loop with area)", a, b0)};
   }
   std::vector<double> alphas;
   for (const auto* p : loops) {
@@ -434,10 +434,10 @@ void correct_for_lag(const PointRefs& loops, const PointRefs& mags, double sampl
     worst = std::max(worst, std::abs(stage_lag(w) + w * x[1]));
   }
   if (!std::isfinite(x[1]) || !(worst <= kMaxLoopLag_rad)) {
-    std::ostringstream s;
-    s << "the lag at the loops' frequency is " << worst << " rad (delay " << x[1]
-      << " s beyond the stage): too large to correct the areas to first order; measure slower loops";
-    res.lag_note = s.str();
+    res.lag_note = fmt::format(
+        "the lag at the loops' frequency is {:g} rad (delay {:g} s beyond the stage): too large to correct the areas "
+        "to first order; measure slower loops",
+        worst, x[1]);
     return;
   }
   res.lag_identified = true;

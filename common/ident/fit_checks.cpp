@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
-#include <sstream>
+#include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
@@ -12,23 +12,21 @@ namespace hystloop {
 
 FitCheck check_fit_samples(std::span<const double> u, std::span<const double> y) {
   if (u.size() != y.size() || u.empty()) {
-    std::ostringstream s;
-    s << "u has " << u.size() << " samples, y has " << y.size();
-    return FitCheck{FitStatus::size_mismatch, s.str()};
+    return FitCheck{FitStatus::size_mismatch, fmt::format("u has {} samples, y has {}", u.size(), y.size())};
   }
   for (std::size_t k = 0; k < u.size(); ++k) {
     if (!std::isfinite(u[k]) || !std::isfinite(y[k])) {
-      std::ostringstream s;
-      s << "sample " << k << " is not finite (u = " << u[k] << ", y = " << y[k] << ")";
-      return FitCheck{FitStatus::non_finite_data, s.str()};
+      return FitCheck{FitStatus::non_finite_data,
+                      fmt::format("sample {} is not finite (u = {:g}, y = {:g})", k, u[k], y[k])};
     }
     if (std::abs(u[k]) > kFitMaxAbsVoltage_V || std::abs(y[k]) > kFitMaxAbsPosition_m) {
       const bool bad_u = std::abs(u[k]) > kFitMaxAbsVoltage_V;
-      std::ostringstream s;
-      s << "sample " << k << ": " << (bad_u ? "u = " : "y = ") << (bad_u ? u[k] : y[k]) << (bad_u ? " V" : " m")
-        << " is beyond the sanity bound +-" << (bad_u ? kFitMaxAbsVoltage_V : kFitMaxAbsPosition_m)
-        << (bad_u ? " V" : " m") << " (u in volts, y in metres?)";
-      return FitCheck{FitStatus::out_of_range, s.str()};
+      const char* const unit = bad_u ? "V" : "m";
+      return FitCheck{
+          FitStatus::out_of_range,
+          fmt::format("sample {}: {} = {:g} {} is beyond the sanity bound +-{:g} {} (u in volts, y in metres?)", k,
+                      bad_u ? "u" : "y", bad_u ? u[k] : y[k], unit, bad_u ? kFitMaxAbsVoltage_V : kFitMaxAbsPosition_m,
+                      unit)};
     }
   }
   return {};
@@ -39,9 +37,8 @@ FitCheck check_fit_input(std::span<const double> u, std::span<const double> y, d
   if (FitCheck c = check_fit_samples(u, y); !c.ok()) return c;
   const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
   if (!(*hi - *lo >= min_input_range_V) || *hi == *lo) {
-    std::ostringstream s;
-    s << "u spans " << (*hi - *lo) << " V (< " << min_input_range_V << " V): nothing to identify";
-    return FitCheck{FitStatus::constant_input, s.str()};
+    return FitCheck{FitStatus::constant_input,
+                    fmt::format("u spans {:g} V (< {:g} V): nothing to identify", *hi - *lo, min_input_range_V)};
   }
   if (u_min_V != nullptr) *u_min_V = *lo;
   if (u_max_V != nullptr) *u_max_V = *hi;
@@ -66,32 +63,31 @@ FitCheck check_after_second_reversal(std::span<const double> u, std::size_t min_
 
 FitCheck check_fit_residual(double residual_rms_m, double y_span_m) {
   if (!std::isfinite(residual_rms_m) || residual_rms_m < 0.0) {
-    std::ostringstream s;
-    s << "the fit's residual is " << residual_rms_m << ": no usable solution";
-    return FitCheck{FitStatus::solver_failure, s.str()};
+    return FitCheck{FitStatus::solver_failure,
+                    fmt::format("the fit's residual is {:g}: no usable solution", residual_rms_m)};
   }
   if (residual_rms_m > y_span_m) {
-    std::ostringstream s;
-    s << "the fit's residual " << residual_rms_m << " m RMS exceeds the data's span " << y_span_m
-      << " m: the model explains nothing";
-    return FitCheck{FitStatus::out_of_range, s.str()};
+    return FitCheck{
+        FitStatus::out_of_range,
+        fmt::format("the fit's residual {:g} m RMS exceeds the data's span {:g} m: the model explains nothing",
+                    residual_rms_m, y_span_m)};
   }
   return {};
 }
 
 FitCheck check_katalenic_params(const KatalenicParams& params, double u_span_V) {
   if (FitCheck c = check_valid(params, "Katalenic parameters outside their domain: "); !c.ok()) return c;
-  std::ostringstream s;
   if (!(params.k1 <= u_span_V)) {
-    s << "k1 = " << params.k1 << " V exceeds the input span " << u_span_V
-      << " V: a band that wide never moves, so the data do not determine it";
-    return FitCheck{FitStatus::out_of_range, s.str()};
+    return FitCheck{FitStatus::out_of_range, fmt::format("k1 = {:g} V exceeds the input span {:g} V: a band that wide "
+                                                         "never moves, so the data do not determine it",
+                                                         params.k1, u_span_V)};
   }
   const double sharpness = params.k2 * u_span_V;
   if (!(sharpness >= 1e-6 && sharpness <= 1e6)) {
-    s << "k2 = " << params.k2 << " 1/V times the input span " << u_span_V << " V is " << sharpness
-      << " (outside [1e-6, 1e6]): the transition cannot be told from a line or a corner";
-    return FitCheck{FitStatus::out_of_range, s.str()};
+    return FitCheck{FitStatus::out_of_range,
+                    fmt::format("k2 = {:g} 1/V times the input span {:g} V is {:g} (outside [1e-6, 1e6]): the "
+                                "transition cannot be told from a line or a corner",
+                                params.k2, u_span_V, sharpness)};
   }
   return {};
 }

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
+#include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "ident/fit_checks.hpp"
@@ -178,17 +178,13 @@ MemParams unscale(const ScaledMem& m, const Scales& sc) {
 
 // The physical range, with a sentence for the refusal ("" when fine).
 std::string range_problem(const MemParams& p, const MemFitOptions& o) {
-  std::ostringstream s;
-  if (!(p.c1 > 0.0))
-    s << "c1 = " << p.c1 << " m/V: must be > 0 (the stage does not move with u)";
-  else if (p.c2 < 0.0)
-    s << "c2 = " << p.c2 << ": must be >= 0 (the loop bends the wrong way for MEM)";
-  else if (!(p.c3 > 0.0) || p.c3 > o.c3_max)
-    s << "c3 = " << p.c3 << ": must be in (0, " << o.c3_max << "]";
-  else if (p.c2 > 0.0 && (p.c3 >= o.c3_max * (1.0 - 1e-6) || p.c3 <= o.c3_min * (1.0 + 1e-6)))
-    s << "c3 = " << p.c3 << " sits on the search bound [" << o.c3_min << ", " << o.c3_max
-      << "]: the data do not determine it";
-  if (!s.str().empty()) return s.str();
+  if (!(p.c1 > 0.0)) return fmt::format("c1 = {:g} m/V: must be > 0 (the stage does not move with u)", p.c1);
+  if (p.c2 < 0.0) return fmt::format("c2 = {:g}: must be >= 0 (the loop bends the wrong way for MEM)", p.c2);
+  if (!(p.c3 > 0.0) || p.c3 > o.c3_max) return fmt::format("c3 = {:g}: must be in (0, {:g}]", p.c3, o.c3_max);
+  if (p.c2 > 0.0 && (p.c3 >= o.c3_max * (1.0 - 1e-6) || p.c3 <= o.c3_min * (1.0 + 1e-6))) {
+    return fmt::format("c3 = {:g} sits on the search bound [{:g}, {:g}]: the data do not determine it", p.c3, o.c3_min,
+                       o.c3_max);
+  }
   return check_valid(p, "").reason;
 }
 
@@ -198,10 +194,9 @@ MemFitResult solve(const Data& coarse, const Data& data, const Scales& sc, const
   // A stage that does not respond: y spans no more than its own noise. (The constrained fit
   // would otherwise return a tiny but "valid" slope.)
   if (sc.y_span < 20.0 * result.noise_rms_m) {
-    std::ostringstream s;
-    s << "y spans " << sc.y_span << " m, within its noise (" << result.noise_rms_m
-      << " m RMS): the stage does not move with u";
-    return refuse(std::move(result), FitStatus::out_of_range, s.str());
+    const std::string why = fmt::format("y spans {:g} m, within its noise ({:g} m RMS): the stage does not move with u",
+                                        sc.y_span, result.noise_rms_m);
+    return refuse(std::move(result), FitStatus::out_of_range, why);
   }
   const double c3 = search_c3(coarse, data, o);
   const LinearPart lin = data.project(c3);
@@ -246,10 +241,10 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
   const std::vector<BranchSegment> branches = split_branches(u, o.reversal_dead_band_V);
   result.branches_used = branches.size();
   if (branches.size() < o.min_branches) {
-    std::ostringstream s;
-    s << branches.size() << " branches after the first reversal (need " << o.min_branches
-      << "); the part before it is the skeleton curve and is not used";
-    return timer.finish(result, FitStatus::too_few_branches, s.str());
+    return timer.finish(result, FitStatus::too_few_branches,
+                        fmt::format("{} branches after the first reversal (need {}); the part before it is the "
+                                    "skeleton curve and is not used",
+                                    branches.size(), o.min_branches));
   }
   Scales sc;
   sc.u = 0.0;
@@ -270,9 +265,8 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     const IntegratedData data = build_integrated(u, y, branches, sc, o);
     result.samples_used = data.y.size();
     if (result.samples_used < o.min_samples) {
-      std::ostringstream s;
-      s << result.samples_used << " samples on branches (need " << o.min_samples << ")";
-      return timer.finish(result, FitStatus::too_few_samples, s.str());
+      return timer.finish(result, FitStatus::too_few_samples,
+                          fmt::format("{} samples on branches (need {})", result.samples_used, o.min_samples));
     }
     result = solve(build_integrated(u, y, branches, sc, o, kGridStride), data, sc, o, std::move(result));
   } else {
@@ -282,10 +276,10 @@ MemFitResult fit_mem(std::span<const double> u, std::span<const double> y, const
     const DerivativeData data = build_derivative(u, y, branches, sc, min_du, o);
     result.samples_used = data.z.size();
     if (result.samples_used < o.min_samples) {
-      std::ostringstream s;
-      s << result.samples_used << " difference points reach SNR " << o.min_snr << " (need " << o.min_samples
-        << "; |du| must be >= " << min_du << " V per " << o.derivative_lag << " samples)";
-      return timer.finish(result, FitStatus::too_few_samples, s.str());
+      return timer.finish(
+          result, FitStatus::too_few_samples,
+          fmt::format("{} difference points reach SNR {:g} (need {}; |du| must be >= {:g} V per {} samples)",
+                      result.samples_used, o.min_snr, o.min_samples, min_du, o.derivative_lag));
     }
     result = solve(build_derivative(u, y, branches, sc, min_du, o, kGridStride), data, sc, o, std::move(result));
   }

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <fmt/format.h>
 #include <string>
 
 #include "core/errors.hpp"
@@ -107,10 +107,10 @@ ModelSelection select_model(std::span<const double> u, std::span<const double> y
   const auto target = static_cast<std::size_t>((1.0 - o.holdout_fraction) * static_cast<double>(u.size()));
   const auto it = std::lower_bound(rev.begin(), rev.end(), target);
   if (rev.size() < 4 || it == rev.end() || static_cast<std::size_t>(it - rev.begin()) < 3) {
-    std::ostringstream s;
-    s << rev.size() << " reversals: need >= 3 before and 1 after " << (1.0 - o.holdout_fraction) * 100.0
-      << " % of the record to fit and hold out";
-    return with_status(std::move(sel), FitStatus::too_few_branches, s.str());
+    return with_status(
+        std::move(sel), FitStatus::too_few_branches,
+        fmt::format("{} reversals: need >= 3 before and 1 after {:g} % of the record to fit and hold out", rev.size(),
+                    (1.0 - o.holdout_fraction) * 100.0));
   }
   sel.split_index = *it;
   const std::size_t split = sel.split_index, train_begin = rev[1];

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <sstream>
+#include <fmt/format.h>
 
 #include "core/errors.hpp"
 #include "ident/branches.hpp"
@@ -105,9 +105,8 @@ MemRefitOutcome OnlineMemEstimator::evaluate(const MemWindow& w, const MemParams
     return out;
   };
   if (w.poison != PoisonKind::none) {
-    std::ostringstream s;
-    s << "window from sample " << w.first_seq << " holds a " << to_string(w.poison) << " at sample " << w.poison_seq;
-    return refuse(FitStatus::poisoned_window, s.str());
+    return refuse(FitStatus::poisoned_window, fmt::format("window from sample {} holds a {} at sample {}", w.first_seq,
+                                                          to_string(w.poison), w.poison_seq));
   }
   if (w.u.size() != w.y.size() || w.u.empty()) return refuse(FitStatus::size_mismatch, "empty window");
   const std::vector<BranchSegment> branches = split_branches(w.u, o.fit.reversal_dead_band_V);
@@ -129,14 +128,11 @@ MemRefitOutcome OnlineMemEstimator::evaluate(const MemWindow& w, const MemParams
   if (complete < o.holdout_branches + o.fit.min_branches) {
     const auto [lo, hi] = std::minmax_element(w.u.begin(), w.u.end());
     if (*hi - *lo < std::max(o.fit.min_input_range_V, 1e-300)) {
-      std::ostringstream s;
-      s << "u spans " << (*hi - *lo) << " V in the window: constant input";
-      return refuse(FitStatus::constant_input, s.str());
+      return refuse(FitStatus::constant_input, fmt::format("u spans {:g} V in the window: constant input", *hi - *lo));
     }
-    std::ostringstream s;
-    s << complete << " complete branches in the window; need " << o.fit.min_branches << " to fit + "
-      << o.holdout_branches << " held out";
-    return refuse(FitStatus::too_few_branches, s.str());
+    return refuse(FitStatus::too_few_branches,
+                  fmt::format("{} complete branches in the window; need {} to fit + {} held out", complete,
+                              o.fit.min_branches, o.holdout_branches));
   }
   const std::span<const BranchSegment> held(branches.data() + complete - o.holdout_branches, o.holdout_branches);
   const std::size_t train_end = held.front().begin + 1;  // up to and including the held-out reversal
@@ -146,23 +142,21 @@ MemRefitOutcome OnlineMemEstimator::evaluate(const MemWindow& w, const MemParams
   const auto [ylo, yhi] = std::minmax_element(w.y.begin(), w.y.end());
   const double bound = std::min(o.max_residual_rms_m, o.max_relative_residual * 0.5 * (*yhi - *ylo));
   if (!(out.fit.residual_rms_m <= bound)) {
-    std::ostringstream s;
-    s << "fit residual " << out.fit.residual_rms_m << " m exceeds the bound " << bound << " m";
-    return refuse(FitStatus::out_of_range, s.str());
+    return refuse(FitStatus::out_of_range,
+                  fmt::format("fit residual {:g} m exceeds the bound {:g} m", out.fit.residual_rms_m, bound));
   }
   out.holdout_rms_candidate_m = mem_branch_rms(w.u, w.y, held, out.candidate);
   out.holdout_rms_in_use_m = mem_branch_rms(w.u, w.y, held, in_use);
   if (!(out.holdout_rms_candidate_m < (1.0 - o.min_relative_improvement) * out.holdout_rms_in_use_m)) {
-    std::ostringstream s;
-    s << "held-out branch RMS " << out.holdout_rms_candidate_m << " m vs " << out.holdout_rms_in_use_m
-      << " m in use: not " << o.min_relative_improvement * 100.0 << " % better";
-    return refuse(FitStatus::no_improvement, s.str());
+    return refuse(
+        FitStatus::no_improvement,
+        fmt::format("held-out branch RMS {:g} m vs {:g} m in use: not {:g} % better", out.holdout_rms_candidate_m,
+                    out.holdout_rms_in_use_m, o.min_relative_improvement * 100.0));
   }
   out.status = FitStatus::ok;
   out.accepted = true;
-  std::ostringstream s;
-  s << "held-out branch RMS " << out.holdout_rms_candidate_m << " m vs " << out.holdout_rms_in_use_m << " m in use";
-  out.reason = s.str();
+  out.reason =
+      fmt::format("held-out branch RMS {:g} m vs {:g} m in use", out.holdout_rms_candidate_m, out.holdout_rms_in_use_m);
   return out;
 }
 
