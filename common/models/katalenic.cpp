@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <string>
 
 #include "core/errors.hpp"
@@ -13,12 +12,6 @@ namespace hystloop {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string describe(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 }  // namespace
 
@@ -33,13 +26,13 @@ void KatalenicParams::validate() const {
     require_finite("k2_domain_max", k2_domain_max);
     if (!(k2_domain_min < k2_domain_max)) throw ParameterError("k2_domain_max", "must be > k2_domain_min");
     if (!(k2_min() > 0.0)) {
-      throw ParameterError(
-          "k2_slope",
-          "k2(x) = k2 + k2_slope * x must stay > 0 on [k2_domain_min, k2_domain_max] (min " + describe(k2_min()) + ")");
+      throw ParameterError("k2_slope",
+                           "k2(x) = k2 + k2_slope * x must stay > 0 on [k2_domain_min, k2_domain_max] (min " +
+                               number_text(k2_min()) + ")");
     }
     if (!(std::abs(k2_slope) < max_k2_slope())) {
-      throw ParameterError("k2_slope", "|k2_slope| must be < e * k2_min / (2 k1) = " + describe(max_k2_slope()) +
-                                           " for the operator to stay invertible (got " + describe(k2_slope) + ")");
+      throw ParameterError("k2_slope", "|k2_slope| must be < e * k2_min / (2 k1) = " + number_text(max_k2_slope()) +
+                                           " for the operator to stay invertible (got " + number_text(k2_slope) + ")");
     }
   }
   require_in_range("initial_offset", initial_offset, -k1, k1);
