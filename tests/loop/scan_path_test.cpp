@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -209,7 +210,7 @@ TEST(ScanPath, RasterValidationNamesTheField) {
   EXPECT_EQ(refused([](RasterSpec& s) { s.width_m = std::nan(""); }), "raster.width_m");
   EXPECT_EQ(refused([](RasterSpec& s) { s.width_m = -1e-6; }), "raster.width_m");
   EXPECT_EQ(refused([](RasterSpec& s) { s.height_m = -1e-6; }), "raster.height_m");
-  EXPECT_EQ(refused([](RasterSpec& s) { s.height_m = INFINITY; }), "raster.height_m");
+  EXPECT_EQ(refused([](RasterSpec& s) { s.height_m = std::numeric_limits<double>::infinity(); }), "raster.height_m");
   EXPECT_EQ(refused([](RasterSpec& s) { s.line_rate_hz = 0.0; }), "raster.line_rate_hz");
   EXPECT_EQ(refused([](RasterSpec& s) { s.corner_s = 0.01; }), "raster.corner_s");  // a whole line
   EXPECT_EQ(refused([](RasterSpec& s) { s.corner_s = 0.0; }), "raster.corner_s");   // steps need a corner
@@ -271,7 +272,8 @@ TEST(ScanPath, LissajousValidationNamesTheField) {
   EXPECT_EQ(refused([](LissajousSpec& s) { s.frequency_hz[1] = 0.0; }), "lissajous.frequency_hz");
   EXPECT_EQ(refused([](LissajousSpec& s) { s.amplitude_m[0] = -1e-6; }), "lissajous.amplitude_m");
   EXPECT_EQ(refused([](LissajousSpec& s) { s.amplitude_m = {}; }), "lissajous.amplitude_m");
-  EXPECT_EQ(refused([](LissajousSpec& s) { s.phase_rad[0] = INFINITY; }), "lissajous.phase_rad");
+  EXPECT_EQ(refused([](LissajousSpec& s) { s.phase_rad[0] = std::numeric_limits<double>::infinity(); }),
+            "lissajous.phase_rad");
   EXPECT_EQ(refused([](LissajousSpec& s) { s.centre_m[2] = std::nan(""); }), "lissajous.centre_m");
   EXPECT_EQ(refused([](LissajousSpec& s) { s.duration_s = 0.0; }), "lissajous.duration_s");
   EXPECT_EQ(refused([](LissajousSpec& s) { s.start_s = std::nan(""); }), "lissajous.start_s");

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -110,7 +111,7 @@ std::string refused_field(F&& f) {
 }
 
 fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("hystloop_error_map_" + name + "_" + std::to_string(::getpid()));
+  fs::path dir = fs::temp_directory_path() / ("hystloop_error_map_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -275,7 +276,7 @@ TEST(ErrorMap, RefusesBadColumnsLengthsValuesAndSpecs) {
   }
   std::vector<double> bad_t = t, bad_e = e;
   bad_t[1] = std::nan("");
-  bad_e[2] = INFINITY;
+  bad_e[2] = std::numeric_limits<double>::infinity();
   EXPECT_EQ(refused_field([&] { (void)build_error_map(spec, bad_t, e, ErrorMapOptions{}); }), "t_s[1]");
   EXPECT_EQ(refused_field([&] { (void)build_error_map(spec, t, bad_e, ErrorMapOptions{}); }), "error_m[2]");
   RasterSpec one_line = spec;
