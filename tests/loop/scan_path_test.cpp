@@ -25,18 +25,27 @@ constexpr std::size_t kX = 0, kY = 1, kZ = 2;
 
 // 8 lines of 20 um at 100 lines/s, 10 um high, corners of 1 ms, around (1, -2, 0.5) um.
 RasterSpec raster(SlowMode mode = SlowMode::kSteps) {
-  RasterSpec s;
-  s.fast_axis = 0;
-  s.slow_axis = 1;
-  s.width_m = 20e-6;
-  s.height_m = 10e-6;
-  s.lines = 8;
-  s.line_rate_hz = 100.0;
-  s.corner_s = 1e-3;
-  s.centre_m = {1e-6, -2e-6, 0.5e-6};
-  s.slow_mode = mode;
-  s.settle_s = 0.02;
-  s.start_s = 0.5;
+  return {.fast_axis = 0,
+          .slow_axis = 1,
+          .width_m = 20e-6,
+          .height_m = 10e-6,
+          .lines = 8,
+          .line_rate_hz = 100.0,
+          .corner_s = 1e-3,
+          .centre_m = {1e-6, -2e-6, 0.5e-6},
+          .slow_mode = mode,
+          .settle_s = 0.02,
+          .start_s = 0.5};
+}
+
+// 64 lines of 2 um around 0, 2 um high: steps of 32 nm (8 lines would step 0.29 um within a 1 ms
+// corner, 8.9e4 V/s).
+RasterSpec two_micron_raster() {
+  RasterSpec s = raster();
+  s.centre_m = {};
+  s.width_m = 2e-6;
+  s.height_m = 2e-6;
+  s.lines = 64;
   return s;
 }
 
@@ -288,11 +297,7 @@ std::array<AxisActuator, 3> static_gains() {
 TEST(ScanPath, FastAxisOverItsSlewLimitIsRefusedByName) {
   // 2 um lines (+-156 V): the fast slope is width * line rate, a little more with the corners of
   // 1 ms: 2e-6 m / (10 ms - 1 ms + 2 ms / pi) = 2.08e-4 m/s, 3.2e4 V/s at 100 lines/s; 6.7e4 V/s at 200.
-  RasterSpec s = raster();
-  s.centre_m = {};
-  s.width_m = 2e-6;
-  s.height_m = 2e-6;
-  s.lines = 64;  // steps of 32 nm: 8 lines would step 0.29 um within a 1 ms corner, 8.9e4 V/s
+  RasterSpec s = two_micron_raster();
   const auto actuators = static_gains();
   const ScanFeasibility fine = check_raster_feasible(s, actuators);
   EXPECT_TRUE(fine.ok()) << fine.reason;
@@ -350,11 +355,7 @@ TEST(ScanPath, SlowAxisOutOfRangeAndMissingActuatorsAreRefused) {
 TEST(ScanPath, SlowAxisBoundWithTheStageIsAboveItsOwnRate) {
   // With Banning's stage the slow axis's bound adds the inverse's derivative terms to the static
   // rate v / g; for this raster's gentle steps they are small but present.
-  RasterSpec s = raster();
-  s.centre_m = {};
-  s.width_m = 2e-6;
-  s.height_m = 2e-6;
-  s.lines = 64;  // steps of 32 nm: 8 lines would step 0.29 um within a 1 ms corner, 8.9e4 V/s
+  RasterSpec s = two_micron_raster();
   std::array<AxisActuator, 2> actuators{};
   for (auto& a : actuators) a.plant = {kGain, SecondOrderStageParams{}};
   const ScanFeasibility v = check_raster_feasible(s, actuators);

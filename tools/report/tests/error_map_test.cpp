@@ -37,18 +37,14 @@ constexpr double kNm = 1e-9;
 constexpr std::size_t kColumns = 16;
 
 RasterSpec test_raster() {
-  RasterSpec s;
-  s.fast_axis = 0;
-  s.slow_axis = 1;
-  s.width_m = 1e-6;
-  s.height_m = 1e-6;
-  s.lines = 8;
-  s.line_rate_hz = 50.0;
-  s.corner_s = 1e-3;
-  s.centre_m = {2e-6, -3e-6, 0.0};
-  s.settle_s = 0.01;
-  s.start_s = 0.005;
-  return s;
+  return {.width_m = 1e-6,
+          .height_m = 1e-6,
+          .lines = 8,
+          .line_rate_hz = 50.0,
+          .corner_s = 1e-3,
+          .centre_m = {2e-6, -3e-6, 0.0},
+          .settle_s = 0.01,
+          .start_s = 0.005};
 }
 
 // A sample as the test sees it, from the geometry alone.
