@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -16,14 +15,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// %g keeps 2e-05 m and 4e+04 V/s readable (std::to_string prints 0.000020).
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-std::string got(double v, const char* unit) { return " (got " + num(v) + " " + unit + ")"; }
+std::string got(double v, const char* unit) { return " (got " + number_text(v) + " " + unit + ")"; }
 
 void finite_in(const std::string& field, double v, const char* unit) {
   if (!std::isfinite(v)) throw ParameterError(field, std::string("must be a finite number of ") + unit + got(v, unit));
@@ -49,10 +41,11 @@ void require_axis(const std::string& field, int axis) {
 
 std::size_t index(int axis) noexcept { return static_cast<std::size_t>(axis); }
 
-// The usable parts of evaluate(): an unvalidated spec must not index out of range or divide by 0.
+// The usable parts of evaluate(): an unvalidated spec must not index out of range, divide by 0 or
+// convert a NaN line number to int (an infinite line rate gives 0 * inf).
 bool evaluable(const RasterSpec& s) noexcept {
   return valid_axis(s.fast_axis) && valid_axis(s.slow_axis) && s.fast_axis != s.slow_axis && s.lines >= 2 &&
-         s.line_rate_hz > 0.0;
+         s.lines <= RasterSpec::kMaxLines && s.line_rate_hz > 0.0 && std::isfinite(s.line_rate_hz);
 }
 
 double lines_s(const RasterSpec& s) noexcept { return s.lines / s.line_rate_hz; }
@@ -111,8 +104,8 @@ void RasterSpec::validate() const {
   }
   non_negative_in("raster.corner_s", corner_s, "s");
   if (!(corner_s < 1.0 / line_rate_hz)) {
-    throw ParameterError("raster.corner_s", "must be below one line's duration (" + num(1.0 / line_rate_hz) + " s at " +
-                                                num(line_rate_hz) + " Hz)" + got(corner_s, "s"));
+    throw ParameterError("raster.corner_s", "must be below one line's duration (" + number_text(1.0 / line_rate_hz) +
+                                                " s at " + number_text(line_rate_hz) + " Hz)" + got(corner_s, "s"));
   }
   if (slow_mode == SlowMode::kSteps) {
     if (!(corner_s > 0.0)) {
@@ -311,9 +304,9 @@ void require_actuated(const std::string& field, int axis, std::size_t n) {
 // "[-300, 300] V". Appended piece by piece: GCC 12's -Wrestrict misreads "[" + std::string.
 std::string interval_V(double lo_V, double hi_V) {
   std::string out("[");
-  out += num(lo_V);
+  out += number_text(lo_V);
   out += ", ";
-  out += num(hi_V);
+  out += number_text(hi_V);
   out += "] V";
   return out;
 }
@@ -334,7 +327,8 @@ ScanFeasibility verdict(const std::array<VoltageNeed, kScanAxes>& needs, std::sp
       v.reason += interval_V(needs[i].u_min_V, needs[i].u_max_V) + ", " +
                   interval_V(lim.usable_min_V(), lim.usable_max_V()) + " usable";
     } else {
-      v.reason += num(needs[i].rate_V_per_s) + " V/s, " + num(lim.usable_slew_V_per_s()) + " V/s usable";
+      v.reason +=
+          number_text(needs[i].rate_V_per_s) + " V/s, " + number_text(lim.usable_slew_V_per_s()) + " V/s usable";
     }
     break;
   }

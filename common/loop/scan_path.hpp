@@ -88,7 +88,9 @@ RasterPoint raster_point(const RasterSpec& spec, double t_s) noexcept;
 
 // A Lissajous figure: axis i is centre_m[i] + amplitude_m[i] sin(2 pi frequency_hz[i] tau +
 // phase_rad[i]) for tau = t - start_s in [0, duration_s]; it holds its value at tau = 0 before and
-// at duration_s after (the approach from where the stage was is the caller's). An axis of
+// at duration_s after. An axis not at a peak or trough there starts and stops with the sine's
+// velocity, a step the peaks and the feasibility check below do not include: approaching the path
+// and leaving it (as the compensator's blend approaches a trajectory) is the caller's. An axis of
 // amplitude 0 holds its centre.
 struct LissajousSpec {
   AxisPositions amplitude_m{};                   // peak [m], >= 0; at least one axis > 0
@@ -132,7 +134,7 @@ struct ScanFeasibility {
   std::array<VoltageNeed, kScanAxes> needs{};  // per axis; entries >= the number of actuators: 0
   int axis = -1;                               // the first axis that does not fit; -1 when all do
   Limit limit = Limit::kNone;                  // which of its limits it breaks
-  std::string reason;                          // "x: needs a slew of 6.2e+04 V/s, 5e+04 V/s usable"; empty when ok
+  std::string reason;  // "x (fast axis) exceeds its slew limit: needs 67398.2 V/s, 50000 V/s usable"; empty when ok
   bool ok() const noexcept { return limit == Limit::kNone; }
 };
 

@@ -205,6 +205,24 @@ TEST(ScanPath, EvaluationAllocatesNothing) {
   EXPECT_TRUE(std::isfinite(sum));
 }
 
+// evaluate() and raster_point() run on specs nobody validated (they are noexcept, for the tick):
+// such a spec gives a held position and line 0, never a NaN line number converted to int (the
+// sanitizer build would report that) or an index past the axes.
+TEST(ScanPath, UnvalidatedSpecsEvaluateToTheStartWithoutUndefinedBehaviour) {
+  for (const double rate : {std::numeric_limits<double>::infinity(), std::nan(""), 0.0, -1.0}) {
+    RasterSpec s = raster();
+    s.line_rate_hz = rate;
+    EXPECT_EQ(raster_point(s, 1.0).line, 0) << rate;
+    EXPECT_FALSE(raster_point(s, 1.0).on_straight) << rate;
+  }
+  RasterSpec s = raster();
+  s.lines = RasterSpec::kMaxLines + 1;
+  EXPECT_EQ(raster_point(s, 1.0).line, 0);
+  s = raster();
+  s.fast_axis = 7;
+  EXPECT_FALSE(raster_point(s, 1.0).on_straight);
+}
+
 TEST(ScanPath, RasterValidationNamesTheField) {
   auto refused = [](auto change) {
     RasterSpec s = raster();
@@ -360,9 +378,18 @@ TEST(ScanPath, SlowAxisBoundWithTheStageIsAboveItsOwnRate) {
   for (auto& a : actuators) a.plant = {kGain, SecondOrderStageParams{}};
   const ScanFeasibility v = check_raster_feasible(s, actuators);
   EXPECT_TRUE(v.ok()) << v.reason;
-  const ShapePeaks slow = raster_peaks(s)[kY].derivatives;
-  EXPECT_GT(v.needs[kY].rate_V_per_s, slow.velocity_m_per_s / kGain);
+  const AxisPeaks peaks = raster_peaks(s)[kY];
+  const ShapePeaks& d = peaks.derivatives;
+  EXPECT_GT(v.needs[kY].rate_V_per_s, d.velocity_m_per_s / kGain);
   EXPECT_GT(v.needs[kY].u_max_V, 1e-6 / kGain);
+  // The bound term by term: u = (y + (c/k) y' + y''/k) / g with each derivative at its peak.
+  const SecondOrderStageParams stage;
+  const double margin_m = stage.c / stage.k * d.velocity_m_per_s + d.acceleration_m_per_s2 / stage.k;
+  EXPECT_DOUBLE_EQ(v.needs[kY].u_max_V, (peaks.max_m + margin_m) / kGain);
+  EXPECT_DOUBLE_EQ(v.needs[kY].u_min_V, (peaks.min_m - margin_m) / kGain);
+  EXPECT_DOUBLE_EQ(
+      v.needs[kY].rate_V_per_s,
+      (d.velocity_m_per_s + stage.c / stage.k * d.acceleration_m_per_s2 + d.jerk_m_per_s3 / stage.k) / kGain);
 }
 
 TEST(ScanPath, LissajousAxisOverItsSlewLimitIsRefusedByName) {
