@@ -1,5 +1,6 @@
 #include "loop/multi_axis_stage.hpp"
 
+#include <cassert>
 #include <string>
 
 #include "core/errors.hpp"
@@ -9,7 +10,16 @@ namespace hystloop {
 void MultiAxisStageConfig::validate() const {
   coupling.validate();
   for (int i = 0; i < axes(); ++i) {
-    validate_within("axis[" + std::to_string(i) + "].", [&] { axis[static_cast<std::size_t>(i)].validate(); });
+    const SimulatedStageConfig& a = axis[static_cast<std::size_t>(i)];
+    validate_within("axis[" + std::to_string(i) + "].", [&] { a.validate(); });
+    for (int j = 0; j < i; ++j) {
+      const SimulatedStageConfig& b = axis[static_cast<std::size_t>(j)];
+      if (a.noise_rms_m > 0.0 && b.noise_rms_m > 0.0 && a.seed == b.seed) {
+        throw ParameterError("axis[" + std::to_string(i) + "].seed", "must differ from axis[" + std::to_string(j) +
+                                                                         "]'s (" + std::to_string(a.seed) +
+                                                                         "): two sensors would draw the same noise");
+      }
+    }
   }
 }
 
@@ -36,15 +46,22 @@ MultiAxisStage::MultiAxisStage(const MultiAxisStageConfig& config)
 
 void MultiAxisStage::step(std::span<const double> u_V, double t_s, double dt_s, std::span<double> y_m) noexcept {
   const int n = axes();
+  assert(u_V.size() >= static_cast<std::size_t>(n) && y_m.size() >= static_cast<std::size_t>(n));
   AxisVector s = AxisVector::Zero();
-  AxisVector noise = AxisVector::Zero();
   for (int i = 0; i < n; ++i) {
     SimulatedStage& stage = stages_[static_cast<std::size_t>(i)];
-    noise[i] = stage.step(u_V[static_cast<std::size_t>(i)], t_s, dt_s) - stage.true_position_m();
+    y_m[static_cast<std::size_t>(i)] = stage.step(u_V[static_cast<std::size_t>(i)], t_s, dt_s);  // s_i + n_i
     s[i] = stage.true_position_m();
   }
+  // Each reading gains what the other axes' displacements do to it (C's diagonal is 1): an
+  // uncoupled axis's reading is its own stage's, bit for bit.
+  const AxisMatrix& c = config_.coupling.matrix();
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      if (i != j) y_m[static_cast<std::size_t>(j)] += c(j, i) * s[i];
+    }
+  }
   true_ = config_.coupling.couple(s);
-  for (int j = 0; j < n; ++j) y_m[static_cast<std::size_t>(j)] = true_[j] + noise[j];
 }
 
 }  // namespace hystloop

@@ -17,8 +17,8 @@
 namespace hystloop {
 
 struct MultiAxisStageConfig {
-  // axis[i] for i < coupling.n(): each axis's plant, drift and sensor noise (its own seed: axes
-  // with the same seed would draw the same noise).
+  // axis[i] for i < coupling.n(): each axis's plant, drift and sensor noise, with its own seed
+  // (validate() refuses two noisy axes with one seed: they would draw the same noise).
   std::array<SimulatedStageConfig, kMaxAxes> axis{};
   AxisCoupling coupling{};  // its n() is the number of axes; one uncoupled axis by default
 

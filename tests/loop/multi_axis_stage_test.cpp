@@ -98,6 +98,14 @@ TEST(MultiAxisStage, RefusalsNameTheAxis) {
     EXPECT_EQ(e.field(), "axis[1].bridge.noise_rms_m");
   }
   c.axis[1].noise_rms_m = 1e-9;
+  c.axis[1].seed = c.axis[0].seed;
+  try {
+    MultiAxisStage same_noise(c);
+    FAIL() << "accepted two noisy sensors drawing the same noise";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "axis[1].seed");
+  }
+  c.axis[1].seed = c.axis[0].seed + 1;
   c.axis[2].noise_rms_m = -1.0;  // past n = 2: never used, not refused
   EXPECT_NO_THROW(MultiAxisStage ok(c));
 }
