@@ -6,7 +6,9 @@
 // Only samples on a line's straight part are binned (raster_point(...).on_straight): in the
 // corners the fast axis turns and the slow axis steps, before the start and in the settle it
 // holds, so their errors belong to no point of the image. A sample's column is taken from where
-// the fast axis is, from its low end (centre - width/2), whichever way the line runs: column 0 is
+// the reference puts the fast axis at its time (the planned path, not the measured position, so
+// an error moves no sample to another cell), from its low end (centre - width/2), whichever way
+// the line runs: column 0 is
 // the low end on trace (direction +1, even lines) and retrace (-1, odd lines) alike, so the image
 // is the scanned area and not the order the samples came in. Trace and retrace are also summed
 // apart: a hysteresis inverse that is off leaves the stage behind the reference one way and ahead
