@@ -26,8 +26,14 @@ AxisMatrix typical() { return testing::typical_coupling(); }
 std::optional<ParameterError> refusal(int n, const AxisMatrix& c) {
   return testing::thrown<ParameterError>([&] { AxisCoupling coupling(n, c); });
 }
-std::string field_of(int n, const AxisMatrix& c) { return refusal(n, c) ? refusal(n, c)->field() : "accepted"; }
-std::string reason_of(int n, const AxisMatrix& c) { return refusal(n, c) ? refusal(n, c)->reason() : "accepted"; }
+std::string field_of(int n, const AxisMatrix& c) {
+  const auto e = refusal(n, c);
+  return e ? e->field() : "accepted";
+}
+std::string reason_of(int n, const AxisMatrix& c) {
+  const auto e = refusal(n, c);
+  return e ? e->reason() : "accepted";
+}
 
 TEST(AxisCoupling, DecoupleUndoesCouple) {
   const AxisCoupling coupling(3, typical());
