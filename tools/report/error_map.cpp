@@ -28,8 +28,6 @@ void require_finite_samples(const char* name, std::span<const double> values) {
   }
 }
 
-char axis_letter(int axis) noexcept { return axis >= 0 && axis < 3 ? "xyz"[axis] : '?'; }
-
 // A gnuplot single-quoted string: a quote inside is doubled.
 std::string quoted(const std::string& text) {
   std::string out = "'";
@@ -183,9 +181,9 @@ PlotResult write_error_map(const ErrorMap& map, const std::filesystem::path& dir
      << "set title "
      << quoted(title + ": RMS " + nm_text(s.rms_m) + " (trace " + nm_text(s.trace_rms_m) + ", retrace " +
                nm_text(s.retrace_rms_m) + ") over " + std::to_string(s.samples) + " samples")
-     << "\nset xlabel 'fast axis " << axis_letter(map.fast_axis()) << " [µm]'\n"
-     << (by_line ? std::string("set ylabel 'line'\n")
-                 : std::string("set ylabel 'slow axis ") + axis_letter(map.slow_axis()) + " [µm]'\n")
+     << "\nset xlabel 'fast axis " << axis_name(map.fast_axis()) << " [µm]'\n"
+     << "set ylabel '"
+     << (by_line ? std::string("line") : "slow axis " + std::string(axis_name(map.slow_axis())) + " [µm]") << "'\n"
      << "set cblabel 'tracking error RMS [nm]'\nset cbrange [0:*]\n"
      // A sequential palette from dark (no error) to bright; an empty cell (NaN) stays blank.
      << "set palette defined (0 '#000004', 1 '#3b0f70', 2 '#8c2981', 3 '#de4968', 4 '#fe9f6d', 5 '#fcfdbf')\n"
