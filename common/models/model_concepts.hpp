@@ -28,30 +28,30 @@ concept ModelParameters = std::copyable<P> && requires(const P& p) {
 template <class M>
 using model_params_t = std::remove_cvref_t<decltype(std::declval<const M&>().params())>;
 
-// u [V] -> y [m], sample by sample.
+// What a model and an inverse share: built from its parameters, reset to a point, its parameters
+// read back and swapped.
 template <class M>
-concept HysteresisForward = ModelParameters<model_params_t<M>> && std::constructible_from < M,
+concept SampleModel = ModelParameters<model_params_t<M>> && std::constructible_from < M,
         const model_params_t<M>
-& > &&requires(M& m, const M& cm, double u) {
-  m.reset(u);
-  { m.forward(u) }
-  noexcept->std::same_as<double>;
+& > &&requires(M& m, const M& cm, double x) {
+  m.reset(x);
   { cm.params() }
   noexcept->std::same_as<const model_params_t<M>&>;
   m.set_params(cm.params());
 };
 
+// u [V] -> y [m], sample by sample.
+template <class M>
+concept HysteresisForward = SampleModel<M> && requires(M& m, double u) {
+  { m.forward(u) }
+  noexcept->std::same_as<double>;
+};
+
 // y_ref [m] -> u [V], sample by sample (a feedforward compensator).
 template <class M>
-concept HysteresisInverse = ModelParameters<model_params_t<M>> && std::constructible_from < M,
-        const model_params_t<M>
-& > &&requires(M& m, const M& cm, double y) {
-  m.reset(y);
+concept HysteresisInverse = SampleModel<M> && requires(M& m, double y) {
   { m.inverse(y) }
   noexcept->std::same_as<double>;
-  { cm.params() }
-  noexcept->std::same_as<const model_params_t<M>&>;
-  m.set_params(cm.params());
 };
 
 }  // namespace hystloop
