@@ -126,8 +126,34 @@ void Compensator::set_learning(bool on) noexcept { learner_.set_enabled(on); }
 
 void Compensator::reset_learning() noexcept { learner_.reset(); }
 
+const TrajectorySpec& Compensator::periodic_reference() const noexcept {
+  if (scan_) {
+    if (const TrajectorySpec* fast = scan_->share.periodic_part()) return *fast;
+  }
+  return trajectory_;
+}
+
+Compensator::ReferencePoint Compensator::reference_point(const TrajectorySpec& trajectory,
+                                                         const std::optional<ScanInForce>& scan, double t_s) noexcept {
+  const double y = evaluate(trajectory, t_s);
+  if (!scan) return {y, y};
+  const ScanShare::Point p = scan->share.point(t_s);
+  const double sensor = y + (p.own_m - scan->base_m);
+  // The decoupling's term fades in along a smoothstep (zero slope and curvature at both ends: the
+  // stage's inverse differentiates it twice) over the approach, where the axis is still holding.
+  double weight = 1.0;
+  const double begin = scan->share.start_s() - scan->blend_s;
+  if (t_s < scan->share.start_s()) {
+    const double x = scan->blend_s > 0.0 ? std::clamp((t_s - begin) / scan->blend_s, 0.0, 1.0) : 0.0;
+    weight = x * x * x * (10.0 - 15.0 * x + 6.0 * x * x);
+  }
+  return {sensor, sensor + weight * (p.share_m - p.own_m)};
+}
+
 void Compensator::restart_learning(std::int64_t k) noexcept {
-  const auto period = period_ticks(trajectory_, config_.dt_s);
+  // A scan's hold (the trajectory under it) is not periodic: without a periodic part, no learning.
+  const TrajectorySpec& reference = periodic_reference();
+  const auto period = period_ticks(reference, config_.dt_s);
   if (!period || !learning_room_) {
     learner_.stop();
     return;
@@ -137,7 +163,7 @@ void Compensator::restart_learning(std::int64_t k) noexcept {
   // reference there, harmless where the reference moves fastest but, at a reversal, a tiny extra
   // reversal of the voltage: a minor loop the stage does not close (Coleman-Hodgdon's next branch
   // moves by ~2 alpha (f - y) du), i.e. a random offset until the next period's learning.
-  const double phase0_s = trajectory_.start_s + first_extreme_s(trajectory_) + 0.25 / trajectory_.frequency_hz;
+  const double phase0_s = reference.start_s + first_extreme_s(reference) + 0.25 / reference.frequency_hz;
   const auto k0 = static_cast<std::int64_t>(std::ceil(phase0_s / config_.dt_s - 1e-9));
   learner_.restart(std::max(k, k0), *period);
 }
@@ -184,7 +210,7 @@ TrajectoryVerdict Compensator::take_trajectory(TrajectorySpec spec, double start
   return v;
 }
 
-void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s) noexcept {
+void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s, const ScanShare* scan) noexcept {
   TrajectorySpec spec = given;
   learner_restart_ = true;
   // The reference in force moves (a periodic shape already entered, or its approach): the new
@@ -192,12 +218,15 @@ void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s) 
   bool moving = false;
   if (!trajectory_starts_now_ && next_tick_ > 0 && counters_.planned > 0 && !in_experiment_ && !awaiting_anchor_) {
     const double t = loop_time(next_tick_);
-    moving = evaluate(trajectory_, t) != evaluate(trajectory_, t - config_.dt_s);
+    moving = reference_at(t).aim_m != reference_at(t - config_.dt_s).aim_m;
   }
   if (moving) {
     previous_trajectory_ = trajectory_;
+    previous_scan_ = scan_;
     from_moving_ = true;
   }  // else a fade under way (into a hold) goes on into the new approach
+  scan_.reset();
+  if (scan) scan_.emplace(ScanInForce{*scan, spec.offset_m, spec.blend_s});
   const bool timed = !std::isnan(start_s);
   if (timed && next_tick_ >= 0 && start_s - spec.blend_s < loop_time(next_tick_)) {
     trajectory_ = spec;
@@ -238,6 +267,49 @@ PlanExtent Compensator::dry_run(const TrajectorySpec& spec, double start_s) cons
       std::min(k + kDryRunMaxTicks, static_cast<std::int64_t>(std::ceil((t0 + span) / config_.dt_s)));
   for (; k <= end; ++k) c.plan_tick(k);
   return c.extent_;
+}
+
+TrajectoryVerdict Compensator::take_scan(const ScanShare& share, double blend_s) {
+  require_in_range("scan.blend_s", blend_s, 0.0, 60.0);
+  TrajectorySpec hold;
+  hold.shape = TrajectoryShape::kHold;
+  hold.offset_m = share.point(share.start_s()).own_m;
+  hold.blend_s = blend_s;
+  hold.validate();
+  const double next_s = loop_time(std::max<std::int64_t>(next_tick_, 0));
+  if (share.start_s() - blend_s < next_s) {
+    ++counters_.trajectories_refused;
+    throw ParameterError("scan.start_s", "must leave the approach (" + si(blend_s, "s") + ") before it: starts at " +
+                                             si(share.start_s(), "s") + ", the next tick not yet planned is at " +
+                                             si(next_s, "s") + " (loop time)");
+  }
+  // The dry run: the approach and the whole path, in a copy (as dry_run does for a trajectory).
+  Compensator c = *this;
+  c.learner_.stop();
+  c.experiments_.stop(next_s);
+  std::int64_t k = std::max<std::int64_t>(next_tick_, 0);
+  if (c.awaiting_anchor_ || c.in_experiment_) {
+    c.awaiting_anchor_ = false;
+    c.in_experiment_ = false;
+    c.restart_reference(c.loop_time(k), c.last_ref_);
+  }
+  c.apply_trajectory(hold, share.start_s(), &share);
+  c.extent_ = PlanExtent{kInf, -kInf, 0.0, 0};
+  c.last_u_wanted_ = kNaN;
+  const std::int64_t end =
+      std::min(k + kDryRunMaxTicks, static_cast<std::int64_t>(std::ceil((share.end_s() + 0.01) / config_.dt_s)));
+  for (; k <= end; ++k) c.plan_tick(k);
+  const PlanExtent e = c.extent_;
+  if (!feasible(e)) {
+    ++counters_.trajectories_refused;
+    throw ParameterError("scan", "axis " + std::string(axis_name(share.axis())) + ": " + limits_left(e));
+  }
+  TrajectoryVerdict v;
+  v.extent = e;
+  learning_room_ = e.rate_max_V_per_s <= kLearningSlewShare * config_.slew_V_per_s;
+  apply_trajectory(hold, share.start_s(), &share);
+  v.spec = trajectory_;
+  return v;
 }
 
 PlanExtent Compensator::dry_run_periodic(const TrajectorySpec& spec) const {
@@ -611,6 +683,9 @@ Compensator Compensator::restarted(CompensatorConfig config, std::string& refusa
 }
 
 void Compensator::restart_reference(double t_s, double from_m) noexcept {
+  // A scan is fixed in loop time and has moved on meanwhile: it ends, and the reference approaches
+  // the hold under it (where the path started).
+  scan_.reset();
   trajectory_.blend_s = std::max(trajectory_.blend_s, 0.5);
   const double earliest = t_s + trajectory_.blend_s;
   // A trajectory given a start time keeps it when it is still ahead; otherwise as soon as possible.
@@ -682,7 +757,11 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
     restart_learning(k);
     learner_restart_ = false;
   }
-  double y_ref = evaluate(trajectory_, t);
+  // The lines are over: the raster holds its end, no period left to learn.
+  if (scan_ && scan_->share.periodic_part() && t >= scan_->share.end_s() && t - config_.dt_s < scan_->share.end_s()) {
+    learner_.stop();
+  }
+  ReferencePoint ref = reference_at(t);
   if (from_moving_) {
     // A new reference while the old one moves: the approach starts from the old one, faded out
     // along a smoothstep (zero slope and curvature at both ends), so that neither its velocity
@@ -694,18 +773,23 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
       from_moving_ = false;
     } else if (s > 0.0) {
       const double w = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
-      y_ref = (1.0 - w) * evaluate(previous_trajectory_, t) + w * y_ref;
+      const ReferencePoint old = previous_reference_at(t);
+      ref = {(1.0 - w) * old.sensor_m + w * ref.sensor_m, (1.0 - w) * old.aim_m + w * ref.aim_m};
     } else {
-      y_ref = evaluate(previous_trajectory_, t);
+      ref = previous_reference_at(t);
     }
   }
-  if (reversals_.update(y_ref) == ReversalDetector::Event::kReversal) {
+  // The sensor's reference (the servo's, the learning's, the anchor's) and the one the inverses aim
+  // the axis's own displacement at: equal but during a decoupled scan.
+  const double y_ref = ref.sensor_m;
+  const double y_aim = ref.aim_m;
+  if (reversals_.update(y_aim) == ReversalDetector::Event::kReversal) {
     ++counters_.reversals;
     if (pending_ && !params_held_by_learning()) swap_params(k);
     u_prev_rev_ = last_u_ - anchor_offset_.u_offset(k);
   }
   if (inverse_fresh_) {
-    reset_inverse(y_ref);
+    reset_inverse(y_aim);
     inverse_fresh_ = false;
     anchor_.reset();
     if (anchor_offset_.measuring()) ++counters_.reanchors_skipped;
@@ -715,7 +799,7 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
   // The reference the inverse aims at: with what the learning has found this point of the period
   // needs, and, for hysteresis then stage, through the stage's inverse first.
   const double correction = learner_.correction(k, y_ref);
-  const double r = y_ref + correction;
+  const double r = y_aim + correction;
   const bool stage_first = stage_inverse_ && stage_model_.order == BanningOrder::kHysteresisThenStage;
   if (stage_first && stage_fresh_) {
     stage_inverse_->reset(r);

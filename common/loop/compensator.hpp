@@ -47,6 +47,7 @@
 #include "loop/feedforward_anchor.hpp"
 #include "loop/hysteresis_inverses.hpp"
 #include "loop/periodic_learner.hpp"
+#include "loop/scan_path.hpp"
 #include "loop/trajectory.hpp"
 #include "models/katalenic.hpp"
 #include "models/linear.hpp"
@@ -203,6 +204,17 @@ class Compensator {
   bool set_trajectory(TrajectorySpec spec, double start_s);
   // The same, saying how it was taken (the corner chosen, the shaping).
   TrajectoryVerdict take_trajectory(TrajectorySpec spec, double start_s);
+  // This axis's share of a multi-axis path (loop/scan_path.hpp: a raster or a Lissajous figure,
+  // decoupled by the row of C^{-1} it carries). The path is fixed in loop time, every axis on the
+  // same clock: it starts at share.start_s(), which must be at least blend_s after the next tick
+  // not yet planned (else ParameterError: the axes would not start together), approached from the
+  // reference planned last over blend_s as a trajectory is. Checked by a dry run over the approach
+  // and the whole path (refused, never shaped: shaping one axis would tear the path apart). After
+  // its end the reference holds the path's last point. Learning follows a raster's fast axis when
+  // its share is that axis alone (ScanShare::periodic_part); an experiment or a new trajectory
+  // ends the scan, and so does a restart of the bridge's clock (restarted()).
+  TrajectoryVerdict take_scan(const ScanShare& share, double blend_s);
+  const ScanShare* scan() const noexcept { return scan_ ? &scan_->share : nullptr; }
   // What the plan would need for `spec` from here, without changing anything (a dry run in a copy).
   PlanExtent dry_run(const TrajectorySpec& spec, double start_s) const;
   // The same over its periods only, as if the plan had just entered the shape at rest.
@@ -269,7 +281,25 @@ class Compensator {
   // The position the servo's share of the voltage made at this sample [m] (observe, for the learning).
   double servo_share_m(const CompensatorInput& sample) noexcept;
   CommandTick plan_tick(std::int64_t k) noexcept;
-  void apply_trajectory(const TrajectorySpec& spec, double start_s) noexcept;
+  void apply_trajectory(const TrajectorySpec& spec, double start_s, const ScanShare* scan = nullptr) noexcept;
+  // The reference at t: what the sensor must read (`sensor_m`: the trajectory plus, during a scan,
+  // the axis's own path from its start) and what the inverse aims the axis's own displacement at
+  // (`aim_m`: the same plus, during a scan, what the decoupling adds, w_a - r_a, faded in over the
+  // approach). The bridge's servo and the learning work on the first, the inverses on the second.
+  struct ReferencePoint {
+    double sensor_m;
+    double aim_m;
+  };
+  struct ScanInForce;
+  static ReferencePoint reference_point(const TrajectorySpec& trajectory, const std::optional<ScanInForce>& scan,
+                                        double t_s) noexcept;
+  ReferencePoint reference_at(double t_s) const noexcept { return reference_point(trajectory_, scan_, t_s); }
+  // The one a new approach fades out.
+  ReferencePoint previous_reference_at(double t_s) const noexcept {
+    return reference_point(previous_trajectory_, previous_scan_, t_s);
+  }
+  // The periodic reference learning follows: the trajectory, or a raster's fast triangle.
+  const TrajectorySpec& periodic_reference() const noexcept;
   bool feasible(const PlanExtent& e) const noexcept;
   double choose_corner(const TrajectorySpec& spec, std::string& note) const;
   std::string infeasibility(const TrajectorySpec& spec, double start_s, const PlanExtent& e) const;
@@ -299,7 +329,16 @@ class Compensator {
   bool trajectory_starts_now_ = true;     // start_s is set at the next planned tick
   bool trajectory_timed_ = false;         // start_s was given: an experiment's end does not move it
   TrajectorySpec previous_trajectory_{};  // the reference a new one's approach fades out
-  bool from_moving_ = false;              // ... while that approach lasts
+  // A scan in force: trajectory_ is then a hold at the axis's own reference at the path's start
+  // (base_m; the approach is the trajectory's), and the path adds its motion from there.
+  struct ScanInForce {
+    ScanShare share;
+    double base_m;
+    double blend_s;  // the approach, over which the decoupling's term fades in
+  };
+  std::optional<ScanInForce> scan_;
+  std::optional<ScanInForce> previous_scan_;  // of previous_trajectory_
+  bool from_moving_ = false;                  // ... while that approach lasts
   HysteresisInverses inverses_;
   struct Pending {
     ModelParamSet params;

@@ -143,13 +143,20 @@ TrajectorySpec raster_fast_trajectory(const RasterSpec& spec) noexcept {
   return t;
 }
 
-AxisPositions evaluate(const RasterSpec& spec, double t_s) noexcept {
+namespace {
+// evaluate() with the fast triangle built once (ScanShare keeps it).
+AxisPositions raster_at(const RasterSpec& spec, const TrajectorySpec& fast, double t_s) noexcept {
   AxisPositions y = spec.centre_m;
   if (!evaluable(spec)) return y;
   const double tau_s = clamped_tau_s(spec, t_s);
-  y[index(spec.fast_axis)] = evaluate_shape(raster_fast_trajectory(spec), tau_s);
+  y[index(spec.fast_axis)] = evaluate_shape(fast, tau_s);
   y[index(spec.slow_axis)] += slow_offset_m(spec, tau_s);
   return y;
+}
+}  // namespace
+
+AxisPositions evaluate(const RasterSpec& spec, double t_s) noexcept {
+  return raster_at(spec, raster_fast_trajectory(spec), t_s);
 }
 
 RasterPoint raster_point(const RasterSpec& spec, double t_s) noexcept {
@@ -246,8 +253,14 @@ TrajectorySpec lissajous_axis_trajectory(const LissajousSpec& spec, int axis) no
   return t;
 }
 
+namespace {
+double lissajous_tau_s(const LissajousSpec& spec, double t_s) noexcept {
+  return std::clamp(t_s - spec.start_s, 0.0, std::max(0.0, spec.duration_s));
+}
+}  // namespace
+
 AxisPositions evaluate(const LissajousSpec& spec, double t_s) noexcept {
-  const double tau_s = std::clamp(t_s - spec.start_s, 0.0, std::max(0.0, spec.duration_s));
+  const double tau_s = lissajous_tau_s(spec, t_s);
   AxisPositions y{};
   for (int i = 0; i < kMaxAxes; ++i) y[index(i)] = evaluate_shape(lissajous_axis_trajectory(spec, i), tau_s);
   return y;
@@ -264,6 +277,65 @@ std::array<AxisPeaks, kScanAxes> lissajous_peaks(const LissajousSpec& spec) noex
   }
   return peaks;
 }
+
+namespace {
+
+void validate_row(int axis, const AxisVector& row) {
+  require_axis("scan.axis", axis);
+  for (int j = 0; j < kMaxAxes; ++j) {
+    if (!std::isfinite(row[j])) {
+      throw ParameterError("scan.row",
+                           "the weight of axis " + std::string(axis_name(j)) + " must be finite" + got(row[j], "m/m"));
+    }
+  }
+  if (row[axis] == 0.0) {
+    throw ParameterError("scan.row", "must weigh axis " + std::string(axis_name(axis)) +
+                                         "'s own reference (its weight is 0: not a row of an inverse coupling)");
+  }
+}
+
+}  // namespace
+
+ScanShare::ScanShare(const RasterSpec& raster, int axis, const AxisVector& row)
+    : path_(raster), axis_(axis), row_(row), start_s_(raster.start_s) {
+  raster.validate();
+  validate_row(axis, row);
+  shapes_[0] = raster_fast_trajectory(raster);
+  end_s_ = raster.start_s + lines_s(raster);
+  AxisVector unit = AxisVector::Zero();
+  unit[raster.fast_axis] = 1.0;
+  periodic_ = row == unit;
+}
+
+ScanShare::ScanShare(const LissajousSpec& lissajous, int axis, const AxisVector& row)
+    : path_(lissajous), axis_(axis), row_(row), start_s_(lissajous.start_s) {
+  lissajous.validate();
+  validate_row(axis, row);
+  for (int i = 0; i < kMaxAxes; ++i) shapes_[index(i)] = lissajous_axis_trajectory(lissajous, i);
+  end_s_ = lissajous.start_s + lissajous.duration_s;
+}
+
+AxisPositions ScanShare::path_at(double t_s) const noexcept {
+  if (const auto* raster = std::get_if<RasterSpec>(&path_)) return raster_at(*raster, shapes_[0], t_s);
+  AxisPositions y{};
+  if (const auto* lissajous = std::get_if<LissajousSpec>(&path_)) {
+    const double tau_s = lissajous_tau_s(*lissajous, t_s);
+    for (std::size_t i = 0; i < kScanAxes; ++i) y[i] = evaluate_shape(shapes_[i], tau_s);
+  }
+  return y;
+}
+
+ScanShare::Point ScanShare::point(double t_s) const noexcept {
+  const AxisPositions r = path_at(t_s);
+  Point p;
+  p.own_m = r[index(axis_)];
+  for (std::size_t j = 0; j < kScanAxes; ++j) {
+    if (row_[static_cast<Eigen::Index>(j)] != 0.0) p.share_m += row_[static_cast<Eigen::Index>(j)] * r[j];
+  }
+  return p;
+}
+
+double ScanShare::at(double t_s) const noexcept { return point(t_s).share_m; }
 
 namespace {
 

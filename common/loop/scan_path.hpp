@@ -34,6 +34,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <variant>
 
 #include "loop/feasibility.hpp"
 #include "loop/trajectory.hpp"
@@ -122,6 +123,53 @@ struct AxisPeaks {
 std::array<AxisPeaks, kScanAxes> raster_peaks(const RasterSpec& spec) noexcept;
 // Lissajous: each axis's sine, (2 pi f)^n A.
 std::array<AxisPeaks, kScanAxes> lissajous_peaks(const LissajousSpec& spec) noexcept;
+
+// One axis's share of a decoupled path, what that axis's compensator follows:
+//
+//   w_a(t) = sum_j row_j r_j(t),
+//
+// r the path's reference per axis (a raster or a Lissajous figure, above) and row axis a's row of
+// C^{-1} (models/axis_coupling.hpp), so that the stage, which couples the axes' own displacements
+// by C, reaches r on every axis. With an identity row it is the path's own axis. Built once (the
+// raster's triangle, the Lissajous sines), then at() per tick: allocation- and throw-free.
+class ScanShare {
+ public:
+  // Validate the path (ParameterError naming its field) and the row ("scan.row": finite, and
+  // non-zero at `axis`, whose own reference it must contain).
+  ScanShare(const RasterSpec& raster, int axis, const AxisVector& row);
+  ScanShare(const LissajousSpec& lissajous, int axis, const AxisVector& row);
+
+  double at(double t_s) const noexcept;
+  // The axis's own reference r_a(t), what its sensor must read, and its share w_a(t), what its own
+  // displacement must be (the two differ by what the other axes' displacements add to the reading).
+  struct Point {
+    double own_m = 0.0;
+    double share_m = 0.0;
+  };
+  Point point(double t_s) const noexcept;
+  int axis() const noexcept { return axis_; }
+  double start_s() const noexcept { return start_s_; }
+  // From here on the path holds its last point for good (a raster's settle only holds it).
+  double end_s() const noexcept { return end_s_; }
+  const AxisVector& row() const noexcept { return row_; }
+  // The path (std::get_if for the kind).
+  const std::variant<RasterSpec, LissajousSpec>& path() const noexcept { return path_; }
+  // Every path axis's reference at t (what each axis's share is made of).
+  AxisPositions path_at(double t_s) const noexcept;
+  // The fast axis's triangle when the share is a raster's fast axis alone (its row is that axis's
+  // unit vector): a periodic reference, period 2 / line_rate_hz, over [start_s, start_s + lines /
+  // line_rate_hz), that learning can follow. nullptr otherwise.
+  const TrajectorySpec* periodic_part() const noexcept { return periodic_ ? &shapes_[0] : nullptr; }
+
+ private:
+  std::variant<RasterSpec, LissajousSpec> path_;
+  std::array<TrajectorySpec, kScanAxes> shapes_{};  // raster: [0] the fast triangle; Lissajous: each axis's sine
+  int axis_ = 0;
+  AxisVector row_ = AxisVector::Zero();
+  double start_s_ = 0.0;
+  double end_s_ = 0.0;
+  bool periodic_ = false;
+};
 
 // One axis's actuator: feasibility.hpp's plant and limits.
 struct AxisActuator {

@@ -409,3 +409,78 @@ TEST(ScanPath, LissajousAxisOverItsSlewLimitIsRefusedByName) {
 
 }  // namespace
 }  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+// C with x moving y by 3 % and z by 1 %, y moving x by -2 %.
+AxisCoupling coupled() {
+  AxisMatrix c = AxisMatrix::Identity();
+  c(1, 0) = 0.03;
+  c(2, 0) = 0.01;
+  c(0, 1) = -0.02;
+  return AxisCoupling(3, c);
+}
+
+TEST(ScanShare, AnIdentityRowIsThePathsOwnAxisBitForBit) {
+  const RasterSpec s = raster();
+  for (int axis = 0; axis < 3; ++axis) {
+    AxisVector row = AxisVector::Zero();
+    row[axis] = 1.0;
+    const ScanShare share(s, axis, row);
+    for (double t = 0.4; t < 0.6; t += 3.7e-4) {
+      const ScanShare::Point p = share.point(t);
+      EXPECT_EQ(p.own_m, evaluate(s, t)[static_cast<std::size_t>(axis)]) << t;
+      EXPECT_EQ(p.share_m, p.own_m) << t;
+    }
+  }
+}
+
+TEST(ScanShare, TheSharesOfTheInverseCouplingAddUpToThePathThroughTheStage) {
+  const AxisCoupling c = coupled();
+  const RasterSpec s = raster(SlowMode::kRamp);
+  std::vector<ScanShare> shares;
+  for (int axis = 0; axis < 3; ++axis) shares.emplace_back(s, axis, c.inverse_matrix().row(axis).transpose());
+  for (double t = 0.45; t < 0.6; t += 1.3e-4) {
+    AxisVector w;
+    for (int axis = 0; axis < 3; ++axis) w[axis] = shares[static_cast<std::size_t>(axis)].at(t);
+    const AxisVector y = c.couple(w);  // what the stage's sensors read when each axis reaches its share
+    const AxisPositions r = evaluate(s, t);
+    for (int axis = 0; axis < 3; ++axis) EXPECT_NEAR(y[axis], r[static_cast<std::size_t>(axis)], 1e-20) << t;
+  }
+}
+
+TEST(ScanShare, OnlyARastersFastAxisAloneIsPeriodic) {
+  const RasterSpec s = raster();
+  EXPECT_NE(ScanShare(s, 0, AxisVector(1.0, 0.0, 0.0)).periodic_part(), nullptr);
+  EXPECT_EQ(ScanShare(s, 1, AxisVector(-0.03, 1.0, 0.0)).periodic_part(), nullptr);
+  EXPECT_EQ(ScanShare(s, 0, AxisVector(1.0, 0.02, 0.0)).periodic_part(), nullptr);
+  const ScanShare x(s, 0, AxisVector(1.0, 0.0, 0.0));
+  const TrajectorySpec* fast = x.periodic_part();
+  ASSERT_NE(fast, nullptr);
+  EXPECT_DOUBLE_EQ(fast->frequency_hz, 50.0);  // two lines per period at 100 lines/s
+}
+
+TEST(ScanShare, RefusesARowWithoutItsOwnAxisOrWithANonFiniteWeight) {
+  const RasterSpec s = raster();
+  EXPECT_EQ(refused_field([&] { ScanShare(s, 1, AxisVector(1.0, 0.0, 0.0)); }), "scan.row");
+  EXPECT_EQ(refused_field([&] { ScanShare(s, 0, AxisVector(1.0, std::nan(""), 0.0)); }), "scan.row");
+  EXPECT_EQ(refused_field([&] { ScanShare(s, 3, AxisVector(1.0, 0.0, 0.0)); }), "scan.axis");
+  RasterSpec bad = s;
+  bad.lines = 1;
+  EXPECT_EQ(refused_field([&] { ScanShare(bad, 0, AxisVector(1.0, 0.0, 0.0)); }), "raster.lines");
+}
+
+TEST(ScanShare, EvaluatesWithoutAllocating) {
+  const ScanShare share(raster(), 1, coupled().inverse_matrix().row(1).transpose());
+  double sum = 0.0;
+  {
+    const testing::AllocationCounter count;
+    for (int n = 0; n < 1000; ++n) sum += share.at(0.5 + n * kDt);
+    EXPECT_EQ(count.allocations(), 0u);
+  }
+  EXPECT_TRUE(std::isfinite(sum));
+}
+
+}  // namespace
+}  // namespace hystloop
