@@ -102,6 +102,11 @@ class BridgeCore {
   void arm(std::int64_t k) noexcept;
   void disarm() noexcept;
   bool armed() const noexcept { return armed_; }
+  // tick(k) would trip the watchdog (armed, no command for k, the buffer dry for too long): a
+  // stage of several axes takes all of them to the safe state on the same tick (MultiAxisBridge).
+  bool watchdog_due(std::int64_t k) const noexcept {
+    return armed_ && !buffer_.has(k) && k - last_supplied_tick_ > watchdog_ticks_;
+  }
 
   // New servo gains (validated by the caller: FeedbackGains::validate), bumplessly.
   void set_servo_gains(const FeedbackGains& gains) noexcept;

@@ -36,6 +36,8 @@ class CommandBuffer {
   std::int64_t next_tick() const noexcept { return next_tick_; }
   // Consecutive ticks buffered from next_tick() on.
   std::int64_t depth() const noexcept { return filled_through_ - next_tick_ + 1; }
+  // A command for tick k waits (take(k) would return it).
+  bool has(std::int64_t k) const noexcept { return k >= next_tick_ && holds(k); }
   // Drops everything buffered (the ticks taken so far stay taken).
   void clear() noexcept;
 
