@@ -25,8 +25,8 @@ IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude
   return identify_models_through_loop(e, input);
 }
 
-ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, const ScanReference& r,
-                 const ScanOptions& o) {
+LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const IdentifiedModels& models,
+                                      const ScanOptions& o) {
   LoopSimulationConfig c = tracking_loop_config(e);
   c.compensator.mode = o.mode.value_or(models.ranking.empty() ? FeedforwardMode::kPi : mode_of(models.ranking.front()));
   use_models(c, models, models.mem);
@@ -45,6 +45,12 @@ ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, co
     c.servo.notch_q = o.notch_q;
     c.servo.nominal_gain_m_per_V = models.linear.gain;
   }
+  return c;
+}
+
+ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, const ScanReference& r,
+                 const ScanOptions& o) {
+  const LoopSimulationConfig c = scan_loop_config(e, models, o);
   LoopSimulation sim(c);
   TrajectorySpec spec;
   spec.shape = r.shape;

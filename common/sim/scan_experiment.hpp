@@ -62,6 +62,11 @@ struct ScanRun {
   FeedforwardMode mode = FeedforwardMode::kOff;  // the model used
 };
 
+// The loop run_scan runs: the models (o.mode or the ranking's best), the stage's inverse, learning,
+// the servo and the block size as `o` asks.
+LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const IdentifiedModels& models,
+                                      const ScanOptions& o);
+
 ScanRun run_scan(const TrackingExperiment& e, const IdentifiedModels& models, const ScanReference& r,
                  const ScanOptions& o);
 

@@ -1,0 +1,79 @@
+// A raster on the simulated XY stage (sim/raster_experiment.hpp), in process: 1 um x 1 um at a
+// 50 Hz line rate, 64 lines, x coupled into y by 3 %, per axis the loop of a line-rate scan (the
+// identified model, the stage's inverse, the servo). The figures are docs/SCANNING.md's
+// (bench/raster_table prints them and draws the error maps). The runs are deterministic (seeded
+// sensor noise), so the comparisons between them are exact, not statistical.
+#include "sim/raster_experiment.hpp"
+
+#include <gtest/gtest.h>
+
+namespace hystloop {
+namespace {
+
+class Raster : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { models_ = identify_for_scan(TrackingExperiment{}, 0.5e-6); }
+  static IdentifiedModels models_;
+  const TrackingExperiment experiment_{};  // Banning's stage, 1 nm sensor noise per axis
+};
+IdentifiedModels Raster::models_;
+
+TEST_F(Raster, MeetsTheTargetsWithTheCouplingDecoupled) {
+  ASSERT_FALSE(models_.ranking.empty());
+  RasterOptions o;
+  const RasterRun on = run_raster(experiment_, models_, o);
+  ASSERT_FALSE(on.refused) << on.reason;
+  EXPECT_EQ(on.t_s.size(), 12800u);         // 64 lines at 50 Hz: 1.28 s of ticks
+  EXPECT_LE(on.stats[0].rms_true_m, 2e-9);  // fast axis
+  EXPECT_LE(on.stats[1].rms_true_m, 1e-9);  // slow axis
+  EXPECT_EQ(on.clamped_ticks, 0u);
+  EXPECT_EQ(on.stage_trips, 0u);
+
+  o.learning = true;
+  const RasterRun learned = run_raster(experiment_, models_, o);
+  ASSERT_FALSE(learned.refused) << learned.reason;
+  EXPECT_LE(learned.stats[0].rms_true_m, 1e-9);
+  EXPECT_LE(learned.stats[1].rms_true_m, 1e-9);
+  EXPECT_EQ(learned.clamped_ticks, 0u);
+}
+
+TEST_F(Raster, WithoutDecouplingTheSlowAxisCarriesTheCoupling) {
+  RasterOptions o;
+  const RasterRun on = run_raster(experiment_, models_, o);
+  o.decouple = false;
+  const RasterRun off = run_raster(experiment_, models_, o);
+  ASSERT_FALSE(on.refused || off.refused) << on.reason << off.reason;
+  // The servo rejects most of 3 % of a 50 Hz line (a 30 nm triangle), not all of it.
+  EXPECT_GT(off.stats[1].rms_true_m, 1.2 * on.stats[1].rms_true_m);
+  EXPECT_NEAR(off.stats[0].rms_true_m, on.stats[0].rms_true_m, 1e-15);  // x is coupled into y, not back
+  // Feedforward alone (no servo), the coupling is the slow axis's error: a triangle of 3 % of the
+  // line's 1 um, 8.7 nm RMS, on top of the axis's own.
+  o.loop.servo = false;
+  const RasterRun bare = run_raster(experiment_, models_, o);
+  ASSERT_FALSE(bare.refused) << bare.reason;
+  EXPECT_GT(bare.stats[1].rms_true_m, 8e-9);
+}
+
+TEST_F(Raster, AnAxisCountTheDecouplingDoesNotMatchIsRefused) {
+  MultiAxisLoopConfig c;
+  MultiAxisLoopSimulation sim(c);
+  sim.run(0.01);
+  RasterSpec r;
+  r.width_m = r.height_m = 1e-6;
+  r.lines = 8;
+  r.line_rate_hz = 10.0;
+  r.corner_s = 2e-3;
+  r.start_s = 1.0;
+  try {
+    sim.take_raster(r, AxisCoupling::identity(3), 0.2);
+    FAIL() << "a 3-axis decoupling taken by a 2-axis stage";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "decoupling");
+    EXPECT_NE(std::string(e.what()).find("is for 3 axes, the stage has 2"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(sim.compensator(0).scan(), nullptr);
+  EXPECT_EQ(sim.compensator(1).scan(), nullptr);
+}
+
+}  // namespace
+}  // namespace hystloop
