@@ -64,6 +64,7 @@ Verdict check_message(const sensor_block_t& msg) noexcept {
   f.tick(msg.seq);
   f.within(msg.dt_s, 1e-7, 1.0);
   f.require(msg.dt_s > 0.0);
+  f.require(msg.n_axes >= 1 && msg.n_axes <= sensor_block_t::MAX_AXES);
   if (f.count(msg.n_ticks, 1, sensor_block_t::MAX_TICKS, arrays_consistent(msg))) {
     for (std::size_t i = 0; i < msg.u_V.size(); ++i) {
       f.within(msg.u_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
@@ -91,6 +92,7 @@ Verdict check_message(const command_block_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.sample_seq >= -1 && msg.sample_seq <= kMaxTick);
   f.tick(msg.seq);
+  f.require(msg.n_axes >= 1 && msg.n_axes <= command_block_t::MAX_AXES);
   if (f.count(msg.n_ticks, 1, command_block_t::MAX_TICKS, arrays_consistent(msg))) {
     for (std::size_t i = 0; i < msg.u_ff_V.size(); ++i) {
       f.within(msg.u_ff_V[i], -kMaxAbsVoltage_V, kMaxAbsVoltage_V);

@@ -18,11 +18,13 @@ bool all_sized(std::int32_t n, const V&... vectors) noexcept {
 }  // namespace
 
 void reserve_storage(sensor_block_t& m) {
-  reserve_all(sensor_block_t::MAX_TICKS, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
+  reserve_all(std::size_t{sensor_block_t::MAX_TICKS} * sensor_block_t::MAX_AXES, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m,
+              m.y_m, m.flags);
 }
 
 void reserve_storage(command_block_t& m) {
-  reserve_all(command_block_t::MAX_TICKS, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
+  reserve_all(std::size_t{command_block_t::MAX_TICKS} * command_block_t::MAX_AXES, m.u_ff_V, m.y_ref_m,
+              m.params_version, m.mode);
 }
 
 void reserve_storage(sim_truth_t& m) { m.y_true_m.reserve(sim_truth_t::MAX_TICKS); }
@@ -33,12 +35,22 @@ void clear_arrays(command_block_t& m) noexcept { clear_all(m.u_ff_V, m.y_ref_m, 
 
 void clear_arrays(sim_truth_t& m) noexcept { m.y_true_m.clear(); }
 
+namespace {
+// n_values is what LCM sizes the arrays by; it must also be n_ticks x n_axes, or a block's ticks
+// and axes would not be what its arrays hold.
+bool values_of_ticks(std::int32_t n_ticks, std::int8_t n_axes, std::int32_t n_values) noexcept {
+  return n_ticks >= 0 && n_axes >= 1 && static_cast<std::int64_t>(n_ticks) * n_axes == n_values;
+}
+}  // namespace
+
 bool arrays_consistent(const sensor_block_t& m) noexcept {
-  return all_sized(m.n_ticks, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
+  return values_of_ticks(m.n_ticks, m.n_axes, m.n_values) &&
+         all_sized(m.n_values, m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags);
 }
 
 bool arrays_consistent(const command_block_t& m) noexcept {
-  return all_sized(m.n_ticks, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
+  return values_of_ticks(m.n_ticks, m.n_axes, m.n_values) &&
+         all_sized(m.n_values, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
 }
 
 bool arrays_consistent(const sim_truth_t& m) noexcept { return all_sized(m.n_ticks, m.y_true_m); }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
 
 namespace hystloop {
@@ -29,7 +30,9 @@ SensorRepair SensorBlockRepair::repair(sensor_block_t& b) noexcept {
   }
   const std::size_t n =
       std::min({b.u_V.size(), b.u_ff_V.size(), b.u_fb_V.size(), b.y_ref_m.size(), b.y_m.size(), b.flags.size()});
+  const std::size_t axes = axes_of(b);
   for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t axis = i % axes;  // tick-major: the values of one tick, axis by axis
     bool replaced = false;
     std::int32_t& flags = b.flags[i];
     if (flags < 0 || (flags & ~kKnownSampleFlags) != 0) {
@@ -41,13 +44,13 @@ SensorRepair SensorBlockRepair::repair(sensor_block_t& b) noexcept {
     for (std::size_t v = 0; v < 3; ++v) {
       double& u = *voltages[v];
       if (allowed(u, kMaxAbsVoltage_V)) continue;
-      u = clamp_or(u, kMaxAbsVoltage_V, v == 0 ? last_u_V_ : 0.0);
+      u = clamp_or(u, kMaxAbsVoltage_V, v == 0 ? last_u_V_[axis] : 0.0);
       flags |= kSaturated;
       ++r.voltages;
       replaced = true;
     }
     if (!allowed(b.y_m[i], kMaxAbsPosition_m)) {
-      b.y_m[i] = last_y_m_;
+      b.y_m[i] = last_y_m_[axis];
       flags |= kSensorFault;
       ++r.positions;
       replaced = true;
@@ -57,8 +60,8 @@ SensorRepair SensorBlockRepair::repair(sensor_block_t& b) noexcept {
       ++r.references;
       replaced = true;
     }
-    last_u_V_ = b.u_V[i];
-    last_y_m_ = b.y_m[i];
+    last_u_V_[axis] = b.u_V[i];
+    last_y_m_[axis] = b.y_m[i];
     if (replaced) ++r.ticks;
   }
   return r;

@@ -17,6 +17,7 @@
 // makes the re-identifier skip the tick. Allocation-, lock- and throw-free: the I/O thread runs it
 // on every block (it also keeps the last good values), the counts go to HX_STATUS.
 
+#include <array>
 #include <cstdint>
 
 #include "hystloop/sensor_block_t.hpp"
@@ -37,12 +38,13 @@ struct SensorRepair {
 class SensorBlockRepair {
  public:
   // Makes `block` pass check_message (given consistent arrays of 1..MAX_TICKS ticks, as the
-  // bridge fills them), and remembers its last good u and y for the next block.
+  // bridge fills them), and remembers each axis's last good u and y for the next block. A tick
+  // counts once in `ticks` per axis it was replaced on.
   SensorRepair repair(sensor_block_t& block) noexcept;
 
  private:
-  double last_u_V_ = 0.0;
-  double last_y_m_ = 0.0;
+  std::array<double, sensor_block_t::MAX_AXES> last_u_V_{};  // per axis
+  std::array<double, sensor_block_t::MAX_AXES> last_y_m_{};
 };
 
 }  // namespace hystloop

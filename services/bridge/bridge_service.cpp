@@ -23,6 +23,11 @@
 #include "runtime/summary_file.hpp"
 
 namespace hystloop {
+
+namespace {
+// The axes this bridge drives (x): a command block planned for another count is refused whole.
+constexpr std::int8_t kAxes = 1;
+}  // namespace
 BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, const ChannelNames& channels)
     : settings_(settings),
       lcm_(lcm),
@@ -43,11 +48,15 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
 
 void BridgeService::on_command(const command_block_t& msg) noexcept {
   ++command_blocks_;
+  if (msg.n_axes != kAxes) {  // planned for another stage: no axis of it is guessed at
+    ++command_blocks_wrong_axes_;
+    return;
+  }
   if (const auto elapsed = sent_.elapsed_since(msg.sample_seq, monotonic_ns())) {
     latency_.add(*elapsed);
     latency_total_.add(*elapsed);
   }
-  for (std::size_t i = 0; i < msg.u_ff_V.size(); ++i) {
+  for (std::size_t i = 0, n = ticks_of(msg); i < n; ++i) {
     if (!rt_.push_command(command_tick(msg, i))) ++command_queue_full_;
   }
 }
@@ -302,6 +311,7 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
       {"samples_dropped", rt.samples_dropped},
       {"command_queue_full", command_queue_full_},
       {"command_blocks", command_blocks_},
+      {"command_blocks_wrong_axes", command_blocks_wrong_axes_},
       {"sensor_blocks", sensor_blocks_},
       {"sensor_blocks_repaired", sensor_blocks_repaired_},
       {"sensor_ticks_repaired", sensor_ticks_repaired_},
@@ -389,10 +399,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   counters_.report(status_, "command", commands_.counters());
   counters_.report(status_, "control", control_.counters());
   counters_.report(status_, "sensor", sensor_pub_.counters());
-  status_.add_rejected(static_cast<std::int64_t>(counters_.since("rejected_nonfinite", core.rejected_nonfinite) +
-                                                 counters_.since("rejected_future", core.rejected_future) +
-                                                 counters_.since("command_queue_full", command_queue_full_) +
-                                                 counters_.since("control_refused", control_refused_)));
+  status_.add_rejected(
+      static_cast<std::int64_t>(counters_.since("rejected_nonfinite", core.rejected_nonfinite) +
+                                counters_.since("rejected_future", core.rejected_future) +
+                                counters_.since("command_queue_full", command_queue_full_) +
+                                counters_.since("command_blocks_wrong_axes", command_blocks_wrong_axes_) +
+                                counters_.since("control_refused", control_refused_)));
   status_.late(static_cast<std::int64_t>(counters_.since("late", core.late)));
   status_.loop_timing(rt.work);
   status_.latency(latency_);

@@ -84,6 +84,7 @@ class BridgeService {
   std::uint64_t control_refused_ = 0;
   ControlAcks acks_;  // what was done with the last requests, for their senders
   std::uint64_t command_blocks_ = 0;
+  std::uint64_t command_blocks_wrong_axes_ = 0;  // planned for another number of axes: refused whole
   std::uint64_t sensor_blocks_ = 0;
   // Sensor blocks whose values the contract refuses are published repaired (sensor_block_repair.hpp):
   std::uint64_t sensor_blocks_repaired_ = 0;

@@ -50,6 +50,8 @@ namespace {
 // are not one stream [us].
 constexpr std::int64_t kConfirmWindowUs = 100'000;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The axes this service plans (x): a block of another count is refused, not assigned by guess.
+constexpr std::int8_t kAxes = 1;
 
 // HX_MODEL: an unknown kind or format version reaches on_model, which counts it by its reason.
 Subscription<model_params_t>::Options model_envelope() {
@@ -90,6 +92,10 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
 
 void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
   const std::int64_t start_ns = monotonic_ns();
+  if (msg.n_axes != kAxes) {
+    ++counters_.sensor_blocks_wrong_axes;
+    return;
+  }
   // The block's own time, not the receive time: the commands stay a function of the messages.
   // discontinuities_ notes where a confirmed jump or restart went, for log_sequence_events().
   switch (discontinuities_.check(guard_, msg.seq, msg.n_ticks, msg.utime)) {
@@ -100,7 +106,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
     case SequenceGuard::Verdict::jump:
     case SequenceGuard::Verdict::take: break;
   }
-  const SensorTick last = sensor_tick(msg, msg.u_V.size() - 1);
+  const SensorTick last = sensor_tick(msg, static_cast<std::size_t>(msg.n_ticks) - 1);
   for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m, t.u_ff_V}); });
   last_sample_utime_ = last.utime;
   ++blocks_in_period_;
@@ -313,6 +319,7 @@ CounterSet::Entries CompensatorService::collect_counters() const {
   return {{"samples", c.samples},
           {"command_blocks_published", s.command_blocks_published},
           {"command_ticks_published", s.command_ticks_published},
+          {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
           {"planned", c.planned},
           {"ticks_behind", c.ticks_behind},
           {"gaps", c.gaps},
@@ -449,7 +456,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   reported_.report(status_, counters);
   std::uint64_t semantic_rejects = 0;
   for (const char* name : {"params_rejected", "params_invalid", "model_unknown_kind", "model_unknown_format",
-                           "trajectory_refused", "control_refused"}) {
+                           "trajectory_refused", "control_refused", "sensor_blocks_wrong_axes"}) {
     for (const auto& [n, value] : counters) {
       if (n == name) semantic_rejects += reported_.since(n, value);
     }

@@ -62,6 +62,9 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
 // The compensator's own counters (cumulative; RESET_COUNTERS reports them from a baseline).
 struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;
+  // Sensor blocks of another number of axes than this compensator's (one): not used, never
+  // assigned to an axis by guess.
+  std::uint64_t sensor_blocks_wrong_axes = 0;
   std::uint64_t command_ticks_published = 0;
   std::uint64_t params_invalid = 0;        // valid = false: diagnostic sets, never used
   std::uint64_t params_stale = 0;          // version not above the last one accepted from the same publisher

@@ -21,6 +21,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -207,7 +208,8 @@ control_t valid_control(std::int64_t id) {
   return m;
 }
 
-// N of each: truncated, wrong type, non-finite, out of range, on each input channel of `target`.
+// N of each: truncated, wrong type, non-finite, out of range, on each input channel of `target`;
+// and N blocks of two axes on the block channel (HX_COMMAND, HX_SENSOR).
 int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int count) {
   const std::int64_t base_id = now_utime();
   for (int i = 0; i < count; ++i) {
@@ -230,6 +232,12 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
       publish_unchecked(lcm, ch.command, m);
       m.u_ff_V[0] = 1e6;  // beyond any amplifier: a unit mistake
       publish_unchecked(lcm, ch.command, m);
+      command_block_t xy{};  // valid, but planned for two axes: the one-axis bridge refuses it whole
+      begin_block(xy, 1, now_utime(), -1, 2);
+      const std::array<CommandTick, 2> both{CommandTick{1, 0.0, 0.0, 0, command_block_t::MODE_MEM},
+                                            CommandTick{1, 0.0, 0.0, 0, command_block_t::MODE_MEM}};
+      append_tick(xy, both);
+      publish_unchecked(lcm, ch.command, xy);
     } else {
       sensor_block_t s = one_tick_sensor_block();
       publish_truncated(lcm, ch.sensor, s);
@@ -239,6 +247,11 @@ int inject(lcm::LCM& lcm, const ChannelNames& ch, const std::string& target, int
       s.y_m[0] = 0.0;
       s.seq = -5;
       publish_unchecked(lcm, ch.sensor, s);
+      sensor_block_t xy{};  // valid, but of two axes: the one-axis compensator refuses it whole
+      begin_block(xy, 1, now_utime(), 1e-4, 2);
+      const std::array<SensorTick, 2> both{};
+      append_tick(xy, both);
+      publish_unchecked(lcm, ch.sensor, xy);
 
       trajectory_t t{};
       t.utime = now_utime();

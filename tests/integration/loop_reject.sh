@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Malformed (truncated), wrong-type, non-finite and out-of-range messages on every input channel
 # of each service -- HX_COMMAND and HX_CONTROL for the bridge; HX_SENSOR, HX_TRAJECTORY, HX_PARAMS
-# and HX_CONTROL for the compensator -- are rejected and counted in HX_STATUS, and nothing unsafe
-# reaches the actuator. Inside tools/netns-run.
+# and HX_CONTROL for the compensator -- and blocks of two axes for these one-axis services are
+# rejected and counted in HX_STATUS, and nothing unsafe reaches the actuator. Inside tools/netns-run.
 #   loop_reject.sh <hystloop-bridge> <hystloop-compensator> <loop_probe>
 source "$(dirname "$0")/loop_common.sh" "$@"
 n=5
@@ -27,7 +27,8 @@ counted() {
     ckeys+=(sensor.rejected_$reason $n trajectory.rejected_$reason $n params.rejected_$reason $n
             control.rejected_$reason $((2 * n)))
   done
-  status_at_least bridge "${keys[@]}" && status_at_least compensator "${ckeys[@]}" params_invalid 1 control_refused 1
+  status_at_least bridge "${keys[@]}" command_blocks_wrong_axes $n &&
+    status_at_least compensator "${ckeys[@]}" params_invalid 1 control_refused 1 sensor_blocks_wrong_axes $n
 }
 wait_until 20 "both services reported every bad message" counted
 kill -TERM $bpid $cpid
@@ -45,6 +46,8 @@ for reason in decode_failed wrong_type non_finite out_of_range; do
   expect_value compensator control.rejected_$reason $((2 * n))
 done
 expect_value compensator params_invalid 1
+expect_value bridge command_blocks_wrong_axes $n
+expect_value compensator sensor_blocks_wrong_axes $n
 expect_value compensator params_swapped 0
 expect_value compensator control_refused 1
 expect_value bridge watchdog_trips 0

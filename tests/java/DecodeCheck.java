@@ -2,8 +2,8 @@
 // (lcm.spy.LCMTypeDatabase scans the class path, as lcm-spy does): it picks the class by
 // the fingerprint at the start of each message, decodes, re-encodes and requires the same
 // bytes (no field lost or changed), and checks a few values against the C++ fixtures'
-// formulas (tests/lcm/message_fixtures.hpp: tick t of a block carries values computed from t,
-// every array holds n_ticks elements). It also requires the jar to hold exactly the six
+// formulas (tests/lcm/message_fixtures.hpp: tick t of a block carries values computed from t;
+// the fixtures' blocks have one axis, so every array holds n_values = n_ticks elements). It also requires the jar to hold exactly the six
 // hystloop types.
 //
 //   java -cp hystloop_lcmtypes.jar:lcm.jar:. DecodeCheck <jar> <log> <rounds>
@@ -81,9 +81,9 @@ public class DecodeCheck {
       if (msg instanceof hystloop.sensor_block_t) {
         hystloop.sensor_block_t s = (hystloop.sensor_block_t) msg;
         int n = s.n_ticks;
-        if (n < 1 || s.u_V.length != n || s.u_ff_V.length != n || s.u_fb_V.length != n || s.y_ref_m.length != n
-            || s.y_m.length != n || s.flags.length != n) {
-          fail("sensor block at seq " + s.seq + ": arrays do not hold n_ticks = " + n);
+        if (n < 1 || s.n_axes != 1 || s.n_values != n || s.u_V.length != n || s.u_ff_V.length != n
+            || s.u_fb_V.length != n || s.y_ref_m.length != n || s.y_m.length != n || s.flags.length != n) {
+          fail("sensor block at seq " + s.seq + ": not one axis, or its arrays do not hold n_ticks = " + n);
         } else {
           for (int i = 0; i < n; ++i) {
             long t = s.seq + i;
@@ -94,8 +94,9 @@ public class DecodeCheck {
       } else if (msg instanceof hystloop.command_block_t) {
         hystloop.command_block_t c = (hystloop.command_block_t) msg;
         int n = c.n_ticks;
-        if (n < 1 || c.u_ff_V.length != n || c.y_ref_m.length != n || c.params_version.length != n || c.mode.length != n) {
-          fail("command block at seq " + c.seq + ": arrays do not hold n_ticks = " + n);
+        if (n < 1 || c.n_axes != 1 || c.n_values != n || c.u_ff_V.length != n || c.y_ref_m.length != n
+            || c.params_version.length != n || c.mode.length != n) {
+          fail("command block at seq " + c.seq + ": not one axis, or its arrays do not hold n_ticks = " + n);
         } else {
           for (int i = 0; i < n; ++i) {
             long t = c.seq + i;

@@ -204,9 +204,10 @@ static_assert(static_cast<int>(TrajectoryShape::kPoints) == trajectory_t::POINTS
 static_assert(TrajectorySpec::kMaxPoints == static_cast<std::size_t>(trajectory_t::MAX_POINTS));
 
 TEST(LcmTypes, BlocksHaveTheirWireSize) {
-  // 8-byte fingerprint + header + per-tick arrays: what 10 kHz of ticks costs on the wire.
-  EXPECT_EQ(fixtures::sensor_ticks(0, 10).getEncodedSize(), 8 + 8 + 8 + 8 + 4 + 4 + 10 * (5 * 8 + 4));
-  EXPECT_EQ(fixtures::command_ticks(0, 10, 0).getEncodedSize(), 8 + 3 * 8 + 4 + 10 * (2 * 8 + 4 + 1));
+  // 8-byte fingerprint + header (n_ticks, n_axes, n_values) + per-tick arrays: what 10 kHz of
+  // ticks of one axis costs on the wire.
+  EXPECT_EQ(fixtures::sensor_ticks(0, 10).getEncodedSize(), 8 + 8 + 8 + 8 + 4 + 4 + 1 + 4 + 10 * (5 * 8 + 4));
+  EXPECT_EQ(fixtures::command_ticks(0, 10, 0).getEncodedSize(), 8 + 3 * 8 + 4 + 1 + 4 + 10 * (2 * 8 + 4 + 1));
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ class WireLayoutGenerator(unittest.TestCase):
         self.assertEqual(run.returncode, 0, run.stderr)
         defs = (self.tmp / "wire_layout_defs.inc").read_text()
         self.assertIn("::hystloop::sensor_block_t::getHash(), k_sensor_block_t, "
-                      "::hystloop::sensor_block_t::MAX_TICKS", defs)
+                      "::hystloop::sensor_block_t::MAX_VALUES", defs)
         self.assertIn("::hystloop::control_t::getHash(), k_control_t, 0", defs)
 
     def test_a_fixed_array_is_its_elements_and_a_boolean_one_byte(self):

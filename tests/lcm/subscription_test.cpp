@@ -253,15 +253,15 @@ TEST_F(SubscriptionTest, ReceivingBlocksOfAnySizeAllocatesNothing) {
   EXPECT_EQ(sensor.counters().accepted, 100u);
 }
 
-// A tick count past MAX_TICKS (or beyond the bytes) must not reach decode, which would
+// A value count past MAX_VALUES (or beyond the bytes) must not reach decode, which would
 // resize every array to it: the wire-layout walk refuses it first.
 TEST_F(SubscriptionTest, ACorruptedTickCountIsADecodeFailureAndAllocatesNothing) {
   Subscription<sensor_block_t> sensor(lcm_, "HX_SENSOR");
   const auto good = fixtures::encode(fixtures::sensor_block(3));
-  constexpr std::size_t kCountOffset = 8 + 8 + 8 + 8 + 4;
+  constexpr std::size_t kCountOffset = 8 + 8 + 8 + 8 + 4 + 4 + 1;  // n_values
   ASSERT_EQ(good[kCountOffset + 3], 4u);
   testing::AllocationCounter counter;
-  for (const std::uint32_t bad : {0x7fffffffu, 0x10000000u, 1001u, 5u, 0xffffffffu}) {
+  for (const std::uint32_t bad : {0x7fffffffu, 0x10000000u, 3001u, 5u, 0xffffffffu}) {
     std::array<std::uint8_t, 512> bytes{};
     ASSERT_LE(good.size(), bytes.size());
     std::copy(good.begin(), good.end(), bytes.begin());

@@ -32,9 +32,9 @@ void put_be32(std::vector<std::uint8_t>& bytes, std::size_t at, std::int32_t val
 template <class T>
 constexpr std::int32_t kBound = 0;
 template <>
-constexpr std::int32_t kBound<sensor_block_t> = sensor_block_t::MAX_TICKS;
+constexpr std::int32_t kBound<sensor_block_t> = sensor_block_t::MAX_VALUES;
 template <>
-constexpr std::int32_t kBound<command_block_t> = command_block_t::MAX_TICKS;
+constexpr std::int32_t kBound<command_block_t> = command_block_t::MAX_VALUES;
 template <>
 constexpr std::int32_t kBound<trajectory_t> = trajectory_t::MAX_POINTS;
 template <>
@@ -69,7 +69,7 @@ void expect_generated_layout_agrees_with_encoding() {
   for (const std::int32_t bad : {kBound<T> + 1, -1, -2147483647 - 1}) {
     T msg{};
     wire_samples::fill_wire_sample(msg, bad);
-    std::vector<std::uint8_t> bytes(1 << 16);  // not getEncodedSize(): a negative count shrinks it
+    std::vector<std::uint8_t> bytes(1 << 18);  // not getEncodedSize(): a negative count shrinks it
     const int size = msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     ASSERT_GT(size, 8) << bad;
     EXPECT_EQ(walk_wire_layout(layout, bytes.data(), static_cast<std::size_t>(size)), -1) << bad;
@@ -137,18 +137,19 @@ TEST(WireLayout, CountsDecodeWouldAllocateForAreRefused) {
   EXPECT_LT(walk_wire_layout(wire_layout_of<trajectory_t>(), bytes.data(), bytes.size()), 0);
 }
 
-// n_ticks sits after the fingerprint and sensor_block_t's utime, seq, dt_s, buffer_depth_ticks;
-// after command_block_t's utime, seq, sample_seq.
-constexpr std::size_t kSensorCountOffset = 8 + 8 + 8 + 8 + 4;
-constexpr std::size_t kCommandCountOffset = 8 + 8 + 8 + 8;
+// n_values, the arrays' length, sits after the fingerprint and sensor_block_t's utime, seq, dt_s,
+// buffer_depth_ticks, n_ticks and n_axes; after command_block_t's utime, seq, sample_seq, n_ticks
+// and n_axes.
+constexpr std::size_t kSensorCountOffset = 8 + 8 + 8 + 8 + 4 + 4 + 1;
+constexpr std::size_t kCommandCountOffset = 8 + 8 + 8 + 8 + 4 + 1;
 
-// A corrupted tick count is refused by the walk, i.e. before decode would resize six
-// arrays to it (a negative count or one past MAX_TICKS, or more ticks than the bytes hold).
+// A corrupted value count is refused by the walk, i.e. before decode would resize six
+// arrays to it (a negative count or one past MAX_VALUES, or more values than the bytes hold).
 template <class T>
 void expect_bad_tick_counts_refused(std::vector<std::uint8_t> bytes, std::size_t offset, std::int32_t n_ticks) {
   ASSERT_EQ(bytes[offset + 3], static_cast<std::uint8_t>(n_ticks));  // the offset is right
   ASSERT_EQ(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), static_cast<std::int64_t>(bytes.size()));
-  for (const std::int32_t bad : {-1, -2147483647 - 1, T::MAX_TICKS + 1, 1 << 28, 2147483647, n_ticks + 1}) {
+  for (const std::int32_t bad : {-1, -2147483647 - 1, T::MAX_VALUES + 1, 1 << 28, 2147483647, n_ticks + 1}) {
     put_be32(bytes, offset, bad);
     EXPECT_LT(walk_wire_layout(wire_layout_of<T>(), bytes.data(), bytes.size()), 0) << T::getTypeName() << " " << bad;
   }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -285,6 +286,28 @@ TEST(CompensatorService, AFirstBlockCountsNoTicksBehind) {
   Harness h;
   h.run(5000, 1000);
   EXPECT_EQ(h.service.compensator().counters().ticks_behind, 0u);
+}
+
+// A sensor block of two axes reaching a one-axis compensator: refused whole and counted, never read
+// as x (its arrays would be two axes interleaved, read as twice the ticks).
+TEST(CompensatorService, ASensorBlockOfAnotherNumberOfAxesIsRefusedNotGuessed) {
+  Harness h;
+  h.run(0, 100);
+  const std::size_t published = h.ticks.size();
+  sensor_block_t xy{};
+  begin_block(xy, 100, utime_of(100), kDt, 2);
+  for (std::int64_t k = 100; k < 110; ++k) {
+    const std::array<SensorTick, 2> axes{SensorTick{utime_of(k), k, 1.0, 1.0, 0.0, 0.0, 1e-9, 0},
+                                         SensorTick{utime_of(k), k, 2.0, 2.0, 0.0, 0.0, 2e-9, 0}};
+    ASSERT_TRUE(append_tick(xy, axes));
+  }
+  h.service.on_sensor(xy, wall_utime());
+  h.drain();
+  EXPECT_EQ(h.service.counters().sensor_blocks_wrong_axes, 1u);
+  EXPECT_EQ(h.ticks.size(), published);  // nothing planned from it
+  EXPECT_EQ(h.service.compensator().last_seq(), 99);
+  h.send(100);  // the stream goes on with blocks of its own axis count
+  EXPECT_EQ(h.service.compensator().last_seq(), 109);
 }
 
 // Counts operator new in this thread. LCM's C core allocates with malloc (memq copies each

@@ -69,6 +69,8 @@ void write_log(const fs::path& file) {
     s.dt_s = kDt;
     s.buffer_depth_ticks = static_cast<std::int32_t>(20 + b);
     s.n_ticks = kTicks;
+    s.n_axes = 1;
+    s.n_values = kTicks;
     for (std::int64_t i = 0; i < kTicks; ++i) {
       const std::int64_t k = b * kTicks + i;
       s.u_V.push_back(u_of(k));
@@ -84,6 +86,8 @@ void write_log(const fs::path& file) {
     c.seq = (b + 1) * kTicks;
     c.sample_seq = (b + 1) * kTicks - 1;
     c.n_ticks = kTicks;
+    c.n_axes = 1;
+    c.n_values = kTicks;
     for (std::int64_t i = 0; i < kTicks; ++i) {
       c.u_ff_V.push_back(u_of(c.seq + i));
       c.y_ref_m.push_back(y_ref_of(c.seq + i));

@@ -46,6 +46,8 @@ class CsvLegendTest : public ::testing::Test {
     s.dt_s = 1e-4;
     s.buffer_depth_ticks = 10;
     s.n_ticks = 2;
+    s.n_axes = 1;
+    s.n_values = 2;
     s.u_V = {1.0, 2.0};
     s.u_ff_V = {1.0, 2.0};
     s.u_fb_V = {0.0, 0.0};
@@ -58,6 +60,8 @@ class CsvLegendTest : public ::testing::Test {
     c.seq = 2;
     c.sample_seq = 1;
     c.n_ticks = 1;
+    c.n_axes = 1;
+    c.n_values = 1;
     c.u_ff_V = {3.0};
     c.y_ref_m = {3e-6};
     c.params_version = {1};
