@@ -7,7 +7,8 @@
 // line-rate scans (the model identified from a 10 Hz sine of a 1 um line's loops, the stage's
 // inverse, the servo); the raster 1 um x 1 um, 64 lines at 50 lines/s, its slow axis stepping in
 // the corners. Each axis follows its share of C^-1 r (decoupled) or r alone (coupled), with and
-// without the servo, and with learning on the fast axis. RMS and max of r - y (the true position,
+// without the servo, and with learning on the fast axis. Then a Lissajous figure, decoupled and
+// coupled. RMS and max of r - y (the true position,
 // against the path's reference) over the lines, per axis; the bridge's clamped ticks.
 //
 //   raster_table [--out DIR] [--lines N] [--line-rate HZ] [--coupling F] [--columns N]
@@ -31,7 +32,7 @@ using namespace hystloop;
 
 struct Row {
   const char* name;
-  RasterRun run;
+  PathRun run;
 };
 
 void print_row(const Row& r) {
@@ -95,11 +96,11 @@ int run(int argc, char** argv) {
                 models.ranking.empty() ? "none" : std::string(to_string(models.ranking.front())).c_str());
     std::printf("| run | x (fast) RMS | x max | y (slow) RMS | y max | clamped ticks |\n");
     std::printf("| --- | --- | --- | --- | --- | --- |\n");
-    Row decoupled{"decoupled, servo", run_raster(e, models, o)};
-    print_row(decoupled);
+    const RasterRun decoupled = run_raster(e, models, o);
+    print_row({"decoupled, servo", decoupled});
     o.decouple = false;
-    Row coupled{"coupled (no decoupling), servo", run_raster(e, models, o)};
-    print_row(coupled);
+    const RasterRun coupled = run_raster(e, models, o);
+    print_row({"coupled (no decoupling), servo", coupled});
     o.decouple = true;
     o.learning = true;
     print_row({"decoupled, servo, learning", run_raster(e, models, o)});
@@ -108,10 +109,18 @@ int run(int argc, char** argv) {
     print_row({"decoupled, feedforward only", run_raster(e, models, o)});
     o.decouple = false;
     print_row({"coupled, feedforward only", run_raster(e, models, o)});
+    std::printf(
+        "\nLissajous figure, 0.5 um at 50 Hz on x and 48 Hz on y, one second (each axis entered at its "
+        "trough):\n\n| run | x RMS | x max | y RMS | y max | clamped ticks |\n| --- | --- | --- | --- | --- | --- |\n");
+    LissajousOptions l;
+    l.coupling = o.coupling;
+    print_row({"decoupled, servo", run_lissajous(e, models, l)});
+    l.decouple = false;
+    print_row({"coupled (no decoupling), servo", run_lissajous(e, models, l)});
     std::printf("\nerror maps in %s:\n", out.string().c_str());
     std::filesystem::create_directories(out);
-    if (!decoupled.run.refused) write_maps(decoupled.run, "decoupled", out, columns);
-    if (!coupled.run.refused) write_maps(coupled.run, "coupled", out, columns);
+    if (!decoupled.refused) write_maps(decoupled, "decoupled", out, columns);
+    if (!coupled.refused) write_maps(coupled, "coupled", out, columns);
   } catch (const std::exception& err) {
     std::fprintf(stderr, "raster_table: %s\n", err.what());
     return 1;

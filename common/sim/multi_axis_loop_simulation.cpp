@@ -46,7 +46,17 @@ MultiAxisLoopSimulation::MultiAxisLoopSimulation(const MultiAxisLoopConfig& conf
   }
 }
 
-void MultiAxisLoopSimulation::take_raster(const RasterSpec& raster, const AxisCoupling& decoupling, double blend_s) {
+void MultiAxisLoopSimulation::take_path(const RasterSpec& raster, const AxisCoupling& decoupling, double blend_s) {
+  take(raster, decoupling, blend_s);
+}
+
+void MultiAxisLoopSimulation::take_path(const LissajousSpec& lissajous, const AxisCoupling& decoupling,
+                                        double blend_s) {
+  take(lissajous, decoupling, blend_s);
+}
+
+template <class Path>
+void MultiAxisLoopSimulation::take(const Path& path, const AxisCoupling& decoupling, double blend_s) {
   if (decoupling.n() != axes()) {
     throw ParameterError("decoupling",
                          "is for " + std::to_string(decoupling.n()) + " axes, the stage has " + std::to_string(axes()));
@@ -55,7 +65,7 @@ void MultiAxisLoopSimulation::take_raster(const RasterSpec& raster, const AxisCo
   std::vector<ScanShare> shares;
   shares.reserve(static_cast<std::size_t>(axes()));
   for (int i = 0; i < axes(); ++i) {
-    shares.emplace_back(raster, i, AxisVector(decoupling.inverse_matrix().row(i).transpose()));
+    shares.emplace_back(path, i, AxisVector(decoupling.inverse_matrix().row(i).transpose()));
     Compensator copy = compensators_[static_cast<std::size_t>(i)];
     copy.take_scan(shares.back(), blend_s);
   }

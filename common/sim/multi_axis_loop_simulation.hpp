@@ -45,11 +45,12 @@ class MultiAxisLoopSimulation {
 
   void run(double seconds, const std::function<void(const MultiAxisTick&)>& on_tick = {});
 
-  // The raster (its start_s: the loop time of line 0, at least blend_s after the next tick) on every
-  // axis, axis i following row i of decoupling's C^-1 (AxisCoupling::identity: no decoupling).
+  // A path on every axis (its start_s: the loop time it starts at, at least blend_s after the next
+  // tick), axis i following row i of decoupling's C^-1 (AxisCoupling::identity: no decoupling).
   // decoupling.n() must be the stage's axis count (ParameterError "decoupling", never a silent
   // misassignment); an axis's refusal (Compensator::take_scan) names it and no axis takes the path.
-  void take_raster(const RasterSpec& raster, const AxisCoupling& decoupling, double blend_s);
+  void take_path(const RasterSpec& raster, const AxisCoupling& decoupling, double blend_s);
+  void take_path(const LissajousSpec& lissajous, const AxisCoupling& decoupling, double blend_s);
 
   // A compensator that stops sending one axis's commands (a fault to test the stage's safety).
   void drop_commands(int axis, bool drop) noexcept { drop_[static_cast<std::size_t>(axis)] = drop; }
@@ -68,6 +69,9 @@ class MultiAxisLoopSimulation {
   MultiAxisBridge bridge_;
   MultiAxisStage stage_;
   std::vector<Compensator> compensators_;
+  template <class Path>
+  void take(const Path& path, const AxisCoupling& decoupling, double blend_s);
+
   std::int64_t k_ = 0;
   std::vector<CommandTick> plan_;  // scratch for the compensators' plans
   std::array<BridgeTick, kScanAxes> ticks_{};

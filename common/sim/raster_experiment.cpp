@@ -7,11 +7,18 @@
 
 namespace hystloop {
 
-RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models, const RasterOptions& o) {
+namespace {
+
+constexpr double kBlendS = 0.2;  // the approach to the path's start
+// After the approach, which starts after the plan's horizon (50 ms) from the first samples.
+constexpr double kStartS = 0.5;
+
+// Per axis the one-axis scan loop, on a flexure stage coupled by o.coupling.
+MultiAxisLoopConfig path_loop_config(const TrackingExperiment& e, const IdentifiedModels& models,
+                                     const PathLoopOptions& o) {
   ScanOptions per_axis = o.loop;
   per_axis.learning = o.learning;
   const LoopSimulationConfig one = scan_loop_config(e, models, per_axis);
-
   MultiAxisLoopConfig c;
   c.stage = flexure_stage(o.axes, o.coupling);
   for (std::size_t i = 0; i < static_cast<std::size_t>(o.axes); ++i) {
@@ -23,8 +30,58 @@ RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models
     c.servo[i] = one.servo;
   }
   c.block_ticks = one.block_ticks;
-  MultiAxisLoopSimulation sim(c);
+  return c;
+}
 
+// Takes the path on every axis and runs it through `end_s`, measuring r - y over [start_s, end_s).
+template <class Path>
+void run_path(MultiAxisLoopSimulation& sim, const Path& path, const AxisCoupling& decoupling, double start_s,
+              double end_s, double run_to_s, PathRun& run) {
+  sim.run(0.05);  // the first samples: each plan knows where its axis is
+  try {
+    sim.take_path(path, decoupling, kBlendS);
+  } catch (const ParameterError& err) {
+    run.refused = true;
+    run.reason = err.what();
+    return;
+  }
+  const auto axes = static_cast<std::size_t>(sim.axes());
+  std::array<double, kScanAxes> sum_sq{}, sum_sq_meas{};
+  sim.run(run_to_s - sim.now_s(), [&](const MultiAxisTick& tick) {
+    for (std::size_t i = 0; i < axes; ++i) {
+      if (tick.flags[i] & (sample_flags::kSaturated | sample_flags::kSlewLimited)) ++run.clamped_ticks;
+    }
+    if (tick.t_s < start_s || tick.t_s >= end_s) return;
+    const AxisPositions want = evaluate(path, tick.t_s);
+    run.t_s.push_back(tick.t_s);
+    for (std::size_t i = 0; i < axes; ++i) {
+      const double err = want[i] - tick.y_true_m[i];
+      const double meas = want[i] - tick.y_m[i];
+      run.error_m[i].push_back(err);
+      sum_sq[i] += err * err;
+      sum_sq_meas[i] += meas * meas;
+      run.stats[i].max_abs_true_m = std::max(run.stats[i].max_abs_true_m, std::abs(err));
+    }
+  });
+  for (std::size_t i = 0; i < axes; ++i) {
+    TrackingStats& s = run.stats[i];
+    s.n = run.t_s.size();
+    if (s.n == 0) continue;
+    s.rms_true_m = std::sqrt(sum_sq[i] / static_cast<double>(s.n));
+    s.rms_measured_m = std::sqrt(sum_sq_meas[i] / static_cast<double>(s.n));
+  }
+  run.stage_trips = sim.bridge().stage_trips();
+}
+
+AxisCoupling decoupling_of(const MultiAxisLoopConfig& c, const PathLoopOptions& o) {
+  return o.decouple ? c.stage.coupling : AxisCoupling::identity(o.axes);
+}
+
+}  // namespace
+
+RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models, const RasterOptions& o) {
+  const MultiAxisLoopConfig c = path_loop_config(e, models, o);
+  MultiAxisLoopSimulation sim(c);
   RasterRun run;
   RasterSpec& r = run.raster;
   r.fast_axis = 0;
@@ -39,44 +96,25 @@ RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models
   const StageModel& stage = c.compensator[0].stage;
   r.corner_s = stage.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency() : 1e-3;
   // r.centre_m stays 0 m: the middle of the voltage range, as the one-axis scans.
-  const double blend_s = 0.2;
-  r.start_s = 0.5;  // after the approach, which starts after the plan's horizon (50 ms) from now
+  r.start_s = kStartS;
   r.settle_s = 0.05;
-  sim.run(0.05);  // the first samples: each plan knows where its axis is
-  try {
-    sim.take_raster(r, o.decouple ? c.stage.coupling : AxisCoupling::identity(o.axes), blend_s);
-  } catch (const ParameterError& err) {
-    run.refused = true;
-    run.reason = err.what();
-    return run;
-  }
   const double lines_end_s = r.start_s + r.lines / r.line_rate_hz;
-  std::array<double, kScanAxes> sum_sq{}, sum_sq_meas{};
-  sim.run(raster_duration_s(r) + r.start_s - sim.now_s(), [&](const MultiAxisTick& tick) {
-    for (int i = 0; i < o.axes; ++i) {
-      if (tick.flags[static_cast<std::size_t>(i)] & (sample_flags::kSaturated | sample_flags::kSlewLimited))
-        ++run.clamped_ticks;
-    }
-    if (tick.t_s < r.start_s || tick.t_s >= lines_end_s) return;
-    const AxisPositions want = evaluate(r, tick.t_s);
-    run.t_s.push_back(tick.t_s);
-    for (std::size_t i = 0; i < static_cast<std::size_t>(o.axes); ++i) {
-      const double err = want[i] - tick.y_true_m[i];
-      const double meas = want[i] - tick.y_m[i];
-      run.error_m[i].push_back(err);
-      sum_sq[i] += err * err;
-      sum_sq_meas[i] += meas * meas;
-      run.stats[i].max_abs_true_m = std::max(run.stats[i].max_abs_true_m, std::abs(err));
-    }
-  });
-  for (std::size_t i = 0; i < static_cast<std::size_t>(o.axes); ++i) {
-    TrackingStats& s = run.stats[i];
-    s.n = run.t_s.size();
-    if (s.n == 0) continue;
-    s.rms_true_m = std::sqrt(sum_sq[i] / static_cast<double>(s.n));
-    s.rms_measured_m = std::sqrt(sum_sq_meas[i] / static_cast<double>(s.n));
-  }
-  run.stage_trips = sim.bridge().stage_trips();
+  run_path(sim, r, decoupling_of(c, o), r.start_s, lines_end_s, r.start_s + raster_duration_s(r), run);
+  return run;
+}
+
+LissajousRun run_lissajous(const TrackingExperiment& e, const IdentifiedModels& models, const LissajousOptions& o) {
+  const MultiAxisLoopConfig c = path_loop_config(e, models, o);
+  MultiAxisLoopSimulation sim(c);
+  LissajousRun run;
+  LissajousSpec& l = run.figure;
+  l.amplitude_m = o.amplitude_m;
+  l.frequency_hz = o.frequency_hz;
+  l.phase_rad.fill(-0.5 * std::numbers::pi);  // each axis at its trough at the start: at rest
+  l.duration_s = o.duration_s;
+  l.start_s = kStartS;
+  const double end_s = l.start_s + l.duration_s;
+  run_path(sim, l, decoupling_of(c, o), l.start_s, end_s, end_s + 0.05, run);
   return run;
 }
 

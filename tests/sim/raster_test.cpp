@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace hystloop {
 namespace {
 
@@ -65,7 +67,7 @@ TEST_F(Raster, AnAxisCountTheDecouplingDoesNotMatchIsRefused) {
   r.corner_s = 2e-3;
   r.start_s = 1.0;
   try {
-    sim.take_raster(r, AxisCoupling::identity(3), 0.2);
+    sim.take_path(r, AxisCoupling::identity(3), 0.2);
     FAIL() << "a 3-axis decoupling taken by a 2-axis stage";
   } catch (const ParameterError& e) {
     EXPECT_EQ(e.field(), "decoupling");
@@ -73,6 +75,45 @@ TEST_F(Raster, AnAxisCountTheDecouplingDoesNotMatchIsRefused) {
   }
   EXPECT_EQ(sim.compensator(0).scan(), nullptr);
   EXPECT_EQ(sim.compensator(1).scan(), nullptr);
+}
+
+}  // namespace
+}  // namespace hystloop
+
+namespace hystloop {
+namespace {
+
+TEST_F(Raster, ALissajousFigureIsTrackedOnBothAxes) {
+  LissajousOptions o;  // 0.5 um at 50 Hz on x, 48 Hz on y, one second
+  const LissajousRun on = run_lissajous(experiment_, models_, o);
+  ASSERT_FALSE(on.refused) << on.reason;
+  o.decouple = false;
+  const LissajousRun off = run_lissajous(experiment_, models_, o);
+  ASSERT_FALSE(off.refused) << off.reason;
+  std::printf("lissajous: x %.3f / %.3f nm, y %.3f / %.3f nm (decoupled / coupled)\n", on.stats[0].rms_true_m * 1e9,
+              off.stats[0].rms_true_m * 1e9, on.stats[1].rms_true_m * 1e9, off.stats[1].rms_true_m * 1e9);
+  EXPECT_EQ(on.t_s.size(), 10000u);
+  EXPECT_LE(on.stats[0].rms_true_m, 2e-9);
+  EXPECT_LE(on.stats[1].rms_true_m, 2e-9);
+  EXPECT_EQ(on.clamped_ticks, 0u);
+}
+
+TEST(MultiAxisLoop, OneAxisLosingItsCommandsTakesTheWholeStageToTheSafeStateOnOneTick) {
+  MultiAxisLoopSimulation sim(MultiAxisLoopConfig{});
+  sim.run(0.1);
+  ASSERT_TRUE(sim.bridge().armed());
+  sim.drop_commands(1, true);  // y's commands stop arriving; x's keep coming
+  std::int64_t first_safe[2] = {-1, -1};
+  sim.run(0.2, [&](const MultiAxisTick& t) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      if ((t.flags[i] & sample_flags::kSafeState) != 0 && first_safe[i] < 0) first_safe[i] = t.k;
+    }
+  });
+  EXPECT_GE(first_safe[1], 0);
+  EXPECT_EQ(first_safe[0], first_safe[1]);
+  EXPECT_EQ(sim.bridge().stage_trips(), 1u);
+  EXPECT_EQ(sim.bridge().tripped_by(), 1);
+  EXPECT_FALSE(sim.bridge().axis(0).armed());
 }
 
 }  // namespace
