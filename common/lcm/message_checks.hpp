@@ -30,14 +30,15 @@ inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FA
 static_assert(kMaxBlockTicks == sensor_block_t::MAX_TICKS && kMaxBlockTicks == command_block_t::MAX_TICKS,
               "core/ticks.hpp's block bound is the wire's");
 
-// sensor_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u, u_ff,
-// u_fb and y within the sanity bounds, y_ref finite or NaN (none), known flags; seq, utime and
-// buffer depth >= 0, 0 < dt_s <= 1 s.
+// sensor_block_t: 1..MAX_TICKS ticks of 1..MAX_AXES axes with every array of n_values = n_ticks x
+// n_axes; per tick and axis finite u, u_ff, u_fb and y within the sanity bounds, y_ref finite or NaN (none), known
+// flags; seq, utime and buffer depth >= 0, 0 < dt_s <= 1 s.
 Verdict check_message(const sensor_block_t& msg) noexcept;
 // sim_truth_t: 1..MAX_TICKS ticks with the array of that size, each within the position bound;
 // seq and utime >= 0.
 Verdict check_message(const sim_truth_t& msg) noexcept;
-// command_block_t: 1..MAX_TICKS ticks with every array of that size; per tick finite u_ff,
+// command_block_t: 1..MAX_TICKS ticks of 1..MAX_AXES axes with every array of n_values = n_ticks x
+// n_axes; per tick and axis finite u_ff,
 // y_ref finite or NaN (no reference), params_version >= 0, a known mode; seq >= 0,
 // sample_seq >= -1, utime >= 0.
 Verdict check_message(const command_block_t& msg) noexcept;

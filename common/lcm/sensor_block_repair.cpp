@@ -31,6 +31,7 @@ SensorRepair SensorBlockRepair::repair(sensor_block_t& b) noexcept {
   const std::size_t n =
       std::min({b.u_V.size(), b.u_ff_V.size(), b.u_fb_V.size(), b.y_ref_m.size(), b.y_m.size(), b.flags.size()});
   const std::size_t axes = axes_of(b);
+  std::size_t counted_tick = n;  // the last tick counted in r.ticks (n: none yet)
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t axis = i % axes;  // tick-major: the values of one tick, axis by axis
     bool replaced = false;
@@ -62,7 +63,10 @@ SensorRepair SensorBlockRepair::repair(sensor_block_t& b) noexcept {
     }
     last_u_V_[axis] = b.u_V[i];
     last_y_m_[axis] = b.y_m[i];
-    if (replaced) ++r.ticks;
+    if (replaced && i / axes != counted_tick) {
+      counted_tick = i / axes;
+      ++r.ticks;
+    }
   }
   return r;
 }

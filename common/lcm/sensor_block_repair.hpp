@@ -39,7 +39,7 @@ class SensorBlockRepair {
  public:
   // Makes `block` pass check_message (given consistent arrays of 1..MAX_TICKS ticks, as the
   // bridge fills them), and remembers each axis's last good u and y for the next block. A tick
-  // counts once in `ticks` per axis it was replaced on.
+  // counts once in `ticks` whichever of its axes had values replaced.
   SensorRepair repair(sensor_block_t& block) noexcept;
 
  private:

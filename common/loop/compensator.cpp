@@ -218,7 +218,10 @@ void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s, 
   bool moving = false;
   if (!trajectory_starts_now_ && next_tick_ > 0 && counters_.planned > 0 && !in_experiment_ && !awaiting_anchor_) {
     const double t = loop_time(next_tick_);
-    moving = reference_at(t).aim_m != reference_at(t - config_.dt_s).aim_m;
+    const ReferencePoint now = reference_at(t);
+    // A scan that holds its end still carries its decoupling term (the aim is not the sensor's
+    // reference): dropping it would step the inverse's target; it is faded out as a moving one.
+    moving = now.aim_m != reference_at(t - config_.dt_s).aim_m || now.aim_m != now.sensor_m;
   }
   if (moving) {
     previous_trajectory_ = trajectory_;
@@ -226,7 +229,7 @@ void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s, 
     from_moving_ = true;
   }  // else a fade under way (into a hold) goes on into the new approach
   scan_.reset();
-  if (scan) scan_.emplace(ScanInForce{*scan, spec.offset_m, spec.blend_s});
+  if (scan) scan_.emplace(ScanInForce{*scan, spec.offset_m, spec.blend_s, false});
   const bool timed = !std::isnan(start_s);
   if (timed && next_tick_ >= 0 && start_s - spec.blend_s < loop_time(next_tick_)) {
     trajectory_ = spec;
@@ -277,6 +280,19 @@ TrajectoryVerdict Compensator::take_scan(const ScanShare& share, double blend_s)
   hold.blend_s = blend_s;
   hold.validate();
   const double next_s = loop_time(std::max<std::int64_t>(next_tick_, 0));
+  if (in_experiment_ || awaiting_anchor_ || experiments_.running() || experiments_.queued() > 0) {
+    ++counters_.trajectories_refused;
+    throw ParameterError("scan",
+                         "an identification experiment is running or queued: its end restarts the "
+                         "reference, which would leave this axis behind the path the others follow");
+  }
+  if (share.end_s() - next_s > static_cast<double>(kDryRunMaxTicks) * config_.dt_s) {
+    ++counters_.trajectories_refused;
+    throw ParameterError("scan", "ends " + si(share.end_s() - next_s, "s") +
+                                     " of loop time from now; a path is checked whole before it is taken, at "
+                                     "most " +
+                                     si(static_cast<double>(kDryRunMaxTicks) * config_.dt_s, "s") + " ahead");
+  }
   if (share.start_s() - blend_s < next_s) {
     ++counters_.trajectories_refused;
     throw ParameterError("scan.start_s", "must leave the approach (" + si(blend_s, "s") + ") before it: starts at " +
@@ -452,13 +468,33 @@ std::string Compensator::limits_left(const PlanExtent& e) const {
 }
 
 void Compensator::check_running_line(const ModelParamSet& candidate, bool switch_model) const {
-  if (next_tick_ < 0 || in_experiment_ || awaiting_anchor_ || !periodic(trajectory_)) return;
+  if (next_tick_ < 0 || in_experiment_ || awaiting_anchor_) return;
+  const bool scanning = scan_ && !scan_->lines_over;
+  if (!scanning && !periodic(trajectory_)) return;
   const bool in_use = (switch_model && mode_ != FeedforwardMode::kOff) || mode_of(candidate.kind) == mode_ ||
                       (!switch_model && mode_ == FeedforwardMode::kMem);
   if (!in_use) return;    // a set for a model not in use changes nothing the line needs
   Compensator c = *this;  // off the per-sample path: the line planned as if the set were in
   c.pending_ = Pending{candidate, switch_model};
   c.swap_params(next_tick_);
+  if (scanning) {  // what is left of the path, planned under the set (the slew only, as below)
+    c.learner_.stop();
+    c.extent_ = PlanExtent{kInf, -kInf, 0.0, 0};
+    c.last_u_wanted_ = kNaN;
+    const std::int64_t end =
+        std::min(next_tick_ + kDryRunMaxTicks,
+                 static_cast<std::int64_t>(std::ceil((scan_->share.end_s() + 0.01) / config_.dt_s)));
+    for (std::int64_t k = next_tick_; k <= end; ++k) c.plan_tick(k);
+    PlanExtent e = c.extent_;
+    e.u_min_V = std::max(e.u_min_V, config_.u_min_V);
+    e.u_max_V = std::min(e.u_max_V, config_.u_max_V);
+    if (!feasible(e)) {
+      throw ParameterError("params",
+                           "under this set the scan in force (axis " + std::string(axis_name(scan_->share.axis())) +
+                               ") would leave the actuator's limits: " + limits_left(e) + "; the set in use stays");
+    }
+    return;
+  }
   // The slew only: a set asking a volt beyond the range at the line's extremes is clamped there
   // by the plan, a loss of nanometres at two points, where refusing it could keep a set that a
   // wrong start left far off (the demo's repair); beyond the slew the whole line is held back.
@@ -758,8 +794,9 @@ CommandTick Compensator::tracking_tick(std::int64_t k) noexcept {
     learner_restart_ = false;
   }
   // The lines are over: the raster holds its end, no period left to learn.
-  if (scan_ && scan_->share.periodic_part() && t >= scan_->share.end_s() && t - config_.dt_s < scan_->share.end_s()) {
-    learner_.stop();
+  if (scan_ && !scan_->lines_over && t >= scan_->share.end_s()) {
+    scan_->lines_over = true;
+    if (scan_->share.periodic_part()) learner_.stop();
   }
   ReferencePoint ref = reference_at(t);
   if (from_moving_) {

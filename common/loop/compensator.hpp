@@ -209,10 +209,13 @@ class Compensator {
   // same clock: it starts at share.start_s(), which must be at least blend_s after the next tick
   // not yet planned (else ParameterError: the axes would not start together), approached from the
   // reference planned last over blend_s as a trajectory is. Checked by a dry run over the approach
-  // and the whole path (refused, never shaped: shaping one axis would tear the path apart). After
-  // its end the reference holds the path's last point. Learning follows a raster's fast axis when
-  // its share is that axis alone (ScanShare::periodic_part); an experiment or a new trajectory
-  // ends the scan, and so does a restart of the bridge's clock (restarted()).
+  // and the whole path (refused, never shaped: shaping one axis would tear the path apart; a path
+  // ending more than 200,000 ticks ahead, 20 s at 10 kHz, is refused, as is one taken while an
+  // experiment runs or waits). After its end the reference holds the path's last point. Learning follows a
+  // raster's fast axis when its share is that axis alone (ScanShare::periodic_part); an experiment
+  // or a new trajectory ends the scan (a new one fades out its decoupling term over its approach),
+  // and so does a restart of the bridge's clock (restarted()). New parameter sets are checked
+  // against what is left of the path (offer_model, offer_mem_params).
   TrajectoryVerdict take_scan(const ScanShare& share, double blend_s);
   const ScanShare* scan() const noexcept { return scan_ ? &scan_->share : nullptr; }
   // What the plan would need for `spec` from here, without changing anything (a dry run in a copy).
@@ -334,7 +337,8 @@ class Compensator {
   struct ScanInForce {
     ScanShare share;
     double base_m;
-    double blend_s;  // the approach, over which the decoupling's term fades in
+    double blend_s;   // the approach, over which the decoupling's term fades in
+    bool lines_over;  // the path's end has been planned (learning stopped there)
   };
   std::optional<ScanInForce> scan_;
   std::optional<ScanInForce> previous_scan_;  // of previous_trajectory_

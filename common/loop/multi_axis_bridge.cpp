@@ -51,10 +51,12 @@ bool MultiAxisBridge::submit(int axis, const CommandTick& command) noexcept {
 }
 
 void MultiAxisBridge::tick(std::int64_t k, std::span<const double> y_m, std::span<BridgeTick> out) noexcept {
-  // Decided before any axis applies tick k, so that every axis enters the safe state on it.
+  // Decided before any axis applies tick k, so that every axis enters the safe state on it. (An armed
+  // stage with a disarmed axis cannot arise through this interface; it would trip the stage too.)
   if (armed_) {
     for (int i = 0; i < axes_; ++i) {
-      if (!cores_[static_cast<std::size_t>(i)].watchdog_due(k)) continue;
+      const BridgeCore& core = cores_[static_cast<std::size_t>(i)];
+      if (!core.watchdog_due(k) && core.armed()) continue;
       ++stage_trips_;
       tripped_by_ = i;
       disarm();

@@ -1,11 +1,10 @@
 #pragma once
 // The bridge's logic for a stage of several axes on one tick clock: per axis a BridgeCore (its
 // actuator's limits, servo, jitter buffer and safe ramp), and one safe state for the whole stage.
-// An axis whose watchdog is due, or that is disarmed, takes every axis to the safe state on the
-// same tick: the axes of a flexure stage share the moving platform, and one axis holding a scan's
-// voltage while another ramps to its safe voltage would drive the platform along a path nobody
-// planned (and, with the coupling, against the other axis's servo). All axes then ramp to their
-// safe voltages together, each at its own safe_ramp_V_per_s, and are armed again together.
+// An axis whose watchdog is due takes every axis to the safe state on the same tick: the axes of a flexure stage share
+// the moving platform, and one axis holding a scan's voltage while another ramps to its safe voltage would drive the
+// platform along a path nobody planned (and, with the coupling, against the other axis's servo). All axes then ramp to
+// their safe voltages together, each at its own safe_ramp_V_per_s, and are armed again together.
 
 #include <array>
 #include <cstdint>
@@ -27,7 +26,8 @@ class MultiAxisBridge {
   bool submit(int axis, const CommandTick& command) noexcept;
 
   // Every axis's tick k: y_m[i] is axis i's position measured at the end of the previous tick,
-  // out[i] its tick (both at least axes() long). One axis's watchdog trips the stage.
+  // out[i] its tick (both at least axes() long). One axis's watchdog trips the stage. A stage trip
+  // is counted here (stage_trips), the tripping axis's watchdog in its own core's counters.
   void tick(std::int64_t k, std::span<const double> y_m, std::span<BridgeTick> out) noexcept;
 
   void arm(std::int64_t k) noexcept;  // every axis
@@ -35,7 +35,7 @@ class MultiAxisBridge {
   bool armed() const noexcept { return armed_; }
 
   int axes() const noexcept { return axes_; }
-  BridgeCore& axis(int i) noexcept { return cores_[static_cast<std::size_t>(i)]; }
+  // One axis's core, to read (arming and disarming go through the stage: arm(), disarm()).
   const BridgeCore& axis(int i) const noexcept { return cores_[static_cast<std::size_t>(i)]; }
   // How often one axis took the stage to the safe state, and which axis did it last (-1: none).
   std::uint64_t stage_trips() const noexcept { return stage_trips_; }

@@ -19,6 +19,11 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
       stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
 
 void ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept {
+  if (block.n_axes != 1) {  // the refit is one axis's: which axis is which is never guessed
+    counters_.add(ReidentCounter::sensor_blocks_wrong_axes);
+    on_refused_block(block.n_ticks, now_us);
+    return;
+  }
   for_each_tick(block, [this, now_us](const SensorTick& tick) { on_sample(tick, now_us); });
 }
 

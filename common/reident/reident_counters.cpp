@@ -23,6 +23,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "params_invalid",
     "params_implausible",
     "command_versions_dropped",
+    "sensor_blocks_wrong_axes",
     // One per refusal reason, in FitStatus's order from kFirstRefusal.
     "refits_rejected_size_mismatch",
     "refits_rejected_non_finite_data",

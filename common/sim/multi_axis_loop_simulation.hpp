@@ -35,7 +35,7 @@ struct MultiAxisTick {
   AxisPositions u_V{};       // applied
   AxisPositions y_m{};       // measured (sensor noise included)
   AxisPositions y_true_m{};  // the stage's true position per axis, (C s)_j
-  AxisPositions y_ref_m{};   // the axis's reference in force (NaN when none): its share of C^-1 r
+  AxisPositions y_ref_m{};   // the axis's reference in force (NaN when none): its own r_a, what its sensor must read
   std::array<std::int32_t, kScanAxes> flags{};
 };
 
@@ -52,8 +52,11 @@ class MultiAxisLoopSimulation {
   void take_path(const RasterSpec& raster, const AxisCoupling& decoupling, double blend_s);
   void take_path(const LissajousSpec& lissajous, const AxisCoupling& decoupling, double blend_s);
 
-  // A compensator that stops sending one axis's commands (a fault to test the stage's safety).
-  void drop_commands(int axis, bool drop) noexcept { drop_[static_cast<std::size_t>(axis)] = drop; }
+  // A compensator that stops sending one axis's commands (a fault to test the stage's safety). An
+  // axis outside 0..kMaxAxes-1 is ignored.
+  void drop_commands(int axis, bool drop) noexcept {
+    if (axis >= 0 && axis < kMaxAxes) drop_[static_cast<std::size_t>(axis)] = drop;
+  }
 
   int axes() const noexcept { return stage_.axes(); }
   Compensator& compensator(int axis) { return compensators_.at(static_cast<std::size_t>(axis)); }

@@ -3,7 +3,7 @@
 // recorded byte-exact, whatever its type) -> RecordRing -> LogWriter (disk thread) ->
 // LogFileSet. The receive path (LCM's handler, in the thread that calls run()) looks up
 // the channel in a fixed table, checks the ticks of the HX_SENSOR/HX_COMMAND blocks for
-// gaps by decoding into messages reserved for MAX_TICKS, and copies the bytes into the
+// gaps by decoding into messages reserved for MAX_VALUES, and copies the bytes into the
 // ring: no allocation, no lock, no log, no disk. A full ring drops the message and counts
 // it per channel.
 //
@@ -89,7 +89,7 @@ class LoggerService {
   std::unique_ptr<LogFileSet> files_;
   std::unique_ptr<LogWriter> writer_;
   lcm_subscription_t* raw_ = nullptr;
-  sensor_block_t sensor_block_{};  // storage reserved for MAX_TICKS
+  sensor_block_t sensor_block_{};  // storage reserved for MAX_VALUES (MAX_TICKS of MAX_AXES)
   command_block_t command_block_{};
 
   ControlFilter control_filter_{kProcessName};

@@ -224,7 +224,7 @@ TEST(SubscriptionFuzz, CorruptedBuffersNeverCrashAndAreAllCounted) {
   fuzz(originals(&fixtures::control), 6, kFuzzRounds);
 }
 
-// Storage for MAX_TICKS is reserved at construction: blocks of any size, and the corrupt
+// Storage for MAX_VALUES is reserved at construction: blocks of any size, and the corrupt
 // ones, are received without allocating.
 TEST_F(SubscriptionTest, ReceivingBlocksOfAnySizeAllocatesNothing) {
   std::int64_t last = -1;

@@ -1,6 +1,7 @@
 // The compensator following one axis's share of a multi-axis path (Compensator::take_scan).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -106,6 +107,73 @@ TEST(CompensatorScan, ANewTrajectoryEndsTheScan) {
   EXPECT_EQ(loop.comp.scan(), nullptr);
   loop.run(3000);
   EXPECT_NEAR(loop.plan.at(8500).y_ref_m, 0.0, 1e-15);  // faded out into the hold at 0 m
+}
+
+// A finished decoupled scan still holds its decoupling term (y's aim is r_y - 0.03 r_x at the
+// end): what replaces it fades that out over its approach, without a step of the position.
+TEST(CompensatorScan, ReplacingAFinishedDecoupledScanFadesItsDecouplingOut) {
+  CompensatorLoop loop(compensator_config(FeedforwardMode::kMem, 50));
+  loop.run(100);
+  loop.comp.take_scan(ScanShare(raster(), 1, AxisVector(-0.03, 1.0, 0.0)), 0.2);
+  loop.run(9500);  // the lines end at 0.9 s
+  TrajectorySpec hold;
+  hold.blend_s = 0.1;
+  loop.comp.set_trajectory(hold, std::nan(""));
+  loop.run(3000);
+  double largest = 0.0;
+  for (std::size_t k = 9050; k < loop.y_measured.size(); ++k)
+    largest = std::max(largest, std::abs(loop.y_measured[k] - loop.y_measured[k - 1]));
+  // The approach to 0 m moves up to 1.1 nm per tick; a dropped term would step by 15 nm (0.03 x the
+  // fast axis's 0.5 um) in one.
+  EXPECT_LT(largest, 2e-9);
+  EXPECT_NEAR(loop.y_measured.back(), 0.0, 1e-12);
+}
+
+TEST(CompensatorScan, APathThatEndsTooFarAheadToBeCheckedWholeIsRefused) {
+  CompensatorLoop loop(compensator_config(FeedforwardMode::kMem, 50));
+  loop.run(100);
+  RasterSpec late = raster();
+  late.start_s = 25.0;  // ends at 25.4 s: beyond the 20 s the dry run covers
+  EXPECT_EQ(refused_field([&] { loop.comp.take_scan(ScanShare(late, 0, AxisVector(1.0, 0.0, 0.0)), 0.2); }), "scan");
+  EXPECT_EQ(loop.comp.scan(), nullptr);
+}
+
+TEST(CompensatorScan, AScanIsNotTakenWhileAnExperimentRunsOrWaits) {
+  CompensatorLoop loop(compensator_config(FeedforwardMode::kMem, 50));
+  loop.run(100);
+  ExperimentSpec e;
+  e.amplitude_V = 10.0;
+  e.duration_s = 0.2;
+  loop.comp.start_experiment(e);
+  RasterSpec r = raster();
+  r.start_s = 1.0;
+  EXPECT_EQ(refused_field([&] { loop.comp.take_scan(ScanShare(r, 0, AxisVector(1.0, 0.0, 0.0)), 0.2); }), "scan");
+  EXPECT_EQ(loop.comp.scan(), nullptr);
+  loop.run(4000);  // the experiment is over and the plan anchored: now it is taken
+  loop.comp.take_scan(ScanShare(r, 0, AxisVector(1.0, 0.0, 0.0)), 0.2);
+  EXPECT_NE(loop.comp.scan(), nullptr);
+}
+
+TEST(CompensatorScan, AParameterSetUnderWhichTheRestOfTheScanWouldLeaveTheLimitsIsRefused) {
+  CompensatorConfig c;  // the real actuator: 5e4 V/s
+  c.horizon_ticks = 50;
+  CompensatorLoop loop(c);
+  loop.run(100);
+  RasterSpec fast = raster();
+  fast.width_m = 3e-6;  // 3 um lines at 50 lines/s: about half the slew limit
+  fast.line_rate_hz = 50.0;
+  loop.comp.take_scan(ScanShare(fast, 0, AxisVector(1.0, 0.0, 0.0)), 0.2);
+  loop.run(5500);  // on the lines
+  MemParams soft = loop.comp.mem_params();
+  soft.c1 *= 0.4;  // a stage 2.5 times softer: the same lines need 2.5 times the voltage rate
+  soft.c2 *= 0.4;
+  EXPECT_EQ(refused_field([&] { loop.comp.offer_mem_params(soft, 2); }), "params");
+  EXPECT_FALSE(loop.comp.params_pending());
+  MemParams stiff = loop.comp.mem_params();
+  stiff.c1 *= 1.1;
+  stiff.c2 *= 1.1;
+  loop.comp.offer_mem_params(stiff, 3);  // needs less: taken
+  EXPECT_TRUE(loop.comp.params_pending());
 }
 
 }  // namespace

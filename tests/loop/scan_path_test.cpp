@@ -440,6 +440,7 @@ TEST(ScanShare, TheSharesOfTheInverseCouplingAddUpToThePathThroughTheStage) {
   const AxisCoupling c = coupled();
   const RasterSpec s = raster(SlowMode::kRamp);
   std::vector<ScanShare> shares;
+  shares.reserve(3);
   for (int axis = 0; axis < 3; ++axis) shares.emplace_back(s, axis, c.inverse_matrix().row(axis).transpose());
   for (double t = 0.45; t < 0.6; t += 1.3e-4) {
     AxisVector w;
@@ -473,13 +474,21 @@ TEST(ScanShare, RefusesARowWithoutItsOwnAxisOrWithANonFiniteWeight) {
 
 TEST(ScanShare, EvaluatesWithoutAllocating) {
   const ScanShare share(raster(), 1, coupled().inverse_matrix().row(1).transpose());
+  LissajousSpec l;
+  l.amplitude_m = {1e-6, 2e-6, 0.0};
+  l.frequency_hz = {50.0, 49.0, 1.0};
+  const ScanShare figure(l, 0, coupled().inverse_matrix().row(0).transpose());
   double sum = 0.0;
   {
     const testing::AllocationCounter count;
-    for (int n = 0; n < 1000; ++n) sum += share.at(0.5 + n * kDt);
+    for (int n = 0; n < 1000; ++n) sum += share.at(0.5 + n * kDt) + figure.point(n * kDt).own_m;
     EXPECT_EQ(count.allocations(), 0u);
   }
   EXPECT_TRUE(std::isfinite(sum));
+  // The figure's share is its row times the axes' sines.
+  const AxisPositions r = evaluate(l, 0.0123);
+  const AxisVector row = coupled().inverse_matrix().row(0).transpose();
+  EXPECT_NEAR(figure.at(0.0123), row[0] * r[kX] + row[1] * r[kY] + row[2] * r[kZ], 1e-20);
 }
 
 }  // namespace

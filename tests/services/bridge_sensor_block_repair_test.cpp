@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -128,6 +129,32 @@ TEST(BridgeSensorBlockRepair, AServoGoneWildStillLeavesEveryTickInTheRecord) {
       EXPECT_NE(b.flags[static_cast<std::size_t>(i)] & kSaturated, 0) << i;
     }
   }
+}
+
+// With several axes each keeps its own last good values: a lost y reading of axis y is y's last
+// good one, never x's; a tick counts once whichever axes were repaired.
+TEST(SensorBlockRepair, EachAxisKeepsItsOwnLastGoodValues) {
+  sensor_block_t b{};
+  reserve_storage(b);
+  begin_block(b, 0, 1000, 1e-4, 2);
+  const std::array<SensorTick, 2> first{tick(0, 1.0, 0.0, 1e-6), tick(0, 2.0, 0.0, -3e-6)};
+  const std::array<SensorTick, 2> lost{tick(1, kNaN, 0.0, 1.1e-6), tick(1, 2.5, 0.0, kNaN)};
+  const std::array<SensorTick, 2> both{tick(2, kInf, 0.0, kNaN), tick(2, kNaN, 0.0, kInf)};
+  ASSERT_TRUE(append_tick(b, first));
+  ASSERT_TRUE(append_tick(b, lost));
+  ASSERT_TRUE(append_tick(b, both));
+  SensorBlockRepair repair;
+  const SensorRepair r = repair.repair(b);
+  EXPECT_EQ(check_message(b), Verdict::kOk);
+  EXPECT_EQ(r.ticks, 2);                                  // ticks 1 and 2, each once
+  EXPECT_EQ(sensor_tick(b, 1, 0).u_V, 1.0);               // x's last good u
+  EXPECT_EQ(sensor_tick(b, 1, 1).y_m, -3e-6);             // y's last good y, not x's 1.1e-6
+  EXPECT_EQ(sensor_tick(b, 2, 0).y_m, 1.1e-6);            // x's last good y
+  EXPECT_EQ(sensor_tick(b, 2, 1).u_V, 2.5);               // y's last good u
+  EXPECT_EQ(sensor_tick(b, 2, 1).y_m, -3e-6);             // again y's own
+  EXPECT_EQ(sensor_tick(b, 2, 0).u_V, kMaxAbsVoltage_V);  // an infinite voltage clamped to the bound
+  EXPECT_NE(sensor_tick(b, 1, 1).flags & kSensorFault, 0);
+  EXPECT_EQ(sensor_tick(b, 1, 0).flags & kSensorFault, 0);
 }
 
 }  // namespace

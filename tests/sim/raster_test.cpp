@@ -1,6 +1,6 @@
 // A raster on the simulated XY stage (sim/raster_experiment.hpp), in process: 1 um x 1 um at a
 // 50 Hz line rate, 64 lines, x coupled into y by 3 %, per axis the loop of a line-rate scan (the
-// identified model, the stage's inverse, the servo). The figures are docs/SCANNING.md's
+// identified model, the stage's inverse, the servo). The figures are docs/TRACKING.md's
 // (bench/raster_table prints them and draws the error maps). The runs are deterministic (seeded
 // sensor noise), so the comparisons between them are exact, not statistical.
 #include "sim/raster_experiment.hpp"
