@@ -73,11 +73,56 @@ void run_path(MultiAxisLoopSimulation& sim, const Path& path, const AxisCoupling
   run.stage_trips = sim.bridge().stage_trips();
 }
 
-AxisCoupling decoupling_of(const MultiAxisLoopConfig& c, const PathLoopOptions& o) {
-  return o.decouple ? c.stage.coupling : AxisCoupling::identity(o.axes);
+// The decoupling a run uses: none, the stage's own coupling, or the one identified on it (refused:
+// nullopt, the reason in run.reason).
+std::optional<AxisCoupling> decoupling_of(const TrackingExperiment& e, const IdentifiedModels& models,
+                                          const MultiAxisLoopConfig& c, const PathLoopOptions& o, PathRun& run) {
+  if (!o.decouple) return AxisCoupling::identity(o.axes);
+  if (!o.identified_decoupling) return c.stage.coupling;
+  run.coupling_fit = identify_coupling(e, models, o);
+  if (run.coupling_fit->ok()) return run.coupling_fit->coupling;
+  run.refused = true;
+  run.reason = "coupling identification: " + run.coupling_fit->reason;
+  return std::nullopt;
 }
 
 }  // namespace
+
+CouplingFitResult identify_coupling(const TrackingExperiment& e, const IdentifiedModels& models,
+                                    const PathLoopOptions& o, double amplitude_V) {
+  PathLoopOptions open_loop = o;
+  open_loop.loop.servo = false;
+  const MultiAxisLoopConfig c = path_loop_config(e, models, open_loop);
+  MultiAxisLoopSimulation sim(c);
+  const auto axes = static_cast<std::size_t>(sim.axes());
+  ExperimentSpec spec;
+  spec.amplitude_V = amplitude_V;
+  spec.frequency_hz = 5.0;
+  spec.duration_s = 0.8;
+  std::array<std::array<std::vector<double>, kScanAxes>, kScanAxes> records;
+  std::vector<AxisExcitation> experiments;
+  sim.run(0.05);  // the first samples: each plan knows where its axis is
+  for (std::size_t moved = 0; moved < axes; ++moved) {
+    sim.compensator(static_cast<int>(moved)).start_experiment(spec);
+    // The experiment starts at the next tick not yet planned (the horizon ahead) and lasts its
+    // periods; the samples of its ticks (mode experiment on the moved axis) are what is fitted.
+    sim.run(spec.duration_s + 0.2, [&](const MultiAxisTick& tick) {
+      if (std::isnan(tick.y_ref_m[moved]) && tick.u_V[moved] != 0.0) {
+        for (std::size_t j = 0; j < axes; ++j) records[moved][j].push_back(tick.y_m[j]);
+      }
+    });
+    // After its experiment an axis approaches its reference again (over 0.5 s): the next axis's
+    // experiment waits for it, or that motion would read as coupling.
+    sim.run(1.0);
+    AxisExcitation x;
+    x.axis = static_cast<int>(moved);
+    for (std::size_t j = 0; j < axes; ++j) x.y_m[j] = records[moved][j];
+    experiments.push_back(x);
+  }
+  CouplingFitOptions fit;
+  fit.axes = static_cast<int>(axes);
+  return fit_coupling(experiments, fit);
+}
 
 RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models, const RasterOptions& o) {
   const MultiAxisLoopConfig c = path_loop_config(e, models, o);
@@ -99,7 +144,9 @@ RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models
   r.start_s = kStartS;
   r.settle_s = 0.05;
   const double lines_end_s = r.start_s + r.lines / r.line_rate_hz;
-  run_path(sim, r, decoupling_of(c, o), r.start_s, lines_end_s, r.start_s + raster_duration_s(r), run);
+  const std::optional<AxisCoupling> decoupling = decoupling_of(e, models, c, o, run);
+  if (!decoupling) return run;
+  run_path(sim, r, *decoupling, r.start_s, lines_end_s, r.start_s + raster_duration_s(r), run);
   return run;
 }
 
@@ -114,7 +161,9 @@ LissajousRun run_lissajous(const TrackingExperiment& e, const IdentifiedModels& 
   l.duration_s = o.duration_s;
   l.start_s = kStartS;
   const double end_s = l.start_s + l.duration_s;
-  run_path(sim, l, decoupling_of(c, o), l.start_s, end_s, end_s + 0.05, run);
+  const std::optional<AxisCoupling> decoupling = decoupling_of(e, models, c, o, run);
+  if (!decoupling) return run;
+  run_path(sim, l, *decoupling, l.start_s, end_s, end_s + 0.05, run);
   return run;
 }
 

@@ -9,9 +9,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "ident/coupling_fit.hpp"
 #include "sim/multi_axis_loop_simulation.hpp"
 #include "sim/scan_experiment.hpp"
 
@@ -22,8 +24,11 @@ struct PathLoopOptions {
   int axes = 2;            // 2 (XY) or 3 (XYZ: z holds its centre under the coupling of x and y)
   double coupling = 0.03;  // x -> y (and x, y -> z with three axes): flexure_stage()
   bool decouple = true;    // the shares of C^{-1} r; false: each axis its own reference
-  bool learning = false;   // a raster's fast axis learns from its lines
-  ScanOptions loop{};      // per axis: servo, stage inverse, block size (its learning is `learning`)
+  // Decouple with the coupling identified on the stage first (identify_coupling), as a lab must,
+  // instead of the simulated stage's true one.
+  bool identified_decoupling = false;
+  bool learning = false;  // a raster's fast axis learns from its lines
+  ScanOptions loop{};     // per axis: servo, stage inverse, block size (its learning is `learning`)
 };
 
 struct RasterOptions : PathLoopOptions {
@@ -52,6 +57,8 @@ struct PathRun {
   std::array<std::vector<double>, kScanAxes> error_m;
   std::uint64_t clamped_ticks = 0;  // bridge ticks clamped (range or slew) on any axis, from the approach on
   std::uint64_t stage_trips = 0;
+  // With identified_decoupling: the identification the decoupling used (refused: the run is too).
+  std::optional<CouplingFitResult> coupling_fit;
 };
 
 struct RasterRun : PathRun {
@@ -61,6 +68,14 @@ struct RasterRun : PathRun {
 struct LissajousRun : PathRun {
   LissajousSpec figure;  // as run
 };
+
+// The coupling experiment a lab runs on the stage: each axis in turn driven by a sine of
+// `amplitude_V` at 5 Hz (four periods, the compensator's identification experiment) with every
+// servo off (a servo would hold the other axes against the very coupling to be measured) and
+// the other axes holding, every sensor recorded, one second between experiments for the axis
+// just excited to come back to rest; fit_coupling on the records.
+CouplingFitResult identify_coupling(const TrackingExperiment& e, const IdentifiedModels& models,
+                                    const PathLoopOptions& o, double amplitude_V = 100.0);
 
 RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models, const RasterOptions& o);
 LissajousRun run_lissajous(const TrackingExperiment& e, const IdentifiedModels& models, const LissajousOptions& o);

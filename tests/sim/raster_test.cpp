@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace hystloop {
@@ -54,6 +55,31 @@ TEST_F(Raster, WithoutDecouplingTheSlowAxisCarriesTheCoupling) {
   const RasterRun bare = run_raster(experiment_, models_, o);
   ASSERT_FALSE(bare.refused) << bare.reason;
   EXPECT_GT(bare.stats[1].rms_true_m, 8e-9);
+}
+
+TEST_F(Raster, TheCouplingIdentifiedOnTheStageDecouplesItsRaster) {
+  RasterOptions o;
+  const CouplingFitResult fit = identify_coupling(experiment_, models_, o);
+  ASSERT_TRUE(fit.ok()) << fit.reason;
+  const AxisMatrix truth = flexure_stage(2, o.coupling).coupling.matrix();
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      if (i == j) continue;
+      EXPECT_GT(fit.standard_error(j, i), 0.0);
+      EXPECT_LT(std::abs(fit.estimate(j, i) - truth(j, i)), 4.0 * fit.standard_error(j, i))
+          << "C(" << j << "," << i << ") = " << fit.estimate(j, i) << " +- " << fit.standard_error(j, i);
+    }
+  }
+  o.identified_decoupling = true;
+  const RasterRun run = run_raster(experiment_, models_, o);
+  ASSERT_FALSE(run.refused) << run.reason;
+  ASSERT_TRUE(run.coupling_fit && run.coupling_fit->ok());
+  std::printf("identified x->y %.5f +- %.1e, y->x %.5f; raster with it: x %.3f nm, y %.3f nm\n", fit.estimate(1, 0),
+              fit.standard_error(1, 0), fit.estimate(0, 1), run.stats[0].rms_true_m * 1e9,
+              run.stats[1].rms_true_m * 1e9);
+  EXPECT_LE(run.stats[0].rms_true_m, 2e-9);
+  EXPECT_LE(run.stats[1].rms_true_m, 1e-9);
+  EXPECT_EQ(run.clamped_ticks, 0u);
 }
 
 TEST_F(Raster, AnAxisCountTheDecouplingDoesNotMatchIsRefused) {
