@@ -45,6 +45,7 @@ struct IdentifyArgs {
   std::string time_from = "seq";
   std::optional<double> from_s, to_s;
   std::optional<std::size_t> experiment;
+  int axis = 0;  // --axis x|y|z: whose samples (and experiments) of a log of several axes
   double max_late = 0.02;
   double max_missing = 0.01;
   // --publish; its rig prefix and compensator name also say whose channels a log is read from

@@ -341,6 +341,7 @@ ExperimentLogOptions experiment_options(const IdentifyArgs& args) {
   o.max_not_as_commanded = args.max_late;
   o.max_missing = args.max_missing;
   o.rate_independent_below_Hz = BanningFitOptions{}.frequency_threshold_Hz;
+  o.axis = args.axis;
   return o;
 }
 
@@ -412,6 +413,7 @@ std::vector<SampleTable> read_inputs(const IdentifyArgs& args, bool logs) {
   o.dt_s = args.dt_s;
   o.from_s = args.from_s;
   o.to_s = args.to_s;
+  o.axis = args.axis;
   if (args.experiment) {
     // One experiment the loop ran (e.g. hystloop-ctl experiment --mem-paper), as listed.
     LoggedExperiments logged = read_experiments(args);

@@ -69,13 +69,23 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
     if (event.channel == o.sensor_channel) {
       if (decode_logged(event, sensor) && check_message(sensor) == Verdict::kOk) {
-        for_each_tick(sensor, [&](const SensorTick& t) { r.samples.push_back({t.seq, t.u_V, t.y_m, t.flags}); });
+        require_axis_in(sensor, o.axis, event.channel + " event " + std::to_string(event.eventnum));
+        for_each_tick(
+            sensor,
+            [&](const SensorTick& t) {
+              r.samples.push_back({t.seq, t.u_V, t.y_m, t.flags});
+            },
+            static_cast<std::size_t>(o.axis));
       }
     } else if (event.channel == o.command_channel) {
-      if (decode_logged(event, command) && check_message(command) == Verdict::kOk) {
-        for_each_tick(command, [&](const CommandTick& t) {
-          r.commands.push_back({t.seq, event.timestamp, t.u_ff_V, t.mode == command_block_t::MODE_EXPERIMENT});
-        });
+      if (decode_logged(event, command) && check_message(command) == Verdict::kOk &&
+          o.axis < static_cast<int>(axes_of(command))) {
+        for_each_tick(
+            command,
+            [&](const CommandTick& t) {
+              r.commands.push_back({t.seq, event.timestamp, t.u_ff_V, t.mode == command_block_t::MODE_EXPERIMENT});
+            },
+            static_cast<std::size_t>(o.axis));
       }
     } else if (event.channel == o.control_channel) {
       if (!decode_logged(event, control) || check_message(control) != Verdict::kOk) return;
@@ -217,6 +227,7 @@ void ExperimentLogOptions::validate() const {
   require_in_range("max_not_as_commanded", max_not_as_commanded, 0.0, 1.0);
   require_in_range("max_missing", max_missing, 0.0, 1.0);
   require_positive("rate_independent_below_Hz", rate_independent_below_Hz);
+  require_in_range("axis", axis, 0, sensor_block_t::MAX_AXES - 1);
 }
 
 LoggedExperiments read_logged_experiments(const std::vector<std::string>& files, const ExperimentLogOptions& o) {

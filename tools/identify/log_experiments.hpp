@@ -42,7 +42,8 @@ struct ExperimentLogOptions {
   double max_not_as_commanded = 0.02;               // fraction of a fast experiment's samples, in [0, 1]
   double max_missing = 0.01;                        // fraction of a slow experiment's ticks, in [0, 1]
   double rate_independent_below_Hz = 10.0;          // BanningFitOptions::frequency_threshold_Hz
-  void validate() const;                            // throws ParameterError naming the field
+  int axis = 0;           // whose samples and commands: an experiment is the ticks this axis's commands mark as one
+  void validate() const;  // throws ParameterError naming the field
 };
 
 struct LoggedExperiment {

@@ -29,15 +29,21 @@ class RecordBuilder {
   // One block: refused if a tick's u or y is not finite, counted if it breaks the contract,
   // else its ticks in order.
   void add(const std::string& file, std::int64_t eventnum, const sensor_block_t& block) {
-    for_each_tick(block, [&](const SensorTick& s) {
-      if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
-      throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) +
-                           "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") +
-                           " is not finite (u_V = " + number_text(s.u_V) + ", y_m = " + number_text(s.y_m) + ")");
-    });
+    require_axis_in(block, options_.axis, where(file, eventnum));
+    const auto axis = static_cast<std::size_t>(options_.axis);
+    for_each_tick(
+        block,
+        [&](const SensorTick& s) {
+          if (std::isfinite(s.u_V) && std::isfinite(s.y_m)) return;
+          throw SampleLogError(where(file, eventnum) + " (seq " + std::to_string(s.seq) +
+                               "): " + (std::isfinite(s.u_V) ? "y_m" : "u_V") +
+                               " is not finite (u_V = " + number_text(s.u_V) + ", y_m = " + number_text(s.y_m) + ")");
+        },
+        axis);
     if (check_message(block) != Verdict::kOk) return void(++out_.undecodable);
     out_.sensor_ticks += static_cast<std::size_t>(block.n_ticks);
-    for_each_tick(block, [&](const SensorTick& s) { add_tick(file, eventnum, s); });
+    for_each_tick(
+        block, [&](const SensorTick& s) { add_tick(file, eventnum, s); }, axis);
     previous_block_first_ = std::max(previous_block_first_.value_or(block.seq), block.seq);
   }
 
@@ -96,8 +102,18 @@ class RecordBuilder {
 
 }  // namespace
 
+void require_axis_in(const sensor_block_t& block, int axis, const std::string& where) {
+  const int axes = static_cast<int>(axes_of(block));
+  if (axis < axes) return;
+  std::string names;
+  for (int a = 0; a < axes; ++a) names += std::string(a == 0 ? "" : a + 1 == axes ? " and " : ", ") + "xyz"[a];
+  throw SampleLogError(where + ": its blocks carry " + std::to_string(axes) + (axes == 1 ? " axis (" : " axes (") +
+                       names + "), not " + "xyz"[axis] + " (--axis)");
+}
+
 void LogReadOptions::validate() const {
   if (sensor_channel.empty()) throw ParameterError("sensor_channel", "must not be empty");
+  require_in_range("axis", axis, 0, sensor_block_t::MAX_AXES - 1);
   require_positive("dt", dt_s);
   if (from_s) require_non_negative("from", *from_s);
   if (to_s) {

@@ -1,9 +1,9 @@
 #pragma once
-// Identification samples from LCM event logs: the ticks of the rig's HX_SENSOR sensor_block_t
-// messages (common/lcm/blocks.hpp), read with lcm::LogFile from one or several files in the
-// order given (a rotated recording is one record), into the same SampleTable the CSV reader
-// makes: one sample per tick, u = u_V, y = y_m, and t = (seq - seq of the first tick) * dt, or
-// from the tick's utime.
+// Identification samples from LCM event logs: the ticks of one axis of the rig's HX_SENSOR
+// sensor_block_t messages (common/lcm/blocks.hpp; x unless LogReadOptions::axis says another), read with lcm::LogFile
+// from one or several files in the order given (a rotated recording is one record), into the same SampleTable the CSV
+// reader makes: one sample per tick, u = u_V, y = y_m, and t = (seq - seq of the first tick) * dt, or from the tick's
+// utime.
 //
 // What a recording may hold and what becomes of it:
 //  - ticks flagged SAFE_STATE (the bridge holding the safe voltage, not the experiment) or
@@ -29,6 +29,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "hystloop/sensor_block_t.hpp"
 #include "ident/sample_csv.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/rig_auth.hpp"
@@ -42,6 +43,9 @@ class SampleLogError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Throws SampleLogError unless `block` carries `axis`: "<where>: its blocks carry 1 axis (x), not y".
+void require_axis_in(const sensor_block_t& block, int axis, const std::string& where);
+
 enum class LogTimeBase { seq, utime };
 
 struct LogReadOptions {
@@ -51,8 +55,11 @@ struct LogReadOptions {
   // Time range [from, to) relative to the first sample of the record [s]; empty = open.
   std::optional<double> from_s;
   std::optional<double> to_s;
+  // The axis whose samples are read (0 x, 1 y, 2 z): blocks carry every axis of the stage. A block
+  // without it (a one-axis record read for y) is refused, naming the axes it has.
+  int axis = 0;
 
-  // Throws ParameterError naming the field ("dt", "from", "to").
+  // Throws ParameterError naming the field ("dt", "from", "to", "axis").
   void validate() const;
 };
 

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -68,6 +69,62 @@ TEST_F(IdentifyLog, SkipsFlaggedSamplesCountsTheGapAndIgnoresOtherChannels) {
   const std::string text = describe(s, {});
   EXPECT_NE(text.find("10 SAFE_STATE, 3 SENSOR_FAULT"), std::string::npos) << text;
   EXPECT_NE(text.find("seq gaps: 1 (50 samples missing); seq 13000 +50"), std::string::npos) << text;
+}
+
+// A stage of two axes: every block carries x and y. x is the record, y the same stage twice as
+// stiff (half the travel); --axis chooses, and an axis the blocks do not carry is refused.
+void write_two_axis_log(const std::string& file, const std::vector<SensorTick>& x) {
+  lcm::LogFile log(file, "w");
+  ASSERT_TRUE(log.good()) << file;
+  std::int64_t eventnum = 0;
+  for (const auto& [first, last] : block_ranges(x, 0, x.size())) {
+    sensor_block_t b{};
+    begin_block(b, x[first].seq, x[first].utime, 1e-4, 2);
+    for (std::size_t i = first; i < last; ++i) {
+      SensorTick y = x[i];
+      y.y_m = 0.5 * x[i].y_m;
+      const std::array<SensorTick, 2> both{x[i], y};
+      ASSERT_TRUE(append_tick(b, both));
+    }
+    write_event(log, eventnum, x[last - 1].utime, "HX_SENSOR", encoded(b));
+  }
+}
+
+TEST_F(IdentifyLog, TheAxisOfAStageOfSeveralIsChosenAndOneTheBlocksLackIsRefused) {
+  const auto record = mem_record(truth_);
+  write_two_axis_log(path("xy.lcmlog"), record);
+  const LogSamples x = read_sample_logs({path("xy.lcmlog")}, {});
+  LogReadOptions on_y;
+  on_y.axis = 1;
+  const LogSamples y = read_sample_logs({path("xy.lcmlog")}, on_y);
+  ASSERT_EQ(x.table.y.size(), record.size());
+  ASSERT_EQ(y.table.y.size(), record.size());
+  for (std::size_t i = 0; i < record.size(); i += 997) {
+    EXPECT_EQ(x.table.y[i], record[i].y_m) << i;
+    EXPECT_EQ(y.table.y[i], 0.5 * record[i].y_m) << i;
+    EXPECT_EQ(y.table.u[i], record[i].u_V) << i;
+  }
+  LogReadOptions on_z;
+  on_z.axis = 2;
+  try {
+    read_sample_logs({path("xy.lcmlog")}, on_z);
+    FAIL() << "z read from blocks of x and y";
+  } catch (const SampleLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("its blocks carry 2 axes (x and y), not z (--axis)"), std::string::npos)
+        << e.what();
+  }
+  // The tool: y's linear gain is half x's; z is refused; an axis that is no axis is a usage error.
+  const ToolRun gx = run_tool(path("xy.lcmlog") + " --model linear --out " + path("x.yaml"));
+  const ToolRun gy = run_tool(path("xy.lcmlog") + " --model linear --axis y --out " + path("y.yaml"));
+  ASSERT_EQ(gx.exit_code, 0) << gx.output;
+  ASSERT_EQ(gy.exit_code, 0) << gy.output;
+  const double gain_x = YAML::LoadFile(path("x.yaml"))["linear"]["gain"].as<double>();
+  const double gain_y = YAML::LoadFile(path("y.yaml"))["linear"]["gain"].as<double>();
+  EXPECT_NEAR(gain_y / gain_x, 0.5, 1e-9);
+  const ToolRun gz = run_tool(path("xy.lcmlog") + " --model linear --axis z --out " + path("z.yaml"));
+  EXPECT_EQ(gz.exit_code, 2) << gz.output;
+  EXPECT_NE(gz.output.find("not z (--axis)"), std::string::npos) << gz.output;
+  EXPECT_EQ(run_tool(path("xy.lcmlog") + " --model linear --axis w").exit_code, 2);
 }
 
 TEST_F(IdentifyLog, TimeFromUtimeAndAnotherRig) {
