@@ -1,7 +1,9 @@
 #include "command_alteration.hpp"
 
+#include <array>
 #include <bit>
 #include <set>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -33,14 +35,18 @@ AlterationResult write_altered_log(const std::filesystem::path& log, const std::
         if (!target && first_time && wanted) target = t.seq;
       });
       if (target) {
-        begin_block(altered, msg.seq, msg.utime, msg.sample_seq);
-        for_each_tick(msg, [&](CommandTick t) {
-          if (t.seq == *target) {
-            done = AlterationResult{t.seq, t.u_ff_V, changed(t.u_ff_V)};
-            t.u_ff_V = done->new_u_ff_V;
+        // The block rebuilt with every axis it carries; x's command at the target tick altered.
+        const std::size_t axes = axes_of(msg);
+        begin_block(altered, msg.seq, msg.utime, msg.sample_seq, static_cast<int>(axes));
+        for (std::size_t i = 0, n = ticks_of(msg); i < n; ++i) {
+          std::array<CommandTick, command_block_t::MAX_AXES> tick{};
+          for (std::size_t a = 0; a < axes; ++a) tick[a] = command_tick(msg, i, a);
+          if (tick[0].seq == *target) {
+            done = AlterationResult{tick[0].seq, tick[0].u_ff_V, changed(tick[0].u_ff_V)};
+            tick[0].u_ff_V = done->new_u_ff_V;
           }
-          append_tick(altered, t);
-        });
+          append_tick(altered, std::span<const CommandTick>(tick.data(), axes));
+        }
         buffer.resize(static_cast<std::size_t>(altered.getEncodedSize()));
         altered.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
         copy.data = buffer.data();

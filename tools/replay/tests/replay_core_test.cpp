@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "command_alteration.hpp"
 #include "command_comparison.hpp"
 #include "core/errors.hpp"
+#include "decode.hpp"
 #include "lcm/blocks.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
@@ -279,7 +281,7 @@ struct TempDir {
 // block 6 carries ticks 100..119. A control before its start, one after its start but before
 // block 2, params mid-run; a status of another process first.
 std::filesystem::path write_recorded_log(const std::filesystem::path& dir) {
-  const auto path = dir / "recorded.lcmlog";
+  auto path = dir / "recorded.lcmlog";
   const ChannelNames c;
   LogWriter w(path);
   w.write(999'000, c.status, status_msg("bridge", 900'000));
@@ -445,6 +447,40 @@ TEST(CommandAlteration, ChangesExactlyOneTickAndTheComparisonNamesIt) {
   EXPECT_EQ(write_altered_log(recorded, altered, c, {0, 10, std::nullopt}).seq, 39);
   EXPECT_EQ(write_altered_log(recorded, altered, c, {0, 60, std::nullopt}).seq, 89);
   EXPECT_THROW(write_altered_log(recorded, altered, c, {0, 1000, std::nullopt}), std::runtime_error);
+}
+
+// A log of two axes: the altered block keeps both, y's commands untouched.
+TEST(CommandAlteration, KeepsEveryAxisOfABlock) {
+  TempDir tmp;
+  const auto recorded = tmp.path / "xy.lcmlog";
+  const ChannelNames c;
+  command_block_t xy{};
+  {
+    LogWriter w(recorded);
+    begin_block(xy, 30, 1'000'000, 29, 2);
+    for (std::int64_t t = 30; t < 40; ++t) {
+      const std::array<CommandTick, 2> both{CommandTick{t, 0.25 * static_cast<double>(t), 1e-9, 1, 2},
+                                            CommandTick{t, -0.5 * static_cast<double>(t), 2e-9, 1, 2}};
+      ASSERT_TRUE(append_tick(xy, both));
+    }
+    w.write(1'000'100, c.command, xy);
+  }
+  const auto altered = tmp.path / "altered.lcmlog";
+  const auto r = write_altered_log(recorded, altered, c, {35, std::nullopt, 1.0});
+  EXPECT_EQ(r.seq, 35);
+  lcm::LogFile log(altered.string(), "r");
+  const lcm::LogEvent* e = log.readNextEvent();
+  ASSERT_NE(e, nullptr);
+  command_block_t got{};
+  ASSERT_TRUE(report::decode_checked(*e, got));
+  ASSERT_EQ(got.n_axes, 2);
+  ASSERT_EQ(got.n_ticks, 10);
+  for (std::size_t i = 0; i < 10; ++i) {
+    const double t = 30.0 + static_cast<double>(i);
+    EXPECT_EQ(command_tick(got, i, 0).u_ff_V, 0.25 * t + (i == 5 ? 1.0 : 0.0)) << i;
+    EXPECT_EQ(command_tick(got, i, 1).u_ff_V, -0.5 * t) << i;
+    EXPECT_EQ(command_tick(got, i, 1).y_ref_m, 2e-9) << i;
+  }
 }
 
 }  // namespace
