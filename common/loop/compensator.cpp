@@ -30,6 +30,10 @@ constexpr std::int64_t kDryRunMaxTicks = 200'000;
 std::string si(double value, const char* unit) { return number_text(value, 3) + " " + unit; }
 }  // namespace
 
+double resonance_corner_s(const StageModel& stage) noexcept {
+  return stage.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency() : 0.0;
+}
+
 // Each online model's mode number is its registry entry's (models/model_set.hpp).
 FeedforwardMode mode_of(ModelKind kind) noexcept {
   FeedforwardMode mode = FeedforwardMode::kOff;
@@ -247,6 +251,10 @@ void Compensator::apply_trajectory(const TrajectorySpec& given, double start_s, 
 }
 
 PlanExtent Compensator::dry_run(const TrajectorySpec& spec, double start_s) const {
+  return dry_run(spec, start_s, nullptr);
+}
+
+PlanExtent Compensator::dry_run(const TrajectorySpec& spec, double start_s, const ScanShare* scan) const {
   Compensator c = *this;  // off the per-sample path: a copy plans what this one would
   c.learner_.stop();
   c.experiments_.stop(loop_time(std::max<std::int64_t>(next_tick_, 0)));
@@ -256,18 +264,25 @@ PlanExtent Compensator::dry_run(const TrajectorySpec& spec, double start_s) cons
     c.in_experiment_ = false;
     c.restart_reference(c.loop_time(k), c.last_ref_);
   }
-  c.apply_trajectory(spec, start_s);
+  c.apply_trajectory(spec, start_s, scan);
   c.extent_ = PlanExtent{kInf, -kInf, 0.0, 0};
   c.last_u_wanted_ = kNaN;
-  TrajectorySpec from_here = spec;
-  from_here.hold_m = c.last_ref_;  // where the approach starts decides where the shape is entered
-  const double t0 =
-      (c.trajectory_starts_now_ ? c.loop_time(k) + spec.blend_s : c.trajectory_.start_s) + first_extreme_s(from_here);
-  double span = 0.01;
-  if (periodic(spec)) span = kDryRunPeriods / spec.frequency_hz;
-  if (spec.shape == TrajectoryShape::kPoints && spec.n_points > 0) span = spec.points_t_s[spec.n_points - 1] + 0.01;
-  const std::int64_t end =
-      std::min(k + kDryRunMaxTicks, static_cast<std::int64_t>(std::ceil((t0 + span) / config_.dt_s)));
+  // Through the approach and what shows what the reference needs: a scan's whole path, a periodic
+  // shape's first periods, a point list's points.
+  double until_s = 0.0;
+  if (scan != nullptr) {
+    until_s = scan->end_s() + 0.01;
+  } else {
+    TrajectorySpec from_here = spec;
+    from_here.hold_m = c.last_ref_;  // where the approach starts decides where the shape is entered
+    const double t0 =
+        (c.trajectory_starts_now_ ? c.loop_time(k) + spec.blend_s : c.trajectory_.start_s) + first_extreme_s(from_here);
+    double span = 0.01;
+    if (periodic(spec)) span = kDryRunPeriods / spec.frequency_hz;
+    if (spec.shape == TrajectoryShape::kPoints && spec.n_points > 0) span = spec.points_t_s[spec.n_points - 1] + 0.01;
+    until_s = t0 + span;
+  }
+  const std::int64_t end = std::min(k + kDryRunMaxTicks, static_cast<std::int64_t>(std::ceil(until_s / config_.dt_s)));
   for (; k <= end; ++k) c.plan_tick(k);
   return c.extent_;
 }
@@ -299,23 +314,7 @@ TrajectoryVerdict Compensator::take_scan(const ScanShare& share, double blend_s)
                                              si(share.start_s(), "s") + ", the next tick not yet planned is at " +
                                              si(next_s, "s") + " (loop time)");
   }
-  // The dry run: the approach and the whole path, in a copy (as dry_run does for a trajectory).
-  Compensator c = *this;
-  c.learner_.stop();
-  c.experiments_.stop(next_s);
-  std::int64_t k = std::max<std::int64_t>(next_tick_, 0);
-  if (c.awaiting_anchor_ || c.in_experiment_) {
-    c.awaiting_anchor_ = false;
-    c.in_experiment_ = false;
-    c.restart_reference(c.loop_time(k), c.last_ref_);
-  }
-  c.apply_trajectory(hold, share.start_s(), &share);
-  c.extent_ = PlanExtent{kInf, -kInf, 0.0, 0};
-  c.last_u_wanted_ = kNaN;
-  const std::int64_t end =
-      std::min(k + kDryRunMaxTicks, static_cast<std::int64_t>(std::ceil((share.end_s() + 0.01) / config_.dt_s)));
-  for (; k <= end; ++k) c.plan_tick(k);
-  const PlanExtent e = c.extent_;
+  const PlanExtent e = dry_run(hold, share.start_s(), &share);  // the approach and the whole path
   if (!feasible(e)) {
     ++counters_.trajectories_refused;
     throw ParameterError("scan", "axis " + std::string(axis_name(share.axis())) + ": " + limits_left(e));
@@ -373,8 +372,7 @@ double Compensator::choose_corner(const TrajectorySpec& spec, std::string& note)
   // than two periods of its resonance: what a corner has at and above the resonance is what
   // neither the stage's model nor the servo knows well (a 10 Hz line with 0.05 ms corners tracks
   // at 5 nm, with 1.2 ms at 1 nm, bench/tracking_table), for 2.3 % of a 10 Hz line.
-  const double floor_s =
-      stage_model_.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage_model_.second_order.natural_frequency() : 0.0;
+  const double floor_s = resonance_corner_s(stage_model_);
   const double longest = kMaxCornerShare / spec.frequency_hz;
   auto fits = [&](double tau) {
     TrajectorySpec t = spec;

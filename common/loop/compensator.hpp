@@ -91,6 +91,10 @@ inline LearningConfig default_learning() {
   return l;
 }
 
+// The shortest rounding of a line's corners the compensator chooses with a stage model: two periods
+// of its resonance, what neither the stage's model nor the servo knows well (0 without dynamics).
+double resonance_corner_s(const StageModel& stage) noexcept;
+
 struct CompensatorConfig {
   FeedforwardMode mode = FeedforwardMode::kMem;
   // Every online model's parameters; PI's are the MEM paper's 15 plays.
@@ -285,6 +289,8 @@ class Compensator {
   double servo_share_m(const CompensatorInput& sample) noexcept;
   CommandTick plan_tick(std::int64_t k) noexcept;
   void apply_trajectory(const TrajectorySpec& spec, double start_s, const ScanShare* scan = nullptr) noexcept;
+  // dry_run for `spec` with the scan `scan` taken under it (nullptr: none), through the path's end.
+  PlanExtent dry_run(const TrajectorySpec& spec, double start_s, const ScanShare* scan) const;
   // The reference at t: what the sensor must read (`sensor_m`: the trajectory plus, during a scan,
   // the axis's own path from its start) and what the inverse aims the axis's own displacement at
   // (`aim_m`: the same plus, during a scan, what the decoupling adds, w_a - r_a, faded in over the

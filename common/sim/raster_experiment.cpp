@@ -136,10 +136,9 @@ RasterRun run_raster(const TrackingExperiment& e, const IdentifiedModels& models
   r.lines = o.lines;
   r.line_rate_hz = o.line_rate_hz;
   r.slow_mode = o.slow_mode;
-  // The corners the compensator chooses for a line: two periods of the stage's resonance, what
-  // neither the stage's model nor the servo knows well (Compensator::choose_corner).
-  const StageModel& stage = c.compensator[0].stage;
-  r.corner_s = stage.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency() : 1e-3;
+  // The corners the compensator chooses for a line (1 ms without a stage model).
+  const double corner_s = resonance_corner_s(c.compensator[0].stage);
+  r.corner_s = corner_s > 0.0 ? corner_s : 1e-3;
   // r.centre_m stays 0 m: the middle of the voltage range, as the one-axis scans.
   r.start_s = kStartS;
   r.settle_s = 0.05;

@@ -29,6 +29,13 @@ RasterSpec raster() {
           .start_s = 0.5};
 }
 
+// The compensator's defaults: the real actuator's range and slew limit (5e4 V/s).
+CompensatorConfig real_actuator() {
+  CompensatorConfig c;
+  c.horizon_ticks = 50;
+  return c;
+}
+
 TEST(CompensatorScan, TheServoTracksThePathsAxisAndTheInverseAimsAtTheShare) {
   CompensatorLoop loop(compensator_config(FeedforwardMode::kMem, 50));
   loop.run(100);
@@ -77,9 +84,7 @@ TEST(CompensatorScan, AStartTheApproachCannotReachIsRefusedAndNothingChanges) {
 }
 
 TEST(CompensatorScan, AnInfeasibleScanIsRefusedNamingTheAxisAndTheLimit) {
-  CompensatorConfig c;  // the real actuator: 5e4 V/s
-  c.horizon_ticks = 50;
-  CompensatorLoop loop(c);
+  CompensatorLoop loop(real_actuator());
   loop.run(100);
   RasterSpec fast = raster();
   fast.width_m = 20e-6;  // 20 um lines at 20 lines/s: 4e-4 m/s, about 6e4 V/s
@@ -155,9 +160,7 @@ TEST(CompensatorScan, AScanIsNotTakenWhileAnExperimentRunsOrWaits) {
 }
 
 TEST(CompensatorScan, AParameterSetUnderWhichTheRestOfTheScanWouldLeaveTheLimitsIsRefused) {
-  CompensatorConfig c;  // the real actuator: 5e4 V/s
-  c.horizon_ticks = 50;
-  CompensatorLoop loop(c);
+  CompensatorLoop loop(real_actuator());
   loop.run(100);
   RasterSpec fast = raster();
   fast.width_m = 3e-6;  // 3 um lines at 50 lines/s: about half the slew limit

@@ -11,6 +11,7 @@
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop {
 namespace {
@@ -106,9 +107,12 @@ void require_axis_in(const sensor_block_t& block, int axis, const std::string& w
   const int axes = static_cast<int>(axes_of(block));
   if (axis < axes) return;
   std::string names;
-  for (int a = 0; a < axes; ++a) names += std::string(a == 0 ? "" : a + 1 == axes ? " and " : ", ") + "xyz"[a];
+  for (int a = 0; a < axes; ++a) {
+    names += a == 0 ? "" : a + 1 == axes ? " and " : ", ";
+    names += axis_name(a);
+  }
   throw SampleLogError(where + ": its blocks carry " + std::to_string(axes) + (axes == 1 ? " axis (" : " axes (") +
-                       names + "), not " + "xyz"[axis] + " (--axis)");
+                       names + "), not " + std::string(axis_name(axis)) + " (--axis)");
 }
 
 void LogReadOptions::validate() const {
