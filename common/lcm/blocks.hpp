@@ -8,10 +8,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/ticks.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/sim_truth_t.hpp"
 
 namespace hystloop {
 
@@ -25,6 +27,8 @@ inline std::size_t axes_of(const sensor_block_t& b) noexcept { return axes_of(b.
 inline std::size_t axes_of(const command_block_t& b) noexcept { return axes_of(b.n_axes); }
 inline std::size_t ticks_of(const sensor_block_t& b) noexcept { return b.u_V.size() / axes_of(b); }
 inline std::size_t ticks_of(const command_block_t& b) noexcept { return b.u_ff_V.size() / axes_of(b); }
+inline std::size_t axes_of(const sim_truth_t& b) noexcept { return axes_of(b.n_axes); }
+inline std::size_t ticks_of(const sim_truth_t& b) noexcept { return b.y_true_m.size() / axes_of(b); }
 
 // Tick i of `axis` (0: x, the only one of a one-axis block) of a block whose arrays are consistent
 // (check_message / arrays_consistent) and axis < n_axes.
@@ -56,6 +60,10 @@ void for_each_tick(const command_block_t& b, Fn&& fn, std::size_t axis = 0) {
   for (std::size_t i = 0, n = ticks_of(b); i < n; ++i) fn(command_tick(b, i, axis));
 }
 
+// One axis's true positions of a truth block, tick by tick (for tools: allocates); empty when the
+// block lacks the axis.
+std::vector<double> axis_truth(const sim_truth_t& b, std::size_t axis = 0);
+
 // Last tick a block covers (seq + n_ticks - 1).
 inline std::int64_t last_seq(const sensor_block_t& b) noexcept { return b.seq + b.n_ticks - 1; }
 inline std::int64_t last_seq(const command_block_t& b) noexcept { return b.seq + b.n_ticks - 1; }
@@ -71,6 +79,11 @@ void begin_block(command_block_t& b, std::int64_t seq, std::int64_t utime, std::
 // reserve_storage. The tick's seq and utime are implied by the block's and are not checked.
 bool append_tick(sensor_block_t& b, const SensorTick& t) noexcept;
 bool append_tick(command_block_t& b, const CommandTick& t) noexcept;
+// A truth block for the ticks of a sensor block of `axes` axes from tick `seq` (storage kept).
+void begin_block(sim_truth_t& b, std::int64_t seq, std::int64_t utime, int axes = 1) noexcept;
+// The next tick's true position of every axis (exactly n_axes of them, else false, nothing appended).
+bool append_tick(sim_truth_t& b, std::span<const double> y_true_m) noexcept;
+
 // The next tick of every axis: ticks[a] is axis a's, exactly n_axes of them (else false, nothing
 // appended).
 bool append_tick(sensor_block_t& b, std::span<const SensorTick> ticks) noexcept;

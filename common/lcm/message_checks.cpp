@@ -82,6 +82,7 @@ Verdict check_message(const sim_truth_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0);
   f.tick(msg.seq);
+  f.require(msg.n_axes >= 1 && msg.n_axes <= sim_truth_t::MAX_AXES);
   if (f.count(msg.n_ticks, 1, sim_truth_t::MAX_TICKS, arrays_consistent(msg))) {
     for (const double y : msg.y_true_m) f.within(y, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   }

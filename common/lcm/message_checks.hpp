@@ -34,8 +34,8 @@ static_assert(kMaxBlockTicks == sensor_block_t::MAX_TICKS && kMaxBlockTicks == c
 // n_axes; per tick and axis finite u, u_ff, u_fb and y within the sanity bounds, y_ref finite or NaN (none), known
 // flags; seq, utime and buffer depth >= 0, 0 < dt_s <= 1 s.
 Verdict check_message(const sensor_block_t& msg) noexcept;
-// sim_truth_t: 1..MAX_TICKS ticks with the array of that size, each within the position bound;
-// seq and utime >= 0.
+// sim_truth_t: 1..MAX_TICKS ticks of 1..MAX_AXES axes with the array of n_values = n_ticks x n_axes,
+// each within the position bound; seq and utime >= 0.
 Verdict check_message(const sim_truth_t& msg) noexcept;
 // command_block_t: 1..MAX_TICKS ticks of 1..MAX_AXES axes with every array of n_values = n_ticks x
 // n_axes; per tick and axis finite u_ff,

@@ -27,7 +27,7 @@ void reserve_storage(command_block_t& m) {
               m.params_version, m.mode);
 }
 
-void reserve_storage(sim_truth_t& m) { m.y_true_m.reserve(sim_truth_t::MAX_TICKS); }
+void reserve_storage(sim_truth_t& m) { m.y_true_m.reserve(sim_truth_t::MAX_VALUES); }
 
 void clear_arrays(sensor_block_t& m) noexcept { clear_all(m.u_V, m.u_ff_V, m.u_fb_V, m.y_ref_m, m.y_m, m.flags); }
 
@@ -53,7 +53,9 @@ bool arrays_consistent(const command_block_t& m) noexcept {
          all_sized(m.n_values, m.u_ff_V, m.y_ref_m, m.params_version, m.mode);
 }
 
-bool arrays_consistent(const sim_truth_t& m) noexcept { return all_sized(m.n_ticks, m.y_true_m); }
+bool arrays_consistent(const sim_truth_t& m) noexcept {
+  return values_of_ticks(m.n_ticks, m.n_axes, m.n_values) && all_sized(m.n_values, m.y_true_m);
+}
 
 void reserve_storage(trajectory_t& msg) { reserve_all(trajectory_t::MAX_POINTS, msg.points_t_s, msg.points_y_m); }
 

@@ -1,17 +1,27 @@
 #pragma once
 // The bridge's arming rules, without threads or a clock (time is the tick argument): who may arm
-// BridgeCore and when. An operator's ARM arms, DISARM disarms and ends every automatic arming; the
+// the stage and when. An operator's ARM arms, DISARM disarms and ends every automatic arming; the
 // stop disarms for good; `auto_arm` arms once when commands first flow; `rearm_after_trip_s` > 0
 // (opt-in, for soak runs) re-arms that long after a watchdog trip once commands are buffered again.
-// BridgeRealtime calls it at every tick around BridgeCore::tick.
+// BridgeRealtime calls it at every tick around the stage's tick. The stage is a BridgeCore (one
+// axis) or a MultiAxisBridge (every axis armed and disarmed together): anything with the members
+// ArmableStage names.
 
+#include <concepts>
 #include <cstdint>
-
-#include "loop/bridge_core.hpp"
 
 namespace hystloop {
 
 enum class ArmRequest : std::uint8_t { kNone = 0, kArm = 1, kDisarm = 2 };
+
+template <class S>
+concept ArmableStage = requires(S s, const S& cs, std::int64_t k) {
+  s.arm(k);
+  s.disarm();
+  { cs.armed() } -> std::convertible_to<bool>;
+  { cs.buffer_depth() } -> std::convertible_to<std::int64_t>;  // ticks buffered ahead (every axis: the least)
+  { cs.watchdog_trips() } -> std::convertible_to<std::uint64_t>;
+};
 
 struct ArmingSettings {
   bool auto_arm = false;            // arm as soon as commands flow (first arm only)
@@ -24,15 +34,62 @@ class ArmingPolicy {
   explicit ArmingPolicy(const ArmingSettings& settings) noexcept
       : settings_(settings), auto_arm_pending_(settings.auto_arm) {}
 
-  // From this call on the core is disarmed and never armed again (the safe stop). Idempotent.
-  void stop(BridgeCore& core) noexcept;
+  // From this call on the stage is disarmed and never armed again (the safe stop). Idempotent.
+  template <ArmableStage S>
+  void stop(S& stage) noexcept {
+    if (stopping_) return;
+    stopping_ = true;
+    stage.disarm();
+    auto_arm_pending_ = false;
+    tripped_ = false;
+  }
+
   // An operator's request, taken at tick k.
-  void request(ArmRequest request, std::int64_t k, BridgeCore& core) noexcept;
-  // After the tick's commands were submitted, before core.tick(k): the automatic arming.
+  template <ArmableStage S>
+  void request(ArmRequest request, std::int64_t k, S& stage) noexcept {
+    switch (request) {
+      case ArmRequest::kArm:
+        if (stopping_) return;
+        stage.arm(k);
+        tripped_ = false;
+        return;
+      case ArmRequest::kDisarm:
+        stage.disarm();
+        auto_arm_pending_ = false;  // an explicit disarm ends the convenience ...
+        tripped_ = false;           // ... and an operator's disarm is never undone automatically
+        return;
+      case ArmRequest::kNone: return;
+    }
+  }
+
+  // After the tick's commands were submitted, before the stage's tick k: the automatic arming.
   // `commands_seen`: any command was ever submitted.
-  void before_tick(std::int64_t k, bool commands_seen, BridgeCore& core) noexcept;
-  // After core.tick(k): notices a watchdog trip.
-  void after_tick(std::int64_t k, const BridgeCore& core) noexcept;
+  template <ArmableStage S>
+  void before_tick(std::int64_t k, bool commands_seen, S& stage) noexcept {
+    if (commands_seen && stage.buffer_depth() > 0 && !stage.armed() && !stopping_) {
+      if (auto_arm_pending_) {
+        stage.arm(k);
+        auto_arm_pending_ = false;
+        ++auto_arms_;
+      } else if (tripped_ && settings_.rearm_after_trip_s > 0.0 &&
+                 static_cast<double>(k - last_trip_tick_) * settings_.dt_s >= settings_.rearm_after_trip_s) {
+        stage.arm(k);
+        tripped_ = false;
+        ++auto_arms_;
+      }
+    }
+    if (stage.armed()) auto_arm_pending_ = false;  // armed by an operator: no auto-arm later
+  }
+
+  // After the stage's tick k: notices a watchdog trip.
+  template <ArmableStage S>
+  void after_tick(std::int64_t k, const S& stage) noexcept {
+    if (stage.watchdog_trips() != trips_seen_) {
+      trips_seen_ = stage.watchdog_trips();
+      last_trip_tick_ = k;
+      tripped_ = true;
+    }
+  }
 
   bool stopping() const noexcept { return stopping_; }
   bool tripped() const noexcept { return tripped_; }  // safe because of the watchdog, not an operator

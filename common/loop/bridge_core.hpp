@@ -113,6 +113,7 @@ class BridgeCore {
   const FeedbackGains& servo_gains() const noexcept { return servo_.gains(); }
 
   const BridgeCounters& counters() const noexcept { return counters_; }
+  std::uint64_t watchdog_trips() const noexcept { return counters_.watchdog_trips; }
   // The clamped ticks of the last whole second of loop time: ticks [(s - 1) n, s n) while tick k
   // is in second s = floor(k / n), n = round(1 / dt) ticks per second (zero before the first).
   const ClampCounts& clamped_last_second() const noexcept { return clamp_last_second_; }

@@ -44,6 +44,8 @@ class MultiAxisStage {
   double displacement_m(int axis) const noexcept { return stages_[static_cast<std::size_t>(axis)].true_position_m(); }
   // Axis j's true position [m]: its reading without the noise, (C s)_j.
   double true_position_m(int axis) const noexcept { return true_[axis]; }
+  // Axis i's gain relative to its start (its drift).
+  double gain_scale(int axis) const noexcept { return stages_[static_cast<std::size_t>(axis)].gain_scale(); }
   const MultiAxisStageConfig& config() const noexcept { return config_; }
 
  private:

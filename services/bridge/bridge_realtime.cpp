@@ -13,17 +13,29 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/errors.hpp"
 #include "core/clock.hpp"  // wall_utime: clock_gettime through the vDSO, no system call
 #include "core/periodic_timer.hpp"
 
 namespace hystloop {
+
+namespace {
+int axes_checked(const BridgeSettings& settings, const StageBackend& backend) {
+  if (backend.axes() != settings.axes) {
+    throw ParameterError("bridge.axes", "is " + std::to_string(settings.axes) + " but the backend " + backend.name() +
+                                            " drives " + std::to_string(backend.axes()));
+  }
+  return settings.axes;
+}
+}  // namespace
+
 BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<StageBackend> backend)
     : settings_(settings),
       backend_(std::move(backend)),
-      core_(settings.limits, settings.servo, settings.dt_s()),
+      stage_(axes_checked(settings, *backend_), settings.limits, settings.servo, settings.dt_s()),
       arming_(ArmingSettings{settings.auto_arm, settings.rearm_after_trip_s, settings.dt_s()}),
       dt_s_(settings.dt_s()) {
-  core_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
+  stage_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
 }
@@ -119,48 +131,75 @@ void BridgeRealtime::run() noexcept {
 }
 
 std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t start_ns) noexcept {
+  const auto axes = static_cast<std::size_t>(stage_.axes());
   if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
-    stop_u_start_V_ = core_.last_applied_V();
-    arming_.stop(core_);  // from this tick the core ramps to the safe voltage and is never armed again
+    stop_u_start_V_ = stage_.axis(0).last_applied_V();
+    arming_.stop(stage_);  // from this tick every axis ramps to the safe voltage and is never armed again
   }
-  arming_.request(arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel), k, core_);
-  while (const auto gains = gains_.try_pop()) core_.set_servo_gains(*gains);
-  while (const auto command = commands_.try_pop()) {
-    ++commands_processed_;
-    commands_seen_ = true;
-    core_.submit(*command);
+  arming_.request(arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel), k, stage_);
+  while (const auto gains = gains_.try_pop()) {
+    for (std::size_t a = 0; a < axes; ++a) stage_.set_servo_gains(static_cast<int>(a), *gains);
   }
-  arming_.before_tick(k, commands_seen_, core_);
+  for (std::size_t a = 0; a < axes; ++a) {
+    while (const auto command = commands_[a].try_pop()) {
+      ++commands_processed_;
+      commands_seen_ = true;
+      stage_.submit(static_cast<int>(a), *command);
+    }
+  }
+  arming_.before_tick(k, commands_seen_, stage_);
 
-  const double u_before_V = core_.last_applied_V();
-  const BridgeTick decided = core_.tick(k, y_last_m_);
-  arming_.after_tick(k, core_);
-  if (core_.armed() && commands_seen_) {
-    min_depth_period_ =
-        min_depth_period_ < 0 ? decided.buffer_depth : std::min(min_depth_period_, decided.buffer_depth);
-    min_depth_total_ = min_depth_total_ < 0 ? decided.buffer_depth : std::min(min_depth_total_, decided.buffer_depth);
+  std::array<double, kMaxAxes> u_before_V{};
+  for (std::size_t a = 0; a < axes; ++a) u_before_V[a] = stage_.axis(static_cast<int>(a)).last_applied_V();
+  std::array<BridgeTick, kMaxAxes> decided{};
+  stage_.tick(k, std::span(y_last_m_).first(axes), decided);
+  arming_.after_tick(k, stage_);
+  std::int64_t depth = decided[0].buffer_depth;
+  for (std::size_t a = 1; a < axes; ++a) depth = std::min(depth, decided[a].buffer_depth);
+  if (stage_.armed() && commands_seen_) {
+    min_depth_period_ = min_depth_period_ < 0 ? depth : std::min(min_depth_period_, depth);
+    min_depth_total_ = min_depth_total_ < 0 ? depth : std::min(min_depth_total_, depth);
   }
   // After an overrun the stage has been holding the last voltage for the skipped ticks too.
   const double step_s = dt_s_ * static_cast<double>(1 + skipped);
   const double t_s = static_cast<double>(k) * dt_s_;
-  const StageReading reading = backend_->step(decided.u_applied_V, t_s, step_s);
-  if (reading.go_safe && core_.armed()) arming_.request(ArmRequest::kDisarm, k, core_);  // from the next tick
-  y_last_m_ = reading.y_m;
+  std::array<double, kMaxAxes> u_V{};
+  for (std::size_t a = 0; a < axes; ++a) u_V[a] = decided[a].u_applied_V;
+  std::array<StageReading, kMaxAxes> readings{};
+  backend_->step_axes(std::span(u_V).first(axes), t_s, step_s, std::span(readings).first(axes));
+  bool go_safe = false;
+  for (std::size_t a = 0; a < axes; ++a) {
+    go_safe = go_safe || readings[a].go_safe;
+    y_last_m_[a] = readings[a].y_m;
+  }
+  if (go_safe && stage_.armed()) arming_.request(ArmRequest::kDisarm, k, stage_);  // from the next tick
   last_tick_ = k;
   bool reached_now = false;
   if (arming_.stopping() && !safe_reached_.load(std::memory_order_relaxed)) {
-    if (decided.u_applied_V != u_before_V) ++stop_ramp_ticks_;
-    if (!core_.armed() && decided.u_applied_V == settings_.limits.safe_u_V) {
+    bool moved = false;
+    bool at_safe = !stage_.armed();
+    for (std::size_t a = 0; a < axes; ++a) {
+      moved = moved || decided[a].u_applied_V != u_before_V[a];
+      at_safe = at_safe && decided[a].u_applied_V == settings_.limits.safe_u_V;
+    }
+    if (moved) ++stop_ramp_ticks_;
+    if (at_safe) {
       stop_reached_ns_ = monotonic_ns();
       backend_->hold_safe(settings_.limits.safe_u_V);
       reached_now = true;  // published once this tick's sample is queued
     }
   }
 
-  const OutgoingTick out{SensorTick{wall_utime(), k, decided.u_applied_V, decided.u_ff_V, decided.u_fb_V,
-                                    decided.y_ref_m, reading.y_m, decided.flags | reading.flags},
-                         static_cast<std::int32_t>(std::min<std::int64_t>(decided.buffer_depth, INT32_MAX)),
-                         reading.y_true_m};
+  OutgoingTick out;
+  const std::int64_t utime = wall_utime();
+  for (std::size_t a = 0; a < axes; ++a) {
+    const BridgeTick& d = decided[a];
+    out.ticks[a] = SensorTick{utime,    k,         d.u_applied_V,   d.u_ff_V,
+                              d.u_fb_V, d.y_ref_m, readings[a].y_m, d.flags | readings[a].flags};
+    out.y_true_m[a] = readings[a].y_true_m;
+  }
+  out.buffer_depth = static_cast<std::int32_t>(std::min<std::int64_t>(depth, INT32_MAX));
+  out.axes = static_cast<std::int32_t>(axes);
   if (samples_.try_push(out)) {
     if ((k + 1) % settings_.block_ticks == 0) {  // a block is complete: wake the I/O thread
       const std::uint64_t one = 1;
@@ -175,7 +214,12 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   const std::int64_t end_ns = monotonic_ns();
   report.work.add(end_ns - start_ns);
   reports_.serve_request([&](RtReport& r) {
-    r.core = core_.counters();
+    r.core = stage_.counters();
+    r.axes = static_cast<int>(axes);
+    for (std::size_t a = 0; a < axes; ++a) {
+      r.axis_core[a] = stage_.axis(static_cast<int>(a)).counters();
+      r.axis_u_V[a] = stage_.axis(static_cast<int>(a)).last_applied_V();
+    }
     r.ticks_skipped = ticks_skipped_;
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
@@ -184,11 +228,11 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     r.last_trip_tick = arming_.last_trip_tick();
     r.min_depth_period = min_depth_period_;
     r.min_depth_total = min_depth_total_;
-    r.buffer_depth = core_.buffer_depth();
-    r.clamped_last_second = core_.clamped_last_second();
-    r.u_applied_V = core_.last_applied_V();
+    r.buffer_depth = stage_.buffer_depth();
+    r.clamped_last_second = stage_.clamped_last_second();
+    r.u_applied_V = stage_.axis(0).last_applied_V();
     r.gain_scale = backend_->gain_scale();
-    r.armed = core_.armed();
+    r.armed = stage_.armed();
     min_depth_period_ = -1;
   });
   return end_ns;  // a status period's hand-over above counts in the next tick's work (once a second)

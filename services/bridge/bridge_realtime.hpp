@@ -1,11 +1,12 @@
 #pragma once
 // The bridge's real-time thread: at each tick of the 10 kHz clock it moves the commands the
-// I/O thread received into BridgeCore's jitter buffer, lets BridgeCore decide the voltage for
-// tick k (feedforward + servo, clamped), steps the backend, and hands the tick to the I/O
-// thread, waking it through an eventfd once a block is complete. With rt.ticks_per_wake > 1 it
-// wakes once per that many ticks and runs them back to back (a simulator's choice).
-// Nothing here allocates, locks, logs or does I/O other than that eventfd write.
+// I/O thread received into the axes' jitter buffers, lets MultiAxisBridge decide every axis's
+// voltage for tick k (per axis a BridgeCore: feedforward + servo, clamped; one safe state), steps
+// the backend, and hands the tick to the I/O thread, waking it through an eventfd once a block is complete. With
+// rt.ticks_per_wake > 1 it wakes once per that many ticks and runs them back to back (a simulator's choice). Nothing
+// here allocates, locks, logs or does I/O other than that eventfd write.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
@@ -20,16 +21,19 @@
 #include "core/ticks.hpp"
 #include "loop/arming_policy.hpp"
 #include "loop/bridge_core.hpp"
+#include "loop/multi_axis_bridge.hpp"
 #include "loop/spsc_queue.hpp"
 
 namespace hystloop {
 
-// A tick the real-time thread did, with the buffer's depth after it, for the I/O thread to
-// publish in blocks.
+// A tick the real-time thread did, every axis's, with the buffers' depth after it, for the I/O
+// thread to publish in blocks.
 struct OutgoingTick {
-  SensorTick tick;
-  std::int32_t buffer_depth = 0;
-  double y_true_m = std::numeric_limits<double>::quiet_NaN();  // StageReading::y_true_m
+  std::array<SensorTick, kMaxAxes> ticks{};  // axis a's tick; the first `axes` are the stage's
+  std::array<double, kMaxAxes> y_true_m{};   // StageReading::y_true_m per axis
+  std::int32_t buffer_depth = 0;             // the axis with the fewest commands ahead
+  std::int32_t axes = 1;
+  const SensorTick& tick() const noexcept { return ticks[0]; }  // seq and utime: every axis's
 };
 
 // How the stop's ramp to actuator.safe_u_V went (BridgeRealtime::begin_safe_stop / stop).
@@ -65,9 +69,13 @@ class BridgeRealtime {
   // calls backend.hold_safe(). Returns how the ramp went (also when called again).
   SafeStopResult stop();
 
-  // I/O thread side.
-  bool push_command(const CommandTick& command) noexcept { return commands_.try_push(command); }
+  // I/O thread side. A command for one axis (0..axes()-1).
+  bool push_command(int axis, const CommandTick& command) noexcept {
+    return commands_[static_cast<std::size_t>(axis)].try_push(command);
+  }
+  // Every axis's servo.
   bool push_gains(const FeedbackGains& gains) noexcept { return gains_.try_push(gains); }
+  int axes() const noexcept { return stage_.axes(); }
   std::optional<OutgoingTick> pop_tick() noexcept { return samples_.try_pop(); }
   void request_arm(ArmRequest request) noexcept { arm_request_.store(request, std::memory_order_release); }
   RtReportExchange& reports() noexcept { return reports_; }
@@ -86,10 +94,10 @@ class BridgeRealtime {
 
   BridgeSettings settings_;
   std::unique_ptr<StageBackend> backend_;
-  BridgeCore core_;
+  MultiAxisBridge stage_;
   ArmingPolicy arming_;  // RT thread
   double dt_s_;
-  SpscQueue<CommandTick, kCommandQueue> commands_;
+  std::array<SpscQueue<CommandTick, kCommandQueue>, kMaxAxes> commands_;  // per axis
   SpscQueue<FeedbackGains, 8> gains_;
   SpscQueue<OutgoingTick, kSampleQueue> samples_;
   std::atomic<ArmRequest> arm_request_{ArmRequest::kNone};
@@ -114,9 +122,9 @@ class BridgeRealtime {
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;
   std::int64_t last_tick_ = -1;
-  double y_last_m_ = 0.0;               // the stage's last measured position
-  std::int64_t min_depth_period_ = -1;  // lowest buffer depth at an armed tick this report period
-  std::int64_t min_depth_total_ = -1;   // ... since start (after the first command)
+  std::array<double, kMaxAxes> y_last_m_{};  // each axis's last measured position
+  std::int64_t min_depth_period_ = -1;       // lowest buffer depth at an armed tick this report period
+  std::int64_t min_depth_total_ = -1;        // ... since start (after the first command)
   bool commands_seen_ = false;
 };
 

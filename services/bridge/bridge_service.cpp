@@ -24,10 +24,6 @@
 
 namespace hystloop {
 
-namespace {
-// The axes this bridge drives (x): a command block planned for another count is refused whole.
-constexpr std::int8_t kAxes = 1;
-}  // namespace
 BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, const ChannelNames& channels)
     : settings_(settings),
       lcm_(lcm),
@@ -39,7 +35,7 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
       status_(lcm, channels.status, "bridge"),
       gains_(settings.servo) {
   reserve_storage(block_);
-  begin_block(block_, 0, 0, settings_.dt_s());
+  begin_block(block_, 0, 0, settings_.dt_s(), settings_.axes);
   if (rt_.backend().simulated()) {
     truth_pub_.emplace(lcm, channels.sim_truth);
     reserve_storage(truth_);
@@ -48,7 +44,7 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
 
 void BridgeService::on_command(const command_block_t& msg) noexcept {
   ++command_blocks_;
-  if (msg.n_axes != kAxes) {  // planned for another stage: no axis of it is guessed at
+  if (msg.n_axes != settings_.axes) {  // planned for another stage: no axis of it is guessed at
     ++command_blocks_wrong_axes_;
     return;
   }
@@ -57,7 +53,9 @@ void BridgeService::on_command(const command_block_t& msg) noexcept {
     latency_total_.add(*elapsed);
   }
   for (std::size_t i = 0, n = ticks_of(msg); i < n; ++i) {
-    if (!rt_.push_command(command_tick(msg, i))) ++command_queue_full_;
+    for (int a = 0; a < settings_.axes; ++a) {
+      if (!rt_.push_command(a, command_tick(msg, i, static_cast<std::size_t>(a)))) ++command_queue_full_;
+    }
   }
 }
 
@@ -159,7 +157,7 @@ void BridgeService::publish_block() noexcept {
   }
   sent_.record(last_seq(block_), monotonic_ns());
   publish_truth();
-  begin_block(block_, 0, 0, settings_.dt_s());
+  begin_block(block_, 0, 0, settings_.dt_s(), settings_.axes);
 }
 
 void BridgeService::publish_truth() noexcept {
@@ -172,26 +170,26 @@ void BridgeService::publish_truth() noexcept {
 
 void BridgeService::append_truth(const OutgoingTick& t) noexcept {
   if (!truth_pub_) return;
-  if (block_.n_ticks == 1) {  // the tick just appended began a block: so does the truth's
-    truth_.utime = block_.utime;
-    truth_.seq = block_.seq;
-    truth_.n_ticks = 0;
-    truth_.y_true_m.clear();
+  // the tick just appended began a block: so does the truth's
+  if (block_.n_ticks == 1) begin_block(truth_, block_.seq, block_.utime, settings_.axes);
+  const auto axes = static_cast<std::size_t>(t.axes);
+  for (std::size_t a = 0; a < axes; ++a) {
+    if (!std::isfinite(t.y_true_m[a])) return;
   }
-  if (!std::isfinite(t.y_true_m) || truth_.n_ticks != block_.n_ticks - 1) return;
-  truth_.y_true_m.push_back(t.y_true_m);  // within the reserved MAX_TICKS
-  ++truth_.n_ticks;
+  if (truth_.n_ticks != block_.n_ticks - 1) return;
+  append_tick(truth_, std::span(t.y_true_m).first(axes));  // within the reserved MAX_VALUES
 }
 
 void BridgeService::publish_samples(bool flush) noexcept {
   while (const auto t = rt_.pop_tick()) {
     // A block holds consecutive ticks and ends at a multiple of block_ticks (or at a gap).
-    if (block_.n_ticks > 0 && t->tick.seq != last_seq(block_) + 1) publish_block();
-    if (block_.n_ticks == 0) begin_block(block_, t->tick.seq, t->tick.utime, settings_.dt_s());
-    append_tick(block_, t->tick);
+    const SensorTick& tick = t->tick();
+    if (block_.n_ticks > 0 && tick.seq != last_seq(block_) + 1) publish_block();
+    if (block_.n_ticks == 0) begin_block(block_, tick.seq, tick.utime, settings_.dt_s(), settings_.axes);
+    append_tick(block_, std::span(t->ticks).first(static_cast<std::size_t>(t->axes)));
     append_truth(*t);
     block_.buffer_depth_ticks = t->buffer_depth;
-    if ((t->tick.seq + 1) % settings_.block_ticks == 0 || block_.n_ticks == sensor_block_t::MAX_TICKS) publish_block();
+    if ((tick.seq + 1) % settings_.block_ticks == 0 || block_.n_ticks == sensor_block_t::MAX_TICKS) publish_block();
   }
   if (flush) publish_block();
 }
@@ -320,6 +318,20 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
       {"control_acted", control_acted_},
       {"control_refused", control_refused_},
   };
+  if (rt.axes > 1) {  // the sums above, axis by axis: which axis clamps, which is late
+    now.emplace_back("axes", static_cast<std::uint64_t>(rt.axes));
+    for (int a = 0; a < rt.axes; ++a) {
+      const BridgeCounters& c = rt.axis_core[static_cast<std::size_t>(a)];
+      const std::string p = std::string(axis_name(a)) + "_";
+      now.emplace_back(p + "applied", c.applied);
+      now.emplace_back(p + "late", c.late);
+      now.emplace_back(p + "stale", c.stale);
+      now.emplace_back(p + "rejected_nonfinite", c.rejected_nonfinite);
+      now.emplace_back(p + "clamped", c.clamped);
+      now.emplace_back(p + "slew_limited", c.slew_limited);
+      now.emplace_back(p + "clamped_either", c.clamped_either);
+    }
+  }
   rt_.backend().append_counters(now);  // e.g. comedi: sensor_faults, sensor_fault_safe, comedi_read_errors
   if (truth_pub_) now.emplace_back("sim_truth_unpublished", truth_unpublished_);
   return now;
@@ -371,8 +383,17 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   previous_unpublished_ = sensor_ticks_unpublished_;
   auto [state, detail] = assess_bridge_health(health);
   if (rt.armed) safe_reason_ = "not armed";  // the next safe state says its own reason
-  detail += fmt::format("{}backend {}, u {:.4g} V, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
-                        detail.empty() ? "" : "; ", rt_.backend().name(), rt.u_applied_V, rt.gain_scale,
+  std::string u;
+  if (rt.axes == 1) {
+    u = fmt::format("u {:.4g} V", rt.u_applied_V);
+  } else {
+    for (int a = 0; a < rt.axes; ++a) {
+      u += fmt::format("{}{} {:.4g} V", a == 0 ? "u " : ", ", axis_name(a), rt.axis_u_V[static_cast<std::size_t>(a)]);
+    }
+  }
+  detail += fmt::format("{}backend {}{}, {}, gain x{:.4f}, late {:.3g} % this period, buffer {} ticks ahead",
+                        detail.empty() ? "" : "; ", rt_.backend().name(),
+                        rt.axes > 1 ? fmt::format(" ({} axes)", rt.axes) : std::string(), u, rt.gain_scale,
                         100.0 * late_fraction, rt.buffer_depth);
   if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail += "; " + note;
 

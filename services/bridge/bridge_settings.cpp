@@ -14,8 +14,41 @@
 #include "runtime/rig_auth_config.hpp"
 
 namespace hystloop {
+namespace {
+// coupling.<from>_to_<to>: C(to, from).
+struct CouplingKey {
+  const char* key;
+  int to;
+  int from;
+};
+constexpr CouplingKey kCouplingKeys[] = {{"coupling.x_to_y", 1, 0}, {"coupling.x_to_z", 2, 0},
+                                         {"coupling.y_to_x", 0, 1}, {"coupling.y_to_z", 2, 1},
+                                         {"coupling.z_to_x", 0, 2}, {"coupling.z_to_y", 1, 2}};
+}  // namespace
+
+AxisMatrix default_stage_coupling() noexcept { return flexure_stage(kMaxAxes).coupling.matrix(); }
+
+MultiAxisStageConfig multi_axis_stage(const BridgeSettings& settings) {
+  MultiAxisStageConfig config;
+  config.coupling = AxisCoupling(settings.axes, settings.coupling);
+  const PlantKind plant = parse_plant_kind(settings.backend, "bridge.backend");
+  for (std::size_t i = 0; i < config.axis.size(); ++i) {
+    config.axis[i] = settings.stage;
+    config.axis[i].plant = plant;
+    config.axis[i].seed = settings.stage.seed + i;
+  }
+  return config;
+}
+
 const std::vector<std::string>& bridge_config_keys() {
   static const std::vector<std::string> keys = {"bridge.backend",
+                                                "bridge.axes",
+                                                "coupling.x_to_y",
+                                                "coupling.x_to_z",
+                                                "coupling.y_to_x",
+                                                "coupling.y_to_z",
+                                                "coupling.z_to_x",
+                                                "coupling.z_to_y",
                                                 "bridge.rate_hz",
                                                 "bridge.noise_rms_m",
                                                 "bridge.seed",
@@ -66,6 +99,16 @@ BridgeSettings load_bridge_settings(const Config& config) {
   if (s.backend != "sim" && s.backend != "ro" && s.backend != "comedi") {
     config.fail("bridge.backend", "must be sim, ro or comedi (got '" + s.backend + "')");
   }
+  s.axes = static_cast<int>(config.get_int_in_range("bridge.axes", s.axes, 1, kMaxAxes));
+  if (s.backend == "comedi" && s.axes != 1) {
+    config.fail("bridge.axes",
+                "must be 1 with bridge.backend comedi: its channel map drives one axis (the "
+                "simulators sim and ro drive up to " +
+                    std::to_string(kMaxAxes) + ")");
+  }
+  for (const CouplingKey& c : kCouplingKeys) {
+    s.coupling(c.to, c.from) = config.get_in_range(c.key, s.coupling(c.to, c.from), -kMaxCoupling, kMaxCoupling);
+  }
   s.comedi = load_comedi_settings(config);  // validated whatever the backend: one config serves both
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
   s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
@@ -91,6 +134,10 @@ BridgeSettings load_bridge_settings(const Config& config) {
   validate_config_section(
       config, "ro.", [&] { st.ramberg_osgood = params_from_config<MemDescriptor>(config, st.ramberg_osgood, "ro"); });
   validate_config_section(config, "", [&] { st.validate(); });
+  if (s.axes > 1 && s.backend != "comedi") {
+    // The coupling's conditioning, the seeds: everything the XY(Z) stage checks, named by its field.
+    validate_config_section(config, "", [&] { multi_axis_stage(s).validate(); });
+  }
 
   ActuatorLimits& a = s.limits;
   a.u_min_V = config.get_in_range("actuator.u_min_V", a.u_min_V, -1e4, 1e4);
@@ -143,6 +190,19 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   const auto& st = s.stage;
   const auto& a = s.limits;
   std::vector<std::string> lines;
+  if (s.axes > 1) {
+    std::string c;
+    for (int j = 0; j < s.axes; ++j) {
+      for (int i = 0; i < s.axes; ++i) {
+        if (i != j && s.coupling(j, i) != 0.0)
+          c += fmt::format(", {} -> {} {:+.3g}", axis_name(i), axis_name(j), s.coupling(j, i));
+      }
+    }
+    lines.push_back(fmt::format(
+        "axes: {} on one clock and one safe state, the same actuator limits and servo each; "
+        "noise seeds {}..{}; coupling{}",
+        s.axes, s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1, c.empty() ? " none" : c));
+  }
   lines.push_back(fmt::format(
       "bridge: backend {}, rate {} Hz, noise {:.3g} m RMS, seed {}, drift {:+.3g} over {} s from {} s, {}{}", s.backend,
       s.rate_hz, st.noise_rms_m, st.seed, st.drift_fraction, st.drift_duration_s, st.drift_start_s,

@@ -10,7 +10,9 @@
 #include "bridge/comedi_config.hpp"
 #include "core/config.hpp"
 #include "loop/bridge_core.hpp"
+#include "loop/multi_axis_stage.hpp"
 #include "loop/simulated_stage.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop {
 
@@ -23,8 +25,19 @@ struct RtSettings {
   int cpu = -1;              // pin the real-time thread to this CPU; -1 = no pinning
 };
 
+// The simulated XY(Z) stage's default coupling: x moves y by 3 %, and z by 3 % of x and of y, as
+// flexure stages show (flexure_stage()).
+AxisMatrix default_stage_coupling() noexcept;
+
 struct BridgeSettings {
-  std::string backend = "sim";   // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
+  std::string backend = "sim";  // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
+  // Axes on the one clock (1..kMaxAxes: x, y, z), each with the actuator limits and servo below,
+  // all in one safe state (MultiAxisBridge). More than one: the simulators only, for now.
+  int axes = 1;
+  // The simulated XY(Z) stage's coupling C (models/axis_coupling.hpp): C(j, i) is axis j's output
+  // per metre of axis i's own displacement (coupling.x_to_y is C(1, 0)). Only its axes x axes
+  // block is used; an AxisCoupling is built from it (validated) when axes > 1.
+  AxisMatrix coupling = default_stage_coupling();
   double rate_hz = 10000.0;      // the loop's clock
   SimulatedStageConfig stage{};  // noise, seed, drift and the plants' parameters
   ComediSettings comedi{};       // the comedi.* keys (used when backend is comedi)
@@ -51,6 +64,10 @@ struct BridgeSettings {
 // the range farthest from it at min(safe_ramp, slew)): the real-time thread's next wake-up and a
 // busy machine. 250 V at 1e3 V/s: 0.25 s + 0.5 s.
 inline constexpr double kStopRampMargin_s = 0.5;
+
+// The built-in XY(Z) stage these settings describe: per axis `stage` with the plant bridge.backend
+// names and the noise seed bridge.seed + axis; `coupling`'s axes x axes block.
+MultiAxisStageConfig multi_axis_stage(const BridgeSettings& settings);
 
 // Every key the bridge reads (for check_no_unknown_keys and the docs).
 const std::vector<std::string>& bridge_config_keys();

@@ -10,11 +10,13 @@
 // it released the buffer it took (it resets that buffer's windows), so the two never
 // touch the same buffer.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 
 #include "core/latency_stats.hpp"
 #include "loop/bridge_core.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop {
 
@@ -31,9 +33,13 @@ struct RtReport {
   std::int64_t min_depth_total = -1;   // ... since the first command arrived
   std::int64_t buffer_depth = 0;       // now
   ClampCounts clamped_last_second{};   // armed ticks clamped in the last whole second of loop time
-  double u_applied_V = 0.0;
+  double u_applied_V = 0.0;            // x's
   double gain_scale = 1.0;
   bool armed = false;
+  // A stage of several axes: `core` above is the stage's (MultiAxisBridge::counters), these each axis's.
+  int axes = 1;
+  std::array<BridgeCounters, kMaxAxes> axis_core{};
+  std::array<double, kMaxAxes> axis_u_V{};
   // This report period's windows.
   LatencyStats work;      // RT work per tick (wake-up or the tick before's end, to sample pushed) [ns]
   LatencyStats lateness;  // timer wake-up lateness [ns]

@@ -5,12 +5,15 @@
 
 #include <cstdint>
 #include <limits>
+#include <array>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "bridge/bridge_settings.hpp"
+#include "loop/multi_axis_stage.hpp"
 #include "loop/simulated_stage.hpp"
 
 namespace hystloop {
@@ -28,8 +31,16 @@ struct StageReading {
 class StageBackend {
  public:
   virtual ~StageBackend() = default;
-  // Applies u [V] over [t, t + dt] and returns the position measured at its end.
+  // Applies u [V] over [t, t + dt] and returns the position measured at its end (a stage of
+  // several axes: to x, the others holding their last voltage).
   virtual StageReading step(double u_V, double t_s, double dt_s) noexcept = 0;
+  // The axes it drives on one clock (1..kMaxAxes).
+  virtual int axes() const noexcept { return 1; }
+  // Applies u_V[i] to axis i over [t, t + dt] and writes the axes' readings at its end to out[i];
+  // both hold axes() entries. What the bridge's clock thread calls; a one-axis stage's is step().
+  virtual void step_axes(std::span<const double> u_V, double t_s, double dt_s, std::span<StageReading> out) noexcept {
+    out[0] = step(u_V[0], t_s, dt_s);
+  }
   // "sim", "ro", ... (logged and reported in HX_STATUS).
   virtual const std::string& name() const noexcept = 0;
   // Stage gain relative to its start (1 for hardware: unknown), for the status detail.
@@ -65,12 +76,31 @@ class SimulatedBackend final : public StageBackend {
   SimulatedStage stage_;
 };
 
+// The built-in XY(Z) stage (MultiAxisStage): per axis the simulator above, with its own noise
+// seed, and the coupling matrix on the outputs.
+class MultiAxisSimulatedBackend final : public StageBackend {
+ public:
+  MultiAxisSimulatedBackend(std::string name, const MultiAxisStageConfig& config);
+  StageReading step(double u_V, double t_s, double dt_s) noexcept override;
+  int axes() const noexcept override { return stage_.axes(); }
+  void step_axes(std::span<const double> u_V, double t_s, double dt_s, std::span<StageReading> out) noexcept override;
+  const std::string& name() const noexcept override { return name_; }
+  double gain_scale() const noexcept override;
+  bool simulated() const noexcept override { return true; }
+  void hold_safe(double /*safe_u_V*/) noexcept override {}
+
+ private:
+  std::string name_;
+  MultiAxisStage stage_;
+  std::array<double, kMaxAxes> u_last_V_{};  // what step() holds the axes other than x at
+};
+
 // The backend `name` names: "sim" (Banning) or "ro" (Ramberg-Osgood); the plant kind in
 // `config` is set from the name. Throws ParameterError("bridge.backend") otherwise.
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config);
 
-// The backend bridge.backend names: sim, ro, or comedi (ComediBackend: opens the card; throws
-// ConfigError for a config the card refuses, std::runtime_error when it cannot be opened).
+// The backend bridge.backend names: sim, ro (an XY(Z) stage of them when bridge.axes > 1), or comedi (ComediBackend:
+// opens the card; throws ConfigError for a config the card refuses, std::runtime_error when it cannot be opened).
 std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings);
 
 }  // namespace hystloop

@@ -47,12 +47,12 @@ BridgeSettings comedi_settings() {
 // Started, armed by the first command and driven to `u_V`; the samples tell when it got there.
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, double u_V, std::int64_t ticks = 8000) {
   auto rt = std::make_unique<BridgeRealtime>(s, make_stage_backend(s));
-  for (std::int64_t k = 0; k < ticks; ++k) EXPECT_TRUE(rt->push_command({k, u_V, std::nan(""), 1, 2}));
+  for (std::int64_t k = 0; k < ticks; ++k) EXPECT_TRUE(rt->push_command(0, {k, u_V, std::nan(""), 1, 2}));
   rt->start();
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   bool there = false;
   while (!there && std::chrono::steady_clock::now() < until) {
-    while (const auto t = rt->pop_tick()) there = there || t->tick.u_V == u_V;
+    while (const auto t = rt->pop_tick()) there = there || t->tick().u_V == u_V;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_TRUE(there) << "the stage never got to " << u_V << " V";
@@ -121,7 +121,8 @@ TEST_F(ComediExitTest, TheWatchdogRampsToSafe) {
   bool safe = false;
   while (!safe && std::chrono::steady_clock::now() < until) {
     while (const auto t = rt->pop_tick()) {
-      safe = safe || ((t->tick.flags & sample_flags::kSafeState) != 0 && t->tick.u_V == 0.0 && t->tick.seq > 1000);
+      safe =
+          safe || ((t->tick().flags & sample_flags::kSafeState) != 0 && t->tick().u_V == 0.0 && t->tick().seq > 1000);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
@@ -142,9 +143,9 @@ TEST_F(ComediExitTest, RepeatedSensorFaultsTakeTheBridgeToSafe) {
   while (!safe && std::chrono::steady_clock::now() < until) {
     while (const auto t = rt->pop_tick()) {
       if (safe) continue;
-      if ((t->tick.flags & sample_flags::kSafeState) != 0 && t->tick.seq > 100) {
+      if ((t->tick().flags & sample_flags::kSafeState) != 0 && t->tick().seq > 100) {
         safe = true;
-      } else if ((t->tick.flags & sample_flags::kSensorFault) != 0) {
+      } else if ((t->tick().flags & sample_flags::kSensorFault) != 0) {
         ++faults_before_safe;
       }
     }

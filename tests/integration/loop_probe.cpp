@@ -102,7 +102,7 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
       lcm, ch.sim_truth,
       [&](const sim_truth_t& m, std::int64_t) {
         long long seq = m.seq;
-        for (const double y : m.y_true_m) std::fprintf(truth, "%lld,%.17g\n", seq++, y);
+        for (const double y : axis_truth(m)) std::fprintf(truth, "%lld,%.17g\n", seq++, y);
       },
       to);
   Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {

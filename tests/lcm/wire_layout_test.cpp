@@ -42,7 +42,7 @@ constexpr std::int32_t kBound<model_params_t> = model_params_t::MAX_OPERATORS;
 template <>
 constexpr std::int32_t kBound<service_status_t> = service_status_t::MAX_COUNTERS;
 template <>
-constexpr std::int32_t kBound<sim_truth_t> = sim_truth_t::MAX_TICKS;
+constexpr std::int32_t kBound<sim_truth_t> = sim_truth_t::MAX_VALUES;
 
 // The generated layout of T (cmake/lcm_wire_layouts.py) against lcm-gen's own encoder: a message
 // with every count at 0, 1, 7 and the bound, each array that long, walks to exactly its encoded

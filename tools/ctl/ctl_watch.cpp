@@ -57,8 +57,9 @@ void TruthPairing::add_sensor_block(const sensor_block_t& block, WatchSecond& in
 
 void TruthPairing::add_truth_block(const sim_truth_t& truth, WatchSecond& into) {
   const auto match = std::find_if(refs_.begin(), refs_.end(), [&](const Block& r) { return r.seq == truth.seq; });
-  if (match == refs_.end()) return keep(truths_, Block{truth.seq, truth.y_true_m});
-  pair(match->y_m, truth.y_true_m, into);
+  std::vector<double> y_true = axis_truth(truth);
+  if (match == refs_.end()) return keep(truths_, Block{truth.seq, std::move(y_true)});
+  pair(match->y_m, y_true, into);
   refs_.erase(match);
 }
 

@@ -118,9 +118,9 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
     } else if (event.channel == channels.sim_truth) {
       if (!decode_checked(event, truth)) return void(++run.undecodable);
       if (const auto b = sensor_blocks.find(truth.seq); b != sensor_blocks.end()) {
-        apply_truth(b->second, truth.y_true_m);
+        apply_truth(b->second, axis_truth(truth));
       } else {
-        truth_waiting[truth.seq] = truth.y_true_m;
+        truth_waiting[truth.seq] = axis_truth(truth);
       }
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);

@@ -151,10 +151,7 @@ void write_log(const fs::path& file, TruthBlocks truth = {}) {
   reserve_storage(sb);
   sim_truth_t tb{};
   for (std::int64_t first = 0; first < kTicks; first += kBlock) {
-    tb.utime = at(t_of(first));
-    tb.seq = first;
-    tb.n_ticks = static_cast<std::int32_t>(kBlock);
-    tb.y_true_m.clear();
+    begin_block(tb, first, at(t_of(first)));
     begin_block(sb, first, at(t_of(first)), 1e-4);
     for (std::int64_t k = first; k < first + kBlock; ++k) {
       const double m = magnitude(k);
@@ -163,7 +160,8 @@ void write_log(const fs::path& file, TruthBlocks truth = {}) {
       t.y_m = (m > 0.0 ? t.y_ref_m : 0.0) - ((k % 2) != 0 ? m : -m);
       t.flags = flags(k);
       append_tick(sb, t);
-      tb.y_true_m.push_back(m > 0.0 ? t.y_ref_m - 0.5 * (t.y_ref_m - t.y_m) : t.y_m);
+      const double y_true_m = m > 0.0 ? t.y_ref_m - 0.5 * (t.y_ref_m - t.y_m) : t.y_m;
+      append_tick(tb, std::span(&y_true_m, 1));
     }
     sb.buffer_depth_ticks = 400;
     const std::int64_t received = at(t_of(first + kBlock - 1));  // with its last tick

@@ -1,0 +1,197 @@
+// hystloop-bridge with several axes on its one clock: bridge.axes and the simulated XY(Z) stage's
+// coupling are validated where they enter (a refusal names the key), the simulators build the
+// coupled stage the settings describe, and the real-time thread drives every axis from its own
+// commands, arms them together and takes all of them to the safe state when one axis's commands
+// stop. Real threads, real time: a few tenths of a second in all.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bridge/bridge_realtime.hpp"
+#include "bridge/bridge_settings.hpp"
+#include "bridge/stage_backend.hpp"
+
+namespace hystloop {
+namespace {
+
+std::string refusal(const std::string& yaml) {
+  try {
+    load_bridge_settings(Config::from_string(yaml, "bridge.yaml"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(BridgeAxes, SettingsTakeTheAxesAndTheCouplingAndNameWhatTheyRefuse) {
+  const BridgeSettings one = load_bridge_settings(Config::from_string("bridge: {backend: sim}", "bridge.yaml"));
+  EXPECT_EQ(one.axes, 1);
+  const BridgeSettings xy =
+      load_bridge_settings(Config::from_string("bridge: {axes: 2}\ncoupling: {x_to_y: 0.05, y_to_x: -0.01}", "b.yaml"));
+  EXPECT_EQ(xy.axes, 2);
+  EXPECT_EQ(xy.coupling(1, 0), 0.05);   // C(y, x): y's reading per metre of x
+  EXPECT_EQ(xy.coupling(0, 1), -0.01);  // C(x, y)
+  const BridgeSettings xyz = load_bridge_settings(Config::from_string("bridge: {axes: 3}", "bridge.yaml"));
+  EXPECT_EQ(xyz.coupling(2, 0), 0.03);  // the default flexure stage: x -> z too
+  bool says_axes = false;
+  for (const std::string& line : describe(xyz)) says_axes = says_axes || contains(line, "axes: 3");
+  EXPECT_TRUE(says_axes);
+
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 4}"), "bridge.axes"));
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 0}"), "bridge.axes"));
+  EXPECT_TRUE(contains(refusal("bridge: {backend: comedi, axes: 2}"), "bridge.axes"));
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\ncoupling: {x_to_y: 0.7}"), "coupling.x_to_y"));
+  // Each entry allowed, together nearly singular: refused for the whole matrix.
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\ncoupling: {x_to_y: 0.5, y_to_x: 1.99}"), "coupling"));
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 3}\ncoupling: {x_to_y: -0.5, x_to_z: -0.5, y_to_x: -0.5, y_to_z: "
+                               "-0.5, z_to_x: -0.5, z_to_y: -0.5}"),
+                       "coupling"));
+  EXPECT_EQ(refusal("bridge: {axes: 3, backend: ro}"), "accepted");
+}
+
+TEST(BridgeAxes, TheSimulatorsBuildTheCoupledStageTheSettingsDescribe) {
+  for (const char* backend : {"sim", "ro"}) {
+    BridgeSettings s;
+    s.backend = backend;
+    s.axes = 2;
+    s.stage.noise_rms_m = 0.0;
+    const auto stage = make_stage_backend(s);
+    ASSERT_EQ(stage->axes(), 2) << backend;
+    EXPECT_TRUE(stage->simulated());
+    std::array<StageReading, 2> r{};
+    const std::array<double, 2> u{100.0, 0.0};  // x moves, y held at 0 V
+    for (int k = 0; k < 2000; ++k) stage->step_axes(u, k * 1e-4, 1e-4, r);
+    EXPECT_GT(r[0].y_m, 3e-7) << backend;
+    EXPECT_NEAR(r[1].y_m, 0.03 * r[0].y_m, 1e-12 * r[0].y_m) << backend;  // y reads 3 % of x, nothing of its own
+    EXPECT_EQ(r[1].y_true_m, r[1].y_m);                                   // no noise: the truth is the reading
+    EXPECT_EQ(r[1].flags, 4);                                             // SIMULATED
+  }
+  BridgeSettings s;
+  s.axes = 3;
+  s.stage.noise_rms_m = 1e-9;
+  const MultiAxisStageConfig c = multi_axis_stage(s);
+  EXPECT_EQ(c.axes(), 3);
+  EXPECT_EQ(c.axis[0].seed, s.stage.seed);  // each axis its own noise
+  EXPECT_EQ(c.axis[2].seed, s.stage.seed + 2);
+}
+
+// A two-axis stage that records what each axis was given.
+struct AxesRecord {
+  std::vector<std::array<double, 2>> u_V;
+  std::atomic<std::size_t> steps{0};
+};
+
+class TwoAxisRecordingBackend final : public StageBackend {
+ public:
+  explicit TwoAxisRecordingBackend(AxesRecord& r) : r_(r) { r_.u_V.reserve(1 << 20); }
+  StageReading step(double u_V, double, double) noexcept override { return {u_V * 1e-9, 0.0, 4}; }
+  int axes() const noexcept override { return 2; }
+  void step_axes(std::span<const double> u_V, double, double, std::span<StageReading> out) noexcept override {
+    if (r_.u_V.size() < r_.u_V.capacity()) r_.u_V.push_back({u_V[0], u_V[1]});
+    r_.steps.fetch_add(1);
+    out[0] = {0.0, 0.0, 4};
+    out[1] = {0.0, 0.0, 4};
+  }
+  const std::string& name() const noexcept override { return name_; }
+  bool simulated() const noexcept override { return true; }
+  void hold_safe(double) noexcept override {}
+
+ private:
+  AxesRecord& r_;
+  std::string name_ = "recording-xy";
+};
+
+template <class Condition>
+bool eventually(Condition done) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() >= until) return done();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+BridgeSettings two_axes() {
+  BridgeSettings s;
+  s.axes = 2;
+  s.rt.ticks_per_wake = 20;
+  s.block_ticks = 20;
+  s.auto_arm = true;
+  s.limits.safe_ramp_V_per_s = 1e4;  // 1 V per tick
+  s.limits.watchdog_s = 2e-3;        // 20 ticks
+  s.stop_ramp_timeout_s = 2.0;
+  return s;
+}
+
+TEST(BridgeAxes, EveryAxisFollowsItsOwnCommandsAndOneAxisRunningDryTakesBothSafe) {
+  const BridgeSettings s = two_axes();
+  AxesRecord record;
+  BridgeRealtime rt(s, std::make_unique<TwoAxisRecordingBackend>(record));
+  ASSERT_EQ(rt.axes(), 2);
+  // x gets 4000 ticks of 10 V, y only 2000 of -20 V: y's buffer runs dry first.
+  for (std::int64_t k = 0; k < 4000; ++k) {
+    ASSERT_TRUE(rt.push_command(0, {k, 10.0, std::nan(""), 1, 2}));
+    if (k < 2000) {
+      ASSERT_TRUE(rt.push_command(1, {k, -20.0, std::nan(""), 1, 2}));
+    }
+  }
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 3000; }));
+  // Samples carry both axes.
+  const auto out = rt.pop_tick();
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(out->axes, 2);
+  rt.stop();
+
+  // Both axes reached their commands (the slew limit: 5 V per tick) ...
+  std::size_t both_there = record.u_V.size();
+  for (std::size_t i = 0; i < record.u_V.size(); ++i) {
+    if (record.u_V[i][0] == 10.0 && record.u_V[i][1] == -20.0) {
+      both_there = i;
+      break;
+    }
+  }
+  ASSERT_LT(both_there, record.u_V.size()) << "the axes never both reached their commands";
+  // ... then y ran dry, and x, with commands left, left its 10 V on the same tick as y its -20 V.
+  std::size_t x_left = 0, y_left = 0;
+  for (std::size_t i = both_there; i < record.u_V.size() && (x_left == 0 || y_left == 0); ++i) {
+    if (x_left == 0 && record.u_V[i][0] != 10.0) x_left = i;
+    if (y_left == 0 && record.u_V[i][1] != -20.0) y_left = i;
+  }
+  ASSERT_GT(y_left, 0u) << "y never left its command";
+  EXPECT_EQ(x_left, y_left) << "one safe state: both axes ramp from the same tick";
+  EXPECT_NEAR(record.u_V[y_left][0], 9.0, 1e-12);  // the ramp: 1 V per tick towards 0 V
+  EXPECT_NEAR(record.u_V[y_left][1], -19.0, 1e-12);
+  EXPECT_EQ(record.u_V.back()[0], 0.0);
+  EXPECT_EQ(record.u_V.back()[1], 0.0);
+}
+
+TEST(BridgeAxes, AStageArmsOnlyWhenEveryAxisHasCommands) {
+  const BridgeSettings s = two_axes();
+  AxesRecord record;
+  BridgeRealtime rt(s, std::make_unique<TwoAxisRecordingBackend>(record));
+  for (std::int64_t k = 0; k < 3000; ++k) ASSERT_TRUE(rt.push_command(0, {k, 10.0, std::nan(""), 1, 2}));
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 1000; }));
+  rt.stop();
+  for (const auto& u : record.u_V) ASSERT_EQ(u[0], 0.0) << "x moved although y had no commands: never armed";
+}
+
+TEST(BridgeAxes, ABackendOfAnotherAxisCountIsRefused) {
+  BridgeSettings s = two_axes();
+  s.axes = 3;
+  AxesRecord record;
+  EXPECT_THROW(BridgeRealtime(s, std::make_unique<TwoAxisRecordingBackend>(record)), ParameterError);
+}
+
+}  // namespace
+}  // namespace hystloop
