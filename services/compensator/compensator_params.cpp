@@ -64,11 +64,21 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
   const auto from = static_cast<std::uint64_t>(h.publisher_id);
   try {
     require_plausible(set, gain_plausibility(settings_));
-    if (switch_model) {
-      compensator_->offer_model(set, h.version);
-    } else {
-      compensator_->offer_mem_params(set.mem, h.version);
+    // One set for every axis: each checks it first (a copy of its law), then all take it or none does.
+    const auto take = [&](Compensator& c) {
+      if (switch_model) {
+        c.offer_model(set, h.version);
+      } else {
+        c.offer_mem_params(set.mem, h.version);
+      }
+    };
+    if (settings_.axes > 1) {
+      for_each_law([&](const Compensator& c) {
+        Compensator copy = c;
+        take(copy);
+      });
     }
+    for_each_law(take);
     admission_.accept(h.publisher_id, h.version);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_ns())) {
       spdlog::info(

@@ -50,14 +50,19 @@ namespace {
 // are not one stream [us].
 constexpr std::int64_t kConfirmWindowUs = 100'000;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The axes this service plans (x): a block of another count is refused, not assigned by guess.
-constexpr std::int8_t kAxes = 1;
 
 // HX_MODEL: an unknown kind or format version reaches on_model, which counts it by its reason.
 Subscription<model_params_t>::Options model_envelope() {
   Subscription<model_params_t>::Options o;
   o.check = &check_model_params_envelope;
   return o;
+}
+
+// Axis a's control law (every axis configured alike); none past the stage's axes.
+std::optional<Compensator> make_law(const CompensatorSettings& settings, int axis) {
+  static_assert(kMaxAxes == 3, "laws_ is built one initialiser per axis");
+  if (axis >= settings.axes) return std::nullopt;
+  return std::optional<Compensator>(std::in_place, settings.control);
 }
 
 template <class T>
@@ -72,7 +77,7 @@ typename Subscription<T>::Options queue_of(int capacity) {
 CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm::LCM& lcm, const ChannelNames& channels)
     : settings_(settings),
       lcm_(lcm),
-      compensator_(std::in_place, settings.control),
+      laws_{make_law(settings, 0), make_law(settings, 1), make_law(settings, 2)},
       command_pub_(lcm, channels.command),
       samples_(
           lcm, channels.sensor, [this](const sensor_block_t& m, std::int64_t t) { on_sensor(m, t); },
@@ -87,12 +92,12 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       // or a reorder: the plan still covers them); one further away must be confirmed.
       guard_(settings.control.horizon_ticks, kConfirmWindowUs) {
   reserve_storage(command_);
-  compensator_->set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
+  x().set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
 }
 
 void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept {
   const std::int64_t start_ns = monotonic_ns();
-  if (msg.n_axes != kAxes) {
+  if (msg.n_axes != settings_.axes) {
     ++counters_.sensor_blocks_wrong_axes;
     return;
   }
@@ -107,11 +112,20 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
     case SequenceGuard::Verdict::take: break;
   }
   const SensorTick last = sensor_tick(msg, static_cast<std::size_t>(msg.n_ticks) - 1);
-  for_each_tick(msg, [&](const SensorTick& t) { compensator_->observe({t.seq, t.u_V, t.y_m, t.u_ff_V}); });
+  for (int a = 0; a < settings_.axes; ++a) {
+    Compensator& law = *laws_[static_cast<std::size_t>(a)];
+    for_each_tick(
+        msg,
+        [&](const SensorTick& t) {
+          law.observe({t.seq, t.u_V, t.y_m, t.u_ff_V});
+        },
+        static_cast<std::size_t>(a));
+  }
   last_sample_utime_ = last.utime;
   ++blocks_in_period_;
   if (!have_sample_) {
     have_sample_ = true;
+    if (settings_.scan.path != ScanSettings::Path::kNone && !scan_taken_) take_configured_scan();
     if (pending_trajectory_) {  // now the loop time is known
       const TrajectorySpec spec = *pending_trajectory_;
       pending_trajectory_.reset();
@@ -137,9 +151,23 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
 }
 
 void CompensatorService::publish_plan() noexcept {
-  while (const std::size_t n = compensator_->plan(plan_)) {
-    begin_block(command_, plan_[0].seq, wall_utime(), compensator_->last_seq());
-    for (std::size_t i = 0; i < n; ++i) append_tick(command_, plan_[i]);
+  const auto axes = static_cast<std::size_t>(settings_.axes);
+  for (;;) {
+    // Every law observed the same ticks, so each plans the same ones; should they differ, the
+    // ticks every axis has are sent (the others are planned again from the next block).
+    std::size_t n = x().plan(plan_[0]);
+    for (std::size_t a = 1; a < axes; ++a) {
+      const std::size_t m = laws_[a]->plan(plan_[a]);
+      if (m != n) ++counters_.plan_mismatch;
+      n = std::min(n, m);
+    }
+    if (n == 0) return;
+    begin_block(command_, plan_[0][0].seq, wall_utime(), x().last_seq(), settings_.axes);
+    std::array<CommandTick, kMaxAxes> tick{};
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t a = 0; a < axes; ++a) tick[a] = plan_[a][i];
+      append_tick(command_, std::span<const CommandTick>(tick).first(axes));
+    }
     if (command_pub_.publish(command_)) {
       ++counters_.command_blocks_published;
       counters_.command_ticks_published += n;
@@ -147,10 +175,35 @@ void CompensatorService::publish_plan() noexcept {
   }
 }
 
+void CompensatorService::take_configured_scan() {
+  scan_taken_ = true;
+  const double start_s = static_cast<double>(x().last_seq()) * x().config().dt_s + settings_.scan.start_after_s;
+  try {
+    // Every axis checks its share first (a copy of each law): all take the path or none does.
+    std::array<std::optional<ScanShare>, kMaxAxes> shares;
+    for (int a = 0; a < settings_.axes; ++a) {
+      const auto i = static_cast<std::size_t>(a);
+      shares[i].emplace(scan_share(settings_, a, start_s, laws_[i]->stage()));
+      Compensator copy = *laws_[i];
+      copy.take_scan(*shares[i], settings_.scan.blend_s);
+    }
+    for (int a = 0; a < settings_.axes; ++a) {
+      const auto i = static_cast<std::size_t>(a);
+      laws_[i]->take_scan(*shares[i], settings_.scan.blend_s);
+    }
+    ++counters_.scans;
+    spdlog::info("scan taken by {} axes: starts at loop time {:.4f} s, ends at {:.4f} s", settings_.axes, start_s,
+                 shares[0]->end_s());
+  } catch (const std::exception& e) {
+    ++counters_.scans_refused;
+    spdlog::error("the configured scan was refused: {}", e.what());
+  }
+}
+
 void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version) {
   TrajectoryVerdict v;
   if (start_utime == 0) {
-    v = compensator_->take_trajectory(spec, kNaN);
+    v = x().take_trajectory(spec, kNaN);
     pending_trajectory_.reset();  // a newer trajectory replaces one waiting for the first sample
   } else if (!have_sample_) {
     spec.validate();
@@ -159,7 +212,7 @@ void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64
     pending_version_ = version;
     return;
   } else {
-    Compensator& c = *compensator_;
+    Compensator& c = x();
     const double start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
     v = c.take_trajectory(spec, start_s);
     if (!v.started) ++counters_.trajectory_late_start;
@@ -230,9 +283,9 @@ void CompensatorService::on_control(const control_t& msg) {
         if (!mode || *mode == FeedforwardMode::kExperiment) {
           return refuse("mode " + std::to_string(msg.mode) + " is not selectable (" + selectable_mode_choices() + ")");
         }
-        compensator_->set_mode(*mode);
+        for_each_law([&](Compensator& c) { c.set_mode(*mode); });
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info("mode {} (request {}){}", to_string(compensator_->mode()), msg.request_id, suppressed_note(g));
+          spdlog::info("mode {} (request {}){}", to_string(x().mode()), msg.request_id, suppressed_note(g));
         }
         break;
       }
@@ -240,29 +293,28 @@ void CompensatorService::on_control(const control_t& msg) {
         const ExperimentSpec e =
             make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,
                                  msg.experiment_frequency_Hz, msg.experiment_duration_s);
-        const bool queued = compensator_->experiment_running();
-        compensator_->start_experiment(e);
+        const bool queued = x().experiment_running();
+        x().start_experiment(e);
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info(
-              "experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
-              e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
-              queued ? "queued, " + std::to_string(compensator_->experiments_queued()) + " waiting" : "started",
-              msg.request_id, suppressed_note(g));
+          spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
+                       e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
+                       queued ? "queued, " + std::to_string(x().experiments_queued()) + " waiting" : "started",
+                       msg.request_id, suppressed_note(g));
         }
         break;
       }
       case control_t::STOP_EXPERIMENT:
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info("experiment stopped, {} queued dropped (request {}){}", compensator_->experiments_queued(),
-                       msg.request_id, suppressed_note(g));
+          spdlog::info("experiment stopped, {} queued dropped (request {}){}", x().experiments_queued(), msg.request_id,
+                       suppressed_note(g));
         }
-        compensator_->stop_experiment();
+        x().stop_experiment();
         break;
       case control_t::SET_LEARNING:
         switch (msg.learning) {
-          case control_t::LEARNING_OFF: compensator_->set_learning(false); break;
-          case control_t::LEARNING_ON: compensator_->set_learning(true); break;
-          case control_t::LEARNING_RESET: compensator_->reset_learning(); break;
+          case control_t::LEARNING_OFF: for_each_law([](Compensator& c) { c.set_learning(false); }); break;
+          case control_t::LEARNING_ON: for_each_law([](Compensator& c) { c.set_learning(true); }); break;
+          case control_t::LEARNING_RESET: for_each_law([](Compensator& c) { c.reset_learning(); }); break;
           default: return refuse("learning " + std::to_string(msg.learning) + " is not off (0), on (1) or reset (2)");
         }
         if (const LogLimiter::Gate g = acted()) {
@@ -300,62 +352,75 @@ void CompensatorService::on_control(const control_t& msg) {
 }
 
 void CompensatorService::restart_control_law() {
-  std::string refusal;
-  Compensator next = compensator_->restarted(settings_.control, refusal);
-  if (!refusal.empty()) {
-    ++counters_.trajectory_refused;
-    spdlog::warn("after the bridge's restart the trajectory in force was not taken again: {}", escape_wire(refusal));
+  for (int a = 0; a < settings_.axes; ++a) {
+    std::optional<Compensator>& law = laws_[static_cast<std::size_t>(a)];
+    std::string refusal;
+    Compensator next = law->restarted(settings_.control, refusal);
+    if (!refusal.empty()) {
+      ++counters_.trajectory_refused;
+      spdlog::warn("after the bridge's restart the trajectory in force on {} was not taken again: {}", axis_name(a),
+                   escape_wire(refusal));
+    }
+    retired_ += law->counters();
+    law.emplace(std::move(next));
   }
-  retired_ += compensator_->counters();
-  compensator_.emplace(std::move(next));
   have_sample_ = false;
   ++counters_.bridge_restarts;
 }
 
 CounterSet::Entries CompensatorService::collect_counters() const {
   CompensatorCounters c = retired_;
-  c += compensator_->counters();
+  for (int a = 0; a < settings_.axes; ++a) c += laws_[static_cast<std::size_t>(a)]->counters();
   const CompensatorServiceCounters& s = counters_;
-  return {{"samples", c.samples},
-          {"command_blocks_published", s.command_blocks_published},
-          {"command_ticks_published", s.command_ticks_published},
-          {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
-          {"planned", c.planned},
-          {"ticks_behind", c.ticks_behind},
-          {"gaps", c.gaps},
-          {"out_of_order", c.out_of_order},
-          {"nonfinite_outputs", c.nonfinite_outputs},
-          {"reversals", c.reversals},
-          {"params_accepted", c.params_accepted},
-          {"params_rejected", c.params_rejected + s.params_refused},
-          {"params_invalid", s.params_invalid},
-          {"params_stale", s.params_stale},
-          {"params_stale_repeat", s.params_stale_repeat},
-          {"params_stale_below", s.params_stale_below},
-          {"params_swapped", c.params_swapped},
-          {"model_switches", c.model_switches},
-          {"model_unknown_kind", s.model_unknown_kind},
-          {"model_unknown_format", s.model_unknown_format},
-          {"reanchors", c.reanchors},
-          {"reanchors_skipped", c.reanchors_skipped},
-          {"u_clamped", c.u_clamped},
-          {"u_slew_clamped", c.u_slew_clamped},
-          {"learning_held", c.learning_held},
-          {"trajectories_shaped", c.trajectories_shaped},
-          {"stage_swaps", c.stage_swaps},
-          {"experiment_ramped", c.experiment_ramped},
-          {"trajectories", s.trajectories},
-          {"trajectory_repeats", s.trajectory_repeats},
-          {"trajectory_refused", s.trajectory_refused},
-          {"trajectory_late_start", s.trajectory_late_start},
-          {"control_acted", s.control_acted},
-          {"control_refused", s.control_refused},
-          {"bridge_restarts", s.bridge_restarts},
-          {"sensor_jumps", guard_.counters().jumps},
-          {"sensor_jumps_ignored", guard_.counters().ignored},
-          {"sensor_blocks_held", guard_.counters().held},
-          {"params_publishers_evicted", admission_.evictions()},
-          {"log_lines_suppressed", log_limiter_.suppressed_total()}};
+  CounterSet::Entries entries = {{"samples", c.samples},
+                                 {"command_blocks_published", s.command_blocks_published},
+                                 {"command_ticks_published", s.command_ticks_published},
+                                 {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
+                                 {"planned", c.planned},
+                                 {"ticks_behind", c.ticks_behind},
+                                 {"gaps", c.gaps},
+                                 {"out_of_order", c.out_of_order},
+                                 {"nonfinite_outputs", c.nonfinite_outputs},
+                                 {"reversals", c.reversals},
+                                 {"params_accepted", c.params_accepted},
+                                 {"params_rejected", c.params_rejected + s.params_refused},
+                                 {"params_invalid", s.params_invalid},
+                                 {"params_stale", s.params_stale},
+                                 {"params_stale_repeat", s.params_stale_repeat},
+                                 {"params_stale_below", s.params_stale_below},
+                                 {"params_swapped", c.params_swapped},
+                                 {"model_switches", c.model_switches},
+                                 {"model_unknown_kind", s.model_unknown_kind},
+                                 {"model_unknown_format", s.model_unknown_format},
+                                 {"reanchors", c.reanchors},
+                                 {"reanchors_skipped", c.reanchors_skipped},
+                                 {"u_clamped", c.u_clamped},
+                                 {"u_slew_clamped", c.u_slew_clamped},
+                                 {"learning_held", c.learning_held},
+                                 {"trajectories_shaped", c.trajectories_shaped},
+                                 {"stage_swaps", c.stage_swaps},
+                                 {"experiment_ramped", c.experiment_ramped},
+                                 {"trajectories", s.trajectories},
+                                 {"trajectory_repeats", s.trajectory_repeats},
+                                 {"trajectory_refused", s.trajectory_refused},
+                                 {"trajectory_late_start", s.trajectory_late_start},
+                                 {"control_acted", s.control_acted},
+                                 {"control_refused", s.control_refused},
+                                 {"bridge_restarts", s.bridge_restarts},
+                                 {"sensor_jumps", guard_.counters().jumps},
+                                 {"sensor_jumps_ignored", guard_.counters().ignored},
+                                 {"sensor_blocks_held", guard_.counters().held},
+                                 {"params_publishers_evicted", admission_.evictions()},
+                                 {"log_lines_suppressed", log_limiter_.suppressed_total()}};
+  // A stage of several axes: the counters above are summed over the axes' laws (samples: every
+  // axis's), and these say how the axes planned together.
+  if (settings_.axes > 1 || settings_.scan.path != ScanSettings::Path::kNone) {
+    entries.emplace_back("axes", static_cast<std::uint64_t>(settings_.axes));
+    entries.emplace_back("plan_mismatch", s.plan_mismatch);
+    entries.emplace_back("scans", s.scans);
+    entries.emplace_back("scans_refused", s.scans_refused);
+  }
+  return entries;
 }
 
 // Off the sensor path: what the SequenceGuard decided since the last report.
@@ -392,7 +457,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   verdict_due_ = false;
   log_sequence_events();
   const auto counters = collect_counters();
-  const Compensator& c = *compensator_;
+  const Compensator& c = x();
   if (c.counters().params_swapped != swaps_reported_) {
     swaps_reported_ = c.counters().params_swapped;
     spdlog::info("parameters v{} in use: {}", c.params_version(), describe_model(c.model_params()));

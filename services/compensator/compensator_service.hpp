@@ -62,7 +62,7 @@ CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounter
 // The compensator's own counters (cumulative; RESET_COUNTERS reports them from a baseline).
 struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;
-  // Sensor blocks of another number of axes than this compensator's (one): not used, never
+  // Sensor blocks of another number of axes than this compensator's: not used, never
   // assigned to an axis by guess.
   std::uint64_t sensor_blocks_wrong_axes = 0;
   std::uint64_t command_ticks_published = 0;
@@ -80,6 +80,9 @@ struct CompensatorServiceCounters {
   std::uint64_t control_acted = 0;
   std::uint64_t control_refused = 0;
   std::uint64_t bridge_restarts = 0;  // sample seq went back (confirmed): the control law was restarted
+  std::uint64_t plan_mismatch = 0;    // the axes' laws planned different tick counts (published: the fewest)
+  std::uint64_t scans = 0;            // the configured scan taken
+  std::uint64_t scans_refused = 0;
   // The last trajectory_t.version taken (as given or shaped), refused, shaped: what
   // hystloop-ctl trajectory waits for.
   std::int64_t trajectory_version = 0;
@@ -112,7 +115,9 @@ class CompensatorService {
   // verdict), which leaves the period's timing and sample counts running.
   void report(std::int64_t utime, bool stopping, bool end_period = true);
 
-  const Compensator& compensator() const noexcept { return *compensator_; }
+  const Compensator& compensator() const noexcept { return *laws_[0]; }  // x's
+  const Compensator& compensator(int axis) const noexcept { return *laws_[static_cast<std::size_t>(axis)]; }
+  int axes() const noexcept { return settings_.axes; }
   const CompensatorServiceCounters& counters() const noexcept { return counters_; }
   const SequenceGuard::Counters& sequence_counters() const noexcept { return guard_.counters(); }
 
@@ -150,10 +155,19 @@ class CompensatorService {
 
   CompensatorSettings settings_;
   lcm::LCM& lcm_;
-  std::optional<Compensator> compensator_;
+  // One control law per axis (laws_[0]: x, the one trajectories and experiments drive).
+  std::array<std::optional<Compensator>, kMaxAxes> laws_;
+  Compensator& x() noexcept { return *laws_[0]; }
+  const Compensator& x() const noexcept { return *laws_[0]; }
+  template <class Fn>
+  void for_each_law(Fn&& fn) {
+    for (int a = 0; a < settings_.axes; ++a) fn(*laws_[static_cast<std::size_t>(a)]);
+  }
+  // The configured scan, taken by every axis with the first sample (false: refused, logged).
+  void take_configured_scan();
   Publisher<command_block_t> command_pub_;
-  command_block_t command_{};  // storage reserved
-  std::array<CommandTick, command_block_t::MAX_TICKS> plan_{};
+  command_block_t command_{};                                                         // storage reserved
+  std::array<std::array<CommandTick, command_block_t::MAX_TICKS>, kMaxAxes> plan_{};  // per axis
   Subscription<sensor_block_t> samples_;
   Subscription<trajectory_t> trajectories_;
   Subscription<mem_params_t> params_;
@@ -165,6 +179,7 @@ class CompensatorService {
 
   // What maps utime to loop time, and a trajectory whose start time needs it.
   bool have_sample_ = false;
+  bool scan_taken_ = false;  // the configured scan is taken once, with the first sample
   std::int64_t last_sample_utime_ = 0;
   std::optional<TrajectorySpec> pending_trajectory_;  // a timed start that arrived before the first sample
   std::int64_t pending_start_utime_ = 0;

@@ -77,7 +77,100 @@ void read_plausibility(const Config& config, CompensatorSettings& s) {
   });
 }
 
+// decoupling.<from>_to_<to>: C(to, from), as the bridge's simulated stage names its coupling.
+struct CouplingKey {
+  const char* key;
+  int to;
+  int from;
+};
+constexpr CouplingKey kDecouplingKeys[] = {{"decoupling.x_to_y", 1, 0}, {"decoupling.x_to_z", 2, 0},
+                                           {"decoupling.y_to_x", 0, 1}, {"decoupling.y_to_z", 2, 1},
+                                           {"decoupling.z_to_x", 0, 2}, {"decoupling.z_to_y", 1, 2}};
+
+// A list of one value per axis (at most kMaxAxes), the rest 0.
+AxisPositions per_axis_list(const Config& config, const std::string& key, double lo, double hi) {
+  const std::vector<double> v = config.get<std::vector<double>>(key, {});
+  if (v.size() > kScanAxes) config.fail(key, "takes at most one value per axis (x, y, z)");
+  AxisPositions out{};
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!(v[i] >= lo && v[i] <= hi)) config.fail(key, fmt::format("values must lie in [{}, {}]", lo, hi));
+    out[i] = v[i];
+  }
+  return out;
+}
+
+void read_axes_and_scan(const Config& config, CompensatorSettings& s) {
+  s.axes = static_cast<int>(config.get_int_in_range("compensator.axes", s.axes, 1, kMaxAxes));
+  AxisMatrix c = AxisMatrix::Identity();
+  for (const CouplingKey& k : kDecouplingKeys)
+    c(k.to, k.from) = config.get_in_range(k.key, 0.0, -kMaxCoupling, kMaxCoupling);
+  validate_config_section(config, "", [&] { s.decoupling = AxisCoupling(s.axes, c); });
+
+  ScanSettings& scan = s.scan;
+  const std::string path = config.get<std::string>("scan.path", "none");
+  if (path == "none") return;
+  if (path == "raster") {
+    scan.path = ScanSettings::Path::kRaster;
+  } else if (path == "lissajous") {
+    scan.path = ScanSettings::Path::kLissajous;
+  } else {
+    config.fail("scan.path", "must be none, raster or lissajous (got '" + path + "')");
+  }
+  scan.start_after_s = config.get_in_range("scan.start_after_s", scan.start_after_s, 0.0, 20.0);
+  scan.blend_s = config.get_in_range("scan.blend_s", scan.blend_s, 0.0, 10.0);
+  scan.decouple = config.get<bool>("scan.decouple", scan.decouple);
+  const AxisPositions centre = per_axis_list(config, "scan.centre_m", -1e-3, 1e-3);
+  if (scan.path == ScanSettings::Path::kRaster) {
+    if (s.axes < 2) config.fail("scan.path", "a raster needs two axes (compensator.axes >= 2)");
+    RasterSpec& r = scan.raster;
+    r.width_m = config.get_in_range("scan.width_m", 1e-6, 1e-12, 1e-3);
+    r.height_m = config.get_in_range("scan.height_m", 1e-6, 0.0, 1e-3);
+    r.lines = static_cast<int>(config.get_int_in_range("scan.lines", 64, 2, RasterSpec::kMaxLines));
+    r.line_rate_hz = config.get_in_range("scan.line_rate_hz", 50.0, 1e-3, 5000.0);
+    r.settle_s = config.get_in_range("scan.settle_s", 0.05, 0.0, 60.0);
+    r.corner_s = config.get_non_negative("scan.corner_s", 0.0);
+    const std::string slow = config.get<std::string>("scan.slow", "steps");
+    if (slow != "steps" && slow != "ramp") config.fail("scan.slow", "must be steps or ramp (got '" + slow + "')");
+    r.slow_mode = slow == "ramp" ? SlowMode::kRamp : SlowMode::kSteps;
+    r.centre_m = centre;
+    RasterSpec checked = r;  // the corner chosen later is at least 1 ms
+    if (checked.corner_s == 0.0) checked.corner_s = std::min(1e-3, 0.5 / r.line_rate_hz);
+    validate_config_section(config, "scan.", [&] { checked.validate(); });
+  } else {
+    LissajousSpec& l = scan.lissajous;
+    l.amplitude_m = per_axis_list(config, "scan.amplitude_m", 0.0, 1e-3);
+    l.frequency_hz = per_axis_list(config, "scan.frequency_hz", 0.0, 5000.0);
+    l.phase_rad = per_axis_list(config, "scan.phase_rad", -100.0, 100.0);
+    l.duration_s = config.get_in_range("scan.duration_s", 1.0, 1e-3, 3600.0);
+    l.centre_m = centre;
+    for (int i = s.axes; i < kMaxAxes; ++i) {
+      if (l.amplitude_m[static_cast<std::size_t>(i)] != 0.0) {
+        config.fail("scan.amplitude_m", "moves axis " + std::string(axis_name(i)) + ", which this stage lacks");
+      }
+    }
+    validate_config_section(config, "scan.", [&] { l.validate(); });
+  }
+}
+
 }  // namespace
+
+ScanShare scan_share(const CompensatorSettings& settings, int axis, double start_s, const StageModel& stage) {
+  const ScanSettings& scan = settings.scan;
+  const AxisVector row = scan.decouple ? AxisVector(settings.decoupling.inverse_matrix().row(axis).transpose())
+                                       : AxisVector(AxisVector::Unit(axis));
+  if (scan.path == ScanSettings::Path::kRaster) {
+    RasterSpec r = scan.raster;
+    if (r.corner_s == 0.0) {
+      const double c = resonance_corner_s(stage);
+      r.corner_s = c > 0.0 ? c : 1e-3;
+    }
+    r.start_s = start_s;
+    return ScanShare(r, axis, row);
+  }
+  LissajousSpec l = scan.lissajous;
+  l.start_s = start_s;
+  return ScanShare(l, axis, row);
+}
 
 GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept {
   GainPlausibility rig;
@@ -125,7 +218,30 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "trajectory.corner_s",
                                   "trajectory.shape_if_infeasible",
                                   "trajectory.points_t_s",
-                                  "trajectory.points_y_m"};
+                                  "trajectory.points_y_m",
+                                  "compensator.axes",
+                                  "decoupling.x_to_y",
+                                  "decoupling.x_to_z",
+                                  "decoupling.y_to_x",
+                                  "decoupling.y_to_z",
+                                  "decoupling.z_to_x",
+                                  "decoupling.z_to_y",
+                                  "scan.path",
+                                  "scan.start_after_s",
+                                  "scan.blend_s",
+                                  "scan.decouple",
+                                  "scan.width_m",
+                                  "scan.height_m",
+                                  "scan.lines",
+                                  "scan.line_rate_hz",
+                                  "scan.slow",
+                                  "scan.settle_s",
+                                  "scan.corner_s",
+                                  "scan.amplitude_m",
+                                  "scan.frequency_hz",
+                                  "scan.phase_rad",
+                                  "scan.duration_s",
+                                  "scan.centre_m"};
     OnlineModels::for_each([&]<class D>() { append_config_keys(k, D::name, D::table()); });
     return k;
   }();
@@ -217,6 +333,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
     t.points_y_m[i] = py[i];
   }
   validate_config_section(config, "", [&] { t.validate(); });
+  read_axes_and_scan(config, s);
   return s;
 }
 
@@ -269,6 +386,31 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
                               to_string(t.shape), t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s, t.n_points));
+  if (s.axes > 1) {
+    std::string coupled;
+    for (int j = 0; j < s.axes; ++j) {
+      for (int i = 0; i < s.axes; ++i) {
+        const double v = s.decoupling.matrix()(j, i);
+        if (i != j && v != 0.0) coupled += fmt::format(", {} -> {} {:+.4g}", axis_name(i), axis_name(j), v);
+      }
+    }
+    lines.push_back(fmt::format("axes: {}, one control law each (HX_TRAJECTORY moves x); coupling to cancel{}", s.axes,
+                                coupled.empty() ? " none" : coupled));
+  }
+  const ScanSettings& sc = s.scan;
+  if (sc.path == ScanSettings::Path::kRaster) {
+    const RasterSpec& r = sc.raster;
+    lines.push_back(fmt::format(
+        "scan: raster {:.4g} x {:.4g} m, {} lines at {} lines/s, slow axis {}, {} {} s after the first sample{}",
+        r.width_m, r.height_m, r.lines, r.line_rate_hz, r.slow_mode == SlowMode::kRamp ? "ramping" : "stepping",
+        sc.decouple ? "decoupled," : "not decoupled,", sc.start_after_s,
+        r.corner_s > 0.0 ? fmt::format(", corners {} s", r.corner_s) : std::string()));
+  } else if (sc.path == ScanSettings::Path::kLissajous) {
+    const LissajousSpec& l = sc.lissajous;
+    lines.push_back(fmt::format("scan: Lissajous, amplitudes {} m at {} Hz for {} s, {} {} s after the first sample",
+                                format_list(l.amplitude_m), format_list(l.frequency_hz), l.duration_s,
+                                sc.decouple ? "decoupled," : "not decoupled,", sc.start_after_s));
+  }
   return lines;
 }
 

@@ -6,19 +6,41 @@
 // reads (mem: {c1, c2, c3}, pi: {count, range_V, thresholds, weights}, linear: {gain, offset},
 // katalenic: {k1, k2, ..., input_shaping: {...}}).
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "core/config.hpp"
 #include "loop/compensator.hpp"
+#include "loop/scan_path.hpp"
+#include "models/axis_coupling.hpp"
 #include "loop/trajectory.hpp"
 #include "models/gain_plausibility.hpp"
 #include "models/model_set.hpp"
 
 namespace hystloop {
 
+// A path every axis follows together, taken with the first sensor block (scan.* keys).
+struct ScanSettings {
+  enum class Path : std::int8_t { kNone, kRaster, kLissajous };
+  Path path = Path::kNone;
+  RasterSpec raster{};         // its corner_s 0: resonance_corner_s of the stage model (1 ms without one)
+  LissajousSpec lissajous{};   //
+  double start_after_s = 0.2;  // loop time from the first sample to the path's start [s]
+  double blend_s = 0.05;       // the approach from where each axis is [s]
+  bool decouple = true;        // each axis its share of C^{-1} r (C: the decoupling keys); false: r alone
+};
+
 struct CompensatorSettings {
+  // Axes of the stage (1..kMaxAxes), one control law each, every one configured as `control`;
+  // sensor blocks of another count are refused. HX_TRAJECTORY moves x (the others hold their
+  // reference); parameter sets and modes apply to every axis; experiments run on x.
+  int axes = 1;
+  // The stage's coupling as identified (models/axis_coupling.hpp; decoupling.x_to_y is C(y, x)):
+  // a scan gives each axis its share of C^{-1} r. Identity: none known.
+  AxisCoupling decoupling{};
+  ScanSettings scan{};
   CompensatorConfig control{};      // mode, models, horizon, dt
   TrajectorySpec trajectory{};      // the initial reference (default: hold at 0), started with the first sample
   double run_seconds = 0.0;         // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
@@ -43,6 +65,10 @@ CompensatorSettings load_compensator_settings(const Config& config);
 // Merges a parameter snippet (as hystloop-identify --out writes it) over `config`, key by key.
 // Throws ConfigError naming the snippet file when it cannot be read.
 void merge_params_file(Config& config, const std::filesystem::path& snippet);
+
+// The configured scan as each axis's share (ScanShare) for a path starting at loop time start_s,
+// its raster corners chosen for `stage` when the settings leave them at 0.
+ScanShare scan_share(const CompensatorSettings& settings, int axis, double start_s, const StageModel& stage);
 
 // One line per section, for the start-up log.
 std::vector<std::string> describe(const CompensatorSettings& settings);

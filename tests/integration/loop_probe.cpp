@@ -1,8 +1,8 @@
 // The integration tests' hands and eyes on a running bridge + compensator (udpm inside
 // tools/netns-run):
 //
-//   loop_probe record  --dir D [--seconds S] [--rt-priority N]   until SIGTERM or S seconds: HX_SENSOR -> D/sensor.csv,
-//   HX_COMMAND -> D/command.csv, HX_SIM_TRUTH -> D/truth.csv (seq,y_true_m),
+//   loop_probe record  --dir D [--seconds S] [--rt-priority N] [--axis A]   until SIGTERM or S seconds: HX_SENSOR ->
+//   D/sensor.csv, HX_COMMAND -> D/command.csv, HX_SIM_TRUTH -> D/truth.csv (seq,y_true_m),
 //                                                HX_STATUS -> D/status.log (one line per report:
 //                                                process=P state=S ... counters ... host=H pid=N detail=D)
 //   loop_probe control --command arm|disarm|set_mode|set_gains|start_experiment|stop_experiment|
@@ -57,7 +57,8 @@ std::int64_t now_utime() {
 
 void pause_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
 
-int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds, int rt_priority) {
+int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds, int rt_priority,
+           std::size_t axis) {
   install_stop_handlers();  // SIGTERM ends the recording cleanly
   // A recorder starved for longer than its socket buffer (~0.5 s of traffic) loses samples.
   if (rt_priority > 0) set_realtime_priority(rt_priority);
@@ -77,10 +78,14 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   Subscription<sensor_block_t> s(
       lcm, ch.sensor,
       [&](const sensor_block_t& m, std::int64_t) {
-        for_each_tick(m, [&](const SensorTick& t) {
-          std::fprintf(sensor, "%lld,%lld,%.17g,%.17g,%d,%.17g,%.17g,%.17g\n", static_cast<long long>(t.seq),
-                       static_cast<long long>(t.utime), t.u_V, t.y_m, t.flags, t.y_ref_m, t.u_ff_V, t.u_fb_V);
-        });
+        if (axis >= axes_of(m)) return;
+        for_each_tick(
+            m,
+            [&](const SensorTick& t) {
+              std::fprintf(sensor, "%lld,%lld,%.17g,%.17g,%d,%.17g,%.17g,%.17g\n", static_cast<long long>(t.seq),
+                           static_cast<long long>(t.utime), t.u_V, t.y_m, t.flags, t.y_ref_m, t.u_ff_V, t.u_fb_V);
+            },
+            axis);
       },
       so);
   Subscription<command_block_t>::Options co;
@@ -89,11 +94,14 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
   Subscription<command_block_t> c(
       lcm, ch.command,
       [&](const command_block_t& m, std::int64_t) {
-        if (!arrays_consistent(m)) return;
-        for_each_tick(m, [&](const CommandTick& t) {
-          std::fprintf(command, "%lld,%lld,%.17g,%.17g,%d,%d\n", static_cast<long long>(t.seq),
-                       static_cast<long long>(m.sample_seq), t.u_ff_V, t.y_ref_m, t.params_version, t.mode);
-        });
+        if (!arrays_consistent(m) || axis >= axes_of(m)) return;
+        for_each_tick(
+            m,
+            [&](const CommandTick& t) {
+              std::fprintf(command, "%lld,%lld,%.17g,%.17g,%d,%d\n", static_cast<long long>(t.seq),
+                           static_cast<long long>(m.sample_seq), t.u_ff_V, t.y_ref_m, t.params_version, t.mode);
+            },
+            axis);
       },
       co);
   Subscription<sim_truth_t>::Options to;
@@ -102,7 +110,7 @@ int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double
       lcm, ch.sim_truth,
       [&](const sim_truth_t& m, std::int64_t) {
         long long seq = m.seq;
-        for (const double y : axis_truth(m)) std::fprintf(truth, "%lld,%.17g\n", seq++, y);
+        for (const double y : axis_truth(m, axis)) std::fprintf(truth, "%lld,%.17g\n", seq++, y);
       },
       to);
   Subscription<service_status_t> st(lcm, ch.status, [&](const service_status_t& m, std::int64_t) {
@@ -417,6 +425,8 @@ int run_probe(int argc, char** argv) {
   rec->add_option("--dir", dir)->required();
   rec->add_option("--seconds", seconds, "at most this long; SIGTERM stops it earlier");
   rec->add_option("--rt-priority", rt_priority, "SCHED_FIFO priority (0 = normal)");
+  std::size_t axis = 0;
+  rec->add_option("--axis", axis, "the axis of a multi-axis stage to record (0: x, 1: y, 2: z)");
 
   ControlArgs ca;
   auto* ctl = app.add_subcommand("control");
@@ -474,7 +484,7 @@ int run_probe(int argc, char** argv) {
     if (*sv) return status_value(dir, process, key);
     const ChannelNames ch(prefix);
     auto lcm = open_lcm(url);
-    if (*rec) return record(*lcm, ch, dir, seconds, rt_priority);
+    if (*rec) return record(*lcm, ch, dir, seconds, rt_priority, axis);
     if (*ctl) return control(*lcm, ch, ca);
     if (*inj) return inject(*lcm, ch, target, count);
     if (*tr) {

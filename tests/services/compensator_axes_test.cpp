@@ -1,0 +1,260 @@
+// hystloop-compensator for a stage of several axes: compensator.axes control laws, one per axis,
+// answering each sensor block of that many axes with one command block of every axis; blocks of
+// another count refused; the configured scan (a raster or a Lissajous figure) taken by every axis
+// with the first sample, each its share of C^{-1} r when decoupled; parameter sets for every axis
+// at once; the per-block path allocation-free with several axes too.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "compensator/compensator_service.hpp"
+#include "lcm/blocks.hpp"
+#include "lcm/connection.hpp"
+#include "support/allocation_counter.hpp"
+
+namespace hystloop {
+namespace {
+
+constexpr std::int64_t kBaseUtime = 1'700'000'000'000'000;
+constexpr double kDt = 1e-4;
+constexpr double kGain = 6.3e-9;
+
+std::int64_t utime_of(std::int64_t tick) { return kBaseUtime + tick * 100; }
+
+const std::string kConfigDir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
+
+CompensatorSettings load(const std::string& overrides) {
+  Config config = Config::load_file(kConfigDir + "compensator.yaml");
+  std::string line;
+  for (char c : overrides + "\n") {
+    if (c != '\n') {
+      line += c;
+      continue;
+    }
+    if (!line.empty()) config.apply_override(line);
+    line.clear();
+  }
+  return load_compensator_settings(config);
+}
+
+std::string refusal(const std::string& overrides) {
+  try {
+    load(overrides);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(CompensatorAxes, SettingsTakeTheAxesTheDecouplingAndTheScanAndNameWhatTheyRefuse) {
+  const CompensatorSettings one = load("");
+  EXPECT_EQ(one.axes, 1);
+  EXPECT_EQ(one.scan.path, ScanSettings::Path::kNone);
+  const CompensatorSettings xy =
+      load("compensator.axes=2\ndecoupling.x_to_y=0.03\nscan.path=raster\nscan.lines=16\nscan.line_rate_hz=25");
+  EXPECT_EQ(xy.axes, 2);
+  EXPECT_EQ(xy.decoupling.matrix()(1, 0), 0.03);
+  EXPECT_NEAR(xy.decoupling.inverse_matrix()(1, 0), -0.03, 1e-15);
+  EXPECT_EQ(xy.scan.path, ScanSettings::Path::kRaster);
+  EXPECT_EQ(xy.scan.raster.lines, 16);
+  EXPECT_EQ(xy.scan.raster.line_rate_hz, 25.0);
+  EXPECT_TRUE(xy.scan.decouple);
+  bool says = false;
+  for (const std::string& l : describe(xy)) says = says || contains(l, "scan: raster");
+  EXPECT_TRUE(says);
+
+  EXPECT_TRUE(contains(refusal("compensator.axes=4"), "compensator.axes"));
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\ndecoupling.x_to_y=0.9"), "decoupling.x_to_y"));
+  EXPECT_TRUE(contains(refusal("scan.path=raster"), "two axes"));  // one axis
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\nscan.path=spiral"), "scan.path"));
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\nscan.path=raster\nscan.slow=jump"), "scan.slow"));
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\nscan.path=raster\nscan.lines=1"), "scan.lines"));
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\nscan.path=lissajous\nscan.amplitude_m=[1e-7,1e-7,1e-7]\n"
+                               "scan.frequency_hz=[5,4,3]"),
+                       "scan.amplitude_m"));  // moves z, which an XY stage lacks
+  EXPECT_TRUE(contains(refusal("compensator.axes=2\nscan.path=lissajous\nscan.amplitude_m=[1e-7,1e-7]"),
+                       "scan."));  // moving axes need frequencies
+  EXPECT_EQ(refusal("compensator.axes=2\nscan.path=lissajous\nscan.amplitude_m=[1e-7,1e-7]\n"
+                    "scan.frequency_hz=[5,4]"),
+            "accepted");
+}
+
+// The service on memq for a stage of `axes` axes; a bridge that feeds each axis what it was sent
+// (u = the feedforward, y = kGain u) and a listener that keeps every axis's commands.
+struct AxesHarness {
+  std::unique_ptr<lcm::LCM> lcm = open_lcm("memq://");
+  ChannelNames channels{};
+  CompensatorService service;
+  int axes;
+  std::array<std::map<std::int64_t, CommandTick>, kMaxAxes> sent;  // per axis: tick -> its last command
+  std::vector<std::int8_t> block_axes;                             // n_axes of every command block
+  Subscription<command_block_t> commands;
+  sensor_block_t sensor{};
+
+  explicit AxesHarness(const CompensatorSettings& s)
+      : service(s, *lcm, channels),
+        axes(s.axes),
+        commands(*lcm, channels.command, [this](const command_block_t& b, std::int64_t) { record(b); }) {
+    reserve_storage(sensor);
+  }
+
+  void record(const command_block_t& b) {
+    block_axes.push_back(b.n_axes);
+    for (std::size_t a = 0; a < axes_of(b); ++a) {
+      for_each_tick(
+          b, [&](const CommandTick& t) { sent[a][t.seq] = t; }, a);
+    }
+  }
+
+  const sensor_block_t& build(std::int64_t seq, std::int64_t n) {
+    begin_block(sensor, seq, utime_of(seq), kDt, axes);
+    for (std::int64_t k = seq; k < seq + n; ++k) {
+      std::array<SensorTick, kMaxAxes> t{};
+      for (int a = 0; a < axes; ++a) {
+        const auto& m = sent[static_cast<std::size_t>(a)];
+        const auto it = m.find(k);
+        const double u = it == m.end() ? 0.0 : it->second.u_ff_V;
+        const double y_ref = it == m.end() ? std::nan("") : it->second.y_ref_m;
+        t[static_cast<std::size_t>(a)] = SensorTick{utime_of(k), k, u, u, 0.0, y_ref, kGain * u, 0};
+      }
+      append_tick(sensor, std::span<const SensorTick>(t).first(static_cast<std::size_t>(axes)));
+    }
+    return sensor;
+  }
+
+  void drain() {
+    while (handle_pending(*lcm, std::chrono::microseconds(0), 100000) > 0) {
+    }
+  }
+
+  void run(std::int64_t from, std::int64_t n, std::int64_t block = 50) {
+    for (std::int64_t k = from; k < from + n; k += block) {
+      service.on_sensor(build(k, std::min(block, from + n - k)), wall_utime());
+      drain();
+    }
+  }
+};
+
+CompensatorSettings raster(bool decouple) {
+  CompensatorSettings s = load(
+      "compensator.axes=2\ndecoupling.x_to_y=0.03\nscan.path=raster\nscan.lines=8\nscan.line_rate_hz=50\n"
+      "scan.start_after_s=0.1\nscan.blend_s=0.05\ncompensator.mode=mem\nscan.decouple=" +
+      std::string(decouple ? "true" : "false"));
+  return s;
+}
+
+TEST(CompensatorAxes, EverySensorBlockOfTheStagesAxesIsAnsweredForEveryAxisAndOthersAreRefused) {
+  AxesHarness h(raster(true));
+  h.run(0, 500);
+  ASSERT_FALSE(h.block_axes.empty());
+  for (const std::int8_t n : h.block_axes) ASSERT_EQ(n, 2);
+  const std::int64_t horizon = h.service.compensator().config().horizon_ticks;
+  EXPECT_EQ(h.sent[0].rbegin()->first, 499 + horizon);  // both axes through the horizon
+  EXPECT_EQ(h.sent[1].rbegin()->first, 499 + horizon);
+  EXPECT_EQ(h.service.counters().plan_mismatch, 0u);
+
+  // A one-axis block: refused whole, nothing planned, nothing observed.
+  sensor_block_t one{};
+  begin_block(one, 500, utime_of(500), kDt, 1);
+  append_tick(one, SensorTick{utime_of(500), 500, 0.0, 0.0, 0.0, 0.0, 0.0, 0});
+  const std::size_t blocks = h.block_axes.size();
+  h.service.on_sensor(one, wall_utime());
+  h.drain();
+  EXPECT_EQ(h.service.counters().sensor_blocks_wrong_axes, 1u);
+  EXPECT_EQ(h.block_axes.size(), blocks);
+  EXPECT_EQ(h.service.compensator(1).last_seq(), 499);
+}
+
+TEST(CompensatorAxes, TheConfiguredRasterIsTakenByEveryAxisAndDecouplingReachesOnlyTheCoupledAxis) {
+  AxesHarness dec(raster(true)), cou(raster(false));
+  // The raster: 8 lines at 50 lines/s from 0.1 s after the first sample (tick 49): ticks 1049 ..
+  // 2649, then a settle.
+  dec.run(0, 3000);
+  cou.run(0, 3000);
+  EXPECT_EQ(dec.service.counters().scans, 1u);
+  EXPECT_EQ(cou.service.counters().scans, 1u);
+  ASSERT_TRUE(dec.service.compensator(1).scan());
+  // Mid-raster: x draws lines (+-0.5 um), y has stepped up through the lines (-0.5 .. +0.5 um).
+  std::size_t y_differs = 0;
+  double x_span_min = 0, x_span_max = 0, y_min = 1, y_max = -1;
+  for (std::int64_t k = 1100; k < 2600; ++k) {
+    const CommandTick& dx = dec.sent[0].at(k);
+    const CommandTick& cx = cou.sent[0].at(k);
+    const CommandTick& dy = dec.sent[1].at(k);
+    const CommandTick& cy = cou.sent[1].at(k);
+    // x's row of C^{-1} is its own axis: the same commands whether decoupled or not.
+    ASSERT_EQ(dx.u_ff_V, cx.u_ff_V) << k;
+    ASSERT_EQ(dx.y_ref_m, cx.y_ref_m) << k;
+    // y's sensor must read the raster's y either way (the servo's reference) ...
+    ASSERT_EQ(dy.y_ref_m, cy.y_ref_m) << k;
+    // ... but decoupled, its own displacement leaves room for what x moves it by.
+    if (dy.u_ff_V != cy.u_ff_V) ++y_differs;
+    x_span_min = std::min(x_span_min, dx.y_ref_m);
+    x_span_max = std::max(x_span_max, dx.y_ref_m);
+    y_min = std::min(y_min, dy.y_ref_m);
+    y_max = std::max(y_max, dy.y_ref_m);
+  }
+  EXPECT_GT(y_differs, 1000u);
+  EXPECT_NEAR(x_span_max - x_span_min, 1e-6, 1e-9);
+  EXPECT_GT(y_max - y_min, 0.7e-6);  // lines 0..7 of 8 over 1 um, most of them within the window
+  // The decoupled y feedforward subtracts 3 % of x's share: the difference follows x's line.
+  const double k_mid = 1049 + 0.25 * 200;  // a quarter into the first line: x moving up
+  const double diff_V =
+      dec.sent[1].at(static_cast<std::int64_t>(k_mid)).u_ff_V - cou.sent[1].at(static_cast<std::int64_t>(k_mid)).u_ff_V;
+  // y's share is r_y - 0.03 r_x, and r_x = -0.25 um there: 7.5 nm more of y's own displacement, a
+  // volt or a few at the stage's local slope (2e-9 .. 8e-9 m/V).
+  EXPECT_GT(diff_V, 0.5);
+  EXPECT_LT(diff_V, 5.0);
+}
+
+mem_params_t params(std::int32_t version, double c1) {
+  mem_params_t p{};
+  p.version = version;
+  p.publisher_id = 7;
+  p.c1 = c1;
+  p.c2 = 1.5e-12;
+  p.c3 = 1.1;
+  p.valid = 1;
+  p.source = "test";
+  return p;
+}
+
+TEST(CompensatorAxes, AParameterSetIsTakenByEveryAxisOrByNone) {
+  AxesHarness h(load("compensator.axes=2\ncompensator.mode=mem"));
+  h.run(0, 200);
+  h.service.on_params(params(2, 2.1e-9));
+  EXPECT_EQ(h.service.counters().params_refused, 0u);
+  EXPECT_EQ(h.service.compensator(0).counters().params_accepted, 1u);
+  EXPECT_EQ(h.service.compensator(1).counters().params_accepted, 1u);
+
+  // Under a raster, the same set would take y's decoupled share past the slew limit: refused,
+  // and x, whose line alone it would not refuse, keeps its set too.
+  AxesHarness r(raster(true));
+  r.run(0, 200);
+  r.service.on_params(params(2, 2.1e-9));
+  EXPECT_EQ(r.service.counters().params_refused, 1u);
+  EXPECT_EQ(r.service.compensator(0).counters().params_accepted, 0u);
+  EXPECT_EQ(r.service.compensator(1).counters().params_accepted, 0u);
+}
+
+TEST(CompensatorAxes, TheSensorBlockPathDoesNotAllocateWithSeveralAxes) {
+  AxesHarness h(raster(true));
+  h.run(0, 1000);  // warm-up: sizes the publisher's buffer
+  std::vector<sensor_block_t> blocks;
+  for (std::int64_t seq = 1000; seq < 4000; seq += 50) blocks.push_back(h.build(seq, 50));
+  testing::AllocationCounter counter;
+  for (const sensor_block_t& b : blocks) h.service.on_sensor(b, b.utime + 20);
+  EXPECT_EQ(counter.allocations(), 0u);
+  h.drain();
+}
+
+}  // namespace
+}  // namespace hystloop
