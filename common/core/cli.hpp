@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -24,6 +25,14 @@ namespace hystloop {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
+
+// An option naming an axis of an XY(Z) stage as x, y or z, stored as 0, 1 or 2 (anything else is
+// refused by the parser, naming the choices).
+inline CLI::Option* add_axis_option(CLI::App* app, const std::string& name, int& axis, const std::string& help) {
+  return app->add_option(name, axis, help)
+      ->transform(CLI::CheckedTransformer(std::map<std::string, int>{{"x", 0}, {"y", 1}, {"z", 2}}).description(""))
+      ->type_name("x|y|z");
+}
 
 // nullopt: parsed, go on; otherwise the code to exit with.
 inline std::optional<int> parse_cli(CLI::App& app, int argc, const char* const* argv) {

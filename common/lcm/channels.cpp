@@ -31,6 +31,7 @@ ChannelNames::ChannelNames(std::string_view rig_prefix)
       status(prefix + std::string(kStatusSuffix)),
       control(prefix + std::string(kControlSuffix)),
       model(prefix + std::string(kModelSuffix)),
-      sim_truth(prefix + std::string(kSimTruthSuffix)) {}
+      sim_truth(prefix + std::string(kSimTruthSuffix)),
+      scan(prefix + std::string(kScanSuffix)) {}
 
 }  // namespace hystloop

@@ -19,6 +19,7 @@ void validate_rig_prefix(std::string_view prefix);
 inline constexpr std::string_view kSensorSuffix = "SENSOR";          // sensor_block_t, 10 kHz of ticks in blocks
 inline constexpr std::string_view kCommandSuffix = "COMMAND";        // command_block_t, one block per sensor block
 inline constexpr std::string_view kTrajectorySuffix = "TRAJECTORY";  // trajectory_t, on change
+inline constexpr std::string_view kScanSuffix = "SCAN";              // scan_t, on change: a path of every axis
 inline constexpr std::string_view kParamsSuffix = "PARAMS";          // mem_params_t, on refit
 // model_params_t, on a model change: any model (HX_PARAMS stays MEM-only, so its tools and logs
 // work unchanged; a channel carries one type).
@@ -34,7 +35,7 @@ struct ChannelSpec {
   std::string_view suffix;
   std::string_view type_name;
 };
-inline constexpr std::array<ChannelSpec, 8> kChannelSpecs{{
+inline constexpr std::array<ChannelSpec, 9> kChannelSpecs{{
     {kSensorSuffix, "hystloop.sensor_block_t"},
     {kCommandSuffix, "hystloop.command_block_t"},
     {kTrajectorySuffix, "hystloop.trajectory_t"},
@@ -43,6 +44,7 @@ inline constexpr std::array<ChannelSpec, 8> kChannelSpecs{{
     {kControlSuffix, "hystloop.control_t"},
     {kModelSuffix, "hystloop.model_params_t"},
     {kSimTruthSuffix, "hystloop.sim_truth_t"},
+    {kScanSuffix, "hystloop.scan_t"},
 }};
 
 // The full names for one prefix, built once (publishing then never builds a string).
@@ -56,6 +58,7 @@ struct ChannelNames {
   std::string control;
   std::string model;
   std::string sim_truth;
+  std::string scan;
 
   // Validates the prefix (throws ParameterError naming "rig.prefix").
   explicit ChannelNames(std::string_view rig_prefix = kDefaultRigPrefix);

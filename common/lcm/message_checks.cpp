@@ -109,6 +109,7 @@ Verdict check_message(const trajectory_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.version >= 1);
   f.require(msg.shape >= trajectory_t::HOLD && msg.shape <= trajectory_t::POINTS);
+  f.require(msg.axis >= 0 && msg.axis < kWireAxes);
   f.within(msg.amplitude_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   f.within(msg.offset_m, -kMaxAbsPosition_m, kMaxAbsPosition_m);
   f.within(msg.phase_rad, -kHuge, kHuge);
@@ -132,6 +133,7 @@ Verdict check_message(const trajectory_t& msg) noexcept {
 Verdict check_message(const mem_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
+  f.require(msg.axis >= 0 && msg.axis < kWireAxes);
   f.text(msg.source);
   f.finite(msg.c1);
   f.require(!(msg.c1 <= 0.0) && !(msg.c1 > 1.0));  // [m/V]
@@ -195,6 +197,7 @@ void check_model_kind(Findings& f, const model_params_t& msg) noexcept {
 Verdict check_model_params_envelope(const model_params_t& msg) noexcept {
   Findings f;
   f.require(msg.utime >= 0 && msg.version >= 1 && msg.samples_used >= 0);
+  f.require(msg.axis >= 0 && msg.axis < kWireAxes);
   f.text(msg.source);
   f.finite(msg.stage_k);
   f.finite(msg.stage_c);
@@ -239,6 +242,7 @@ Verdict check_message(const control_t& msg) noexcept {
   f.text(msg.experiment);
   f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::RELEASE_PARAMS);
   f.require(msg.learning >= control_t::LEARNING_OFF && msg.learning <= control_t::LEARNING_RESET);
+  f.require(msg.axis >= 0 && msg.axis < kWireAxes);
   f.require(is_command_mode(msg.mode));
   f.nan_or_within(msg.kp, 0.0, kHuge);  // NaN: keep the gain in force
   f.nan_or_within(msg.ki, 0.0, kHuge);
@@ -252,6 +256,34 @@ Verdict check_message(const control_t& msg) noexcept {
   if (msg.command == control_t::START_EXPERIMENT) {
     f.require(!msg.experiment.empty() && msg.experiment_amplitude_V > 0.0 && msg.experiment_frequency_Hz > 0.0 &&
               msg.experiment_duration_s > 0.0);
+  }
+  return f.verdict();
+}
+
+Verdict check_message(const scan_t& msg) noexcept {
+  Findings f;
+  f.require(msg.utime >= 0 && msg.start_utime >= 0 && msg.version >= 1);
+  f.require(msg.path == scan_t::RASTER || msg.path == scan_t::LISSAJOUS);
+  for (const double c : msg.centre_m) f.within(c, -kMaxAbsPosition_m, kMaxAbsPosition_m);
+  f.within(msg.blend_s, 0.0, kMaxDuration_s);
+  f.within(msg.width_m, 0.0, kMaxAbsPosition_m);
+  f.within(msg.height_m, 0.0, kMaxAbsPosition_m);
+  f.within(msg.line_rate_Hz, 0.0, kMaxAbsFrequency_Hz);
+  f.within(msg.corner_s, 0.0, kMaxDuration_s);
+  f.within(msg.settle_s, 0.0, kMaxDuration_s);
+  f.within(msg.duration_s, 0.0, kMaxDuration_s);
+  for (int i = 0; i < kWireAxes; ++i) {
+    f.within(msg.amplitude_m[i], 0.0, kMaxAbsPosition_m);
+    f.within(msg.frequency_Hz[i], 0.0, kMaxAbsFrequency_Hz);
+    f.within(msg.phase_rad[i], -kHuge, kHuge);
+  }
+  if (msg.path == scan_t::RASTER) {
+    f.require(msg.fast_axis >= 0 && msg.fast_axis < kWireAxes && msg.slow_axis >= 0 && msg.slow_axis < kWireAxes &&
+              msg.fast_axis != msg.slow_axis);
+    f.require(msg.slow_mode == scan_t::STEPS || msg.slow_mode == scan_t::RAMP);
+    f.require(msg.width_m > 0.0 && msg.line_rate_Hz > 0.0 && msg.lines >= 2 && msg.lines <= 4096);
+  } else {
+    f.require(msg.duration_s > 0.0);
   }
   return f.verdict();
 }

@@ -15,6 +15,7 @@
 #include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/sim_truth_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "core/ticks.hpp"
@@ -26,7 +27,8 @@ inline constexpr double kMaxAbsVoltage_V = 1.0e4;  // no piezo amplifier goes ne
 inline constexpr double kMaxAbsPosition_m = 1.0;   // a nanopositioner moves micrometres
 inline constexpr double kMaxAbsFrequency_Hz = 1.0e5;
 inline constexpr double kMaxDuration_s = 86400.0;
-inline constexpr std::int32_t kKnownSampleFlags = 63;  // SATURATED .. SENSOR_FAULT
+inline constexpr std::int32_t kKnownSampleFlags = 63;       // SATURATED .. SENSOR_FAULT
+inline constexpr int kWireAxes = sensor_block_t::MAX_AXES;  // axes a message may name: 0 (x) .. kWireAxes - 1
 static_assert(kMaxBlockTicks == sensor_block_t::MAX_TICKS && kMaxBlockTicks == command_block_t::MAX_TICKS,
               "core/ticks.hpp's block bound is the wire's");
 
@@ -65,9 +67,16 @@ Verdict check_model_params_envelope(const model_params_t& msg) noexcept;
 // service_status_t: non-empty process, pid > 0, known state, 0..MAX_COUNTERS counters >= 0
 // with matching array sizes, timings NaN (not measured) or finite >= 0.
 Verdict check_message(const service_status_t& msg) noexcept;
+// trajectory_t, mem_params_t, model_params_t and control_t name an axis: 0..kWireAxes-1.
 // control_t: known command and mode, request_id > 0, gains and notch NaN (keep) or finite >= 0; START_EXPERIMENT
 // needs a name and amplitude, frequency and duration > 0.
 Verdict check_message(const control_t& msg) noexcept;
+
+// scan_t: a known path, finite numbers within the position, frequency and duration bounds, version
+// >= 1; a raster's two different axes, known slow mode, width and line rate > 0 and 2..4096 lines; a
+// Lissajous figure's duration > 0. (Whether the stage has those axes, and whether the actuator can
+// follow, is the compensator's check.)
+Verdict check_message(const scan_t& msg) noexcept;
 
 // The check a Subscription/Publisher uses; the default is check_message for T.
 template <class T>

@@ -12,6 +12,7 @@
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/model_params_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/sim_truth_t.hpp"
@@ -29,6 +30,7 @@ void reserve_storage(mem_params_t& msg);
 void reserve_storage(model_params_t& msg);
 void reserve_storage(service_status_t& msg);
 void reserve_storage(control_t& msg);
+inline void reserve_storage(scan_t&) {}  // fixed-size arrays only
 
 // clear_arrays: empties every variable array, keeping its capacity. Needed before decoding
 // into a reused message: lcm-gen's decode skips a primitive array whose count is 0, so it
@@ -39,6 +41,7 @@ void clear_arrays(sim_truth_t& msg) noexcept;
 inline void clear_arrays(mem_params_t&) noexcept {}
 void clear_arrays(model_params_t& msg) noexcept;
 inline void clear_arrays(control_t&) noexcept {}
+inline void clear_arrays(scan_t&) noexcept {}
 void clear_arrays(trajectory_t& msg) noexcept;
 void clear_arrays(service_status_t& msg) noexcept;
 
@@ -51,6 +54,7 @@ bool arrays_consistent(const sim_truth_t& msg) noexcept;
 inline bool arrays_consistent(const mem_params_t&) noexcept { return true; }
 bool arrays_consistent(const model_params_t& msg) noexcept;
 inline bool arrays_consistent(const control_t&) noexcept { return true; }
+inline bool arrays_consistent(const scan_t&) noexcept { return true; }
 bool arrays_consistent(const trajectory_t& msg) noexcept;
 bool arrays_consistent(const service_status_t& msg) noexcept;
 

@@ -25,8 +25,8 @@ namespace hystloop {
 // refused unsigned. HX_SENSOR is one of them: the compensator plans from its tick numbers and
 // the re-identifier fits its samples, so a forged block moves the plan. HX_STATUS is not: it
 // only reports (docs/SECURITY.md).
-inline constexpr std::array<std::string_view, 6> kAuthenticatedSuffixes{
-    kCommandSuffix, kControlSuffix, kTrajectorySuffix, kParamsSuffix, kModelSuffix, kSensorSuffix};
+inline constexpr std::array<std::string_view, 7> kAuthenticatedSuffixes{
+    kCommandSuffix, kControlSuffix, kTrajectorySuffix, kScanSuffix, kParamsSuffix, kModelSuffix, kSensorSuffix};
 
 // True if `channel` is <prefix><suffix> for one of kAuthenticatedSuffixes (the prefix ends in '_').
 bool is_authenticated_channel(std::string_view channel) noexcept;

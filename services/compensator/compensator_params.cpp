@@ -64,27 +64,20 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
   const auto from = static_cast<std::uint64_t>(h.publisher_id);
   try {
     require_plausible(set, gain_plausibility(settings_));
-    // One set for every axis: each checks it first (a copy of its law), then all take it or none does.
-    const auto take = [&](Compensator& c) {
-      if (switch_model) {
-        c.offer_model(set, h.version);
-      } else {
-        c.offer_mem_params(set.mem, h.version);
-      }
-    };
-    if (settings_.axes > 1) {
-      for_each_law([&](const Compensator& c) {
-        Compensator copy = c;
-        take(copy);
-      });
+    Compensator& c = law(h.axis, "params.axis");  // a set models one axis's actuator
+    if (switch_model) {
+      c.offer_model(set, h.version);
+    } else {
+      c.offer_mem_params(set.mem, h.version);
     }
-    for_each_law(take);
     admission_.accept(h.publisher_id, h.version);
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogParamsAccepted, monotonic_ns())) {
       spdlog::info(
-          "{} parameters v{} from '{}' (publisher {:x}) accepted ({}; residual {:.3g} m); swapped in at the "
+          "{} parameters v{} from '{}' (publisher {:x}) accepted{} ({}; residual {:.3g} m); swapped in at the "
           "next reversal{}",
-          h.what, h.version, escape_wire(h.source), from, describe_model(set), h.residual_m, suppressed_note(g));
+          h.what, h.version, escape_wire(h.source), from,
+          settings_.axes > 1 ? " for " + std::string(axis_name(h.axis)) : std::string(), describe_model(set),
+          h.residual_m, suppressed_note(g));
     }
   } catch (const ParameterError& e) {
     ++counters_.params_refused;
@@ -99,14 +92,14 @@ void CompensatorService::offer(const ParamsHeader& h, const ModelParamSet& set, 
 }
 
 void CompensatorService::on_params(const mem_params_t& msg) {
-  const ParamsHeader h{"MEM", msg.version, msg.publisher_id, msg.valid != 0, msg.source, msg.residual_m};
+  const ParamsHeader h{"MEM", msg.version, msg.publisher_id, msg.valid != 0, msg.source, msg.residual_m, msg.axis};
   if (admit(h)) offer(h, model_from_message(msg), false);
 }
 
 void CompensatorService::on_model(const model_params_t& msg) {
   const std::optional<ModelKind> kind = model_kind_from_int(msg.kind);
   const std::string_view what = kind ? to_string(*kind) : std::string_view("model");
-  const ParamsHeader h{what, msg.version, msg.publisher_id, msg.valid != 0, msg.source, msg.residual_m};
+  const ParamsHeader h{what, msg.version, msg.publisher_id, msg.valid != 0, msg.source, msg.residual_m, msg.axis};
   const bool format_known = msg.format_version == model_params_t::FORMAT_VERSION;
   const std::optional<ModelParamSet> set = format_known ? model_from_message(msg) : std::nullopt;
   if (!set) {

@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "compensator/scan_message.hpp"
 #include "compensator/trajectory_message.hpp"
 #include "core/clock.hpp"
 #include "core/periodic_timer.hpp"
@@ -83,6 +84,7 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
           lcm, channels.sensor, [this](const sensor_block_t& m, std::int64_t t) { on_sensor(m, t); },
           queue_of<sensor_block_t>(settings.sample_queue_capacity)),
       trajectories_(lcm, channels.trajectory, [this](const trajectory_t& m, std::int64_t) { on_trajectory(m); }),
+      scans_(lcm, channels.scan, [this](const scan_t& m, std::int64_t) { on_scan(m); }),
       params_(lcm, channels.params, [this](const mem_params_t& m, std::int64_t) { on_params(m); }),
       models_(
           lcm, channels.model, [this](const model_params_t& m, std::int64_t) { on_model(m); }, model_envelope()),
@@ -92,6 +94,9 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       // or a reorder: the plan still covers them); one further away must be confirmed.
       guard_(settings.control.horizon_ticks, kConfirmWindowUs) {
   reserve_storage(command_);
+  for (int a = 1; a < kMaxAxes; ++a) {
+    axis_params_counter_[static_cast<std::size_t>(a)] = std::string(axis_name(a)) + "_params_version";
+  }
   x().set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
 }
 
@@ -130,7 +135,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
       const TrajectorySpec spec = *pending_trajectory_;
       pending_trajectory_.reset();
       try {
-        apply_trajectory(spec, pending_start_utime_, pending_version_);
+        apply_trajectory(spec, pending_start_utime_, pending_version_, pending_axis_);
       } catch (const std::exception& e) {
         ++counters_.trajectory_refused;
         decide_trajectory(pending_version_, e.what(), true, false);
@@ -179,40 +184,92 @@ void CompensatorService::take_configured_scan() {
   scan_taken_ = true;
   const double start_s = static_cast<double>(x().last_seq()) * x().config().dt_s + settings_.scan.start_after_s;
   try {
-    // Every axis checks its share first (a copy of each law): all take the path or none does.
-    std::array<std::optional<ScanShare>, kMaxAxes> shares;
-    for (int a = 0; a < settings_.axes; ++a) {
-      const auto i = static_cast<std::size_t>(a);
-      shares[i].emplace(scan_share(settings_, a, start_s, laws_[i]->stage()));
-      Compensator copy = *laws_[i];
-      copy.take_scan(*shares[i], settings_.scan.blend_s);
-    }
-    for (int a = 0; a < settings_.axes; ++a) {
-      const auto i = static_cast<std::size_t>(a);
-      laws_[i]->take_scan(*shares[i], settings_.scan.blend_s);
-    }
-    ++counters_.scans;
-    spdlog::info("scan taken by {} axes: starts at loop time {:.4f} s, ends at {:.4f} s", settings_.axes, start_s,
-                 shares[0]->end_s());
+    spdlog::info("{}", take_scan(settings_.scan, start_s));
   } catch (const std::exception& e) {
-    ++counters_.scans_refused;
     spdlog::error("the configured scan was refused: {}", e.what());
   }
 }
 
-void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version) {
+std::string CompensatorService::take_scan(const ScanSettings& scan, double start_s) {
+  try {
+    std::array<std::optional<ScanShare>, kMaxAxes> shares;
+    for (int a = 0; a < settings_.axes; ++a) {
+      const auto i = static_cast<std::size_t>(a);
+      shares[i].emplace(scan_share(scan, settings_.decoupling, a, start_s, laws_[i]->stage()));
+      Compensator copy = *laws_[i];
+      copy.take_scan(*shares[i], scan.blend_s);
+    }
+    for (int a = 0; a < settings_.axes; ++a) {
+      const auto i = static_cast<std::size_t>(a);
+      laws_[i]->take_scan(*shares[i], scan.blend_s);
+    }
+    ++counters_.scans;
+    return fmt::format("scan taken by {} axes{}: from loop time {:.4f} s to {:.4f} s", settings_.axes,
+                       scan.decouple && settings_.axes > 1 ? ", decoupled" : "", start_s, shares[0]->end_s());
+  } catch (...) {
+    ++counters_.scans_refused;
+    throw;
+  }
+}
+
+void CompensatorService::on_scan(const scan_t& msg) {
+  if (msg.version == trajectory_version_ || msg.version == refused_version_) {  // UDP repeats: decided once
+    ++counters_.trajectory_repeats;
+    return;
+  }
+  try {
+    if (!have_sample_) {
+      throw ParameterError("scan", "no sensor block yet: where the axes are, and the loop time, are not known");
+    }
+    const ScanSettings scan = scan_from_message(msg, settings_.axes);
+    const Compensator& c = x();
+    const double dt_s = c.config().dt_s;
+    const double earliest_s = static_cast<double>(std::max<std::int64_t>(c.next_tick(), 0)) * dt_s + scan.blend_s;
+    const double start_s =
+        msg.start_utime == 0 ? earliest_s : loop_time_of_utime(msg.start_utime, last_sample_utime_, c.last_seq(), dt_s);
+    const std::string note = take_scan(scan, start_s);
+    trajectory_version_ = msg.version;
+    ++counters_.trajectories;
+    decide_trajectory(msg.version, note, false, false);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_ns())) {
+      spdlog::info("scan v{}: {}{}", msg.version, note, suppressed_note(g));
+    }
+  } catch (const std::exception& e) {
+    ++counters_.trajectory_refused;
+    refused_version_ = msg.version;
+    decide_trajectory(msg.version, e.what(), true, false);
+    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_ns())) {
+      spdlog::warn("scan v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
+    }
+  }
+  if (verdict_due_) report(wall_utime(), false, false);
+}
+
+Compensator& CompensatorService::law(int axis, const char* field) {
+  if (axis < 0 || axis >= settings_.axes) {
+    ++counters_.wrong_axis;
+    throw ParameterError(field, "names axis " + std::string(axis_name(axis)) + ", but this stage has " +
+                                    (settings_.axes == 1 ? std::string("only x (compensator.axes 1)")
+                                                         : std::to_string(settings_.axes) + " axes"));
+  }
+  return *laws_[static_cast<std::size_t>(axis)];
+}
+
+void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version,
+                                          int axis) {
+  Compensator& c = law(axis, "trajectory.axis");
   TrajectoryVerdict v;
   if (start_utime == 0) {
-    v = x().take_trajectory(spec, kNaN);
+    v = c.take_trajectory(spec, kNaN);
     pending_trajectory_.reset();  // a newer trajectory replaces one waiting for the first sample
   } else if (!have_sample_) {
     spec.validate();
     pending_trajectory_ = spec;
     pending_start_utime_ = start_utime;
     pending_version_ = version;
+    pending_axis_ = axis;
     return;
   } else {
-    Compensator& c = x();
     const double start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
     v = c.take_trajectory(spec, start_s);
     if (!v.started) ++counters_.trajectory_late_start;
@@ -245,7 +302,7 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
     return;
   }
   try {
-    apply_trajectory(trajectory_from_message(msg), msg.start_utime, msg.version);
+    apply_trajectory(trajectory_from_message(msg), msg.start_utime, msg.version, msg.axis);
     trajectory_version_ = msg.version;
     if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_ns())) {
       spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", msg.version,
@@ -293,12 +350,23 @@ void CompensatorService::on_control(const control_t& msg) {
         const ExperimentSpec e =
             make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,
                                  msg.experiment_frequency_Hz, msg.experiment_duration_s);
-        const bool queued = x().experiment_running();
-        x().start_experiment(e);
+        Compensator& driven = law(msg.axis, "control.axis");
+        if (settings_.axes > 1) {
+          for (int a = 0; a < settings_.axes; ++a) {
+            const Compensator& c = *laws_[static_cast<std::size_t>(a)];
+            const double next_s = static_cast<double>(std::max<std::int64_t>(c.next_tick(), 0)) * c.config().dt_s;
+            if (c.scan() != nullptr && next_s < c.scan()->end_s()) {
+              return refuse("a scan is running (until loop time " + fmt::format("{:.3f}", c.scan()->end_s()) +
+                            " s): an experiment on one axis would tear the path the others follow");
+            }
+          }
+        }
+        const bool queued = driven.experiment_running();
+        driven.start_experiment(e);
         if (const LogLimiter::Gate g = acted()) {
           spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
                        e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
-                       queued ? "queued, " + std::to_string(x().experiments_queued()) + " waiting" : "started",
+                       queued ? "queued, " + std::to_string(driven.experiments_queued()) + " waiting" : "started",
                        msg.request_id, suppressed_note(g));
         }
         break;
@@ -419,6 +487,7 @@ CounterSet::Entries CompensatorService::collect_counters() const {
     entries.emplace_back("plan_mismatch", s.plan_mismatch);
     entries.emplace_back("scans", s.scans);
     entries.emplace_back("scans_refused", s.scans_refused);
+    entries.emplace_back("wrong_axis", s.wrong_axis);
   }
   return entries;
 }
@@ -534,6 +603,10 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   acks_.report(status_);
   status_.counter("mode", static_cast<std::uint64_t>(c.mode()));  // the tracking mode (command_block_t.MODE_*)
   status_.counter("params_version", at_least_0(c.params_version()));
+  for (int a = 1; a < settings_.axes; ++a) {  // the other axes' sets: hystloop-ctl params --axis waits on them
+    status_.counter(axis_params_counter_[static_cast<std::size_t>(a)],
+                    at_least_0(laws_[static_cast<std::size_t>(a)]->params_version()));
+  }
   status_.counter("learning_active", learner.active ? 1u : 0u);
   status_.counter("learning_periods", learner.periods_learned);
   status_.counter("params_held_by_learning", c.params_held_by_learning() ? 1u : 0u);

@@ -42,6 +42,7 @@
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/model_params_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/control_filter.hpp"
@@ -81,8 +82,9 @@ struct CompensatorServiceCounters {
   std::uint64_t control_refused = 0;
   std::uint64_t bridge_restarts = 0;  // sample seq went back (confirmed): the control law was restarted
   std::uint64_t plan_mismatch = 0;    // the axes' laws planned different tick counts (published: the fewest)
-  std::uint64_t scans = 0;            // the configured scan taken
+  std::uint64_t scans = 0;            // scans taken (configured or HX_SCAN)
   std::uint64_t scans_refused = 0;
+  std::uint64_t wrong_axis = 0;  // a trajectory, parameter set or experiment for an axis the stage lacks
   // The last trajectory_t.version taken (as given or shaped), refused, shaped: what
   // hystloop-ctl trajectory waits for.
   std::int64_t trajectory_version = 0;
@@ -107,6 +109,8 @@ class CompensatorService {
   // The handlers, public so that tests can drive the service without a network.
   void on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept;
   void on_trajectory(const trajectory_t& msg);
+  // HX_SCAN: a path of every axis (its verdict reported as a trajectory's, under its version).
+  void on_scan(const scan_t& msg);
   void on_params(const mem_params_t& msg);
   // HX_MODEL: any model; the feedforward switches to it at the next reversal (compensator_params.cpp).
   void on_model(const model_params_t& msg);
@@ -122,7 +126,9 @@ class CompensatorService {
   const SequenceGuard::Counters& sequence_counters() const noexcept { return guard_.counters(); }
 
  private:
-  void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version);
+  void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version, int axis);
+  // The axis a message names, when this stage has it; else throws ParameterError naming `field`.
+  Compensator& law(int axis, const char* field);
   void decide_trajectory(std::int64_t version, const std::string& verdict, bool refused, bool shaped);
   // What HX_PARAMS and HX_MODEL sets share: admit() refuses a diagnostic or stale set (counted,
   // logged once per reason and publisher); offer() validates and offers an admitted one.
@@ -133,6 +139,7 @@ class CompensatorService {
     bool valid;
     std::string_view source;
     double residual_m;
+    int axis;  // the axis whose actuator it models
   };
   bool admit(const ParamsHeader& header);
   void offer(const ParamsHeader& header, const ModelParamSet& set, bool switch_model);
@@ -163,13 +170,18 @@ class CompensatorService {
   void for_each_law(Fn&& fn) {
     for (int a = 0; a < settings_.axes; ++a) fn(*laws_[static_cast<std::size_t>(a)]);
   }
-  // The configured scan, taken by every axis with the first sample (false: refused, logged).
+  // The configured scan, taken by every axis with the first sample (refused: logged, counted).
   void take_configured_scan();
+  // `scan` on every axis, its path starting at loop time start_s; every axis checks its share first
+  // (a copy of its law), then all take it or none does (throws ParameterError: why). Returns the note
+  // of the verdict.
+  std::string take_scan(const ScanSettings& scan, double start_s);
   Publisher<command_block_t> command_pub_;
   command_block_t command_{};                                                         // storage reserved
   std::array<std::array<CommandTick, command_block_t::MAX_TICKS>, kMaxAxes> plan_{};  // per axis
   Subscription<sensor_block_t> samples_;
   Subscription<trajectory_t> trajectories_;
+  Subscription<scan_t> scans_;
   Subscription<mem_params_t> params_;
   Subscription<model_params_t> models_;
   Subscription<control_t> control_;
@@ -179,12 +191,15 @@ class CompensatorService {
 
   // What maps utime to loop time, and a trajectory whose start time needs it.
   bool have_sample_ = false;
-  bool scan_taken_ = false;  // the configured scan is taken once, with the first sample
+  bool scan_taken_ = false;
+  std::array<std::string, kMaxAxes>
+      axis_params_counter_;  // "y_params_version", ...  // the configured scan is taken once, with the first sample
   std::int64_t last_sample_utime_ = 0;
   std::optional<TrajectorySpec> pending_trajectory_;  // a timed start that arrived before the first sample
   std::int64_t pending_start_utime_ = 0;
   std::int64_t trajectory_version_ = 0;
   std::int64_t pending_version_ = 0;  // of pending_trajectory_
+  int pending_axis_ = 0;              // of pending_trajectory_
   std::int64_t refused_version_ = 0;  // the last trajectory_t.version refused
   // The last verdict on a trajectory, in HX_STATUS's detail for a while after it was decided.
   std::string verdict_;

@@ -154,9 +154,9 @@ void read_axes_and_scan(const Config& config, CompensatorSettings& s) {
 
 }  // namespace
 
-ScanShare scan_share(const CompensatorSettings& settings, int axis, double start_s, const StageModel& stage) {
-  const ScanSettings& scan = settings.scan;
-  const AxisVector row = scan.decouple ? AxisVector(settings.decoupling.inverse_matrix().row(axis).transpose())
+ScanShare scan_share(const ScanSettings& scan, const AxisCoupling& decoupling, int axis, double start_s,
+                     const StageModel& stage) {
+  const AxisVector row = scan.decouple ? AxisVector(decoupling.inverse_matrix().row(axis).transpose())
                                        : AxisVector(AxisVector::Unit(axis));
   if (scan.path == ScanSettings::Path::kRaster) {
     RasterSpec r = scan.raster;

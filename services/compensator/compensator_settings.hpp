@@ -66,9 +66,11 @@ CompensatorSettings load_compensator_settings(const Config& config);
 // Throws ConfigError naming the snippet file when it cannot be read.
 void merge_params_file(Config& config, const std::filesystem::path& snippet);
 
-// The configured scan as each axis's share (ScanShare) for a path starting at loop time start_s,
-// its raster corners chosen for `stage` when the settings leave them at 0.
-ScanShare scan_share(const CompensatorSettings& settings, int axis, double start_s, const StageModel& stage);
+// A scan as one axis's share (ScanShare) of its path starting at loop time start_s: the row of
+// C^{-1} (C = `decoupling`) when scan.decouple, else the axis's own reference; a raster's corners
+// chosen for `stage` when left at 0 (resonance_corner_s; 1 ms without dynamics).
+ScanShare scan_share(const ScanSettings& scan, const AxisCoupling& decoupling, int axis, double start_s,
+                     const StageModel& stage);
 
 // One line per section, for the start-up log.
 std::vector<std::string> describe(const CompensatorSettings& settings);

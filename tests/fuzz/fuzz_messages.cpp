@@ -94,14 +94,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t* body = data + 1;
   const std::size_t n = size - 1;
-  switch (data[0] % 7) {
+  switch (data[0] % 9) {
     case 0: receive<sensor_block_t>(body, n); break;
     case 1: receive<command_block_t>(body, n); break;
     case 2: receive<trajectory_t>(body, n); break;
     case 3: receive<mem_params_t>(body, n); break;
     case 4: receive<service_status_t>(body, n); break;
     case 5: receive<control_t>(body, n); break;
-    default: receive<model_params_t>(body, n); break;
+    case 6: receive<model_params_t>(body, n); break;
+    case 7: receive<sim_truth_t>(body, n); break;
+    default: receive<scan_t>(body, n); break;
   }
   return 0;
 }

@@ -38,6 +38,6 @@ sleep 2  # a duration: two of lcm-spy's once-a-second rate updates
 DISPLAY="$display" import -window root "$shot"
 echo "window: ${title:-none}; lcm-spy said: $(tr '\n' ' ' <"$spy_out")"
 [ -n "$title" ] || { echo "FAIL: no 'LCM Spy' window"; exit 1; }
-grep -q "Found 8 LCM types" "$spy_out" || { echo "FAIL: lcm-spy did not load the 8 hystloop types"; exit 1; }
+grep -q "Found 9 LCM types" "$spy_out" || { echo "FAIL: lcm-spy did not load the 9 hystloop types"; exit 1; }
 [ "$(head -c 8 "$shot" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || { echo "FAIL: no PNG screenshot"; exit 1; }
 echo "screenshot: $shot"

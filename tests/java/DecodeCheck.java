@@ -3,7 +3,7 @@
 // the fingerprint at the start of each message, decodes, re-encodes and requires the same
 // bytes (no field lost or changed), and checks a few values against the C++ fixtures'
 // formulas (tests/lcm/message_fixtures.hpp: tick t of a block carries values computed from t;
-// the fixtures' blocks have one axis, so every array holds n_values = n_ticks elements). It also requires the jar to hold exactly the six
+// the fixtures' blocks have one axis, so every array holds n_values = n_ticks elements). It also requires the jar to hold exactly the nine
 // hystloop types.
 //
 //   java -cp hystloop_lcmtypes.jar:lcm.jar:. DecodeCheck <jar> <log> <rounds>
@@ -48,7 +48,7 @@ public class DecodeCheck {
         }
       }
     }
-    if (byFingerprint.size() != 8) fail("expected 8 LCM types in the jar, found " + byFingerprint.size());
+    if (byFingerprint.size() != 9) fail("expected 9 LCM types in the jar, found " + byFingerprint.size());
 
     lcm.spy.LCMTypeDatabase spyTypes = new lcm.spy.LCMTypeDatabase();
     for (Map.Entry<Long, Class<?>> e : byFingerprint.entrySet()) {

@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/model_params_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/sim_truth_t.hpp"
 
@@ -30,6 +31,7 @@ TEST(Channels, AnotherRigGetsItsOwnNames) {
   const ChannelNames names("RIG2_");
   EXPECT_EQ(names.sensor, "RIG2_SENSOR");
   EXPECT_EQ(names.sim_truth, "RIG2_SIM_TRUTH");
+  EXPECT_EQ(names.scan, "RIG2_SCAN");
   EXPECT_EQ(channel_name("RIG2_", kControlSuffix), "RIG2_CONTROL");
 }
 
@@ -45,7 +47,8 @@ TEST(Channels, RefusesPrefixesThatAreNotLiteralRegexes) {
 }
 
 TEST(Channels, SpecsListEveryChannelOnce) {
-  EXPECT_EQ(kChannelSpecs.size(), 8u);
+  EXPECT_EQ(kChannelSpecs.size(), 9u);
+  EXPECT_EQ(kChannelSpecs[8].type_name, std::string("hystloop.") + scan_t::getTypeName());
   EXPECT_EQ(kChannelSpecs[7].type_name, std::string("hystloop.") + sim_truth_t::getTypeName());
   EXPECT_EQ(kChannelSpecs[6].type_name, std::string("hystloop.") + model_params_t::getTypeName());
   EXPECT_EQ(kChannelSpecs[0].type_name, "hystloop.sensor_block_t");

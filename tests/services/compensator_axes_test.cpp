@@ -215,7 +215,7 @@ TEST(CompensatorAxes, TheConfiguredRasterIsTakenByEveryAxisAndDecouplingReachesO
   EXPECT_LT(diff_V, 5.0);
 }
 
-mem_params_t params(std::int32_t version, double c1) {
+mem_params_t params(std::int32_t version, double c1, std::int8_t axis) {
   mem_params_t p{};
   p.version = version;
   p.publisher_id = 7;
@@ -224,25 +224,105 @@ mem_params_t params(std::int32_t version, double c1) {
   p.c3 = 1.1;
   p.valid = 1;
   p.source = "test";
+  p.axis = axis;
   return p;
 }
 
-TEST(CompensatorAxes, AParameterSetIsTakenByEveryAxisOrByNone) {
+TEST(CompensatorAxes, AParameterSetIsTakenByTheAxisItNames) {
   AxesHarness h(load("compensator.axes=2\ncompensator.mode=mem"));
   h.run(0, 200);
-  h.service.on_params(params(2, 2.1e-9));
+  h.service.on_params(params(2, 2.1e-9, 1));
   EXPECT_EQ(h.service.counters().params_refused, 0u);
+  EXPECT_EQ(h.service.compensator(0).counters().params_accepted, 0u);
+  EXPECT_EQ(h.service.compensator(1).counters().params_accepted, 1u);
+  h.service.on_params(params(3, 2.2e-9, 0));
   EXPECT_EQ(h.service.compensator(0).counters().params_accepted, 1u);
   EXPECT_EQ(h.service.compensator(1).counters().params_accepted, 1u);
+  h.service.on_params(params(4, 2.2e-9, 2));  // z: this stage has none
+  EXPECT_EQ(h.service.counters().params_refused, 1u);
+  EXPECT_EQ(h.service.counters().wrong_axis, 1u);
 
-  // Under a raster, the same set would take y's decoupled share past the slew limit: refused,
-  // and x, whose line alone it would not refuse, keeps its set too.
+  // Under a raster, a set that would take y's decoupled share past the slew limit is refused.
   AxesHarness r(raster(true));
   r.run(0, 200);
-  r.service.on_params(params(2, 2.1e-9));
+  r.service.on_params(params(2, 2.1e-9, 1));
   EXPECT_EQ(r.service.counters().params_refused, 1u);
-  EXPECT_EQ(r.service.compensator(0).counters().params_accepted, 0u);
   EXPECT_EQ(r.service.compensator(1).counters().params_accepted, 0u);
+}
+
+scan_t raster_message(std::int64_t version) {
+  scan_t m{};
+  m.version = version;
+  m.path = scan_t::RASTER;
+  m.fast_axis = 0;
+  m.slow_axis = 1;
+  m.width_m = 1e-6;
+  m.height_m = 1e-6;
+  m.lines = 8;
+  m.line_rate_Hz = 50.0;
+  m.slow_mode = scan_t::STEPS;
+  m.settle_s = 0.02;
+  m.decouple = 1;
+  m.blend_s = 0.05;
+  return m;
+}
+
+TEST(CompensatorAxes, AScanOnHxScanIsTakenByEveryAxisAndDecidedAsATrajectory) {
+  AxesHarness h(load("compensator.axes=2\ndecoupling.x_to_y=0.03\ncompensator.mode=mem"));
+  h.service.on_scan(raster_message(4));  // before any sample: where the axes are is not known
+  EXPECT_EQ(h.service.counters().trajectory_refused_version, 4);
+  h.run(0, 200);
+  h.service.on_scan(raster_message(5));
+  EXPECT_EQ(h.service.counters().trajectory_version, 5);
+  EXPECT_EQ(h.service.counters().scans, 1u);
+  h.service.on_scan(raster_message(5));  // a UDP repeat
+  EXPECT_EQ(h.service.counters().trajectory_repeats, 1u);
+  EXPECT_EQ(h.service.counters().scans, 1u);
+  h.run(200, 2500);
+  double y_min = 1, y_max = -1;
+  for (std::int64_t k = 1000; k < 2500; ++k) {
+    y_min = std::min(y_min, h.sent[1].at(k).y_ref_m);
+    y_max = std::max(y_max, h.sent[1].at(k).y_ref_m);
+  }
+  EXPECT_GT(y_max - y_min, 0.7e-6);  // y steps across the raster
+
+  scan_t z = raster_message(6);
+  z.slow_axis = 2;  // this stage has no z
+  h.service.on_scan(z);
+  EXPECT_EQ(h.service.counters().trajectory_refused_version, 6);
+  EXPECT_EQ(h.service.counters().scans, 1u);
+
+  AxesHarness one(load(""));  // a one-axis stage: no raster
+  one.run(0, 200);
+  one.service.on_scan(raster_message(7));
+  EXPECT_EQ(one.service.counters().trajectory_refused_version, 7);
+}
+
+TEST(CompensatorAxes, ATrajectoryMovesTheAxisItNames) {
+  AxesHarness h(load("compensator.axes=2\ncompensator.mode=mem"));
+  h.run(0, 200);
+  trajectory_t t{};
+  t.version = 3;
+  t.shape = trajectory_t::SINE;
+  t.amplitude_m = 0.2e-6;
+  t.frequency_Hz = 10.0;
+  t.blend_s = 0.01;
+  t.axis = 1;
+  h.service.on_trajectory(t);
+  EXPECT_EQ(h.service.counters().trajectory_version, 3);
+  h.run(200, 2000);
+  double x_span = 0, y_span = 0;
+  for (std::int64_t k = 1000; k < 2000; ++k) {
+    x_span = std::max(x_span, std::abs(h.sent[0].at(k).y_ref_m));
+    y_span = std::max(y_span, std::abs(h.sent[1].at(k).y_ref_m));
+  }
+  EXPECT_EQ(x_span, 0.0);
+  EXPECT_NEAR(y_span, 0.2e-6, 0.01e-6);
+  t.version = 4;
+  t.axis = 2;
+  h.service.on_trajectory(t);
+  EXPECT_EQ(h.service.counters().trajectory_refused_version, 4);
+  EXPECT_EQ(h.service.counters().wrong_axis, 1u);
 }
 
 TEST(CompensatorAxes, TheSensorBlockPathDoesNotAllocateWithSeveralAxes) {

@@ -144,8 +144,13 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   return 0;
 }
 
-int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
-                       const VerdictOptions& o) {
+namespace {
+
+// Publishes with `publish` (3 copies) on `channel`, prints "sent <what> <description> ..." and, with
+// wait, follows the compensator's HX_STATUS until it reports on `version`.
+template <class Message>
+int publish_and_follow(CtlLink& link, const std::string& channel, const Message& msg, const char* what,
+                       const std::string& description, const VerdictOptions& o) {
   // Listening before publishing: the compensator reports right after it decides.
   TrajectoryVerdict verdict;
   bool heard = false, has_counters = false;
@@ -157,12 +162,12 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
                                           has_counters = has_counters || v.has_counters;
                                           if (verdict.outcome == TrajectoryOutcome::kPending) verdict = v;
                                         });
-  if (!publish_repeated(link.lcm(), link.channels().trajectory, msg)) {
-    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().trajectory.c_str());
+  if (!publish_repeated(link.lcm(), channel, msg)) {
+    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", channel.c_str());
     return 1;
   }
-  std::printf("hystloop-ctl: sent trajectory %s on %s (version %lld)\n", description.c_str(),
-              link.channels().trajectory.c_str(), static_cast<long long>(msg.version));
+  std::printf("hystloop-ctl: sent %s %s on %s (version %lld)\n", what, description.c_str(), channel.c_str(),
+              static_cast<long long>(msg.version));
   std::fflush(stdout);
   if (!o.wait) return 0;
   const auto deadline = after(o.timeout_s);
@@ -173,15 +178,15 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
   const char* who = o.compensator_process.c_str();
   switch (verdict.outcome) {
     case TrajectoryOutcome::kAccepted:
-      std::printf("hystloop-ctl: %s accepted trajectory %lld%s%s\n", who, version, verdict.detail.empty() ? "" : ": ",
+      std::printf("hystloop-ctl: %s accepted %s %lld%s%s\n", who, what, version, verdict.detail.empty() ? "" : ": ",
                   verdict.detail.c_str());
       return 0;
     case TrajectoryOutcome::kShaped:
-      std::printf("hystloop-ctl: %s shaped trajectory %lld: %s\n", who, version,
+      std::printf("hystloop-ctl: %s shaped %s %lld: %s\n", who, what, version,
                   verdict.detail.empty() ? "(no detail given)" : verdict.detail.c_str());
       return 0;
     case TrajectoryOutcome::kRefused:
-      std::fprintf(stderr, "hystloop-ctl: %s refused trajectory %lld: %s\n", who, version,
+      std::fprintf(stderr, "hystloop-ctl: %s refused %s %lld: %s\n", who, what, version,
                    verdict.detail.empty() ? "(no reason given)" : verdict.detail.c_str());
       return 1;
     case TrajectoryOutcome::kSuperseded:
@@ -196,9 +201,20 @@ int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string
       !heard ? " (no status from '" + o.compensator_process + "' on " + link.channels().status + ": is it running?)"
       : !has_counters ? " ('" + o.compensator_process + "' reports no trajectory_version: a build without verdicts?)"
                       : "";
-  std::fprintf(stderr, "hystloop-ctl: no compensator confirmed trajectory version %lld within %g s%s\n", version,
+  std::fprintf(stderr, "hystloop-ctl: no compensator confirmed %s version %lld within %g s%s\n", what, version,
                o.timeout_s, hint.c_str());
   return 1;
+}
+
+}  // namespace
+
+int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
+                       const VerdictOptions& o) {
+  return publish_and_follow(link, link.channels().trajectory, msg, "trajectory", description, o);
+}
+
+int publish_scan(CtlLink& link, const scan_t& msg, const std::string& description, const VerdictOptions& o) {
+  return publish_and_follow(link, link.channels().scan, msg, "scan", description, o);
 }
 
 int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& o,
@@ -267,16 +283,21 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   std::optional<std::int8_t> mode;  // of the latest command
   std::optional<std::int64_t> last_seq;
   bool sent = false;
+  const auto axis = static_cast<std::size_t>(o.axis);
   auto on_command = [&](const command_block_t& c, std::int64_t) {
-    for_each_tick(c, [&](const CommandTick& t) {
-      mode = t.mode;
-      last_seq = t.seq;
-      if (!sent || !o.wait) return;
-      if (const auto step = tracker.on_command(t.seq, t.mode == command_block_t::MODE_EXPERIMENT)) {
-        std::printf("[%zu/%zu] %s\n", *step + 1, steps.size(), steps[*step].what.c_str());
-        std::fflush(stdout);
-      }
-    });
+    if (axis >= axes_of(c)) return;  // a stage without that axis: the compensator refuses the requests
+    for_each_tick(
+        c,
+        [&](const CommandTick& t) {
+          mode = t.mode;
+          last_seq = t.seq;
+          if (!sent || !o.wait) return;
+          if (const auto step = tracker.on_command(t.seq, t.mode == command_block_t::MODE_EXPERIMENT)) {
+            std::printf("[%zu/%zu] %s\n", *step + 1, steps.size(), steps[*step].what.c_str());
+            std::fflush(stdout);
+          }
+        },
+        axis);
   };
   Subscription<command_block_t> commands(link.lcm(), link.channels().command, on_command,
                                          {.queue_capacity = kBlockQueue, .on_reject = {}});
@@ -322,6 +343,7 @@ int run_series(CtlLink& link, const std::vector<SeriesStep>& steps, const Series
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const std::int64_t now = wall_utime();
     control_t msg = make_control(control_t::START_EXPERIMENT, o.target, base_id + static_cast<std::int64_t>(i), now);
+    msg.axis = static_cast<std::int8_t>(o.axis);
     apply(steps[i].request, msg);
     if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
       std::fprintf(stderr, "hystloop-ctl: could not publish request %zu on %s%s\n", i + 1,

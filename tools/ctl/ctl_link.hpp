@@ -81,6 +81,7 @@ struct SeriesRunOptions {
   double dt_s = 1e-4;            // the rig's tick [s], to follow the series from the command ticks
   bool wait = true;              // follow the series until it ends (else: send and return)
   double start_timeout_s = 3.0;  // the first experiment command must arrive within this
+  int axis = 0;                  // the axis the experiments drive (0: x)
 };
 
 // Sends the steps as START_EXPERIMENT requests (the compensator queues them) and, with wait,
@@ -100,6 +101,8 @@ struct VerdictOptions {
 // not be published.
 int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
                        const VerdictOptions& options);
+// The same for a path of every axis on HX_SCAN (the compensator reports it as a trajectory).
+int publish_scan(CtlLink& link, const scan_t& msg, const std::string& description, const VerdictOptions& options);
 
 struct AckOptions {
   bool wait = true;        // wait for the answers (else: send and return)

@@ -196,6 +196,7 @@ trajectory_t make_trajectory(const TrajectoryRequest& request, std::int64_t vers
   msg.points_y_m = request.points_y_m;
   msg.corner_s = msg.shape == trajectory_t::TRIANGLE ? request.corner_s : 0.0;
   msg.if_infeasible = request.shape_to_feasible ? trajectory_t::SHAPE : trajectory_t::REFUSE;
+  msg.axis = static_cast<std::int8_t>(request.axis);
   if (check_message(msg) != Verdict::kOk) throw ParameterError("trajectory", "refused by the message contract");
   return msg;
 }
@@ -222,7 +223,69 @@ mem_params_t make_params(const ParamsRequest& request, std::int64_t utime) {
   msg.window_s = 0.0;
   msg.valid = true;
   msg.source = "hystloop-ctl";
+  msg.axis = static_cast<std::int8_t>(request.axis);
   if (check_message(msg) != Verdict::kOk) throw ParameterError("params", "refused by the message contract");
+  return msg;
+}
+
+namespace {
+void require_per_axis(const char* name, const std::vector<double>& v) {
+  if (v.size() > 3) throw ParameterError(name, "takes at most one value per axis (x, y, z)");
+}
+}  // namespace
+
+void ScanRequest::validate() const {
+  if (path != "raster" && path != "lissajous") {
+    throw ParameterError("path", "must be raster or lissajous (got '" + path + "')");
+  }
+  require_per_axis("centre", centre_m);
+  require_in_range("blend", blend_s, 0.0, 60.0);
+  if (path == "raster") {
+    if (fast_axis == slow_axis) throw ParameterError("slow-axis", "must differ from --fast-axis");
+    if (slow != "steps" && slow != "ramp") throw ParameterError("slow", "must be steps or ramp (got '" + slow + "')");
+    require_in_range("lines", lines, 2, 4096);
+    require_positive("width", width_m);
+    require_non_negative("height", height_m);
+    require_positive("line-rate", line_rate_Hz);
+    require_non_negative("corner", corner_s);
+    require_non_negative("settle", settle_s);
+  } else {
+    require_per_axis("amplitude", amplitude_m);
+    require_per_axis("frequency", frequency_Hz);
+    require_per_axis("phase", phase_rad);
+    if (amplitude_m.empty()) throw ParameterError("amplitude", "give one amplitude per moving axis (x, y[, z]) [m]");
+    if (frequency_Hz.size() != amplitude_m.size()) {
+      throw ParameterError("frequency",
+                           "give one frequency per amplitude (" + std::to_string(amplitude_m.size()) + ")");
+    }
+    require_positive("duration", duration_s);
+  }
+}
+
+scan_t make_scan(const ScanRequest& request, std::int64_t version, std::int64_t utime) {
+  request.validate();
+  scan_t msg{};
+  msg.utime = utime;
+  msg.version = version;
+  msg.path = request.path == "raster" ? scan_t::RASTER : scan_t::LISSAJOUS;
+  for (std::size_t i = 0; i < request.centre_m.size(); ++i) msg.centre_m[i] = request.centre_m[i];
+  msg.fast_axis = static_cast<std::int8_t>(request.fast_axis);
+  msg.slow_axis = static_cast<std::int8_t>(request.slow_axis);
+  msg.width_m = request.width_m;
+  msg.height_m = request.height_m;
+  msg.lines = request.lines;
+  msg.line_rate_Hz = request.line_rate_Hz;
+  msg.slow_mode = request.slow == "ramp" ? scan_t::RAMP : scan_t::STEPS;
+  msg.corner_s = request.corner_s;
+  msg.settle_s = request.settle_s;
+  for (std::size_t i = 0; i < request.amplitude_m.size(); ++i) msg.amplitude_m[i] = request.amplitude_m[i];
+  for (std::size_t i = 0; i < request.frequency_Hz.size(); ++i) msg.frequency_Hz[i] = request.frequency_Hz[i];
+  for (std::size_t i = 0; i < request.phase_rad.size(); ++i) msg.phase_rad[i] = request.phase_rad[i];
+  msg.duration_s = request.duration_s;
+  msg.decouple = request.decouple;
+  msg.start_utime = 0;
+  msg.blend_s = request.blend_s;
+  if (check_message(msg) != Verdict::kOk) throw ParameterError("scan", "refused by the message contract");
   return msg;
 }
 

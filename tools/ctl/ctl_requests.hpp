@@ -13,6 +13,7 @@
 
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/trajectory_t.hpp"
 
 namespace hystloop::ctl {
@@ -68,6 +69,7 @@ struct TrajectoryRequest {
   std::vector<double> points_t_s, points_y_m;  // points: >= 1, t >= 0 strictly increasing
   double corner_s = 0.0;  // triangle only: each corner's duration, below half the period; 0 = the compensator's choice
   bool shape_to_feasible = false;  // if_infeasible SHAPE (else REFUSE)
+  int axis = 0;                    // the axis it moves (0: x)
   void validate() const;
 };
 
@@ -87,10 +89,36 @@ struct ParamsRequest {
   double c3 = 0.0;           // [-], 0 < c3 <= 50
   double residual_m = 0.0;   // >= 0
   std::int32_t version = 0;  // >= 1
+  int axis = 0;              // the axis whose hysteresis it models (0: x)
   void validate() const;
 };
 
 // valid = true, source "hystloop-ctl".
 mem_params_t make_params(const ParamsRequest& request, std::int64_t utime);
+
+// A path of every axis (HX_SCAN): a raster or a Lissajous figure (scan_t has the geometry).
+struct ScanRequest {
+  std::string path;  // raster | lissajous
+  // raster
+  int fast_axis = 0;
+  int slow_axis = 1;
+  double width_m = 1e-6;   // fast-axis travel, peak to peak, > 0
+  double height_m = 1e-6;  // slow-axis travel, first line to last, >= 0
+  int lines = 64;          // 2..4096
+  double line_rate_Hz = 50.0;
+  std::string slow = "steps";  // steps | ramp
+  double corner_s = 0.0;       // 0: the compensator's choice
+  double settle_s = 0.05;
+  // lissajous: per axis (x, y[, z])
+  std::vector<double> amplitude_m, frequency_Hz, phase_rad;
+  double duration_s = 1.0;
+  std::vector<double> centre_m;  // per axis, default 0
+  bool decouple = true;
+  double blend_s = 0.05;
+  void validate() const;  // throws ParameterError naming the option
+};
+
+// version as make_trajectory's; start as soon as the approach allows.
+scan_t make_scan(const ScanRequest& request, std::int64_t version, std::int64_t utime);
 
 }  // namespace hystloop::ctl

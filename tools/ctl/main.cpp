@@ -15,6 +15,9 @@
 //              then waits for the compensator's verdict on HX_STATUS ([--timeout S] (3), [--no-wait],
 //              [--compensator P]): exit 0 accepted or shaped (printed how), 1 refused (its reason) or
 //              not confirmed in time
+//   scan raster|lissajous [--width --height --lines --line-rate --slow steps|ramp | --amplitude a,b
+//        --frequency f,g --duration S] [--no-decouple]   a path of every axis (HX_SCAN), then its verdict
+//   (trajectory, params and experiment take --axis x|y|z on a stage of several axes)
 //   params --c1 --c2 --c3 [--residual M] [--version N]
 //   watch [--seconds S] [--bridge P] [--compensator P]   tracking error, late and clamped ticks, learning
 //   config-get FILE KEY.PATH [--default V]   a YAML value for scripts (ctl_config_get.hpp)
@@ -49,6 +52,7 @@
 #include "lcm/rig_auth.hpp"
 #include "lcm/servo_gains_status.hpp"
 #include "loop/trajectory.hpp"
+#include "models/axis_coupling.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -77,6 +81,8 @@ struct Options {
   std::string learn_target = "compensator";  // only the compensator learns
   ParamsRequest params;
   std::optional<std::int32_t> params_version;
+  ScanRequest scan;
+  int experiment_axis = 0;
   double params_listen_s = 1.5;
   StatusOptions status;
   WatchOptions watch;
@@ -156,16 +162,20 @@ int send_params(const Options& o) {
   CtlLink link(o.link);
   request.version = o.params_version ? *o.params_version : next_params_version(link, o.params_listen_s);
   const mem_params_t msg = make_params(request, wall_utime());
+  // The compensator reports x's set as params_version, another axis's as <axis>_params_version.
+  const std::string in_use_counter =
+      request.axis == 0 ? std::string("params_version") : std::string(axis_name(request.axis)) + "_params_version";
   if (!publish_repeated(link.lcm(), link.channels().params, msg)) {
     std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().params.c_str());
     return 1;
   }
-  std::printf("hystloop-ctl: sent MEM parameters v%d c1 %g m/V c2 %g c3 %g on %s\n", msg.version, msg.c1, msg.c2,
-              msg.c3, link.channels().params.c_str());
+  std::printf("hystloop-ctl: sent MEM parameters v%d c1 %g m/V c2 %g c3 %g%s on %s\n", msg.version, msg.c1, msg.c2,
+              msg.c3, request.axis == 0 ? "" : (" for " + std::string(axis_name(request.axis))).c_str(),
+              link.channels().params.c_str());
   std::fflush(stdout);
   if (!o.ack.wait) return 0;
   const std::string& compensator = o.verdict.compensator_process;
-  const StatusWait w = wait_for_status(link, compensator, counter_is("params_version", msg.version), o.ack.timeout_s);
+  const StatusWait w = wait_for_status(link, compensator, counter_is(in_use_counter, msg.version), o.ack.timeout_s);
   if (const auto r = w.last.find(kPinModelTarget); r != w.last.end() && find_counter(r->second, "params_held") == 0) {
     std::printf(
         "hystloop-ctl: note: the re-identifier runs and is not holding: its next refit replaces this set "
@@ -182,7 +192,7 @@ int send_params(const Options& o) {
                  w.last.empty() ? "no rig is running" : "is the compensator running, under this name?");
     return 1;
   }
-  const auto in_use = find_counter(c->second, "params_version");
+  const auto in_use = find_counter(c->second, in_use_counter);
   if (find_counter(c->second, "params_held_by_learning").value_or(0) != 0) {
     std::fprintf(stderr,
                  "hystloop-ctl: '%s' did not adopt parameters v%d (in use: %s): a set is waiting because the "
@@ -201,6 +211,26 @@ int send_params(const Options& o) {
   return 1;
 }
 
+int send_scan(const Options& o) {
+  if (!(o.verdict.timeout_s > 0.0)) throw ParameterError("timeout", "must be > 0");
+  const std::int64_t now = wall_utime();
+  const scan_t msg = make_scan(o.scan, now, now);  // version: wall time, as trajectories
+  const ScanRequest& r = o.scan;
+  std::string description;
+  if (msg.path == scan_t::RASTER) {
+    description = fmt::format("raster {:g} x {:g} m, {} lines at {:g} lines/s, {} fast, {} {}{}", r.width_m, r.height_m,
+                              r.lines, r.line_rate_Hz, axis_name(r.fast_axis), axis_name(r.slow_axis),
+                              r.slow == "ramp" ? "ramping" : "stepping",
+                              r.corner_s > 0.0 ? fmt::format(", corners {:g} s", r.corner_s) : std::string());
+  } else {
+    description = fmt::format("Lissajous, amplitudes {} m at {} Hz for {:g} s", fmt::join(r.amplitude_m, "/"),
+                              fmt::join(r.frequency_Hz, "/"), r.duration_s);
+  }
+  description += r.decouple ? ", decoupled" : ", not decoupled";
+  CtlLink link(o.link);
+  return publish_scan(link, msg, description, o.verdict);
+}
+
 int run_banning_series(Options& o) {
   const std::vector<SeriesStep> steps = banning_series(o.plan);
   std::size_t experiments = steps.empty() ? 0 : steps.back().experiment + 1;
@@ -211,6 +241,7 @@ int run_banning_series(Options& o) {
     return 0;
   }
   o.series.target = o.target;
+  o.series.axis = o.experiment_axis;
   CtlLink link(o.link);
   return run_series(link, steps, o.series);
 }
@@ -367,6 +398,8 @@ int run(int argc, char** argv) {
       },
       "Send and return at once (without it: wait for the compensator to confirm; a series is followed to its end)");
   with_default(experiment, "--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")->needs(series);
+  add_axis_option(experiment, "--axis", o.experiment_axis,
+                  "The axis the experiment drives (default x); the others hold their references");
 
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
   trajectory->add_option("--shape", o.trajectory.shape, trajectory_shape_choices());
@@ -394,6 +427,42 @@ int run(int argc, char** argv) {
       ->excludes(no_wait);
   with_default(trajectory, "--compensator", o.verdict.compensator_process,
                "Process name of the compensator in HX_STATUS");
+  add_axis_option(trajectory, "--axis", o.trajectory.axis,
+                  "The axis it moves (default x); the stage's other axes keep their references");
+
+  CLI::App* scan = app.add_subcommand(
+      "scan",
+      "Send a path of every axis (HX_SCAN): a raster or a Lissajous figure, each axis its share of the "
+      "decoupled path; then wait for the compensator's verdict");
+  scan->add_option("path", o.scan.path, "raster or lissajous")
+      ->required()
+      ->check(CLI::IsMember({"raster", "lissajous"}));
+  add_axis_option(scan, "--fast-axis", o.scan.fast_axis, "raster: the axis drawing the lines")->capture_default_str();
+  add_axis_option(scan, "--slow-axis", o.scan.slow_axis, "raster: the axis stepping between them")
+      ->capture_default_str();
+  with_default(scan, "--width", o.scan.width_m, "raster: fast-axis travel, peak to peak [m]");
+  with_default(scan, "--height", o.scan.height_m, "raster: slow-axis travel, first line to last [m]");
+  with_default(scan, "--lines", o.scan.lines, "raster: lines, 2..4096");
+  with_default(scan, "--line-rate", o.scan.line_rate_Hz, "raster: lines per second [Hz]");
+  with_default(scan, "--slow", o.scan.slow, "raster: the slow axis steps in the corners or ramps across (steps|ramp)");
+  with_default(scan, "--corner", o.scan.corner_s,
+               "raster: each rounded corner [s]; 0 = the compensator's choice (two periods of the resonance)");
+  with_default(scan, "--settle", o.scan.settle_s, "raster: hold at the end [s]");
+  scan->add_option("--amplitude", o.scan.amplitude_m, "lissajous: peak per axis x,y[,z] [m]")->delimiter(',');
+  scan->add_option("--frequency", o.scan.frequency_Hz, "lissajous: frequency per axis x,y[,z] [Hz]")->delimiter(',');
+  scan->add_option("--phase", o.scan.phase_rad, "lissajous: phase per axis x,y[,z] [rad] (default 0)")->delimiter(',');
+  with_default(scan, "--duration", o.scan.duration_s, "lissajous: how long it runs [s]");
+  scan->add_option("--centre", o.scan.centre_m, "the path's centre per axis x,y[,z] [m] (default 0)")->delimiter(',');
+  scan->add_flag(
+      "--no-decouple", [&](std::int64_t) { o.scan.decouple = false; },
+      "Give each axis its own reference alone, not its share of C^-1 r (to see the coupling)");
+  with_default(scan, "--blend", o.scan.blend_s, "The approach from where each axis is [s]");
+  auto* scan_no_wait = scan->add_flag(
+      "--no-wait", [&](std::int64_t) { o.verdict.wait = false; },
+      "Send and return at once, without waiting for the compensator's verdict");
+  with_default(scan, "--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
+      ->excludes(scan_no_wait);
+  with_default(scan, "--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS");
 
   CLI::App* params = app.add_subcommand("params", "Send a MEM parameter set (HX_PARAMS, valid, source hystloop-ctl)");
   params->add_option("--c1", o.params.c1, "Slope at a branch point [m/V], > 0")->required();
@@ -405,6 +474,7 @@ int run(int argc, char** argv) {
                      "publishes with a new publisher id, so the compensator takes it whatever others sent");
   with_default(params, "--listen", o.params_listen_s, "How long to look for the version in use [s]");
   with_default(params, "--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS");
+  add_axis_option(params, "--axis", o.params.axis, "The axis whose hysteresis it models (default x)");
   add_wait_options(params, o);
 
   CLI::App* watch = app.add_subcommand("watch",
@@ -472,9 +542,13 @@ int run(int argc, char** argv) {
     }
     o.experiment.validate();
     return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
-                        [&](control_t& msg) { apply(o.experiment, msg); });
+                        [&](control_t& msg) {
+                          apply(o.experiment, msg);
+                          msg.axis = static_cast<std::int8_t>(o.experiment_axis);
+                        });
   }
   if (*trajectory) return send_trajectory(o);
+  if (*scan) return send_scan(o);
   if (*params) return send_params(o);
   if (*watch) {
     require_non_negative("seconds", o.watch.seconds);

@@ -3,6 +3,7 @@
 #include <map>
 #include <string>
 
+#include "core/cli.hpp"
 #include "log_samples.hpp"
 
 namespace hystloop {
@@ -66,11 +67,9 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
       ->capture_default_str();
   logs->add_option("--from", args.from_s, "fit only samples at t >= this [s after the record's first sample]");
   logs->add_option("--to", args.to_s, "fit only samples at t < this [s after the record's first sample]");
-  logs->add_option("--axis", args.axis,
-                   "which axis of a stage of several to identify (default x; the blocks carry every axis; a "
-                   "one-axis log has x only)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, int>{{"x", 0}, {"y", 1}, {"z", 2}}).description(""))
-      ->type_name("x|y|z");
+  add_axis_option(logs, "--axis", args.axis,
+                  "which axis of a stage of several to identify (default x; the blocks carry every axis; a "
+                  "one-axis log has x only)");
   logs->add_option("--experiment", args.experiment,
                    "fit only this experiment the loop ran (numbered from 0 as listed; e.g. the one hystloop-ctl "
                    "experiment --mem-paper ran). A log with several experiments needs it (or --from/--to): "

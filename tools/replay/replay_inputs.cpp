@@ -32,7 +32,8 @@ LogStart read_log_start(const std::filesystem::path& log, const ChannelNames& ch
 }
 
 bool is_other_input(const std::string& channel, const ChannelNames& c) {
-  return channel == c.trajectory || channel == c.params || channel == c.control;
+  return channel == c.trajectory || channel == c.scan || channel == c.params || channel == c.model ||
+         channel == c.control;
 }
 
 template <class T>
@@ -43,7 +44,9 @@ bool decodes(const lcm::LogEvent& event) {
 
 bool other_input_decodes(const lcm::LogEvent& event, const ChannelNames& c) {
   if (event.channel == c.trajectory) return decodes<trajectory_t>(event);
+  if (event.channel == c.scan) return decodes<scan_t>(event);
   if (event.channel == c.params) return decodes<mem_params_t>(event);
+  if (event.channel == c.model) return decodes<model_params_t>(event);
   return decodes<control_t>(event);
 }
 
@@ -114,7 +117,7 @@ std::string describe(const ReplayInputSelection& s) {
         "the replay may diverge\n";
   }
   out += fmt::format(
-      "replay inputs: {} sensor blocks ({} ticks), {} trajectory/params/control messages ({} logged "
+      "replay inputs: {} sensor blocks ({} ticks), {} trajectory/scan/params/model/control messages ({} logged "
       "before the compensator ran, left out)\n",
       s.blocks_written, s.ticks_written, s.other_inputs_written, s.other_inputs_skipped);
   if (s.blocks_unanswered > 0) {

@@ -35,7 +35,7 @@ struct ReplayInputSelection {
   std::uint64_t blocks_before_start = 0;        // sensor blocks before the first answered one (warm-up), left out
   std::uint64_t blocks_unanswered = 0;          // later sensor blocks no command block of the original answered
   std::uint64_t blocks_unanswered_dropped = 0;  // of those, left out (only_answered)
-  std::uint64_t other_inputs_written = 0;       // trajectory, params, control
+  std::uint64_t other_inputs_written = 0;       // trajectory, scan, params, model, control
   std::uint64_t other_inputs_skipped = 0;       // logged before the compensator ran
   std::uint64_t undecodable = 0;                // input events that failed to decode or check (left out)
 };

@@ -8,6 +8,7 @@
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/model_params_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
@@ -69,6 +70,7 @@ std::vector<CodeLegend> make_legends() {
   constexpr std::string_view trajectory = "hystloop.trajectory_t";
   constexpr std::string_view status = "hystloop.service_status_t";
   constexpr std::string_view model = "hystloop.model_params_t";
+  constexpr std::string_view scan = "hystloop.scan_t";
   return {
       {sensor,
        "flags",
@@ -91,6 +93,8 @@ std::vector<CodeLegend> make_legends() {
        {HX_CODES(model_params_t, "ORDER_", ORDER_HYSTERESIS_THEN_STAGE, ORDER_STAGE_THEN_HYSTERESIS)}},
       {model, "kat_in_shaping", shapings()},
       {model, "kat_out_shaping", shapings()},
+      {scan, "path", {HX_CODES(scan_t, "", RASTER, LISSAJOUS)}},
+      {scan, "slow_mode", {HX_CODES(scan_t, "", STEPS, RAMP)}},
   };
 }
 

@@ -252,6 +252,65 @@ TEST(CtlRequests, ParamsValidation) {
   EXPECT_EQ(field_of([&] { p.validate(); }), "version");
 }
 
+TEST(CtlRequests, TrajectoriesAndParametersNameTheirAxis) {
+  TrajectoryRequest t;
+  t.shape = "sine";
+  t.amplitude_m = 1e-7;
+  EXPECT_EQ(make_trajectory(t, 1, 1).axis, 0);  // x unless told
+  t.axis = 1;
+  EXPECT_EQ(make_trajectory(t, 2, 2).axis, 1);
+  ParamsRequest p{1e-7, 1e-9, 0.5, 0, 1};
+  p.axis = 2;
+  EXPECT_EQ(make_params(p, 5).axis, 2);
+}
+
+TEST(CtlRequests, ScansAreCheckedAndPassTheContract) {
+  ScanRequest r;
+  r.path = "raster";
+  r.lines = 32;
+  r.line_rate_Hz = 25.0;
+  r.centre_m = {1e-7, -1e-7};
+  const scan_t raster = make_scan(r, 7, 8);
+  EXPECT_EQ(raster.path, scan_t::RASTER);
+  EXPECT_EQ(raster.version, 7);
+  EXPECT_EQ(raster.lines, 32);
+  EXPECT_EQ(raster.fast_axis, 0);
+  EXPECT_EQ(raster.slow_axis, 1);
+  EXPECT_EQ(raster.centre_m[1], -1e-7);
+  EXPECT_EQ(raster.centre_m[2], 0.0);
+  EXPECT_TRUE(raster.decouple);
+  EXPECT_EQ(check_message(raster), Verdict::kOk);
+
+  ScanRequest l;
+  l.path = "lissajous";
+  l.amplitude_m = {5e-7, 5e-7};
+  l.frequency_Hz = {50, 48};
+  l.decouple = false;
+  const scan_t fig = make_scan(l, 9, 9);
+  EXPECT_EQ(fig.path, scan_t::LISSAJOUS);
+  EXPECT_EQ(fig.frequency_Hz[1], 48.0);
+  EXPECT_FALSE(fig.decouple);
+
+  ScanRequest bad = r;
+  bad.slow_axis = 0;
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "slow-axis");
+  bad = r;
+  bad.lines = 1;
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "lines");
+  bad = r;
+  bad.slow = "jump";
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "slow");
+  bad = r;
+  bad.path = "spiral";
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "path");
+  bad = l;
+  bad.frequency_Hz = {50};
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "frequency");
+  bad = l;
+  bad.amplitude_m = {1e-7, 1e-7, 1e-7, 1e-7};
+  EXPECT_EQ(field_of([&] { bad.validate(); }), "amplitude");
+}
+
 namespace {
 service_status_t report(const std::string& process, std::int8_t state, const std::string& detail = "") {
   service_status_t s{};
