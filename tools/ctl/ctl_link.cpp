@@ -25,10 +25,12 @@ namespace hystloop::ctl {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// A listening subcommand's queue on a block channel: a few seconds of blocks.
+constexpr int kBlockQueue = 4'000;
 
-// Dispatches what LCM holds, waiting at most `slice` and never past `deadline`; false if LCM failed.
-bool receive(CtlLink& link, Clock::time_point deadline, std::chrono::microseconds slice, int max_messages = 256) {
+}  // namespace
+
+bool receive(CtlLink& link, Clock::time_point deadline, std::chrono::microseconds slice, int max_messages) {
   const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now());
   return handle_pending(link.lcm(), std::clamp(left, std::chrono::microseconds(0), slice), max_messages) >= 0;
 }
@@ -41,11 +43,6 @@ int receive_failed(const CtlLink& link) {
 Clock::time_point after(double seconds) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
-
-// A listening subcommand's queue on a block channel: a few seconds of blocks.
-constexpr int kBlockQueue = 4'000;
-
-}  // namespace
 
 CtlLink::CtlLink(const LinkOptions& options)
     : channels_(options.rig),

@@ -42,6 +42,14 @@ class CtlLink {
   std::unique_ptr<lcm::LCM> lcm_;
 };
 
+using Clock = std::chrono::steady_clock;
+
+// Dispatches what LCM holds, waiting at most `slice` and never past `deadline`; false if LCM failed.
+bool receive(CtlLink& link, Clock::time_point deadline, std::chrono::microseconds slice, int max_messages = 256);
+// Says so on stderr; returns 1 (the exit status).
+int receive_failed(const CtlLink& link);
+Clock::time_point after(double seconds);
+
 // Publishes `msg` 3 times, 5 ms apart (UDP may drop one; receivers dedupe by request id /
 // version). Returns false if the message was refused or never sent.
 template <class T>

@@ -10,6 +10,7 @@
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
+//   experiment --coupling [--amplitude V] [--out FILE]   an XY(Z) stage's cross-coupling (ctl_coupling.hpp)
 //   trajectory --shape cosine|sine|triangle|hold|points --amplitude M --frequency HZ --offset M
 //              --blend S [--points-csv FILE] [--corner S] [--shape-to-feasible]   |   trajectory --mem-paper
 //              then waits for the compensator's verdict on HX_STATUS ([--timeout S] (3), [--no-wait],
@@ -44,6 +45,7 @@
 #include "core/errors.hpp"
 #include "ctl_ack.hpp"
 #include "ctl_config_get.hpp"
+#include "ctl_coupling.hpp"
 #include "ctl_health.hpp"
 #include "ctl_link.hpp"
 #include "ctl_pin_model.hpp"
@@ -83,6 +85,8 @@ struct Options {
   std::optional<std::int32_t> params_version;
   ScanRequest scan;
   int experiment_axis = 0;
+  bool coupling = false;
+  CouplingRunOptions coupling_run;
   double params_listen_s = 1.5;
   StatusOptions status;
   WatchOptions watch;
@@ -398,8 +402,20 @@ int run(int argc, char** argv) {
       },
       "Send and return at once (without it: wait for the compensator to confirm; a series is followed to its end)");
   with_default(experiment, "--dt", o.series.dt_s, "series: the rig's tick [s], to follow the series")->needs(series);
-  add_axis_option(experiment, "--axis", o.experiment_axis,
-                  "The axis the experiment drives (default x); the others hold their references");
+  auto* axis_option = add_axis_option(experiment, "--axis", o.experiment_axis,
+                                      "The axis the experiment drives (default x); the others hold their references");
+  auto* coupling =
+      experiment
+          ->add_flag("--coupling", o.coupling,
+                     "The cross-coupling of an XY(Z) stage: each axis in turn a sine (--amplitude, default "
+                     "100 V; --frequency, 5 Hz; --duration, 0.8 s) with the bridge's servo off (its gains "
+                     "put back after), every sensor recorded; prints C and, with --out, writes the "
+                     "compensator's decoupling.* keys")
+          ->excludes(mem_paper_exp, series, kind, offset, axis_option);
+  experiment->add_option("--out", o.coupling_run.out, "coupling: YAML file for hystloop-compensator --params")
+      ->needs(coupling);
+  with_default(experiment, "--rest", o.coupling_run.rest_s, "coupling: rest between the axes' experiments [s]")
+      ->needs(coupling);
 
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
   trajectory->add_option("--shape", o.trajectory.shape, trajectory_shape_choices());
@@ -533,6 +549,15 @@ int run(int argc, char** argv) {
   }
   if (*experiment) {
     if (o.banning_series) return run_banning_series(o);
+    if (o.coupling) {
+      CouplingRunOptions& c = o.coupling_run;
+      if (amplitude->count() > 0) c.amplitude_V = o.experiment.amplitude_V;
+      if (frequency->count() > 0) c.frequency_Hz = o.experiment.frequency_Hz;
+      if (duration->count() > 0) c.duration_s = o.experiment.duration_s;
+      c.timeout_s = o.ack.timeout_s;
+      CtlLink link(o.link);
+      return run_coupling_experiment(link, c);
+    }
     if (o.experiment_mem_paper) {
       o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
     } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {

@@ -14,6 +14,7 @@
 
 #include "core/errors.hpp"
 #include "ctl_ack.hpp"
+#include "ctl_coupling.hpp"
 #include "ctl_health.hpp"
 #include "ctl_requests.hpp"
 #include "ctl_series.hpp"
@@ -309,6 +310,36 @@ TEST(CtlRequests, ScansAreCheckedAndPassTheContract) {
   bad = l;
   bad.amplitude_m = {1e-7, 1e-7, 1e-7, 1e-7};
   EXPECT_EQ(field_of([&] { bad.validate(); }), "amplitude");
+}
+
+TEST(CtlCoupling, RecordsOfEachAxisGiveTheCouplingAndTheCompensatorsKeys) {
+  // x moves y by 3 %, y moves x by nothing; each record: the moved axis a 1 um triangle.
+  std::vector<CouplingRecord> records(2);
+  for (int a = 0; a < 2; ++a) {
+    records[static_cast<std::size_t>(a)].axis = a;
+    for (int k = 0; k < 2000; ++k) {
+      const double own = 1e-6 * std::abs((k % 400) - 200) / 200.0;
+      const double other = a == 0 ? 0.03 * own + 2e-9 : 5e-9;
+      records[static_cast<std::size_t>(a)].y_m[static_cast<std::size_t>(a)].push_back(own);
+      records[static_cast<std::size_t>(a)].y_m[static_cast<std::size_t>(1 - a)].push_back(other);
+    }
+  }
+  const CouplingFitResult fit = fit_records(records, 2);
+  ASSERT_TRUE(fit.ok()) << fit.reason;
+  EXPECT_NEAR(fit.coupling.matrix()(1, 0), 0.03, 1e-12);
+  EXPECT_NEAR(fit.coupling.matrix()(0, 1), 0.0, 1e-12);
+  const std::string yaml = decoupling_yaml(fit, 2, "a test");
+  EXPECT_NE(yaml.find("decoupling:\n  x_to_y: 0.03"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("  y_to_x: "), std::string::npos) << yaml;
+  EXPECT_EQ(yaml.find("z"), std::string::npos) << "an XY stage has no z keys: " << yaml;
+  EXPECT_NE(describe_fit(fit, 2).find("x -> y: +0.03000"), std::string::npos) << describe_fit(fit, 2);
+
+  records.pop_back();  // y never excited: its column unknown, refused
+  EXPECT_FALSE(fit_records(records, 2).ok());
+
+  CouplingRunOptions o;
+  o.duration_s = 0.1;  // half a period at 5 Hz
+  EXPECT_EQ(field_of([&] { o.validate(); }), "duration");
 }
 
 namespace {
