@@ -7,11 +7,13 @@
 namespace hystloop {
 
 namespace {
-void require_axis(const char* field, int axis, int axes) {
+// `axis` when the stage has it, else throws naming `field`.
+int require_axis(const char* field, int axis, int axes) {
   if (axis < 0 || axis >= axes) {
     throw ParameterError(field, "names axis " + std::string(axis_name(axis)) + ", but this stage has " +
                                     std::to_string(axes) + (axes == 1 ? " axis" : " axes"));
   }
+  return axis;
 }
 }  // namespace
 
@@ -22,12 +24,10 @@ ScanSettings scan_from_message(const scan_t& msg, int axes) {
   AxisPositions centre{};
   for (std::size_t i = 0; i < kScanAxes; ++i) centre[i] = msg.centre_m[i];
   if (msg.path == scan_t::RASTER) {
-    require_axis("scan.fast_axis", msg.fast_axis, axes);
-    require_axis("scan.slow_axis", msg.slow_axis, axes);
     s.path = ScanSettings::Path::kRaster;
     RasterSpec& r = s.raster;
-    r.fast_axis = msg.fast_axis;
-    r.slow_axis = msg.slow_axis;
+    r.fast_axis = require_axis("scan.fast_axis", msg.fast_axis, axes);
+    r.slow_axis = require_axis("scan.slow_axis", msg.slow_axis, axes);
     r.width_m = msg.width_m;
     r.height_m = msg.height_m;
     r.lines = msg.lines;

@@ -282,7 +282,7 @@ scan_t make_scan(const ScanRequest& request, std::int64_t version, std::int64_t 
   for (std::size_t i = 0; i < request.frequency_Hz.size(); ++i) msg.frequency_Hz[i] = request.frequency_Hz[i];
   for (std::size_t i = 0; i < request.phase_rad.size(); ++i) msg.phase_rad[i] = request.phase_rad[i];
   msg.duration_s = request.duration_s;
-  msg.decouple = request.decouple;
+  msg.decouple = request.decouple ? 1 : 0;
   msg.start_utime = 0;
   msg.blend_s = request.blend_s;
   if (check_message(msg) != Verdict::kOk) throw ParameterError("scan", "refused by the message contract");

@@ -331,7 +331,7 @@ TEST(CtlCoupling, RecordsOfEachAxisGiveTheCouplingAndTheCompensatorsKeys) {
   const std::string yaml = decoupling_yaml(fit, 2, "a test");
   EXPECT_NE(yaml.find("decoupling:\n  x_to_y: 0.03"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("  y_to_x: "), std::string::npos) << yaml;
-  EXPECT_EQ(yaml.find("z"), std::string::npos) << "an XY stage has no z keys: " << yaml;
+  EXPECT_EQ(yaml.find('z'), std::string::npos) << "an XY stage has no z keys: " << yaml;
   EXPECT_NE(describe_fit(fit, 2).find("x -> y: +0.03000"), std::string::npos) << describe_fit(fit, 2);
 
   records.pop_back();  // y never excited: its column unknown, refused
