@@ -85,23 +85,25 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
   install_stop_handlers();
   WatchLine line;
   std::optional<std::int64_t> late_before_report;
-  TruthPairing truth;
+  const auto axis = static_cast<std::size_t>(o.axis);
+  TruthPairing truth(axis);
   Subscription<sensor_block_t> samples(link.lcm(), link.channels().sensor,
                                        [&](const sensor_block_t& b, std::int64_t) {
-                                         line.second.add_sensor_block(b);
+                                         line.second.add_sensor_block(b, axis);
                                          truth.add_sensor_block(b, line.second);
                                        },
                                        {.queue_capacity = kBlockQueue, .on_reject = {}});
   Subscription<sim_truth_t> truths(link.lcm(), link.channels().sim_truth,
                                    [&](const sim_truth_t& t, std::int64_t) { truth.add_truth_block(t, line.second); },
                                    {.queue_capacity = kBlockQueue, .on_reject = {}});
-  Subscription<command_block_t> commands(link.lcm(), link.channels().command,
-                                         [&](const command_block_t& c, std::int64_t) {
-                                           line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
-                                           line.params_in_use =
-                                               command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version;
-                                         },
-                                         {.queue_capacity = kBlockQueue, .on_reject = {}});
+  Subscription<command_block_t> commands(
+      link.lcm(), link.channels().command,
+      [&](const command_block_t& c, std::int64_t) {
+        if (axis >= axes_of(c)) return;
+        line.second.commands += static_cast<std::uint64_t>(c.n_ticks);
+        line.params_in_use = command_tick(c, static_cast<std::size_t>(c.n_ticks - 1), axis).params_version;
+      },
+      {.queue_capacity = kBlockQueue, .on_reject = {}});
   Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
     if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
   });

@@ -79,6 +79,7 @@ struct WatchOptions {
   double seconds = 0.0;  // 0: until SIGINT/SIGTERM
   std::string bridge_process = "bridge";
   std::string compensator_process = "compensator";
+  int axis = 0;  // the axis watched (0: x)
 };
 
 // Prints a line per second; returns 0 (1 if LCM failed).

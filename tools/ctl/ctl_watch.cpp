@@ -22,13 +22,17 @@ std::optional<double> ErrorStats::rms_m() const noexcept {
   return std::sqrt(sum_sq_m2 / static_cast<double>(count));
 }
 
-void WatchSecond::add_sensor_block(const sensor_block_t& block) noexcept {
+void WatchSecond::add_sensor_block(const sensor_block_t& block, std::size_t axis) noexcept {
+  if (axis >= axes_of(block)) return;
   bool armed = true;
-  for_each_tick(block, [&](const SensorTick& t) {
-    ++samples;
-    if (std::isfinite(t.y_ref_m)) error.add(t.y_ref_m - t.y_m);
-    armed = armed && (t.flags & sensor_block_t::SAFE_STATE) == 0;
-  });
+  for_each_tick(
+      block,
+      [&](const SensorTick& t) {
+        ++samples;
+        if (std::isfinite(t.y_ref_m)) error.add(t.y_ref_m - t.y_m);
+        armed = armed && (t.flags & sensor_block_t::SAFE_STATE) == 0;
+      },
+      axis);
   if (armed) buffer_min_ticks = std::min(buffer_min_ticks.value_or(block.buffer_depth_ticks), block.buffer_depth_ticks);
 }
 
@@ -46,9 +50,11 @@ void TruthPairing::keep(std::deque<Block>& waiting, Block block) {
 }
 
 void TruthPairing::add_sensor_block(const sensor_block_t& block, WatchSecond& into) {
+  if (axis_ >= axes_of(block)) return;
   Block b{block.seq, {}};
   b.y_m.reserve(static_cast<std::size_t>(std::max(block.n_ticks, 0)));
-  for_each_tick(block, [&](const SensorTick& t) { b.y_m.push_back(t.y_ref_m); });
+  for_each_tick(
+      block, [&](const SensorTick& t) { b.y_m.push_back(t.y_ref_m); }, axis_);
   const auto match = std::find_if(truths_.begin(), truths_.end(), [&](const Block& t) { return t.seq == b.seq; });
   if (match == truths_.end()) return keep(refs_, std::move(b));
   pair(b.y_m, match->y_m, into);
@@ -57,7 +63,7 @@ void TruthPairing::add_sensor_block(const sensor_block_t& block, WatchSecond& in
 
 void TruthPairing::add_truth_block(const sim_truth_t& truth, WatchSecond& into) {
   const auto match = std::find_if(refs_.begin(), refs_.end(), [&](const Block& r) { return r.seq == truth.seq; });
-  std::vector<double> y_true = axis_truth(truth);
+  std::vector<double> y_true = axis_truth(truth, axis_);
   if (match == refs_.end()) return keep(truths_, Block{truth.seq, std::move(y_true)});
   pair(match->y_m, y_true, into);
   refs_.erase(match);

@@ -35,9 +35,9 @@ struct WatchSecond {
   ErrorStats true_error;                         // y_ref - y_true of those with their true position too
   std::optional<std::int32_t> buffer_min_ticks;  // lowest buffer depth of an armed sensor block
 
-  // Every tick of the block (its error where it has a reference), and its buffer depth when no
-  // tick is SAFE_STATE. Allocation-free.
-  void add_sensor_block(const sensor_block_t& block) noexcept;
+  // Every tick of the block's `axis` (its error where it has a reference; nothing when the block
+  // lacks the axis), and its buffer depth when no tick is SAFE_STATE. Allocation-free.
+  void add_sensor_block(const sensor_block_t& block, std::size_t axis = 0) noexcept;
 };
 
 // Pairs each HX_SIM_TRUTH block with the HX_SENSOR block of the same seq, in either arrival
@@ -48,6 +48,7 @@ struct WatchSecond {
 class TruthPairing {
  public:
   static constexpr std::size_t kWaiting = 64;
+  explicit TruthPairing(std::size_t axis = 0) noexcept : axis_(axis) {}  // the axis paired (0: x)
   void add_sensor_block(const sensor_block_t& block, WatchSecond& into);
   void add_truth_block(const sim_truth_t& truth, WatchSecond& into);
 
@@ -58,6 +59,7 @@ class TruthPairing {
   };
   static void pair(const std::vector<double>& y_ref, const std::vector<double>& y_true, WatchSecond& into) noexcept;
   static void keep(std::deque<Block>& waiting, Block block);
+  std::size_t axis_ = 0;
   std::deque<Block> refs_, truths_;
 };
 

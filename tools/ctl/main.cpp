@@ -499,6 +499,7 @@ int run(int argc, char** argv) {
   watch->add_option("--seconds", o.watch.seconds, "Stop after this long [s] (default: until Ctrl-C)");
   with_default(watch, "--bridge", o.watch.bridge_process, "Process name of the bridge in HX_STATUS");
   with_default(watch, "--compensator", o.watch.compensator_process, "Process name of the compensator in HX_STATUS");
+  add_axis_option(watch, "--axis", o.watch.axis, "The axis watched on a stage of several (default x)");
 
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
 

@@ -476,6 +476,37 @@ TEST(CtlWatch, TruthBlocksPairWithTheirSensorBlocksInEitherOrder) {
   EXPECT_FALSE(WatchSecond{}.true_error.rms_m());
 }
 
+TEST(CtlWatch, AStageOfSeveralAxesIsWatchedOneAxisAtATime) {
+  sensor_block_t b{};
+  reserve_storage(b);
+  begin_block(b, 100, 1, 1e-4, 2);
+  for (int k = 0; k < 10; ++k) {
+    // x off by 1 nm, y by 3 nm, at every tick
+    const std::array<SensorTick, 2> t{SensorTick{1, 100 + k, 0.0, 0.0, 0.0, 1e-6, 1e-6 - 1e-9, 0},
+                                      SensorTick{1, 100 + k, 0.0, 0.0, 0.0, 2e-6, 2e-6 - 3e-9, 0}};
+    ASSERT_TRUE(append_tick(b, t));
+  }
+  WatchSecond x, y, z;
+  x.add_sensor_block(b, 0);
+  y.add_sensor_block(b, 1);
+  z.add_sensor_block(b, 2);  // the block has no z: nothing
+  EXPECT_NEAR(*x.error.rms_m(), 1e-9, 1e-18);
+  EXPECT_NEAR(*y.error.rms_m(), 3e-9, 1e-18);
+  EXPECT_EQ(z.samples, 0u);
+
+  sim_truth_t truth{};
+  begin_block(truth, 100, 1, 2);
+  for (int k = 0; k < 10; ++k) {
+    const std::array<double, 2> v{1e-6 - 2e-9, 2e-6 - 5e-9};  // true errors 2 nm and 5 nm
+    ASSERT_TRUE(append_tick(truth, v));
+  }
+  TruthPairing pairs_y(1);
+  WatchSecond second;
+  pairs_y.add_sensor_block(b, second);
+  pairs_y.add_truth_block(truth, second);
+  EXPECT_NEAR(*second.true_error.rms_m(), 5e-9, 1e-18);
+}
+
 TEST(CtlWatch, LineIsTidy) {
   WatchLine l;
   l.elapsed_s = 12;
