@@ -631,8 +631,8 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
 
 int CompensatorService::run() {
   for (const std::string& line : describe(settings_)) spdlog::info("{}", line);
-  spdlog::info("channels: {} in, {} out; {}, {}, {} in", samples_.channel(), command_pub_.channel(),
-               trajectories_.channel(), params_.channel(), control_.channel());
+  spdlog::info("channels: {} in, {} out; {}, {}, {}, {}, {} in", samples_.channel(), command_pub_.channel(),
+               trajectories_.channel(), scans_.channel(), params_.channel(), models_.channel(), control_.channel());
   const double started_s = monotonic_s();
   IoLoopOptions options;
   options.poll_timeout = std::chrono::microseconds(20000);
