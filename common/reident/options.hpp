@@ -4,6 +4,8 @@
 // and hystloop-identify writes (mem: {c1, c2, c3}), so one YAML snippet configures both; the rest is the
 // `reidentifier:` section (each key also --set reidentifier.KEY=V):
 //
+//   reidentifier.axis                      x, y or z: the stage axis this process fits (x). One process per axis:
+//                                     the fits are independent; a lab runs one per axis, on any host (--axis)
 //   reidentifier.rate_hz                   tick rate of HX_SENSOR [Hz], converts s -> samples (10000)
 //   reidentifier.refit_period_s            time between refits [s] (1)
 //   reidentifier.window_s                  data fitted per refit [s] (2)
@@ -48,6 +50,7 @@ namespace hystloop {
 
 struct ReidentOptions {
   MemParams initial{};  // mem.c1, mem.c2, mem.c3
+  int axis = 0;         // reidentifier.axis: 0 x, 1 y, 2 z (the blocks' axis index)
   double rate_hz = 10000.0;
   double refit_period_s = 1.0;
   double window_s = 2.0;

@@ -14,6 +14,7 @@ std::string_view to_string(ParamsOffer offer) noexcept {
     case ParamsOffer::stale: return "stale";
     case ParamsOffer::invalid: return "invalid";
     case ParamsOffer::forged: return "forged";
+    case ParamsOffer::other_axis: return "other_axis";
   }
   return "unknown";
 }

@@ -43,11 +43,12 @@
 namespace hystloop {
 
 enum class ParamsOffer : std::uint8_t {
-  adopted,  // valid, newer than its publisher's last: now the set in use
-  echo,     // one we published
-  stale,    // not newer than the last set adopted from the same publisher
-  invalid,  // valid = false (diagnostic), or parameters outside the model's domain
-  forged,   // our publisher id, but a version we never published
+  adopted,     // valid, newer than its publisher's last: now the set in use
+  echo,        // one we published
+  stale,       // not newer than the last set adopted from the same publisher
+  invalid,     // valid = false (diagnostic), or parameters outside the model's domain
+  forged,      // our publisher id, but a version we never published
+  other_axis,  // for another axis than the re-identifier's (ReidentCore): another re-identifier's business
 };
 std::string_view to_string(ParamsOffer offer) noexcept;
 

@@ -2,15 +2,27 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "core/errors.hpp"
 
 namespace hystloop {
 
+namespace {
+// Checked before the worker thread starts (the members after axis_).
+std::size_t block_axis(int axis) {
+  if (axis < 0 || axis >= sensor_block_t::MAX_AXES) {
+    throw ParameterError("reidentifier.axis", "must be 0 (x), 1 (y) or 2 (z), got " + std::to_string(axis));
+  }
+  return static_cast<std::size_t>(axis);
+}
+}  // namespace
+
 ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread,
                          RefitWorker::OnEvaluated on_evaluated)
     : options_(options),
+      axis_(block_axis(options.axis)),
       estimator_(options.estimator, options.initial),
       stage_removal_(options.stage, 1.0 / options.rate_hz),
       in_use_(options.initial, std::move(own_source), new_publisher_id()),
@@ -18,13 +30,17 @@ ReidentCore::ReidentCore(const ReidentOptions& options, std::string own_source, 
       period_us_(std::llround(options.refit_period_s * 1e6)),
       stale_after_us_(std::llround(options.stale_after_s * 1e6)) {}
 
-void ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept {
-  if (block.n_axes != 1) {  // the refit is one axis's: which axis is which is never guessed
+bool ReidentCore::on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept {
+  if (axis_ >= axes_of(block)) {
+    // Another axis in our place would be fitted as ours: refused, and its ticks are no gap (the
+    // window is poisoned, so no refit straddles the hole).
     counters_.add(ReidentCounter::sensor_blocks_wrong_axes);
     on_refused_block(block.n_ticks, now_us);
-    return;
+    return false;
   }
-  for_each_tick(block, [this, now_us](const SensorTick& tick) { on_sample(tick, now_us); });
+  for_each_tick(
+      block, [this, now_us](const SensorTick& tick) { on_sample(tick, now_us); }, axis_);
+  return true;
 }
 
 void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcept {
@@ -75,7 +91,18 @@ void ReidentCore::on_refused_block(std::int64_t ticks, std::int64_t now_us) noex
 }
 
 void ReidentCore::on_command_block(const command_block_t& block) noexcept {
-  for_each_tick(block, [this](const CommandTick& tick) { in_use_.on_command(tick.seq, tick.params_version); });
+  if (axis_ >= axes_of(block)) return;
+  for_each_tick(
+      block, [this](const CommandTick& tick) { in_use_.on_command(tick.seq, tick.params_version); }, axis_);
+}
+
+ParamsOffer ReidentCore::on_params(int axis, const MemParams& params, std::int32_t version, std::int64_t publisher_id,
+                                   bool valid, std::string_view source) noexcept {
+  if (axis != options_.axis) {
+    counters_.add(ReidentCounter::params_other_axis);
+    return ParamsOffer::other_axis;
+  }
+  return on_params(params, version, publisher_id, valid, source);
 }
 
 ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
@@ -93,7 +120,10 @@ ParamsOffer ReidentCore::on_params(const MemParams& params, std::int32_t version
     case ParamsOffer::echo: counters_.add(ReidentCounter::params_echo); break;
     case ParamsOffer::stale: counters_.add(ReidentCounter::params_stale); break;
     case ParamsOffer::invalid: counters_.add(ReidentCounter::params_invalid); break;
-    case ParamsOffer::forged: break;  // counted by ParamsInUse (forged_sets; params_forged on HX_STATUS)
+    // forged: counted by ParamsInUse (forged_sets; params_forged on HX_STATUS); other_axis is
+    // on_params(axis, ...)'s answer, never ParamsInUse's.
+    case ParamsOffer::forged:
+    case ParamsOffer::other_axis: break;
   }
   return offer;
 }

@@ -1,14 +1,15 @@
 #pragma once
 // The re-identifier without a connection and without a clock: blocks in, refit decisions
-// out. It owns the OnlineMemEstimator (fed on the calling thread, the "I/O thread"), the
-// refit worker, the set in use and the counters. Time is an argument (now_us, any monotonic
-// microsecond clock). The blocks are decoded messages; their ticks are walked with
+// out, for one axis of the stage (options.axis: x, y or z; a lab runs one process per axis, the
+// fits being independent). It owns the OnlineMemEstimator (fed on the calling thread, the "I/O
+// thread"), the refit worker, the set in use and the counters. Time is an argument (now_us, any
+// monotonic microsecond clock). The blocks are decoded messages; their ticks are walked with
 // for_each_tick (lcm/blocks.hpp), so a block is what a sequence of on_sample calls would be.
 //
-//   HX_SENSOR:      on_sensor_block(block, now_us)        per tick: on_sample; no allocation, no lock
+//   HX_SENSOR:      on_sensor_block(block, now_us)        per tick of our axis: on_sample; no allocation, no lock
 //   refused block:  on_refused_block(ticks, now_us)       a NaN/out-of-range block poisons the window
-//   HX_COMMAND:     on_command_block(block)               the params_version applied, by tick
-//   HX_PARAMS:      on_params(...)                        a newer valid set becomes the set in use
+//   HX_COMMAND:     on_command_block(block)               the params_version applied to our axis, by tick
+//   HX_PARAMS:      on_params(axis, ...)                  a newer valid set for our axis becomes the set in use
 //   often (~10 ms): poll(now_us) -> RefitDecision          collects a finished refit, starts the next
 //
 // A refit starts every refit_period_s once a full window of new samples is there and the
@@ -55,8 +56,10 @@ class ReidentCore {
   ReidentCore(const ReidentOptions& options, std::string own_source, bool start_thread = true,
               RefitWorker::OnEvaluated on_evaluated = {});
 
-  // An accepted HX_SENSOR block (check_message passed): every tick, in order, through on_sample.
-  void on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept;
+  // An accepted HX_SENSOR block (check_message passed): every tick of our axis, in order, through
+  // on_sample. A block without our axis (fewer axes) is refused whole, as on_refused_block, and
+  // counted (sensor_blocks_wrong_axes): false, so that the caller can say so.
+  bool on_sensor_block(const sensor_block_t& block, std::int64_t now_us) noexcept;
   // One tick: the applied voltage u_V and the measured y_m feed the estimator, unless the tick
   // is flagged SAFE_STATE or SENSOR_FAULT (skipped and counted); seq gaps are counted.
   void on_sample(const SensorTick& tick, std::int64_t now_us) noexcept;
@@ -64,9 +67,16 @@ class ReidentCore {
   // service's estimate, >= 1): its ticks are no gap, and the window is marked as holding a
   // non-finite sample, so no refit straddles it.
   void on_refused_block(std::int64_t ticks, std::int64_t now_us) noexcept;
-  // An accepted HX_COMMAND block: which parameter version the compensator applies, by tick.
+  // An accepted HX_COMMAND block: which parameter version the compensator applies to our axis, by
+  // tick. A block without our axis says nothing about it: ignored.
   void on_command_block(const command_block_t& block) noexcept;
-  // A set on HX_PARAMS; ours (our publisher id, in_use().own_publisher_id()) is an echo. A valid
+  // A set on HX_PARAMS for `axis` (mem_params_t.axis). A set for another axis is another
+  // re-identifier's: other_axis, counted (params_other_axis) and nothing else (its version is not
+  // followed, it is never adopted and never forged, whatever its publisher id). One for our axis
+  // goes on as below.
+  ParamsOffer on_params(int axis, const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
+                        std::string_view source) noexcept;
+  // A set for our axis; ours (our publisher id, in_use().own_publisher_id()) is an echo. A valid
   // set whose gain leaves options().plausibility is not adopted: `invalid`, counted as
   // params_implausible, the reason in implausible_reason().
   ParamsOffer on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
@@ -100,6 +110,7 @@ class ReidentCore {
   // Why the last set on HX_PARAMS counted as params_implausible was refused ("" before any).
   const std::string& implausible_reason() const noexcept { return implausible_reason_; }
   const ReidentOptions& options() const noexcept { return options_; }
+  int axis() const noexcept { return options_.axis; }  // 0 x, 1 y, 2 z
   const OnlineMemEstimator& estimator() const noexcept { return estimator_; }
   RefitWorker& worker() noexcept { return worker_; }
 
@@ -110,6 +121,7 @@ class ReidentCore {
   bool implausible(const MemParams& params) noexcept;
 
   ReidentOptions options_;
+  std::size_t axis_;  // options_.axis as the blocks index it
   OnlineMemEstimator estimator_;
   StageRemoval stage_removal_;  // the stage taken out of each sample before the estimator sees it
   ParamsInUse in_use_;

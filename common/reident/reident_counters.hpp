@@ -33,7 +33,8 @@ enum class ReidentCounter : std::uint8_t {
   params_invalid,            // valid = false sets
   params_implausible,        // valid sets whose gain leaves the rig's band (models/gain_plausibility.hpp)
   command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
-  sensor_blocks_wrong_axes,  // HX_SENSOR blocks of more than one axis: not fitted (one axis's fit only), as refused
+  sensor_blocks_wrong_axes,  // HX_SENSOR blocks without the re-identifier's axis: not fitted, as refused
+  params_other_axis,         // HX_PARAMS sets for another axis: another re-identifier's, ignored
   refits_rejected_first      // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "models/axis_coupling.hpp"
 #include "models/model_descriptors.hpp"
 #include "models/param_config.hpp"
 #include "runtime/config_validation.hpp"
@@ -15,6 +16,7 @@ namespace hystloop {
 
 namespace {
 constexpr const char* kReidentKeys[] = {
+    "reidentifier.axis",
     "reidentifier.rate_hz",
     "reidentifier.refit_period_s",
     "reidentifier.window_s",
@@ -95,6 +97,15 @@ void read_plausibility(const Config& config, ReidentOptions& o) {
   validate_config_section(config, "", [&] { require_plausible(initial, p); });
 }
 
+// reidentifier.axis: the axis by its name, as hystloop-ctl and hystloop-identify take it (--axis).
+int read_axis(const Config& config) {
+  const std::string name = config.get<std::string>("reidentifier.axis", "x");
+  for (int axis = 0; axis < kMaxAxes; ++axis) {
+    if (name == axis_name(axis)) return axis;
+  }
+  config.fail("reidentifier.axis", "expected x, y or z, the stage axis this re-identifier fits (got \"" + name + "\")");
+}
+
 std::size_t samples_of(double seconds, double rate_hz) {
   return static_cast<std::size_t>(std::llround(seconds * rate_hz));
 }
@@ -111,6 +122,7 @@ ReidentOptions read_reident_options(const Config& config) {
   config.check_no_unknown_keys(known);
 
   ReidentOptions o;
+  o.axis = read_axis(config);
   validate_config_section(config, "mem.",
                           [&] { o.initial = params_from_config<MemDescriptor>(config, MemParams::paper_like()); });
   read_plausibility(config, o);

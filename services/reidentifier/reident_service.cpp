@@ -9,6 +9,7 @@
 #include "core/clock.hpp"
 #include "core/process.hpp"
 #include "lcm/feedforward_mode.hpp"
+#include "models/axis_coupling.hpp"
 #include "runtime/io_loop.hpp"
 #include "runtime/model_params_message.hpp"
 
@@ -55,23 +56,31 @@ RefitWorker::OnEvaluated refusal_logger() {
 }
 }  // namespace
 
+std::string ReidentService::process_name(int axis) {
+  // x keeps the name every tool, test and deploy script knows; the others say their axis.
+  return axis == 0 ? std::string(kProcessName) : std::string(kProcessName) + "-" + std::string(axis_name(axis));
+}
+
 ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options)
     : lcm_(lcm),
       options_(options),
-      own_source_(std::string(kProcessName) + "@" + host_name()),
+      process_(process_name(options.axis)),
+      own_source_(process_ + "@" + host_name()),
       core_(std::make_unique<ReidentCore>(options, own_source_, true, refusal_logger())),
       params_out_(lcm, names.params),
       chooser_(
           std::make_unique<ModelChooser>(options.models, initial_model(options), core_->estimator().make_window())),
       model_out_(lcm, names.model),
-      status_(lcm, names.status, kProcessName),
-      control_filter_(kProcessName) {
+      status_(lcm, names.status, process_),
+      control_filter_(process_) {
   core_->hold(options.hold);
   if (options.hold) spdlog::info("holding the set in use from the start (reidentifier.hold): nothing is published");
   out_.source = own_source_;
   out_.publisher_id = core_->in_use().own_publisher_id();
+  out_.axis = static_cast<std::int8_t>(options.axis);  // the compensator offers a set only to the axis it names
   model_msg_.source = own_source_;
   model_msg_.publisher_id = core_->in_use().own_publisher_id();
+  model_msg_.axis = static_cast<std::int8_t>(options.axis);
   reserve_storage(model_msg_);
   Subscription<sensor_block_t>::Options sensor_options;
   sensor_options.queue_capacity = static_cast<int>(options.lcm_queue);
@@ -94,14 +103,28 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
 
 void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
   const std::int64_t t0 = monotonic_ns();
-  core_->on_sensor_block(msg, t0 / 1000);
+  if (!core_->on_sensor_block(msg, t0 / 1000)) log_wrong_axes(msg.n_axes, t0);
   block_cost_.add(monotonic_ns() - t0);
+}
+
+void ReidentService::log_wrong_axes(std::int8_t n_axes, std::int64_t now_ns) noexcept {
+  const LogLimiter::Gate g = log_limiter_.allow(kLogWrongAxes, now_ns);
+  if (!g) return;
+  try {  // off the per-sample path: a refused block, at most one line a second
+    std::string carried;
+    for (int a = 0; a < n_axes; ++a) carried += (a == 0 ? "" : ", ") + std::string(axis_name(a));
+    spdlog::warn(
+        "HX_SENSOR block of {} {} ({}) has no {}, the axis this re-identifier fits (reidentifier.axis): "
+        "refused whole, counted (sensor_blocks_wrong_axes){}",
+        n_axes, n_axes == 1 ? "axis" : "axes", carried, axis_name(options_.axis), suppressed_note(g));
+  } catch (...) {  // out of memory while formatting: the count still says it
+  }
 }
 
 void ReidentService::on_params(const mem_params_t& msg) {
   const MemParams p{msg.c1, msg.c2, msg.c3};
   const std::uint64_t implausible_before = core_->counters().get(ReidentCounter::params_implausible);
-  const ParamsOffer offer = core_->on_params(p, msg.version, msg.publisher_id, msg.valid, msg.source);
+  const ParamsOffer offer = core_->on_params(msg.axis, p, msg.version, msg.publisher_id, msg.valid, msg.source);
   // Counted by the core (params_adopted, _stale, _invalid, _implausible); logged at most once a second per kind.
   const auto id = static_cast<std::uint64_t>(msg.publisher_id);
   const auto log = [&](LogReason reason, spdlog::level::level_enum level, const std::string& what) {
@@ -113,7 +136,11 @@ void ReidentService::on_params(const mem_params_t& msg) {
   if (core_->counters().get(ReidentCounter::params_implausible) != implausible_before) {
     return log(kLogInvalid, spdlog::level::warn, "not adopted: " + core_->implausible_reason());
   }
-  if (offer == ParamsOffer::adopted) {
+  if (offer == ParamsOffer::other_axis) {
+    log(kLogOtherAxis, spdlog::level::debug,
+        fmt::format("ignored: for {}, another re-identifier's axis (this one fits {})", axis_name(msg.axis),
+                    axis_name(options_.axis)));
+  } else if (offer == ParamsOffer::adopted) {
     log(kLogAdopted, spdlog::level::info,
         fmt::format("in use now: c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", msg.c1, msg.c2, msg.c3));
   } else if (offer == ParamsOffer::stale) {
@@ -147,7 +174,7 @@ CounterSet::Entries ReidentService::counter_entries() {
 
 void ReidentService::on_control(const control_t& msg) {
   if (!control_filter_.accept(msg)) return;
-  if (msg.command == control_t::SET_MODE && msg.target == kProcessName) {
+  if (msg.command == control_t::SET_MODE && msg.target == process_) {
     pin_model(msg);
   } else if (msg.command == control_t::HOLD_PARAMS || msg.command == control_t::RELEASE_PARAMS) {
     const bool on = msg.command == control_t::HOLD_PARAMS;
@@ -175,7 +202,7 @@ void ReidentService::on_control(const control_t& msg) {
     reported_.rebase("params_out", params_out_.counters());
     reported_.rebase("model_out", model_out_.counters());
   }
-  if (msg.target == kProcessName && !acks_.due()) {
+  if (msg.target == process_ && !acks_.due()) {
     acks_.refused(msg.request_id,
                   "command " + std::to_string(msg.command) +
                       " is not the re-identifier's (pin-model, hold, reset-counters, shutdown)",
@@ -288,7 +315,17 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
         static_cast<std::uint64_t>(in_use.own_publisher_id()), in_use.last_forged_version(),
         in_use.forged_applied() ? ", but the compensator applies it" : "", in_use.forged_sets());
   }
+  // Blocks without our axis since the last report: a bridge of fewer axes than this process
+  // expects fits nothing here, which the poisoned-window rule would say only minutes later.
+  const std::uint64_t wrong_axes = core_->counters().get(ReidentCounter::sensor_blocks_wrong_axes);
+  if (!stopping && wrong_axes > wrong_axes_reported_) {
+    state = service_status_t::DEGRADED;
+    why += fmt::format("{} HX_SENSOR blocks without axis {} since the last report (sensor_blocks_wrong_axes); ",
+                       wrong_axes - wrong_axes_reported_, axis_name(options_.axis));
+  }
+  wrong_axes_reported_ = wrong_axes;
   const LatencyStats& refit = core_->refit_time();
+  if (options_.axis != 0) why += fmt::format("axis {}: ", axis_name(options_.axis));  // x: as before axes existed
   why += fmt::format("params version {} from '{}': c1 {:.6g} m/V, c2 {:.6g}, c3 {:.6g}", in_use.version(),
                      escape_wire(in_use.source()), in_use.params().c1, in_use.params().c2, in_use.params().c3);
   const std::int32_t applied = in_use.applied_version();

@@ -6,6 +6,8 @@
 #   reident_run.sh good    <...same...>   refit of a plant whose gain moved 10 % is published
 #   reident_run.sh garbage <...same...>   NaN / constant u / stuck y never publish a set
 #   reident_run.sh invalid <...same...>   with --publish-invalid, refused refits go out as valid = false
+#   reident_run.sh axis    <...same...>   --axis y on blocks of x and y: fits y's, as "reidentifier-y",
+#                                         its sets carry y; a bad axis exits 2 naming --axis / the key
 set -euo pipefail
 what="$1"; reident="$2"; stream="$3"; src="$4"
 url="udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"
@@ -38,20 +40,21 @@ stop_within_1s() {
   grep -q "stopping:" "$dir/reident.log" || fail "no stop summary in the log"
 }
 
+check_bad() {  # expected-field args...
+  local field="$1"; shift
+  local rc=0
+  "$reident" "$@" >/dev/null 2>"$dir/err" || rc=$?
+  [ "$rc" = 2 ] || fail "exit $rc (want 2) for $*"
+  grep -qF -- "$field" "$dir/err" || fail "stderr does not name $field: $(cat "$dir/err")"
+  echo "refused ($*): $(cat "$dir/err")"
+}
+
 case "$what" in
   cli)
     "$reident" --help >"$dir/help" || fail "--help exit status"
     for w in --config --set --lcm-url --rig --publish-invalid reidentifier.refit_period_s mem.; do
       grep -q -- "$w" "$dir/help" || fail "--help does not mention $w"
     done
-    check_bad() {  # expected-field args...
-      local field="$1"; shift
-      local rc=0
-      "$reident" "$@" >/dev/null 2>"$dir/err" || rc=$?
-      [ "$rc" = 2 ] || fail "exit $rc (want 2) for $*"
-      grep -qF -- "$field" "$dir/err" || fail "stderr does not name $field: $(cat "$dir/err")"
-      echo "refused ($*): $(cat "$dir/err")"
-    }
     check_bad "reidentifier.refit_period_s" --set reidentifier.refit_period_s=-1
     check_bad "reidentifier.capacity_s" --set reidentifier.window_s=5 --set reidentifier.capacity_s=2
     check_bad "mem.c1" --set mem.c1=0
@@ -93,6 +96,17 @@ case "$what" in
     grep -q "refit refused (poisoned_window)" "$dir/reident.log" || fail "refusals not logged"
     ! grep -q "published params" "$dir/reident.log" || fail "a set was published"
     ;;
-  *) echo "usage: reident_run.sh cli|good|invalid|garbage <reidentifier> <stream> <source dir>" >&2; exit 2 ;;
+  axis)
+    "$reident" --help | grep -q -- "--axis" || fail "--help does not mention --axis"
+    check_bad "--axis" --axis w
+    check_bad "reidentifier.axis" --set reidentifier.axis=w
+    start --axis y
+    "$stream" good --axis y --url "$url" --duration-s 6 --frequency-hz 1 --tolerance 0.03 || fail "stream check"
+    stop_within_1s
+    grep -q 'axis: y (process "reidentifier-y"' "$dir/reident.log" || fail "the axis is not logged at start"
+    grep -q "reidentifier-y\[" "$dir/reident.log" || fail "the log does not name the process reidentifier-y"
+    grep -q "published params version" "$dir/reident.log" || fail "no 'published' log line"
+    ;;
+  *) echo "usage: reident_run.sh cli|good|invalid|garbage|axis <reidentifier> <stream> <source dir>" >&2; exit 2 ;;
 esac
 echo "reident_run.sh $what: OK"

@@ -5,6 +5,8 @@
 //   reident_stream garbage --url U [--phase-s 2]
 //   reident_stream shutdown --url U     sends control_t SHUTDOWN to "reidentifier" (after its first status)
 //   reident_stream status  --url U      until the re-identifier's first status (it serves; exit 1 if none in 10 s)
+//   every mode: [--axis x|y|z]          the axis of the re-identifier under test (its process is
+//                                       "reidentifier", "reidentifier-y" or "reidentifier-z")
 //
 // Every mode waits for the re-identifier's first HX_STATUS; good and garbage then stream 10 kHz
 // of real time as the bridge and compensator do: one sensor_block_t of 10 ticks per millisecond,
@@ -23,9 +25,17 @@
 //           refused on the wire), constant u with noisy y, y stuck while u moves. Passes if no
 //           valid set is ever published and the status counts poisoned-window and constant-input
 //           refusals, non-finite samples and dropouts, and no gap for the refused blocks.
+//  --axis y|z: the blocks carry every axis up to it (x, y[, z]), as a bridge of that many axes
+//           sends them; the axis under test gets the streams above, the others a drive 0.6 x as
+//           large through a MEM 0.8 x as steep (a fit of the wrong axis misses c1 by ~30 %) and
+//           commands from version 30; good also announces a set for x (version 40, another
+//           publisher), which must be left alone. Passes, beyond the above, if the published sets
+//           carry the axis, their versions stay below x's 30 and 40 (not followed), and the status
+//           counts the x set as params_other_axis and no block as sensor_blocks_wrong_axes.
 // Prints the figures (refit time p50/max, per-block feed cost) from the last status.
 // Exit status 0 = pass, 1 = fail, 2 = usage.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -34,6 +44,7 @@
 #include <numbers>
 #include <random>
 #include <set>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -59,9 +70,11 @@ namespace {
 
 using clock = std::chrono::steady_clock;
 
-constexpr std::int64_t kBlockTicks = 10;     // the bridge's default: 1 kHz of blocks
-constexpr std::int64_t kHorizonTicks = 300;  // commands planned 30 ms ahead
-constexpr std::int32_t kAppliedVersion = 7;  // what the commands of the good mode say is applied
+constexpr std::int64_t kBlockTicks = 10;           // the bridge's default: 1 kHz of blocks
+constexpr std::int64_t kHorizonTicks = 300;        // commands planned 30 ms ahead
+constexpr std::int32_t kAppliedVersion = 7;        // what the commands of the good mode say is applied
+constexpr std::int32_t kOtherAxisVersion = 30;     // what they say for the axes not under test (--axis y|z)
+constexpr std::int32_t kOtherAxisSetVersion = 40;  // the set announced for x (--axis y|z)
 
 struct Options {
   std::string mode;
@@ -73,6 +86,9 @@ struct Options {
   double tolerance = 0.03;
   double settle_s = 2.5;
   bool expect_invalid = false;  // the re-identifier runs with --publish-invalid
+  std::string axis = "x";       // --axis: the re-identifier's
+  int axis_index = 0;
+  std::string process = "reidentifier";
   double c1 = MemParams::paper_like().c1, c2 = MemParams::paper_like().c2, c3 = MemParams::paper_like().c3;
 };
 
@@ -90,7 +106,13 @@ Options parse(int argc, char** argv) {
                         {"--frequency-hz", &o.frequency_hz},
                         {"--tolerance", &o.tolerance},
                         {"--settle-s", &o.settle_s},
-                        {"--expect-invalid", &o.expect_invalid}});
+                        {"--expect-invalid", &o.expect_invalid},
+                        {"--axis", &o.axis}});
+  const std::array<const char*, 3> names{"x", "y", "z"};
+  const auto it = std::find(names.begin(), names.end(), o.axis);
+  if (it == names.end()) throw std::invalid_argument("--axis must be x, y or z");
+  o.axis_index = static_cast<int>(it - names.begin());
+  if (o.axis_index > 0) o.process = "reidentifier-" + o.axis;
   return o;
 }
 
@@ -129,7 +151,7 @@ class Stream {
     }
     if (o_.mode == "status") return 0;
     if (o_.mode == "shutdown") {
-      probe::send_shutdown(*lcm_, names_.control, "reidentifier", 1);  // its status is not this mode's verdict
+      probe::send_shutdown(*lcm_, names_.control, o_.process, 1);  // its status is not this mode's verdict
       return 0;
     }
     return o_.mode == "good" ? run_good() : run_garbage();
@@ -137,7 +159,7 @@ class Stream {
 
  private:
   void on_params(const mem_params_t& m) {
-    if (m.source.rfind("reidentifier@", 0) != 0) return;  // our own announcement
+    if (m.source.rfind(o_.process + "@", 0) != 0) return;  // our own announcements
     if (!seen_.versions.insert(m.version).second) seen_.duplicate_version = true;
     if (m.valid) {
       ++seen_.valid_params;
@@ -150,7 +172,7 @@ class Stream {
     }
   }
   void on_status(const service_status_t& m) {
-    if (m.process != "reidentifier") return;
+    if (m.process != o_.process) return;
     ++seen_.statuses;
     seen_.last_status = m;
     if (std::isfinite(m.loop_p50_us)) {
@@ -176,17 +198,26 @@ class Stream {
         .count();
   }
 
-  // Commands for the ticks not yet commanded, up to (excluding) `until`, in one block.
+  // Axes per block: one for x (as before axes existed), else every axis up to the one under test.
+  int block_axes() const { return o_.axis_index + 1; }
+
+  // Commands for the ticks not yet commanded, up to (excluding) `until`, in one block; the axes
+  // not under test from kOtherAxisVersion.
   void command_until(std::int64_t until, std::int32_t params_version) {
     if (commanded_ >= until) return;
-    begin_block(commands_, commanded_, wall_us(), seq_ - 1);
+    begin_block(commands_, commanded_, wall_us(), seq_ - 1, block_axes());
     constexpr double kNoReference = std::numeric_limits<double>::quiet_NaN();
     for (; commanded_ < until; ++commanded_) {
-      append_tick(commands_, CommandTick{.seq = commanded_,
-                                         .u_ff_V = 0.0,
-                                         .y_ref_m = kNoReference,
-                                         .params_version = params_version,
-                                         .mode = command_block_t::MODE_MEM});
+      std::array<CommandTick, 3> ticks{};
+      for (int a = 0; a < block_axes(); ++a) {
+        ticks[static_cast<std::size_t>(a)] =
+            CommandTick{.seq = commanded_,
+                        .u_ff_V = 0.0,
+                        .y_ref_m = kNoReference,
+                        .params_version = a == o_.axis_index ? params_version : kOtherAxisVersion,
+                        .mode = command_block_t::MODE_MEM};
+      }
+      append_tick(commands_, std::span<const CommandTick>(ticks).first(static_cast<std::size_t>(block_axes())));
     }
     command_pub_.publish(commands_);
   }
@@ -200,13 +231,23 @@ class Stream {
     for (std::int64_t k = 0; k < n; k += kBlockTicks) {
       const std::int64_t ticks = std::min(kBlockTicks, n - k);
       command_until(seq_ + ticks + kHorizonTicks, params_version);
-      begin_block(block_, seq_, wall_us(), 1e-4);
+      begin_block(block_, seq_, wall_us(), 1e-4, block_axes());
       for (std::int64_t i = 0; i < ticks; ++i) {
         double u = 0.0, y = 0.0;
         fill(k + i, u, y);
-        append_tick(
-            block_,
-            SensorTick{.u_V = u, .u_ff_V = u, .y_ref_m = kNoReference, .y_m = y, .flags = sensor_block_t::SIMULATED});
+        // The other axes: their own drive through their own stage.
+        const double u_other = 0.6 * u;
+        const double y_other = std::isfinite(u_other) ? other_axes_.forward(u_other) : 0.0;
+        std::array<SensorTick, 3> axes{};
+        for (int a = 0; a < block_axes(); ++a) {
+          const bool ours = a == o_.axis_index;
+          axes[static_cast<std::size_t>(a)] = SensorTick{.u_V = ours ? u : u_other,
+                                                         .u_ff_V = ours ? u : u_other,
+                                                         .y_ref_m = kNoReference,
+                                                         .y_m = ours ? y : y_other,
+                                                         .flags = sensor_block_t::SIMULATED};
+        }
+        append_tick(block_, std::span<const SensorTick>(axes).first(static_cast<std::size_t>(block_axes())));
       }
       sensor_.publish(block_);
       seq_ += ticks;
@@ -263,7 +304,17 @@ class Stream {
     external.c3 = initial.c3;
     external.valid = true;
     external.source = "probe";
+    external.axis = static_cast<std::int8_t>(o_.axis_index);
     params_pub_.publish(external);
+    if (o_.axis_index > 0) {  // x's re-identifier's business, newer than everything
+      mem_params_t x_set = external;
+      x_set.version = kOtherAxisSetVersion;
+      x_set.publisher_id = 0x0dd;
+      x_set.c1 = 0.8 * initial.c1;
+      x_set.source = "probe-x";
+      x_set.axis = 0;
+      params_pub_.publish(x_set);
+    }
 
     MemModel model(truth);
     std::mt19937_64 rng(42);
@@ -289,6 +340,11 @@ class Stream {
       check(b.version >= kAppliedVersion + 1,
             "version " + std::to_string(b.version) + " is not above the applied version 7 (nor the external set's 5)");
       check(std::isfinite(b.residual_m) && b.residual_m > 0 && b.residual_m < 20e-9, "residual_m out of range");
+      check(b.axis == o_.axis_index, "the set carries axis " + std::to_string(b.axis) + ", not " + o_.axis);
+      if (o_.axis_index > 0) {
+        check(b.version < kOtherAxisVersion,
+              "version " + std::to_string(b.version) + " follows another axis's (30 on HX_COMMAND, 40 on HX_PARAMS)");
+      }
       check(b.samples_used > 0 && b.window_s > 0, "samples_used/window_s missing");
     }
     if (o_.expect_invalid) {
@@ -304,6 +360,11 @@ class Stream {
     check(counter("params_version_applied") == kAppliedVersion, "the applied version (HX_COMMAND) is not reported");
     check(counter("refits_accepted") >= 1, "status does not count the accepted refit");
     check(counter("seq_gaps") == 0, "samples were lost on the way");
+    if (o_.axis_index > 0) {
+      check(counter("params_other_axis") >= 1, "the set for x is not counted as another axis's");
+      check(counter("params_forged") == 0, "a set was counted as forged");
+      check(counter("sensor_blocks_wrong_axes") == 0, "blocks with the axis were refused");
+    }
     return failures_ == 0 ? 0 : 1;
   }
 
@@ -356,6 +417,7 @@ class Stream {
   Subscription<mem_params_t> params_;
   Subscription<service_status_t> status_;
   Observed seen_;
+  MemModel other_axes_{MemParams{0.8 * o_.c1, 0.8 * o_.c2, o_.c3}};  // the axes not under test (--axis y|z)
   sensor_block_t block_{};
   command_block_t commands_{};
   std::int64_t seq_ = 0;        // next sensor tick

@@ -269,17 +269,19 @@ TEST(ReidentCore, ABlockIsItsTicksInOrder) {
   EXPECT_TRUE(rig.core.seen_samples());
 }
 
-TEST(ReidentCore, ABlockOfSeveralAxesIsNotFittedButCountedAsRefused) {
-  Rig rig;
+TEST(ReidentCore, ABlockWithoutItsAxisIsNotFittedButCountedAsRefused) {
+  ReidentOptions options = testdata::small_reident_options(testdata::piezo_truth());
+  options.axis = 2;  // z
+  ReidentCore core{options, "reident@test", /*start_thread=*/false};
   sensor_block_t xy = testdata::reserved_sensor_block();
-  begin_block(xy, 100, rig.now, 1e-4, 2);
+  begin_block(xy, 100, 10 * kSecond, 1e-4, 2);
   for (std::int64_t k = 100; k < 104; ++k) {
     const std::array<SensorTick, 2> axes{SensorTick{.seq = k, .u_V = 1.0, .y_m = 1e-9},
                                          SensorTick{.seq = k, .u_V = 2.0, .y_m = 2e-9}};
     ASSERT_TRUE(append_tick(xy, axes));
   }
-  rig.core.on_sensor_block(xy, rig.now);
-  const ReidentCounters& c = rig.core.counters();
+  EXPECT_FALSE(core.on_sensor_block(xy, 10 * kSecond));
+  const ReidentCounters& c = core.counters();
   EXPECT_EQ(c.get(ReidentCounter::sensor_blocks_wrong_axes), 1u);
   // Like a block refused on the wire: one poison marker, no sample of either axis.
   EXPECT_EQ(c.get(ReidentCounter::samples_fed), 1u);

@@ -122,6 +122,21 @@ TEST(ReidentOptions, TheDeployedStageIsTheCompensators) {
   }
 }
 
+// One re-identifier per axis: reidentifier.axis names it as hystloop-ctl's --axis does.
+TEST(ReidentOptions, TheAxisIsXByDefaultAndNamedXYOrZ) {
+  EXPECT_EQ(read_reident_options(Config()).axis, 0);
+  EXPECT_EQ(read_reident_options(Config::from_string("reidentifier: {axis: x}\n")).axis, 0);
+  EXPECT_EQ(read_reident_options(Config::from_string("reidentifier: {axis: y}\n")).axis, 1);
+  EXPECT_EQ(read_reident_options(Config::from_string("reidentifier: {axis: z}\n")).axis, 2);
+  const ReidentOptions deployed =
+      read_reident_options(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/reidentifier.yaml"));
+  EXPECT_EQ(deployed.axis, 0);
+  for (const char* bad : {"w", "1", "X", "xy"}) {
+    const std::string why = refusal("reidentifier: {axis: " + std::string(bad) + "}\n");
+    EXPECT_NE(why.find("r.yaml: reidentifier.axis: expected x, y or z"), std::string::npos) << why;
+  }
+}
+
 TEST(ReidentOptions, ReadsAndChecksTheStage) {
   EXPECT_FALSE(read_reident_options(Config()).stage.has_dynamics()) << "none by default: samples as measured";
   const ReidentOptions o = read_reident_options(

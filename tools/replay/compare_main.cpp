@@ -4,14 +4,14 @@
 //                           [--tolerance-V V] [--tolerance-m M] [--rig HX_]
 //
 // Takes the command_block_t blocks apart into ticks and matches them by tick, over the ticks
-// the original commanded; compares u_ff_V, y_ref_m, mode, params_version (exact by default:
-// bitwise equal doubles).
-// Prints the first divergence (tick, field, expected, got) and a summary.
-// Exit 0: equal; 1: diverged, nothing compared, or the replay lost samples in transport with no
+// the original commanded, every axis the blocks carry (each with its own report); compares u_ff_V, y_ref_m, mode,
+// params_version (exact by default: bitwise equal doubles). Prints the first divergence (tick, field, expected, got)
+// and a summary. Exit 0: equal; 1: diverged, nothing compared, or the replay lost samples in transport with no
 // divergence before the first loss (the verdict line tells which); 2: bad arguments or unreadable log.
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <optional>
@@ -21,6 +21,7 @@
 #include "core/cli.hpp"
 #include "command_comparison.hpp"
 #include "core/errors.hpp"
+#include "models/axis_coupling.hpp"
 
 int main(int argc, char** argv) try {
   CLI::App app{"Compares a replayed compensator's commands with a recorded log's (tools/replay-check)."};
@@ -41,25 +42,37 @@ int main(int argc, char** argv) try {
   try {
     tolerance.validate();
     const hystloop::ChannelNames channels(rig);
-    const auto expected = hystloop::replay::read_commands(expected_log, channels);
-    const auto actual = hystloop::replay::read_commands(actual_log, channels);
     std::optional<std::set<std::int64_t>> played;
     if (!inputs_log.empty()) played = hystloop::replay::read_sample_seqs(inputs_log, channels);
-    if (expected.by_seq.empty()) {
-      std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(),
-                   channels.command.c_str());
-      return hystloop::kExitUsage;
+    // Every axis the recorded blocks carry, each compared on its own (a one-axis log: x, as always).
+    int axes = 1;
+    int exit_code = hystloop::kExitOk;
+    for (int axis = 0; axis < axes; ++axis) {
+      const auto expected = hystloop::replay::read_commands(expected_log, channels, axis);
+      const auto actual = hystloop::replay::read_commands(actual_log, channels, axis);
+      axes = std::max(expected.axes, 1);
+      if (expected.by_seq.empty()) {
+        std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(),
+                     channels.command.c_str());
+        return hystloop::kExitUsage;
+      }
+      if (axes > 1) std::printf("axis %s:\n", std::string(hystloop::axis_name(axis)).c_str());
+      if (actual.axes != expected.axes) {
+        std::printf("verdict: the replay's blocks carry %d axes, the log's %d\n", actual.axes, expected.axes);
+        return 1;
+      }
+      const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
+      if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
+        std::printf(
+            "note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu "
+            "undecodable blocks\n",
+            static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
+            static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
+      }
+      std::fputs(hystloop::replay::format_report(report, tolerance).c_str(), stdout);
+      if (exit_code == hystloop::kExitOk) exit_code = report.exit_code();
     }
-    const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
-    if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
-      std::printf(
-          "note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu "
-          "undecodable blocks\n",
-          static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
-          static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
-    }
-    std::fputs(hystloop::replay::format_report(report, tolerance).c_str(), stdout);
-    return report.exit_code();
+    return exit_code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hystloop-replay-compare: %s\n", e.what());
     return hystloop::kExitUsage;

@@ -1,12 +1,14 @@
 #include "recorded_commands.hpp"
 
+#include <algorithm>
+
 #include "decode.hpp"
 #include "lcm/blocks.hpp"
 #include "log_reader.hpp"
 
 namespace hystloop::replay {
 
-CommandLog read_commands(const std::filesystem::path& log, const ChannelNames& channels) {
+CommandLog read_commands(const std::filesystem::path& log, const ChannelNames& channels, int axis) {
   CommandLog out;
   command_block_t block;
   report::for_each_event({log}, [&](const lcm::LogEvent& event) {
@@ -14,10 +16,16 @@ CommandLog read_commands(const std::filesystem::path& log, const ChannelNames& c
     if (!report::decode_checked(event, block)) return void(++out.undecodable);
     ++out.blocks;
     if (block.sample_seq >= 0) out.answered_samples.insert(block.sample_seq);
-    for_each_tick(block, [&](const CommandTick& t) {
-      const RecordedCommand c{t.seq, block.sample_seq, t.u_ff_V, t.y_ref_m, t.params_version, t.mode};
-      if (!out.by_seq.emplace(c.seq, c).second) ++out.duplicates;
-    });
+    const auto axes = static_cast<int>(axes_of(block));
+    out.axes = std::max(out.axes, axes);
+    if (axis >= axes) return;
+    for_each_tick(
+        block,
+        [&](const CommandTick& t) {
+          const RecordedCommand c{t.seq, block.sample_seq, t.u_ff_V, t.y_ref_m, t.params_version, t.mode};
+          if (!out.by_seq.emplace(c.seq, c).second) ++out.duplicates;
+        },
+        static_cast<std::size_t>(axis));
   });
   return out;
 }

@@ -26,11 +26,12 @@ struct CommandLog {
   std::uint64_t blocks = 0;                        // decodable blocks
   std::uint64_t duplicates = 0;                    // further commands for a tick already held (ignored)
   std::uint64_t undecodable = 0;                   // events on the command channel that failed to decode or check
+  int axes = 0;                                    // the most axes a decodable block carried (a one-axis rig's: 1)
 };
 
-// Every command on channels.command. Throws std::runtime_error naming the file if it
-// cannot be opened as an LCM event log.
-CommandLog read_commands(const std::filesystem::path& log, const ChannelNames& channels);
+// Every command of `axis` (0: x) on channels.command; blocks without that axis hold none of it. Throws
+// std::runtime_error naming the file if it cannot be opened as an LCM event log.
+CommandLog read_commands(const std::filesystem::path& log, const ChannelNames& channels, int axis = 0);
 
 // Ticks of the decodable sensor blocks on channels.sensor (every tick of every block).
 std::set<std::int64_t> read_sample_seqs(const std::filesystem::path& log, const ChannelNames& channels);

@@ -301,6 +301,7 @@ struct TableBuilder::Impl {
   std::vector<Message> messages;  // each table's, reused from event to event
   std::int64_t t0_utime = 0;
   double lower_s = 0.0, upper_s = 0.0;
+  std::size_t axis = 0;  // the axis of a block's ticks that make its rows
 
   double t_of(std::int64_t utime) const { return static_cast<double>(utime - t0_utime) * 1e-6; }
   bool in_range(double t) const { return t >= lower_s && t <= upper_s; }
@@ -342,16 +343,19 @@ struct TableBuilder::Impl {
           }
           if constexpr (!kBlock<M>) {
             row(event_t, [&](Row& r) { fields(r, m); });
-          } else {
+          } else if (axis < axes_of(m)) {  // a block without the axis has no row of it
             std::size_t i = 0;
-            for_each_tick(m, [&](const auto& k) {
-              // A sensor tick is dated as the report's time axis dates it, a command tick by its block's arrival.
-              double tick_t = event_t;
-              if constexpr (std::is_same_v<M, sensor_block_t>) {
-                tick_t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
-              }
-              row(tick_t, [&](Row& r) { fields(r, m, k); });
-            });
+            for_each_tick(
+                m,
+                [&](const auto& k) {
+                  // A sensor tick is dated as the report's time axis dates it, a command tick by its block's arrival.
+                  double tick_t = event_t;
+                  if constexpr (std::is_same_v<M, sensor_block_t>) {
+                    tick_t = t_of(tick_recv_utime(e.timestamp, m.n_ticks, i++, m.dt_s));
+                  }
+                  row(tick_t, [&](Row& r) { fields(r, m, k); });
+                },
+                axis);
           }
           return true;
         },
@@ -360,12 +364,13 @@ struct TableBuilder::Impl {
 };
 
 TableBuilder::TableBuilder(std::function<bool(const std::string&)> wanted, std::int64_t t0_utime, double lower_s,
-                           double upper_s)
+                           double upper_s, int axis)
     : impl_(std::make_unique<Impl>()) {
   impl_->wanted = std::move(wanted);
   impl_->t0_utime = t0_utime;
   impl_->lower_s = lower_s;
   impl_->upper_s = upper_s;
+  impl_->axis = static_cast<std::size_t>(axis);
 }
 
 TableBuilder::~TableBuilder() = default;

@@ -53,11 +53,12 @@ struct ChannelTable {
 };
 
 // Collects the rows of the channels `wanted` accepts, with lower_s <= t_s <= upper_s, t_s
-// relative to t0_utime [us] (the sensor ticks dated as hystloop-report dates them).
+// relative to t0_utime [us] (the sensor ticks dated as hystloop-report dates them). A block's rows
+// are the ticks of `axis` (0 x, 1 y, 2 z; hystloop-report --axis); a block without it has none.
 class TableBuilder {
  public:
   TableBuilder(std::function<bool(const std::string& channel)> wanted, std::int64_t t0_utime, double lower_s,
-               double upper_s);
+               double upper_s, int axis = 0);
   ~TableBuilder();
   TableBuilder(const TableBuilder&) = delete;
   TableBuilder& operator=(const TableBuilder&) = delete;

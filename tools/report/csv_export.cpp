@@ -96,7 +96,7 @@ std::string csv_legend_text(const ChannelTable& table) {
 
 std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs,
                                   const std::vector<std::string>& channels, std::int64_t t0_utime, double lower_s,
-                                  double upper_s, const std::filesystem::path& dir) {
+                                  double upper_s, const std::filesystem::path& dir, int axis) {
   std::vector<ChannelWriter> writers;
   writers.reserve(channels.size());
   auto writer_of = [&](const std::string& channel) {
@@ -113,7 +113,7 @@ std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs
   }
   // The rows are written and dropped event by event: a long channel is never held whole.
   TableBuilder builder([&](const std::string& channel) { return writer_of(channel) != writers.end(); }, t0_utime,
-                       lower_s, upper_s);
+                       lower_s, upper_s, axis);
   for_each_event(logs, [&](const lcm::LogEvent& e) {
     ChannelTable* t = builder.add(e);
     if (t == nullptr) return;

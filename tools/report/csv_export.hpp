@@ -30,9 +30,10 @@ struct CsvExport {
 std::string csv_legend_text(const ChannelTable& table);
 
 // One pass over the logs, writing each channel's rows with lower_s <= t_s <= upper_s
-// (t_s relative to t0_utime), and each channel's legend file. Throws std::runtime_error if a file cannot be written.
+// (t_s relative to t0_utime; a block's rows are the ticks of `axis`), and each channel's legend
+// file. Throws std::runtime_error if a file cannot be written.
 std::vector<CsvExport> export_csv(const std::vector<std::filesystem::path>& logs,
                                   const std::vector<std::string>& channels, std::int64_t t0_utime, double lower_s,
-                                  double upper_s, const std::filesystem::path& dir);
+                                  double upper_s, const std::filesystem::path& dir, int axis = 0);
 
 }  // namespace hystloop::report

@@ -11,6 +11,7 @@
 #include "decode.hpp"
 #include "event_file.hpp"
 #include "lcm/blocks.hpp"
+#include "models/axis_coupling.hpp"
 #include "models/model_set.hpp"
 
 namespace hystloop::report {
@@ -70,8 +71,27 @@ std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks
   return block_recv_utime - static_cast<std::int64_t>(std::llround(back_us));
 }
 
-RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels) {
+std::string axes_text(int axes) {
+  std::string names;
+  for (int a = 0; a < axes; ++a) {
+    names += std::string(a == 0 ? "" : a + 1 == axes ? " and " : ", ") + std::string(axis_name(a));
+  }
+  return std::to_string(axes) + (axes == 1 ? " axis (" : " axes (") + names + ")";
+}
+
+void require_axis(const RunData& run, const std::string& sensor_channel) {
+  if (run.sensor_blocks_by_axes.empty()) return;
+  const int most = run.sensor_blocks_by_axes.rbegin()->first;
+  if (run.axis < most) return;
+  throw ParameterError("--axis", "the log's " + sensor_channel + " blocks carry " +
+                                     (run.sensor_blocks_by_axes.size() > 1 ? "at most " : "") + axes_text(most) +
+                                     ", not " + std::string(axis_name(run.axis)));
+}
+
+RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels, int axis) {
   RunData run;
+  run.axis = axis;
+  const auto a = static_cast<std::size_t>(axis);
   sensor_block_t sensor;
   command_block_t command;
   mem_params_t params;
@@ -100,13 +120,18 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
     const std::int64_t t = event.timestamp;
     if (event.channel == channels.sensor) {
       if (!decode_checked(event, sensor)) return void(++run.undecodable);
+      ++run.sensor_blocks_by_axes[static_cast<int>(axes_of(sensor))];
+      if (a >= axes_of(sensor)) return void(++run.blocks_without_axis);
       bool armed = true;
       std::size_t i = 0;
-      for_each_tick(sensor, [&](const SensorTick& k) {
-        run.samples.push_back(
-            {tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m, k.flags});
-        armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
-      });
+      for_each_tick(
+          sensor,
+          [&](const SensorTick& k) {
+            run.samples.push_back(
+                {tick_recv_utime(t, sensor.n_ticks, i++, sensor.dt_s), k.seq, k.u_V, k.y_ref_m, k.y_m, k.flags});
+            armed = armed && (k.flags & sensor_block_t::SAFE_STATE) == 0;
+          },
+          a);
       run.sensor_blocks.push_back({t, sensor.dt_s, sensor.buffer_depth_ticks, armed});
       const auto n = static_cast<std::size_t>(sensor.n_ticks);
       const BlockSamples block{run.samples.size() - n, n};
@@ -118,20 +143,24 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
     } else if (event.channel == channels.sim_truth) {
       if (!decode_checked(event, truth)) return void(++run.undecodable);
       if (const auto b = sensor_blocks.find(truth.seq); b != sensor_blocks.end()) {
-        apply_truth(b->second, axis_truth(truth));
+        apply_truth(b->second, axis_truth(truth, a));
       } else {
-        truth_waiting[truth.seq] = axis_truth(truth);
+        truth_waiting[truth.seq] = axis_truth(truth, a);
       }
     } else if (event.channel == channels.command) {
       if (!decode_checked(event, command)) return void(++run.undecodable);
       run.command_blocks.push_back({t, command.seq, command.sample_seq});
-      for_each_tick(command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version, k.mode); });
+      if (a >= axes_of(command)) return;  // no command of this axis: its ticks' versions stay unknown
+      for_each_tick(
+          command, [&](const CommandTick& k) { run.command_versions.add(k.seq, k.params_version, k.mode); }, a);
     } else if (event.channel == channels.params) {
       if (!decode_checked(event, params)) return void(++run.undecodable);
+      if (params.axis != axis) return;  // another axis's hysteresis
       run.params.push_back({t, params.version, params.c1, params.c2, params.c3, params.residual_m, params.valid != 0,
                             "mem", params.residual_m, false});
     } else if (event.channel == channels.model) {
       if (!decode_checked(event, model)) return void(++run.undecodable);
+      if (model.axis != axis) return;
       const bool mem = model.kind == model_params_t::KIND_MEM;
       const std::optional<ModelKind> kind = model_kind_from_int(model.kind);
       run.params.push_back({t, model.version, mem ? model.mem_c1 : kNaN, mem ? model.mem_c2 : kNaN,

@@ -21,8 +21,18 @@
 namespace hystloop::report {
 
 // Throws std::runtime_error naming the file if one cannot be opened. What each file held
-// beyond its events (junk, a truncated tail) is in RunData::files.
-RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels);
+// beyond its events (junk, a truncated tail) is in RunData::files. `axis` (0 x, 1 y, 2 z) is the
+// axis whose ticks, commands, true positions and parameter sets are kept (RunData::axis); a sensor
+// block without it is left out whole and counted (RunData::blocks_without_axis).
+RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels, int axis = 0);
+
+// "1 axis (x)", "2 axes (x and y)", "3 axes (x, y and z)".
+std::string axes_text(int axes);
+
+// Throws ParameterError("--axis", "the log's HX_SENSOR blocks carry 1 axis (x), not y") when the
+// log has sensor blocks and none carries run.axis (a log without any is left to the report's
+// warning).
+void require_axis(const RunData& run, const std::string& sensor_channel);
 
 // The time of tick i of a sensor block of n_ticks received at block_recv_utime (run_data.hpp):
 // block_recv_utime - (n_ticks - 1 - i) * dt_s [us].

@@ -1,12 +1,19 @@
 // hystloop-report: the figures of a recorded run, from LCM event logs.
 //
-//   hystloop-report LOG... --out DIR [--csv CHANNEL]... [--from S] [--to S] [--skip-initial S]
+//   hystloop-report LOG... --out DIR [--axis x|y|z] [--csv CHANNEL]... [--from S] [--to S] [--skip-initial S]
 //                   [--rig PREFIX] [--quiet] [--no-plots] [--gnuplot PATH] [--scan | --no-scan] [--scan-settle S]
+//                   [--map-columns N]
 //
 // Writes DIR/summary.json, DIR/<channel>.csv for each --csv, and the plots (PNG via
 // gnuplot, with their data files and plots.gp); prints a table of the main figures.
+// Every figure, table and plot is of one axis of the stage (--axis, default x): its ticks,
+// commands, true positions, parameter sets and trajectories; a log whose sensor blocks lack it is
+// refused (exit 2), naming the axes they carry.
 // A log of several periodic trajectories (deploy/hystloop scan), or --scan, also gets the scan
-// table (scan_report.hpp: scan.json, scan.md, scan_*.png), printed last.
+// table (scan_report.hpp: scan.json, scan.md, scan_*.png).
+// A log with paths on HX_SCAN (hystloop-ctl scan raster|lissajous) gets the scan-path table of
+// every axis (path_report.hpp: raster.csv, error_map_<axis>.png, summary.json's scan_paths),
+// printed last.
 // A file that is empty, holds no event, bytes that are not events (skipped by the reader) or a
 // truncated last event is named in a warning on stderr; so are events on the rig's channels
 // that do not decode (summary.json: undecodable_events).
@@ -29,6 +36,8 @@
 #include "csv_export.hpp"
 #include "lcm/channels.hpp"
 #include "log_reader.hpp"
+#include "models/axis_coupling.hpp"
+#include "path_report.hpp"
 #include "plot_series.hpp"
 #include "plots.hpp"
 #include "report_metrics.hpp"
@@ -52,6 +61,8 @@ struct Options {
   bool no_plots = false;
   PlotOptions plots;
   ScanReportOptions scan;  // --scan, --no-scan, --scan-settle, --compensator-process
+  int axis = 0;            // --axis
+  std::size_t map_columns = ErrorMapOptions{}.columns;
 };
 
 // A line on stderr as each phase of a long log starts (a 30 s run at 10 kHz is some 25 MB and
@@ -91,7 +102,7 @@ int run(const Options& o) {
   std::snprintf(what, sizeof what, "reading %zu log file(s), %.1f MB", o.logs.size(),
                 static_cast<double>(progress.bytes()) * 1e-6);
   progress.phase(what);
-  const RunData data = read_logs(o.logs, channels);
+  const RunData data = read_logs(o.logs, channels, o.axis);
   for (const auto& problem : describe_scan_problems(data.files)) {
     std::fprintf(stderr, "hystloop-report: warning: %s\n", problem.c_str());
   }
@@ -104,6 +115,12 @@ int run(const Options& o) {
   if (data.events == data.undecodable) {
     std::fprintf(stderr, "hystloop-report: nothing decodable in %zu log file(s): no report written\n", o.logs.size());
     return 1;
+  }
+  require_axis(data, channels.sensor);
+  if (data.blocks_without_axis > 0) {
+    std::fprintf(stderr, "hystloop-report: warning: %llu %s block(s) do not carry %s; their ticks are left out\n",
+                 static_cast<unsigned long long>(data.blocks_without_axis), channels.sensor.c_str(),
+                 std::string(axis_name(o.axis)).c_str());
   }
   std::vector<std::string> csv_channels;
   for (const auto& name : o.csv)
@@ -119,12 +136,21 @@ int run(const Options& o) {
     std::fprintf(stderr, "hystloop-report: warning: no %s ticks in the log; most figures are null\n",
                  channels.sensor.c_str());
   }
-  write_text_file(o.out / "summary.json", summary_json(metrics, o.range, o.logs));
+  PathReportOptions path_options;
+  path_options.compensator_process = o.scan.compensator_process;
+  path_options.map.columns = o.map_columns;
+  path_options.quiet = o.quiet;
+  path_options.no_plots = o.no_plots;
+  path_options.plots = o.plots;
+  if (data.channel_counts.count(channels.scan) != 0) progress.phase("measuring the paths on " + channels.scan);
+  const std::vector<PathFigures> paths = compute_path_report(o.logs, data, channels, path_options);
+  write_text_file(o.out / "summary.json", summary_json(metrics, o.range, o.logs, paths));
 
   std::vector<CsvExport> exports;
   if (!csv_channels.empty()) {
     progress.phase("exporting CSV");
-    exports = export_csv(o.logs, csv_channels, data.time_zero_utime(), o.range.lower_s(), o.range.upper_s(), o.out);
+    exports =
+        export_csv(o.logs, csv_channels, data.time_zero_utime(), o.range.lower_s(), o.range.upper_s(), o.out, o.axis);
   }
   PlotResult plots;
   if (!o.no_plots) {
@@ -147,8 +173,11 @@ int run(const Options& o) {
   scan.quiet = o.quiet;
   scan.no_plots = o.no_plots;
   scan.plots = o.plots;
+  scan.axis = o.axis;
   progress.phase("looking for a scan (periodic trajectories)");
   const int rc = write_scan_report(o.logs, data, channels, o.out, scan);
+  if (!paths.empty()) progress.phase("writing the scan paths' table and error maps");
+  write_path_report(paths, channels, o.out, path_options);
   progress.phase("done");
   return rc;
 }
@@ -163,6 +192,9 @@ int report_main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--out", o.out, "Output folder (created if missing)")->required();
+  add_axis_option(&app, "--axis", o.axis,
+                  "The axis of a stage of several whose ticks, commands, parameter sets and trajectories every figure, "
+                  "table and plot shows (default x; a log whose sensor blocks lack it is refused)");
   app.add_option("--csv", o.csv, "Export a channel to DIR/<channel>.csv, e.g. HX_SENSOR or SENSOR (repeatable)");
   app.add_option("--from", o.range.from_s, "Start of the analysed range [s after the first sensor tick]");
   app.add_option("--to", o.range.to_s, "End of the analysed range [s after the first sensor tick]");
@@ -187,6 +219,10 @@ int report_main(int argc, char** argv) {
                  "Scan: skipped at each segment's start, after a trajectory's blend [s]")
       ->capture_default_str();
   app.add_option("--compensator-process", o.scan.compensator_process, "Process name of the compensator in HX_STATUS")
+      ->capture_default_str();
+  app.add_option("--map-columns", o.map_columns,
+                 "Scan paths: bins of a raster's error maps along the fast axis (error_map_<axis>.png)")
+      ->check(CLI::Range(4, 4096))
       ->capture_default_str();
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   return run(o);

@@ -141,6 +141,8 @@ std::vector<TrackPoint> track_points(const RunData& run, const ReportOptions& op
 
 ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) {
   ReportMetrics m;
+  m.axis = run.axis;
+  m.log_axes = run.sensor_blocks_by_axes.empty() ? 0 : run.sensor_blocks_by_axes.rbegin()->first;
   m.channels = run.channel_counts;
   m.events = run.events;
   m.undecodable = run.undecodable;

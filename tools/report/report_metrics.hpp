@@ -72,6 +72,8 @@ struct ParamsSwap {
 };
 
 struct ReportMetrics {
+  int axis = 0;             // whose ticks every figure is of (RunData::axis)
+  int log_axes = 0;         // the most axes a sensor block of the log carries; 0: no block
   std::size_t samples = 0;  // sensor samples in the range
   double duration_s = 0.0;  // last minus first sample time in the range
   std::optional<double> first_sample_t_s, last_sample_t_s;

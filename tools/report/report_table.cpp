@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cstdarg>
 #include <cstdio>
+#include <string>
+
+#include "log_reader.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop::report {
 
@@ -38,6 +42,10 @@ std::string params(const std::optional<MemParams>& p) {
 std::string format_table(const ReportMetrics& m) {
   std::string out;
   auto row = [&out](const char* name, const std::string& value) { out += fmt("  %-22s %s\n", name, value.c_str()); };
+  // Only a log of several axes names the one shown: a one-axis report reads as it always did.
+  if (m.log_axes > 1)
+    row("axis",
+        fmt("%s  (the sensor blocks carry %s)", std::string(axis_name(m.axis)).c_str(), axes_text(m.log_axes).c_str()));
   row("duration",
       fmt("%.2f s, %zu ticks, %llu events", m.duration_s, m.samples, static_cast<unsigned long long>(m.events)));
   row("tracking RMS error", nm(m.rms_error_m) + fmt("  (%zu ticks with a reference)", m.tracking_samples));

@@ -120,7 +120,13 @@ struct LogFileScan {
 };
 
 struct RunData {
-  std::vector<SampleRecord> samples;  // every tick, in log order
+  // The axis the ticks below are of (0 x, 1 y, 2 z: hystloop-report --axis): a sensor block carries
+  // every axis of the stage on one clock (common/lcm/blocks.hpp); commands, truth and parameter
+  // sets are read for this axis too.
+  int axis = 0;
+  std::map<int, std::uint64_t> sensor_blocks_by_axes;  // HX_SENSOR blocks by their n_axes
+  std::uint64_t blocks_without_axis = 0;               // HX_SENSOR blocks that lack `axis`: left out whole
+  std::vector<SampleRecord> samples;                   // every tick of `axis`, in log order
   std::vector<SensorBlockRecord> sensor_blocks;
   std::vector<CommandBlockRecord> command_blocks;
   CommandVersions command_versions;

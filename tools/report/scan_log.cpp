@@ -45,7 +45,7 @@ bool ScanTrajectory::periodic() const noexcept {
 }
 
 ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, const ChannelNames& channels,
-                            const std::string& compensator_process) {
+                            const std::string& compensator_process, int axis) {
   ScanEvents out;
   std::set<std::int64_t> versions, requests;
   trajectory_t trajectory;
@@ -54,7 +54,10 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
   for_each_event(files, [&](const lcm::LogEvent& event) {
     const std::int64_t t = event.timestamp;
     if (event.channel == channels.trajectory) {
-      if (!decode_checked(event, trajectory) || !versions.insert(trajectory.version).second) return;
+      if (!decode_checked(event, trajectory) || trajectory.axis != axis ||
+          !versions.insert(trajectory.version).second) {
+        return;
+      }
       out.trajectories.push_back({t, trajectory.version, std::string(shape_name(trajectory.shape)),
                                   trajectory.amplitude_m, trajectory.offset_m, trajectory.frequency_Hz,
                                   trajectory.blend_s, trajectory.corner_s,
@@ -74,9 +77,11 @@ ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, con
       s.trajectory_version = find_counter(status, "trajectory_version");
       s.trajectory_refused_version = find_counter(status, "trajectory_refused_version");
       s.trajectory_shaped_version = find_counter(status, "trajectory_shaped_version");
-      s.learning_active = find_counter(status, "learning_active");
-      s.learning_periods = find_counter(status, "learning_periods");
-      s.learning_rms_pm = find_counter(status, "learning_rms_pm");
+      if (axis == 0) {  // x's learner (above)
+        s.learning_active = find_counter(status, "learning_active");
+        s.learning_periods = find_counter(status, "learning_periods");
+        s.learning_rms_pm = find_counter(status, "learning_rms_pm");
+      }
       s.model_switches = find_counter(status, "model_switches");
       s.params_swapped = find_counter(status, "params_swapped");
       out.compensator.push_back(std::move(s));

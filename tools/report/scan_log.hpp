@@ -54,9 +54,13 @@ struct ScanEvents {
 };
 
 // Reads `files` in order (as read_logs does). Events that do not decode are skipped here: the
-// report's reader counts them. Throws std::runtime_error naming a file that cannot be opened.
+// report's reader counts them. Only the trajectories of `axis` (0 x, 1 y, 2 z) are kept: another
+// axis's reference is no segment of this one. The compensator reports its learner's figures
+// (learning_active, learning_periods, learning_rms_pm) for x alone, so for another axis they are
+// left out (the learning state then comes from the SET_LEARNING requests only). Throws
+// std::runtime_error naming a file that cannot be opened.
 ScanEvents read_scan_events(const std::vector<std::filesystem::path>& files, const ChannelNames& channels,
-                            const std::string& compensator_process);
+                            const std::string& compensator_process, int axis = 0);
 
 // The mode in the compensator's detail ("... mode pi, params v3 ..."), "" when none.
 std::string compensator_mode(const std::string& detail);

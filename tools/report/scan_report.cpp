@@ -11,7 +11,7 @@ namespace hystloop::report {
 int write_scan_report(const std::vector<std::filesystem::path>& logs, const RunData& data, const ChannelNames& channels,
                       const std::filesystem::path& dir, const ScanReportOptions& o) {
   if (o.off) return 0;
-  const ScanEvents events = read_scan_events(logs, channels, o.compensator_process);
+  const ScanEvents events = read_scan_events(logs, channels, o.compensator_process, o.axis);
   if (!o.force && periodic_trajectories(events) < 2) return 0;
   if (periodic_trajectories(events) == 0) {
     std::fprintf(stderr, "hystloop-report: --scan: no periodic trajectory on %s in the log: no scan table\n",

@@ -19,6 +19,7 @@ struct ScanReportOptions {
   bool off = false;    // --no-scan
   ScanOptions figures;
   std::string compensator_process = "compensator";
+  int axis = 0;           // whose trajectories (--axis); RunData's ticks must be of it
   bool quiet = false;     // print no table
   bool no_plots = false;  // write no PNG
   PlotOptions plots;

@@ -5,6 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "models/axis_coupling.hpp"
+#include "path_output.hpp"
+
 namespace hystloop::report {
 
 namespace {
@@ -62,7 +65,7 @@ void counted(Json& j, const std::string& key, const std::optional<std::int64_t>&
 }  // namespace
 
 std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
-                         const std::vector<std::filesystem::path>& files) {
+                         const std::vector<std::filesystem::path>& files, const std::vector<PathFigures>& paths) {
   Json j;
   j["tool"] = "hystloop-report";
   j["files"] = Json::array();
@@ -70,6 +73,7 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
   j["time_axis"] =
       "t_s = LCM event-log timestamp minus that of the first sensor tick [s]; the log's timestamps are the "
       "logger's receive times; tick i of a sensor block of n received at R is dated R - (n - 1 - i) * dt_s";
+  j["axis"] = std::string(axis_name(m.axis));
   j["error_definition"] = "e = y_ref_m - y_m of each HX_SENSOR tick with a finite y_ref_m";
   j["range"] = Json{{"from_s", number_or_null(options.lower_s())},
                     {"to_s", number_or_null(options.upper_s())},
@@ -146,6 +150,7 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
       "per process: cpu_user_us + cpu_system_us of its HX_STATUS counters, last minus first status in the range, "
       "over the wall time between them (1 = one core busy)";
   j["cpu_fraction"] = map_json(m.cpu_fraction);
+  if (!paths.empty()) j["scan_paths"] = paths_json(paths);
   // Two-space indentation as before; invalid UTF-8 in a file name is replaced, not thrown.
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
