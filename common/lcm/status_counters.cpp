@@ -63,4 +63,9 @@ std::optional<std::int64_t> find_counter(const service_status_t& status, std::st
   return std::nullopt;
 }
 
+std::string params_version_counter(int axis) {
+  if (axis <= 0 || axis >= 3) return "params_version";
+  return std::string(1, "xyz"[axis]) + "_params_version";
+}
+
 }  // namespace hystloop

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "hystloop/service_status_t.hpp"
@@ -28,5 +29,9 @@ bool add_publisher_counters(service_status_t& status, std::string_view endpoint,
 // The value of the named counter of a status message (as received: the arrays are trusted only
 // as far as both reach); nullopt when it has none by that name.
 std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name);
+
+// The compensator's counter of the parameter set in use on `axis` (0: x): "params_version" for x,
+// "y_params_version" / "z_params_version" for the others (what a tool that publishes a set waits on).
+std::string params_version_counter(int axis);
 
 }  // namespace hystloop

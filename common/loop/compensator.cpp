@@ -1,5 +1,6 @@
 #include "loop/compensator.hpp"
 
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -288,6 +289,11 @@ PlanExtent Compensator::dry_run(const TrajectorySpec& spec, double start_s, cons
 }
 
 TrajectoryVerdict Compensator::take_scan(const ScanShare& share, double blend_s) {
+  const PlanExtent e = check_scan(share, blend_s);
+  return apply_scan(share, blend_s, e);
+}
+
+PlanExtent Compensator::check_scan(const ScanShare& share, double blend_s) {
   require_in_range("scan.blend_s", blend_s, 0.0, 60.0);
   TrajectorySpec hold;
   hold.shape = TrajectoryShape::kHold;
@@ -319,12 +325,28 @@ TrajectoryVerdict Compensator::take_scan(const ScanShare& share, double blend_s)
     ++counters_.trajectories_refused;
     throw ParameterError("scan", "axis " + std::string(axis_name(share.axis())) + ": " + limits_left(e));
   }
+  return e;
+}
+
+TrajectoryVerdict Compensator::apply_scan(const ScanShare& share, double blend_s, const PlanExtent& checked) {
+  TrajectorySpec hold;
+  hold.shape = TrajectoryShape::kHold;
+  hold.offset_m = share.point(share.start_s()).own_m;
+  hold.blend_s = blend_s;
   TrajectoryVerdict v;
-  v.extent = e;
-  learning_room_ = e.rate_max_V_per_s <= kLearningSlewShare * config_.slew_V_per_s;
+  v.extent = checked;
+  learning_room_ = checked.rate_max_V_per_s <= kLearningSlewShare * config_.slew_V_per_s;
   apply_trajectory(hold, share.start_s(), &share);
   v.spec = trajectory_;
   return v;
+}
+
+void take_scan_on_every_axis(std::span<Compensator* const> laws, std::span<const ScanShare> shares, double blend_s) {
+  if (laws.size() != shares.size()) throw ParameterError("scan", "one share per axis");
+  std::array<PlanExtent, kMaxAxes> checked{};
+  if (laws.size() > checked.size()) throw ParameterError("scan", "at most " + std::to_string(kMaxAxes) + " axes");
+  for (std::size_t i = 0; i < laws.size(); ++i) checked[i] = laws[i]->check_scan(shares[i], blend_s);
+  for (std::size_t i = 0; i < laws.size(); ++i) laws[i]->apply_scan(shares[i], blend_s, checked[i]);
 }
 
 PlanExtent Compensator::dry_run_periodic(const TrajectorySpec& spec) const {

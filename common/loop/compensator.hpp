@@ -95,6 +95,13 @@ inline LearningConfig default_learning() {
 // of its resonance, what neither the stage's model nor the servo knows well (0 without dynamics).
 double resonance_corner_s(const StageModel& stage) noexcept;
 
+class Compensator;
+class ScanShare;
+// Every axis's law takes its share of one path (laws[i] shares[i]), or none does: each share is
+// checked first (Compensator::check_scan: throws ParameterError naming the axis, nothing taken),
+// then all are applied.
+void take_scan_on_every_axis(std::span<Compensator* const> laws, std::span<const ScanShare> shares, double blend_s);
+
 struct CompensatorConfig {
   FeedforwardMode mode = FeedforwardMode::kMem;
   // Every online model's parameters; PI's are the MEM paper's 15 plays.
@@ -221,6 +228,12 @@ class Compensator {
   // and so does a restart of the bridge's clock (restarted()). New parameter sets are checked
   // against what is left of the path (offer_model, offer_mem_params).
   TrajectoryVerdict take_scan(const ScanShare& share, double blend_s);
+  // take_scan in two steps, for the axes of a stage to take a path together or not at all
+  // (take_scan_on_every_axis): check_scan runs every check and the dry run and changes nothing but
+  // the refusal counter (throws ParameterError as take_scan does); apply_scan takes a share that
+  // check_scan accepted, with the extent it returned, before anything else changed the plan.
+  PlanExtent check_scan(const ScanShare& share, double blend_s);
+  TrajectoryVerdict apply_scan(const ScanShare& share, double blend_s, const PlanExtent& checked);
   const ScanShare* scan() const noexcept { return scan_ ? &scan_->share : nullptr; }
   // What the plan would need for `spec` from here, without changing anything (a dry run in a copy).
   PlanExtent dry_run(const TrajectorySpec& spec, double start_s) const;

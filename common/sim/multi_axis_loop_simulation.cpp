@@ -61,17 +61,14 @@ void MultiAxisLoopSimulation::take(const Path& path, const AxisCoupling& decoupl
     throw ParameterError("decoupling",
                          "is for " + std::to_string(decoupling.n()) + " axes, the stage has " + std::to_string(axes()));
   }
-  // Every axis checks its share first (a copy of each law): either all take the path or none does.
   std::vector<ScanShare> shares;
+  std::vector<Compensator*> laws;
   shares.reserve(static_cast<std::size_t>(axes()));
   for (int i = 0; i < axes(); ++i) {
     shares.emplace_back(path, i, AxisVector(decoupling.inverse_matrix().row(i).transpose()));
-    Compensator copy = compensators_[static_cast<std::size_t>(i)];
-    copy.take_scan(shares.back(), blend_s);
+    laws.push_back(&compensators_[static_cast<std::size_t>(i)]);
   }
-  for (int i = 0; i < axes(); ++i) {
-    compensators_[static_cast<std::size_t>(i)].take_scan(shares[static_cast<std::size_t>(i)], blend_s);
-  }
+  take_scan_on_every_axis(laws, shares, blend_s);
 }
 
 void MultiAxisLoopSimulation::run(double seconds, const std::function<void(const MultiAxisTick&)>& on_tick) {

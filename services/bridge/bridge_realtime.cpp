@@ -57,6 +57,13 @@ BridgeRealtime::~BridgeRealtime() {
   if (wake_fd_ >= 0) ::close(wake_fd_);
 }
 
+bool BridgeRealtime::push_commands(std::span<const CommandTick> per_axis) noexcept {
+  if (per_axis.size() != static_cast<std::size_t>(stage_.axes())) return false;
+  TickCommands t;
+  for (std::size_t a = 0; a < per_axis.size(); ++a) t.axis[a] = per_axis[a];
+  return commands_.try_push(t);
+}
+
 void BridgeRealtime::start() {
   thread_ = std::thread([this] { run(); });
 }
@@ -140,12 +147,10 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   while (const auto gains = gains_.try_pop()) {
     for (std::size_t a = 0; a < axes; ++a) stage_.set_servo_gains(static_cast<int>(a), *gains);
   }
-  for (std::size_t a = 0; a < axes; ++a) {
-    while (const auto command = commands_[a].try_pop()) {
-      ++commands_processed_;
-      commands_seen_ = true;
-      stage_.submit(static_cast<int>(a), *command);
-    }
+  while (const auto commands = commands_.try_pop()) {
+    ++commands_processed_;
+    commands_seen_ = true;
+    for (std::size_t a = 0; a < axes; ++a) stage_.submit(static_cast<int>(a), commands->axis[a]);
   }
   arming_.before_tick(k, commands_seen_, stage_);
 

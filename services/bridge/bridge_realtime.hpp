@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <thread>
 
 #include "bridge/bridge_settings.hpp"
@@ -69,10 +70,12 @@ class BridgeRealtime {
   // calls backend.hold_safe(). Returns how the ramp went (also when called again).
   SafeStopResult stop();
 
-  // I/O thread side. A command for one axis (0..axes()-1).
-  bool push_command(int axis, const CommandTick& command) noexcept {
-    return commands_[static_cast<std::size_t>(axis)].try_push(command);
-  }
+  // I/O thread side. One tick's commands, one per axis (exactly axes() of them), taken together:
+  // a tick is never commanded on some axes and not on others (false: the queue is full, or the
+  // count is wrong; nothing taken).
+  bool push_commands(std::span<const CommandTick> per_axis) noexcept;
+  // A one-axis stage's command.
+  bool push_command(const CommandTick& command) noexcept { return push_commands(std::span(&command, 1)); }
   // Every axis's servo.
   bool push_gains(const FeedbackGains& gains) noexcept { return gains_.try_push(gains); }
   int axes() const noexcept { return stage_.axes(); }
@@ -97,7 +100,10 @@ class BridgeRealtime {
   MultiAxisBridge stage_;
   ArmingPolicy arming_;  // RT thread
   double dt_s_;
-  std::array<SpscQueue<CommandTick, kCommandQueue>, kMaxAxes> commands_;  // per axis
+  struct TickCommands {
+    std::array<CommandTick, kMaxAxes> axis{};
+  };
+  SpscQueue<TickCommands, kCommandQueue> commands_;  // a tick's commands of every axis
   SpscQueue<FeedbackGains, 8> gains_;
   SpscQueue<OutgoingTick, kSampleQueue> samples_;
   std::atomic<ArmRequest> arm_request_{ArmRequest::kNone};

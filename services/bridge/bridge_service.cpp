@@ -52,10 +52,11 @@ void BridgeService::on_command(const command_block_t& msg) noexcept {
     latency_.add(*elapsed);
     latency_total_.add(*elapsed);
   }
+  std::array<CommandTick, kMaxAxes> tick{};
+  const auto axes = static_cast<std::size_t>(settings_.axes);
   for (std::size_t i = 0, n = ticks_of(msg); i < n; ++i) {
-    for (int a = 0; a < settings_.axes; ++a) {
-      if (!rt_.push_command(a, command_tick(msg, i, static_cast<std::size_t>(a)))) ++command_queue_full_;
-    }
+    for (std::size_t a = 0; a < axes; ++a) tick[a] = command_tick(msg, i, a);
+    if (!rt_.push_commands(std::span<const CommandTick>(tick).first(axes))) ++command_queue_full_;
   }
 }
 

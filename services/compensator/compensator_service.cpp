@@ -15,6 +15,7 @@
 #include "core/periodic_timer.hpp"
 #include "core/process.hpp"
 #include "lcm/blocks.hpp"
+#include "lcm/status_counters.hpp"
 #include "lcm/feedforward_mode.hpp"
 #include "models/model_descriptors.hpp"
 #include "runtime/io_loop.hpp"
@@ -94,9 +95,7 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       // or a reorder: the plan still covers them); one further away must be confirmed.
       guard_(settings.control.horizon_ticks, kConfirmWindowUs) {
   reserve_storage(command_);
-  for (int a = 1; a < kMaxAxes; ++a) {
-    axis_params_counter_[static_cast<std::size_t>(a)] = std::string(axis_name(a)) + "_params_version";
-  }
+  for (int a = 1; a < kMaxAxes; ++a) axis_params_counter_[static_cast<std::size_t>(a)] = params_version_counter(a);
   x().set_trajectory(settings.trajectory, kNaN);  // the configured reference starts with the plan
 }
 
@@ -158,13 +157,16 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
 void CompensatorService::publish_plan() noexcept {
   const auto axes = static_cast<std::size_t>(settings_.axes);
   for (;;) {
-    // Every law observed the same ticks, so each plans the same ones; should they differ, the
-    // ticks every axis has are sent (the others are planned again from the next block).
-    std::size_t n = x().plan(plan_[0]);
+    // Every law observed the same ticks, so each plans the same ones. Should they ever differ (a
+    // bug), nothing is sent: a tick commanded on some axes and not others would move the stage
+    // along no path; the bridge's watchdog then takes every axis to the safe state.
+    const std::size_t n = x().plan(plan_[0]);
     for (std::size_t a = 1; a < axes; ++a) {
       const std::size_t m = laws_[a]->plan(plan_[a]);
-      if (m != n) ++counters_.plan_mismatch;
-      n = std::min(n, m);
+      if (m != n || (n > 0 && plan_[a][0].seq != plan_[0][0].seq)) {
+        ++counters_.plan_mismatch;
+        return;
+      }
     }
     if (n == 0) return;
     begin_block(command_, plan_[0][0].seq, wall_utime(), x().last_seq(), settings_.axes);
@@ -192,24 +194,39 @@ void CompensatorService::take_configured_scan() {
 
 std::string CompensatorService::take_scan(const ScanSettings& scan, double start_s) {
   try {
-    std::array<std::optional<ScanShare>, kMaxAxes> shares;
-    for (int a = 0; a < settings_.axes; ++a) {
-      const auto i = static_cast<std::size_t>(a);
-      shares[i].emplace(scan_share(scan, settings_.decoupling, a, start_s, laws_[i]->stage()));
-      Compensator copy = *laws_[i];
-      copy.take_scan(*shares[i], scan.blend_s);
+    // One corner for every axis (x's stage model decides it): the axes run one path.
+    const double corner_s = raster_corner_s(scan.raster, x().stage());
+    const double check_s = scan_check_s(scan, corner_s);
+    if (check_s * settings_.axes > kScanCheckBudget_s) {
+      throw ParameterError("scan", fmt::format("runs {:.3g} s on each of {} axes; a scan is checked whole before it is "
+                                               "taken, on the compensator's one thread, at most {} s of loop time over "
+                                               "all axes (the bridge holds {} s of commands meanwhile): split it",
+                                               check_s, settings_.axes, kScanCheckBudget_s,
+                                               static_cast<double>(x().config().horizon_ticks) * x().config().dt_s));
     }
+    std::vector<ScanShare> shares;
+    std::vector<Compensator*> laws;
     for (int a = 0; a < settings_.axes; ++a) {
-      const auto i = static_cast<std::size_t>(a);
-      laws_[i]->take_scan(*shares[i], scan.blend_s);
+      shares.push_back(scan_share(scan, settings_.decoupling, a, start_s, corner_s));
+      laws.push_back(&*laws_[static_cast<std::size_t>(a)]);
     }
+    take_scan_on_every_axis(laws, shares, scan.blend_s);
     ++counters_.scans;
     return fmt::format("scan taken by {} axes{}: from loop time {:.4f} s to {:.4f} s", settings_.axes,
-                       scan.decouple && settings_.axes > 1 ? ", decoupled" : "", start_s, shares[0]->end_s());
+                       scan.decouple && settings_.axes > 1 ? ", decoupled" : "", start_s, shares[0].end_s());
   } catch (...) {
     ++counters_.scans_refused;
     throw;
   }
+}
+
+bool CompensatorService::scan_running() const noexcept {
+  for (int a = 0; a < settings_.axes; ++a) {
+    const Compensator& c = *laws_[static_cast<std::size_t>(a)];
+    const double next_s = static_cast<double>(std::max<std::int64_t>(c.next_tick(), 0)) * c.config().dt_s;
+    if (c.scan() != nullptr && next_s < c.scan()->end_s()) return true;
+  }
+  return false;
 }
 
 void CompensatorService::on_scan(const scan_t& msg) {
@@ -221,7 +238,7 @@ void CompensatorService::on_scan(const scan_t& msg) {
     if (!have_sample_) {
       throw ParameterError("scan", "no sensor block yet: where the axes are, and the loop time, are not known");
     }
-    const ScanSettings scan = scan_from_message(msg, settings_.axes);
+    const ScanSettings scan = scan_from_message(msg, settings_.axes, x().stage());
     const Compensator& c = x();
     const double dt_s = c.config().dt_s;
     const double earliest_s = static_cast<double>(std::max<std::int64_t>(c.next_tick(), 0)) * dt_s + scan.blend_s;
@@ -258,6 +275,11 @@ Compensator& CompensatorService::law(int axis, const char* field) {
 void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version,
                                           int axis) {
   Compensator& c = law(axis, "trajectory.axis");
+  if (settings_.axes > 1 && scan_running()) {
+    // One axis leaving the path would leave the others following their shares of a motion that no
+    // longer happens (each share holds the others' coupling).
+    throw ParameterError("trajectory", "a scan is running on every axis: wait for its end (or send a scan)");
+  }
   TrajectoryVerdict v;
   if (start_utime == 0) {
     v = c.take_trajectory(spec, kNaN);
@@ -351,15 +373,8 @@ void CompensatorService::on_control(const control_t& msg) {
             make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,
                                  msg.experiment_frequency_Hz, msg.experiment_duration_s);
         Compensator& driven = law(msg.axis, "control.axis");
-        if (settings_.axes > 1) {
-          for (int a = 0; a < settings_.axes; ++a) {
-            const Compensator& c = *laws_[static_cast<std::size_t>(a)];
-            const double next_s = static_cast<double>(std::max<std::int64_t>(c.next_tick(), 0)) * c.config().dt_s;
-            if (c.scan() != nullptr && next_s < c.scan()->end_s()) {
-              return refuse("a scan is running (until loop time " + fmt::format("{:.3f}", c.scan()->end_s()) +
-                            " s): an experiment on one axis would tear the path the others follow");
-            }
-          }
+        if (settings_.axes > 1 && scan_running()) {
+          return refuse("a scan is running: an experiment on one axis would tear the path the others follow");
         }
         const bool queued = driven.experiment_running();
         driven.start_experiment(e);
@@ -371,13 +386,19 @@ void CompensatorService::on_control(const control_t& msg) {
         }
         break;
       }
-      case control_t::STOP_EXPERIMENT:
+      case control_t::STOP_EXPERIMENT: {
+        // Whichever axis runs one: an operator's stop ends every excitation of the stage.
+        std::size_t queued = 0;
+        for_each_law([&](Compensator& c) {
+          queued += c.experiments_queued();
+          c.stop_experiment();
+        });
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info("experiment stopped, {} queued dropped (request {}){}", x().experiments_queued(), msg.request_id,
+          spdlog::info("experiment stopped, {} queued dropped (request {}){}", queued, msg.request_id,
                        suppressed_note(g));
         }
-        x().stop_experiment();
         break;
+      }
       case control_t::SET_LEARNING:
         switch (msg.learning) {
           case control_t::LEARNING_OFF: for_each_law([](Compensator& c) { c.set_learning(false); }); break;
@@ -395,6 +416,7 @@ void CompensatorService::on_control(const control_t& msg) {
         reported_.rebase(collect_counters());
         reported_.rebase("sensor", samples_.counters());
         reported_.rebase("trajectory", trajectories_.counters());
+        reported_.rebase("scan", scans_.counters());
         reported_.rebase("params", params_.counters());
         reported_.rebase("control", control_.counters());
         reported_.rebase("command", command_pub_.counters());
@@ -480,14 +502,15 @@ CounterSet::Entries CompensatorService::collect_counters() const {
                                  {"sensor_blocks_held", guard_.counters().held},
                                  {"params_publishers_evicted", admission_.evictions()},
                                  {"log_lines_suppressed", log_limiter_.suppressed_total()}};
-  // A stage of several axes: the counters above are summed over the axes' laws (samples: every
-  // axis's), and these say how the axes planned together.
-  if (settings_.axes > 1 || settings_.scan.path != ScanSettings::Path::kNone) {
+  // Scans and what named an axis this stage lacks (a one-axis stage counts them too); with several
+  // axes the counters above are summed over the axes' laws (samples: every axis's), and these say
+  // how the axes planned together.
+  entries.emplace_back("scans", s.scans);
+  entries.emplace_back("scans_refused", s.scans_refused);
+  entries.emplace_back("wrong_axis", s.wrong_axis);
+  if (settings_.axes > 1) {
     entries.emplace_back("axes", static_cast<std::uint64_t>(settings_.axes));
     entries.emplace_back("plan_mismatch", s.plan_mismatch);
-    entries.emplace_back("scans", s.scans);
-    entries.emplace_back("scans_refused", s.scans_refused);
-    entries.emplace_back("wrong_axis", s.wrong_axis);
   }
   return entries;
 }
@@ -544,12 +567,20 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     state = service_status_t::DEGRADED;
     detail = "no samples from the bridge this period; ";
   }
-  const CompensatorCounters& now = c.counters();
-  const std::uint64_t clamped = (now.u_clamped - clamped_reported_) + (now.u_slew_clamped - slew_clamped_reported_);
+  // Every axis's clamps and experiments: one axis clamped makes the stage's tracking degraded.
+  std::uint64_t u_clamped = 0, u_slew_clamped = 0;
+  int experimenting = -1;  // an axis running an experiment, -1: none
+  for (int a = 0; a < settings_.axes; ++a) {
+    const Compensator& law = *laws_[static_cast<std::size_t>(a)];
+    u_clamped += law.counters().u_clamped;
+    u_slew_clamped += law.counters().u_slew_clamped;
+    if (experimenting < 0 && law.experiment_running()) experimenting = a;
+  }
+  const std::uint64_t clamped = (u_clamped - clamped_reported_) + (u_slew_clamped - slew_clamped_reported_);
   if (end_period) {
     clamped_in_period_ = clamped;
-    clamped_reported_ = now.u_clamped;
-    slew_clamped_reported_ = now.u_slew_clamped;
+    clamped_reported_ = u_clamped;
+    slew_clamped_reported_ = u_slew_clamped;
   }
   if (state == service_status_t::HEALTHY && clamped_in_period_ > 0) {
     state = service_status_t::DEGRADED;
@@ -570,10 +601,12 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     }
   }
   const MemParams& m = c.mem_params();
-  detail +=
-      fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
-                  to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(), m.c1,
-                  m.c2, m.c3, c.config().horizon_ticks, c.experiment_running() ? ", experiment running" : "");
+  detail += fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
+                        to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(),
+                        m.c1, m.c2, m.c3, c.config().horizon_ticks,
+                        experimenting < 0    ? std::string()
+                        : settings_.axes > 1 ? fmt::format(", experiment running on {}", axis_name(experimenting))
+                                             : std::string(", experiment running"));
   if (c.stage().has_dynamics()) {
     detail += fmt::format("; stage {:.4g} Hz zeta {:.3g} inverted",
                           c.stage().second_order.natural_frequency() / (2.0 * std::numbers::pi),
@@ -614,6 +647,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   if (c.next_tick() >= 0) status_.counter("plan_ahead_ticks", at_least_0(c.next_tick() - 1 - c.last_seq()));
   reported_.report(status_, "sensor", samples_.counters());
   reported_.report(status_, "trajectory", trajectories_.counters());
+  reported_.report(status_, "scan", scans_.counters());
   reported_.report(status_, "params", params_.counters());
   reported_.report(status_, "model", models_.counters());
   reported_.report(status_, "control", control_.counters());

@@ -81,7 +81,7 @@ struct CompensatorServiceCounters {
   std::uint64_t control_acted = 0;
   std::uint64_t control_refused = 0;
   std::uint64_t bridge_restarts = 0;  // sample seq went back (confirmed): the control law was restarted
-  std::uint64_t plan_mismatch = 0;    // the axes' laws planned different tick counts (published: the fewest)
+  std::uint64_t plan_mismatch = 0;    // the axes' laws planned different ticks: nothing published (a bug)
   std::uint64_t scans = 0;            // scans taken (configured or HX_SCAN)
   std::uint64_t scans_refused = 0;
   std::uint64_t wrong_axis = 0;  // a trajectory, parameter set or experiment for an axis the stage lacks
@@ -176,6 +176,8 @@ class CompensatorService {
   // (a copy of its law), then all take it or none does (throws ParameterError: why). Returns the note
   // of the verdict.
   std::string take_scan(const ScanSettings& scan, double start_s);
+  // A scan's path has not ended on some axis (its plan has not reached the path's end).
+  bool scan_running() const noexcept;
   Publisher<command_block_t> command_pub_;
   command_block_t command_{};                                                         // storage reserved
   std::array<std::array<CommandTick, command_block_t::MAX_TICKS>, kMaxAxes> plan_{};  // per axis

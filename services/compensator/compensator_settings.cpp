@@ -133,8 +133,8 @@ void read_axes_and_scan(const Config& config, CompensatorSettings& s) {
     if (slow != "steps" && slow != "ramp") config.fail("scan.slow", "must be steps or ramp (got '" + slow + "')");
     r.slow_mode = slow == "ramp" ? SlowMode::kRamp : SlowMode::kSteps;
     r.centre_m = centre;
-    RasterSpec checked = r;  // the corner chosen later is at least 1 ms
-    if (checked.corner_s == 0.0) checked.corner_s = std::min(1e-3, 0.5 / r.line_rate_hz);
+    RasterSpec checked = r;  // with the corners it will run with
+    checked.corner_s = raster_corner_s(r, s.control.stage);
     validate_config_section(config, "scan.", [&] { checked.validate(); });
   } else {
     LissajousSpec& l = scan.lissajous;
@@ -150,26 +150,54 @@ void read_axes_and_scan(const Config& config, CompensatorSettings& s) {
     }
     validate_config_section(config, "scan.", [&] { l.validate(); });
   }
+  // What the compensator would refuse at the first sample is refused here, naming the key.
+  const double check_s = scan_check_s(scan, raster_corner_s(scan.raster, s.control.stage));
+  if (check_s * s.axes > kScanCheckBudget_s) {
+    config.fail(scan.path == ScanSettings::Path::kRaster ? "scan.lines" : "scan.duration_s",
+                fmt::format("the scan runs {:.3g} s on each of {} axes; a scan is checked whole before it is taken, "
+                            "at most {} s of loop time over all axes",
+                            check_s, s.axes, kScanCheckBudget_s));
+  }
+  const double earliest_s = scan.blend_s + static_cast<double>(s.control.horizon_ticks) * s.control.dt_s + 0.01;
+  if (scan.start_after_s < earliest_s) {
+    config.fail("scan.start_after_s",
+                fmt::format("must leave the plan's horizon and the approach (scan.blend_s) before "
+                            "the path: at least {:.3g} s",
+                            earliest_s));
+  }
 }
 
 }  // namespace
 
+double raster_corner_s(const RasterSpec& raster, const StageModel& stage) noexcept {
+  if (raster.corner_s > 0.0) return raster.corner_s;
+  const double c = resonance_corner_s(stage);
+  return c > 0.0 ? c : 1e-3;
+}
+
 ScanShare scan_share(const ScanSettings& scan, const AxisCoupling& decoupling, int axis, double start_s,
-                     const StageModel& stage) {
+                     double corner_s) {
   const AxisVector row = scan.decouple ? AxisVector(decoupling.inverse_matrix().row(axis).transpose())
                                        : AxisVector(AxisVector::Unit(axis));
   if (scan.path == ScanSettings::Path::kRaster) {
     RasterSpec r = scan.raster;
-    if (r.corner_s == 0.0) {
-      const double c = resonance_corner_s(stage);
-      r.corner_s = c > 0.0 ? c : 1e-3;
-    }
+    r.corner_s = corner_s;
     r.start_s = start_s;
     return ScanShare(r, axis, row);
   }
   LissajousSpec l = scan.lissajous;
   l.start_s = start_s;
   return ScanShare(l, axis, row);
+}
+
+double scan_check_s(const ScanSettings& scan, double corner_s) noexcept {
+  double path_s = scan.lissajous.duration_s;
+  if (scan.path == ScanSettings::Path::kRaster) {
+    RasterSpec r = scan.raster;
+    r.corner_s = corner_s;
+    path_s = raster_duration_s(r);
+  }
+  return scan.blend_s + path_s;
 }
 
 GainPlausibility gain_plausibility(const CompensatorSettings& settings) noexcept {

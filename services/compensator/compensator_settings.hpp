@@ -66,11 +66,22 @@ CompensatorSettings load_compensator_settings(const Config& config);
 // Throws ConfigError naming the snippet file when it cannot be read.
 void merge_params_file(Config& config, const std::filesystem::path& snippet);
 
+// The corners a raster runs with: its own corner_s, else the compensator's choice for `stage`
+// (resonance_corner_s; 1 ms without dynamics). One value for every axis of the path.
+double raster_corner_s(const RasterSpec& raster, const StageModel& stage) noexcept;
+
 // A scan as one axis's share (ScanShare) of its path starting at loop time start_s: the row of
 // C^{-1} (C = `decoupling`) when scan.decouple, else the axis's own reference; a raster's corners
-// chosen for `stage` when left at 0 (resonance_corner_s; 1 ms without dynamics).
+// corner_s (raster_corner_s, settled once for all axes).
 ScanShare scan_share(const ScanSettings& scan, const AxisCoupling& decoupling, int axis, double start_s,
-                     const StageModel& stage);
+                     double corner_s);
+
+// Loop time a scan's check may cost on the compensator's one thread, summed over the axes: each
+// axis's share is checked whole by a dry run of its plan (~0.25 us a tick here), while the bridge's
+// buffer holds 50 ms of commands. A longer path (or one of more axes) is refused, naming this.
+inline constexpr double kScanCheckBudget_s = 6.0;
+// The loop time a scan's check covers on every axis: from now to its end (its approach, its path).
+double scan_check_s(const ScanSettings& scan, double corner_s) noexcept;
 
 // One line per section, for the start-up log.
 std::vector<std::string> describe(const CompensatorSettings& settings);

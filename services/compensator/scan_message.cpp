@@ -17,7 +17,7 @@ int require_axis(const char* field, int axis, int axes) {
 }
 }  // namespace
 
-ScanSettings scan_from_message(const scan_t& msg, int axes) {
+ScanSettings scan_from_message(const scan_t& msg, int axes, const StageModel& stage) {
   ScanSettings s;
   s.blend_s = msg.blend_s;
   s.decouple = msg.decouple != 0;
@@ -36,8 +36,8 @@ ScanSettings scan_from_message(const scan_t& msg, int axes) {
     r.corner_s = msg.corner_s;
     r.settle_s = msg.settle_s;
     r.centre_m = centre;
-    RasterSpec checked = r;  // a corner left to the compensator is chosen when the path is taken
-    if (checked.corner_s == 0.0) checked.corner_s = 1e-3 < 0.5 / r.line_rate_hz ? 1e-3 : 0.25 / r.line_rate_hz;
+    RasterSpec checked = r;  // with the corners it will run with
+    checked.corner_s = raster_corner_s(r, stage);
     checked.validate();
   } else if (msg.path == scan_t::LISSAJOUS) {
     s.path = ScanSettings::Path::kLissajous;

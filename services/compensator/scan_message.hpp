@@ -10,7 +10,8 @@
 namespace hystloop {
 
 // The path, blend and decouple flag of `msg` for a stage of `axes` axes (start_after_s unused:
-// the caller maps msg.start_utime to loop time). Throws ParameterError.
-ScanSettings scan_from_message(const scan_t& msg, int axes);
+// the caller maps msg.start_utime to loop time), a raster checked with the corners it will run with
+// on `stage` (raster_corner_s). Throws ParameterError.
+ScanSettings scan_from_message(const scan_t& msg, int axes, const StageModel& stage);
 
 }  // namespace hystloop

@@ -47,7 +47,7 @@ BridgeSettings comedi_settings() {
 // Started, armed by the first command and driven to `u_V`; the samples tell when it got there.
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, double u_V, std::int64_t ticks = 8000) {
   auto rt = std::make_unique<BridgeRealtime>(s, make_stage_backend(s));
-  for (std::int64_t k = 0; k < ticks; ++k) EXPECT_TRUE(rt->push_command(0, {k, u_V, std::nan(""), 1, 2}));
+  for (std::int64_t k = 0; k < ticks; ++k) EXPECT_TRUE(rt->push_command({k, u_V, std::nan(""), 1, 2}));
   rt->start();
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   bool there = false;

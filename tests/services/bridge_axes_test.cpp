@@ -129,6 +129,7 @@ BridgeSettings two_axes() {
   s.limits.safe_ramp_V_per_s = 1e4;  // 1 V per tick
   s.limits.watchdog_s = 2e-3;        // 20 ticks
   s.stop_ramp_timeout_s = 2.0;
+  s.max_lead_s = 0.5;  // every command below is taken: x still has hundreds buffered when y's run out
   return s;
 }
 
@@ -137,13 +138,15 @@ TEST(BridgeAxes, EveryAxisFollowsItsOwnCommandsAndOneAxisRunningDryTakesBothSafe
   AxesRecord record;
   BridgeRealtime rt(s, std::make_unique<TwoAxisRecordingBackend>(record));
   ASSERT_EQ(rt.axes(), 2);
-  // x gets 4000 ticks of 10 V, y only 2000 of -20 V: y's buffer runs dry first.
+  // x gets 4000 ticks of 10 V, y 2000 of -20 V and then non-finite commands, which its core
+  // refuses: y's buffer runs dry at tick 2000 while x's holds 2000 more.
   for (std::int64_t k = 0; k < 4000; ++k) {
-    ASSERT_TRUE(rt.push_command(0, {k, 10.0, std::nan(""), 1, 2}));
-    if (k < 2000) {
-      ASSERT_TRUE(rt.push_command(1, {k, -20.0, std::nan(""), 1, 2}));
-    }
+    const std::array<CommandTick, 2> tick{CommandTick{k, 10.0, std::nan(""), 1, 2},
+                                          CommandTick{k, k < 2000 ? -20.0 : std::nan(""), std::nan(""), 1, 2}};
+    ASSERT_TRUE(rt.push_commands(tick));
   }
+  const CommandTick one_axis{0, 1.0, std::nan(""), 1, 2};
+  EXPECT_FALSE(rt.push_command(one_axis)) << "a tick of one axis on a stage of two is refused";
   rt.start();
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 3000; }));
   // Samples carry both axes.
@@ -169,6 +172,7 @@ TEST(BridgeAxes, EveryAxisFollowsItsOwnCommandsAndOneAxisRunningDryTakesBothSafe
   }
   ASSERT_GT(y_left, 0u) << "y never left its command";
   EXPECT_EQ(x_left, y_left) << "one safe state: both axes ramp from the same tick";
+  EXPECT_LT(x_left, 2100u) << "x left its command when y ran dry, not when its own commands ended";
   EXPECT_NEAR(record.u_V[y_left][0], 9.0, 1e-12);  // the ramp: 1 V per tick towards 0 V
   EXPECT_NEAR(record.u_V[y_left][1], -19.0, 1e-12);
   EXPECT_EQ(record.u_V.back()[0], 0.0);
@@ -179,7 +183,12 @@ TEST(BridgeAxes, AStageArmsOnlyWhenEveryAxisHasCommands) {
   const BridgeSettings s = two_axes();
   AxesRecord record;
   BridgeRealtime rt(s, std::make_unique<TwoAxisRecordingBackend>(record));
-  for (std::int64_t k = 0; k < 3000; ++k) ASSERT_TRUE(rt.push_command(0, {k, 10.0, std::nan(""), 1, 2}));
+  // y's commands are all refused (non-finite): y never has one buffered, so auto-arm never arms.
+  for (std::int64_t k = 0; k < 3000; ++k) {
+    const std::array<CommandTick, 2> tick{CommandTick{k, 10.0, std::nan(""), 1, 2},
+                                          CommandTick{k, std::nan(""), std::nan(""), 1, 2}};
+    ASSERT_TRUE(rt.push_commands(tick));
+  }
   rt.start();
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 1000; }));
   rt.stop();

@@ -82,7 +82,7 @@ bool eventually(Condition done) {
 // Started, armed by the first command and driven to `u_V` (the slew limit: 5 V per tick).
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, Record& record, double u_V) {
   auto rt = std::make_unique<BridgeRealtime>(s, std::make_unique<RecordingBackend>(record));
-  for (std::int64_t k = 0; k < 8000; ++k) EXPECT_TRUE(rt->push_command(0, {k, u_V, std::nan(""), 1, 2}));
+  for (std::int64_t k = 0; k < 8000; ++k) EXPECT_TRUE(rt->push_command({k, u_V, std::nan(""), 1, 2}));
   rt->start();
   EXPECT_TRUE(eventually([&] { return record.last_u_V.load() == u_V; })) << "the stage never got there";
   return rt;

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <optional>
+#include <utility>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -96,53 +98,86 @@ int run_coupling_experiment(CtlLink& link, const CouplingRunOptions& o) {
       "kd %g put back after)\n",
       axes, o.amplitude_V, o.frequency_Hz, o.duration_s, gains->kp, gains->ki_per_s, gains->kd_s);
   std::fflush(stdout);
-  if (set_servo(link, o, 0.0, 0.0, 0.0) != 0) return 1;
-
-  int rc = 0;
-  try {
-    for (int a = 0; a < axes && rc == 0 && !stop_requested(); ++a) {
-      ExperimentRequest e;
-      e.amplitude_V = o.amplitude_V;
-      e.frequency_Hz = o.frequency_Hz;
-      e.duration_s = o.duration_s;
+  // From the first SET_GAINS on, every way out puts the gains back (an unanswered request may still
+  // have zeroed them) and stops an excitation still running.
+  bool restored = false;
+  const auto restore = [&]() -> bool {
+    if (moved >= 0) {
       const std::int64_t now = wall_utime();
-      control_t msg =
-          make_control(control_t::START_EXPERIMENT, o.compensator_process, new_request_id(now, ::getpid()), now);
-      apply(e, msg);
-      msg.axis = static_cast<std::int8_t>(a);
-      records.push_back({a, {}});
-      moved = a;
       AckOptions ack;
       ack.timeout_s = o.timeout_s;
       ack.expected = {o.compensator_process};
-      if (send_control_confirmed(link, msg, fmt::format("START_EXPERIMENT on {}", axis_name(a)), ack) != 0) {
-        rc = 1;
-        break;
-      }
-      // Its ticks start a horizon ahead and last the duration; done once none came for 0.2 s.
-      const auto end = after(o.duration_s + o.timeout_s);
-      while (Clock::now() < end && !stop_requested()) {
-        if (!receive(link, end, std::chrono::microseconds(20'000))) return receive_failed(link);
-        if (!records.back().y_m[0].empty() && Clock::now() - last_sample > std::chrono::milliseconds(200)) break;
-      }
+      send_control_confirmed(
+          link, make_control(control_t::STOP_EXPERIMENT, o.compensator_process, new_request_id(now, ::getpid()), now),
+          "STOP_EXPERIMENT", ack);
       moved = -1;
-      std::printf("hystloop-ctl: %s excited: %zu samples\n", std::string(axis_name(a)).c_str(),
-                  records.back().y_m[0].size());
-      std::fflush(stdout);
-      const auto rest = after(o.rest_s);  // the axis comes back to its reference before the next moves
-      while (Clock::now() < rest && !stop_requested()) {
-        if (!receive(link, rest, std::chrono::microseconds(20'000))) return receive_failed(link);
+    }
+    restored = set_servo(link, o, gains->kp, gains->ki_per_s, gains->kd_s) == 0;
+    return restored;
+  };
+  struct OnExit {
+    std::function<void()> fn;
+    explicit OnExit(std::function<void()> f) : fn(std::move(f)) {}
+    OnExit(const OnExit&) = delete;
+    OnExit& operator=(const OnExit&) = delete;
+    ~OnExit() {
+      try {
+        fn();
+      } catch (...) {  // already leaving on an error: the message below names the gains
       }
     }
-  } catch (...) {
-    set_servo(link, o, gains->kp, gains->ki_per_s, gains->kd_s);
-    throw;
-  }
-  if (set_servo(link, o, gains->kp, gains->ki_per_s, gains->kd_s) != 0) {
+  } on_exit([&] {
+    if (!restored && !restore()) {
+      std::fprintf(stderr,
+                   "hystloop-ctl: the servo's gains were NOT confirmed back: set them with hystloop-ctl gains "
+                   "--kp %g --ki %g --kd %g\n",
+                   gains->kp, gains->ki_per_s, gains->kd_s);
+    }
+  });
+  if (set_servo(link, o, 0.0, 0.0, 0.0) != 0) return 1;
+
+  // One axis's experiment: 0 done, else the exit status.
+  const auto excite = [&](int a) -> int {
+    ExperimentRequest e;
+    e.amplitude_V = o.amplitude_V;
+    e.frequency_Hz = o.frequency_Hz;
+    e.duration_s = o.duration_s;
+    const std::int64_t now = wall_utime();
+    control_t msg =
+        make_control(control_t::START_EXPERIMENT, o.compensator_process, new_request_id(now, ::getpid()), now);
+    apply(e, msg);
+    msg.axis = static_cast<std::int8_t>(a);
+    records.push_back({a, {}});
+    moved = a;
+    AckOptions ack;
+    ack.timeout_s = o.timeout_s;
+    ack.expected = {o.compensator_process};
+    if (send_control_confirmed(link, msg, fmt::format("START_EXPERIMENT on {}", axis_name(a)), ack) != 0) return 1;
+    // Its ticks start a horizon ahead and last the duration; done once none came for 0.2 s.
+    const auto end = after(o.duration_s + o.timeout_s);
+    while (Clock::now() < end && !stop_requested()) {
+      if (!receive(link, end, std::chrono::microseconds(20'000))) return receive_failed(link);
+      if (!records.back().y_m[0].empty() && Clock::now() - last_sample > std::chrono::milliseconds(200)) break;
+    }
+    if (stop_requested()) return 1;  // still moving: on_exit stops it
+    moved = -1;
+    std::printf("hystloop-ctl: %s excited: %zu samples\n", std::string(axis_name(a)).c_str(),
+                records.back().y_m[0].size());
+    std::fflush(stdout);
+    const auto rest = after(o.rest_s);  // the axis comes back to its reference before the next moves
+    while (Clock::now() < rest && !stop_requested()) {
+      if (!receive(link, rest, std::chrono::microseconds(20'000))) return receive_failed(link);
+    }
+    return 0;
+  };
+  int rc = 0;
+  for (int a = 0; a < axes && rc == 0 && !stop_requested(); ++a) rc = excite(a);
+  if (!restore()) {
     std::fprintf(stderr,
                  "hystloop-ctl: the servo's gains were NOT confirmed back: set them with hystloop-ctl gains "
                  "--kp %g --ki %g --kd %g\n",
                  gains->kp, gains->ki_per_s, gains->kd_s);
+    restored = true;  // said once
     rc = 1;
   }
   if (stop_requested()) {

@@ -53,6 +53,7 @@
 #include "auth/rig_key.hpp"
 #include "lcm/rig_auth.hpp"
 #include "lcm/servo_gains_status.hpp"
+#include "lcm/status_counters.hpp"
 #include "loop/trajectory.hpp"
 #include "models/axis_coupling.hpp"
 #include "runtime/status_reporter.hpp"
@@ -167,8 +168,7 @@ int send_params(const Options& o) {
   request.version = o.params_version ? *o.params_version : next_params_version(link, o.params_listen_s);
   const mem_params_t msg = make_params(request, wall_utime());
   // The compensator reports x's set as params_version, another axis's as <axis>_params_version.
-  const std::string in_use_counter =
-      request.axis == 0 ? std::string("params_version") : std::string(axis_name(request.axis)) + "_params_version";
+  const std::string in_use_counter = params_version_counter(request.axis);
   if (!publish_repeated(link.lcm(), link.channels().params, msg)) {
     std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().params.c_str());
     return 1;

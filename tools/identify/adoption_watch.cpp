@@ -15,14 +15,16 @@ constexpr std::array<const char*, 5> kRefusalCounters{"params_rejected", "params
 
 }  // namespace
 
-AdoptionWatch::AdoptionWatch(std::string compensator_process, std::int32_t published_version)
-    : compensator_(std::move(compensator_process)), version_(published_version) {}
+AdoptionWatch::AdoptionWatch(std::string compensator_process, std::int32_t published_version, int axis)
+    : compensator_(std::move(compensator_process)),
+      version_(published_version),
+      counter_(params_version_counter(axis)) {}
 
 void AdoptionWatch::on_status(const service_status_t& status) {
   heard_.insert(status.process);
   if (status.process != compensator_) return;
   compensator_heard_ = true;
-  if (const auto v = find_counter(status, "params_version")) status_version_ = *v;
+  if (const auto v = find_counter(status, counter_)) status_version_ = *v;
   for (const char* name : kRefusalCounters) {
     if (const auto v = find_counter(status, name)) {
       refusals_first_.try_emplace(name, *v);

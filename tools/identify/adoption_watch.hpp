@@ -24,7 +24,8 @@ namespace hystloop {
 
 class AdoptionWatch {
  public:
-  AdoptionWatch(std::string compensator_process, std::int32_t published_version);
+  // axis: the axis the set is for; its params_version counter (params_version_counter) is watched.
+  AdoptionWatch(std::string compensator_process, std::int32_t published_version, int axis = 0);
 
   void on_status(const service_status_t& status);
   void on_command_version(std::int32_t params_version);  // of a command tick
@@ -38,6 +39,7 @@ class AdoptionWatch {
  private:
   std::string compensator_;
   std::int32_t version_;
+  std::string counter_;          // the compensator's counter of the set in use on the axis
   std::set<std::string> heard_;  // processes that reported on HX_STATUS
   bool compensator_heard_ = false;
   std::optional<std::int64_t> status_version_;                          // the compensator's params_version counter

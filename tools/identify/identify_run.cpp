@@ -479,6 +479,7 @@ int fit_inputs(const IdentifyArgs& args) {
     if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));
     PublishOptions p = args.link;
     if (args.timeout_s) p.timeout_s = *args.timeout_s;
+    p.axis = args.axis;                      // the set models the axis the samples were of
     link = std::make_unique<ParamsLink>(p);  // before the fit: a refused URL or no route fails fast
   } else {
     validate_rig_prefix(args.link.rig);

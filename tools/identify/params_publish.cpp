@@ -117,12 +117,18 @@ int publish_repeated(lcm::LCM& lcm, const std::string& channel, const T& msg, co
 
 }  // namespace
 
-int ParamsLink::publish(const mem_params_t& msg) { return publish_repeated(*lcm_, channels_.params, msg, options_); }
+int ParamsLink::publish(mem_params_t msg) {
+  msg.axis = static_cast<std::int8_t>(options_.axis);
+  return publish_repeated(*lcm_, channels_.params, msg, options_);
+}
 
-int ParamsLink::publish(const model_params_t& msg) { return publish_repeated(*lcm_, channels_.model, msg, options_); }
+int ParamsLink::publish(model_params_t msg) {
+  msg.axis = static_cast<std::int8_t>(options_.axis);
+  return publish_repeated(*lcm_, channels_.model, msg, options_);
+}
 
 ParamsLink::Adoption ParamsLink::wait_for_adoption(std::int32_t version) {
-  AdoptionWatch watch(options_.compensator, version);
+  AdoptionWatch watch(options_.compensator, version, options_.axis);
   Subscription<service_status_t> status(*lcm_, channels_.status,
                                         [&](const service_status_t& s, std::int64_t) { watch.on_status(s); });
   Subscription<command_block_t>::Options queue;
@@ -130,8 +136,10 @@ ParamsLink::Adoption ParamsLink::wait_for_adoption(std::int32_t version) {
   Subscription<command_block_t> commands(
       *lcm_, channels_.command,
       [&](const command_block_t& c, std::int64_t) {
-        if (c.n_ticks > 0)
-          watch.on_command_version(command_tick(c, static_cast<std::size_t>(c.n_ticks - 1)).params_version);
+        const auto axis = static_cast<std::size_t>(options_.axis);
+        if (c.n_ticks > 0 && axis < axes_of(c)) {
+          watch.on_command_version(command_tick(c, static_cast<std::size_t>(c.n_ticks - 1), axis).params_version);
+        }
       },
       queue);
   using Clock = std::chrono::steady_clock;

@@ -35,6 +35,7 @@ struct PublishOptions {
   int repeats = 3;                      // UDP may drop one; receivers dedupe by version
   std::chrono::milliseconds gap{10};
   std::string compensator = "compensator";  // the process whose adoption counts
+  int axis = 0;                             // the axis the set is for (0: x): its messages name it
   double timeout_s = 5.0;                   // how long to wait for it [s]
 
   // Throws ParameterError naming the field ("version", "listen_s", "repeats", "rig.prefix",
@@ -78,8 +79,9 @@ class ParamsLink {
 
   // Publishes msg options.repeats times, options.gap apart (on HX_PARAMS / HX_MODEL). Returns
   // how many were handed to LCM (0 if the message fails the contract check).
-  int publish(const mem_params_t& msg);
-  int publish(const model_params_t& msg);
+  // Each with its axis set to options.axis.
+  int publish(mem_params_t msg);
+  int publish(model_params_t msg);
 
   struct Adoption {
     bool adopted = false;

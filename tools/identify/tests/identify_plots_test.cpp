@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "adoption_watch.hpp"
+#include "lcm/status_counters.hpp"
 #include "sensor_log_fixture.hpp"
 #include "support/tool_run.hpp"
 
@@ -228,6 +229,16 @@ TEST(AdoptionWatch, TheCompensatorsVersionInUseDecides) {
   w.on_status(status("compensator", {{"params_version", 8}}));
   EXPECT_TRUE(w.adopted());
   EXPECT_EQ(w.verdict(3, "HX_STATUS"), "adopted by 'compensator' (version 8)");
+}
+
+TEST(AdoptionWatch, ASetForAnotherAxisWaitsOnThatAxissVersion) {
+  AdoptionWatch w("compensator", 8, 1);  // a set for y
+  w.on_status(status("compensator", {{"params_version", 8}, {"y_params_version", 7}}));
+  EXPECT_FALSE(w.adopted()) << "x's version says nothing of y's";
+  w.on_status(status("compensator", {{"params_version", 8}, {"y_params_version", 8}}));
+  EXPECT_TRUE(w.adopted());
+  EXPECT_EQ(params_version_counter(0), "params_version");
+  EXPECT_EQ(params_version_counter(2), "z_params_version");
 }
 
 TEST(AdoptionWatch, CommandTicksTellTheVersionWhenTheStatusDoesNot) {
