@@ -121,4 +121,15 @@ std::string AxisCoupling::describe() const {
   return out;
 }
 
+std::string describe_coupling(const AxisMatrix& c, int n) {
+  std::string out;
+  for (const CouplingEntry& e : kCouplingEntries) {
+    if (e.to >= n || e.from >= n || c(e.to, e.from) == 0.0) continue;
+    char value[32];
+    std::snprintf(value, sizeof value, "%+.4g", c(e.to, e.from));
+    out += ", " + std::string(axis_name(e.from)) + " -> " + std::string(axis_name(e.to)) + " " + value;
+  }
+  return out.empty() ? " none" : out;
+}
+
 }  // namespace hystloop

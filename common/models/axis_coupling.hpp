@@ -15,6 +15,7 @@
 // constructor validates and computes the inverse once, so the per-sample calls are matrix-vector
 // products with no check, no allocation and no throw.
 
+#include <array>
 #include <string>
 #include <string_view>
 
@@ -39,6 +40,20 @@ using AxisMatrix = Eigen::Matrix3d;
 
 // "x", "y", "z" ("?" outside 0..kMaxAxes-1).
 std::string_view axis_name(int axis) noexcept;
+
+// The off-diagonal entries of C by name, as configuration keys spell them: "<from>_to_<to>" is
+// C(to, from), the fraction of axis <from>'s own displacement that axis <to>'s sensor reads.
+struct CouplingEntry {
+  std::string_view name;
+  int to;
+  int from;
+};
+inline constexpr std::array<CouplingEntry, 6> kCouplingEntries{
+    {{"x_to_y", 1, 0}, {"x_to_z", 2, 0}, {"y_to_x", 0, 1}, {"y_to_z", 2, 1}, {"z_to_x", 0, 2}, {"z_to_y", 1, 2}}};
+
+// ", x -> y +0.03, ..." for the non-zero off-diagonal entries among the first n axes; " none" when
+// there are none (for start-up lines: "coupling" + describe_coupling(C, n)).
+std::string describe_coupling(const AxisMatrix& c, int n);
 
 // C and its inverse, both fixed-size: copying allocates nothing, so a refitted coupling can be
 // assigned between ticks.

@@ -221,6 +221,7 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   reports_.serve_request([&](RtReport& r) {
     r.core = stage_.counters();
     r.axes = static_cast<int>(axes);
+    r.tripped_by = stage_.tripped_by();
     for (std::size_t a = 0; a < axes; ++a) {
       r.axis_core[a] = stage_.axis(static_cast<int>(a)).counters();
       r.axis_u_V[a] = stage_.axis(static_cast<int>(a)).last_applied_V();

@@ -361,9 +361,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   previous_dropped_ = rt.samples_dropped;
   if (core.watchdog_trips != trips_reported_) {
     trips_reported_ = core.watchdog_trips;
+    // With several axes, which one ran dry: all of them went to the safe state on that tick.
     safe_reason_ =
-        fmt::format("watchdog: no command buffered for more than {} s, tripped at tick {}; re-arm via HX_CONTROL",
-                    settings_.limits.watchdog_s, rt.last_trip_tick);
+        fmt::format("watchdog: no command buffered for more than {} s{}, tripped at tick {}{}; re-arm via HX_CONTROL",
+                    settings_.limits.watchdog_s,
+                    rt.axes > 1 && rt.tripped_by >= 0 ? fmt::format(" on {}", axis_name(rt.tripped_by)) : std::string(),
+                    rt.last_trip_tick, rt.axes > 1 ? ", every axis to the safe state" : "");
     spdlog::warn("{}", safe_reason_);
   }
 

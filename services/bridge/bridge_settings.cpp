@@ -14,18 +14,6 @@
 #include "runtime/rig_auth_config.hpp"
 
 namespace hystloop {
-namespace {
-// coupling.<from>_to_<to>: C(to, from).
-struct CouplingKey {
-  const char* key;
-  int to;
-  int from;
-};
-constexpr CouplingKey kCouplingKeys[] = {{"coupling.x_to_y", 1, 0}, {"coupling.x_to_z", 2, 0},
-                                         {"coupling.y_to_x", 0, 1}, {"coupling.y_to_z", 2, 1},
-                                         {"coupling.z_to_x", 0, 2}, {"coupling.z_to_y", 1, 2}};
-}  // namespace
-
 AxisMatrix default_stage_coupling() noexcept { return flexure_stage(kMaxAxes).coupling.matrix(); }
 
 MultiAxisStageConfig multi_axis_stage(const BridgeSettings& settings) {
@@ -106,8 +94,9 @@ BridgeSettings load_bridge_settings(const Config& config) {
                 "simulators sim and ro drive up to " +
                     std::to_string(kMaxAxes) + ")");
   }
-  for (const CouplingKey& c : kCouplingKeys) {
-    s.coupling(c.to, c.from) = config.get_in_range(c.key, s.coupling(c.to, c.from), -kMaxCoupling, kMaxCoupling);
+  for (const CouplingEntry& c : kCouplingEntries) {  // coupling.<from>_to_<to>: C(to, from)
+    s.coupling(c.to, c.from) =
+        config.get_in_range("coupling." + std::string(c.name), s.coupling(c.to, c.from), -kMaxCoupling, kMaxCoupling);
   }
   s.comedi = load_comedi_settings(config);  // validated whatever the backend: one config serves both
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
@@ -191,17 +180,11 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   const auto& a = s.limits;
   std::vector<std::string> lines;
   if (s.axes > 1) {
-    std::string c;
-    for (int j = 0; j < s.axes; ++j) {
-      for (int i = 0; i < s.axes; ++i) {
-        if (i != j && s.coupling(j, i) != 0.0)
-          c += fmt::format(", {} -> {} {:+.3g}", axis_name(i), axis_name(j), s.coupling(j, i));
-      }
-    }
-    lines.push_back(fmt::format(
-        "axes: {} on one clock and one safe state, the same actuator limits and servo each; "
-        "noise seeds {}..{}; coupling{}",
-        s.axes, s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1, c.empty() ? " none" : c));
+    lines.push_back(
+        fmt::format("axes: {} on one clock and one safe state, the same actuator limits and servo each; "
+                    "noise seeds {}..{}; coupling{}",
+                    s.axes, s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1,
+                    describe_coupling(s.coupling, s.axes)));
   }
   lines.push_back(fmt::format(
       "bridge: backend {}, rate {} Hz, noise {:.3g} m RMS, seed {}, drift {:+.3g} over {} s from {} s, {}{}", s.backend,

@@ -38,6 +38,7 @@ struct RtReport {
   bool armed = false;
   // A stage of several axes: `core` above is the stage's (MultiAxisBridge::counters), these each axis's.
   int axes = 1;
+  int tripped_by = -1;  // the axis whose watchdog last took the stage to the safe state (-1: none)
   std::array<BridgeCounters, kMaxAxes> axis_core{};
   std::array<double, kMaxAxes> axis_u_V{};
   // This report period's windows.

@@ -162,7 +162,7 @@ class CompensatorService {
 
   CompensatorSettings settings_;
   lcm::LCM& lcm_;
-  // One control law per axis (laws_[0]: x, the one trajectories and experiments drive).
+  // One control law per axis (laws_[0]: x; the stage status and the experiment's mode report x's).
   std::array<std::optional<Compensator>, kMaxAxes> laws_;
   Compensator& x() noexcept { return *laws_[0]; }
   const Compensator& x() const noexcept { return *laws_[0]; }

@@ -77,16 +77,6 @@ void read_plausibility(const Config& config, CompensatorSettings& s) {
   });
 }
 
-// decoupling.<from>_to_<to>: C(to, from), as the bridge's simulated stage names its coupling.
-struct CouplingKey {
-  const char* key;
-  int to;
-  int from;
-};
-constexpr CouplingKey kDecouplingKeys[] = {{"decoupling.x_to_y", 1, 0}, {"decoupling.x_to_z", 2, 0},
-                                           {"decoupling.y_to_x", 0, 1}, {"decoupling.y_to_z", 2, 1},
-                                           {"decoupling.z_to_x", 0, 2}, {"decoupling.z_to_y", 1, 2}};
-
 // A list of one value per axis (at most kMaxAxes), the rest 0.
 AxisPositions per_axis_list(const Config& config, const std::string& key, double lo, double hi) {
   const std::vector<double> v = config.get<std::vector<double>>(key, {});
@@ -102,8 +92,9 @@ AxisPositions per_axis_list(const Config& config, const std::string& key, double
 void read_axes_and_scan(const Config& config, CompensatorSettings& s) {
   s.axes = static_cast<int>(config.get_int_in_range("compensator.axes", s.axes, 1, kMaxAxes));
   AxisMatrix c = AxisMatrix::Identity();
-  for (const CouplingKey& k : kDecouplingKeys)
-    c(k.to, k.from) = config.get_in_range(k.key, 0.0, -kMaxCoupling, kMaxCoupling);
+  for (const CouplingEntry& k : kCouplingEntries) {  // decoupling.<from>_to_<to>: C(to, from), as the bridge's
+    c(k.to, k.from) = config.get_in_range("decoupling." + std::string(k.name), 0.0, -kMaxCoupling, kMaxCoupling);
+  }
   validate_config_section(config, "", [&] { s.decoupling = AxisCoupling(s.axes, c); });
 
   ScanSettings& scan = s.scan;
@@ -415,15 +406,10 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
                               to_string(t.shape), t.amplitude_m, t.offset_m, t.frequency_hz, t.blend_s, t.n_points));
   if (s.axes > 1) {
-    std::string coupled;
-    for (int j = 0; j < s.axes; ++j) {
-      for (int i = 0; i < s.axes; ++i) {
-        const double v = s.decoupling.matrix()(j, i);
-        if (i != j && v != 0.0) coupled += fmt::format(", {} -> {} {:+.4g}", axis_name(i), axis_name(j), v);
-      }
-    }
-    lines.push_back(fmt::format("axes: {}, one control law each (HX_TRAJECTORY moves x); coupling to cancel{}", s.axes,
-                                coupled.empty() ? " none" : coupled));
+    lines.push_back(fmt::format(
+        "axes: {}, one control law each (trajectories, parameter sets and experiments name theirs); coupling to "
+        "cancel{}",
+        s.axes, describe_coupling(s.decoupling.matrix(), s.axes)));
   }
   const ScanSettings& sc = s.scan;
   if (sc.path == ScanSettings::Path::kRaster) {

@@ -34,8 +34,8 @@ struct ScanSettings {
 
 struct CompensatorSettings {
   // Axes of the stage (1..kMaxAxes), one control law each, every one configured as `control`;
-  // sensor blocks of another count are refused. HX_TRAJECTORY moves x (the others hold their
-  // reference); parameter sets and modes apply to every axis; experiments run on x.
+  // sensor blocks of another count are refused. Trajectories, parameter sets and experiments move
+  // or model the axis they name (the others keep theirs); modes and learning apply to every axis.
   int axes = 1;
   // The stage's coupling as identified (models/axis_coupling.hpp; decoupling.x_to_y is C(y, x)):
   // a scan gives each axis its share of C^{-1} r. Identity: none known.
