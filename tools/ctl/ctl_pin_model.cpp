@@ -18,4 +18,9 @@ std::int8_t pin_model_mode(const std::string& name) {
   throw ParameterError("model", "expected " + choice_list(names) + " (got \"" + name + "\")");
 }
 
+std::string reidentifier_process(int axis) {
+  if (axis <= 0 || axis >= 3) return kPinModelTarget;
+  return std::string(kPinModelTarget) + "-" + std::string(1, "xyz"[axis]);
+}
+
 }  // namespace hystloop::ctl

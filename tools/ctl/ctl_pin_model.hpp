@@ -12,6 +12,9 @@ namespace hystloop::ctl {
 
 inline constexpr const char* kPinModelTarget = "reidentifier";
 
+// The re-identifier of `axis` (one process per axis): "reidentifier" for x, "reidentifier-y", "-z".
+std::string reidentifier_process(int axis);
+
 // The control_t mode for a pin-model argument; throws ParameterError("model") for anything else.
 std::int8_t pin_model_mode(const std::string& name);
 

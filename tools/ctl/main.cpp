@@ -180,7 +180,8 @@ int send_params(const Options& o) {
   if (!o.ack.wait) return 0;
   const std::string& compensator = o.verdict.compensator_process;
   const StatusWait w = wait_for_status(link, compensator, counter_is(in_use_counter, msg.version), o.ack.timeout_s);
-  if (const auto r = w.last.find(kPinModelTarget); r != w.last.end() && find_counter(r->second, "params_held") == 0) {
+  if (const auto r = w.last.find(reidentifier_process(request.axis));
+      r != w.last.end() && find_counter(r->second, "params_held") == 0) {
     std::printf(
         "hystloop-ctl: note: the re-identifier runs and is not holding: its next refit replaces this set "
         "(hystloop-ctl hold on keeps it)\n");
@@ -324,6 +325,8 @@ int run(int argc, char** argv) {
   std::string pin_model;
   CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
   pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
+  int reident_axis = 0;
+  add_axis_option(pin, "--axis", reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
   add_wait_options(pin, o);
   std::string hold_what;
   CLI::App* hold = app.add_subcommand(
@@ -332,6 +335,7 @@ int run(int argc, char** argv) {
   hold->add_option("what", hold_what, "on (hold) or off (release: publish what it fits from now on)")
       ->required()
       ->check(CLI::IsMember({"on", "off"}));
+  add_axis_option(hold, "--axis", reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
   add_wait_options(hold, o);
 
   CLI::App* gains = app.add_subcommand(
@@ -525,12 +529,12 @@ int run(int argc, char** argv) {
   if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
   if (*pin) {
     const std::int8_t m = ctl::pin_model_mode(pin_model);
-    return send_control(o, control_t::SET_MODE, ctl::kPinModelTarget, "PIN_MODEL " + pin_model, nullptr, {},
-                        [m](control_t& msg) { msg.mode = m; });
+    return send_control(o, control_t::SET_MODE, reidentifier_process(reident_axis), "PIN_MODEL " + pin_model, nullptr,
+                        {}, [m](control_t& msg) { msg.mode = m; });
   }
   if (*hold) {
     const bool on = hold_what == "on";
-    return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, ctl::kPinModelTarget,
+    return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, reidentifier_process(reident_axis),
                         on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr, counter_is("params_held", on ? 1 : 0));
   }
   if (*mode) {

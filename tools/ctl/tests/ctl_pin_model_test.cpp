@@ -21,6 +21,12 @@ TEST(CtlPinModel, NamesMapToTheModesTheReidentifierReads) {
   for (const char* bad : {"", "banning", "MEM", "experiment"}) EXPECT_THROW(pin_model_mode(bad), ParameterError) << bad;
 }
 
+TEST(CtlPinModel, EachAxisHasItsReidentifier) {
+  EXPECT_EQ(reidentifier_process(0), "reidentifier");  // the name every one-axis rig knows
+  EXPECT_EQ(reidentifier_process(1), "reidentifier-y");
+  EXPECT_EQ(reidentifier_process(2), "reidentifier-z");
+}
+
 TEST(CtlPinModel, TheRefusalListsEveryModelAndAuto) {
   try {
     pin_model_mode("banning");
