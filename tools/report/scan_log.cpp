@@ -28,8 +28,8 @@ std::optional<ScanControl::Kind> control_kind(const control_t& c) noexcept {
       return std::nullopt;
     case control_t::SET_MODE:
       // The re-identifier's pin-model request is a SET_MODE too; it changes the feedforward only
-      // through HX_MODEL, which is no boundary.
-      if (c.target == "reidentifier") return std::nullopt;
+      // through HX_MODEL, which is no boundary (any axis's re-identifier: reidentifier, reidentifier-y, ...).
+      if (c.target.rfind("reidentifier", 0) == 0) return std::nullopt;
       return ScanControl::Kind::kMode;
     case control_t::START_EXPERIMENT: return ScanControl::Kind::kExperiment;
     case control_t::DISARM:
