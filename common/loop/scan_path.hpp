@@ -43,6 +43,10 @@
 namespace hystloop {
 
 inline constexpr std::size_t kScanAxes = static_cast<std::size_t>(kMaxAxes);
+
+// A raster's fast-axis share that differs from its own triangle by at most this is still periodic
+// (ScanShare::periodic_part) [m]: a tenth of a nanometre, below any position sensor's noise.
+inline constexpr double kPeriodicShareTolerance_m = 1e-10;
 using AxisPositions = std::array<double, kScanAxes>;  // one reference per axis [m]
 
 enum class SlowMode : std::int8_t { kSteps = 0, kRamp = 1 };
@@ -157,8 +161,9 @@ class ScanShare {
   // Every path axis's reference at t (what each axis's share is made of).
   AxisPositions path_at(double t_s) const noexcept;
   // The fast axis's triangle when the share is a raster's fast axis alone (its row is that axis's
-  // unit vector): a periodic reference, period 2 / line_rate_hz, over [start_s, start_s + lines /
-  // line_rate_hz), that learning can follow. nullptr otherwise.
+  // unit vector, up to entries that move the share by at most kPeriodicShareTolerance_m: an
+  // identified coupling's near-zero ones): a periodic reference, period 2 / line_rate_hz, over
+  // [start_s, start_s + lines / line_rate_hz), that learning can follow. nullptr otherwise.
   const TrajectorySpec* periodic_part() const noexcept { return periodic_ ? &shapes_[0] : nullptr; }
 
  private:
