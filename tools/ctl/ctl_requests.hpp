@@ -114,7 +114,7 @@ struct ScanRequest {
   double duration_s = 1.0;
   std::vector<double> centre_m;  // per axis, default 0
   bool decouple = true;
-  double blend_s = 0.3;  // the approach: gentle enough that learning has room on the path (scan.yaml's too)
+  double blend_s = 0.3;   // the approach: gentle enough that learning has room on the path (scan.yaml's too)
   void validate() const;  // throws ParameterError naming the option
 };
 
