@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "compensator/compensator_service.hpp"
+#include "hystloop/service_status_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "support/allocation_counter.hpp"
@@ -400,6 +401,24 @@ TEST(CompensatorAxes, APathTooLongToCheckOnTheLoopsThreadIsRefusedNamingTheLimit
                   .find("scan.duration_s") != std::string::npos);
   EXPECT_TRUE(refusal("compensator.axes=2\nscan.path=raster\nscan.start_after_s=0.05").find("scan.start_after_s") !=
               std::string::npos);
+}
+
+TEST(CompensatorAxes, TheStatusOfThreeAxesWithAScanHasEveryCounter) {
+  // Every counter fits in one report, down to the resource figures the report's CPU comes from
+  // (they are added last): a report cut at MAX_COUNTERS loses them silently.
+  AxesHarness h(load("compensator.axes=3\nscan.path=raster\nscan.lines=8"));
+  std::vector<service_status_t> reports;
+  Subscription<service_status_t> status(*h.lcm, h.channels.status,
+                                        [&](const service_status_t& s, std::int64_t) { reports.push_back(s); });
+  h.run(0, 200);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  ASSERT_FALSE(reports.empty());
+  const service_status_t& r = reports.back();
+  EXPECT_LT(r.n_counters, service_status_t::MAX_COUNTERS) << "the report is full: counters were dropped";
+  bool cpu = false;
+  for (const std::string& n : r.counter_names) cpu = cpu || n == "cpu_user_us";
+  EXPECT_TRUE(cpu);
 }
 
 TEST(CompensatorAxes, TheSensorBlockPathDoesNotAllocateWithSeveralAxes) {
