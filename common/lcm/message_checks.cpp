@@ -242,7 +242,8 @@ Verdict check_message(const control_t& msg) noexcept {
   f.text(msg.experiment);
   f.require(msg.command >= control_t::SET_MODE && msg.command <= control_t::RELEASE_PARAMS);
   f.require(msg.learning >= control_t::LEARNING_OFF && msg.learning <= control_t::LEARNING_RESET);
-  f.require(msg.axis >= 0 && msg.axis < kWireAxes);
+  f.require((msg.axis >= 0 && msg.axis < kWireAxes) ||
+            (msg.axis == control_t::EVERY_AXIS && msg.command == control_t::SET_GAINS));
   f.require(is_command_mode(msg.mode));
   f.nan_or_within(msg.kp, 0.0, kHuge);  // NaN: keep the gain in force
   f.nan_or_within(msg.ki, 0.0, kHuge);

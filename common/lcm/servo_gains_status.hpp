@@ -3,12 +3,14 @@
 // back. service_status_t carries integers only, so each gain travels as a counter in a fixed
 // fraction of its SI unit, named with that unit: "servo_kp_ppm" is kp x 1e6. The resolution
 // (1e-6 of kp, 1 ps of kd, 1 mHz of the notch) is far below anything a gain change is made with;
-// a partial change is merged by the bridge from the exact values, never from these.
+// a partial change is merged by the bridge from the exact values, never from these. A stage of
+// several axes reports axis x's under these names and the others' behind their axis ("y_servo_kp_ppm").
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace hystloop {
@@ -41,12 +43,20 @@ inline std::uint64_t servo_gain_counter(const ServoGainCounter& c, const ServoGa
   return v > 0.0 && std::isfinite(v) ? static_cast<std::uint64_t>(std::llround(v)) : 0U;
 }
 
-// The gains from a report's counters; nullopt when any is missing (a bridge that reports none).
+// Axis `axis`'s counter name: c.name for x (0), "y_" + c.name, "z_" + c.name.
+inline std::string servo_gain_counter_name(const ServoGainCounter& c, int axis) {
+  static constexpr std::string_view kPrefix[] = {"", "y_", "z_"};
+  const std::string_view prefix = axis > 0 && axis < 3 ? kPrefix[axis] : std::string_view();
+  return std::string(prefix) + std::string(c.name);
+}
+
+// Axis `axis`'s gains from a report's counters; nullopt when any is missing (a bridge that
+// reports none, or not that axis).
 template <class FindCounter>
-std::optional<ServoGainsFigures> servo_gains_from_counters(FindCounter&& find) {
+std::optional<ServoGainsFigures> servo_gains_from_counters(FindCounter&& find, int axis = 0) {
   ServoGainsFigures g;
   for (const ServoGainCounter& c : kServoGainCounters) {
-    const std::optional<std::int64_t> v = find(c.name);
+    const std::optional<std::int64_t> v = find(servo_gain_counter_name(c, axis));
     if (!v) return std::nullopt;
     g.*c.value = static_cast<double>(*v) / c.scale;
   }

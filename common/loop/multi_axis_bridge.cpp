@@ -26,10 +26,12 @@ BridgeCore make_core(int i, int axes, std::span<const ActuatorLimits> limits, st
                      double dt_s) {
   if (i >= axes) return BridgeCore(ActuatorLimits{}, FeedbackGains{}, dt_s);
   const auto at = static_cast<std::size_t>(i);
-  validate_within(std::string(axis_name(i)) + ".", [&] {
+  try {
     limits[at].validate();
     servo[at].validate();
-  });
+  } catch (const ParameterError& e) {
+    throw ParameterError(axis_field(e.field(), i), e.reason());  // the axis's own key: actuator.y.slew_V_per_s
+  }
   return BridgeCore(limits[at], servo[at], dt_s);
 }
 

@@ -18,7 +18,7 @@ namespace hystloop {
 class MultiAxisBridge {
  public:
   // axes in 1..kMaxAxes; limits and servo hold one entry per axis (ParameterError naming the
-  // axis: "y.actuator.slew_V_per_s", or "axes" for a count that does not match).
+  // axis: "actuator.y.slew_V_per_s", or "axes" for a count that does not match).
   MultiAxisBridge(int axes, std::span<const ActuatorLimits> limits, std::span<const FeedbackGains> servo,
                   double dt_s = 1e-4);
   // Every axis with the same actuator limits and servo.

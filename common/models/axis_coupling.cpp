@@ -33,6 +33,14 @@ AxisVector apply(const AxisMatrix& m, int n, const AxisVector& v) noexcept {
 
 }  // namespace
 
+std::string axis_field(std::string_view field, int axis) {
+  if (axis == 0) return std::string(field);
+  const std::size_t dot = field.find('.');
+  const std::string name(axis_name(axis));
+  if (dot == std::string_view::npos) return name + "." + std::string(field);
+  return std::string(field.substr(0, dot + 1)) + name + "." + std::string(field.substr(dot + 1));
+}
+
 std::string_view axis_name(int axis) noexcept {
   switch (axis) {
     case 0: return "x";

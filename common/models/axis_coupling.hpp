@@ -40,6 +40,9 @@ using AxisMatrix = Eigen::Matrix3d;
 
 // "x", "y", "z" ("?" outside 0..kMaxAxes-1).
 std::string_view axis_name(int axis) noexcept;
+// A per-axis key or field: axis x's is `field` itself, the others' carry the axis after the
+// section ("actuator.u_max_V", 1 -> "actuator.y.u_max_V"; a field without a section gets it in front).
+std::string axis_field(std::string_view field, int axis);
 
 // The off-diagonal entries of C by name, as configuration keys spell them: "<from>_to_<to>" is
 // C(to, from), the fraction of axis <from>'s own displacement that axis <to>'s sensor reads.

@@ -32,9 +32,13 @@ int axes_checked(const BridgeSettings& settings, const StageBackend& backend) {
 BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<StageBackend> backend)
     : settings_(settings),
       backend_(std::move(backend)),
-      stage_(axes_checked(settings, *backend_), settings.limits, settings.servo, settings.dt_s()),
+      stage_(axes_checked(settings, *backend_),
+             std::span<const ActuatorLimits>(settings.axes_limits()).first(static_cast<std::size_t>(settings.axes)),
+             std::span<const FeedbackGains>(settings.axes_servo()).first(static_cast<std::size_t>(settings.axes)),
+             settings.dt_s()),
       arming_(ArmingSettings{settings.auto_arm, settings.rearm_after_trip_s, settings.dt_s()}),
-      dt_s_(settings.dt_s()) {
+      dt_s_(settings.dt_s()),
+      safe_u_V_(settings.safe_voltages()) {
   stage_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
@@ -47,11 +51,11 @@ BridgeRealtime::~BridgeRealtime() {
   const SafeStopResult r = stop();
   if (running) {
     if (r.reached) {
-      spdlog::warn("stopped without the service's stop: ramped from {:.6g} V to the safe {} V in {} ticks ({:.4g} s)",
+      spdlog::warn("stopped without the service's stop: ramped x from {:.6g} V to the safe {} V in {} ticks ({:.4g} s)",
                    r.u_start_V, settings_.limits.safe_u_V, r.ramp_ticks, r.ramp_s);
     } else {
-      spdlog::error("stopped without the service's stop: the ramp to the safe {} V did not end within {} s",
-                    settings_.limits.safe_u_V, settings_.stop_ramp_timeout_s);
+      spdlog::error("stopped without the service's stop: the ramp to the safe voltage did not end within {} s",
+                    settings_.stop_ramp_timeout_s);
     }
   }
   if (wake_fd_ >= 0) ::close(wake_fd_);
@@ -92,7 +96,7 @@ SafeStopResult BridgeRealtime::stop() {
     stop_result_.wall_s =
         static_cast<double>(stop_result_.reached ? stop_reached_ns_ - safe_stop_begin_ns_ : waited_ns) * 1e-9;
   }
-  backend_->hold_safe(settings_.limits.safe_u_V);  // after the ramp, and whatever happened before
+  backend_->hold_safe(safe_voltages());  // after the ramp, and whatever happened before
   return stop_result_;
 }
 
@@ -144,8 +148,10 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     arming_.stop(stage_);  // from this tick every axis ramps to the safe voltage and is never armed again
   }
   arming_.request(arm_request_.exchange(ArmRequest::kNone, std::memory_order_acq_rel), k, stage_);
-  while (const auto gains = gains_.try_pop()) {
-    for (std::size_t a = 0; a < axes; ++a) stage_.set_servo_gains(static_cast<int>(a), *gains);
+  while (const auto change = gains_.try_pop()) {
+    for (std::size_t a = 0; a < axes; ++a) {
+      if (change->set[a]) stage_.set_servo_gains(static_cast<int>(a), change->gains[a]);
+    }
   }
   while (const auto commands = commands_.try_pop()) {
     ++commands_processed_;
@@ -185,12 +191,12 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     bool at_safe = !stage_.armed();
     for (std::size_t a = 0; a < axes; ++a) {
       moved = moved || decided[a].u_applied_V != u_before_V[a];
-      at_safe = at_safe && decided[a].u_applied_V == settings_.limits.safe_u_V;
+      at_safe = at_safe && decided[a].u_applied_V == safe_u_V_[a];
     }
     if (moved) ++stop_ramp_ticks_;
     if (at_safe) {
       stop_reached_ns_ = monotonic_ns();
-      backend_->hold_safe(settings_.limits.safe_u_V);
+      backend_->hold_safe(safe_voltages());
       reached_now = true;  // published once this tick's sample is queued
     }
   }

@@ -17,6 +17,7 @@
 
 #include "bridge/bridge_settings.hpp"
 #include "bridge/rt_report.hpp"
+#include "bridge/servo_request.hpp"
 #include "bridge/stage_backend.hpp"
 #include "core/process.hpp"
 #include "core/ticks.hpp"
@@ -76,8 +77,9 @@ class BridgeRealtime {
   bool push_commands(std::span<const CommandTick> per_axis) noexcept;
   // A one-axis stage's command.
   bool push_command(const CommandTick& command) noexcept { return push_commands(std::span(&command, 1)); }
-  // Every axis's servo.
-  bool push_gains(const FeedbackGains& gains) noexcept { return gains_.try_push(gains); }
+  // New servo gains for the axes `change` sets (validated by the caller), bumplessly, all on the
+  // same tick (false: the queue is full; nothing taken).
+  bool push_gains(const AxisGainsChange& change) noexcept { return gains_.try_push(change); }
   int axes() const noexcept { return stage_.axes(); }
   std::optional<OutgoingTick> pop_tick() noexcept { return samples_.try_pop(); }
   void request_arm(ArmRequest request) noexcept { arm_request_.store(request, std::memory_order_release); }
@@ -88,6 +90,10 @@ class BridgeRealtime {
   const SetupStatus& priority_status() const noexcept { return priority_status_; }
   const SetupStatus& affinity_status() const noexcept { return affinity_status_; }
   const StageBackend& backend() const noexcept { return *backend_; }
+  // Each axis's safe voltage, axes() entries.
+  std::span<const double> safe_voltages() const noexcept {
+    return std::span(safe_u_V_).first(static_cast<std::size_t>(stage_.axes()));
+  }
 
  private:
   void run() noexcept;
@@ -104,7 +110,8 @@ class BridgeRealtime {
     std::array<CommandTick, kMaxAxes> axis{};
   };
   SpscQueue<TickCommands, kCommandQueue> commands_;  // a tick's commands of every axis
-  SpscQueue<FeedbackGains, 8> gains_;
+  SpscQueue<AxisGainsChange, 8> gains_;
+  std::array<double, kMaxAxes> safe_u_V_{};  // each axis's actuator.safe_u_V
   SpscQueue<OutgoingTick, kSampleQueue> samples_;
   std::atomic<ArmRequest> arm_request_{ArmRequest::kNone};
   RtReportExchange reports_;

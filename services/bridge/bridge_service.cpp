@@ -33,7 +33,7 @@ BridgeService::BridgeService(const BridgeSettings& settings, lcm::LCM& lcm, cons
                 {.queue_capacity = settings.command_queue_capacity, .on_reject = {}}),
       control_(lcm, channels.control, [this](const control_t& msg, std::int64_t) { on_control(msg); }),
       status_(lcm, channels.status, "bridge"),
-      gains_(settings.servo) {
+      gains_(settings.axes_servo()) {
   reserve_storage(block_);
   begin_block(block_, 0, 0, settings_.dt_s(), settings_.axes);
   if (rt_.backend().simulated()) {
@@ -87,20 +87,25 @@ void BridgeService::on_control(const control_t& msg) {
       safe_reason_ = "disarmed via HX_CONTROL";
       return;
     case control_t::SET_GAINS: {
-      FeedbackGains g;
+      AxisGainsChange change;
       try {
-        g = requested_gains(gains_, msg);
+        change = requested_axis_gains(gains_, settings_.axes, msg);
       } catch (const std::exception& e) {
-        return refuse(msg, "SET_GAINS", e.what());  // the gains in force stay
+        return refuse(msg, "SET_GAINS", e.what());  // the gains in force stay, on every axis
       }
-      if (!rt_.push_gains(g)) {
+      if (!rt_.push_gains(change)) {
         return refuse(msg, "SET_GAINS", "the real-time thread has not taken the last gains yet: send again");
       }
       act(msg, nullptr);
-      gains_ = g;
-      spdlog::info("servo gains kp {}, ki {} 1/s, kd {} s, {} (request {})", g.kp, g.ki, g.kd,
-                   g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
-                   msg.request_id);
+      gains_ = change.gains;
+      for (int a = 0; a < settings_.axes; ++a) {
+        if (!change.set[static_cast<std::size_t>(a)]) continue;
+        const FeedbackGains& g = gains_[static_cast<std::size_t>(a)];
+        spdlog::info("servo{} gains kp {}, ki {} 1/s, kd {} s, {} (request {})",
+                     settings_.axes > 1 ? fmt::format(" {}", axis_name(a)) : std::string(), g.kp, g.ki, g.kd,
+                     g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
+                     msg.request_id);
+      }
       return;
     }
     case control_t::RESET_COUNTERS:
@@ -338,6 +343,14 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
   return now;
 }
 
+bool BridgeService::at_safe_voltage(const RtReport& rt) const noexcept {
+  if (rt.armed) return false;
+  for (int a = 0; a < rt.axes; ++a) {
+    if (rt.axis_u_V[static_cast<std::size_t>(a)] != settings_.limits_of(a).safe_u_V) return false;
+  }
+  return true;
+}
+
 void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping) {
   const BridgeCounters& core = rt.core;
   CounterSet::Entries now = counter_entries(rt);
@@ -372,7 +385,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
 
   const BridgeHealthInput health{.stopping = stopping,
                                  .armed = rt.armed,
-                                 .at_safe_voltage = rt.u_applied_V == settings_.limits.safe_u_V && !rt.armed,
+                                 .at_safe_voltage = at_safe_voltage(rt),
                                  .safe_u_V = settings_.limits.safe_u_V,
                                  .safe_reason = safe_reason_,
                                  .late_fraction = late_fraction,
@@ -405,9 +418,13 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   counters_.report(status_, now);
   status_.counter("armed", rt.armed ? 1 : 0);
   acks_.report(status_);
-  const ServoGainsFigures gains{gains_.kp, gains_.ki, gains_.kd, gains_.notch_hz,
-                                gains_.has_notch() ? gains_.notch_q : 0.0};
-  for (const ServoGainCounter& c : kServoGainCounters) status_.counter(c.name, servo_gain_counter(c, gains));
+  for (int a = 0; a < settings_.axes; ++a) {
+    const FeedbackGains& g = gains_[static_cast<std::size_t>(a)];
+    const ServoGainsFigures gains{g.kp, g.ki, g.kd, g.notch_hz, g.has_notch() ? g.notch_q : 0.0};
+    for (const ServoGainCounter& c : kServoGainCounters) {
+      status_.counter(servo_gain_counter_name(c, a), servo_gain_counter(c, gains));
+    }
+  }
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
   status_.counter("clamped_per_s", rt.clamped_last_second.either);
   status_.counter("buffer_depth_ticks", static_cast<std::uint64_t>(std::max<std::int64_t>(0, rt.buffer_depth)));

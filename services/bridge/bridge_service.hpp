@@ -58,6 +58,8 @@ class BridgeService {
   void serve(bool stopping);  // one pass of the I/O loop: samples out, LCM in, status
   CounterSet::Entries counter_entries(const RtReport& rt) const;
   void report(const RtReport& rt, std::int64_t utime, bool stopping);
+  // Disarmed, and every axis at its actuator.safe_u_V.
+  bool at_safe_voltage(const RtReport& rt) const noexcept;
   void log_safe_stop(const SafeStopResult& safe) const;
   void summarize(const RtReport& rt, const SafeStopResult& safe) const;
 
@@ -94,7 +96,7 @@ class BridgeService {
   SensorBlockRepair repair_;
   LogLimiter log_limiter_;  // one line a second per reason (LogReason)
   enum LogReason : std::size_t { kLogSensorRepaired, kLogSensorUnpublished };
-  FeedbackGains gains_;  // the servo's, as last set
+  std::array<FeedbackGains, kMaxAxes> gains_;  // each axis's servo, as last set
   std::string summary_json_path_;
   double started_s_ = monotonic_s();  // [s], core/clock.hpp
 

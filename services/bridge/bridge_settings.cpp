@@ -4,6 +4,7 @@
 #include <climits>
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -14,6 +15,97 @@
 #include "runtime/rig_auth_config.hpp"
 
 namespace hystloop {
+namespace {
+
+// An axis's own keys: actuator.<field> and servo.<field> for x, actuator.y.<field> ... for y and z.
+constexpr const char* kAxisActuatorKeys[] = {"u_min_V", "u_max_V", "slew_V_per_s", "safe_u_V", "safe_ramp_V_per_s"};
+constexpr const char* kAxisServoKeys[] = {"kp",          "ki",       "kd",     "nominal_gain_m_per_V",
+                                          "d_filter_hz", "notch_hz", "notch_q"};
+
+std::string axis_prefix(const char* section, int axis) { return axis_field(section, axis); }
+std::string axis_key(const char* section, int axis, const char* field) { return axis_prefix(section, axis) + field; }
+
+bool has_axis_keys(const Config& config, const char* section, int axis, std::span<const char* const> fields) {
+  return std::any_of(fields.begin(), fields.end(),
+                     [&](const char* f) { return config.has(axis_key(section, axis, f)); });
+}
+
+// Axis `axis`'s actuator (actuator.* for x, actuator.y.* ...), each key absent taken from `a`.
+ActuatorLimits load_limits(const Config& config, int axis, ActuatorLimits a) {
+  const std::string p = axis_prefix("actuator.", axis);
+  a.u_min_V = config.get_in_range(p + "u_min_V", a.u_min_V, -1e4, 1e4);
+  a.u_max_V = config.get_in_range(p + "u_max_V", a.u_max_V, -1e4, 1e4);
+  a.slew_V_per_s = config.get_positive(p + "slew_V_per_s", a.slew_V_per_s);
+  a.safe_u_V = config.get_in_range(p + "safe_u_V", a.safe_u_V, -1e4, 1e4);
+  a.safe_ramp_V_per_s = config.get_positive(p + "safe_ramp_V_per_s", a.safe_ramp_V_per_s);
+  try {
+    a.validate();
+  } catch (const ParameterError& e) {
+    config.fail(axis_field(e.field(), axis), e.reason());
+  }
+  return a;
+}
+
+// Axis `axis`'s servo (servo.* for x, servo.y.* ...), each key absent taken from `g`; its output
+// range the axis's actuator's `a`.
+FeedbackGains load_servo(const Config& config, int axis, FeedbackGains g, const ActuatorLimits& a, double rate_hz) {
+  const std::string p = axis_prefix("servo.", axis);
+  g.kp = config.get_non_negative(p + "kp", g.kp);
+  g.ki = config.get_non_negative(p + "ki", g.ki);
+  g.kd = config.get_non_negative(p + "kd", g.kd);
+  g.nominal_gain_m_per_V = config.get_positive(p + "nominal_gain_m_per_V", g.nominal_gain_m_per_V);
+  g.d_filter_hz = config.get_positive(p + "d_filter_hz", g.d_filter_hz);
+  g.notch_hz = config.get_non_negative(p + "notch_hz", g.notch_hz);
+  // Checked here even without a notch: a Q the file gives is meant to be used.
+  g.notch_q = config.get_in_range(p + "notch_q", g.notch_q, kNotchMinQ, kNotchMaxQ);
+  g.u_min_V = a.u_min_V;
+  g.u_max_V = a.u_max_V;
+  g.tick_rate_hz = rate_hz;
+  // Its fields are named servo.* (servo.y.*); the gains within the plausibility bounds (loop/feedback.hpp).
+  try {
+    g.check_bounds();
+  } catch (const ParameterError& e) {
+    config.fail(axis_field(e.field(), axis), e.reason());
+  }
+  return g;
+}
+
+}  // namespace
+
+const ActuatorLimits& BridgeSettings::limits_of(int axis) const noexcept {
+  const auto& own = axis_limits[static_cast<std::size_t>(axis)];
+  return axis > 0 && own ? *own : limits;
+}
+
+const FeedbackGains& BridgeSettings::servo_of(int axis) const noexcept {
+  const auto& own = axis_servo[static_cast<std::size_t>(axis)];
+  return axis > 0 && own ? *own : servo;
+}
+
+std::array<ActuatorLimits, kMaxAxes> BridgeSettings::axes_limits() const noexcept {
+  std::array<ActuatorLimits, kMaxAxes> out{};
+  for (int i = 0; i < kMaxAxes; ++i) out[static_cast<std::size_t>(i)] = limits_of(i);
+  return out;
+}
+
+std::array<FeedbackGains, kMaxAxes> BridgeSettings::axes_servo() const noexcept {
+  std::array<FeedbackGains, kMaxAxes> out{};
+  for (int i = 0; i < kMaxAxes; ++i) out[static_cast<std::size_t>(i)] = servo_of(i);
+  return out;
+}
+
+std::array<double, kMaxAxes> BridgeSettings::safe_voltages() const noexcept {
+  std::array<double, kMaxAxes> out{};
+  for (int i = 0; i < kMaxAxes; ++i) out[static_cast<std::size_t>(i)] = limits_of(i).safe_u_V;
+  return out;
+}
+
+double BridgeSettings::longest_safe_ramp_s() const noexcept {
+  double longest = 0.0;
+  for (int i = 0; i < axes; ++i) longest = std::max(longest, limits_of(i).longest_safe_ramp_s());
+  return longest;
+}
+
 AxisMatrix default_stage_coupling() noexcept { return flexure_stage(kMaxAxes).coupling.matrix(); }
 
 MultiAxisStageConfig multi_axis_stage(const BridgeSettings& settings) {
@@ -50,18 +142,6 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "bridge.command_queue_capacity",
                                                 "bridge.block_ticks",
                                                 "bridge.max_lead_s",
-                                                "servo.kp",
-                                                "servo.ki",
-                                                "servo.kd",
-                                                "servo.nominal_gain_m_per_V",
-                                                "servo.d_filter_hz",
-                                                "servo.notch_hz",
-                                                "servo.notch_q",
-                                                "actuator.u_min_V",
-                                                "actuator.u_max_V",
-                                                "actuator.slew_V_per_s",
-                                                "actuator.safe_u_V",
-                                                "actuator.safe_ramp_V_per_s",
                                                 "actuator.watchdog_s",
                                                 "rt.ticks_per_wake",
                                                 "rt.priority",
@@ -70,6 +150,11 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "rt.cpu"};
   static const std::vector<std::string> all = [] {
     std::vector<std::string> k = keys;
+    // actuator.* and servo.* for axis x, actuator.y.*, servo.y.* ... for the others.
+    for (int axis = 0; axis < kMaxAxes; ++axis) {
+      for (const char* field : kAxisActuatorKeys) k.push_back(axis_key("actuator.", axis, field));
+      for (const char* field : kAxisServoKeys) k.push_back(axis_key("servo.", axis, field));
+    }
     k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
     append_config_keys(k, BanningDescriptor::name, BanningDescriptor::table());  // the simulated stage
     append_config_keys(k, "ro", MemDescriptor::table());                         // the Ramberg-Osgood plant
@@ -128,33 +213,30 @@ BridgeSettings load_bridge_settings(const Config& config) {
     validate_config_section(config, "", [&] { multi_axis_stage(s).validate(); });
   }
 
-  ActuatorLimits& a = s.limits;
-  a.u_min_V = config.get_in_range("actuator.u_min_V", a.u_min_V, -1e4, 1e4);
-  a.u_max_V = config.get_in_range("actuator.u_max_V", a.u_max_V, -1e4, 1e4);
-  a.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", a.slew_V_per_s);
-  a.safe_u_V = config.get_in_range("actuator.safe_u_V", a.safe_u_V, -1e4, 1e4);
-  a.safe_ramp_V_per_s = config.get_positive("actuator.safe_ramp_V_per_s", a.safe_ramp_V_per_s);
-  a.watchdog_s = config.get_in_range("actuator.watchdog_s", a.watchdog_s, 1e-5, 10.0);
-  validate_config_section(config, "", [&] { a.validate(); });
-  if (a.watchdog_s < 2.0 * s.dt_s()) {
+  s.limits = load_limits(config, 0, s.limits);
+  s.limits.watchdog_s = config.get_in_range("actuator.watchdog_s", s.limits.watchdog_s, 1e-5, 10.0);
+  validate_config_section(config, "", [&] { s.limits.validate(); });
+  if (s.limits.watchdog_s < 2.0 * s.dt_s()) {
     config.fail("actuator.watchdog_s", "must be at least two ticks (" + std::to_string(2.0 * s.dt_s()) + " s)");
   }
-  s.stop_ramp_timeout_s = a.longest_safe_ramp_s() + kStopRampMargin_s;
-
-  FeedbackGains& g = s.servo;
-  g.kp = config.get_non_negative("servo.kp", g.kp);
-  g.ki = config.get_non_negative("servo.ki", g.ki);
-  g.kd = config.get_non_negative("servo.kd", g.kd);
-  g.nominal_gain_m_per_V = config.get_positive("servo.nominal_gain_m_per_V", g.nominal_gain_m_per_V);
-  g.d_filter_hz = config.get_positive("servo.d_filter_hz", g.d_filter_hz);
-  g.notch_hz = config.get_non_negative("servo.notch_hz", g.notch_hz);
-  // Checked here even without a notch: a Q the file gives is meant to be used.
-  g.notch_q = config.get_in_range("servo.notch_q", g.notch_q, kNotchMinQ, kNotchMaxQ);
-  g.u_min_V = a.u_min_V;
-  g.u_max_V = a.u_max_V;
-  g.tick_rate_hz = s.rate_hz;
-  // Its fields are named servo.*; the gains within the plausibility bounds (loop/feedback.hpp).
-  validate_config_section(config, "", [&] { g.check_bounds(); });
+  s.servo = load_servo(config, 0, s.servo, s.limits, s.rate_hz);
+  for (int axis = 1; axis < kMaxAxes; ++axis) {
+    const bool own_actuator = has_axis_keys(config, "actuator.", axis, kAxisActuatorKeys);
+    const bool own_servo = has_axis_keys(config, "servo.", axis, kAxisServoKeys);
+    if (!own_actuator && !own_servo) continue;
+    if (axis >= s.axes) {
+      const std::string section = own_actuator ? "actuator." : "servo.";
+      config.fail(section + std::string(axis_name(axis)),
+                  "the stage has " + std::to_string(s.axes) + " ax" + (s.axes == 1 ? "is" : "es") +
+                      " (bridge.axes): there is no axis " + std::string(axis_name(axis)));
+    }
+    const auto at = static_cast<std::size_t>(axis);
+    const ActuatorLimits a = load_limits(config, axis, s.limits);
+    if (own_actuator) s.axis_limits[at] = a;
+    // An axis's servo clamps to its own actuator's range, whether its gains are its own or x's.
+    s.axis_servo[at] = load_servo(config, axis, s.servo, a, s.rate_hz);
+  }
+  s.stop_ramp_timeout_s = s.longest_safe_ramp_s() + kStopRampMargin_s;
 
   s.rt.ticks_per_wake = static_cast<int>(config.get_int_in_range("rt.ticks_per_wake", s.rt.ticks_per_wake, 1, 1000));
   if (s.rt.ticks_per_wake > s.block_ticks) {
@@ -177,25 +259,35 @@ BridgeSettings load_bridge_settings(const Config& config) {
 
 std::vector<std::string> describe(const BridgeSettings& s) {
   const auto& st = s.stage;
-  const auto& a = s.limits;
   std::vector<std::string> lines;
   if (s.axes > 1) {
-    lines.push_back(
-        fmt::format("axes: {} on one clock and one safe state, the same actuator limits and servo each; "
-                    "noise seeds {}..{}; coupling{}",
-                    s.axes, s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1,
-                    describe_coupling(s.coupling, s.axes)));
+    lines.push_back(fmt::format("axes: {} on one clock and one safe state; noise seeds {}..{}; coupling{}", s.axes,
+                                s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1,
+                                describe_coupling(s.coupling, s.axes)));
   }
   lines.push_back(fmt::format(
       "bridge: backend {}, rate {} Hz, noise {:.3g} m RMS, seed {}, drift {:+.3g} over {} s from {} s, {}{}", s.backend,
       s.rate_hz, st.noise_rms_m, st.seed, st.drift_fraction, st.drift_duration_s, st.drift_start_s,
       s.auto_arm ? "auto-arm" : "arm via HX_CONTROL",
       s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
+  // Axis x's actuator and servo, then each other axis's where it has its own ("as x" otherwise).
+  const auto axis_label = [&](const char* section, int axis) {
+    return s.axes == 1 ? std::string(section) : fmt::format("{} {}", section, axis_name(axis));
+  };
+  for (int axis = 0; axis < s.axes; ++axis) {
+    const ActuatorLimits& a = s.limits_of(axis);
+    if (axis > 0 && !s.axis_limits[static_cast<std::size_t>(axis)]) {
+      lines.push_back(axis_label("actuator", axis) + ": as x");
+      continue;
+    }
+    lines.push_back(fmt::format("{}: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s",
+                                axis_label("actuator", axis), a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V,
+                                a.safe_ramp_rate_V_per_s(), axis == 0 ? "" : ""));
+  }
   lines.push_back(
-      fmt::format("actuator: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s, watchdog {} s, "
-                  "stop: ramp to safe (at most {:.4g} s) within {} s",
-                  a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V, a.safe_ramp_rate_V_per_s(), a.watchdog_s,
-                  a.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
+      fmt::format("watchdog {} s for the stage; stop: every axis ramps to its safe voltage (the longest "
+                  "ramp at most {:.4g} s) within {} s",
+                  s.limits.watchdog_s, s.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
   if (s.backend == "comedi") {
     lines.push_back(describe(s.comedi));
   } else if (s.backend == "sim") {
@@ -203,12 +295,14 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   } else {
     lines.push_back("ro: " + MemDescriptor::summary_of(st.ramberg_osgood));
   }
-  lines.push_back(fmt::format("servo: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}", s.servo.kp,
-                              s.servo.ki, s.servo.kd, s.servo.nominal_gain_m_per_V,
-                              s.servo.has_notch()
-                                  ? fmt::format("notch at {} Hz (Q {})", s.servo.notch_hz, s.servo.notch_q)
-                                  : std::string("no notch"),
-                              s.servo.enabled() ? "" : " (off: feedforward only)"));
+  for (int axis = 0; axis < s.axes; ++axis) {
+    const FeedbackGains& g = s.servo_of(axis);
+    lines.push_back(fmt::format(
+        "{}: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}", axis_label("servo", axis), g.kp, g.ki,
+        g.kd, g.nominal_gain_m_per_V,
+        g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : std::string("no notch"),
+        g.enabled() ? "" : " (off: feedforward only)"));
+  }
   lines.push_back(
       fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s); commands taken up to {} s "
                   "ahead of the clock (bridge.max_lead_s)",

@@ -3,7 +3,9 @@
 // overrides) and validated there: a refused value throws ConfigError naming the file and
 // the field. Keys carry SI units in their names (see deploy/config/bridge.yaml).
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,8 +33,8 @@ AxisMatrix default_stage_coupling() noexcept;
 
 struct BridgeSettings {
   std::string backend = "sim";  // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
-  // Axes on the one clock (1..kMaxAxes: x, y, z), each with the actuator limits and servo below,
-  // all in one safe state (MultiAxisBridge). More than one: the simulators only, for now.
+  // Axes on the one clock (1..kMaxAxes: x, y, z), each with its actuator limits and servo
+  // (limits_of, servo_of), all in one safe state (MultiAxisBridge).
   int axes = 1;
   // The simulated XY(Z) stage's coupling C (models/axis_coupling.hpp): C(j, i) is axis j's output
   // per metre of axis i's own displacement (coupling.x_to_y is C(1, 0)). Only its axes x axes
@@ -41,9 +43,14 @@ struct BridgeSettings {
   double rate_hz = 10000.0;      // the loop's clock
   SimulatedStageConfig stage{};  // noise, seed, drift and the plants' parameters
   ComediSettings comedi{};       // the comedi.* keys (used when backend is comedi)
-  ActuatorLimits limits{};
-  FeedbackGains servo{};  // the servo on y_ref - y (all gains 0 = feedforward only)
-  int block_ticks = 50;   // ticks per HX_SENSOR block: 200 messages/s (1 = a message per tick)
+  ActuatorLimits limits{};       // axis x's (actuator.*), and every other axis's unless it has its own
+  FeedbackGains servo{};         // axis x's servo on y_ref - y (servo.*; all gains 0 = feedforward only), likewise
+  // Axes y and z with keys of their own (actuator.y.u_max_V, servo.z.kp, ...): axis x's with those
+  // keys applied. Empty: the axis is as x. [0] is never set. The watchdog is the stage's: one key,
+  // actuator.watchdog_s, for every axis.
+  std::array<std::optional<ActuatorLimits>, kMaxAxes> axis_limits{};
+  std::array<std::optional<FeedbackGains>, kMaxAxes> axis_servo{};
+  int block_ticks = 50;  // ticks per HX_SENSOR block: 200 messages/s (1 = a message per tick)
   RtSettings rt{};
   bool auto_arm = false;                 // arm as soon as commands flow (first arm only)
   double rearm_after_trip_s = 0.0;       // > 0: re-arm this long after a watchdog trip once commands flow (0 = never)
@@ -58,6 +65,16 @@ struct BridgeSettings {
   double max_lead_s = 0.06;
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
+  // Axis i's actuator and servo (0 <= i < kMaxAxes).
+  const ActuatorLimits& limits_of(int axis) const noexcept;
+  const FeedbackGains& servo_of(int axis) const noexcept;
+  // Every axis's, axes entries: what MultiAxisBridge takes.
+  std::array<ActuatorLimits, kMaxAxes> axes_limits() const noexcept;
+  std::array<FeedbackGains, kMaxAxes> axes_servo() const noexcept;
+  // Axis i's safe voltage, axes entries (StageBackend::hold_safe).
+  std::array<double, kMaxAxes> safe_voltages() const noexcept;
+  // The stop's ramp: the longest of every axis's (ActuatorLimits::longest_safe_ramp_s).
+  double longest_safe_ramp_s() const noexcept;
 };
 
 // How long a stop's ramp to actuator.safe_u_V may take beyond the longest one (from the end of

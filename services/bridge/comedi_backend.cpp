@@ -154,14 +154,14 @@ ComediBackend::ComediBackend(const ComediSettings& settings, const ActuatorLimit
   tick_insns_[1] = instruction(INSN_READ, &adc_word_, ai_subdevice_, settings_.ai);
   tick_list_.n_insns = 2;
   tick_list_.insns = tick_insns_;
-  hold_safe(limits_.safe_u_V);  // before anything can arm
+  write_safe(limits_.safe_u_V);  // before anything can arm
   g_live.store(this);
   install_emergency_handlers();
   spdlog::info("{}; the safe {} V written (DAC code {})", describe(), limits_.safe_u_V, safe_data_);
 }
 
 ComediBackend::~ComediBackend() {
-  hold_safe(limits_.safe_u_V);  // the last word (a step: the bridge's ramp ended before, or could not run)
+  write_safe(limits_.safe_u_V);  // the last word (a step: the bridge's ramp ended before, or could not run)
   ComediBackend* self = this;
   g_live.compare_exchange_strong(self, nullptr);
 }
@@ -205,7 +205,7 @@ void ComediBackend::check_against_card() {
   safe_list_.n_insns = 1;
   safe_list_.insns = &safe_insn_;
   const auto refuse = [&](const std::string& field, const std::string& reason) {
-    hold_safe(limits_.safe_u_V);
+    write_safe(limits_.safe_u_V);
     fail(field, reason);
   };
   const double lo_V = settings_.card_V(limits_.u_min_V), hi_V = settings_.card_V(limits_.u_max_V);
@@ -219,7 +219,7 @@ void ComediBackend::check_against_card() {
     adc_ = ComediConverter(dev, ai_subdevice_, static_cast<unsigned>(settings_.ai.channel),
                            static_cast<unsigned>(settings_.ai.range), handle_.calibration);
   } catch (const ConfigError&) {
-    hold_safe(limits_.safe_u_V);
+    write_safe(limits_.safe_u_V);
     throw;
   } catch (const std::runtime_error& e) {
     refuse("comedi.ai.range", e.what());
@@ -274,7 +274,9 @@ StageReading ComediBackend::step(double u_V, double /*t_s*/, double /*dt_s*/) no
   return reading;
 }
 
-void ComediBackend::hold_safe(double safe_u_V) noexcept {
+void ComediBackend::hold_safe(std::span<const double> safe_u_V) noexcept { write_safe(safe_u_V[0]); }
+
+void ComediBackend::write_safe(double safe_u_V) noexcept {
   safe_data_ = dac_code(safe_u_V);
   comedi_do_insnlist(handle_.device, &safe_list_);
   counters_.safe_writes.fetch_add(1, std::memory_order_relaxed);

@@ -86,7 +86,7 @@ class ComediBackend final : public StageBackend {
 
   StageReading step(double u_V, double t_s, double dt_s) noexcept override;
   const std::string& name() const noexcept override { return name_; }
-  void hold_safe(double safe_u_V) noexcept override;
+  void hold_safe(std::span<const double> safe_u_V) noexcept override;
   void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& entries) const override;
 
   // The DAC code for `u_V` at the piezo: clamped to the actuator's range, divided by the
@@ -106,6 +106,7 @@ class ComediBackend final : public StageBackend {
 
  private:
   void check_against_card();  // throws ConfigError
+  void write_safe(double safe_u_V) noexcept;
 
   ComediSettings settings_;
   ActuatorLimits limits_;

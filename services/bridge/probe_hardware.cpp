@@ -127,7 +127,7 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
     std::this_thread::sleep_until(next);
   }
-  backend.hold_safe(a.safe_u_V);
+  backend.hold_safe(std::span(&a.safe_u_V, 1));
   const ProbeFit f = fit(command_V, sensor_V, faults);
   std::fprintf(out, "back at the safe %g V (%.4g V at the card)\n", a.safe_u_V, center_V);
   std::fprintf(out, "measured: sensor %+.4g V per V at the card (offset %+.4g V, r %.4f) over %d samples, %d faulted\n",

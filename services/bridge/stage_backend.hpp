@@ -48,13 +48,13 @@ class StageBackend {
   // True when the stage has no wall clock of its own (a simulator): ticks the clock thread
   // could not run on time are then run late, back to back, instead of being skipped.
   virtual bool simulated() const noexcept { return false; }
-  // The safe-state hook: leave the actuator at safe_u_V [V] and keep it there without further
+  // The safe-state hook: leave axis i's actuator at safe_u_V[i] [V] (axes() entries) and keep it there without further
   // step() calls. Called on the real-time thread once the stop's ramp has reached safe_u_V (the
   // last step() applied it), and again after the real-time thread ended and when the bridge is
   // destroyed, whatever happened before (then the ramp may not have finished: a hardware backend
   // takes the actuator there the way the device allows, e.g. its own ramp or output disable).
   // May be called more than once; must not throw, allocate or block for long.
-  virtual void hold_safe(double safe_u_V) noexcept = 0;
+  virtual void hold_safe(std::span<const double> safe_u_V) noexcept = 0;
   // The backend's own counters (cumulative; read on the I/O thread while step() runs, so kept
   // in atomics), appended to the bridge's HX_STATUS counters.
   virtual void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& /*entries*/) const {}
@@ -69,7 +69,7 @@ class SimulatedBackend final : public StageBackend {
   double gain_scale() const noexcept override { return stage_.gain_scale(); }
   bool simulated() const noexcept override { return true; }
   // A simulated stage has no output stage that could keep driving it: nothing to do.
-  void hold_safe(double /*safe_u_V*/) noexcept override {}
+  void hold_safe(std::span<const double> /*safe_u_V*/) noexcept override {}
 
  private:
   std::string name_;
@@ -87,7 +87,7 @@ class MultiAxisSimulatedBackend final : public StageBackend {
   const std::string& name() const noexcept override { return name_; }
   double gain_scale() const noexcept override;
   bool simulated() const noexcept override { return true; }
-  void hold_safe(double /*safe_u_V*/) noexcept override {}
+  void hold_safe(std::span<const double> /*safe_u_V*/) noexcept override {}
 
  private:
   std::string name_;

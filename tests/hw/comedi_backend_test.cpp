@@ -3,6 +3,7 @@
 // read), the conversions both ways (range tables and softcal), the clamp before the DAC, the
 // fault counting and the request to go safe, the refusal of a config the card cannot do after
 // the device was opened (the safe voltage written first), and no allocation per tick.
+#include <array>
 #include "bridge/comedi_backend.hpp"
 
 #include <gtest/gtest.h>
@@ -211,7 +212,7 @@ TEST_F(ComediBackendTest, ATickDoesNotAllocate) {
   b.step(0.0, 0, 1e-4);
   const testing::AllocationCounter count;
   for (int k = 0; k < 1000; ++k) b.step(k * 0.1, k * 1e-4, 1e-4);
-  b.hold_safe(0.0);
+  b.hold_safe(std::array{0.0});
   EXPECT_EQ(count.allocations(), 0u);
 }
 
@@ -219,7 +220,7 @@ TEST_F(ComediBackendTest, HoldSafeAndTheDestructorStepToTheSafeVoltage) {
   {
     ComediBackend b(settings(), limits(-25.0));
     b.step(200.0, 0, 1e-4);
-    b.hold_safe(-25.0);
+    b.hold_safe(std::array{-25.0});
     EXPECT_EQ(fake().lists.back().n_insns, 1u);
     EXPECT_EQ(fake().lists.back().insns[0].data, code(-1.0, -10, 10));
     b.step(200.0, 0, 1e-4);

@@ -311,6 +311,20 @@ TEST(MessageChecks, Control) {
   m = fixtures::control(1);
   m.request_id = 0;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  // An axis, or every axis for a servo's gains only.
+  m = fixtures::control(1);
+  m.command = control_t::SET_GAINS;
+  m.axis = control_t::EVERY_AXIS;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.axis = 2;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.axis = 3;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.axis = -2;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.command = control_t::START_EXPERIMENT;
+  m.axis = control_t::EVERY_AXIS;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
 }
 
 // Found by tests/fuzz/fuzz_messages: a string with a NUL inside decodes, but is cut when the

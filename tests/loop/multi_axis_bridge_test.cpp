@@ -69,7 +69,7 @@ TEST(MultiAxisBridge, RefusesAxisCountsThatDoNotMatchAndNamesTheAxisOfABadLimit)
   EXPECT_EQ(refused_field([&] { MultiAxisBridge(0, std::span(limits).first(0), std::span(servo).first(0)); }), "axes");
   ActuatorLimits bad;
   bad.slew_V_per_s = -1.0;
-  EXPECT_EQ(refused_field([&] { two_axes(bad); }), "y.actuator.slew_V_per_s");
+  EXPECT_EQ(refused_field([&] { two_axes(bad); }), "actuator.y.slew_V_per_s");
 }
 
 TEST(MultiAxisBridge, ACommandForAnAxisTheStageDoesNotHaveIsRefused) {

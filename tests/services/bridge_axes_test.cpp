@@ -5,6 +5,7 @@
 // stop. Real threads, real time: a few tenths of a second in all.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -16,6 +17,7 @@
 
 #include "bridge/bridge_realtime.hpp"
 #include "bridge/bridge_settings.hpp"
+#include "bridge/servo_request.hpp"
 #include "bridge/stage_backend.hpp"
 
 namespace hystloop {
@@ -56,6 +58,107 @@ TEST(BridgeAxes, SettingsTakeTheAxesAndTheCouplingAndNameWhatTheyRefuse) {
                                "-0.5, z_to_x: -0.5, z_to_y: -0.5}"),
                        "coupling"));
   EXPECT_EQ(refusal("bridge: {axes: 3, backend: ro}"), "accepted");
+}
+
+// Each axis its own actuator and servo where it has keys of its own (actuator.y.*, servo.y.*),
+// axis x's otherwise; a refusal names the axis's own key; keys of an axis the stage lacks are refused.
+TEST(BridgeAxes, EachAxisHasItsOwnActuatorAndServoWhereItHasKeys) {
+  const BridgeSettings s = load_bridge_settings(Config::from_string(
+      "bridge: {axes: 3}\nactuator: {u_max_V: 200.0, y: {u_min_V: -30.0, u_max_V: 150.0, safe_u_V: 60.0}}\n"
+      "servo: {kp: 0.05, z: {kp: 0.2, notch_hz: 0.0}}",
+      "bridge.yaml"));
+  EXPECT_EQ(s.limits_of(0).u_max_V, 200.0);
+  EXPECT_EQ(s.limits_of(1).u_min_V, -30.0);
+  EXPECT_EQ(s.limits_of(1).u_max_V, 150.0);
+  EXPECT_EQ(s.limits_of(1).safe_u_V, 60.0);
+  EXPECT_EQ(s.limits_of(1).slew_V_per_s, s.limits.slew_V_per_s);  // the rest as x's
+  EXPECT_EQ(s.limits_of(2).u_max_V, 200.0);                       // z: as x
+  EXPECT_EQ(s.servo_of(0).kp, 0.05);
+  EXPECT_EQ(s.servo_of(1).kp, 0.05);        // y's gains are x's ...
+  EXPECT_EQ(s.servo_of(1).u_max_V, 150.0);  // ... its anti-windup its own actuator's range
+  EXPECT_EQ(s.servo_of(2).kp, 0.2);
+  EXPECT_EQ(s.servo_of(2).notch_hz, 0.0);
+  EXPECT_EQ(s.servo_of(2).ki, s.servo.ki);
+  EXPECT_EQ(s.safe_voltages()[1], 60.0);
+  // The stop's bound is the longest axis's ramp: x's from -250 V to 0 V (y's is 90 V at the same rate).
+  EXPECT_DOUBLE_EQ(s.longest_safe_ramp_s(), 250.0 / 1e3);
+  bool says_y = false, says_z = false;
+  for (const std::string& line : describe(s)) {
+    says_y = says_y || contains(line, "actuator y: range [-30, 150] V");
+    says_z = says_z || contains(line, "servo z: kp 0.2");
+  }
+  EXPECT_TRUE(says_y);
+  EXPECT_TRUE(says_z);
+
+  const BridgeSettings slow = load_bridge_settings(
+      Config::from_string("bridge: {axes: 2}\nactuator: {y: {safe_ramp_V_per_s: 100.0}}", "bridge.yaml"));
+  EXPECT_DOUBLE_EQ(slow.stop_ramp_timeout_s, 250.0 / 100.0 + kStopRampMargin_s);  // y's ramp is the longest
+
+  const std::string bad_range = refusal("bridge: {axes: 2}\nactuator: {y: {u_min_V: 10.0, u_max_V: 5.0}}");
+  EXPECT_TRUE(contains(bad_range, "bridge.yaml: actuator.y.u_max_V")) << bad_range;
+  const std::string bad_safe = refusal("bridge: {axes: 2}\nactuator: {y: {u_max_V: 100.0, safe_u_V: 120.0}}");
+  EXPECT_TRUE(contains(bad_safe, "actuator.y.safe_u_V")) << bad_safe;
+  const std::string bad_gain = refusal("bridge: {axes: 2}\nservo: {y: {kp: 2.5}}");
+  EXPECT_TRUE(contains(bad_gain, "bridge.yaml: servo.y.kp: must be <= 2")) << bad_gain;
+  const std::string no_z = refusal("bridge: {axes: 2}\nservo: {z: {kp: 0.1}}");
+  EXPECT_TRUE(contains(no_z, "servo.z: the stage has 2 axes")) << no_z;
+  EXPECT_TRUE(contains(refusal("actuator: {y: {u_max_V: 100.0}}"), "actuator.y: the stage has 1 axis"));
+  // One watchdog for the stage: an axis has none of its own.
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\nactuator: {y: {watchdog_s: 0.01}}"), "actuator.y.watchdog_s"));
+}
+
+// SET_GAINS names its axis, or every axis; all or nothing, the refusal naming the axis's field.
+TEST(BridgeAxes, SetGainsSetsTheAxisItNamesOrEveryAxis) {
+  const BridgeSettings s =
+      load_bridge_settings(Config::from_string("bridge: {axes: 2}\nservo: {kp: 0.05, y: {kp: 0.1}}", "bridge.yaml"));
+  const std::array<FeedbackGains, kMaxAxes> in_force = s.axes_servo();
+  control_t m{};
+  m.command = control_t::SET_GAINS;
+  m.kp = 0.3;
+  m.ki = std::nan("");
+  m.kd = std::nan("");
+  m.notch_hz = std::nan("");
+  m.notch_q = std::nan("");
+  m.axis = 1;
+  AxisGainsChange c = requested_axis_gains(in_force, 2, m);
+  EXPECT_FALSE(c.set[0]);
+  EXPECT_TRUE(c.set[1]);
+  EXPECT_EQ(c.gains[0].kp, 0.05);
+  EXPECT_EQ(c.gains[1].kp, 0.3);
+  m.axis = control_t::EVERY_AXIS;
+  m.kp = std::nan("");  // each axis keeps its own kp
+  m.ki = 1000.0;
+  c = requested_axis_gains(in_force, 2, m);
+  EXPECT_TRUE(c.set[0] && c.set[1] && !c.set[2]);
+  EXPECT_EQ(c.gains[0].kp, 0.05);
+  EXPECT_EQ(c.gains[1].kp, 0.1);
+  EXPECT_EQ(c.gains[0].ki, 1000.0);
+  EXPECT_EQ(c.gains[1].ki, 1000.0);
+  m.axis = 2;
+  try {
+    requested_axis_gains(in_force, 2, m);
+    FAIL() << "axis z taken on a stage of two";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "control.axis");
+  }
+  m.axis = control_t::EVERY_AXIS;
+  m.ki = 1e6;
+  try {
+    requested_axis_gains(in_force, 2, m);
+    FAIL() << "ki 1e6 taken";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "servo.ki");  // x's, the first axis it does not fit
+  }
+  m.axis = 1;
+  try {
+    requested_axis_gains(in_force, 2, m);
+    FAIL() << "ki 1e6 taken";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "servo.y.ki");
+  }
+  m.axis = 0;
+  m.ki = 1000.0;
+  EXPECT_EQ(requested_axis_gains(std::array<FeedbackGains, kMaxAxes>{s.servo}, 1, m).gains[0].ki, 1000.0);
 }
 
 TEST(BridgeAxes, TheSimulatorsBuildTheCoupledStageTheSettingsDescribe) {
@@ -103,7 +206,7 @@ class TwoAxisRecordingBackend final : public StageBackend {
   }
   const std::string& name() const noexcept override { return name_; }
   bool simulated() const noexcept override { return true; }
-  void hold_safe(double) noexcept override {}
+  void hold_safe(std::span<const double>) noexcept override {}
 
  private:
   AxesRecord& r_;
@@ -193,6 +296,43 @@ TEST(BridgeAxes, AStageArmsOnlyWhenEveryAxisHasCommands) {
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 1000; }));
   rt.stop();
   for (const auto& u : record.u_V) ASSERT_EQ(u[0], 0.0) << "x moved although y had no commands: never armed";
+}
+
+// Each axis clamps to its own actuator's range and ramps to its own safe voltage, at its own rate.
+TEST(BridgeAxes, EachAxisKeepsToItsOwnActuator) {
+  BridgeSettings s = two_axes();
+  ActuatorLimits y = s.limits;
+  y.u_min_V = -5.0;
+  y.u_max_V = 15.0;
+  y.safe_u_V = 5.0;
+  y.safe_ramp_V_per_s = 5e3;  // 0.5 V per tick
+  s.axis_limits[1] = y;
+  s.axis_servo[1] = s.servo;
+  s.axis_servo[1]->u_min_V = y.u_min_V;
+  s.axis_servo[1]->u_max_V = y.u_max_V;
+  AxesRecord record;
+  BridgeRealtime rt(s, std::make_unique<TwoAxisRecordingBackend>(record));
+  for (std::int64_t k = 0; k < 2000; ++k) {
+    const std::array<CommandTick, 2> tick{CommandTick{k, 10.0, std::nan(""), 1, 2},
+                                          CommandTick{k, 20.0, std::nan(""), 1, 2}};
+    ASSERT_TRUE(rt.push_commands(tick));
+  }
+  rt.start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 2300; }));
+  rt.stop();
+  double y_max = -1e9;
+  for (const auto& u : record.u_V) y_max = std::max(y_max, u[1]);
+  EXPECT_EQ(y_max, 15.0) << "y is clamped to its own range, not x's 250 V";
+  std::size_t ran_dry = 0;  // the first tick after the commands: both ramp
+  for (std::size_t i = 1; i < record.u_V.size() && ran_dry == 0; ++i) {
+    if (record.u_V[i - 1][0] == 10.0 && record.u_V[i][0] != 10.0) ran_dry = i;
+  }
+  ASSERT_GT(ran_dry, 0u);
+  EXPECT_NEAR(record.u_V[ran_dry][0], 9.0, 1e-12);   // x: 1 V per tick towards 0 V
+  EXPECT_NEAR(record.u_V[ran_dry][1], 14.5, 1e-12);  // y: 0.5 V per tick towards 5 V
+  EXPECT_EQ(record.u_V.back()[0], 0.0);
+  EXPECT_EQ(record.u_V.back()[1], 5.0);
+  EXPECT_EQ(rt.safe_voltages()[1], 5.0);
 }
 
 TEST(BridgeAxes, ABackendOfAnotherAxisCountIsRefused) {

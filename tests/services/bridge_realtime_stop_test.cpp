@@ -42,12 +42,12 @@ class RecordingBackend final : public StageBackend {
   }
   const std::string& name() const noexcept override { return name_; }
   bool simulated() const noexcept override { return true; }  // ticks run late, never skipped: no gaps
-  void hold_safe(double safe_u_V) noexcept override {
+  void hold_safe(std::span<const double> safe_u_V) noexcept override {
     if (r_.holds.fetch_add(1) == 0) {
       r_.steps_at_first_hold = r_.u_V.size();
       r_.u_at_first_hold_V = r_.u_V.empty() ? std::nan("") : r_.u_V.back();
     }
-    r_.hold_arg_V = safe_u_V;
+    r_.hold_arg_V = safe_u_V[0];
   }
 
  private:

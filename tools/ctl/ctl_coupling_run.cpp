@@ -2,6 +2,8 @@
 // turn through the compensator, every axis's sensor recorded, the gains put back.
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -20,15 +22,17 @@
 #include "lcm/servo_gains_status.hpp"
 #include "lcm/status_counters.hpp"
 #include "lcm/subscription.hpp"
+#include "models/axis_coupling.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop::ctl {
 
 namespace {
 
-// SET_GAINS of kp, ki, kd (the notch stays as in force), confirmed by the bridge.
-int set_servo(CtlLink& link, const CouplingRunOptions& o, double kp, double ki, double kd) {
+// SET_GAINS of kp, ki, kd on `axis` (-1: every axis; the notch stays as in force), confirmed by the bridge.
+int set_servo(CtlLink& link, const CouplingRunOptions& o, int axis, double kp, double ki, double kd) {
   GainsRequest g;
+  g.axis = axis;
   g.kp = kp;
   g.ki = ki;
   g.kd = kd;
@@ -74,10 +78,15 @@ int run_coupling_experiment(CtlLink& link, const CouplingRunOptions& o) {
   const StatusWait w = wait_for_status(
       link, o.bridge_process, [](const service_status_t&) { return true; }, o.timeout_s);
   const auto bridge = w.last.find(o.bridge_process);
-  std::optional<ServoGainsFigures> gains;
+  // Each axis's gains, to put back (a one-axis bridge reports x's only).
+  std::array<std::optional<ServoGainsFigures>, kMaxAxes> axis_gains{};
   if (bridge != w.last.end()) {
-    gains = servo_gains_from_counters([&](std::string_view name) { return find_counter(bridge->second, name); });
+    for (int a = 0; a < kMaxAxes; ++a) {
+      axis_gains[static_cast<std::size_t>(a)] =
+          servo_gains_from_counters([&](std::string_view name) { return find_counter(bridge->second, name); }, a);
+    }
   }
+  const std::optional<ServoGainsFigures>& gains = axis_gains[0];
   if (!gains) {
     std::fprintf(stderr, "hystloop-ctl: no servo gains from '%s' on %s within %g s: is a rig running?\n",
                  o.bridge_process.c_str(), link.channels().status.c_str(), o.timeout_s);
@@ -112,7 +121,12 @@ int run_coupling_experiment(CtlLink& link, const CouplingRunOptions& o) {
           "STOP_EXPERIMENT", ack);
       moved = -1;
     }
-    restored = set_servo(link, o, gains->kp, gains->ki_per_s, gains->kd_s) == 0;
+    restored = true;
+    for (int a = 0; a < axes; ++a) {
+      // An axis the bridge reported no gains of has x's (a bridge that does not report per axis).
+      const ServoGainsFigures& g = axis_gains[static_cast<std::size_t>(a)].value_or(*gains);
+      restored = set_servo(link, o, axes > 1 ? a : -1, g.kp, g.ki_per_s, g.kd_s) == 0 && restored;
+    }
     return restored;
   };
   struct OnExit {
@@ -128,13 +142,15 @@ int run_coupling_experiment(CtlLink& link, const CouplingRunOptions& o) {
     }
   } on_exit([&] {
     if (!restored && !restore()) {
-      std::fprintf(stderr,
-                   "hystloop-ctl: the servo's gains were NOT confirmed back: set them with hystloop-ctl gains "
-                   "--kp %g --ki %g --kd %g\n",
-                   gains->kp, gains->ki_per_s, gains->kd_s);
+      std::fprintf(stderr, "hystloop-ctl: the servo's gains were NOT confirmed back: set them with\n");
+      for (int a = 0; a < std::max(axes, 1); ++a) {
+        const ServoGainsFigures& g = axis_gains[static_cast<std::size_t>(a)].value_or(*gains);
+        std::fprintf(stderr, "  hystloop-ctl gains%s --kp %g --ki %g --kd %g\n",
+                     axes > 1 ? (" --axis " + std::string(axis_name(a))).c_str() : "", g.kp, g.ki_per_s, g.kd_s);
+      }
     }
   });
-  if (set_servo(link, o, 0.0, 0.0, 0.0) != 0) return 1;
+  if (set_servo(link, o, -1, 0.0, 0.0, 0.0) != 0) return 1;
 
   // One axis's experiment: 0 done, else the exit status.
   const auto excite = [&](int a) -> int {

@@ -90,6 +90,7 @@ void apply(const GainsRequest& gains, control_t& msg) {
   msg.kd = gains.kd.value_or(keep);
   msg.notch_hz = gains.notch_hz.value_or(keep);
   msg.notch_q = gains.notch_q.value_or(keep);
+  msg.axis = static_cast<std::int8_t>(gains.axis);
 }
 
 void apply(const ExperimentRequest& experiment, control_t& msg) {

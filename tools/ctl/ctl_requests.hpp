@@ -36,6 +36,9 @@ struct GainsRequest {
   // (0, kMaxNotch_hz]; and its quality factor, in [kNotchMinQ, kNotchMaxQ] (loop/feedback.hpp).
   std::optional<double> notch_hz;
   std::optional<double> notch_q;
+  // The axis whose servo it sets (0 x, 1 y, 2 z), or every axis's (control_t::EVERY_AXIS): each
+  // axis then keeps its own value of what is not given.
+  int axis = -1;
   static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
   // Nothing given: the request is a question (print the gains in force).
   bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q; }

@@ -109,14 +109,20 @@ int send_control(const Options& o, std::int8_t command, const std::string& targe
   return send_control_confirmed(link, msg, what, ack, last);
 }
 
-// Prints the servo gains `report` carries; false if it carries none.
+// Prints the servo gains `report` carries, each axis's on a stage of several; false if it carries none.
 bool print_gains(const std::string& bridge, const service_status_t& report) {
-  const auto g = servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); });
-  if (!g) return false;
-  fmt::print("hystloop-ctl: '{}' servo gains in force: kp {:g}, ki {:g} 1/s, kd {:g} s, {}\n", bridge, g->kp,
-             g->ki_per_s, g->kd_s,
-             g->notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g->notch_hz, g->notch_q) : "no notch");
-  return true;
+  bool any = false;
+  for (int axis = 0; axis < kMaxAxes; ++axis) {
+    const auto g = servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); }, axis);
+    if (!g) break;  // a one-axis bridge reports x's only
+    any = true;
+    const bool several =
+        axis > 0 || servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); }, 1);
+    fmt::print("hystloop-ctl: '{}' servo{} gains in force: kp {:g}, ki {:g} 1/s, kd {:g} s, {}\n", bridge,
+               several ? fmt::format(" {}", axis_name(axis)) : std::string(), g->kp, g->ki_per_s, g->kd_s,
+               g->notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g->notch_hz, g->notch_q) : "no notch");
+  }
+  return any;
 }
 
 int run_gains(Options& o) {
@@ -349,6 +355,9 @@ int run(int argc, char** argv) {
   gains->add_option("--notch-hz", o.gains.notch_hz,
                     "Notch at the stage's resonance [Hz], in (0, 4500]; 0 removes the notch");
   gains->add_option("--notch-q", o.gains.notch_q, "The notch's quality factor (centre / width), in [0.1, 50]");
+  add_axis_option(gains, "--axis", o.gains.axis,
+                  "The axis whose servo it sets (default: every axis, each keeping its own value of a gain not "
+                  "given); printing: every axis's");
   add_wait_options(gains, o);
 
   CLI::App* learn = app.add_subcommand("learn", "Compensator: learning of the feedforward for periodic references");
