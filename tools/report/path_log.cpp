@@ -6,6 +6,7 @@
 
 #include "decode.hpp"
 #include "lcm/blocks.hpp"
+#include "lcm/scan_message.hpp"
 #include "lcm/status_counters.hpp"
 #include "log_reader.hpp"
 
@@ -18,33 +19,8 @@ LoggedPath logged_path(const scan_t& msg, std::int64_t recv_utime) {
   p.blend_s = msg.blend_s;
   p.decouple = msg.decouple != 0;
   p.start_utime = msg.start_utime;
-  AxisPositions centre{};
-  for (std::size_t i = 0; i < kScanAxes; ++i) centre[i] = msg.centre_m[i];
-  if (msg.path == scan_t::RASTER) {
-    RasterSpec r;
-    // 0..2 (check_message), so the unsigned byte is the axis.
-    r.fast_axis = static_cast<unsigned char>(msg.fast_axis);
-    r.slow_axis = static_cast<unsigned char>(msg.slow_axis);
-    r.width_m = msg.width_m;
-    r.height_m = msg.height_m;
-    r.lines = msg.lines;
-    r.line_rate_hz = msg.line_rate_Hz;
-    r.slow_mode = msg.slow_mode == scan_t::RAMP ? SlowMode::kRamp : SlowMode::kSteps;
-    r.corner_s = msg.corner_s;
-    r.settle_s = msg.settle_s;
-    r.centre_m = centre;
-    p.path = r;
-  } else {
-    LissajousSpec l;
-    for (std::size_t i = 0; i < kScanAxes; ++i) {
-      l.amplitude_m[i] = msg.amplitude_m[i];
-      l.frequency_hz[i] = msg.frequency_Hz[i];
-      l.phase_rad[i] = msg.phase_rad[i];
-    }
-    l.duration_s = msg.duration_s;
-    l.centre_m = centre;
-    p.path = l;
-  }
+  // Logged, so it passed check_message: a raster or a Lissajous figure.
+  p.path = scan_path_of(msg);
   return p;
 }
 
