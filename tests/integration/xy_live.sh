@@ -8,7 +8,8 @@
 # leaves in y's error: y's true error regressed on x's reference and its rate (the coupling the servo
 # did not reject, ~0.4 % of r_x at 50 Hz without decoupling) must fall by XY_DECOUPLING_GAIN with
 # the decoupling. Then the compensator is killed mid-figure: both axes must enter the safe state on
-# the same tick (one watchdog, one safe state). Prints what it measured. Inside tools/netns-run.
+# the same tick (one watchdog, one safe state). Before the figures, y's servo gain is changed
+# alone and then every axis's together (hystloop-ctl gains --axis). Prints what it measured. Inside tools/netns-run.
 #   xy_live.sh <hystloop-bridge> <hystloop-compensator> <loop_probe> <hystloop-ctl>
 source "$(dirname "$0")/loop_common.sh" "$@"
 ctl="$4"
@@ -40,6 +41,15 @@ wait_log "$dir/compensator.log" "channels:"
 wait_log "$dir/bridge.log" "started in the safe state"
 "$ctl" status --wait-healthy bridge compensator --timeout 20 >"$dir/ctl-status.out" 2>&1 ||
   fail "bridge and compensator not healthy: $(cat "$dir/ctl-status.out")"
+
+# Each axis its own servo: y's kp changed alone, x's stays; every axis's then put back at once.
+"$ctl" gains --axis y --kp 0.03 >"$dir/ctl-gains.out" 2>&1 || fail "gains --axis y: $(cat "$dir/ctl-gains.out")"
+grep -q "servo y gains in force: kp 0.03," "$dir/ctl-gains.out" &&
+  grep -q "servo x gains in force: kp 0.05," "$dir/ctl-gains.out" ||
+  fail "y's kp alone should have changed: $(cat "$dir/ctl-gains.out")"
+"$ctl" gains --kp 0.05 >"$dir/ctl-gains-all.out" 2>&1 || fail "gains: $(cat "$dir/ctl-gains-all.out")"
+[ "$(grep -c "gains in force: kp 0.05," "$dir/ctl-gains-all.out")" = 2 ] ||
+  fail "every axis's kp should be 0.05: $(cat "$dir/ctl-gains-all.out")"
 
 # Each figure's loop time from the compensator's verdict: "... from loop time A s to B s".
 figure() {  # label ctl-args...
