@@ -2,9 +2,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <limits>
+
+#include <spdlog/spdlog.h>
 
 #include "core/process.hpp"
 #include "lcm/status_counters.hpp"
@@ -29,16 +33,41 @@ void StatusReporter::begin(std::int8_t state, std::string detail) {
   status_.latency_p50_us = status_.latency_p99_us = status_.latency_max_us = kNaN;
   status_.late = 0;
   status_.rejected = 0;
+  dropped_ = 0;
+  first_dropped_.clear();
 }
 
-void StatusReporter::counter(std::string_view name, std::uint64_t value) { add_counter(status_, name, value); }
+void StatusReporter::count_drop(bool added, std::string_view name) {
+  if (added) return;
+  if (dropped_ == 0) first_dropped_ = name;
+  ++dropped_;
+}
+
+void StatusReporter::counter(std::string_view name, std::uint64_t value) {
+  count_drop(add_counter(status_, name, value), name);
+}
 
 void StatusReporter::endpoint(std::string_view name, const EndpointCounters& counters) {
-  add_endpoint_counters(status_, name, counters);
+  const std::int32_t before = status_.n_counters;
+  if (!add_endpoint_counters(status_, name, counters)) {
+    // How many of the endpoint's counters did not fit: those a complete set has beyond `before`.
+    service_status_t whole{};
+    add_endpoint_counters(whole, name, counters);
+    const auto fitted = static_cast<std::uint64_t>(status_.n_counters - before);
+    if (dropped_ == 0) first_dropped_ = std::string(name) + ".*";
+    dropped_ += static_cast<std::uint64_t>(whole.n_counters) - fitted;
+  }
 }
 
 void StatusReporter::publisher(std::string_view name, const PublisherCounters& counters) {
-  add_publisher_counters(status_, name, counters);
+  const std::int32_t before = status_.n_counters;
+  if (!add_publisher_counters(status_, name, counters)) {
+    service_status_t whole{};
+    add_publisher_counters(whole, name, counters);
+    const auto fitted = static_cast<std::uint64_t>(status_.n_counters - before);
+    if (dropped_ == 0) first_dropped_ = std::string(name) + ".*";
+    dropped_ += static_cast<std::uint64_t>(whole.n_counters) - fitted;
+  }
 }
 
 namespace {
@@ -64,6 +93,18 @@ bool StatusReporter::publish(std::int64_t utime) {
   counter("cpu_user_us", static_cast<std::uint64_t>(usage.user_cpu_s * 1e6));
   counter("cpu_system_us", static_cast<std::uint64_t>(usage.system_cpu_s * 1e6));
   counter("peak_rss_kB", static_cast<std::uint64_t>(usage.peak_rss_bytes / 1024));
+  if (dropped_ > 0 && status_.n_counters > 0) {
+    // The last slot says so: a reader finds the loss in the report itself.
+    const std::size_t last = static_cast<std::size_t>(status_.n_counters) - 1;
+    ++dropped_;
+    status_.counter_names[last] = std::string(kDroppedCounter);
+    status_.counter_values[last] = static_cast<std::int64_t>(std::min<std::uint64_t>(dropped_, INT64_MAX));
+    if (!overflow_logged_) {
+      overflow_logged_ = true;
+      spdlog::error("HX_STATUS: {} counters beyond the {} a report holds were dropped, from '{}' on (reported as {})",
+                    dropped_, service_status_t::MAX_COUNTERS, first_dropped_, kDroppedCounter);
+    }
+  }
   status_.utime = utime;
   return publisher_.publish(status_);
 }

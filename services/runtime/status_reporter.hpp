@@ -35,8 +35,18 @@ class StatusReporter {
 
   const service_status_t& status() const noexcept { return status_; }
 
+  // Counters beyond service_status_t::MAX_COUNTERS are not silently lost: the report's last
+  // counter becomes `counters_dropped` (how many did not fit, that one included), and the first
+  // report that overflows logs their names.
+  static constexpr std::string_view kDroppedCounter = "counters_dropped";
+
  private:
+  void count_drop(bool added, std::string_view name);
+
   service_status_t status_{};
+  std::uint64_t dropped_ = 0;  // counters of this report that did not fit
+  std::string first_dropped_;  // ... the first of them, for the log
+  bool overflow_logged_ = false;
   Publisher<service_status_t> publisher_;
 };
 
