@@ -617,6 +617,16 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     detail += fmt::format("; learning a {}-tick period ({} periods learned, last {:.3g} nm RMS)", learner.period_ticks,
                           learner.periods_learned, learner.last_error_rms_m * 1e9);
   }
+  for (int a = 1; a < settings_.axes; ++a) {  // the other axes' sets and learning, each in a few words
+    const Compensator& law = *laws_[static_cast<std::size_t>(a)];
+    const MemParams& am = law.mem_params();
+    const LearnerFigures& al = law.learner().figures();
+    detail += fmt::format(
+        "; {}: params v{} c1={:.6g} c2={:.6g} c3={:.6g}{}", axis_name(a), law.params_version(), am.c1, am.c2, am.c3,
+        al.active
+            ? fmt::format(", learning ({} periods, last {:.3g} nm RMS)", al.periods_learned, al.last_error_rms_m * 1e9)
+            : std::string());
+  }
   if (!verdict_.empty() && monotonic_ns() < verdict_until_ns_) detail += "; " + verdict_;
   if (const std::string note = acks_.refusal_note(utime); !note.empty()) detail += "; " + note;
   status_.begin(state, detail);
@@ -640,10 +650,16 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     status_.counter(axis_params_counter_[static_cast<std::size_t>(a)],
                     at_least_0(laws_[static_cast<std::size_t>(a)]->params_version()));
   }
-  status_.counter("learning_active", learner.active ? 1u : 0u);
-  status_.counter("learning_periods", learner.periods_learned);
-  status_.counter("params_held_by_learning", c.params_held_by_learning() ? 1u : 0u);
-  status_.counter("learning_rms_pm", static_cast<std::uint64_t>(std::llround(learner.last_error_rms_m * 1e12)));
+  // Learning per axis: x's under the one-axis names, the others' behind their axis (y_learning_active, ...).
+  for (int a = 0; a < settings_.axes; ++a) {
+    const Compensator& law = *laws_[static_cast<std::size_t>(a)];
+    const LearnerFigures& l = law.learner().figures();
+    const std::string p = a == 0 ? std::string() : std::string(axis_name(a)) + "_";
+    status_.counter(p + "learning_active", l.active ? 1u : 0u);
+    status_.counter(p + "learning_periods", l.periods_learned);
+    status_.counter(p + "params_held_by_learning", law.params_held_by_learning() ? 1u : 0u);
+    status_.counter(p + "learning_rms_pm", static_cast<std::uint64_t>(std::llround(l.last_error_rms_m * 1e12)));
+  }
   if (c.next_tick() >= 0) status_.counter("plan_ahead_ticks", at_least_0(c.next_tick() - 1 - c.last_seq()));
   reported_.report(status_, "sensor", samples_.counters());
   reported_.report(status_, "trajectory", trajectories_.counters());

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "lcm/status_counters.hpp"
 #include "compensator/compensator_service.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "lcm/blocks.hpp"
@@ -419,6 +420,12 @@ TEST(CompensatorAxes, TheStatusOfThreeAxesWithAScanHasEveryCounter) {
   bool cpu = false;
   for (const std::string& n : r.counter_names) cpu = cpu || n == "cpu_user_us";
   EXPECT_TRUE(cpu);
+  // Each axis's learning and its set, the others' behind their axis.
+  for (const char* name : {"learning_active", "y_learning_active", "z_learning_periods", "z_params_held_by_learning",
+                           "y_learning_rms_pm", "z_params_version"}) {
+    EXPECT_TRUE(find_counter(r, name).has_value()) << name;
+  }
+  EXPECT_NE(r.detail.find("; z: params v"), std::string::npos) << r.detail;
 }
 
 TEST(CompensatorAxes, TheSensorBlockPathDoesNotAllocateWithSeveralAxes) {

@@ -105,23 +105,24 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
       },
       {.queue_capacity = kBlockQueue, .on_reject = {}});
   Subscription<mem_params_t> params(link.lcm(), link.channels().params, [&](const mem_params_t& p, std::int64_t) {
-    if (p.valid) line.params_latest = std::max(line.params_latest.value_or(0), p.version);
+    if (p.valid && static_cast<std::size_t>(p.axis) == axis)
+      line.params_latest = std::max(line.params_latest.value_or(0), p.version);
   });
-  Subscription<service_status_t> status(link.lcm(), link.channels().status,
-                                        [&](const service_status_t& s, std::int64_t) {
-                                          if (s.process == o.compensator_process) {
-                                            line.learning_rms_nm = learning_rms_nm(s);
-                                            line.learning_periods = find_counter(s, "learning_periods");
-                                            line.trajectories_refused = find_counter(s, "trajectory_refused");
-                                            line.trajectories_shaped = find_counter(s, "trajectories_shaped");
-                                          }
-                                          if (s.process != o.bridge_process) return;
-                                          line.late_delta = s.late - late_before_report.value_or(s.late);
-                                          late_before_report = s.late;
-                                          line.late_total = s.late;
-                                          line.bridge_state = state_name(s.state);
-                                          line.clamped_per_s = find_counter(s, "clamped_per_s");
-                                        });
+  Subscription<service_status_t> status(
+      link.lcm(), link.channels().status, [&](const service_status_t& s, std::int64_t) {
+        if (s.process == o.compensator_process) {
+          line.learning_rms_nm = learning_rms_nm(s, static_cast<int>(axis));
+          line.learning_periods = find_counter(s, axis_counter("learning_periods", static_cast<int>(axis)));
+          line.trajectories_refused = find_counter(s, "trajectory_refused");
+          line.trajectories_shaped = find_counter(s, "trajectories_shaped");
+        }
+        if (s.process != o.bridge_process) return;
+        line.late_delta = s.late - late_before_report.value_or(s.late);
+        late_before_report = s.late;
+        line.late_total = s.late;
+        line.bridge_state = state_name(s.state);
+        line.clamped_per_s = find_counter(s, "clamped_per_s");
+      });
 
   const auto start = Clock::now();
   auto next_print = start + std::chrono::seconds(1);

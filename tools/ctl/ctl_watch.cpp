@@ -8,6 +8,7 @@
 
 #include "ctl_health.hpp"
 #include "lcm/blocks.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop::ctl {
 
@@ -69,9 +70,17 @@ void TruthPairing::add_truth_block(const sim_truth_t& truth, WatchSecond& into) 
   refs_.erase(match);
 }
 
-std::optional<double> learning_rms_nm(const service_status_t& compensator) {
-  if (const auto nm = find_counter(compensator, "learning_rms_nm")) return static_cast<double>(*nm);
-  if (const auto pm = find_counter(compensator, "learning_rms_pm")) return static_cast<double>(*pm) * 1e-3;
+std::string axis_counter(std::string_view name, int axis) {
+  std::string out = axis == 0 ? std::string() : std::string(axis_name(axis)) + "_";
+  out.append(name);
+  return out;
+}
+
+std::optional<double> learning_rms_nm(const service_status_t& compensator, int axis) {
+  if (const auto nm = find_counter(compensator, axis_counter("learning_rms_nm", axis))) return static_cast<double>(*nm);
+  if (const auto pm = find_counter(compensator, axis_counter("learning_rms_pm", axis))) {
+    return static_cast<double>(*pm) * 1e-3;
+  }
   return std::nullopt;
 }
 

@@ -9,6 +9,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hystloop/sensor_block_t.hpp"
@@ -82,8 +83,11 @@ struct WatchLine {
   std::optional<std::int64_t> trajectories_shaped;
 };
 
-// The compensator's learning error [nm] from its counter learning_rms_nm, or learning_rms_pm (finer).
-std::optional<double> learning_rms_nm(const service_status_t& compensator);
+// The compensator's learning error [nm] on `axis` from its counter learning_rms_nm, or
+// learning_rms_pm (finer); another axis's behind its name (y_learning_rms_pm).
+std::optional<double> learning_rms_nm(const service_status_t& compensator, int axis = 0);
+// A compensator counter of `axis`: `name` for x, "y_" + name for y, "z_" + name for z.
+std::string axis_counter(std::string_view name, int axis);
 
 // " 12 s  rms   27.9 nm  max   80.1 nm  [true 0.55 nm max 3.1 nm]  ticks 10000/10000  params v3  late 0 (+0)  clamped
 // 0/s  buf min 212

@@ -549,6 +549,12 @@ TEST(CtlWatch, LineIsTidy) {
   comp.counter_names[0] = "learning_rms_nm";
   EXPECT_EQ(learning_rms_nm(comp), std::optional<double>(12345.0));
   EXPECT_EQ(learning_rms_nm(service_status_t{}), std::nullopt);
+  // Another axis's behind its name; x's is not y's.
+  comp.counter_names = {"learning_rms_pm", "y_learning_rms_pm"};
+  comp.counter_values = {12345, 678};
+  EXPECT_EQ(learning_rms_nm(comp, 1), std::optional<double>(0.678));
+  EXPECT_EQ(learning_rms_nm(comp, 2), std::nullopt);
+  EXPECT_EQ(axis_counter("learning_periods", 2), "z_learning_periods");
   EXPECT_EQ(format_watch_line(WatchLine{}),
             "    0 s  rms      -- nm  max      -- nm  ticks      0/0  params --  late --  clamped --  buf min --  "
             "bridge --");
