@@ -147,12 +147,13 @@ int run_watch(CtlLink& link, const WatchOptions& o) {
 namespace {
 
 // Publishes with `publish` (3 copies) on `channel`, prints "sent <what> <description> ..." and, with
-// wait, follows the compensator's HX_STATUS until it reports on `version`.
+// wait, follows the compensator's HX_STATUS until it reports on `version`. Says nothing: the
+// caller reports the result.
 template <class Message>
-int publish_and_follow(CtlLink& link, const std::string& channel, const Message& msg, const char* what,
-                       const std::string& description, const VerdictOptions& o) {
+VerdictResult publish_and_follow(CtlLink& link, const std::string& channel, const Message& msg, const char* what,
+                                 const VerdictOptions& o) {
+  VerdictResult r;
   // Listening before publishing: the compensator reports right after it decides.
-  TrajectoryVerdict verdict;
   bool heard = false, has_counters = false;
   Subscription<service_status_t> status(link.lcm(), link.channels().status,
                                         [&](const service_status_t& s, std::int64_t) {
@@ -160,105 +161,147 @@ int publish_and_follow(CtlLink& link, const std::string& channel, const Message&
                                           heard = true;
                                           const TrajectoryVerdict v = trajectory_verdict(s, msg.version);
                                           has_counters = has_counters || v.has_counters;
-                                          if (verdict.outcome == TrajectoryOutcome::kPending) verdict = v;
+                                          if (r.verdict.outcome == TrajectoryOutcome::kPending) r.verdict = v;
                                         });
   if (!publish_repeated(link.lcm(), channel, msg)) {
-    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", channel.c_str());
-    return 1;
+    r.error = "could not publish on " + channel;
+    return r;
   }
-  std::printf("hystloop-ctl: sent %s %s on %s (version %lld)\n", what, description.c_str(), channel.c_str(),
-              static_cast<long long>(msg.version));
-  std::fflush(stdout);
-  if (!o.wait) return 0;
+  r.published = true;
+  if (!o.wait) return r;
   const auto deadline = after(o.timeout_s);
-  while (verdict.outcome == TrajectoryOutcome::kPending && Clock::now() < deadline) {
-    if (!receive(link, deadline, std::chrono::microseconds(50'000))) return receive_failed(link);
+  while (r.verdict.outcome == TrajectoryOutcome::kPending && Clock::now() < deadline) {
+    if (!receive(link, deadline, std::chrono::microseconds(50'000))) {
+      r.error = "LCM failed while waiting for the verdict (" + link.url() + ")";
+      return r;
+    }
   }
   const long long version = static_cast<long long>(msg.version);
-  const char* who = o.compensator_process.c_str();
-  switch (verdict.outcome) {
+  const std::string& who = o.compensator_process;
+  switch (r.verdict.outcome) {
     case TrajectoryOutcome::kAccepted:
-      std::printf("hystloop-ctl: %s accepted %s %lld%s%s\n", who, what, version, verdict.detail.empty() ? "" : ": ",
-                  verdict.detail.c_str());
-      return 0;
-    case TrajectoryOutcome::kShaped:
-      std::printf("hystloop-ctl: %s shaped %s %lld: %s\n", who, what, version,
-                  verdict.detail.empty() ? "(no detail given)" : verdict.detail.c_str());
-      return 0;
+    case TrajectoryOutcome::kShaped: return r;
     case TrajectoryOutcome::kRefused:
-      std::fprintf(stderr, "hystloop-ctl: %s refused %s %lld: %s\n", who, what, version,
-                   verdict.detail.empty() ? "(no reason given)" : verdict.detail.c_str());
-      return 1;
+      r.error = fmt::format("{} refused {} {}: {}", who, what, version,
+                            r.verdict.detail.empty() ? "(no reason given)" : r.verdict.detail);
+      return r;
     case TrajectoryOutcome::kSuperseded:
-      std::fprintf(stderr,
-                   "hystloop-ctl: %s decided on trajectory %lld, sent after %lld, before reporting on it (another "
-                   "sender?)\n",
-                   who, static_cast<long long>(verdict.later_version), version);
-      return 1;
+      r.error = fmt::format("{} decided on trajectory {}, sent after {}, before reporting on it (another sender?)", who,
+                            static_cast<long long>(r.verdict.later_version), version);
+      return r;
     case TrajectoryOutcome::kPending: break;
   }
   const std::string hint =
       !heard ? " (no status from '" + o.compensator_process + "' on " + link.channels().status + ": is it running?)"
       : !has_counters ? " ('" + o.compensator_process + "' reports no trajectory_version: a build without verdicts?)"
                       : "";
-  std::fprintf(stderr, "hystloop-ctl: no compensator confirmed %s version %lld within %g s%s\n", what, version,
-               o.timeout_s, hint.c_str());
-  return 1;
+  r.error = fmt::format("no compensator confirmed {} version {} within {:g} s{}", what, version, o.timeout_s, hint);
+  return r;
+}
+
+// The tool's lines for a result of publish_and_follow; its exit status.
+template <class Message>
+int print_verdict(const VerdictResult& r, const std::string& channel, const Message& msg, const char* what,
+                  const std::string& description, const VerdictOptions& o) {
+  if (r.published) {
+    std::printf("hystloop-ctl: sent %s %s on %s (version %lld)\n", what, description.c_str(), channel.c_str(),
+                static_cast<long long>(msg.version));
+    std::fflush(stdout);
+  }
+  if (!r.error.empty()) {
+    std::fprintf(stderr, "hystloop-ctl: %s\n", r.error.c_str());
+    return 1;
+  }
+  if (!o.wait) return 0;
+  const long long version = static_cast<long long>(msg.version);
+  const char* who = o.compensator_process.c_str();
+  if (r.verdict.outcome == TrajectoryOutcome::kShaped) {
+    std::printf("hystloop-ctl: %s shaped %s %lld: %s\n", who, what, version,
+                r.verdict.detail.empty() ? "(no detail given)" : r.verdict.detail.c_str());
+  } else {
+    std::printf("hystloop-ctl: %s accepted %s %lld%s%s\n", who, what, version, r.verdict.detail.empty() ? "" : ": ",
+                r.verdict.detail.c_str());
+  }
+  return 0;
 }
 
 }  // namespace
 
+VerdictResult send_trajectory(CtlLink& link, const trajectory_t& msg, const VerdictOptions& o) {
+  return publish_and_follow(link, link.channels().trajectory, msg, "trajectory", o);
+}
+
+VerdictResult send_scan(CtlLink& link, const scan_t& msg, const VerdictOptions& o) {
+  return publish_and_follow(link, link.channels().scan, msg, "scan", o);
+}
+
 int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
                        const VerdictOptions& o) {
-  return publish_and_follow(link, link.channels().trajectory, msg, "trajectory", description, o);
+  return print_verdict(send_trajectory(link, msg, o), link.channels().trajectory, msg, "trajectory", description, o);
 }
 
 int publish_scan(CtlLink& link, const scan_t& msg, const std::string& description, const VerdictOptions& o) {
-  return publish_and_follow(link, link.channels().scan, msg, "scan", description, o);
+  return print_verdict(send_scan(link, msg, o), link.channels().scan, msg, "scan", description, o);
 }
 
-int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& o,
-                           std::map<std::string, service_status_t>* last) {
+ControlResult request_control(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& o) {
+  ControlResult r;
   // Listening before publishing: a process answers right after it acts.
   AckTracker tracker(msg.request_id, o.expected, o.state);
-  std::map<std::string, service_status_t> heard;
   Subscription<service_status_t> status(link.lcm(), link.channels().status,
                                         [&](const service_status_t& s, std::int64_t) {
                                           tracker.update(s);
-                                          heard[s.process] = s;
+                                          r.heard[s.process] = s;
                                         });
   if (!publish_repeated(link.lcm(), link.channels().control, msg)) {
-    std::fprintf(stderr, "hystloop-ctl: could not publish on %s\n", link.channels().control.c_str());
-    return 1;
+    r.error = "could not publish on " + link.channels().control;
+    return r;
   }
-  const std::string to_whom = msg.target.empty() ? "every process" : "'" + msg.target + "'";
-  std::printf("hystloop-ctl: sent %s to %s on %s (request %lld)\n", what.c_str(), to_whom.c_str(),
-              link.channels().control.c_str(), static_cast<long long>(msg.request_id));
-  std::fflush(stdout);
-  if (!o.wait) return 0;
+  r.published = true;
+  if (!o.wait) {
+    r.confirmed = true;
+    return r;
+  }
   const auto start = Clock::now();
   const auto deadline = after(o.timeout_s);
   const auto gathered = after(std::min(o.gather_s, o.timeout_s));
   while (Clock::now() < deadline && !tracker.finished(Clock::now() >= gathered)) {
-    if (!receive(link, deadline, std::chrono::microseconds(20'000))) return receive_failed(link);
+    if (!receive(link, deadline, std::chrono::microseconds(20'000))) {
+      r.error = "LCM failed while waiting for the answers (" + link.url() + ")";
+      return r;
+    }
   }
-  if (last != nullptr) *last = heard;
-  const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
-  if (heard.empty()) {
-    std::fprintf(stderr, "hystloop-ctl: no rig is running: nothing reported on %s within %g s (%s not confirmed)\n",
-                 link.channels().status.c_str(), o.timeout_s, what.c_str());
+  r.waited_s = std::chrono::duration<double>(Clock::now() - start).count();
+  if (r.heard.empty()) {
+    r.error = fmt::format("no rig is running: nothing reported on {} within {:g} s ({} not confirmed)",
+                          link.channels().status, o.timeout_s, what);
+    return r;
+  }
+  r.confirmed = tracker.all_confirmed(true);
+  r.answers = describe_answers(tracker, true);
+  if (!r.confirmed) {
+    r.error = fmt::format("{} not confirmed (waited {:.1f} s of --timeout {:g} s)", what, r.waited_s, o.timeout_s);
+  }
+  return r;
+}
+
+int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& o,
+                           std::map<std::string, service_status_t>* last) {
+  const ControlResult r = request_control(link, msg, what, o);
+  if (r.published) {
+    const std::string to_whom = msg.target.empty() ? "every process" : "'" + msg.target + "'";
+    std::printf("hystloop-ctl: sent %s to %s on %s (request %lld)\n", what.c_str(), to_whom.c_str(),
+                link.channels().control.c_str(), static_cast<long long>(msg.request_id));
+    std::fflush(stdout);
+  }
+  if (last != nullptr) *last = r.heard;
+  for (const std::string& line : r.answers)
+    std::fprintf(r.confirmed ? stdout : stderr, "hystloop-ctl: %s\n", line.c_str());
+  if (!r.error.empty()) {
+    std::fprintf(stderr, "hystloop-ctl: %s\n", r.error.c_str());
     return 1;
   }
-  const bool ok = tracker.all_confirmed(true);
-  for (const std::string& line : describe_answers(tracker, true)) {
-    std::fprintf(ok ? stdout : stderr, "hystloop-ctl: %s\n", line.c_str());
-  }
-  if (!ok) {
-    std::fprintf(stderr, "hystloop-ctl: %s not confirmed (waited %.1f s of --timeout %g s)\n", what.c_str(), waited_s,
-                 o.timeout_s);
-    return 1;
-  }
-  std::printf("hystloop-ctl: %s confirmed in %.0f ms\n", what.c_str(), waited_s * 1e3);
+  if (o.wait) std::printf("hystloop-ctl: %s confirmed in %.0f ms\n", what.c_str(), r.waited_s * 1e3);
   return 0;
 }
 

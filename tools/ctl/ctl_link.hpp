@@ -14,6 +14,7 @@
 
 #include "ctl_ack.hpp"
 #include "ctl_series.hpp"
+#include "ctl_verdict.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/service_status_t.hpp"
 #include "hystloop/trajectory_t.hpp"
@@ -110,6 +111,15 @@ struct VerdictOptions {
 // not be published.
 int publish_trajectory(CtlLink& link, const trajectory_t& msg, const std::string& description,
                        const VerdictOptions& options);
+
+// What publishing a trajectory or a scan came to, without a word printed (a library's caller).
+struct VerdictResult {
+  bool published = false;
+  TrajectoryVerdict verdict;  // kAccepted or kShaped when it was taken (with wait)
+  std::string error;          // empty when taken (or sent without wait); else why not, in the tool's words
+};
+VerdictResult send_trajectory(CtlLink& link, const trajectory_t& msg, const VerdictOptions& options);
+VerdictResult send_scan(CtlLink& link, const scan_t& msg, const VerdictOptions& options);
 // The same for a path of every axis on HX_SCAN (the compensator reports it as a trajectory).
 int publish_scan(CtlLink& link, const scan_t& msg, const std::string& description, const VerdictOptions& options);
 
@@ -129,6 +139,18 @@ struct AckOptions {
 // it could not be published.
 int send_control_confirmed(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& options,
                            std::map<std::string, service_status_t>* last = nullptr);
+
+// What a control request came to, without a word printed (send_control_confirmed prints it; a
+// library's caller raises `error`).
+struct ControlResult {
+  bool published = false;
+  bool confirmed = false;            // every expected process confirmed (or sent, without wait)
+  std::vector<std::string> answers;  // one line per process: "bridge: confirmed", "bridge: refused: <why>", ...
+  std::string error;                 // empty when confirmed; else why not ("no rig is running: ...")
+  double waited_s = 0.0;
+  std::map<std::string, service_status_t> heard;  // the latest report of each process heard
+};
+ControlResult request_control(CtlLink& link, const control_t& msg, const std::string& what, const AckOptions& options);
 
 struct StatusWait {
   bool satisfied = false;
