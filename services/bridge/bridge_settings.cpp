@@ -173,17 +173,12 @@ BridgeSettings load_bridge_settings(const Config& config) {
     config.fail("bridge.backend", "must be sim, ro or comedi (got '" + s.backend + "')");
   }
   s.axes = static_cast<int>(config.get_int_in_range("bridge.axes", s.axes, 1, kMaxAxes));
-  if (s.backend == "comedi" && s.axes != 1) {
-    config.fail("bridge.axes",
-                "must be 1 with bridge.backend comedi: its channel map drives one axis (the "
-                "simulators sim and ro drive up to " +
-                    std::to_string(kMaxAxes) + ")");
-  }
   for (const CouplingEntry& c : kCouplingEntries) {  // coupling.<from>_to_<to>: C(to, from)
     s.coupling(c.to, c.from) =
         config.get_in_range("coupling." + std::string(c.name), s.coupling(c.to, c.from), -kMaxCoupling, kMaxCoupling);
   }
-  s.comedi = load_comedi_settings(config);  // validated whatever the backend: one config serves both
+  // Validated whatever the backend (one config serves both); each axis's channels are required by comedi only.
+  s.comedi = load_comedi_settings(config, s.axes, s.backend == "comedi");
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
   s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
   s.rearm_after_trip_s = config.get_in_range("actuator.rearm_after_trip_s", s.rearm_after_trip_s, 0.0, 3600.0);
@@ -260,7 +255,10 @@ BridgeSettings load_bridge_settings(const Config& config) {
 std::vector<std::string> describe(const BridgeSettings& s) {
   const auto& st = s.stage;
   std::vector<std::string> lines;
-  if (s.axes > 1) {
+  if (s.axes > 1 && s.backend == "comedi") {
+    lines.push_back(
+        fmt::format("axes: {} on one clock and one safe state, a channel pair each (comedi below)", s.axes));
+  } else if (s.axes > 1) {
     lines.push_back(fmt::format("axes: {} on one clock and one safe state; noise seeds {}..{}; coupling{}", s.axes,
                                 s.stage.seed, s.stage.seed + static_cast<std::uint64_t>(s.axes) - 1,
                                 describe_coupling(s.coupling, s.axes)));
@@ -282,14 +280,14 @@ std::vector<std::string> describe(const BridgeSettings& s) {
     }
     lines.push_back(fmt::format("{}: range [{}, {}] V, slew {} V/s, safe {} V reached at {} V/s",
                                 axis_label("actuator", axis), a.u_min_V, a.u_max_V, a.slew_V_per_s, a.safe_u_V,
-                                a.safe_ramp_rate_V_per_s(), axis == 0 ? "" : ""));
+                                a.safe_ramp_rate_V_per_s()));
   }
   lines.push_back(
       fmt::format("watchdog {} s for the stage; stop: every axis ramps to its safe voltage (the longest "
                   "ramp at most {:.4g} s) within {} s",
                   s.limits.watchdog_s, s.longest_safe_ramp_s(), s.stop_ramp_timeout_s));
   if (s.backend == "comedi") {
-    lines.push_back(describe(s.comedi));
+    for (std::string& line : describe(s.comedi)) lines.push_back(std::move(line));
   } else if (s.backend == "sim") {
     lines.push_back("banning: " + BanningDescriptor::summary_of(st.banning));
   } else {

@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <exception>
+#include <optional>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
@@ -65,6 +68,19 @@ comedi_insn instruction(unsigned insn, lsampl_t* data, unsigned subdevice, const
   i.subdev = subdevice;
   i.chanspec = CR_PACK(c.channel, c.range, c.aref);
   return i;
+}
+
+// settings.axes, when `limits` has an entry per axis.
+int checked_axes(const ComediSettings& settings, std::span<const ActuatorLimits> limits) {
+  if (settings.axes < 1 || settings.axes > kMaxAxes) {
+    throw ParameterError("bridge.axes", fmt::format("must be 1..{} (got {})", kMaxAxes, settings.axes));
+  }
+  if (limits.size() != static_cast<std::size_t>(settings.axes)) {
+    throw ParameterError("bridge.axes", fmt::format("the comedi backend drives {} axes but was given {} actuators' "
+                                                    "limits",
+                                                    settings.axes, limits.size()));
+  }
+  return settings.axes;
 }
 
 int find_subdevice(comedi_t* device, int configured, int type) {
@@ -147,23 +163,57 @@ ComediHandle::~ComediHandle() {
   if (device != nullptr) comedi_close(device);
 }
 
-ComediBackend::ComediBackend(const ComediSettings& settings, const ActuatorLimits& limits)
-    : settings_(settings), limits_(limits), handle_(settings.device, settings.calibration, settings.source) {
-  check_against_card();  // writes the safe voltage first when the output is usable, then throws
-  tick_insns_[0] = instruction(INSN_WRITE, &dac_word_, ao_subdevice_, settings_.ao);
-  tick_insns_[1] = instruction(INSN_READ, &adc_word_, ai_subdevice_, settings_.ai);
-  tick_list_.n_insns = 2;
-  tick_list_.insns = tick_insns_;
-  write_safe(limits_.safe_u_V);  // before anything can arm
+ComediBackend::ComediBackend(const ComediSettings& settings, std::span<const ActuatorLimits> limits)
+    : settings_(settings),
+      axes_(checked_axes(settings, limits)),
+      handle_(settings.device, settings.calibration, settings.source) {
+  for (int i = 0; i < axes_; ++i) {
+    Axis& a = axis_[static_cast<std::size_t>(i)];
+    a.settings = settings_.axis(i);
+    a.limits = limits[static_cast<std::size_t>(i)];
+    u_held_V_[static_cast<std::size_t>(i)] = a.limits.safe_u_V;
+  }
+  check_against_card();  // writes the safe voltages of the usable outputs first, then throws
+  const auto n = static_cast<std::size_t>(axes_);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Axis& a = axis_[i];
+    tick_insns_[i] = instruction(INSN_WRITE, &dac_words_[i], a.ao_subdevice, a.settings.ao);
+    tick_insns_[n + i] = instruction(INSN_READ, &adc_words_[i], a.ai_subdevice, a.settings.ai);
+  }
+  tick_list_.n_insns = static_cast<unsigned>(2 * n);
+  tick_list_.insns = tick_insns_.data();
+  write_safe({});  // before anything can arm
   g_live.store(this);
   install_emergency_handlers();
-  spdlog::info("{}; the safe {} V written (DAC code {})", describe(), limits_.safe_u_V, safe_data_);
+  for (const std::string& line : describe()) spdlog::info("{}", line);
+  if (axes_ == 1) {
+    spdlog::info("comedi: the safe {} V written (DAC code {})", axis_[0].limits.safe_u_V, safe_data_[0]);
+  } else {
+    std::string codes;
+    for (std::size_t i = 0; i < n; ++i) {
+      codes += fmt::format("{}{} {} V (DAC code {})", i == 0 ? "" : ", ", axis_name(static_cast<int>(i)),
+                           axis_[i].limits.safe_u_V, safe_data_[i]);
+    }
+    spdlog::info("comedi: the safe voltages written: {}", codes);
+  }
 }
 
 ComediBackend::~ComediBackend() {
-  write_safe(limits_.safe_u_V);  // the last word (a step: the bridge's ramp ended before, or could not run)
+  write_safe({});  // the last word (a step: the bridge's ramp ended before, or could not run)
   ComediBackend* self = this;
   g_live.compare_exchange_strong(self, nullptr);
+}
+
+void ComediBackend::prepare_safe_list(const std::array<bool, kMaxAxes>& usable) noexcept {
+  unsigned n = 0;
+  safe_axes_ = usable;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    if (!usable[i]) continue;
+    const Axis& a = axis_[i];
+    safe_insns_[n++] = instruction(INSN_WRITE, &safe_data_[i], a.ao_subdevice, a.settings.ao);
+  }
+  safe_list_.n_insns = n;
+  safe_list_.insns = n > 0 ? safe_insns_.data() : nullptr;
 }
 
 void ComediBackend::check_against_card() {
@@ -171,9 +221,11 @@ void ComediBackend::check_against_card() {
   const auto fail = [&](const std::string& field, const std::string& reason) {
     throw ConfigError(settings_.source, field, fmt::format("{} ({})", reason, settings_.device));
   };
-  const auto check_channel = [&](const char* prefix, const ComediChannelSettings& c, int type, const char* kind) {
+  // Axis `axis`'s channel `c` (prefix "ao"/"ai"): its subdevice, checked; keys named as the file spells them.
+  const auto check_channel = [&](int axis, const char* prefix, const ComediChannelSettings& c, int type,
+                                 const char* kind) {
     const int s = find_subdevice(dev, c.subdevice, type);
-    const std::string p = std::string("comedi.") + prefix + ".";
+    const std::string p = axis_field(std::string("comedi.") + prefix + ".", axis);
     if (s < 0) fail(p + "subdevice", fmt::format("the card has no {} subdevice", kind));
     if (s >= comedi_get_n_subdevices(dev))
       fail(p + "subdevice", fmt::format("the card has {} subdevices", comedi_get_n_subdevices(dev)));
@@ -193,102 +245,182 @@ void ComediBackend::check_against_card() {
     }
     return su;
   };
-  ao_subdevice_ = check_channel("ao", settings_.ao, COMEDI_SUBD_AO, "analog output");
-  try {
-    dac_ = ComediConverter(dev, ao_subdevice_, static_cast<unsigned>(settings_.ao.channel),
-                           static_cast<unsigned>(settings_.ao.range), handle_.calibration);
-  } catch (const std::runtime_error& e) {
-    fail("comedi.ao.range", e.what());
-  }
-  // From here the output is usable: a refusal below leaves it at the safe voltage.
-  safe_insn_ = instruction(INSN_WRITE, &safe_data_, ao_subdevice_, settings_.ao);
-  safe_list_.n_insns = 1;
-  safe_list_.insns = &safe_insn_;
-  const auto refuse = [&](const std::string& field, const std::string& reason) {
-    write_safe(limits_.safe_u_V);
-    fail(field, reason);
-  };
-  const double lo_V = settings_.card_V(limits_.u_min_V), hi_V = settings_.card_V(limits_.u_max_V);
-  if (lo_V < dac_.min_V() || hi_V > dac_.max_V()) {
-    refuse("comedi.ao.range", fmt::format("the DAC's [{:g}, {:g}] V does not cover actuator.u_min_V..u_max_V / "
-                                          "comedi.amplifier_gain_V_per_V = [{:g}, {:g}] V",
-                                          dac_.min_V(), dac_.max_V(), lo_V, hi_V));
-  }
-  try {
-    ai_subdevice_ = check_channel("ai", settings_.ai, COMEDI_SUBD_AI, "analog input");
-    adc_ = ComediConverter(dev, ai_subdevice_, static_cast<unsigned>(settings_.ai.channel),
-                           static_cast<unsigned>(settings_.ai.range), handle_.calibration);
-  } catch (const ConfigError&) {
-    write_safe(limits_.safe_u_V);
-    throw;
-  } catch (const std::runtime_error& e) {
-    refuse("comedi.ai.range", e.what());
-  }
-}
-
-lsampl_t ComediBackend::dac_code(double u_V) noexcept {
-  if (!(u_V >= limits_.u_min_V)) u_V = limits_.u_min_V;  // also NaN: the low end (BridgeCore never sends one)
-  if (u_V > limits_.u_max_V) u_V = limits_.u_max_V;
-  double v = settings_.card_V(u_V);
-  if (v < dac_.min_V() || v > dac_.max_V()) {
-    counters_.dac_clamped.fetch_add(1, std::memory_order_relaxed);
-    v = v < dac_.min_V() ? dac_.min_V() : dac_.max_V();
-  }
-  return dac_.from_V(v);
-}
-
-double ComediBackend::position_m(lsampl_t counts) const noexcept {
-  if (counts == 0 || counts >= adc_.maxdata()) return std::nan("");
-  return settings_.position_m(adc_.to_V(counts));
-}
-
-StageReading ComediBackend::step(double u_V, double /*t_s*/, double /*dt_s*/) noexcept {
-  dac_word_ = dac_code(u_V);
-  const int rc = comedi_do_insnlist(handle_.device, &tick_list_);
-  counters_.transfers.fetch_add(1, std::memory_order_relaxed);
-  bool fault = false;
-  if (rc < 2) {
-    fault = true;
-    counters_.read_errors.fetch_add(1, std::memory_order_relaxed);
-    if (rc < 1) counters_.write_errors.fetch_add(1, std::memory_order_relaxed);
-  } else {
-    const double y = position_m(adc_word_);
-    if (std::isfinite(y)) {
-      y_last_m_ = y;
-    } else {
-      fault = true;
-      counters_.saturated.fetch_add(1, std::memory_order_relaxed);
+  const auto n = static_cast<std::size_t>(axes_);
+  // Every axis's output first: the ones usable are written their safe voltage before any refusal,
+  // also when another axis's is not (the first refusal is thrown after that write).
+  std::array<bool, kMaxAxes> usable{};
+  std::optional<ConfigError> refused;
+  for (std::size_t i = 0; i < n; ++i) {
+    Axis& a = axis_[i];
+    const int axis = static_cast<int>(i);
+    try {
+      a.ao_subdevice = check_channel(axis, "ao", a.settings.ao, COMEDI_SUBD_AO, "analog output");
+      // The config compared the subdevices as written; here -1 is the one it stands for.
+      for (std::size_t j = 0; j < i; ++j) {
+        if (usable[j] && axis_[j].ao_subdevice == a.ao_subdevice &&
+            axis_[j].settings.ao.channel == a.settings.ao.channel) {
+          fail(axis_field("comedi.ao.channel", axis),
+               fmt::format("axis {} drives ao subdevice {} channel {} already: two axes on one output would drive "
+                           "one amplifier twice",
+                           axis_name(static_cast<int>(j)), a.ao_subdevice, a.settings.ao.channel));
+        }
+      }
+      try {
+        a.dac = ComediConverter(dev, a.ao_subdevice, static_cast<unsigned>(a.settings.ao.channel),
+                                static_cast<unsigned>(a.settings.ao.range), handle_.calibration);
+      } catch (const std::runtime_error& e) {
+        fail(axis_field("comedi.ao.range", axis), e.what());
+      }
+      usable[i] = true;
+    } catch (const ConfigError& e) {
+      if (!refused) refused = e;
     }
   }
-  StageReading reading{y_last_m_, 0};
-  if (!fault) {
-    consecutive_faults_ = 0;
-    return reading;
+  // From here the usable outputs are known: a refusal below leaves them at their safe voltages.
+  prepare_safe_list(usable);
+  const auto refuse = [&](const std::string& field, const std::string& reason) {
+    write_safe({});
+    fail(field, reason);
+  };
+  if (refused) {
+    write_safe({});
+    throw *refused;
   }
-  counters_.sensor_faults.fetch_add(1, std::memory_order_relaxed);
-  reading.flags = sample_flags::kSensorFault;
-  if (++consecutive_faults_ >= settings_.fault_limit) {
-    reading.go_safe = true;
-    if (consecutive_faults_ == settings_.fault_limit) counters_.fault_safe.fetch_add(1, std::memory_order_relaxed);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Axis& a = axis_[i];
+    const double lo_V = a.settings.card_V(a.limits.u_min_V), hi_V = a.settings.card_V(a.limits.u_max_V);
+    if (lo_V < a.dac.min_V() || hi_V > a.dac.max_V()) {
+      const int axis = static_cast<int>(i);
+      refuse(axis_field("comedi.ao.range", axis),
+             fmt::format("the DAC's [{:g}, {:g}] V does not cover {}..{} / {} = [{:g}, {:g}] V", a.dac.min_V(),
+                         a.dac.max_V(), axis_field("actuator.u_min_V", axis), axis_field("actuator.u_max_V", axis),
+                         axis_field("comedi.amplifier_gain_V_per_V", axis), lo_V, hi_V));
+    }
   }
-  return reading;
+  try {
+    for (std::size_t i = 0; i < n; ++i) {
+      Axis& a = axis_[i];
+      const int axis = static_cast<int>(i);
+      a.ai_subdevice = check_channel(axis, "ai", a.settings.ai, COMEDI_SUBD_AI, "analog input");
+      for (std::size_t j = 0; j < i; ++j) {
+        if (axis_[j].ai_subdevice == a.ai_subdevice && axis_[j].settings.ai.channel == a.settings.ai.channel) {
+          fail(axis_field("comedi.ai.channel", axis),
+               fmt::format("axis {} reads ai subdevice {} channel {} already: each axis needs its own sensor's input",
+                           axis_name(static_cast<int>(j)), a.ai_subdevice, a.settings.ai.channel));
+        }
+      }
+      try {
+        a.adc = ComediConverter(dev, a.ai_subdevice, static_cast<unsigned>(a.settings.ai.channel),
+                                static_cast<unsigned>(a.settings.ai.range), handle_.calibration);
+      } catch (const std::runtime_error& e) {
+        fail(axis_field("comedi.ai.range", axis), e.what());
+      }
+    }
+  } catch (const ConfigError&) {
+    write_safe({});
+    throw;
+  }
 }
 
-void ComediBackend::hold_safe(std::span<const double> safe_u_V) noexcept { write_safe(safe_u_V[0]); }
+lsampl_t ComediBackend::dac_code(int axis, double u_V) noexcept {
+  const Axis& a = axis_[static_cast<std::size_t>(axis)];
+  if (!(u_V >= a.limits.u_min_V)) u_V = a.limits.u_min_V;  // also NaN: the low end (BridgeCore never sends one)
+  if (u_V > a.limits.u_max_V) u_V = a.limits.u_max_V;
+  double v = a.settings.card_V(u_V);
+  if (v < a.dac.min_V() || v > a.dac.max_V()) {
+    counters_.dac_clamped.fetch_add(1, std::memory_order_relaxed);
+    v = v < a.dac.min_V() ? a.dac.min_V() : a.dac.max_V();
+  }
+  return a.dac.from_V(v);
+}
 
-void ComediBackend::write_safe(double safe_u_V) noexcept {
-  safe_data_ = dac_code(safe_u_V);
+double ComediBackend::position_m(int axis, lsampl_t counts) const noexcept {
+  const Axis& a = axis_[static_cast<std::size_t>(axis)];
+  if (counts == 0 || counts >= a.adc.maxdata()) return std::nan("");
+  return a.settings.position_m(a.adc.to_V(counts));
+}
+
+StageReading ComediBackend::step(double u_V, double t_s, double dt_s) noexcept {
+  u_held_V_[0] = u_V;
+  std::array<StageReading, kMaxAxes> out{};
+  const auto n = static_cast<std::size_t>(axes_);
+  step_axes(std::span<const double>(u_held_V_).first(n), t_s, dt_s, std::span(out).first(n));
+  return out[0];
+}
+
+void ComediBackend::step_axes(std::span<const double> u_V, double /*t_s*/, double /*dt_s*/,
+                              std::span<StageReading> out) noexcept {
+  const auto n = static_cast<std::size_t>(axes_);
+  for (std::size_t i = 0; i < n; ++i) {
+    u_held_V_[i] = u_V[i];
+    dac_words_[i] = dac_code(static_cast<int>(i), u_V[i]);
+  }
+  // Every write, then every read: comedi stops at the first instruction that fails, so rc says
+  // which axes' reads happened (the reads after the n writes).
+  const int rc = comedi_do_insnlist(handle_.device, &tick_list_);
+  counters_.transfers.fetch_add(1, std::memory_order_relaxed);
+  const std::size_t done = rc > 0 ? static_cast<std::size_t>(rc) : 0;
+  if (done < n) counters_.write_errors.fetch_add(n - done, std::memory_order_relaxed);
+  for (std::size_t i = 0; i < n; ++i) {
+    Axis& a = axis_[i];
+    bool fault = false;
+    if (done < n + i + 1) {
+      fault = true;
+      counters_.read_errors.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      const double y = position_m(static_cast<int>(i), adc_words_[i]);
+      if (std::isfinite(y)) {
+        a.y_last_m = y;
+      } else {
+        fault = true;
+        counters_.saturated.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+    StageReading& r = out[i];
+    r = StageReading{};  // y_true_m NaN: hardware cannot know it
+    r.y_m = a.y_last_m;
+    if (!fault) {
+      a.consecutive_faults = 0;
+      continue;
+    }
+    counters_.sensor_faults.fetch_add(1, std::memory_order_relaxed);
+    counters_.axis_sensor_faults[i].fetch_add(1, std::memory_order_relaxed);
+    r.flags = sample_flags::kSensorFault;
+    if (++a.consecutive_faults >= settings_.fault_limit) {
+      r.go_safe = true;
+      if (a.consecutive_faults == settings_.fault_limit) {
+        counters_.fault_safe.fetch_add(1, std::memory_order_relaxed);
+        counters_.axis_fault_safe[i].fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+  }
+}
+
+void ComediBackend::hold_safe(std::span<const double> safe_u_V) noexcept {
+  write_safe(safe_u_V);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    u_held_V_[i] = i < safe_u_V.size() ? safe_u_V[i] : axis_[i].limits.safe_u_V;
+  }
+}
+
+void ComediBackend::write_safe(std::span<const double> safe_u_V) noexcept {
+  if (safe_list_.n_insns == 0) return;  // no usable output (a refusal before any)
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    if (!safe_axes_[i]) continue;
+    safe_data_[i] = dac_code(static_cast<int>(i), i < safe_u_V.size() ? safe_u_V[i] : axis_[i].limits.safe_u_V);
+  }
   comedi_do_insnlist(handle_.device, &safe_list_);
   counters_.safe_writes.fetch_add(1, std::memory_order_relaxed);
 }
 
 bool ComediBackend::emergency_safe() noexcept {
-  return safe_list_.insns != nullptr && comedi_do_insnlist(handle_.device, &safe_list_) == 1;
+  return safe_list_.insns != nullptr &&
+         comedi_do_insnlist(handle_.device, &safe_list_) == static_cast<int>(safe_list_.n_insns);
 }
 
 void ComediBackend::append_counters(std::vector<std::pair<std::string, std::uint64_t>>& entries) const {
-  const auto add = [&](const char* name, const std::atomic<std::uint64_t>& v) {
-    entries.emplace_back(name, v.load(std::memory_order_relaxed));
+  const auto add = [&](std::string name, const std::atomic<std::uint64_t>& v) {
+    entries.emplace_back(std::move(name), v.load(std::memory_order_relaxed));
   };
   add("comedi_transfers", counters_.transfers);
   add("comedi_write_errors", counters_.write_errors);
@@ -298,16 +430,30 @@ void ComediBackend::append_counters(std::vector<std::pair<std::string, std::uint
   add("sensor_fault_safe", counters_.fault_safe);
   add("comedi_dac_clamped", counters_.dac_clamped);
   add("comedi_safe_writes", counters_.safe_writes);
+  if (axes_ == 1) return;  // the totals are axis x's
+  // Which axis's sensor fails, which one made the bridge go safe: x_sensor_faults, y_..., as the
+  // bridge names its own per-axis counters (x_applied, ...).
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    const std::string p = std::string(axis_name(static_cast<int>(i))) + "_";
+    add(p + "sensor_faults", counters_.axis_sensor_faults[i]);
+    add(p + "sensor_fault_safe", counters_.axis_fault_safe[i]);
+  }
 }
 
-std::string ComediBackend::describe() const {
-  return fmt::format(
-      "comedi {} ({} / {}): ao subdevice {} channel {} {}; ai subdevice {} channel {} aref {} {}; "
-      "calibration {}",
-      settings_.device, comedi_get_driver_name(handle_.device), comedi_get_board_name(handle_.device), ao_subdevice_,
-      settings_.ao.channel, dac_.describe(), ai_subdevice_, settings_.ai.channel, aref_name(settings_.ai.aref),
-      adc_.describe(),
-      handle_.calibration_path.empty() ? std::string("none (range tables)") : handle_.calibration_path);
+std::vector<std::string> ComediBackend::describe() const {
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format(
+      "comedi {} ({} / {}): {} ax{}, calibration {}", settings_.device, comedi_get_driver_name(handle_.device),
+      comedi_get_board_name(handle_.device), axes_, axes_ == 1 ? "is" : "es",
+      handle_.calibration_path.empty() ? std::string("none (range tables)") : handle_.calibration_path));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    const Axis& a = axis_[i];
+    lines.push_back(fmt::format("comedi {}: ao subdevice {} channel {} {}; ai subdevice {} channel {} aref {} {}",
+                                axis_name(static_cast<int>(i)), a.ao_subdevice, a.settings.ao.channel, a.dac.describe(),
+                                a.ai_subdevice, a.settings.ai.channel, aref_name(a.settings.ai.aref),
+                                a.adc.describe()));
+  }
+  return lines;
 }
 
 }  // namespace hystloop

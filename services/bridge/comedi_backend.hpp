@@ -1,22 +1,28 @@
 #pragma once
 // bridge.backend: comedi — a multifunction DAQ card through comedilib (NI, Measurement
-// Computing, Advantech, ...): one analog output drives the piezo amplifier's input, one analog
-// input reads the position sensor. Per tick one comedi_do_insnlist() carrying a write (the
-// tick's voltage) and a read (the sensor just after it), both prepared before the loop: step()
-// only converts, clamps and counts. Units through comedilib's calibration: the board's softcal
-// polynomials when its calibration file has them, else the range table (comedi_to_phys).
+// Computing, Advantech, ...): per axis of the stage (x, y, z) one analog output drives its piezo
+// amplifier's input and one analog input reads its position sensor. Per tick one
+// comedi_do_insnlist() carrying every axis's write (the tick's voltages: all outputs change
+// together), then every axis's read (the sensors just after them), prepared before the loop:
+// step_axes() only converts, clamps and counts. Units through comedilib's calibration, per
+// channel: the board's softcal polynomials when its calibration file has them, else the range
+// table (comedi_to_phys).
 //
-// Safety: the constructor writes the safe voltage before returning (the bridge starts disarmed);
-// hold_safe() and the destructor step the output to it; a fatal signal (SIGSEGV, SIGABRT, ...)
-// or std::terminate steps it there too before the process dies (emergency_safe()). A read that
-// fails or saturates sets SENSOR_FAULT and keeps the last good position; comedi.fault_limit of
-// them in a row ask the bridge to go safe (StageReading::go_safe). See services/bridge/README.md.
+// Safety: the constructor writes every axis's safe voltage before returning (the bridge starts
+// disarmed); hold_safe() and the destructor step every output to it in one list; a fatal signal
+// (SIGSEGV, SIGABRT, ...) or std::terminate steps them there too before the process dies
+// (emergency_safe()). A read that fails or saturates sets SENSOR_FAULT on its axis and keeps
+// that axis's last good position; comedi.fault_limit of them in a row on one axis ask the bridge
+// to go safe (StageReading::go_safe). See services/bridge/README.md.
 
 #include <comedilib.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "bridge/comedi_config.hpp"
 #include "bridge/stage_backend.hpp"
@@ -63,69 +69,98 @@ struct ComediHandle {
   ComediHandle& operator=(const ComediHandle&) = delete;
 };
 
+// Totals over the axes under the one-axis names (what HX_STATUS has always carried), and the
+// faults of each axis (reported per axis when there are several).
 struct ComediCounters {
-  std::atomic<std::uint64_t> transfers{0};      // comedi_do_insnlist calls of step()
-  std::atomic<std::uint64_t> write_errors{0};   // the write did not happen (rc < 1)
-  std::atomic<std::uint64_t> read_errors{0};    // the read did not happen (rc < 2)
-  std::atomic<std::uint64_t> saturated{0};      // read 0 or maxdata (or NaN): the sensor is out of range
-  std::atomic<std::uint64_t> sensor_faults{0};  // ticks flagged SENSOR_FAULT (read error or saturated)
+  std::atomic<std::uint64_t> transfers{0};      // comedi_do_insnlist calls of a tick
+  std::atomic<std::uint64_t> write_errors{0};   // writes that did not happen (an axis each)
+  std::atomic<std::uint64_t> read_errors{0};    // reads that did not happen (an axis each)
+  std::atomic<std::uint64_t> saturated{0};      // reads of 0 or maxdata (or NaN): a sensor is out of range
+  std::atomic<std::uint64_t> sensor_faults{0};  // readings flagged SENSOR_FAULT (read error or saturated), every axis
   std::atomic<std::uint64_t> fault_safe{0};     // times comedi.fault_limit faults in a row asked for the safe state
-  std::atomic<std::uint64_t> dac_clamped{0};    // card voltage clamped to the DAC's range (0 when the config is right)
-  std::atomic<std::uint64_t> safe_writes{0};    // hold_safe / start / emergency writes of the safe voltage
+  std::atomic<std::uint64_t> dac_clamped{0};    // card voltages clamped to a DAC's range (0 when the config is right)
+  std::atomic<std::uint64_t> safe_writes{0};    // hold_safe / start / emergency lists of the safe voltages
+  std::array<std::atomic<std::uint64_t>, kMaxAxes> axis_sensor_faults{};  // sensor_faults, axis by axis
+  std::array<std::atomic<std::uint64_t>, kMaxAxes> axis_fault_safe{};     // fault_safe, by the axis that asked
 };
 
 class ComediBackend final : public StageBackend {
  public:
-  // Opens comedi.device, checks the config against the card (ConfigError naming the field;
-  // when the output channel is usable the safe voltage is written first), prepares the
-  // converters and the per-tick instruction list, and writes the safe voltage.
-  ComediBackend(const ComediSettings& settings, const ActuatorLimits& limits);
-  ~ComediBackend() override;  // steps to the safe voltage, then closes the device
+  // Opens comedi.device, checks the config against the card (ConfigError naming the key; every
+  // output found usable is written its safe voltage first), prepares the converters and the
+  // per-tick instruction list, and writes every axis's safe voltage. `limits` has an entry per
+  // axis, settings.axes of them (ParameterError otherwise).
+  ComediBackend(const ComediSettings& settings, std::span<const ActuatorLimits> limits);
+  // One axis (settings.axes 1): the probe's and the benchmark's.
+  ComediBackend(const ComediSettings& settings, const ActuatorLimits& limits)
+      : ComediBackend(settings, std::span<const ActuatorLimits>(&limits, 1)) {}
+  ~ComediBackend() override;  // steps every output to its safe voltage, then closes the device
   ComediBackend(const ComediBackend&) = delete;
   ComediBackend& operator=(const ComediBackend&) = delete;
 
+  // Axis x; the other axes hold what they were last given (their safe voltages at first).
   StageReading step(double u_V, double t_s, double dt_s) noexcept override;
+  int axes() const noexcept override { return axes_; }
+  void step_axes(std::span<const double> u_V, double t_s, double dt_s, std::span<StageReading> out) noexcept override;
   const std::string& name() const noexcept override { return name_; }
+  // Every axis's safe code in one list; an axis without an entry in `safe_u_V` gets its
+  // actuator's safe_u_V.
   void hold_safe(std::span<const double> safe_u_V) noexcept override;
   void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& entries) const override;
 
-  // The DAC code for `u_V` at the piezo: clamped to the actuator's range, divided by the
-  // amplifier's gain, clamped to the DAC's range, converted (counts a DAC clamp).
-  lsampl_t dac_code(double u_V) noexcept;
-  // The position for an ADC code (NaN when saturated).
-  double position_m(lsampl_t counts) const noexcept;
-  const ComediConverter& dac() const noexcept { return dac_; }
-  const ComediConverter& adc() const noexcept { return adc_; }
+  // The DAC code for `u_V` at axis `axis`'s piezo: clamped to its actuator's range, divided by its
+  // amplifier's gain, clamped to its DAC's range, converted (counts a DAC clamp).
+  lsampl_t dac_code(int axis, double u_V) noexcept;
+  lsampl_t dac_code(double u_V) noexcept { return dac_code(0, u_V); }
+  // Axis `axis`'s position for an ADC code (NaN when saturated).
+  double position_m(int axis, lsampl_t counts) const noexcept;
+  double position_m(lsampl_t counts) const noexcept { return position_m(0, counts); }
+  const ComediConverter& dac(int axis = 0) const noexcept { return axis_[static_cast<std::size_t>(axis)].dac; }
+  const ComediConverter& adc(int axis = 0) const noexcept { return axis_[static_cast<std::size_t>(axis)].adc; }
   const ComediCounters& counters() const noexcept { return counters_; }
   const std::string& calibration_path() const noexcept { return handle_.calibration_path; }
-  std::string describe() const;
+  // The card's line, then one per axis (the start-up log, --probe-hardware).
+  std::vector<std::string> describe() const;
 
-  // Async-signal-safe: writes the last safe code with one comedi_do_insnlist (the fatal-signal
-  // and terminate handlers call it for the live backend). True when the card took it.
+  // Async-signal-safe: writes every axis's last safe code with one comedi_do_insnlist (the
+  // fatal-signal and terminate handlers call it for the live backend). True when the card took it.
   bool emergency_safe() noexcept;
 
  private:
+  struct Axis {
+    ComediAxisSettings settings;
+    ActuatorLimits limits;
+    unsigned ao_subdevice = 0;
+    unsigned ai_subdevice = 0;
+    ComediConverter dac;
+    ComediConverter adc;
+    double y_last_m = 0.0;  // the last good position (what a faulted read reports)
+    int consecutive_faults = 0;
+  };
+
   void check_against_card();  // throws ConfigError
-  void write_safe(double safe_u_V) noexcept;
+  // Prepares the safe list for the axes whose output is usable (`usable`), in axis order.
+  void prepare_safe_list(const std::array<bool, kMaxAxes>& usable) noexcept;
+  // Writes the safe codes of the axes in the safe list: each axis's actuator's safe_u_V, or
+  // `safe_u_V[i]` where given.
+  void write_safe(std::span<const double> safe_u_V) noexcept;
 
   ComediSettings settings_;
-  ActuatorLimits limits_;
+  int axes_ = 1;
   std::string name_ = "comedi";
   ComediHandle handle_;
-  unsigned ao_subdevice_ = 0;
-  unsigned ai_subdevice_ = 0;
-  ComediConverter dac_;
-  ComediConverter adc_;
-  // The per-tick list (write, read) and the safe list (write), with their data words.
-  lsampl_t dac_word_ = 0;
-  lsampl_t adc_word_ = 0;
-  comedi_insn tick_insns_[2]{};
-  comedi_insn safe_insn_{};
-  lsampl_t safe_data_ = 0;  // the safe code (written by the constructor and hold_safe)
+  std::array<Axis, kMaxAxes> axis_{};
+  // The per-tick list (every axis's write, then every axis's read) and the safe list (every
+  // usable axis's write), with their data words: the instructions point into these arrays.
+  std::array<lsampl_t, kMaxAxes> dac_words_{};
+  std::array<lsampl_t, kMaxAxes> adc_words_{};
+  std::array<lsampl_t, kMaxAxes> safe_data_{};  // the safe codes (written by the constructor and hold_safe)
+  std::array<bool, kMaxAxes> safe_axes_{};      // the axes in the safe list (all of them once constructed)
+  std::array<comedi_insn, std::size_t{2} * kMaxAxes> tick_insns_{};
+  std::array<comedi_insn, kMaxAxes> safe_insns_{};
   comedi_insnlist tick_list_{};
   comedi_insnlist safe_list_{};
-  double y_last_m_ = 0.0;
-  int consecutive_faults_ = 0;
+  std::array<double, kMaxAxes> u_held_V_{};  // what step() holds the axes other than x at
   ComediCounters counters_;
 };
 

@@ -50,6 +50,8 @@ int main(int argc, char** argv) try {
       ->check(CLI::Range(0.0, 10.0));
   app.add_option("--duration-s", probe_options.duration_s, "With --probe-hardware --yes: the triangle's duration [s]")
       ->check(CLI::Range(0.05, 60.0));
+  add_axis_option(&app, "--axis", probe_options.axis,
+                  "With --probe-hardware: the axis probed (default x; the others are held at their safe voltage)");
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   // Flags are overrides of their config keys, so every value is validated in one place.

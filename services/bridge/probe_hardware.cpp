@@ -1,10 +1,13 @@
 #include "bridge/probe_hardware.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <iterator>
+#include <span>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -95,29 +98,42 @@ double triangle(double phase) {
 }
 
 int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out) {
-  const ComediSettings& c = settings.comedi;
-  const ActuatorLimits& a = settings.limits;
-  ComediBackend backend(c, a);  // writes the safe voltage; refuses a config the card does not have
-  std::fprintf(out, "%s\n", backend.describe().c_str());
+  const int axis = o.axis;
+  const auto at = static_cast<std::size_t>(axis);
+  const ComediAxisSettings& c = settings.comedi.axis(axis);
+  const ActuatorLimits& a = settings.limits_of(axis);
+  // Every axis's output is opened and held at its safe voltage; only `axis` moves.
+  const std::array<ActuatorLimits, kMaxAxes> limits = settings.axes_limits();
+  const auto n = static_cast<std::size_t>(settings.axes);
+  ComediBackend backend(settings.comedi,
+                        std::span<const ActuatorLimits>(limits).first(n));  // refuses what the card lacks
+  for (const std::string& line : backend.describe()) std::fprintf(out, "%s\n", line.c_str());
   const double center_V = c.card_V(a.safe_u_V);
-  const double lo_V = std::max({center_V - o.amplitude_V, c.card_V(a.u_min_V), backend.dac().min_V()});
-  const double hi_V = std::min({center_V + o.amplitude_V, c.card_V(a.u_max_V), backend.dac().max_V()});
+  const double lo_V = std::max({center_V - o.amplitude_V, c.card_V(a.u_min_V), backend.dac(axis).min_V()});
+  const double hi_V = std::min({center_V + o.amplitude_V, c.card_V(a.u_max_V), backend.dac(axis).max_V()});
   std::fprintf(out,
-               "driving: triangle %.4g V -> %.4g V -> %.4g V -> %.4g V at the card (x%g: %.4g..%.4g V at the piezo), "
-               "%.3g s, %d steps\n",
-               center_V, hi_V, lo_V, center_V, c.amplifier_gain_V_per_V, lo_V * c.amplifier_gain_V_per_V,
-               hi_V * c.amplifier_gain_V_per_V, o.duration_s, static_cast<int>(o.duration_s * o.rate_hz));
+               "driving%s: triangle %.4g V -> %.4g V -> %.4g V -> %.4g V at the card (x%g: %.4g..%.4g V at the "
+               "piezo), %.3g s, %d steps\n",
+               settings.axes > 1 ? (" axis " + std::string(axis_name(axis))).c_str() : "", center_V, hi_V, lo_V,
+               center_V, c.amplifier_gain_V_per_V, lo_V * c.amplifier_gain_V_per_V, hi_V * c.amplifier_gain_V_per_V,
+               o.duration_s, static_cast<int>(o.duration_s * o.rate_hz));
   const int steps = std::max(4, static_cast<int>(o.duration_s * o.rate_hz));
   std::vector<double> command_V, sensor_V;
   command_V.reserve(static_cast<std::size_t>(steps));
   sensor_V.reserve(static_cast<std::size_t>(steps));
   int faults = 0;
+  const std::array<double, kMaxAxes> safe_V = settings.safe_voltages();
+  std::array<double, kMaxAxes> u_V = safe_V;
+  std::array<StageReading, kMaxAxes> readings{};
   const auto period = std::chrono::duration<double>(1.0 / o.rate_hz);
   auto next = std::chrono::steady_clock::now();
   for (int i = 0; i <= steps; ++i) {
     const double t = triangle(static_cast<double>(i) / steps);
     const double card_V = std::clamp(center_V + t * o.amplitude_V, lo_V, hi_V);
-    const StageReading r = backend.step(card_V * c.amplifier_gain_V_per_V, i / o.rate_hz, 1.0 / o.rate_hz);
+    u_V[at] = card_V * c.amplifier_gain_V_per_V;
+    backend.step_axes(std::span<const double>(u_V).first(n), i / o.rate_hz, 1.0 / o.rate_hz,
+                      std::span(readings).first(n));
+    const StageReading& r = readings[at];
     if ((r.flags & sample_flags::kSensorFault) != 0) {
       ++faults;
     } else {
@@ -127,27 +143,29 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
     std::this_thread::sleep_until(next);
   }
-  backend.hold_safe(std::span(&a.safe_u_V, 1));
+  backend.hold_safe(std::span<const double>(safe_V).first(n));
   const ProbeFit f = fit(command_V, sensor_V, faults);
   std::fprintf(out, "back at the safe %g V (%.4g V at the card)\n", a.safe_u_V, center_V);
   std::fprintf(out, "measured: sensor %+.4g V per V at the card (offset %+.4g V, r %.4f) over %d samples, %d faulted\n",
                f.gain_V_per_V, f.offset_V, f.r, f.samples, f.faults);
   const double m_per_V = f.gain_V_per_V * c.sensor_scale_m_per_V / c.amplifier_gain_V_per_V;
-  std::fprintf(
-      out,
-      "  = %+.4g m per V at the piezo with comedi.sensor.scale_m_per_V %g and comedi.amplifier_gain_V_per_V %g "
-      "(servo.nominal_gain_m_per_V is %g)\n",
-      m_per_V, c.sensor_scale_m_per_V, c.amplifier_gain_V_per_V, settings.servo.nominal_gain_m_per_V);
+  const std::string scale_key = axis_field("comedi.sensor.scale_m_per_V", axis);
+  std::fprintf(out, "  = %+.4g m per V at the piezo with %s %g and %s %g (%s is %g)\n", m_per_V, scale_key.c_str(),
+               c.sensor_scale_m_per_V, axis_field("comedi.amplifier_gain_V_per_V", axis).c_str(),
+               c.amplifier_gain_V_per_V, axis_field("servo.nominal_gain_m_per_V", axis).c_str(),
+               settings.servo_of(axis).nominal_gain_m_per_V);
   if (f.samples < 3 || std::abs(f.r) < 0.9) {
     std::fprintf(out,
-                 "verdict: NO CLEAR RESPONSE (|r| < 0.9 or too few good reads): check the wiring, comedi.ai.* "
-                 "and the amplifier's enable before running the loop\n");
+                 "verdict: NO CLEAR RESPONSE (|r| < 0.9 or too few good reads): check the wiring, %s* "
+                 "and the amplifier's enable before running the loop\n",
+                 axis_field("comedi.ai.", axis).c_str());
     return 1;
   }
   if (m_per_V < 0) {
     std::fprintf(out,
                  "verdict: SIGN REVERSED: the position falls as the command rises; swap the sensor's wiring or "
-                 "negate comedi.sensor.scale_m_per_V\n");
+                 "negate %s\n",
+                 scale_key.c_str());
     return 1;
   }
   std::fprintf(out, "verdict: sign OK (position rises with the command)\n");
@@ -157,23 +175,33 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
 }  // namespace
 
 int probe_hardware(const BridgeSettings& settings, const ProbeOptions& options, std::FILE* out) {
-  const ComediSettings& c = settings.comedi;
+  const ComediSettings& card = settings.comedi;
   try {
+    if (options.axis < 0 || options.axis >= settings.axes) {
+      throw ParameterError("--axis",
+                           fmt::format("the stage has {} ax{} (bridge.axes): there is no axis {}", settings.axes,
+                                       settings.axes == 1 ? "is" : "es", axis_name(options.axis)));
+    }
     {
-      const ComediHandle handle(c.device, c.calibration, c.source);
-      std::fprintf(out, "device: %s\n", c.device.c_str());
+      const ComediHandle handle(card.device, card.calibration, card.source);
+      std::fprintf(out, "device: %s\n", card.device.c_str());
       list_card(handle, out);
     }
     if (!options.drive) {
+      const ComediAxisSettings& c = card.axis(options.axis);
+      const ActuatorLimits& a = settings.limits_of(options.axis);
+      const std::string which = settings.axes > 1 ? fmt::format(" axis {}'s", axis_name(options.axis)) : std::string();
       std::fprintf(out,
                    "not driving the output. With --yes, hystloop-bridge would write the safe %g V (%.4g V at the card) "
-                   "to ao subdevice %s channel %d range %d, then a triangle of +-%g V at the card around it for %g s "
-                   "(clamped to actuator.u_min_V..u_max_V = [%g, %g] V at the piezo and the DAC's range), read ai "
-                   "subdevice %s channel %d range %d aref %s at every step, return to the safe voltage and report "
-                   "the sensor's gain and sign. The amplifier must be enabled and the stage free to move.\n",
-                   settings.limits.safe_u_V, c.card_V(settings.limits.safe_u_V),
+                   "to%s ao subdevice %s channel %d range %d%s, then a triangle of +-%g V at the card around it for "
+                   "%g s (clamped to %s..%s = [%g, %g] V at the piezo and the DAC's range), read ai subdevice %s "
+                   "channel %d range %d aref %s at every step, return to the safe voltage and report the sensor's "
+                   "gain and sign. The amplifier must be enabled and the stage free to move.\n",
+                   a.safe_u_V, c.card_V(a.safe_u_V), which.c_str(),
                    c.ao.subdevice < 0 ? "auto" : std::to_string(c.ao.subdevice).c_str(), c.ao.channel, c.ao.range,
-                   options.amplitude_V, options.duration_s, settings.limits.u_min_V, settings.limits.u_max_V,
+                   settings.axes > 1 ? " (every other axis held at its safe voltage)" : "", options.amplitude_V,
+                   options.duration_s, axis_field("actuator.u_min_V", options.axis).c_str(),
+                   axis_field("actuator.u_max_V", options.axis).c_str(), a.u_min_V, a.u_max_V,
                    c.ai.subdevice < 0 ? "auto" : std::to_string(c.ai.subdevice).c_str(), c.ai.channel, c.ai.range,
                    aref_name(c.ai.aref));
       return 0;

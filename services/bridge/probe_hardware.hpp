@@ -5,7 +5,8 @@
 // configured output with a slow triangle of ±amplitude at the card around the safe voltage
 // (clamped to the actuator's range and the DAC's), reads the sensor at every step and reports
 // the sensor's gain and sign against the command, so wiring mistakes show before the loop runs.
-// The output starts and ends at the safe voltage.
+// The output starts and ends at the safe voltage. On a stage of several axes it drives one axis
+// (`axis`, x by default) while every other output holds its safe voltage.
 
 #include <cstdio>
 #include <string>
@@ -19,6 +20,7 @@ struct ProbeOptions {
   double amplitude_V = 1.0;  // at the card's output [V]
   double duration_s = 1.0;   // one triangle: safe -> +A -> -A -> safe
   double rate_hz = 1000.0;   // steps of the triangle
+  int axis = 0;              // the axis driven (0 x, 1 y, 2 z; below bridge.axes)
 };
 
 // Writes the report to `out`. Returns 0, 1 (the card could not be opened / a read failed) or 2

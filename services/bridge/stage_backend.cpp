@@ -44,7 +44,12 @@ std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, Simula
 
 std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings) {
   // A hardware backend is added here, under its bridge.backend name.
-  if (settings.backend == "comedi") return std::make_unique<ComediBackend>(settings.comedi, settings.limits);
+  if (settings.backend == "comedi") {
+    // One actuator per axis, each its own range and safe voltage (axes_limits() is a copy: kept here).
+    const std::array<ActuatorLimits, kMaxAxes> limits = settings.axes_limits();
+    return std::make_unique<ComediBackend>(
+        settings.comedi, std::span<const ActuatorLimits>(limits).first(static_cast<std::size_t>(settings.axes)));
+  }
   if (settings.axes == 1) return make_stage_backend(settings.backend, settings.stage);
   return std::make_unique<MultiAxisSimulatedBackend>(settings.backend, multi_axis_stage(settings));
 }

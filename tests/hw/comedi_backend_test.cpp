@@ -263,7 +263,7 @@ TEST_F(ComediBackendTest, AConfigTheCardRefusesAfterOpeningLeavesTheOutputSafe) 
   c.ao.range = 1;  // [0, 10] V cannot go negative
   EXPECT_TRUE(contains(refused(c, limits()), "comedi.ao.range"));
   c = settings();
-  c.ao.channel = 2;  // no usable output: nothing is written
+  c.ao.channel = static_cast<int>(fake_comedi::kAoChannels);  // no usable output: nothing is written
   EXPECT_TRUE(contains(refused(c, limits()), "comedi.ao.channel"));
   EXPECT_EQ(fake().writes, 0);
   c = settings();

@@ -57,7 +57,7 @@ TEST(ComediProbe, ListsTheCardAndDrivesNothingWithoutYes) {
   const BridgeRun r = run("", "--probe-hardware");
   EXPECT_EQ(r.rc, 0) << r.out;
   expect_says(r, {"card: driver fake_driver, board fake_board, 3 subdevices",
-                  "subdevice 0: analog input, 16 channels, maxdata 65535", "subdevice 1: analog output, 2 channels",
+                  "subdevice 0: analog input, 16 channels, maxdata 65535", "subdevice 1: analog output, 4 channels",
                   "    range 1: [0, 10] V", "calibration: none found (conversions use the range tables)",
                   "not driving the output. With --yes"});
   EXPECT_FALSE(contains(r.out, "measured"));
@@ -103,6 +103,26 @@ TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
   EXPECT_EQ(r.rc, 0) << r.out;
   expect_says(r, {"the safe 0 V written (DAC code 32768)", "stopping on signal 15"});
   EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
+}
+
+// Three axes, each on its own channel pair, y with a safe voltage of its own: the binary starts
+// every output at its safe code and a SIGTERM leaves each there (the fake's log: what each output
+// holds at comedi_close, and how many writes it had).
+TEST(ComediProbe, SigtermLeavesEveryAxissOutputSafe) {
+  const std::string netns = std::string(HYSTLOOP_SOURCE_DIR) + "/tools/netns-run --keyless";
+  const BridgeRun r = run("mirror_by_channel=1",
+                          "--set bridge.axes=3 --set comedi.y.ao.channel=1 --set comedi.y.ai.channel=1 "
+                          "--set comedi.z.ao.channel=2 --set comedi.z.ai.channel=2 --set actuator.y.safe_u_V=25 "
+                          "--set rt.priority=0 --set rt.io_priority=0 --set rt.lock_memory=false --set rt.cpu=-1",
+                          netns + " -- sh -c '$0 & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
+  EXPECT_EQ(r.rc, 0) << r.out;
+  // 25 V / 25 = 1 V at the card: code 36044 of [-10, 10] V.
+  expect_says(r, {"comedi: the safe voltages written: x 0 V (DAC code 32768), y 25 V (DAC code 36044), z 0 V",
+                  "stopping on signal 15"});
+  for (const char* holds : {" ao0=32768/", " ao1=36044/", " ao2=32768/", " ao3=0/0"}) {
+    EXPECT_TRUE(contains(r.log, holds)) << holds << " not in " << r.log;
+  }
+  EXPECT_FALSE(contains(r.log, " ao0=32768/1 ")) << "the loop never wrote: " << r.log;
 }
 
 }  // namespace

@@ -41,6 +41,9 @@ void configure_from_environment(State& s) {
       if (key == "mirror_offset_V") s.mirror_offset_V = value;
       if (key == "calibration") s.calibration = value != 0.0;
       if (key == "open_fails") s.open_fails = value != 0.0;
+      if (key == "mirror_by_channel" && value != 0.0) {
+        for (unsigned c = 0; c < kAiChannels; ++c) s.mirror_ao[c] = c % kAoChannels;
+      }
     }
     pos = end + 1;
   }
@@ -129,8 +132,11 @@ int comedi_close(comedi_t* it) {
   ++s.closes;
   if (const char* log = std::getenv("HX_FAKE_COMEDI_LOG")) {
     if (std::FILE* f = std::fopen(log, "a")) {
-      std::fprintf(f, "writes %ld first %u (%.6g V) last %u (%.6g V)\n", s.writes, s.first_write,
+      // Then what each output channel holds (its last code): every axis's safe code after a stop.
+      std::fprintf(f, "writes %ld first %u (%.6g V) last %u (%.6g V) holds", s.writes, s.first_write,
                    range_to_V(s.first_write, kAoRanges[0]), s.last_write, range_to_V(s.last_write, kAoRanges[0]));
+      for (unsigned c = 0; c < kAoChannels; ++c) std::fprintf(f, " ao%u=%u/%ld", c, s.ao_counts[c], s.ao_writes[c]);
+      std::fprintf(f, "\n");
       std::fclose(f);
     }
   }
@@ -166,7 +172,7 @@ int comedi_get_subdevice_flags(comedi_t*, unsigned int subdevice) {
 int comedi_get_n_channels(comedi_t*, unsigned int subdevice) {
   switch (subdevice) {
     case kAi: return 16;
-    case kAo: return 2;
+    case kAo: return static_cast<int>(kAoChannels);
     case kDio: return 8;
     default: return fail(EINVAL) ? 0 : -1;
   }
@@ -209,9 +215,10 @@ int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
   for (unsigned i = 0; i < il->n_insns; ++i) {
     comedi_insn& insn = il->insns[i];
     const unsigned chan = CR_CHAN(insn.chanspec);
-    if (insn.insn == INSN_WRITE && insn.subdev == kAo && chan < 2) {
+    if (insn.insn == INSN_WRITE && insn.subdev == kAo && chan < kAoChannels) {
       s.ao_counts[chan] = insn.data[0];
       s.ao_range[chan] = CR_RANGE(insn.chanspec);
+      ++s.ao_writes[chan];
       if (s.writes++ == 0) s.first_write = insn.data[0];
       s.last_write = insn.data[0];
       ++done;
@@ -221,22 +228,27 @@ int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
         if (r.rc < 0) {
           read_failed = true;
           done = -1;
-        } else if (r.rc <= static_cast<int>(i)) {
+        } else if (r.rc < 2) {
           read_failed = true;
         } else {
           insn.data[0] = r.counts;
           ++done;
         }
-      } else {
-        const double ao_V = range_to_V(s.ao_counts[0], kAoRanges[s.ao_range[0] % 2]);
-        insn.data[0] = range_from_V(s.mirror_gain * ao_V + s.mirror_offset_V, kAiRanges[CR_RANGE(insn.chanspec) % 3]);
+      } else if (chan < kAiChannels) {
+        const unsigned ao = s.mirror_ao[chan] % kAoChannels;
+        const double ao_V = range_to_V(s.ao_counts[ao], kAoRanges[s.ao_range[ao] % 2]);
+        insn.data[0] = range_from_V(s.mirror_gain * s.mirror_scale[chan] * ao_V + s.mirror_offset_V,
+                                    kAiRanges[CR_RANGE(insn.chanspec) % 3]);
         ++done;
+      } else {
+        g_errno = EINVAL;
+        read_failed = true;
       }
     } else {
       g_errno = EINVAL;
       read_failed = true;
     }
-    if (i < 2) record.insns[i] = {insn.insn, insn.subdev, insn.chanspec, insn.n, insn.data[0]};
+    if (i < kRecordedInsns) record.insns[i] = {insn.insn, insn.subdev, insn.chanspec, insn.n, insn.data[0]};
     if (read_failed) break;
   }
   if (s.lists.size() < s.lists.capacity()) s.lists.push_back(record);

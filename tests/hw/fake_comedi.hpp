@@ -10,8 +10,10 @@
 // HX_FAKE_COMEDI_LOG=<file> (at comedi_close: the first and last DAC codes written and counts).
 //
 // The board: subdevice 0 an analog input (16 channels, 16 bit, ranges ±10, ±5, ±1 V, ground/
-// common/diff), 1 an analog output (2 channels, 16 bit, ranges ±10 V and 0..10 V), 2 a digital
-// I/O. The input "mirrors" the output: ai volts = mirror_gain * ao volts + mirror_offset_V,
+// common/diff), 1 an analog output (4 channels, 16 bit, ranges ±10 V and 0..10 V), 2 a digital
+// I/O. Each input "mirrors" an output: ai channel c volts = mirror_gain * mirror_scale[c] *
+// (ao channel mirror_ao[c] volts) + mirror_offset_V (by default every input sees output 0, as on
+// a one-axis loopback; HX_FAKE_COMEDI="mirror_by_channel=1" makes input c see output c % 4),
 // unless scripted reads are queued.
 
 #include <comedilib.h>
@@ -29,14 +31,22 @@ struct Insn {
   lsampl_t data = 0;  // the first data word: written (INSN_WRITE) or served (INSN_READ)
 };
 
-// One comedi_do_insnlist call (at most 2 instructions recorded).
+inline constexpr unsigned kAiChannels = 16;
+inline constexpr unsigned kAoChannels = 4;
+inline constexpr unsigned kRecordedInsns = 8;  // a tick of 3 axes is 6
+
+// One comedi_do_insnlist call (at most kRecordedInsns instructions recorded).
 struct InsnList {
   unsigned n_insns = 0;
-  Insn insns[2]{};
+  Insn insns[kRecordedInsns]{};
 };
 
+// One read instruction's outcome, served to the read instructions in order (whichever list and
+// place in it). rc >= 2: the read is done and returns `counts`; 0 or 1: this read fails (the list
+// stops there: comedi_do_insnlist returns the instructions done before it, as rc 1 did for a
+// write-and-read list); -1: the whole call fails (returns -1).
 struct ScriptedRead {
-  int rc = 2;           // what comedi_do_insnlist returns (2: both done; 1: the read failed; -1: the call failed)
+  int rc = 2;
   lsampl_t counts = 0;  // what the read returns
 };
 
@@ -45,15 +55,18 @@ struct State {
   bool calibration = false;  // the board has a calibration file with softcal polynomials
   double mirror_gain = 1.0;
   double mirror_offset_V = 0.0;
+  unsigned mirror_ao[kAiChannels]{};  // the output each input sees (all output 0 by default)
+  double mirror_scale[kAiChannels] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};  // each input's own factor
   std::vector<InsnList> lists;      // reserved: recording does not allocate up to its capacity
   std::vector<ScriptedRead> reads;  // served first, in order, before mirroring
   std::size_t next_read = 0;
   int opens = 0;
   int closes = 0;
-  lsampl_t ao_counts[2] = {0, 0};  // what each output channel holds now
-  unsigned ao_range[2] = {0, 0};   // ... in which range
-  long writes = 0;                 // output writes since reset (also past the record's capacity)
-  lsampl_t first_write = 0;
+  lsampl_t ao_counts[kAoChannels]{};  // what each output channel holds now
+  unsigned ao_range[kAoChannels]{};   // ... in which range
+  long ao_writes[kAoChannels]{};      // writes to each output channel since reset
+  long writes = 0;                    // output writes since reset, every channel (also past the record's capacity)
+  lsampl_t first_write = 0;           // of any channel
   lsampl_t last_write = 0;
 };
 

@@ -107,11 +107,14 @@ TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
   EXPECT_EQ(s.servo.notch_hz, 1720.0);
   EXPECT_EQ(s.servo.notch_q, 0.7);
   EXPECT_EQ(s.servo.tick_rate_hz, s.rate_hz);
-  // Every key the bridge reads is documented there (axis y's and z's own actuator and servo keys
-  // in a comment: a one-axis stage refuses them)...
-  const auto per_axis = [](const std::string& key) {
+  // Every key the bridge reads is documented there (axis y's and z's own actuator, servo and comedi
+  // keys in a comment: a one-axis stage refuses them)...
+  const auto per_axis_comedi = [](const std::string& key) {
+    return key.starts_with("comedi.y.") || key.starts_with("comedi.z.");
+  };
+  const auto per_axis = [&](const std::string& key) {
     return key.starts_with("actuator.y.") || key.starts_with("actuator.z.") || key.starts_with("servo.y.") ||
-           key.starts_with("servo.z.");
+           key.starts_with("servo.z.") || per_axis_comedi(key);
   };
   for (const std::string& key : bridge_config_keys()) {
     if (!per_axis(key)) {
@@ -122,6 +125,12 @@ TEST(BridgeSettings, TheDeployConfigIsValidAndComplete) {
   for (const std::string& key : bridge_config_keys()) {
     Config bad(c);
     if (per_axis(key)) bad.apply_override("bridge.axes=3");
+    if (per_axis_comedi(key)) {  // read by the card's backend: three axes, each on its own channels
+      for (const char* set : {"bridge.backend=comedi", "rt.ticks_per_wake=1", "comedi.y.ao.channel=1",
+                              "comedi.y.ai.channel=1", "comedi.z.ao.channel=2", "comedi.z.ai.channel=2"}) {
+        bad.apply_override(set);
+      }
+    }
     bad.apply_override(key + "=[1, 2]");
     std::string what = "accepted";
     try {
