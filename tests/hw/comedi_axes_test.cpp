@@ -26,13 +26,14 @@
 #include "fake_comedi.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/refusal.hpp"
+#include "support/text.hpp"
 
 namespace hystloop {
 namespace {
 
 using fake_comedi::kMaxdata;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 std::string refusal(const std::string& yaml) {
   return testing::config_refusal([&] { load_bridge_settings(Config::from_string(yaml, "bridge.yaml")); });

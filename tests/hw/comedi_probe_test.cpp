@@ -14,6 +14,8 @@
 #include <initializer_list>
 #include <string>
 
+#include "support/text.hpp"
+
 namespace {
 
 const std::string kConfig = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge-comedi.yaml";
@@ -25,7 +27,7 @@ struct BridgeRun {
   std::string log;  // the fake's
 };
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using hystloop::testing::contains;
 // Each of the texts is in the bridge's output (shown in full when one is not).
 void expect_says(const BridgeRun& r, std::initializer_list<const char*> texts) {
   for (const char* text : texts) EXPECT_TRUE(contains(r.out, text)) << "no '" << text << "' in:\n" << r.out;

@@ -19,6 +19,8 @@
 #include "bridge/bridge_settings.hpp"
 #include "bridge/servo_request.hpp"
 #include "bridge/stage_backend.hpp"
+#include "support/text.hpp"
+#include "support/eventually.hpp"
 
 namespace hystloop {
 namespace {
@@ -32,7 +34,7 @@ std::string refusal(const std::string& yaml) {
   return "accepted";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 TEST(BridgeAxes, SettingsTakeTheAxesAndTheCouplingAndNameWhatTheyRefuse) {
   const BridgeSettings one = load_bridge_settings(Config::from_string("bridge: {backend: sim}", "bridge.yaml"));
@@ -217,15 +219,7 @@ class TwoAxisRecordingBackend final : public StageBackend {
   std::string name_ = "recording-xy";
 };
 
-template <class Condition>
-bool eventually(Condition done) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() >= until) return done();
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
+using testing::eventually;
 
 BridgeSettings two_axes() {
   BridgeSettings s;

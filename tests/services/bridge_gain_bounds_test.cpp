@@ -8,6 +8,7 @@
 
 #include "bridge/bridge_settings.hpp"
 #include "bridge/servo_request.hpp"
+#include "support/text.hpp"
 
 namespace hystloop {
 namespace {
@@ -21,7 +22,7 @@ std::string refusal(const std::string& yaml) {
   return "accepted";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 control_t set_gains(double kp, double ki, double kd) {
   control_t m{};

@@ -4,6 +4,7 @@
 // ramp and at the end, and gives up after bridge's stop_ramp_timeout_s. Real threads, real time,
 // a fast ramp: a few tenths of a second in all.
 #include "bridge/bridge_realtime.hpp"
+#include "support/eventually.hpp"
 
 #include <gtest/gtest.h>
 
@@ -67,17 +68,7 @@ BridgeSettings fast_ramp_settings() {
   return s;
 }
 
-// Polls `done` every millisecond until it holds or a deadline generous for a loaded machine and a
-// sanitizer build passes; true if it held.
-template <class Condition>
-bool eventually(Condition done) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() >= until) return done();
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
+using testing::eventually;
 
 // Started, armed by the first command and driven to `u_V` (the slew limit: 5 V per tick).
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, Record& record, double u_V) {

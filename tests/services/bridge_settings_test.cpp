@@ -17,6 +17,7 @@
 #include "bridge/stage_backend.hpp"
 #include "models/model_descriptors.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/text.hpp"
 
 namespace hystloop {
 namespace {
@@ -32,7 +33,7 @@ std::string refusal(const std::string& yaml) {
   return "accepted";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 TEST(BridgeSettings, DefaultsWithoutAConfig) {
   const BridgeSettings s = load_bridge_settings(Config());

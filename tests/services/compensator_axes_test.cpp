@@ -19,6 +19,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/text.hpp"
 
 namespace hystloop {
 namespace {
@@ -54,7 +55,7 @@ std::string refusal(const std::string& overrides) {
   return "accepted";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 TEST(CompensatorAxes, SettingsTakeTheAxesTheDecouplingAndTheScanAndNameWhatTheyRefuse) {
   const CompensatorSettings one = load("");

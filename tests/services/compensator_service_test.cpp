@@ -31,6 +31,7 @@
 #include "hystloop/service_status_t.hpp"
 #include "lcm/connection.hpp"
 #include "support/allocation_counter.hpp"
+#include "support/text.hpp"
 
 #include <sstream>
 
@@ -868,7 +869,7 @@ std::string settings_refusal(const std::string& yaml) {
   return "accepted";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 TEST(CompensatorSettings, RefusedOldKeysSayWhereTheyWent) {
   const std::string lead = settings_refusal("compensator: {mode: mem, lead_ticks: 2}");

@@ -25,6 +25,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/status_counters.hpp"
+#include "support/text.hpp"
 
 namespace hystloop {
 namespace {
@@ -86,7 +87,7 @@ std::int64_t counter(const service_status_t& s, const std::string& name) {
   return value.value_or(-1);
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using testing::contains;
 
 TEST(CompensatorStatus, APublisherFrozenOutByAForgedVersionIsDegradedAndNamed) {
   Harness h;
