@@ -11,8 +11,9 @@ std::variant<RasterSpec, LissajousSpec> scan_path_of(const scan_t& msg) {
   for (std::size_t i = 0; i < kScanAxes; ++i) centre[i] = msg.centre_m[i];
   if (msg.path == scan_t::RASTER) {
     RasterSpec r;
-    r.fast_axis = msg.fast_axis;
-    r.slow_axis = msg.slow_axis;
+    // 0..2 (check_message), so the unsigned byte is the axis.
+    r.fast_axis = static_cast<unsigned char>(msg.fast_axis);
+    r.slow_axis = static_cast<unsigned char>(msg.slow_axis);
     r.width_m = msg.width_m;
     r.height_m = msg.height_m;
     r.lines = msg.lines;

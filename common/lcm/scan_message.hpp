@@ -12,7 +12,8 @@
 namespace hystloop {
 
 // The raster or Lissajous figure `msg` gives, with its centre. `msg` has passed check_message
-// (axes 0..2). Throws ParameterError("scan.path") for a path kind it does not know.
+// (axes 0..2: a negative axis would read as 128 or more, which every stage refuses). Throws ParameterError("scan.path")
+// for a path kind it does not know.
 std::variant<RasterSpec, LissajousSpec> scan_path_of(const scan_t& msg);
 
 }  // namespace hystloop

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <utility>
@@ -73,29 +74,36 @@ void register_rig(py::module_& m) {
 
   py::class_<ctl::RigClient>(m, "Rig", R"(A running hystloop rig over LCM, as hystloop-ctl operates it.
 
-Rig(url=None, rig="HX_", allow_network=False, key_file=None, timeout=3.0,
+Rig(url=None, rig=None, allow_network=False, key_file=None, timeout=3.0,
     bridge="bridge", compensator="compensator")
 
 url: the LCM URL (None: $LCM_DEFAULT_URL, else udpm with ttl=0: this host only); a URL that
-  reaches other hosts needs allow_network=True. rig: the channel prefix. key_file: the rig key
-  (auth.key_file of the services) to sign requests with on a keyed rig. timeout [s]: how long
+  reaches other hosts needs allow_network=True. rig: the channel prefix (None: $HYSTLOOP_RIG,
+  else "HX_"). key_file: the rig key (auth.key_file of the services) to sign requests with on a
+  keyed rig (None: $HYSTLOOP_KEY_FILE, else unsigned). `deploy/hystloop python SCRIPT` sets the
+  three for its rig. timeout [s]: how long
   each acknowledged request waits for its answers. Every request returns when the processes it
   is for confirmed it, and raises RigError with their answers otherwise (refused, no answer, no
   rig running); bad values raise ParameterError before anything is sent.)")
-      .def(py::init([](std::optional<std::string> url, std::string rig, bool allow_network,
-                       std::optional<std::string> key_file, double timeout, std::string bridge,
+      .def(py::init([](const std::optional<std::string>& url, const std::optional<std::string>& rig, bool allow_network,
+                       const std::optional<std::string>& key_file, double timeout, std::string bridge,
                        std::string compensator) {
+             // Not given: from the environment deploy/hystloop python sets for its rig.
+             const auto env = [](const char* name, const char* fallback) {
+               const char* v = std::getenv(name);  // NOLINT(concurrency-mt-unsafe): read once, at construction
+               return std::string(v != nullptr && *v != '\0' ? v : fallback);
+             };
              ctl::RigClientOptions o;
              o.link.lcm_url = url.value_or("");
-             o.link.rig = std::move(rig);
+             o.link.rig = rig.value_or(env("HYSTLOOP_RIG", "HX_"));
              o.link.allow_network = allow_network;
-             o.key_file = key_file.value_or("");
+             o.key_file = key_file.value_or(env("HYSTLOOP_KEY_FILE", ""));
              o.timeout_s = timeout;
              o.bridge = std::move(bridge);
              o.compensator = std::move(compensator);
              return unlocked([&] { return std::make_unique<ctl::RigClient>(o); });
            }),
-           py::arg("url") = py::none(), py::arg("rig") = "HX_", py::arg("allow_network") = false,
+           py::arg("url") = py::none(), py::arg("rig") = py::none(), py::arg("allow_network") = false,
            py::arg("key_file") = py::none(), py::arg("timeout") = 3.0, py::arg("bridge") = "bridge",
            py::arg("compensator") = "compensator")
       .def_property_readonly("url", &ctl::RigClient::url, "The LCM URL in use")

@@ -6,6 +6,7 @@ is said so within the timeout."""
 
 import os
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -113,7 +114,31 @@ class LiveRig(unittest.TestCase):
         self.assertEqual(len(blocks), 3)
         self.assertGreater(blocks[1]["seq"][0], blocks[0]["seq"][0])
 
-    def test_5_disarm_is_acknowledged(self):
+    def run_example(self, name, *args):
+        """An example of examples/, headless, on this rig: its exit status and output."""
+        script = os.path.join(os.environ["HYSTLOOP_SOURCE_DIR"], "examples", name)
+        out = os.path.join(self.dir.name, name)
+        env = dict(os.environ, MPLBACKEND="Agg")
+        p = subprocess.run([sys.executable, script, "--out", out, *args], capture_output=True, text=True,
+                           timeout=120, env=env)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr + self.log_tail())
+        return out, p.stdout
+
+    def test_5_the_mem_paper_example_runs(self):
+        out, text = self.run_example("mem_paper.py", "--seconds", "2")
+        self.assertTrue(os.path.getsize(os.path.join(out, "mem_paper.png")) > 10000)
+        with open(os.path.join(out, "mem_paper.csv")) as f:
+            rows = {r.split(",")[0]: float(r.split(",")[1]) for r in f.read().splitlines()[1:]}
+        self.assertLess(rows["mem"], rows["linear"], text)
+        # The gains it turned off are back.
+        self.assertEqual(self.counter("bridge", "servo_kp_ppm"), 50000)
+
+    def test_6_the_scan_learning_example_runs(self):
+        out, text = self.run_example("scan_learning.py", "--seconds", "2")
+        self.assertTrue(os.path.getsize(os.path.join(out, "scan_learning.png")) > 10000)
+        self.assertIn("learning off", text)
+
+    def test_7_disarm_is_acknowledged(self):
         self.rig.disarm()
         self.assertEqual(self.counter("bridge", "armed"), 0)
 
