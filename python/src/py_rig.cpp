@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "core/config.hpp"
 #include "core/errors.hpp"
 #include "py_common.hpp"
 #include "rig_client.hpp"
@@ -106,6 +107,32 @@ url: the LCM URL (None: $LCM_DEFAULT_URL, else udpm with ttl=0: this host only);
            py::arg("url") = py::none(), py::arg("rig") = py::none(), py::arg("allow_network") = false,
            py::arg("key_file") = py::none(), py::arg("timeout") = 3.0, py::arg("bridge") = "bridge",
            py::arg("compensator") = "compensator")
+      .def_static(
+          "from_rig_file",
+          [](const std::string& path, bool allow_network, const std::optional<std::string>& key_file, double timeout) {
+            // What deploy/hystloop --host reads from it: rig.prefix, rig.lcm_url with rig.ttl, rig.key_file.
+            ctl::RigClientOptions o;
+            try {
+              const Config rig_file = Config::load_file(path);
+              o.link.rig = rig_file.get<std::string>("rig.prefix", "HX_");
+              const std::string url = rig_file.get<std::string>("rig.lcm_url");
+              const auto ttl = rig_file.get_int_in_range("rig.ttl", 0, 0, 1);
+              if (url.find("ttl=") != std::string::npos) {
+                rig_file.fail("rig.lcm_url", "a URL without ttl (give it as rig.ttl), got '" + url + "'");
+              }
+              o.link.lcm_url = url + (url.find('?') == std::string::npos ? "?" : "&") + "ttl=" + std::to_string(ttl);
+              o.key_file = key_file.value_or(rig_file.get<std::string>("rig.key_file", ""));
+            } catch (const ConfigError& e) {
+              throw PyParameterError(e.field(), e.what());
+            }
+            o.link.allow_network = allow_network;
+            o.timeout_s = timeout;
+            return unlocked([&] { return std::make_unique<ctl::RigClient>(o); });
+          },
+          py::arg("path"), py::arg("allow_network") = false, py::arg("key_file") = py::none(), py::arg("timeout") = 3.0,
+          R"(The rig a rig file describes (deploy/rig.yaml: rig.prefix, rig.lcm_url with rig.ttl, rig.key_file,
+a relative key path taken from the current directory). A rig over the lab's network (ttl 1)
+needs allow_network=True, as hystloop-ctl's --allow-network.)")
       .def_property_readonly("url", &ctl::RigClient::url, "The LCM URL in use")
       .def(
           "status",

@@ -161,6 +161,22 @@ class NoRig(unittest.TestCase):
             hystloop.Rig(url="udpm://239.255.76.67:7667?ttl=1")
         self.assertIn("allow", str(e.exception))
 
+    def test_a_rig_file_names_the_rig(self):
+        lab = os.path.join(os.environ["HYSTLOOP_SOURCE_DIR"], "deploy", "rig.yaml")
+        with self.assertRaises(hystloop.ParameterError) as e:  # ttl 1: the lab's network
+            hystloop.Rig.from_rig_file(lab, key_file="")
+        self.assertIn("allow", str(e.exception))
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "rig.yaml")
+            with open(path, "w") as f:
+                f.write('rig: {prefix: LAB_, lcm_url: "udpm://239.255.76.67:7667", ttl: 0}\n')
+            self.assertTrue(hystloop.Rig.from_rig_file(path).url.startswith("udpm://239.255.76.67:7667?ttl=0"))
+            with open(path, "w") as f:
+                f.write('rig: {lcm_url: "udpm://239.255.76.67:7667?ttl=0", ttl: 0}\n')
+            with self.assertRaises(hystloop.ParameterError) as e:
+                hystloop.Rig.from_rig_file(path)
+            self.assertEqual(e.exception.field, "rig.lcm_url")
+
     def test_help_gives_units(self):
         self.assertIn("[1/s]", hystloop.Rig.set_gains.__doc__)
         self.assertIn("[s]", hystloop.Rig.record.__doc__)
