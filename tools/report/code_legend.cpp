@@ -83,6 +83,7 @@ std::vector<CodeLegend> make_legends() {
                  SHUTDOWN, SET_LEARNING, HOLD_PARAMS, RELEASE_PARAMS)}},
       {control, "mode", modes()},
       {control, "learning", {HX_CODES(control_t, "LEARNING_", LEARNING_OFF, LEARNING_ON, LEARNING_RESET)}},
+      {control, "axis", {HX_CODES(control_t, "", EVERY_AXIS)}},  // else the axis's number: 0 x, 1 y, 2 z
       {trajectory, "shape", {HX_CODES(trajectory_t, "", HOLD, SINE, COSINE, TRIANGLE, POINTS)}},
       {trajectory, "if_infeasible", {HX_CODES(trajectory_t, "", REFUSE, SHAPE)}},
       {status, "state", {HX_CODES(service_status_t, "", STARTING, HEALTHY, DEGRADED, SAFE, STOPPING)}},
