@@ -8,7 +8,9 @@ arrays in and out, in SI units (s, V, m):
     y = m.forward(u)                                          # u [V] -> y [m]
     u_ff = m.inverse(y_ref)                                   # y_ref [m] -> u [V]
     fit = hystloop.identify(t, u, y, model="auto")           # fit.model, fit.params, fit.ranking
+    ban = hystloop.identify_banning("series.lcmlog")         # ban.a, ban.b, ban.alpha, ban.k, ban.c, ban.yaml
     log = hystloop.read_log("run.lcmlog", axis=0)            # log["HX_SENSOR"]["y_m"], .units
+    exp = hystloop.read_export("run.h5")                     # hystloop-export's .h5/.mat, as read_log
     rig = hystloop.Rig()                                      # a running rig (ttl=0: this host)
     rig.arm(); rig.set_trajectory("cosine", amplitude_m=1e-6); ticks = rig.record(10.0)
 
@@ -16,6 +18,7 @@ Axes are numbered as on the wire: x = 0, y = 1, z = 2 (hystloop.AXES).
 """
 
 from ._core import (
+    BanningResult,
     Channel,
     FitError,
     IdentifyResult,
@@ -26,10 +29,12 @@ from ._core import (
     Rig,
     RigError,
     identify,
+    identify_banning,
     model_info,
     models,
     read_log,
 )
+from .export import Export, ExportChannel, read_export
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -51,7 +56,10 @@ Rig.blocks = _blocks
 
 __all__ = [
     "AXES",
+    "BanningResult",
     "Channel",
+    "Export",
+    "ExportChannel",
     "FitError",
     "IdentifyResult",
     "Log",
@@ -61,7 +69,9 @@ __all__ = [
     "Rig",
     "RigError",
     "identify",
+    "identify_banning",
     "model_info",
     "models",
+    "read_export",
     "read_log",
 ]

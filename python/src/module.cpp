@@ -57,6 +57,7 @@ PYBIND11_MODULE(_core, m) {
 
   register_models(m);
   register_identify(m);
+  register_banning(m);
   register_log(m);
   register_rig(m);
 }

@@ -81,6 +81,7 @@ py::object wrap_model(std::unique_ptr<ModelHandle> handle);
 
 void register_models(py::module_& m);
 void register_identify(py::module_& m);
+void register_banning(py::module_& m);
 void register_log(py::module_& m);
 void register_rig(py::module_& m);
 
