@@ -52,23 +52,6 @@ struct Log {
   std::string prefix;
 };
 
-// Time zero of every t_s as hystloop-report and hystloop-export take it: the first tick of the
-// first sensor block that decodes, else the first event.
-std::int64_t time_zero_utime(const std::vector<fs::path>& logs, const std::string& sensor_channel) {
-  std::optional<std::int64_t> first_event;
-  sensor_block_t block;
-  for (const auto& file : logs) {
-    report::EventFileReader reader(file);
-    while (const lcm::LogEvent* e = reader.next()) {
-      if (!first_event) first_event = e->timestamp;
-      if (e->channel == sensor_channel && report::decode_checked(*e, block)) {
-        return report::tick_recv_utime(e->timestamp, block.n_ticks, 0, block.dt_s);
-      }
-    }
-  }
-  return first_event.value_or(0);
-}
-
 bool is_block(const ChannelTable& t) {
   return t.type_name == "hystloop.sensor_block_t" || t.type_name == "hystloop.command_block_t";
 }
@@ -308,7 +291,7 @@ Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, con
   std::uint64_t truth_events = 0, truth_skipped = 0;
   {
     const py::gil_scoped_release unlocked;
-    log.t0_utime_us = time_zero_utime(files, names.sensor);
+    log.t0_utime_us = report::log_time_zero_utime(files, names.sensor);
     for (const int a : axes) {
       builders.push_back(std::make_unique<report::TableBuilder>(take, log.t0_utime_us, from_s.value_or(-1e300),
                                                                 to_s.value_or(1e300), a));

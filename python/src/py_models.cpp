@@ -15,6 +15,7 @@
 #include "models/model_concepts.hpp"
 #include "models/model_descriptors.hpp"
 #include "models/param_text.hpp"
+#include "model_loop.hpp"
 #include "params_file.hpp"
 #include "py_common.hpp"
 
@@ -25,7 +26,7 @@ template <class D>
 class HandleFor final : public ModelHandle {
  public:
   using Forward = typename D::Forward;
-  static constexpr bool kHasInverse = !std::is_void_v<typename D::Inverse>;
+  static constexpr bool kHasInverse = model_tool::kHasInverse<D>;
 
   explicit HandleFor(const typename D::Params& params) : params_(params) {}
 
@@ -33,28 +34,14 @@ class HandleFor final : public ModelHandle {
   bool has_inverse() const override { return kHasInverse; }
   bool uses_time() const override { return !HysteresisForward<Forward>; }
 
-  // As model_tool::ModelRun::forward (tools/model/model_registry.cpp), over spans.
+  // hystloop-model's loops (tools/model/model_loop.hpp), over the caller's arrays.
   void forward(std::span<const double> t, std::span<const double> u, std::span<double> y) const override {
-    if (u.empty()) return;
-    Forward model(params_);
-    model.reset(u.front());
-    if constexpr (HysteresisForward<Forward>) {
-      for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
-    } else {
-      // Row k: u[k] held from t[k-1] to t[k], y[k] at t[k]; the first row is the equilibrium at u[0].
-      y[0] = model.output();
-      for (std::size_t k = 1; k < u.size(); ++k) y[k] = model.step(u[k], t[k] - t[k - 1]);
-    }
+    model_tool::run_forward<D>(params_, t, u, y);
   }
 
   void inverse(std::span<const double> y_ref, std::span<double> u) const override {
     if constexpr (kHasInverse) {
-      using Inverse = typename D::Inverse;
-      static_assert(HysteresisInverse<Inverse>);
-      if (y_ref.empty()) return;
-      Inverse inv(params_);
-      inv.reset(y_ref.front());
-      for (std::size_t k = 0; k < y_ref.size(); ++k) u[k] = inv.inverse(y_ref[k]);
+      model_tool::run_inverse<D>(params_, y_ref, u);
     } else {
       throw std::logic_error(std::string(D::name) + " has no inverse");
     }

@@ -47,27 +47,33 @@ void StatusReporter::counter(std::string_view name, std::uint64_t value) {
   count_drop(add_counter(status_, name, value), name);
 }
 
+namespace {
+// Adds a group of counters with `add` (add_endpoint_counters, ...); returns how many of them did
+// not fit: those a complete set has beyond what `status` took.
+template <class Add>
+std::uint64_t add_group(service_status_t& status, Add&& add) {
+  const std::int32_t before = status.n_counters;
+  if (add(status)) return 0;
+  service_status_t whole{};
+  add(whole);
+  return static_cast<std::uint64_t>(whole.n_counters - (status.n_counters - before));
+}
+}  // namespace
+
+void StatusReporter::count_group_drop(std::uint64_t dropped, std::string_view name) {
+  if (dropped == 0) return;
+  if (dropped_ == 0) first_dropped_ = std::string(name) + ".*";
+  dropped_ += dropped;
+}
+
 void StatusReporter::endpoint(std::string_view name, const EndpointCounters& counters) {
-  const std::int32_t before = status_.n_counters;
-  if (!add_endpoint_counters(status_, name, counters)) {
-    // How many of the endpoint's counters did not fit: those a complete set has beyond `before`.
-    service_status_t whole{};
-    add_endpoint_counters(whole, name, counters);
-    const auto fitted = static_cast<std::uint64_t>(status_.n_counters - before);
-    if (dropped_ == 0) first_dropped_ = std::string(name) + ".*";
-    dropped_ += static_cast<std::uint64_t>(whole.n_counters) - fitted;
-  }
+  count_group_drop(add_group(status_, [&](service_status_t& s) { return add_endpoint_counters(s, name, counters); }),
+                   name);
 }
 
 void StatusReporter::publisher(std::string_view name, const PublisherCounters& counters) {
-  const std::int32_t before = status_.n_counters;
-  if (!add_publisher_counters(status_, name, counters)) {
-    service_status_t whole{};
-    add_publisher_counters(whole, name, counters);
-    const auto fitted = static_cast<std::uint64_t>(status_.n_counters - before);
-    if (dropped_ == 0) first_dropped_ = std::string(name) + ".*";
-    dropped_ += static_cast<std::uint64_t>(whole.n_counters) - fitted;
-  }
+  count_group_drop(add_group(status_, [&](service_status_t& s) { return add_publisher_counters(s, name, counters); }),
+                   name);
 }
 
 namespace {

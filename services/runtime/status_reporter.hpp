@@ -42,6 +42,7 @@ class StatusReporter {
 
  private:
   void count_drop(bool added, std::string_view name);
+  void count_group_drop(std::uint64_t dropped, std::string_view name);  // a group named name.*
 
   service_status_t status_{};
   std::uint64_t dropped_ = 0;  // counters of this report that did not fit

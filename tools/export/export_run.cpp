@@ -24,23 +24,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Time zero of every t_s, as hystloop-report takes it: the first tick of the first sensor
-// block that decodes, else the first event. Reading stops there, usually in the first block.
-std::int64_t time_zero_utime(const std::vector<fs::path>& logs, const std::string& sensor_channel) {
-  std::optional<std::int64_t> first_event;
-  sensor_block_t block;
-  for (const auto& file : logs) {
-    report::EventFileReader reader(file);
-    while (const lcm::LogEvent* e = reader.next()) {
-      if (!first_event) first_event = e->timestamp;
-      if (e->channel == sensor_channel && report::decode_checked(*e, block)) {
-        return report::tick_recv_utime(e->timestamp, block.n_ticks, 0, block.dt_s);
-      }
-    }
-  }
-  return first_event.value_or(0);
-}
-
 // Reports how far reading got, at most every two seconds.
 class Progress {
  public:
@@ -152,7 +135,7 @@ void check_writable(const fs::path& file) {
 
 ExportContent collect(const ExportOptions& o, std::FILE* progress) {
   const ChannelNames names(o.rig);
-  const std::int64_t t0 = time_zero_utime(o.logs, names.sensor);
+  const std::int64_t t0 = report::log_time_zero_utime(o.logs, names.sensor);
   std::set<std::string> candidates;  // a requested name as logged or after the prefix; resolved below
   for (const auto& c : o.channels) {
     candidates.insert(c);

@@ -2,61 +2,31 @@
 
 #include <cstdio>
 #include <stdexcept>
-#include <type_traits>
 #include <vector>
 
 #include "models/model_descriptors.hpp"
 #include "models/model_concepts.hpp"
+#include "model_loop.hpp"
 
 namespace hystloop::model_tool {
 namespace {
 
-// A model with dynamics: the input is held for dt [s] (the Banning stage).
-template <class M>
-concept SteppedStage = requires(M& m, const M& cm, double u, double dt) {
-  m.reset(u);
-  { m.step(u, dt) }
-  noexcept->std::same_as<double>;
-  { cm.output() }
-  noexcept->std::same_as<double>;
-};
-
-template <class D>
-constexpr bool kHasInverse = !std::is_void_v<typename D::Inverse>;
-
 template <class D>
 class RunFor final : public ModelRun {
  public:
-  using Forward = typename D::Forward;
-  static_assert(HysteresisForward<Forward> || SteppedStage<Forward>);
-
   explicit RunFor(const typename D::Params& params) : params_(params) {}
 
   std::vector<double> forward(const std::vector<double>& t, const std::vector<double>& u) const override {
     std::vector<double> y(u.size());
-    if (u.empty()) return y;
-    Forward model(params_);
-    model.reset(u.front());
-    if constexpr (HysteresisForward<Forward>) {
-      for (std::size_t k = 0; k < u.size(); ++k) y[k] = model.forward(u[k]);
-    } else {
-      // Row k: u[k] held from t[k-1] to t[k], y[k] at t[k]; the first row is the equilibrium at u[0].
-      y[0] = model.output();
-      for (std::size_t k = 1; k < u.size(); ++k) y[k] = model.step(u[k], t[k] - t[k - 1]);
-    }
+    run_forward<D>(params_, t, u, y);
     return y;
   }
 
   std::vector<double> inverse([[maybe_unused]] const std::vector<double>& t,
                               [[maybe_unused]] const std::vector<double>& y_ref) const override {
     if constexpr (kHasInverse<D>) {
-      using Inverse = typename D::Inverse;
-      static_assert(HysteresisInverse<Inverse>);
       std::vector<double> u(y_ref.size());
-      if (y_ref.empty()) return u;
-      Inverse inv(params_);
-      inv.reset(y_ref.front());
-      for (std::size_t k = 0; k < y_ref.size(); ++k) u[k] = inv.inverse(y_ref[k]);
+      run_inverse<D>(params_, y_ref, u);
       return u;
     } else {
       throw std::logic_error(std::string(D::name) + " has no inverse");

@@ -71,6 +71,21 @@ std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks
   return block_recv_utime - static_cast<std::int64_t>(std::llround(back_us));
 }
 
+std::int64_t log_time_zero_utime(const std::vector<std::filesystem::path>& files, const std::string& sensor_channel) {
+  std::optional<std::int64_t> first_event;
+  sensor_block_t block;
+  for (const auto& file : files) {
+    EventFileReader reader(file);
+    while (const lcm::LogEvent* e = reader.next()) {
+      if (!first_event) first_event = e->timestamp;
+      if (e->channel == sensor_channel && decode_checked(*e, block)) {
+        return tick_recv_utime(e->timestamp, block.n_ticks, 0, block.dt_s);
+      }
+    }
+  }
+  return first_event.value_or(0);
+}
+
 std::string axes_text(int axes) {
   std::string names;
   for (int a = 0; a < axes; ++a) {

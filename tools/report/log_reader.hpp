@@ -38,6 +38,11 @@ void require_axis(const RunData& run, const std::string& sensor_channel);
 // block_recv_utime - (n_ticks - 1 - i) * dt_s [us].
 std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks, std::size_t i, double dt_s) noexcept;
 
+// Time zero of every t_s, as hystloop-report takes it (RunData::time_zero_utime), without reading
+// the whole log: the first tick of the first sensor block that decodes, else the first event.
+// Reading stops there, usually in the first block. [us]
+std::int64_t log_time_zero_utime(const std::vector<std::filesystem::path>& files, const std::string& sensor_channel);
+
 // Calls visit(event) for every event of every file, in order (for exports that need
 // whole messages), and says what each file held besides (LogFileScan). Throws
 // std::runtime_error naming the file if one cannot be opened.
