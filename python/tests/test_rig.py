@@ -114,13 +114,13 @@ class LiveRig(unittest.TestCase):
         self.assertEqual(len(blocks), 3)
         self.assertGreater(blocks[1]["seq"][0], blocks[0]["seq"][0])
 
-    def run_example(self, name, *args):
+    def run_example(self, name, *args, out=True):
         """An example of examples/, headless, on this rig: its exit status and output."""
         script = os.path.join(os.environ["HYSTLOOP_SOURCE_DIR"], "examples", name)
-        out = os.path.join(self.dir.name, name)
+        out = os.path.join(self.dir.name, name) if out else None
         env = dict(os.environ, MPLBACKEND="Agg")
-        p = subprocess.run([sys.executable, script, "--out", out, *args], capture_output=True, text=True,
-                           timeout=120, env=env)
+        p = subprocess.run([sys.executable, script, *(["--out", out] if out else []), *args], capture_output=True,
+                           text=True, timeout=120, env=env)
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr + self.log_tail())
         return out, p.stdout
 
@@ -138,7 +138,11 @@ class LiveRig(unittest.TestCase):
         self.assertTrue(os.path.getsize(os.path.join(out, "scan_learning.png")) > 10000)
         self.assertIn("learning off", text)
 
-    def test_7_disarm_is_acknowledged(self):
+    def test_7_the_record_example_runs(self):
+        _, text = self.run_example("record.py", "--seconds", "1", "--polls", "1", out=False)
+        self.assertIn("missing 0, in order True", text)
+
+    def test_8_disarm_is_acknowledged(self):
         self.rig.disarm()
         self.assertEqual(self.counter("bridge", "armed"), 0)
 
