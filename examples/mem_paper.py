@@ -6,8 +6,11 @@
    with the MEM's inverse, then with linear feedforward, the servo still off;
 4. the tracking error of each against the stage's true position, as a table and a plot.
 
-    ./deploy/hystloop up                                  # the simulated rig (or a real one)
+    ./deploy/hystloop up logger bridge compensator        # the simulated rig, no re-identifier
     ./deploy/hystloop python examples/mem_paper.py        # --out DIR, --seconds S per mode
+
+A running re-identifier would replace the identified set with its own refits while the two
+feedforwards are compared: the example refuses to start beside one.
 
 The servo's gains and the compensator's mode are put back whatever happens. Writes
 mem_paper.png and mem_paper.csv to --out (default out/mem-paper).
@@ -56,7 +59,11 @@ def main():
     status = rig.status()
     missing = [p for p in ("bridge", "compensator") if p not in status]
     if missing:
-        sys.exit(f"mem_paper: no {' or '.join(missing)} on {rig.url}: start a rig (./deploy/hystloop up)")
+        sys.exit(f"mem_paper: no {' or '.join(missing)} on {rig.url}: start a rig "
+                 "(./deploy/hystloop up logger bridge compensator)")
+    if any(p.startswith("reidentifier") for p in status):
+        sys.exit("mem_paper: a re-identifier is running: its refits would replace the identified set during the "
+                 "comparison; stop it (./deploy/hystloop down reidentifier) and run again")
     counters = status["bridge"]["counters"]
     gains = {k: counters.get(f"servo_{c}", 0) / s for k, c, s in
              (("kp", "kp_ppm", 1e6), ("ki", "ki_ppm_per_s", 1e6), ("kd", "kd_ps", 1e12))}
