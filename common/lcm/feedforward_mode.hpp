@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "hystloop/command_block_t.hpp"
-#include "loop/compensator.hpp"
+#include "models/feedforward_mode.hpp"
 
 namespace hystloop {
 

@@ -1,0 +1,37 @@
+#include "loop/compensator_config.hpp"
+
+#include <numbers>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+
+double resonance_corner_s(const StageModel& stage) noexcept {
+  return stage.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency() : 0.0;
+}
+
+void CompensatorConfig::validate() const {
+  if (mode == FeedforwardMode::kExperiment) {
+    throw ParameterError("compensator.mode", "'experiment' is started through HX_CONTROL, not selected as a mode");
+  }
+  OnlineModels::for_each([&]<class D>() { (models.*D::in_set).validate(); });
+  require_in_range("compensator.dt_s", dt_s, 1e-6, 1.0);
+  require_finite("compensator.u_min_V", u_min_V);
+  require_finite("compensator.u_max_V", u_max_V);
+  if (!(u_min_V < u_max_V)) throw ParameterError("compensator.u_max_V", "must exceed u_min_V");
+  require_positive("compensator.slew_V_per_s", slew_V_per_s);
+  require_in_range("compensator.reanchor_ticks", static_cast<double>(reanchor_ticks), 1.0, 1000.0);
+  require_in_range("compensator.reanchor_ramp_ticks", static_cast<double>(reanchor_ramp_ticks), 1.0, 100000.0);
+  require_in_range("compensator.slew_fraction", slew_fraction, 1e-12, 1.0);
+  require_positive("compensator.reanchor_u_rate_V_per_s", reanchor_u_rate_V_per_s);
+  stage.validate(dt_s);
+  learning.validate(dt_s);
+  require_in_range("compensator.plan_slew_fraction", plan_slew_fraction, 0.05, 1.0);
+  require_in_range("compensator.servo_slew_reserve", servo_slew_reserve, 0.0, plan_slew_fraction - 0.05);
+  if (horizon_ticks < 1 || horizon_ticks > kMaxHorizonTicks) {
+    throw ParameterError("compensator.horizon_s", "must be 1 to " + std::to_string(kMaxHorizonTicks) + " ticks (got " +
+                                                      std::to_string(horizon_ticks) + ")");
+  }
+}
+
+}  // namespace hystloop

@@ -1,0 +1,42 @@
+#include "loop/parameter_exchange.hpp"
+
+namespace hystloop {
+
+ParameterExchange::ParameterExchange(const CompensatorConfig& config)
+    : anchor_(config.reanchor_ticks, config.reanchor_ramp_ticks,
+              config.slew_fraction * config.slew_V_per_s * config.dt_s, config.reanchor_u_rate_V_per_s * config.dt_s) {}
+
+void ParameterExchange::offer(const ModelParamSet& params, bool switch_model, std::int32_t version) noexcept {
+  pending_ = Pending{params, switch_model};
+  pending_version_ = version;
+}
+
+bool ParameterExchange::switches_model(FeedforwardMode mode) const noexcept {
+  return pending_->switch_model && mode != FeedforwardMode::kOff && mode_of(pending_->params.kind) != mode;
+}
+
+bool ParameterExchange::held_by_learning(FeedforwardMode mode, const LearnerFigures& f,
+                                         const LearningConfig& config) const noexcept {
+  if (!pending_) return false;
+  const std::int64_t after = config.hold_params_after;
+  if (after <= 0 || !f.active || f.tables_this_line < static_cast<std::uint64_t>(after)) return false;
+  // A table near its bound is no converged line: a model far off, which the new set may repair.
+  if (!(f.correction_rms_m < 0.5 * config.max_correction_m)) return false;
+  // A set for a model the line does not use changes nothing it learned: it goes in as always.
+  return switches_model(mode) || mode_of(pending_->params.kind) == mode;
+}
+
+ParameterExchange::Pending ParameterExchange::take() noexcept {
+  Pending p = *pending_;
+  pending_.reset();
+  version_ = pending_version_;
+  return p;
+}
+
+void ParameterExchange::carry_over(const ParameterExchange& from) noexcept {
+  pending_ = from.pending_;
+  pending_version_ = from.pending_version_;
+  version_ = from.version_;
+}
+
+}  // namespace hystloop
