@@ -1,12 +1,32 @@
 #include "models/hysteresis_plant.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "core/errors.hpp"
 
 namespace hystloop {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// std::visit without its bad_variant_access path (a variant is valueless only after a throwing
+// emplace, which the plant never does): a chain of get_if, so step/reset are noexcept for real.
+template <std::size_t I = 0, class V, class F>
+double visit_model(V& model, F&& f) noexcept {
+  if constexpr (I < std::variant_size_v<V>) {
+    if (auto* m = std::get_if<I>(&model)) return f(*m);
+    return visit_model<I + 1>(model, f);
+  } else {
+    return kNaN;
+  }
+}
+
+}  // namespace
 
 std::string_view to_string(HysteresisPlantKind kind) noexcept {
   const auto i = static_cast<std::size_t>(kind);
@@ -72,22 +92,20 @@ HysteresisPlant::HysteresisPlant(const HysteresisPlantSpec& spec) : spec_(spec),
 void HysteresisPlant::reset(double u0_V) noexcept {
   const double u0 = std::isfinite(u0_V) ? u0_V : 0.0;
   u_ = u0;
-  y_ = std::visit(
-      [u0](auto& m) noexcept -> double {
-        using M = std::decay_t<decltype(m)>;
-        m.reset(u0);
-        if constexpr (std::is_same_v<M, LinearModel>) {
-          return m.params().gain * u0 + m.params().offset;
-        } else {
-          return m.output();
-        }
-      },
-      model_);
+  y_ = visit_model(model_, [u0](auto& m) noexcept -> double {
+    using M = std::decay_t<decltype(m)>;
+    m.reset(u0);
+    if constexpr (std::is_same_v<M, LinearModel>) {
+      return m.params().gain * u0 + m.params().offset;
+    } else {
+      return m.output();
+    }
+  });
 }
 
 double HysteresisPlant::step(double u_V, double dt_s) noexcept {
-  if (!std::isfinite(u_V) || !std::isfinite(dt_s) || !(dt_s > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  y_ = std::visit([u_V](auto& m) noexcept { return m.forward(u_V); }, model_);
+  if (!std::isfinite(u_V) || !std::isfinite(dt_s) || !(dt_s > 0.0)) return kNaN;
+  y_ = visit_model(model_, [u_V](auto& m) noexcept { return m.forward(u_V); });
   u_ = u_V;
   return y_;
 }

@@ -20,6 +20,8 @@
 namespace hystloop {
 namespace {
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 constexpr HysteresisPlantKind kAllKinds[] = {
     HysteresisPlantKind::coleman_hodgdon, HysteresisPlantKind::mem,      HysteresisPlantKind::pi,
     HysteresisPlantKind::katalenic,       HysteresisPlantKind::bouc_wen, HysteresisPlantKind::linear};
@@ -43,6 +45,7 @@ std::vector<double> direct(double u0, const std::vector<double>& path, Args&&...
   M m(std::forward<Args>(args)...);
   m.reset(u0);
   std::vector<double> y;
+  y.reserve(path.size());
   for (double u : path) y.push_back(m.forward(u));
   return y;
 }
@@ -206,11 +209,11 @@ TEST(HysteresisPlant, BadInputOrDtReturnsNanAndKeepsState) {
     plant.step(60.0, 1e-4);
     twin.step(60.0, 1e-4);
     const double y = plant.output();
-    for (double dt : {0.0, -1e-4, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    for (double dt : {0.0, -1e-4, std::nan(""), kInf}) {
       EXPECT_TRUE(std::isnan(plant.step(30.0, dt))) << to_string(kind) << " dt " << dt;
     }
     EXPECT_TRUE(std::isnan(plant.step(std::nan(""), 1e-4))) << to_string(kind);
-    EXPECT_TRUE(std::isnan(plant.step(-INFINITY, 1e-4))) << to_string(kind);
+    EXPECT_TRUE(std::isnan(plant.step(-kInf, 1e-4))) << to_string(kind);
     EXPECT_EQ(plant.output(), y) << to_string(kind);
     EXPECT_EQ(plant.input(), 60.0) << to_string(kind);
     EXPECT_EQ(plant.step(-20.0, 1e-4), twin.step(-20.0, 1e-4)) << to_string(kind);  // as if never called
