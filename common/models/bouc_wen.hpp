@@ -50,9 +50,14 @@ struct BoucWenParams {
   // Defaults: a piezo-like loop, chosen, not fitted (no paper gives SI values for a stack like
   // ours). With u = +-100 V periodic the output swings 10.8 um and the loop is 12.3 % of that
   // stroke wide at u = 0; the slope of y right after a reversal is 0.56 d, rising towards d
-  // (tests/models/bouc_wen_test.cpp checks both). For n = 1 the loop's shape depends only on
-  // alpha, beta A and gamma A: d scales it (d = 6.34e-9 gives the project's ~1.6 um at +-250 V
-  // with beta, gamma scaled by 100/250).
+  // (tests/models/bouc_wen_test.cpp checks all three). How: d = 6.3e-8 m/V is a 100 V stack's
+  // ~6 um per 100 V; alpha = 0.3 takes 30 % off the slope at a reversal (a piezo's small loops
+  // are flatter than its major loop); beta + gamma = 0.02 /V makes a branch saturate over the
+  // sweep (e^{-(beta + gamma) 2A} = e^{-4}), and with h_bound = alpha d / (beta + gamma) = 0.95 um
+  // that sets the width; beta - gamma = 0.01 /V (gamma = beta / 3) keeps the turn at a reversal
+  // gentle. For n = 1 the loop's shape depends only on alpha, beta A and gamma A, and d scales it:
+  // d = 7.4e-9 m/V with beta = 0.006 /V, gamma = 0.002 /V gives the same 12.3 % loop over
+  // +-250 V with the 3.17 um stroke of MemParams::paper_like().
   double d = 6.3e-8;      // [m/V] piezoelectric coefficient: the slope of y = d u - h without hysteresis
   double alpha = 0.3;     // [-] the hysteresis' share of the small-signal slope right after a reversal
   double beta = 0.015;    // [m^(1-n)/V] 1/V here (n = 1)

@@ -316,6 +316,23 @@ TEST(BoucWen, SymmetricPeriodicInputGivesAClosedCentredLoop) {
   }
 }
 
+// For n = 1 the shape depends on alpha, beta A, gamma A; d only scales it. The header's rescaling
+// to the project's +-250 V: 3.17 um of stroke (MemParams::paper_like()'s), the same 12.3 % opening.
+TEST(BoucWen, N1LoopShapeScalesWithBetaATimesAndD) {
+  BoucWenParams p;
+  p.d = 7.4e-9;
+  p.beta = 0.006;
+  p.gamma = 0.002;
+  const std::vector<Loop> scaled = sine_periods(p, 250.0, 400, 15);
+  const std::vector<Loop> defaults = sine_periods(BoucWenParams{}, 100.0, 400, 15);
+  const double stroke = scaled.back().y[100] - scaled.back().y[300];
+  EXPECT_NEAR(stroke, 3.17e-6, 0.01e-6);
+  const double stroke0 = defaults.back().y[100] - defaults.back().y[300];
+  for (int i = 0; i < 400; ++i) {
+    EXPECT_NEAR(scaled.back().y[i] / stroke, defaults.back().y[i] / stroke0, 1e-12) << i;
+  }
+}
+
 // Class I of Ikhouane, Mañosa & Rodellar (2007): |h| <= max(|h(0)|, (alpha d / (beta + gamma))^(1/n))
 // for every input. Random parameters of the class (gamma of both signs, gamma = beta, n from 1 to 4),
 // random initial states inside and outside the bound, random walks and jumps. The bound is tight:
