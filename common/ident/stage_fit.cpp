@@ -187,8 +187,8 @@ SkFit sk_fit(const Prepared& pr, int m, int n, bool unit_dc, double tau_s, int m
   const int b_first = unit_dc ? 1 : 0;
   const int nb = m + 1 - b_first, q = nb + n;
   SkFit fit;
-  fit.poly.b.assign(static_cast<std::size_t>(m + 1), 0.0);
-  fit.poly.d.assign(static_cast<std::size_t>(n + 1), 0.0);
+  fit.poly.b.assign(static_cast<std::size_t>(m) + 1, 0.0);
+  fit.poly.d.assign(static_cast<std::size_t>(n) + 1, 0.0);
   fit.poly.d[0] = 1.0;
   if (unit_dc) fit.poly.b[0] = 1.0;
   fit.poly.tau_s = tau_s;
@@ -221,10 +221,10 @@ SkFit sk_fit(const Prepared& pr, int m, int n, bool unit_dc, double tau_s, int m
     for (int i = 0; i < n; ++i) {
       const double v = x(nb + i);
       change =
-          std::max(change, std::abs(v - fit.poly.d[static_cast<std::size_t>(i + 1)]) / std::max(std::abs(v), 1e-12));
-      fit.poly.d[static_cast<std::size_t>(i + 1)] = v;
+          std::max(change, std::abs(v - fit.poly.d[static_cast<std::size_t>(i) + 1]) / std::max(std::abs(v), 1e-12));
+      fit.poly.d[static_cast<std::size_t>(i) + 1] = v;
     }
-    for (int i = 0; i < nb; ++i) fit.poly.b[static_cast<std::size_t>(i + b_first)] = x(i);
+    for (int i = 0; i < nb; ++i) fit.poly.b[static_cast<std::size_t>(i) + static_cast<std::size_t>(b_first)] = x(i);
     fit.iterations = it + 1;
     if (condition) {
       Eigen::JacobiSVD<Eigen::MatrixXd> svd(As);
@@ -287,8 +287,8 @@ struct RefineResidual {
   bool unit_dc;
   Poly unpack(const double* x) const {
     Poly p;
-    p.b.assign(static_cast<std::size_t>(m + 1), 1.0);
-    p.d.assign(static_cast<std::size_t>(n + 1), 1.0);
+    p.b.assign(static_cast<std::size_t>(m) + 1, 1.0);
+    p.d.assign(static_cast<std::size_t>(n) + 1, 1.0);
     std::size_t j = 0;
     for (int i = unit_dc ? 1 : 0; i <= m; ++i) p.b[static_cast<std::size_t>(i)] = x[j++];
     for (int i = 1; i <= n; ++i) p.d[static_cast<std::size_t>(i)] = x[j++];
