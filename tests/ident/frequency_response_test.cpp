@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "core/errors.hpp"
 #include "ident/multisine.hpp"
@@ -113,6 +114,35 @@ TEST(FrequencyResponse, BiasAndSpreadWithinTheDerivedBounds) {
     if (std::abs(s * s / s2 - 1.0) > 4.0 / std::sqrt(kR * (kP - 2.0))) ++outside;
   EXPECT_LE(outside, 1u);
   EXPECT_TRUE(r.total_available);
+}
+
+TEST(FrequencyResponse, InputNoiseEntersTheVariance) {
+  // A measured input: white noise on the u record the estimator sees (the stage is driven by the
+  // clean one). Then G - G0 ~ -G0 N_U / U, of variance |G0|^2 4 s_u^2 / (N P R A^2): the
+  // first-order variance (header) must account for it, line by line, as it does for output noise.
+  test::TwoModeStage stage;
+  const Multisine m = design_multisine(excitation());
+  const auto y = stage.simulate(m.u_V, 0.0, 1);
+  std::vector<double> u_measured(m.u_V);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (double& v : u_measured) v += noise(rng);
+  const FrequencyResponse r = estimate_frequency_response(u_measured, y, m.lines, frf_options());
+  const FrequencyResponse clean = estimate_frequency_response(m.u_V, y, m.lines, frf_options());
+  ASSERT_TRUE(r.ok()) << r.reason;
+  const double F = static_cast<double>(r.G.size());
+  const double s_u = 2.0 * 0.01 / (m.line_amplitude_V[0] * std::sqrt(static_cast<double>(kN * (kP - 1) * kR)));
+  double err2 = 0.0, vn = 0.0;
+  for (std::size_t i = 0; i < r.G.size(); ++i) {
+    const double s2 = std::norm(clean.G[i]) * s_u * s_u;
+    err2 += std::norm(r.G[i] - clean.G[i]) / (r.sigma_noise[i] * r.sigma_noise[i]) / F;
+    vn += r.sigma_noise[i] * r.sigma_noise[i] / s2 / F;
+  }
+  std::printf("input noise: mean |e|^2 / sigma_noise^2 %.4f, sigma_noise^2 / theory %.4f\n", err2, vn);
+  // |e|^2 / sigma_noise^2 with sigma_noise^2 of nu = 2 R (P - 1) = 40 degrees of freedom has mean
+  // nu / (nu - 2) and a standard deviation ~1.1 per line: 4 of them over F lines.
+  EXPECT_NEAR(err2, 40.0 / 38.0, 4.5 / std::sqrt(F));
+  EXPECT_NEAR(vn, 1.0, 4.0 / std::sqrt(F * kR * (kP - 2)));
 }
 
 TEST(FrequencyResponse, NonlinearDistortionRaisesTheTotalVarianceOnly) {
