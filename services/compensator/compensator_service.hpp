@@ -24,6 +24,10 @@
 //   (model_unknown_kind, model_unknown_format). model_switches and reanchors count the swaps.
 // - Lines triggered by messages are rate-limited (LogLimiter, one per reason a second) and text
 //   off the wire is escaped (escape_wire).
+//
+// One file per concern: compensator_service.cpp (the sensor path, the plan, a restarted bridge,
+// run), compensator_references.cpp (trajectories and scans), compensator_params.cpp (parameter
+// sets), compensator_control.cpp (HX_CONTROL), compensator_report.cpp (HX_STATUS).
 
 #include <cstdint>
 #include <optional>
