@@ -1,0 +1,178 @@
+#include "models/preview_inverse.hpp"
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace hystloop {
+namespace {
+
+using Complex = std::complex<double>;
+
+std::string z_text(Complex z) {
+  return number_text(z.real()) + (z.imag() < 0 ? " - " : " + ") + number_text(std::abs(z.imag())) + "i";
+}
+
+// The l1 norm of E = 1 - Q H_L (Q = 1 + q_1 z + .. + q_m z^m, H_L the series of 1/Q cut after z^L):
+// its taps are at z^{L+1} .. z^{L+m}.
+double truncation_norm(const std::vector<double>& q, const std::vector<double>& h, int taps) {
+  const int m = static_cast<int>(q.size()) - 1;
+  const int last = taps - 1;
+  double norm = 0.0;
+  for (int p = last + 1; p <= last + m; ++p) {
+    double e = 0.0;
+    for (int i = p - last; i <= m; ++i) e += q[static_cast<std::size_t>(i)] * h[static_cast<std::size_t>(p - i)];
+    norm += std::abs(e);
+  }
+  return norm;
+}
+
+}  // namespace
+
+PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::int64_t preview_ticks)
+    : stage_(stage), preview_(preview_ticks) {
+  if (preview_ticks < 0 || preview_ticks > kMaxPreviewTicks) {
+    throw ParameterError("preview_ticks", "must be in [0, " + std::to_string(kMaxPreviewTicks) + "] (got " +
+                                              std::to_string(preview_ticks) + ")");
+  }
+  // Split the zeros: inside -> causal sections, outside -> the anti-causal series.
+  std::vector<Complex> out;
+  scale_ = 1.0 / stage_.d;
+  for (Eigen::Index i = 0; i < stage_.zeros.size(); ++i) {
+    const Complex z = stage_.zeros(i);
+    const double r = std::abs(z);
+    if (std::abs(r - 1.0) <= kMinZeroDistance) {
+      const double f = std::abs(std::arg(z)) / (2.0 * std::numbers::pi * stage_.dt_s);
+      throw ParameterError("stage", "has a zero on the unit circle, z = " + z_text(z) + " (|z| = " + number_text(r, 9) +
+                                        "): it does not pass " + number_text(f) +
+                                        " Hz and no inverse can restore that");
+    }
+    if (r < 1.0) {
+      if (z.imag() < 0.0) continue;  // its conjugate makes the section
+      Section s;
+      if (z.imag() == 0.0) {
+        s.a1 = -z.real();
+      } else {
+        s.a1 = -2.0 * z.real();
+        s.a2 = std::norm(z);
+      }
+      section_[static_cast<std::size_t>(sections_++)] = s;
+    } else {
+      out.push_back(z);
+    }
+  }
+  outside_ = static_cast<int>(out.size());
+  lead_ = stage_.delay_ticks + outside_;
+  if (preview_ticks < lead_) {
+    throw ParameterError("preview_ticks", "must be at least " + std::to_string(lead_) + " ticks (" +
+                                              std::to_string(stage_.delay_ticks) +
+                                              " of delay and one per zero outside " + "the unit circle), got " +
+                                              std::to_string(preview_ticks));
+  }
+  // Q(z) = prod_o (1 - z / z_o), real; scale 1 / (K prod_o (-z_o)).
+  std::vector<Complex> qc{1.0};
+  Complex prod = 1.0;
+  for (const Complex z : out) {
+    std::vector<Complex> next(qc.size() + 1, 0.0);
+    for (std::size_t j = 0; j < qc.size(); ++j) {
+      next[j] += qc[j];
+      next[j + 1] -= qc[j] / z;
+    }
+    qc = next;
+    prod *= -z;
+  }
+  scale_ = 1.0 / (stage_.d * prod.real());
+  std::vector<double> q(qc.size());
+  for (std::size_t j = 0; j < qc.size(); ++j) q[j] = qc[j].real();
+  // h_j, the series of 1 / Q: h_0 = 1, h_j = -sum_i q_i h_{j-i}.
+  const int max_taps = static_cast<int>(preview_ticks) - lead_ + 1;
+  const int m = outside_;
+  std::vector<double> h{1.0};
+  h.resize(static_cast<std::size_t>(max_taps + m), 0.0);
+  for (int j = 1; j < max_taps + m; ++j) {
+    double v = 0.0;
+    for (int i = 1; i <= std::min(j, m); ++i) v -= q[static_cast<std::size_t>(i)] * h[static_cast<std::size_t>(j - i)];
+    h[static_cast<std::size_t>(j)] = v;
+  }
+  // As few taps as bring the bound to 1e-17, at most the preview allows.
+  taps_ = max_taps;
+  for (int t = 1; t <= max_taps; ++t) {
+    if (truncation_norm(q, h, t) <= 1e-17) {
+      taps_ = t;
+      break;
+    }
+  }
+  bound_ = truncation_norm(q, h, taps_);
+  if (bound_ > kMaxTruncationError) {
+    double rho = 0.0;
+    for (const Complex z : out) rho = std::max(rho, 1.0 / std::abs(z));
+    const double needed = lead_ + std::ceil(std::log(kMaxTruncationError) / std::log(rho)) + 1.0;
+    throw ParameterError("preview_ticks",
+                         std::to_string(preview_ticks) + " ticks leave a truncation error bound of " +
+                             number_text(bound_) + " (> " + number_text(kMaxTruncationError) +
+                             "): the zero(s) outside the unit circle, the closest at |z| = " + number_text(1.0 / rho) +
+                             ", need about " + number_text(needed) + " ticks of preview");
+  }
+  for (int j = 0; j < taps_; ++j) h_[static_cast<std::size_t>(j)] = h[static_cast<std::size_t>(j)];
+  den_size_ = static_cast<int>(stage_.denominator.size());
+  for (int i = 0; i < den_size_; ++i) den_[static_cast<std::size_t>(i)] = stage_.denominator(i);
+  reset(0.0);
+}
+
+void PreviewStageInverse::reset(double y0) noexcept {
+  const auto n = static_cast<std::size_t>(preview_) + 1;
+  for (std::size_t i = 0; i < n; ++i) r_[i] = y0;
+  head_ = n - 1;
+  double s = 0.0;
+  for (int j = 0; j < taps_; ++j) s += h_[static_cast<std::size_t>(j)];
+  s *= y0;
+  for (int i = 0; i < den_size_; ++i) s_[static_cast<std::size_t>(i)] = s;
+  double t = 0.0;
+  for (int i = 0; i < den_size_; ++i) t += den_[static_cast<std::size_t>(i)];
+  t *= s;
+  for (int i = 0; i < sections_; ++i) {
+    Section& sec = section_[static_cast<std::size_t>(i)];
+    t /= 1.0 + sec.a1 + sec.a2;
+    sec.u1 = t;
+    sec.u2 = t;
+  }
+  w_prev_ = scale_ * t;
+}
+
+double PreviewStageInverse::step(double r_future) noexcept {
+  if (!std::isfinite(r_future)) return w_prev_;
+  const auto n = static_cast<std::size_t>(preview_) + 1;
+  head_ = head_ + 1 == n ? 0 : head_ + 1;
+  r_[head_] = r_future;  // r_{k+N}
+  // s_k = sum_j h_j r_{k+lead+j}; r_{k+t} sits (N - t) places before the head.
+  std::size_t idx = head_ + n - (static_cast<std::size_t>(preview_) - static_cast<std::size_t>(lead_));
+  if (idx >= n) idx -= n;
+  double s = 0.0;
+  for (int j = 0; j < taps_; ++j) {
+    s += h_[static_cast<std::size_t>(j)] * r_[idx];
+    idx = idx + 1 == n ? 0 : idx + 1;
+  }
+  // The stage's denominator as an FIR over s.
+  for (int i = den_size_ - 1; i > 0; --i) s_[static_cast<std::size_t>(i)] = s_[static_cast<std::size_t>(i) - 1];
+  s_[0] = s;
+  double t = 0.0;
+  for (int i = 0; i < den_size_; ++i) t += den_[static_cast<std::size_t>(i)] * s_[static_cast<std::size_t>(i)];
+  // The inside zeros, causally.
+  for (int i = 0; i < sections_; ++i) {
+    Section& sec = section_[static_cast<std::size_t>(i)];
+    const double u = t - sec.a1 * sec.u1 - sec.a2 * sec.u2;
+    sec.u2 = sec.u1;
+    sec.u1 = u;
+    t = u;
+  }
+  w_prev_ = scale_ * t;
+  return w_prev_;
+}
+
+double PreviewStageInverse::gain(double f_hz) const noexcept { return 1.0 / std::abs(stage_.frequency_response(f_hz)); }
+
+}  // namespace hystloop

@@ -1,0 +1,175 @@
+#include "models/preview_inverse.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/refusal.hpp"
+
+namespace hystloop {
+namespace {
+
+using Mode = LinearStageSpec::Mode;
+constexpr double kDt = 1e-4;  // the bridge's tick
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr std::int64_t kPreview = 500;  // the compensator's 50 ms
+
+const std::vector<Mode> kTwoModes{{780.0, 0.03, 0.7}, {2400.0, 0.02, 0.3}};
+
+// offset + amplitude * (five random sines below 500 Hz, seeded) / (sum of their weights), faded in
+// with a raised cosine after `rest` ticks at the offset (so that the preview is consistent with
+// the reset), n ticks long.
+std::vector<double> smooth_reference(std::uint64_t seed, double amplitude, double offset, int rest, int n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> freq(5.0, 500.0), phase(0.0, kTwoPi), weight(0.2, 1.0);
+  double f[5], p[5], a[5], total = 0.0;
+  for (int i = 0; i < 5; ++i) {
+    f[i] = freq(rng);
+    p[i] = phase(rng);
+    a[i] = weight(rng);
+    total += a[i];
+  }
+  constexpr int kFade = 1000;
+  std::vector<double> r(static_cast<std::size_t>(n), offset);
+  for (int k = rest; k < n; ++k) {
+    const double t = (k - rest) * kDt;
+    const double fade = k - rest >= kFade ? 1.0 : 0.5 - 0.5 * std::cos(std::numbers::pi * (k - rest) / kFade);
+    double v = 0.0;
+    for (int i = 0; i < 5; ++i) v += a[i] * (std::sin(kTwoPi * f[i] * t + p[i]) - std::sin(p[i]));
+    r[static_cast<std::size_t>(k)] = offset + fade * amplitude * v / total;
+  }
+  return r;
+}
+
+// The stage driven by the inverse: the worst |y_k - r_k| over every tick.
+double worst_tracking_error(const DiscreteLinearStage& stage, std::int64_t preview, std::uint64_t seed) {
+  const int n = 12000;
+  const std::vector<double> r = smooth_reference(seed, 1e-6, 0.2e-6, static_cast<int>(preview) + 1, n);
+  PreviewStageInverse inverse(stage, preview);
+  LinearStageSimulator sim(stage);
+  inverse.reset(r[0]);
+  sim.reset(r[0]);
+  double worst = 0.0;
+  for (int k = 0; k + preview < n; ++k) {
+    const double w = inverse.step(r[static_cast<std::size_t>(k + preview)]);
+    const double y = sim.step(w);
+    worst = std::max(worst, std::abs(y - r[static_cast<std::size_t>(k)]));
+  }
+  return worst;
+}
+
+TEST(PreviewStageInverse, MinimumPhaseSecondOrderStageReproducesTheReference) {
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::second_order(1.17e8, 2.03e3), kDt);
+  const PreviewStageInverse inverse(stage, kPreview);
+  EXPECT_EQ(inverse.outside_zeros(), 0);
+  EXPECT_EQ(inverse.anticausal_taps(), 1);
+  EXPECT_EQ(inverse.truncation_error_bound(), 0.0);
+  for (const std::uint64_t seed : {1u, 2u, 3u}) EXPECT_LT(worst_tracking_error(stage, kPreview, seed), 1e-9 * 1.2e-6);
+}
+
+TEST(PreviewStageInverse, TwoLightlyDampedModesWithAFractionalDelayReproduceTheReference) {
+  for (const double delay_ticks : {1.5, 3.0, 0.25, 0.75}) {
+    const DiscreteLinearStage stage = discretise(LinearStageSpec::sum_of_modes(kTwoModes, delay_ticks * kDt), kDt);
+    const PreviewStageInverse inverse(stage, kPreview);
+    EXPECT_LE(inverse.truncation_error_bound(), 1e-15) << delay_ticks;
+    for (const std::uint64_t seed : {4u, 5u}) {
+      EXPECT_LT(worst_tracking_error(stage, kPreview, seed), 1e-9 * 1.2e-6) << delay_ticks << " ticks, seed " << seed;
+    }
+  }
+}
+
+TEST(PreviewStageInverse, ANonMinimumPhaseStageReproducesTheReferenceFromItsPreview) {
+  // A right-half-plane zero at 3 kHz before a 1 kHz mode and a 2 kHz pole: sampled, z = 8.59.
+  const DiscreteLinearStage stage =
+      discretise(LinearStageSpec::zero_pole({{3000.0, 0.0}}, {{-100.0, 995.0}, {-2000.0, 0.0}}), kDt);
+  const PreviewStageInverse inverse(stage, kPreview);
+  EXPECT_EQ(inverse.outside_zeros(), 1);
+  EXPECT_LE(inverse.truncation_error_bound(), 1e-15);
+  EXPECT_LT(inverse.anticausal_taps(), 40);  // |1 / 8.59|^j reaches 1e-17 after 19 taps
+  for (const std::uint64_t seed : {6u, 7u}) EXPECT_LT(worst_tracking_error(stage, kPreview, seed), 1e-9 * 1.2e-6);
+  // Causal inversion is not enough: without preview the same stage is refused.
+  EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(stage, 0); }), "preview_ticks");
+}
+
+TEST(PreviewStageInverse, TheTruncationBoundFallsWithThePreviewAndAShortPreviewIsRefused) {
+  // A zero at z = 1.2: the anti-causal series decays like (1 / 1.2)^j, 1e-12 after about 150 ticks.
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::discrete({1.0, -1.2}, {1.0, -0.5}, kDt), kDt);
+  double previous = 1.0;
+  for (const std::int64_t n : {155, 170, 185, 200}) {
+    const PreviewStageInverse inverse(stage, n);
+    EXPECT_EQ(inverse.anticausal_taps(), n);  // every tick of the preview is used
+    EXPECT_LT(inverse.truncation_error_bound(), previous) << n;
+    EXPECT_LE(inverse.truncation_error_bound(), PreviewStageInverse::kMaxTruncationError) << n;
+    EXPECT_NEAR(inverse.truncation_error_bound(), std::pow(1.0 / 1.2, n), 0.5 * std::pow(1.0 / 1.2, n)) << n;
+    previous = inverse.truncation_error_bound();
+  }
+  // A longer preview than needed stops at 1e-17.
+  EXPECT_LT(PreviewStageInverse(stage, 500).anticausal_taps(), 230);
+  try {
+    PreviewStageInverse inverse(stage, 100);
+    FAIL() << "accepted a preview of 100 ticks, bound " << inverse.truncation_error_bound();
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "preview_ticks");
+    EXPECT_NE(std::string(e.what()).find("need about 154 ticks of preview"), std::string::npos) << e.what();
+  }
+  // The delay takes its ticks from the preview.
+  const DiscreteLinearStage delayed = discretise(LinearStageSpec::sum_of_modes(kTwoModes, 40.0 * kDt), kDt);
+  EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(delayed, 39); }), "preview_ticks");
+  EXPECT_NO_THROW(PreviewStageInverse(delayed, 40));
+  EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(delayed, -1); }), "preview_ticks");
+  EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(delayed, 100000); }), "preview_ticks");
+}
+
+TEST(PreviewStageInverse, RefusesAZeroOnTheUnitCircle) {
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::discrete({1.0, 1.0}, {1.0, -0.5}, kDt), kDt);
+  try {
+    PreviewStageInverse inverse(stage, kPreview);
+    FAIL() << "accepted a zero at -1";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "stage");
+    EXPECT_NE(std::string(e.what()).find("unit circle"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("5000 Hz"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PreviewStageInverse, AtHalfTheTickRateTheInputIsTheInverseGainTimesTheReference) {
+  // A sampling zero at -0.99: the inverse multiplies what the reference has at 5 kHz by |1 / G(-1)|
+  // = 1.5 * 1.99 / (0.01 * 0.5) = 597.
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::discrete({1.0, 0.99}, {1.0, -0.5}, kDt), kDt);
+  PreviewStageInverse inverse(stage, 10);
+  const double gain = inverse.gain(5000.0);
+  EXPECT_NEAR(gain, 597.0, 1e-6);
+  double late = 0.0;
+  for (int k = 0; k < 6000; ++k) {
+    const double w = inverse.step(k % 2 == 0 ? 1e-9 : -1e-9);
+    ASSERT_TRUE(std::isfinite(w));
+    if (k > 4000) late = std::max(late, std::abs(w));
+  }
+  EXPECT_NEAR(late, gain * 1e-9, 1e-3 * gain * 1e-9);
+}
+
+TEST(PreviewStageInverse, RestsWhereResetHoldsOnANonFiniteReferenceAndStepsWithoutAllocating) {
+  const DiscreteLinearStage stage =
+      discretise(LinearStageSpec::zero_pole({{3000.0, 0.0}}, {{-100.0, 995.0}, {-2000.0, 0.0}}, 1.5 * kDt), kDt);
+  PreviewStageInverse inverse(stage, kPreview);
+  inverse.reset(0.5e-6);
+  for (int k = 0; k < 10; ++k) EXPECT_NEAR(inverse.step(0.5e-6), 0.5e-6, 1e-18);
+  const double before = inverse.last_input();
+  EXPECT_EQ(inverse.step(std::nan("")), before);
+  EXPECT_NEAR(inverse.step(0.5e-6), 0.5e-6, 1e-18);
+  testing::AllocationCounter counter;
+  double sum = 0.0;
+  for (int k = 0; k < 2000; ++k) sum += inverse.step(1e-9 * std::sin(0.01 * k));
+  EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_TRUE(std::isfinite(sum));
+}
+
+}  // namespace
+}  // namespace hystloop
