@@ -33,8 +33,9 @@ double truncation_norm(const std::vector<double>& q, const std::vector<double>& 
 
 }  // namespace
 
-PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::int64_t preview_ticks)
-    : stage_(stage), preview_(preview_ticks) {
+PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::int64_t preview_ticks,
+                                         double reference_bandwidth_hz)
+    : stage_(stage), preview_(preview_ticks), bandwidth_hz_(reference_bandwidth_hz) {
   if (preview_ticks < 0 || preview_ticks > kMaxPreviewTicks) {
     throw ParameterError("preview_ticks", "must be in [0, " + std::to_string(kMaxPreviewTicks) + "] (got " +
                                               std::to_string(preview_ticks) + ")");
@@ -67,11 +68,37 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
   }
   outside_ = static_cast<int>(out.size());
   lead_ = stage_.delay_ticks + outside_;
-  if (preview_ticks < lead_) {
-    throw ParameterError("preview_ticks", "must be at least " + std::to_string(lead_) + " ticks (" +
-                                              std::to_string(stage_.delay_ticks) +
-                                              " of delay and one per zero outside " + "the unit circle), got " +
-                                              std::to_string(preview_ticks));
+  // The low-pass: a Blackman-windowed sinc, g_j = 2 fc dt sinc(2 fc dt j) w(j), |j| <= M, sum 1.
+  if (reference_bandwidth_hz != 0.0) {
+    const double lowest = 4.0 / (kMaxLowPassHalfLength * stage_.dt_s), nyquist = 0.5 / stage_.dt_s;
+    if (!std::isfinite(reference_bandwidth_hz) || reference_bandwidth_hz < lowest ||
+        reference_bandwidth_hz >= nyquist) {
+      throw ParameterError("reference_bandwidth_hz", "must be 0 (off) or in [" + number_text(lowest) + ", " +
+                                                         number_text(nyquist) + ") Hz (got " +
+                                                         number_text(reference_bandwidth_hz) + ")");
+    }
+    half_ = static_cast<int>(std::ceil(4.0 / (reference_bandwidth_hz * stage_.dt_s) - 1e-9));
+  }
+  const double fc = reference_bandwidth_hz * stage_.dt_s;  // cycles per tick
+  double gsum = 0.0;
+  for (int j = 0; j <= half_; ++j) {  // symmetric to the last bit: zero phase
+    double g = 1.0;
+    if (half_ > 0) {
+      const double x = 2.0 * std::numbers::pi * fc * j;
+      const double sinc = j == 0 ? 1.0 : std::sin(x) / x;
+      const double phase = std::numbers::pi * j / half_;  // the Blackman window centred on 0
+      g = 2.0 * fc * sinc * (0.42 + 0.5 * std::cos(phase) + 0.08 * std::cos(2.0 * phase));
+    }
+    lowpass_[static_cast<std::size_t>(half_ + j)] = g;
+    lowpass_[static_cast<std::size_t>(half_ - j)] = g;
+    gsum += j == 0 ? g : 2.0 * g;
+  }
+  for (int j = 0; j <= 2 * half_; ++j) lowpass_[static_cast<std::size_t>(j)] /= gsum;
+  if (preview_ticks < lead_ + half_) {
+    throw ParameterError("preview_ticks", "must be at least " + std::to_string(lead_ + half_) + " ticks (" +
+                                              std::to_string(stage_.delay_ticks) + " of delay, one per zero outside " +
+                                              "the unit circle and " + std::to_string(half_) +
+                                              " for the reference's low-pass), got " + std::to_string(preview_ticks));
   }
   // Q(z) = prod_o (1 - z / z_o), real; scale 1 / (K prod_o (-z_o)).
   std::vector<Complex> qc{1.0};
@@ -89,7 +116,7 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
   std::vector<double> q(qc.size());
   for (std::size_t j = 0; j < qc.size(); ++j) q[j] = qc[j].real();
   // h_j, the series of 1 / Q: h_0 = 1, h_j = -sum_i q_i h_{j-i}.
-  const int max_taps = static_cast<int>(preview_ticks) - lead_ + 1;
+  const int max_taps = static_cast<int>(preview_ticks) - lead_ - half_ + 1;
   const int m = outside_;
   std::vector<double> h{1.0};
   h.resize(static_cast<std::size_t>(max_taps + m), 0.0);
@@ -106,29 +133,40 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
       break;
     }
   }
-  bound_ = truncation_norm(q, h, taps_);
+  double lowpass_l1 = 0.0;
+  for (int j = 0; j <= 2 * half_; ++j) lowpass_l1 += std::abs(lowpass_[static_cast<std::size_t>(j)]);
+  bound_ = truncation_norm(q, h, taps_) * lowpass_l1;
   if (bound_ > kMaxTruncationError) {
     double rho = 0.0;
     for (const Complex z : out) rho = std::max(rho, 1.0 / std::abs(z));
-    const double needed = lead_ + std::ceil(std::log(kMaxTruncationError) / std::log(rho)) + 1.0;
+    const double needed = lead_ + half_ + std::ceil(std::log(kMaxTruncationError) / std::log(rho)) + 1.0;
     throw ParameterError("preview_ticks",
                          std::to_string(preview_ticks) + " ticks leave a truncation error bound of " +
                              number_text(bound_) + " (> " + number_text(kMaxTruncationError) +
                              "): the zero(s) outside the unit circle, the closest at |z| = " + number_text(1.0 / rho) +
                              ", need about " + number_text(needed) + " ticks of preview");
   }
-  for (int j = 0; j < taps_; ++j) h_[static_cast<std::size_t>(j)] = h[static_cast<std::size_t>(j)];
+  // c = h * g: c_i multiplies r_{k+lead-M+i}, i = 0 .. taps - 1 + 2M.
+  c_taps_ = taps_ + 2 * half_;
+  for (int i = 0; i < c_taps_; ++i) {
+    double v = 0.0;
+    for (int j = std::max(0, i - 2 * half_); j <= std::min(taps_ - 1, i); ++j) {
+      v += h[static_cast<std::size_t>(j)] * lowpass_[static_cast<std::size_t>(i - j)];
+    }
+    c_[static_cast<std::size_t>(i)] = v;
+  }
+  ring_ = static_cast<std::size_t>(preview_ticks + half_) + 1;
   den_size_ = static_cast<int>(stage_.denominator.size());
   for (int i = 0; i < den_size_; ++i) den_[static_cast<std::size_t>(i)] = stage_.denominator(i);
   reset(0.0);
 }
 
 void PreviewStageInverse::reset(double y0) noexcept {
-  const auto n = static_cast<std::size_t>(preview_) + 1;
+  const std::size_t n = ring_;
   for (std::size_t i = 0; i < n; ++i) r_[i] = y0;
   head_ = n - 1;
   double s = 0.0;
-  for (int j = 0; j < taps_; ++j) s += h_[static_cast<std::size_t>(j)];
+  for (int j = 0; j < c_taps_; ++j) s += c_[static_cast<std::size_t>(j)];
   s *= y0;
   for (int i = 0; i < den_size_; ++i) s_[static_cast<std::size_t>(i)] = s;
   double t = 0.0;
@@ -145,15 +183,15 @@ void PreviewStageInverse::reset(double y0) noexcept {
 
 double PreviewStageInverse::step(double r_future) noexcept {
   if (!std::isfinite(r_future)) return w_prev_;
-  const auto n = static_cast<std::size_t>(preview_) + 1;
+  const std::size_t n = ring_;
   head_ = head_ + 1 == n ? 0 : head_ + 1;
   r_[head_] = r_future;  // r_{k+N}
-  // s_k = sum_j h_j r_{k+lead+j}; r_{k+t} sits (N - t) places before the head.
-  std::size_t idx = head_ + n - (static_cast<std::size_t>(preview_) - static_cast<std::size_t>(lead_));
+  // s_k = sum_i c_i r_{k+lead-M+i}; r_{k+t} sits (N - t) places before the head.
+  std::size_t idx = head_ + n - static_cast<std::size_t>(preview_ - lead_ + half_);
   if (idx >= n) idx -= n;
   double s = 0.0;
-  for (int j = 0; j < taps_; ++j) {
-    s += h_[static_cast<std::size_t>(j)] * r_[idx];
+  for (int j = 0; j < c_taps_; ++j) {
+    s += c_[static_cast<std::size_t>(j)] * r_[idx];
     idx = idx + 1 == n ? 0 : idx + 1;
   }
   // The stage's denominator as an FIR over s.

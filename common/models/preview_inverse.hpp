@@ -45,10 +45,18 @@
 //
 // Per tick: one dot product over the anti-causal taps (only as many as reach 1e-17), one FIR over
 // the stage's denominator, one IIR section per inside zero; fixed-size, allocation and throw free.
-// No low-pass of the reference is applied (the caller's planner shapes it; not implemented here).
+//
+// Optional zero-phase low-pass of the reference, reference_bandwidth_hz (DEFAULT 0 = OFF, so that
+// the stage reproduces the reference itself): a symmetric Blackman-windowed sinc of half-length
+// M = ceil(4 / (bandwidth dt)) ticks (40 at 1 kHz and 10 kHz), unit DC gain, cut-off (-6 dB) at
+// the bandwidth, about -74 dB beyond 1.7 times it. It is convolved with the anti-causal series, so
+// it costs M more ticks of preview and M ticks of past reference; the stage then reproduces the
+// FILTERED reference (reference_lowpass() gives the taps). Use it when the reference may carry
+// content near half the tick rate that the inverse's gain (table above) would amplify.
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "models/linear_stage.hpp"
 
@@ -59,11 +67,15 @@ class PreviewStageInverse {
   static constexpr std::int64_t kMaxPreviewTicks = 2048;
   static constexpr double kMaxTruncationError = 1e-12;  // relative to max |r| over the window
   static constexpr double kMinZeroDistance = 1e-6;      // | |z| - 1 | of a zero ON the unit circle
+  static constexpr int kMaxLowPassHalfLength = 1024;    // ticks (the lowest bandwidth: 39 Hz at 10 kHz)
 
   // Throws ParameterError: "preview_ticks" (outside [0, kMaxPreviewTicks], shorter than the delay
   // plus the outside zeros, or leaving the truncation bound above kMaxTruncationError: the message
   // names the preview needed), "stage" (a zero on the unit circle).
-  PreviewStageInverse(const DiscreteLinearStage& stage, std::int64_t preview_ticks);
+  // "reference_bandwidth_hz" (not 0 and outside [4 / (kMaxLowPassHalfLength dt), 0.5 / dt)), or a
+  // preview too short for the delay, the outside zeros and the low-pass's M ticks.
+  PreviewStageInverse(const DiscreteLinearStage& stage, std::int64_t preview_ticks,
+                      double reference_bandwidth_hz = 0.0);
 
   // At rest at y0: the reference has been y0 for ever, up to tick k + preview_ticks.
   void reset(double y0) noexcept;
@@ -73,10 +85,16 @@ class PreviewStageInverse {
   double step(double r_future) noexcept;
 
   std::int64_t preview_ticks() const noexcept { return preview_; }
-  // |y_k - r_k| <= bound * max |r_j| over the window (rounding aside).
+  // |y_k - r_k| <= bound * max |r_j| over the window (rounding aside; r filtered when the low-pass
+  // is on, whose l1 norm the bound includes).
   double truncation_error_bound() const noexcept { return bound_; }
   int anticausal_taps() const noexcept { return taps_; }  // h_0 .. h_{taps-1}
   int outside_zeros() const noexcept { return outside_; }
+  double reference_bandwidth_hz() const noexcept { return bandwidth_hz_; }
+  // The low-pass's taps g_{-M} .. g_M (applied as sum_j g_j r_{k+j}); one tap of 1 when off.
+  std::span<const double> reference_lowpass() const noexcept {
+    return {lowpass_.data(), static_cast<std::size_t>(2 * half_ + 1)};
+  }
   double last_input() const noexcept { return w_prev_; }
   // |1 / G| at f [Hz]: what the inverse multiplies the reference's content at f by.
   double gain(double f_hz) const noexcept;
@@ -84,7 +102,7 @@ class PreviewStageInverse {
 
  private:
   static constexpr int kMaxSections = DiscreteLinearStage::kMaxStates;
-  static constexpr std::size_t kRing = static_cast<std::size_t>(kMaxPreviewTicks) + 1;
+  static constexpr std::size_t kRing = static_cast<std::size_t>(kMaxPreviewTicks + kMaxLowPassHalfLength) + 1;
 
   struct Section {  // u_k = x_k - a1 u_{k-1} - a2 u_{k-2}
     double a1 = 0.0, a2 = 0.0, u1 = 0.0, u2 = 0.0;
@@ -93,12 +111,17 @@ class PreviewStageInverse {
   DiscreteLinearStage stage_;
   std::int64_t preview_ = 0;
   int lead_ = 0;  // delay + outside zeros: r_{k+lead+j} is multiplied by h_j
-  int taps_ = 1;
+  int taps_ = 1;  // of h
+  double bandwidth_hz_ = 0.0;
+  int half_ = 0;          // M
+  std::size_t ring_ = 1;  // N + M + 1
+  std::array<double, 2 * kMaxLowPassHalfLength + 1> lowpass_{};
+  std::array<double, kRing> c_{};  // h convolved with the low-pass: c_i multiplies r_{k+lead-M+i}
+  int c_taps_ = 1;
   int outside_ = 0;
   double bound_ = 0.0;
-  double scale_ = 1.0;  // 1 / (K prod_o (-z_o))
-  std::array<double, kRing> h_{};
-  std::array<double, kRing> r_{};  // ring of r_k .. r_{k+N}
+  double scale_ = 1.0;             // 1 / (K prod_o (-z_o))
+  std::array<double, kRing> r_{};  // ring of r_{k-M} .. r_{k+N}
   std::size_t head_ = 0;           // where r_{k+N} is
   int den_size_ = 1;
   std::array<double, DiscreteLinearStage::kMaxStates + 1> den_{};

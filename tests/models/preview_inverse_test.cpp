@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <numbers>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -155,10 +156,71 @@ TEST(PreviewStageInverse, AtHalfTheTickRateTheInputIsTheInverseGainTimesTheRefer
   EXPECT_NEAR(late, gain * 1e-9, 1e-3 * gain * 1e-9);
 }
 
+TEST(PreviewStageInverse, WithTheLowPassTheStageReproducesTheFilteredReference) {
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::sum_of_modes(kTwoModes, 1.5 * kDt), kDt);
+  const PreviewStageInverse inverse0(stage, kPreview, 300.0);
+  const std::span<const double> g = inverse0.reference_lowpass();
+  const int m = static_cast<int>(g.size() / 2);
+  ASSERT_EQ(m, 134);  // ceil(4 / (300 Hz * 1e-4 s))
+  double sum = 0.0;
+  for (int j = 0; j < m; ++j) EXPECT_EQ(g[static_cast<std::size_t>(j)], g[static_cast<std::size_t>(2 * m - j)]);
+  for (const double v : g) sum += v;
+  EXPECT_NEAR(sum, 1.0, 1e-15);
+  EXPECT_LE(inverse0.truncation_error_bound(), 1e-15);
+  // The filtered reference, computed here: r before tick 0 is r_0.
+  const int n = 12000;
+  const std::vector<double> r = smooth_reference(8, 1e-6, 0.2e-6, static_cast<int>(kPreview) + m + 1, n);
+  auto at = [&](int k) { return r[static_cast<std::size_t>(std::max(0, k))]; };
+  PreviewStageInverse inverse(stage, kPreview, 300.0);
+  LinearStageSimulator sim(stage);
+  inverse.reset(r[0]);
+  sim.reset(r[0]);
+  double worst = 0.0, worst_unfiltered = 0.0;
+  for (int k = 0; k + kPreview < n; ++k) {
+    const double y = sim.step(inverse.step(r[static_cast<std::size_t>(k + kPreview)]));
+    double filtered = 0.0;
+    for (int j = -m; j <= m; ++j) filtered += g[static_cast<std::size_t>(j + m)] * at(k + j);
+    worst = std::max(worst, std::abs(y - filtered));
+    worst_unfiltered = std::max(worst_unfiltered, std::abs(y - at(k)));
+  }
+  EXPECT_LT(worst, 1e-9 * 1.2e-6);
+  EXPECT_GT(worst_unfiltered, 1e-2 * 1.2e-6);  // the reference has content up to 500 Hz
+}
+
+TEST(PreviewStageInverse, TheLowPassKeepsTheInverseFromAmplifyingContentNearHalfTheTickRate) {
+  // The delay-free two-mode stage: |1 / G| is 323 at 5 kHz. A 4.95 kHz sine in the reference:
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::sum_of_modes(kTwoModes), kDt);
+  auto late_input = [&](double bandwidth_hz) {
+    PreviewStageInverse inverse(stage, kPreview, bandwidth_hz);
+    double late = 0.0;
+    for (int k = 0; k < 4000; ++k) {
+      const double w = inverse.step(1e-9 * std::sin(kTwoPi * 4950.0 * k * kDt));
+      if (k > 2000) late = std::max(late, std::abs(w));
+    }
+    return late;
+  };
+  const double gain = PreviewStageInverse(stage, kPreview).gain(4950.0);
+  EXPECT_GT(gain, 100.0);
+  EXPECT_NEAR(late_input(0.0), gain * 1e-9, 0.01 * gain * 1e-9);
+  EXPECT_LT(late_input(1000.0), 1e-3 * gain * 1e-9);  // the Blackman window's -74 dB
+}
+
+TEST(PreviewStageInverse, RefusesABandwidthOutsideItsRangeOrTooLongForThePreview) {
+  using testing::refused_field;
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::sum_of_modes(kTwoModes, 1.5 * kDt), kDt);
+  EXPECT_EQ(refused_field([&] { PreviewStageInverse(stage, kPreview, -1.0); }), "reference_bandwidth_hz");
+  EXPECT_EQ(refused_field([&] { PreviewStageInverse(stage, kPreview, 5000.0); }), "reference_bandwidth_hz");
+  EXPECT_EQ(refused_field([&] { PreviewStageInverse(stage, kPreview, 10.0); }), "reference_bandwidth_hz");
+  EXPECT_EQ(refused_field([&] { PreviewStageInverse(stage, kPreview, std::nan("")); }), "reference_bandwidth_hz");
+  // 1 tick of delay, 1 outside zero (-4.78), 40 for the low-pass, and the series' taps.
+  EXPECT_EQ(refused_field([&] { PreviewStageInverse(stage, 41, 1000.0); }), "preview_ticks");
+  EXPECT_NO_THROW(PreviewStageInverse(stage, 100, 1000.0));
+}
+
 TEST(PreviewStageInverse, RestsWhereResetHoldsOnANonFiniteReferenceAndStepsWithoutAllocating) {
   const DiscreteLinearStage stage =
       discretise(LinearStageSpec::zero_pole({{3000.0, 0.0}}, {{-100.0, 995.0}, {-2000.0, 0.0}}, 1.5 * kDt), kDt);
-  PreviewStageInverse inverse(stage, kPreview);
+  PreviewStageInverse inverse(stage, kPreview, 800.0);
   inverse.reset(0.5e-6);
   for (int k = 0; k < 10; ++k) EXPECT_NEAR(inverse.step(0.5e-6), 0.5e-6, 1e-18);
   const double before = inverse.last_input();
