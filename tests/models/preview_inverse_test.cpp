@@ -235,3 +235,31 @@ TEST(PreviewStageInverse, RestsWhereResetHoldsOnANonFiniteReferenceAndStepsWitho
 
 }  // namespace
 }  // namespace hystloop
+
+namespace hystloop {
+namespace {
+TEST(PreviewStageInverse, SixteenStatesOfModesWithAFractionalDelayReproduceTheReference) {
+  // Eight modes from 200 Hz to 4.5 kHz, the most the stage takes, with 2.3 ticks of delay.
+  const std::vector<Mode> modes{{200.0, 0.05, 0.3},  {450.0, 0.02, 0.2},   {780.0, 0.03, 0.15},   {1200.0, 0.01, 0.1},
+                                {1800.0, 0.02, 0.1}, {2400.0, 0.02, 0.08}, {3300.0, 0.015, 0.04}, {4500.0, 0.01, 0.03}};
+  const DiscreteLinearStage undelayed = discretise(LinearStageSpec::sum_of_modes(modes), kDt);
+  EXPECT_EQ(undelayed.states(), 16);
+  EXPECT_EQ(PreviewStageInverse(undelayed, kPreview).outside_zeros(), 0);
+  EXPECT_LT(worst_tracking_error(undelayed, kPreview, 9), 1e-9 * 1.2e-6);
+  // The delay's fraction pushes three zeros outside, the closest at |z| = 1.047: 500 ticks are
+  // refused, naming what is needed.
+  const DiscreteLinearStage delayed = discretise(LinearStageSpec::sum_of_modes(modes, 2.3 * kDt), kDt);
+  try {
+    PreviewStageInverse inverse(delayed, kPreview);
+    FAIL() << "accepted, bound " << inverse.truncation_error_bound();
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.field(), "preview_ticks");
+    EXPECT_NE(std::string(e.what()).find("need about 613 ticks"), std::string::npos) << e.what();
+  }
+  const PreviewStageInverse inverse(delayed, 700);
+  EXPECT_EQ(inverse.outside_zeros(), 3);
+  EXPECT_LE(inverse.truncation_error_bound(), PreviewStageInverse::kMaxTruncationError);
+  EXPECT_LT(worst_tracking_error(delayed, 700, 9), 1e-9 * 1.2e-6);
+}
+}  // namespace
+}  // namespace hystloop
