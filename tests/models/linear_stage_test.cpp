@@ -82,6 +82,61 @@ TEST(LinearStage, TheThreeContinuousFormsGiveTheSameResponseWithUnitDcGain) {
   EXPECT_NEAR(std::arg(ratio), -kTwoPi * 1000.0 * 1.5 * kDt, 1e-12);
 }
 
+TEST(LinearStage, EightStatesAsPolynomialsMatchTheirModesAndAnOverdampedModeIsTwoRealPoles) {
+  const std::vector<Mode> modes{{300.0, 0.05, 0.4}, {900.0, 1.5, 0.3}, {1700.0, 0.02, 0.2}, {3100.0, 0.01, 0.1}};
+  // The polynomials of the sum, written out: num = sum_i w_i wn_i^2 prod_{j != i} D_j, den = prod D_j.
+  auto times = [](const std::vector<double>& a, const std::vector<double>& b) {
+    std::vector<double> c(a.size() + b.size() - 1, 0.0);
+    for (std::size_t i = 0; i < a.size(); ++i)
+      for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
+    return c;
+  };
+  std::vector<double> den{1.0}, num(7, 0.0);
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    const double w = kTwoPi * modes[i].frequency_hz;
+    den = times(den, {1.0, 2.0 * modes[i].damping_ratio * w, w * w});
+    std::vector<double> term{modes[i].weight * w * w};
+    for (std::size_t j = 0; j < modes.size(); ++j) {
+      if (j == i) continue;
+      const double wj = kTwoPi * modes[j].frequency_hz;
+      term = times(term, {1.0, 2.0 * modes[j].damping_ratio * wj, wj * wj});
+    }
+    for (std::size_t k = 0; k < term.size(); ++k) num[k] += term[k];
+  }
+  const LinearStageSpec a = LinearStageSpec::sum_of_modes(modes);
+  const LinearStageSpec b = LinearStageSpec::transfer_function(num, den);
+  EXPECT_EQ(b.order(), 8);
+  for (const double hz : {0.0, 50.0, 300.0, 900.0, 1700.0, 3100.0, 4900.0}) {
+    const Complex g = a.frequency_response(hz);
+    EXPECT_LT(std::abs(b.frequency_response(hz) - g), 1e-8 * std::abs(g)) << hz;
+  }
+  const DiscreteLinearStage da = discretise(a, kDt), db = discretise(b, kDt);
+  for (const double hz : {0.0, 300.0, 1700.0, 4900.0}) {
+    const Complex g = da.frequency_response(hz);
+    EXPECT_LT(std::abs(db.frequency_response(hz) - g), 1e-8 * std::abs(g)) << hz;
+  }
+  // zeta 1.5 at 900 Hz: poles e^{-wn (1.5 +- sqrt(1.25)) dt}, real.
+  int real_poles = 0;
+  for (Eigen::Index i = 0; i < da.poles.size(); ++i) real_poles += da.poles(i).imag() == 0.0 ? 1 : 0;
+  EXPECT_EQ(real_poles, 2);
+}
+
+TEST(LinearStage, APureDelayShiftsTheCommandByItsWholeTicks) {
+  // No dynamics, 2.5 ticks: the position at the end of tick k is the command of tick k - 2 (the
+  // fraction only shows between tick ends).
+  const DiscreteLinearStage s = discretise(LinearStageSpec::zero_pole({}, {}, 2.5 * kDt), kDt);
+  EXPECT_EQ(s.delay_ticks, 2);
+  LinearStageSimulator sim(s);
+  std::vector<double> w(100);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 100; ++k) {
+    w[static_cast<std::size_t>(k)] = u(rng);
+    const double y = sim.step(w[static_cast<std::size_t>(k)]);
+    EXPECT_NEAR(y, k >= 2 ? w[static_cast<std::size_t>(k - 2)] : 0.0, 1e-15) << k;
+  }
+}
+
 TEST(LinearStage, EachSampledFormHasUnitDcGainAndTheSamePolesAndZeros) {
   const TwoModeForms f = two_mode_forms();
   for (const double delay : {0.0, 1.5 * kDt, 3.0 * kDt}) {
