@@ -54,6 +54,7 @@ std::vector<Complex> polynomial_roots(const std::vector<double>& p) {
   for (int i = 1; i < n; ++i) companion(i, i - 1) = 1.0;
   const Eigen::EigenSolver<Eigen::MatrixXd> eig(companion, false);
   std::vector<Complex> roots;
+  roots.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) roots.push_back(eig.eigenvalues()(i) * scale);
   return roots;
 }
@@ -154,7 +155,7 @@ Continuous series(const Continuous& s1, const Section& s2) {
 
 // A cascade of first- and second-order sections with unit DC gain each. The caller checked that
 // there are no more zeros than poles and no zero at s = 0.
-Continuous cascade(std::vector<Factor> poles, std::vector<Factor> zeros) {
+Continuous cascade(const std::vector<Factor>& poles, std::vector<Factor> zeros) {
   // Sections of poles: each pair alone, the real poles two by two.
   std::vector<std::vector<Factor>> section_poles, section_zeros;
   std::vector<Factor> reals;

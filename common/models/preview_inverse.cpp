@@ -89,8 +89,9 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
       const double phase = std::numbers::pi * j / half_;  // the Blackman window centred on 0
       g = 2.0 * fc * sinc * (0.42 + 0.5 * std::cos(phase) + 0.08 * std::cos(2.0 * phase));
     }
-    lowpass_[static_cast<std::size_t>(half_ + j)] = g;
-    lowpass_[static_cast<std::size_t>(half_ - j)] = g;
+    const auto centre = static_cast<std::size_t>(half_), offset = static_cast<std::size_t>(j);
+    lowpass_[centre + offset] = g;
+    lowpass_[centre - offset] = g;
     gsum += j == 0 ? g : 2.0 * g;
   }
   for (int j = 0; j <= 2 * half_; ++j) lowpass_[static_cast<std::size_t>(j)] /= gsum;
@@ -119,7 +120,7 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
   const int max_taps = static_cast<int>(preview_ticks) - lead_ - half_ + 1;
   const int m = outside_;
   std::vector<double> h{1.0};
-  h.resize(static_cast<std::size_t>(max_taps + m), 0.0);
+  h.resize(static_cast<std::size_t>(max_taps) + static_cast<std::size_t>(m), 0.0);
   for (int j = 1; j < max_taps + m; ++j) {
     double v = 0.0;
     for (int i = 1; i <= std::min(j, m); ++i) v -= q[static_cast<std::size_t>(i)] * h[static_cast<std::size_t>(j - i)];

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -220,8 +221,9 @@ TEST(LinearStage, SampledResponseIsTheContinuousOneTimesTheHoldAtLowFrequency) {
       const double x = 0.5 * kTwoPi * hz * kDt;
       const Complex hold = std::sin(x) / x * std::polar(1.0, x);
       const Complex expected = spec.frequency_response(hz) * hold;
-      EXPECT_LT(std::abs(s.frequency_response(hz) - expected), 2e-3 * hz / 100.0 * std::abs(expected))
-          << delay << " " << hz;
+      // What aliases back grows like f: measured 1.6e-5 at 100 Hz without delay, 4.3e-4 with 7.25
+      // ticks (a fraction breaks the cancellation of the aliases at +-n / dt).
+      EXPECT_LT(std::abs(s.frequency_response(hz) - expected), 6e-6 * hz * std::abs(expected)) << delay << " " << hz;
     }
   }
 }
@@ -289,7 +291,7 @@ TEST(LinearStageSimulator, RestsWhereResetHoldsOnNonFiniteInputAndStepsWithoutAl
   for (int k = 0; k < 20; ++k) EXPECT_NEAR(sim.step(0.4e-6), 0.4e-6, 1e-18);
   LinearStageSimulator twin = sim;
   EXPECT_TRUE(std::isnan(sim.step(std::nan(""))));
-  EXPECT_TRUE(std::isnan(sim.step(INFINITY)));
+  EXPECT_TRUE(std::isnan(sim.step(std::numeric_limits<double>::infinity())));
   for (int k = 0; k < 20; ++k) EXPECT_EQ(sim.step(1e-6 * k), twin.step(1e-6 * k));
   testing::AllocationCounter counter;
   double sum = 0.0;

@@ -179,7 +179,7 @@ TEST(PreviewStageInverse, WithTheLowPassTheStageReproducesTheFilteredReference) 
   for (int k = 0; k + kPreview < n; ++k) {
     const double y = sim.step(inverse.step(r[static_cast<std::size_t>(k + kPreview)]));
     double filtered = 0.0;
-    for (int j = -m; j <= m; ++j) filtered += g[static_cast<std::size_t>(j + m)] * at(k + j);
+    for (std::size_t i = 0; i < g.size(); ++i) filtered += g[i] * at(k + static_cast<int>(i) - m);
     worst = std::max(worst, std::abs(y - filtered));
     worst_unfiltered = std::max(worst_unfiltered, std::abs(y - at(k)));
   }
