@@ -1,5 +1,6 @@
 #include "models/preview_inverse.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -41,8 +42,7 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
                                               std::to_string(preview_ticks) + ")");
   }
   // Split the zeros: inside -> causal sections, outside -> the anti-causal series.
-  std::vector<Complex> out;
-  scale_ = 1.0 / stage_.d;
+  std::vector<Complex> out, inside;
   for (Eigen::Index i = 0; i < stage_.zeros.size(); ++i) {
     const Complex z = stage_.zeros(i);
     const double r = std::abs(z);
@@ -53,18 +53,44 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
                                         " Hz and no inverse can restore that");
     }
     if (r < 1.0) {
-      if (z.imag() < 0.0) continue;  // its conjugate makes the section
-      Section s;
-      if (z.imag() == 0.0) {
-        s.a1 = -z.real();
-      } else {
-        s.a1 = -2.0 * z.real();
-        s.a2 = std::norm(z);
-      }
-      section_[static_cast<std::size_t>(sections_++)] = s;
+      if (z.imag() >= 0.0) inside.push_back(z);  // a conjugate pair once
     } else {
       out.push_back(z);
     }
+  }
+  std::vector<Complex> poles;
+  for (Eigen::Index i = 0; i < stage_.poles.size(); ++i) {
+    if (stage_.poles(i).imag() >= 0.0) poles.push_back(stage_.poles(i));
+  }
+  // Second-order sections: each inside zero (the inverse's pole) with the stage's pole nearest to
+  // it (the inverse's zero), those nearest the unit circle first, so that no section's output is
+  // a tiny difference of large numbers (a 16th-order polynomial of poles near the unit circle as
+  // one FIR loses about six digits).
+  std::sort(inside.begin(), inside.end(), [](Complex a, Complex b) { return std::abs(a) > std::abs(b); });
+  std::vector<bool> used(poles.size(), false);
+  auto factor = [](Complex root, double& c1, double& c2) {
+    c1 = root.imag() == 0.0 ? -root.real() : -2.0 * root.real();
+    c2 = root.imag() == 0.0 ? 0.0 : std::norm(root);
+  };
+  for (const Complex z : inside) {
+    Section sec;
+    factor(z, sec.a1, sec.a2);
+    std::size_t best = poles.size();
+    for (std::size_t j = 0; j < poles.size(); ++j) {
+      if (used[j] || (poles[j].imag() == 0.0) != (z.imag() == 0.0)) continue;  // same order
+      if (best == poles.size() || std::abs(poles[j] - z) < std::abs(poles[best] - z)) best = j;
+    }
+    if (best < poles.size()) {
+      used[best] = true;
+      factor(poles[best], sec.b1, sec.b2);
+    }
+    section_[static_cast<std::size_t>(sections_++)] = sec;
+  }
+  for (std::size_t j = 0; j < poles.size(); ++j) {
+    if (used[j]) continue;
+    Section sec;
+    factor(poles[j], sec.b1, sec.b2);
+    section_[static_cast<std::size_t>(sections_++)] = sec;
   }
   outside_ = static_cast<int>(out.size());
   lead_ = stage_.delay_ticks + outside_;
@@ -157,8 +183,6 @@ PreviewStageInverse::PreviewStageInverse(const DiscreteLinearStage& stage, std::
     c_[static_cast<std::size_t>(i)] = v;
   }
   ring_ = static_cast<std::size_t>(preview_ticks + half_) + 1;
-  den_size_ = static_cast<int>(stage_.denominator.size());
-  for (int i = 0; i < den_size_; ++i) den_[static_cast<std::size_t>(i)] = stage_.denominator(i);
   reset(0.0);
 }
 
@@ -169,13 +193,12 @@ void PreviewStageInverse::reset(double y0) noexcept {
   double s = 0.0;
   for (int j = 0; j < c_taps_; ++j) s += c_[static_cast<std::size_t>(j)];
   s *= y0;
-  for (int i = 0; i < den_size_; ++i) s_[static_cast<std::size_t>(i)] = s;
-  double t = 0.0;
-  for (int i = 0; i < den_size_; ++i) t += den_[static_cast<std::size_t>(i)];
-  t *= s;
+  double t = s;
   for (int i = 0; i < sections_; ++i) {
     Section& sec = section_[static_cast<std::size_t>(i)];
-    t /= 1.0 + sec.a1 + sec.a2;
+    sec.x1 = t;
+    sec.x2 = t;
+    t *= (1.0 + sec.b1 + sec.b2) / (1.0 + sec.a1 + sec.a2);
     sec.u1 = t;
     sec.u2 = t;
   }
@@ -195,15 +218,13 @@ double PreviewStageInverse::step(double r_future) noexcept {
     s += c_[static_cast<std::size_t>(j)] * r_[idx];
     idx = idx + 1 == n ? 0 : idx + 1;
   }
-  // The stage's denominator as an FIR over s.
-  for (int i = den_size_ - 1; i > 0; --i) s_[static_cast<std::size_t>(i)] = s_[static_cast<std::size_t>(i) - 1];
-  s_[0] = s;
-  double t = 0.0;
-  for (int i = 0; i < den_size_; ++i) t += den_[static_cast<std::size_t>(i)] * s_[static_cast<std::size_t>(i)];
-  // The inside zeros, causally.
+  // The stage's poles (FIR) and inside zeros (IIR, causal), section by section.
+  double t = s;
   for (int i = 0; i < sections_; ++i) {
     Section& sec = section_[static_cast<std::size_t>(i)];
-    const double u = t - sec.a1 * sec.u1 - sec.a2 * sec.u2;
+    const double u = t + sec.b1 * sec.x1 + sec.b2 * sec.x2 - sec.a1 * sec.u1 - sec.a2 * sec.u2;
+    sec.x2 = sec.x1;
+    sec.x1 = t;
     sec.u2 = sec.u1;
     sec.u1 = u;
     t = u;

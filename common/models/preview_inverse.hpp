@@ -43,8 +43,12 @@
 // preview needed. A zero ON the unit circle (within kMinZeroDistance) is refused: the stage does not
 // pass that frequency and nothing can restore it.
 //
-// Per tick: one dot product over the anti-causal taps (only as many as reach 1e-17), one FIR over
-// the stage's denominator, one IIR section per inside zero; fixed-size, allocation and throw free.
+// Per tick: one dot product over the anti-causal taps (only as many as reach 1e-17), then second-
+// order sections, each pairing an inside zero of the stage (the inverse's pole) with the stage's
+// pole nearest to it (the inverse's zero). Sections rather than one FIR over the stage's
+// denominator and one IIR over the inside zeros: for the sixteen-state stage of the tests (eight
+// modes, |p| ~ 0.99) the worst |y - r| for a 1e-6 reference fell from 4.8e-16 to 3.4e-20.
+// Fixed-size, allocation and throw free.
 //
 // Optional zero-phase low-pass of the reference, reference_bandwidth_hz (DEFAULT 0 = OFF, so that
 // the stage reproduces the reference itself): a symmetric Blackman-windowed sinc of half-length
@@ -101,11 +105,12 @@ class PreviewStageInverse {
   const DiscreteLinearStage& stage() const noexcept { return stage_; }
 
  private:
-  static constexpr int kMaxSections = DiscreteLinearStage::kMaxStates;
+  static constexpr int kMaxSections = 2 * DiscreteLinearStage::kMaxStates;
   static constexpr std::size_t kRing = static_cast<std::size_t>(kMaxPreviewTicks + kMaxLowPassHalfLength) + 1;
 
-  struct Section {  // u_k = x_k - a1 u_{k-1} - a2 u_{k-2}
-    double a1 = 0.0, a2 = 0.0, u1 = 0.0, u2 = 0.0;
+  struct Section {  // u_k = x_k + b1 x_{k-1} + b2 x_{k-2} - a1 u_{k-1} - a2 u_{k-2}
+    double b1 = 0.0, b2 = 0.0, a1 = 0.0, a2 = 0.0;
+    double x1 = 0.0, x2 = 0.0, u1 = 0.0, u2 = 0.0;
   };
 
   DiscreteLinearStage stage_;
@@ -123,9 +128,6 @@ class PreviewStageInverse {
   double scale_ = 1.0;             // 1 / (K prod_o (-z_o))
   std::array<double, kRing> r_{};  // ring of r_{k-M} .. r_{k+N}
   std::size_t head_ = 0;           // where r_{k+N} is
-  int den_size_ = 1;
-  std::array<double, DiscreteLinearStage::kMaxStates + 1> den_{};
-  std::array<double, DiscreteLinearStage::kMaxStates + 1> s_{};  // s_k, s_{k-1}, ... (shifted)
   int sections_ = 0;
   std::array<Section, kMaxSections> section_{};
   double w_prev_ = 0.0;
