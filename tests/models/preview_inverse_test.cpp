@@ -166,6 +166,14 @@ TEST(PreviewStageInverse, WithTheLowPassTheStageReproducesTheFilteredReference) 
   for (int j = 0; j < m; ++j) EXPECT_EQ(g[static_cast<std::size_t>(j)], g[static_cast<std::size_t>(2 * m - j)]);
   for (const double v : g) sum += v;
   EXPECT_NEAR(sum, 1.0, 1e-15);
+  auto response = [&](double hz) {  // zero phase: real
+    double h = 0.0;
+    for (std::size_t i = 0; i < g.size(); ++i) h += g[i] * std::cos(kTwoPi * hz * (static_cast<int>(i) - m) * kDt);
+    return h;
+  };
+  EXPECT_NEAR(response(0.5 * 300.0), 1.0, 1e-3);
+  EXPECT_NEAR(response(300.0), 0.5, 0.01);
+  for (double hz = 1.5 * 300.0; hz <= 5000.0; hz += 7.0) EXPECT_LT(std::abs(response(hz)), 2e-4) << hz;
   EXPECT_LE(inverse0.truncation_error_bound(), 1e-15);
   // The filtered reference, computed here: r before tick 0 is r_0.
   const int n = 12000;
