@@ -26,7 +26,8 @@ double truncation_norm(const std::vector<double>& q, const std::vector<double>& 
   double norm = 0.0;
   for (int p = last + 1; p <= last + m; ++p) {
     double e = 0.0;
-    for (int i = p - last; i <= m; ++i) e += q[static_cast<std::size_t>(i)] * h[static_cast<std::size_t>(p - i)];
+    for (int i = p - last; i <= std::min(m, p); ++i)
+      e += q[static_cast<std::size_t>(i)] * h[static_cast<std::size_t>(p - i)];
     norm += std::abs(e);
   }
   return norm;

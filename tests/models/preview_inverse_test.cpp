@@ -99,6 +99,18 @@ TEST(PreviewStageInverse, ANonMinimumPhaseStageReproducesTheReferenceFromItsPrev
   EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(stage, 0); }), "preview_ticks");
 }
 
+TEST(PreviewStageInverse, TwoZerosOutsideTheUnitCircleAreInvertedFromThePreview) {
+  // (1 - 2 z^-1)(1 - 3 z^-1) / (1 - 0.5 z^-1): the series decays like 2^-j; 1e-17 needs ~57 taps.
+  const DiscreteLinearStage stage = discretise(LinearStageSpec::discrete({1.0, -5.0, 6.0}, {1.0, -0.5}, kDt), kDt);
+  const PreviewStageInverse inverse(stage, kPreview);
+  EXPECT_EQ(inverse.outside_zeros(), 2);
+  EXPECT_GE(inverse.anticausal_taps(), 50);
+  EXPECT_LE(inverse.anticausal_taps(), 65);
+  EXPECT_LE(inverse.truncation_error_bound(), 1e-16);
+  EXPECT_LT(worst_tracking_error(stage, kPreview, 10), 1e-9 * 1.2e-6);
+  EXPECT_EQ(testing::refused_field([&] { PreviewStageInverse(stage, 1); }), "preview_ticks");  // 2 at least
+}
+
 TEST(PreviewStageInverse, TheTruncationBoundFallsWithThePreviewAndAShortPreviewIsRefused) {
   // A zero at z = 1.2: the anti-causal series decays like (1 / 1.2)^j, 1e-12 after about 150 ticks.
   const DiscreteLinearStage stage = discretise(LinearStageSpec::discrete({1.0, -1.2}, {1.0, -0.5}, kDt), kDt);
