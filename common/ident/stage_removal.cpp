@@ -5,8 +5,8 @@
 namespace hystloop {
 
 StageRemoval::StageRemoval(const StageModel& stage, double dt_s)
-    : stage_(stage), dt_s_(dt_s), forward_(stage.has_dynamics() ? stage.second_order : SecondOrderStageParams{}) {
-  if (stage_.has_dynamics()) {
+    : stage_(stage), dt_s_(dt_s), forward_(stage.is_second_order() ? stage.second_order : SecondOrderStageParams{}) {
+  if (stage_.is_second_order()) {
     // w = y + (c/k) y' + y''/k holds for the stage's continuous input, which at the end of tick k
     // (where y_k is) is halfway between w_k and w_{k+1}: the held w_k is that input half a tick
     // earlier, y + (c/k - h) y' + (1/k - (c/k) h + h^2/2) y'' with h = dt/2, less the hold's

@@ -16,7 +16,8 @@
 //    1.4 nm.
 //  - stage then hysteresis (y = H(G(u))): the hysteresis' input is the stage's output, G(u),
 //    the exact sampled stage driven by u (causal, no delay, no noise).
-// Kind none passes the samples through. A break in the stream (reset()) hands out the held
+// Kind none passes the samples through, and so (not yet removed) does a linear stage of any order:
+// a fit behind one reads its dynamics as hysteresis. A break in the stream (reset()) hands out the held
 // sample as measured and starts again; a non-finite sample passes through (the estimator counts
 // it as poison) and is a break too. Allocation- and throw-free after construction.
 
@@ -44,7 +45,7 @@ class StageRemoval {
   // The stream breaks (a gap, a skipped tick): the held sample, if any, as measured.
   std::optional<HysteresisSample> reset() noexcept;
 
-  bool active() const noexcept { return stage_.has_dynamics(); }
+  bool active() const noexcept { return stage_.is_second_order(); }
   // One sample late (hysteresis then stage): feed() returns the sample before.
   bool delays() const noexcept { return active() && stage_.order == BanningOrder::kHysteresisThenStage; }
 

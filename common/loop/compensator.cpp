@@ -18,8 +18,10 @@ std::string si(double value, const char* unit) { return number_text(value, 3) + 
 
 Compensator::Compensator(const CompensatorConfig& config)
     : planner_((config.validate(), config)),
-      // Samples arrive up to the horizon after their tick was planned, plus a block or two.
-      learner_(config.learning, config.dt_s, config.horizon_ticks + 2000) {}
+      // Samples arrive up to the horizon after their tick was planned, plus a block or two; a
+      // stage inverted with preview asks the learning for its correction that much earlier.
+      learner_(config.learning, config.dt_s,
+               config.horizon_ticks + 2000 + (config.stage.is_linear() ? PreviewStageInverse::kMaxPreviewTicks : 0)) {}
 
 void Compensator::observe(const CompensatorInput& sample) noexcept {
   if (const auto y = planner_.observe(sample)) learner_.observe(sample.seq, *y);

@@ -7,7 +7,15 @@
 namespace hystloop {
 
 double resonance_corner_s(const StageModel& stage) noexcept {
-  return stage.has_dynamics() ? 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency() : 0.0;
+  if (stage.is_second_order()) return 2.0 * 2.0 * std::numbers::pi / stage.second_order.natural_frequency();
+  if (!stage.is_linear()) return 0.0;
+  try {
+    // Poles up to 50 kHz sampled without aliasing: |ln z| / dt is the pole's own frequency.
+    const double w = stage.lowest_resonance_rad_s(1e-5);
+    return w > 0.0 ? 2.0 * 2.0 * std::numbers::pi / w : 0.0;
+  } catch (const ParameterError&) {  // validated where it entered: not reached
+    return 0.0;
+  }
 }
 
 void CompensatorConfig::validate() const {

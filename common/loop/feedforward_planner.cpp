@@ -19,12 +19,24 @@ FeedforwardPlanner::FeedforwardPlanner(const CompensatorConfig& config)
 
 void FeedforwardPlanner::set_stage(const StageModel& stage) noexcept {
   stage_model_ = stage;
-  if (stage.has_dynamics()) {
+  stage_inverse_.reset();
+  servo_share_stage_.reset();
+  servo_share_linear_.reset();
+  preview_.reset();
+  preview_ticks_ = 0;
+  if (stage.is_second_order()) {
     stage_inverse_.emplace(stage.second_order, config_.dt_s);  // validated by the caller
     servo_share_stage_.emplace(stage.second_order);
-  } else {
-    stage_inverse_.reset();
-    servo_share_stage_.reset();
+  } else if (stage.is_linear()) {
+    // Validated by the caller (StageModel::validate checks that this preview inverts it), so
+    // nothing here throws; a linear stage arrives from the configuration, not per tick.
+    const DiscreteLinearStage sampled = discretise(stage.linear, config_.dt_s);
+    preview_ticks_ = stage_preview_ticks(sampled, stage.preview_ticks, stage.reference_bandwidth_hz);
+    preview_.emplace(sampled, preview_ticks_, stage.reference_bandwidth_hz);
+    servo_share_linear_.emplace(sampled);
+    if (ahead_.size() < static_cast<std::size_t>(preview_ticks_ + 1)) {
+      ahead_.resize(static_cast<std::size_t>(preview_ticks_ + 1));
+    }
   }
   servo_share_seq_ = -1;
   stage_fresh_ = true;
@@ -224,6 +236,10 @@ double FeedforwardPlanner::servo_share_m(const CompensatorInput& sample) noexcep
   servo_share_seq_ = sample.seq;
   if (!std::isfinite(du)) return 0.0;
   const double w = inverses_.linear_params().gain * du;
+  if (servo_share_linear_) {
+    if (!consecutive) servo_share_linear_->reset(w);
+    return servo_share_linear_->step(w);
+  }
   if (!servo_share_stage_) return w;
   if (!consecutive) servo_share_stage_->reset(w);
   return servo_share_stage_->step(w, config_.dt_s);
@@ -246,6 +262,7 @@ void FeedforwardPlanner::restart_reference(double t_s, double from_m) noexcept {
   inverse_fresh_ = true;
   stage_fresh_ = true;
   learner_restart_ = true;
+  ref_next_ = -1;  // what was planned ahead belongs to the reference before
 }
 
 std::size_t FeedforwardPlanner::plan(std::span<CommandTick> out, PeriodicLearner* learning) noexcept {
@@ -293,8 +310,8 @@ CommandTick FeedforwardPlanner::plan_tick(std::int64_t k, PeriodicLearner* learn
   return tracking_tick(k, learning);
 }
 
-CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* learning) noexcept {
-  const double t = loop_time(k);
+FeedforwardPlanner::ReferencePoint FeedforwardPlanner::reference_tick(std::int64_t k, double t,
+                                                                      PeriodicLearner* learning) noexcept {
   if (trajectory_starts_now_) {
     trajectory_.start_s = t + trajectory_.blend_s;
     trajectory_.hold_m = last_ref_;
@@ -327,25 +344,37 @@ CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* l
       ref = previous_reference_at(t);
     }
   }
+  return ref;
+}
+
+void FeedforwardPlanner::at_reversal(std::int64_t k, PeriodicLearner* learning) noexcept {
+  ++counters_.reversals;
+  const bool held = learning != nullptr && exchange_.held_by_learning(mode_, learning->figures(), config_.learning);
+  if (exchange_.has_pending() && !held) swap_params(k, learning);
+  u_prev_rev_ = last_u_ - exchange_.anchor().u_offset(k);
+}
+
+void FeedforwardPlanner::restart_inverse(double y0) noexcept {
+  reset_inverse(y0);
+  inverse_fresh_ = false;
+  anchor_.reset();
+  FeedforwardAnchor& anchor = exchange_.anchor();
+  if (anchor.measuring()) ++counters_.reanchors_skipped;
+  anchor.reset(0.0);
+  u_prev_rev_ = last_u_;
+}
+
+CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* learning) noexcept {
+  if (preview_) return preview_tick(k, learning);
+  const double t = loop_time(k);
+  const ReferencePoint ref = reference_tick(k, t, learning);
   // The sensor's reference (the servo's, the learning's, the anchor's) and the one the inverses aim
   // the axis's own displacement at: equal but during a decoupled scan.
   const double y_ref = ref.sensor_m;
   const double y_aim = ref.aim_m;
   FeedforwardAnchor& anchor = exchange_.anchor();
-  if (reversals_.update(y_aim) == ReversalDetector::Event::kReversal) {
-    ++counters_.reversals;
-    const bool held = learning != nullptr && exchange_.held_by_learning(mode_, learning->figures(), config_.learning);
-    if (exchange_.has_pending() && !held) swap_params(k, learning);
-    u_prev_rev_ = last_u_ - anchor.u_offset(k);
-  }
-  if (inverse_fresh_) {
-    reset_inverse(y_aim);
-    inverse_fresh_ = false;
-    anchor_.reset();
-    if (anchor.measuring()) ++counters_.reanchors_skipped;
-    anchor.reset(0.0);
-    u_prev_rev_ = last_u_;
-  }
+  if (reversals_.update(y_aim) == ReversalDetector::Event::kReversal) at_reversal(k, learning);
+  if (inverse_fresh_) restart_inverse(y_aim);
   // The reference the inverse aims at: with what the learning has found this point of the period
   // needs, and, for hysteresis then stage, through the stage's inverse first.
   const double correction = learning != nullptr ? learning->correction(k, y_ref) : 0.0;
@@ -367,6 +396,13 @@ CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* l
     }
     u = stage_inverse_->step(u);
   }
+  last_ref_ = y_ref;
+  return command(k, u, y_ref, correction, w_ref, shift_V, learning);
+}
+
+CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, double correction, double w_ref,
+                                        double shift_V, PeriodicLearner* learning) noexcept {
+  FeedforwardAnchor& anchor = exchange_.anchor();
   if (!std::isfinite(u)) {  // never hand a non-finite voltage on
     ++counters_.nonfinite_outputs;
     u = last_u_;
@@ -409,10 +445,58 @@ CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* l
   // The anchor compares the measured position with the reference the model was asked for (not
   // the learned correction: what the learning adds is meant to make y follow y_ref).
   anchor.planned(k, y_ref - shift_m_, u - shift_V);
-  last_ref_ = y_ref;
   last_w_ = w_ref;
   last_u_ = u;
   return {k, u, y_ref, exchange_.version(), static_cast<std::int8_t>(mode_)};
+}
+
+void FeedforwardPlanner::plan_reference(std::int64_t j, PeriodicLearner* learning, bool start_inverse) noexcept {
+  const ReferencePoint ref = reference_tick(j, loop_time(j), learning);
+  PlannedReference& p = ahead(j);
+  p.y_ref = ref.sensor_m;
+  p.y_aim = ref.aim_m;
+  p.reversal = reversals_.update(ref.aim_m) == ReversalDetector::Event::kReversal;
+  p.correction = learning != nullptr ? learning->correction(j, ref.sensor_m) : 0.0;
+  p.w = p.y_aim;  // until the inverse's output for this tick arrives, preview_ticks later
+  last_ref_ = ref.sensor_m;
+  const double r = p.y_aim + p.correction;
+  if (start_inverse) preview_->reset(r);
+  // The inverse's output is the stage input of the tick preview_ticks back.
+  const double w = preview_->step(r);
+  if (j - preview_ticks_ >= 0) ahead(j - preview_ticks_).w = w;
+}
+
+CommandTick FeedforwardPlanner::preview_tick(std::int64_t k, PeriodicLearner* learning) noexcept {
+  bool start_inverse = false;
+  if (ref_next_ < k) {
+    // The reference side starts at this tick (a new reference, the first, or the plan fell behind
+    // the bridge): the inverse at rest at its first point, its outputs before this tick unused.
+    ref_next_ = k;
+    start_inverse = true;
+  } else if (stage_fresh_ && ref_next_ == k) {
+    start_inverse = true;  // a stage without preview: nothing planned ahead to feed again
+  } else if (stage_fresh_) {
+    // A new stage under a reference already planned ahead: the inverse restarted at rest and fed
+    // what was planned, so that its output reaches this tick again.
+    preview_->reset(ahead(k).y_aim + ahead(k).correction);
+    for (std::int64_t j = k; j < ref_next_; ++j) {
+      const double w = preview_->step(ahead(j).y_aim + ahead(j).correction);
+      if (j - preview_ticks_ >= k) ahead(j - preview_ticks_).w = w;
+    }
+  }
+  stage_fresh_ = false;
+  for (; ref_next_ <= k + preview_ticks_; ++ref_next_) {
+    plan_reference(ref_next_, learning, start_inverse);
+    start_inverse = false;
+  }
+  const PlannedReference p = ahead(k);
+  if (p.reversal) at_reversal(k, learning);
+  if (inverse_fresh_) restart_inverse(p.w);
+  FeedforwardAnchor& anchor = exchange_.anchor();
+  shift_m_ = anchor.y_offset(k);
+  const double shift_V = anchor.u_offset(k);
+  const double u = feedforward(p.w - shift_m_) + shift_V;
+  return command(k, u, p.y_ref, p.correction, p.w, shift_V, learning);
 }
 
 }  // namespace hystloop

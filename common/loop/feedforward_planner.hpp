@@ -20,6 +20,7 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "core/sequence_gap_detector.hpp"
 #include "core/ticks.hpp"
@@ -31,6 +32,8 @@
 #include "loop/periodic_learner.hpp"
 #include "loop/scan_path.hpp"
 #include "loop/trajectory.hpp"
+#include "models/linear_stage.hpp"
+#include "models/preview_inverse.hpp"
 #include "models/reversal_detector.hpp"
 #include "models/second_order_stage.hpp"
 #include "models/stage_inverse.hpp"
@@ -119,8 +122,34 @@ class FeedforwardPlanner {
   const TrajectorySpec& periodic_reference() const noexcept;
   void restart_learning(std::int64_t k, PeriodicLearner& learning) noexcept;
   CommandTick tracking_tick(std::int64_t k, PeriodicLearner* learning) noexcept;
+  // The reference of tick k at t: the trajectory started, learning restarted and a path's lines
+  // ended where due, the reference before faded out while a new approach lasts.
+  ReferencePoint reference_tick(std::int64_t k, double t, PeriodicLearner* learning) noexcept;
+  // With a stage inverted with preview (a linear stage): the reference side runs preview_ticks
+  // ahead of the commands. plan_reference plans reference tick j (the trajectory, the learning's
+  // correction, reversals) and feeds the preview inverse, whose output is the stage input of tick
+  // j - preview; preview_tick plans command tick k from what was planned for it.
+  struct PlannedReference {
+    double y_ref = 0.0;       // the sensor's reference
+    double y_aim = 0.0;       // what the inverses aim the axis's own displacement at
+    double correction = 0.0;  // the learning's
+    double w = 0.0;           // the stage's input for this tick (the hysteresis model's target)
+    bool reversal = false;    // of the reference, at this tick
+  };
+  PlannedReference& ahead(std::int64_t j) noexcept {
+    return ahead_[static_cast<std::size_t>(j % static_cast<std::int64_t>(ahead_.size()))];
+  }
+  void plan_reference(std::int64_t j, PeriodicLearner* learning, bool start_inverse) noexcept;
+  CommandTick preview_tick(std::int64_t k, PeriodicLearner* learning) noexcept;
+  // The stage input u (after the hysteresis inverse) of tick k made safe, counted and recorded.
+  CommandTick command(std::int64_t k, double u, double y_ref, double correction, double w_ref, double shift_V,
+                      PeriodicLearner* learning) noexcept;
   double feedforward(double y_ref) noexcept;
   void reset_inverse(double y0) noexcept;
+  // A reversal of the reference at tick k: the waiting set swapped in (unless learning holds it).
+  void at_reversal(std::int64_t k, PeriodicLearner* learning) noexcept;
+  // The inverse starts afresh at y0 (a new mode or reference), the anchor's offsets dropped.
+  void restart_inverse(double y0) noexcept;
   void restart_reference(double t_s, double from_m) noexcept;
   void swap_params(std::int64_t k, PeriodicLearner* learning) noexcept;  // at a reversal: the waiting set in
   // Restarts `mode`'s inverse at this reversal (u_rev, model coordinates) without a step; returns
@@ -155,11 +184,17 @@ class FeedforwardPlanner {
   // The stage driven by the servo's share of the voltage (u_V - u_ff_V, times the linear gain):
   // where the servo has moved the stage, which the learning adds back to the measured error.
   std::optional<SecondOrderStage> servo_share_stage_;
-  std::int64_t servo_share_seq_ = -1;  // the last sample it was stepped with
-  bool learner_restart_ = true;        // the trajectory or its start changed: restart learning at the next tick
-  bool learning_room_ = true;          // the trajectory leaves room for learning's corrections
-  double last_w_ = 0.0;                // the stage-inverted reference last planned (the hysteresis model's target)
-  PlanExtent extent_{};                // of the tracking ticks planned (dry runs read it)
+  std::optional<LinearStageSimulator> servo_share_linear_;
+  // A linear stage: its inverse with preview, and the reference planned ahead of the commands.
+  std::optional<PreviewStageInverse> preview_;
+  std::int64_t preview_ticks_ = 0;
+  std::vector<PlannedReference> ahead_;  // a ring over preview_ticks_ + 1 ticks
+  std::int64_t ref_next_ = -1;           // the next reference tick to plan (-1: start at the next command)
+  std::int64_t servo_share_seq_ = -1;    // the last sample it was stepped with
+  bool learner_restart_ = true;          // the trajectory or its start changed: restart learning at the next tick
+  bool learning_room_ = true;            // the trajectory leaves room for learning's corrections
+  double last_w_ = 0.0;                  // the stage-inverted reference last planned (the hysteresis model's target)
+  PlanExtent extent_{};                  // of the tracking ticks planned (dry runs read it)
   double last_u_wanted_ = std::numeric_limits<double>::quiet_NaN();  // the last tick's u before any clamp
   ExperimentQueue experiments_;
   ReversalDetector reversals_;

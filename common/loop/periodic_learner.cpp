@@ -51,6 +51,7 @@ void LearningConfig::validate(double dt_s) const {
   require_in_range("learning.fade_s", fade_s, dt_s, 10.0);
   require_in_range("learning.blend_s", blend_s, 0.0, 1.0);
   if (hold_params_after < 0) throw ParameterError("learning.hold_params_after", "must be >= 0 (0: never hold)");
+  if (monitor_ratio != 0.0) require_in_range("learning.monitor_ratio", monitor_ratio, 1.0, 100.0);
 }
 
 PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std::int64_t max_lag_ticks)
@@ -59,7 +60,8 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
       applied_weight_(config.lag_compensated ? config.gain : 1.0),
       max_correction_m_(config.max_correction_m),
       lag_compensated_(config.lag_compensated),
-      enabled_(config.enabled) {
+      enabled_(config.enabled),
+      monitor_ratio_(config.monitor_ratio) {
   config.validate(dt_s);
   require_in_range("learning.max_lag_ticks", static_cast<double>(max_lag_ticks), 0.0, 1e6);
   max_period_ = static_cast<std::int64_t>(std::floor(config.max_period_s / dt_s + 1e-9));
@@ -80,7 +82,9 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
   ring_r_.assign(ring, 0.0);
   ring_c_.assign(ring, 0.0);
   ring_held_.assign(ring, 0);
-  for (auto* v : {&table_, &next_, &prev_, &acc_, &tmp_}) v->assign(static_cast<std::size_t>(max_period_), 0.0);
+  for (auto* v : {&table_, &next_, &prev_, &acc_, &tmp_, &applied_, &good_}) {
+    v->assign(static_cast<std::size_t>(max_period_), 0.0);
+  }
 }
 
 double PeriodicLearner::filter_null_hz() const noexcept { return 1.0 / (static_cast<double>(window_) * dt_s_); }
@@ -97,6 +101,7 @@ std::size_t PeriodicLearner::slot(std::int64_t k) const noexcept {
 }
 
 void PeriodicLearner::restart(std::int64_t k0, std::int64_t period_ticks) noexcept {
+  stopped_by_monitor_ = false;
   has_target_ = period_ticks >= 2 && period_ticks <= max_period_;
   k0_ = k0;
   n_ = has_target_ ? period_ticks : 0;
@@ -104,6 +109,7 @@ void PeriodicLearner::restart(std::int64_t k0, std::int64_t period_ticks) noexce
 }
 
 void PeriodicLearner::stop() noexcept {
+  stopped_by_monitor_ = false;
   has_target_ = false;
   n_ = 0;
   begin_again();
@@ -112,17 +118,21 @@ void PeriodicLearner::stop() noexcept {
 void PeriodicLearner::set_enabled(bool on) noexcept {
   if (on == enabled_) return;
   enabled_ = on;
+  stopped_by_monitor_ = false;
   begin_again();
 }
 
-void PeriodicLearner::reset() noexcept { begin_again(); }
+void PeriodicLearner::reset() noexcept {
+  stopped_by_monitor_ = false;
+  begin_again();
+}
 
 void PeriodicLearner::begin_again() noexcept {
   // Whatever was being observed or waiting belongs to what is being forgotten.
   pending_ = false;
   cur_open_ = false;
   figures_.period_ticks = n_;
-  if (mode_ == Mode::kLearning && have_table_) {
+  if ((mode_ == Mode::kLearning || mode_ == Mode::kHolding) && have_table_) {
     // A table in use is faded out, never dropped: dropping it would step the reference.
     mode_ = Mode::kFading;
     scale_ = 1.0;
@@ -145,7 +155,13 @@ void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
   table_rms_m_ = 0.0;
   figures_.correction_rms_m = 0.0;
   figures_.tables_this_line = 0;
-  if (!enabled_ || !has_target_) {
+  baseline_rms_m_ = 0.0;
+  best_rms_m_ = 0.0;
+  have_good_ = false;
+  figures_.baseline_rms_m = 0.0;
+  figures_.best_rms_m = 0.0;
+  figures_.diverged = stopped_by_monitor_;
+  if (!enabled_ || !has_target_ || stopped_by_monitor_) {
     mode_ = Mode::kIdle;
   } else {
     mode_ = Mode::kLearning;
@@ -193,6 +209,8 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
   } else if (mode_ == Mode::kFading) {
     c = scale_ * in_use(k, phase(k));
     figures_.correction_rms_m = scale_ * table_rms_m_;
+  } else if (mode_ == Mode::kHolding && k >= table_k0_) {
+    c = in_use(k, phase(k));
   }
   const std::size_t s = slot(k);
   ring_k_[s] = k;
@@ -239,6 +257,7 @@ void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
     cur_ok_ = k == start;
     cur_sum_sq_ = 0.0;
     cur_max_ = 0.0;
+    cur_under_table_ = false;
   } else if (k != cur_next_) {
     cur_ok_ = false;
   }
@@ -252,6 +271,8 @@ void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
     acc_[static_cast<std::size_t>(k - start)] = applied_weight_ * ring_c_[s] + (ring_held_[s] != 0 ? 0.0 : gain_ * e);
     cur_sum_sq_ += e * e;
     cur_max_ = std::max(cur_max_, std::abs(e));
+    applied_[static_cast<std::size_t>(k - start)] = ring_c_[s];
+    cur_under_table_ = cur_under_table_ || ring_c_[s] != 0.0;
   } else {
     // No sample, or its slot was planned over (later than max_lag_ticks): the period has a hole.
     cur_ok_ = false;
@@ -265,11 +286,51 @@ void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
       ++figures_.periods_learned;
       figures_.last_error_rms_m = std::sqrt(cur_sum_sq_ / static_cast<double>(table_n_));
       figures_.last_error_max_m = cur_max_;
-      learn_from_period();
+      if (monitor(figures_.last_error_rms_m)) learn_from_period();
     } else {
       account_skipped(1);
     }
   }
+}
+
+bool PeriodicLearner::monitor(double e_rms_m) noexcept {
+  if (monitor_ratio_ == 0.0) return true;
+  if (!cur_under_table_) {
+    // The line's own error, nothing learned applied: its first such period is the baseline.
+    if (baseline_rms_m_ == 0.0) baseline_rms_m_ = figures_.baseline_rms_m = e_rms_m;
+    return true;
+  }
+  if (baseline_rms_m_ == 0.0) return true;  // a fade from the line before: nothing to compare with
+  if (e_rms_m < baseline_rms_m_ && (!have_good_ || e_rms_m < best_rms_m_)) {
+    best_rms_m_ = figures_.best_rms_m = e_rms_m;
+    std::swap(applied_, good_);  // the corrections of this period: the table to fall back to
+    have_good_ = true;
+  }
+  if (!(e_rms_m > monitor_ratio_ * baseline_rms_m_)) return true;
+  ++figures_.divergences;
+  figures_.diverged = true;
+  stopped_by_monitor_ = true;
+  pending_ = false;
+  cur_open_ = false;
+  if (have_good_) {
+    // Hold the best period's corrections, taking over from the table in use along the blend.
+    std::swap(prev_, table_);
+    std::swap(table_, good_);
+    have_prev_ = have_table_;
+    have_table_ = true;
+    adopted_k_ = last_planned_ + 1;
+    blend_n_ = std::max<std::int64_t>(1, std::min(std::max(blend_ticks_, fade_ticks_), table_n_));
+    double sum_sq = 0.0;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(table_n_); ++i) sum_sq += table_[i] * table_[i];
+    table_rms_m_ = std::sqrt(sum_sq / static_cast<double>(table_n_));
+    figures_.correction_rms_m = table_rms_m_;
+    mode_ = Mode::kHolding;
+    figures_.active = false;
+    figures_.fading = false;
+  } else {
+    begin_again();  // fades the table in use out; the learning stays off for this line
+  }
+  return false;
 }
 
 void PeriodicLearner::learn_from_period() noexcept {

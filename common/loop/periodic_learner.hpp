@@ -108,6 +108,16 @@
 // reference, not in volts, so it means the same to the new inverse as to the old one; what the
 // swap changed in the error is a new repeating error, which the following periods learn away.
 //
+// Learning that makes things worse is stopped. The model the inverse uses may be wrong where Q is
+// not small (a mode off in frequency, a delay left out, a gain far off), and then |1 - T| exceeds
+// the bound above and the tables grow period after period; the clamp at max_correction_m only
+// bounds the damage. So each line's first period learned without a table is its learning-off error
+// (the baseline), and a period learned under a table whose error RMS exceeds monitor_ratio times
+// the baseline ends the learning of that line: the table it falls back to is the corrections that
+// were applied over its best period (when that period was better than the baseline), held as they
+// are, or none (faded out). It is counted (divergences) and shown (diverged, until the line is
+// restarted, reset or learning is turned on again), and it does not learn that line again.
+//
 // Everything is allocated in the constructor; correction(), observe() and the state changes are
 // noexcept and allocate, lock and log nothing.
 
@@ -136,6 +146,9 @@ struct LearningConfig {
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;
+  // A period learned under a table with an error RMS above this many times the line's learning-off
+  // error stops the learning of that line (see above); 0: never.
+  double monitor_ratio = 1.05;
   // Throws ParameterError naming the field ("learning.gain", ...).
   void validate(double dt_s) const;
 };
@@ -153,6 +166,10 @@ struct LearnerFigures {
   double correction_rms_m = 0.0;        // of the table in use (0 when none)
   bool active = false;                  // learning a period (false: idle or fading out)
   bool fading = false;
+  std::uint64_t divergences = 0;  // lines whose learning the monitor stopped
+  bool diverged = false;          // the line's learning was stopped by the monitor (holding or faded)
+  double baseline_rms_m = 0.0;    // the line's learning-off error RMS (0: not measured yet)
+  double best_rms_m = 0.0;        // its best period under a table (0: none yet)
   std::int64_t period_ticks = 0;  // of the periodic reference (0: none, or refused)
 };
 
@@ -200,12 +217,16 @@ class PeriodicLearner {
   bool lag_compensated() const noexcept { return lag_compensated_; }
 
  private:
-  enum class Mode : std::uint8_t { kIdle, kLearning, kFading };
+  // kHolding: the monitor stopped the learning and holds the best table as it is.
+  enum class Mode : std::uint8_t { kIdle, kLearning, kFading, kHolding };
 
   void begin_again() noexcept;                        // the target changed: fade out or start at once
   void start_learning(std::int64_t from_k) noexcept;  // zero table, first period at or after from_k
   void learn_from_period() noexcept;                  // acc_ -> next_ (filter, clamp)
   void account_skipped(std::uint64_t n) noexcept;
+  // A period learned with error RMS e: the baseline, the best table, or the end of the learning.
+  // Returns false when the learning of the line ends here.
+  bool monitor(double e_rms_m) noexcept;
   std::int64_t phase(std::int64_t k) const noexcept;             // of k in the table's period [0, n)
   double in_use(std::int64_t k, std::int64_t i) const noexcept;  // table_ at phase i, blended at tick k
   std::size_t slot(std::int64_t k) const noexcept;
@@ -242,6 +263,13 @@ class PeriodicLearner {
   std::int64_t cur_start_ = 0, cur_next_ = 0, expect_start_ = 0,
                last_observed_ = std::numeric_limits<std::int64_t>::min();
   double cur_sum_sq_ = 0.0, cur_max_ = 0.0;
+  bool cur_under_table_ = false;  // a correction was applied in the period being observed
+
+  // The monitor: its ratio (0: off), the line's baseline and best period, and that period's table.
+  double monitor_ratio_;
+  double baseline_rms_m_ = 0.0, best_rms_m_ = 0.0;
+  bool have_good_ = false, stopped_by_monitor_ = false;
+  std::vector<double> applied_, good_;  // per phase: c_applied in the period being observed, in the best
 
   // Per planned tick (ring over the lag): which tick the slot holds, its r_k and applied c_k.
   std::vector<std::int64_t> ring_k_;

@@ -1,5 +1,7 @@
 #include "models/stage_inverse.hpp"
 
+#include "models/preview_inverse.hpp"
+
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -33,9 +35,66 @@ DiscreteStage discretise_zoh(const SecondOrderStageParams& stage, double dt_s) {
 
 void StageModel::validate(double dt_s) const {
   if (kind == Kind::kNone) return;
-  if (kind != Kind::kSecondOrder) throw ParameterError("stage.kind", "must be none or second_order");
+  if (kind == Kind::kLinear) {
+    linear.validate(dt_s);
+    if (order != BanningOrder::kHysteresisThenStage) {
+      throw ParameterError("stage.order",
+                           "a linear stage is inverted with the reference's preview, ahead of the "
+                           "hysteresis inverse: only hysteresis_then_stage");
+    }
+    require_in_range("stage.preview_ticks", static_cast<double>(preview_ticks), 0.0,
+                     static_cast<double>(PreviewStageInverse::kMaxPreviewTicks));
+    if (reference_bandwidth_hz != 0.0) require_positive("stage.reference_bandwidth_hz", reference_bandwidth_hz);
+    validate_within("stage.",
+                    [&] { stage_preview_ticks(discretise(linear, dt_s), preview_ticks, reference_bandwidth_hz); });
+    return;
+  }
+  if (kind != Kind::kSecondOrder) throw ParameterError("stage.kind", "must be none, second_order or linear");
   validate_within("stage.", [&] { second_order.validate(); });
   const StageInverse check(second_order, dt_s);
+}
+
+double StageModel::lowest_resonance_rad_s(double dt_s) const {
+  if (kind == Kind::kSecondOrder) return second_order.natural_frequency();
+  if (kind != Kind::kLinear) return 0.0;
+  // From the sampled stage's complex poles: omega_n = |ln z| / dt = |p| for z = e^{p dt} (the delay
+  // moves no pole, and is left out so that a fine dt_s is never refused for it).
+  LinearStageSpec no_delay = linear;
+  no_delay.delay_s = 0.0;
+  const DiscreteLinearStage d = discretise(no_delay, dt_s);
+  double lowest = 0.0;
+  for (const auto& p : d.poles) {
+    if (std::abs(p.imag()) < 1e-12 || std::abs(p) == 0.0) continue;
+    const double w = std::abs(std::log(p)) / dt_s;
+    if (lowest == 0.0 || w < lowest) lowest = w;
+  }
+  return lowest;
+}
+
+std::int64_t stage_preview_ticks(const DiscreteLinearStage& stage, std::int64_t wanted, double reference_bandwidth_hz) {
+  if (wanted > 0) {
+    const PreviewStageInverse check(stage, wanted, reference_bandwidth_hz);  // throws naming the preview needed
+    return wanted;
+  }
+  // The shortest preview that is accepted: acceptance grows with the preview, so bisect.
+  const auto accepted = [&](std::int64_t n) {
+    try {
+      const PreviewStageInverse check(stage, n, reference_bandwidth_hz);
+      return true;
+    } catch (const ParameterError&) {
+      return false;
+    }
+  };
+  std::int64_t hi = PreviewStageInverse::kMaxPreviewTicks;
+  if (!accepted(hi)) {
+    const PreviewStageInverse check(stage, hi, reference_bandwidth_hz);  // throws the reason
+  }
+  std::int64_t lo = -1;  // refused (or below the range)
+  while (hi - lo > 1) {
+    const std::int64_t mid = lo + (hi - lo) / 2;
+    (mid >= 0 && accepted(mid) ? hi : lo) = mid;
+  }
+  return hi;
 }
 
 StageInverse::StageInverse(const SecondOrderStageParams& stage, double dt_s)

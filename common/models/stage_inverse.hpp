@@ -30,6 +30,7 @@
 #include <cstdint>
 
 #include "models/banning_stage.hpp"
+#include "models/linear_stage.hpp"
 #include "models/second_order_stage.hpp"
 
 namespace hystloop {
@@ -50,18 +51,36 @@ struct DiscreteStage {
 DiscreteStage discretise_zoh(const SecondOrderStageParams& stage, double dt_s);
 
 // The stage a feedforward inverts beside the hysteresis: none (a plant without dynamics, such as
-// the Ramberg-Osgood backend) or Banning's second order, in either order.
+// the Ramberg-Osgood backend), Banning's second order in either order (inverted causally, below),
+// or a linear stage of any order with an input delay (models/linear_stage.hpp: the forms a lab's
+// identification prints), inverted with the plan's preview (models/preview_inverse.hpp), in the
+// order hysteresis then stage only: the preview runs the reference ahead of the hysteresis inverse.
 struct StageModel {
-  enum class Kind : std::int8_t { kNone = 0, kSecondOrder = 1 };
+  enum class Kind : std::int8_t { kNone = 0, kSecondOrder = 1, kLinear = 2 };
   Kind kind = Kind::kNone;
   SecondOrderStageParams second_order{};
+  LinearStageSpec linear{};
   BanningOrder order = BanningOrder::kHysteresisThenStage;
+  // kLinear: the reference's preview the inverse takes (0: the shortest that meets the inverse's
+  // truncation bound), and its optional zero-phase low-pass (0: off; PreviewStageInverse).
+  std::int64_t preview_ticks = 0;
+  double reference_bandwidth_hz = 0.0;
 
-  bool has_dynamics() const noexcept { return kind == Kind::kSecondOrder; }
+  bool has_dynamics() const noexcept { return kind != Kind::kNone; }
+  bool is_second_order() const noexcept { return kind == Kind::kSecondOrder; }
+  bool is_linear() const noexcept { return kind == Kind::kLinear; }
   // Throws ParameterError naming "stage.k", "stage.c" (also when it cannot be inverted stably
-  // at tick dt_s, see StageInverse).
+  // at tick dt_s, see StageInverse), or the linear stage's field ("stage.poles[1]", "stage.delay_s",
+  // "stage.preview_ticks" when the preview is too short to invert it).
   void validate(double dt_s) const;
+  // The stage's lowest resonance [rad/s] (0: none): what corner roundings and servo notches start from.
+  double lowest_resonance_rad_s(double dt_s) const;
 };
+
+// The preview a linear stage's inverse needs at tick dt_s: `wanted` when it is enough (throws the
+// inverse's ParameterError naming the preview needed otherwise), or with wanted 0 the shortest that
+// meets the truncation bound (throws when none up to PreviewStageInverse::kMaxPreviewTicks does).
+std::int64_t stage_preview_ticks(const DiscreteLinearStage& stage, std::int64_t wanted, double reference_bandwidth_hz);
 
 class StageInverse {
  public:

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "compensator/compensator_service.hpp"
+#include "runtime/stage_config.hpp"
 #include "compensator/scan_message.hpp"
 #include "compensator/trajectory_message.hpp"
 #include "core/clock.hpp"
@@ -173,15 +174,17 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
                         experimenting < 0    ? std::string()
                         : settings_.axes > 1 ? fmt::format(", experiment running on {}", axis_name(experimenting))
                                              : std::string(", experiment running"));
-  if (c.stage().has_dynamics()) {
-    detail += fmt::format("; stage {:.4g} Hz zeta {:.3g} inverted",
-                          c.stage().second_order.natural_frequency() / (2.0 * std::numbers::pi),
-                          c.stage().second_order.damping_ratio());
-  }
+  if (c.stage().has_dynamics()) detail += "; stage " + describe_stage(c.stage(), c.config().dt_s);
   const LearnerFigures& learner = c.learner().figures();
   if (learner.active) {
     detail += fmt::format("; learning a {}-tick period ({} periods learned, last {:.3g} nm RMS)", learner.period_ticks,
                           learner.periods_learned, learner.last_error_rms_m * 1e9);
+  }
+  if (learner.diverged) {
+    detail += fmt::format(
+        "; learning stopped: it made the line's error worse than without (a period at more than "
+        "{} x the {:.3g} nm RMS without learning), the best table held",
+        c.config().learning.monitor_ratio, learner.baseline_rms_m * 1e9);
   }
   for (int a = 1; a < settings_.axes; ++a) {  // the other axes' sets and learning, each in a few words
     const Compensator& law = *laws_[static_cast<std::size_t>(a)];

@@ -213,10 +213,6 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "actuator.u_min_V",
                                   "actuator.u_max_V",
                                   "actuator.slew_V_per_s",
-                                  "stage.kind",
-                                  "stage.k",
-                                  "stage.c",
-                                  "stage.order",
                                   "learning.enabled",
                                   "learning.gain",
                                   "learning.cutoff_hz",
@@ -262,6 +258,8 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "scan.duration_s",
                                   "scan.centre_m"};
     OnlineModels::for_each([&]<class D>() { append_config_keys(k, D::name, D::table()); });
+    for (std::string& key : stage_config_keys()) k.push_back(std::move(key));
+    k.emplace_back("learning.monitor_ratio");
     return k;
   }();
   return keys;
@@ -324,6 +322,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   l.fade_s = config.get_positive("learning.fade_s", l.fade_s);
   l.blend_s = config.get_in_range("learning.blend_s", l.blend_s, 0.0, 1.0);
   l.hold_params_after = config.get_int_in_range("learning.hold_params_after", l.hold_params_after, 0, 1'000'000);
+  l.monitor_ratio = config.get_non_negative("learning.monitor_ratio", l.monitor_ratio);
   validate_config_section(config, "", [&] { l.validate(c.dt_s); });  // its fields are named learning.*
 
   const double horizon_s =
@@ -390,11 +389,9 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
       "actuator: u in [{}, {}] V, slew {:.4g} V/s (an experiment uses at most {:.0f} % of it, a trajectory {:.0f} %)",
       c.u_min_V, c.u_max_V, c.slew_V_per_s, 100.0 * c.plan_slew_fraction, 100.0 * c.tracking_slew_fraction()));
   if (c.stage.has_dynamics()) {
-    lines.push_back(fmt::format(
-        "stage: second order k {:.6g} 1/s^2, c {:.6g} 1/s ({:.4g} Hz, zeta {:.3g}), {}, inverted",
-        c.stage.second_order.k, c.stage.second_order.c,
-        c.stage.second_order.natural_frequency() / (2.0 * 3.141592653589793), c.stage.second_order.damping_ratio(),
-        c.stage.order == BanningOrder::kHysteresisThenStage ? "hysteresis then stage" : "stage then hysteresis"));
+    lines.push_back(
+        "stage: " + describe_stage(c.stage, c.dt_s) + ", " +
+        (c.stage.order == BanningOrder::kHysteresisThenStage ? "hysteresis then stage" : "stage then hysteresis"));
   } else {
     lines.push_back("stage: none (the hysteresis inverse alone)");
   }

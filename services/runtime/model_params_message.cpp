@@ -73,7 +73,9 @@ void set_model(model_params_t& msg, const ModelParamSet& set) {
   msg.stage_kind = model_params_t::STAGE_UNCHANGED;
   msg.stage_k = msg.stage_c = 0.0;
   msg.stage_order = model_params_t::ORDER_HYSTERESIS_THEN_STAGE;
-  if (set.stage) {
+  // A linear stage of any order is not carried (the message has Banning's k and c): the receiver
+  // keeps the stage it has, which a linear one comes from its configuration.
+  if (set.stage && !set.stage->is_linear()) {
     msg.stage_kind = set.stage->has_dynamics() ? model_params_t::STAGE_SECOND_ORDER : model_params_t::STAGE_NONE;
     if (set.stage->has_dynamics()) {
       msg.stage_k = set.stage->second_order.k;

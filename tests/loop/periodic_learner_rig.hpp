@@ -35,9 +35,12 @@ inline constexpr double kLearnDt = 1e-4;
 // The learner with its tables adopted in one step at the boundary (blend_s = 0): the tables in
 // use are then exactly what the update's recursion says, which is what these tests check. The
 // deployed blend is tested on its own (PeriodicLearner.ANewTableTakesOverAlongTheBlend).
+// The monitor is off: these tests check the update's own recursion, whatever it does (the monitor,
+// which ends a line's learning when it makes the error worse, is tested in learning_monitor_test).
 inline LearningConfig stepwise() {
   LearningConfig c;
   c.blend_s = 0.0;
+  c.monitor_ratio = 0.0;
   return c;
 }
 inline constexpr std::int64_t kHorizon = 500;
