@@ -156,7 +156,9 @@ ConfigError::ConfigError(std::string source, std::string field, const std::strin
 
 const std::string& Config::Impl::source_for(std::string_view path) const {
   for (const auto& key : overridden) {
-    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key && path[key.size()] == '.')) {
+    // A key below it, or an entry of its list ("gains[1]"), came from the override too.
+    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key &&
+                        (path[key.size()] == '.' || path[key.size()] == '['))) {
       return kOverrideSource;
     }
   }
