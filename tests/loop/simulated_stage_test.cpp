@@ -14,6 +14,7 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "support/allocation_counter.hpp"
 
 namespace hystloop {
 namespace {
@@ -154,6 +155,20 @@ TEST(SimulatedStageSeries, RefusesAnotherTickAndNonFiniteInputWithNaN) {
   SimulatedStage fresh(two_mode());
   EXPECT_EQ(fresh.step(50.0, 0.0, 1e-4), y1);
   EXPECT_EQ(stage.step(60.0, 1e-4, 1e-4), fresh.step(60.0, 1e-4, 1e-4));
+}
+
+TEST(SimulatedStageSeries, StepsWithoutAllocating) {
+  for (HysteresisPlantKind kind :
+       {HysteresisPlantKind::coleman_hodgdon, HysteresisPlantKind::pi, HysteresisPlantKind::bouc_wen}) {
+    SimulatedStageConfig c = two_mode(kind);
+    c.noise_rms_m = 1e-9;
+    SimulatedStage stage(c);
+    double sum = 0.0;
+    const testing::AllocationCounter counter;
+    for (int k = 0; k < 2000; ++k) sum += stage.step(sweep_u(k), k * 1e-4, 1e-4);
+    EXPECT_EQ(counter.allocations(), 0U) << to_string(kind);
+    EXPECT_TRUE(std::isfinite(sum));
+  }
 }
 
 std::string refused_field(const SimulatedStageConfig& c) {
