@@ -72,9 +72,12 @@ FeedbackGains load_servo(const Config& config, int axis, FeedbackGains g, const 
 
 // The series plant's hysteresis: plant.hysteresis.kind names the model; every model's section
 // plant.hysteresis.<kind>.* is read and validated whatever the kind (as banning.* and ro.* are
-// whatever the backend: one file serves them all). MEM's and the linear spring's through their
-// parameter tables (the names hystloop-identify writes). PI and Katalenic, whose tables hold lists
-// that this file cannot show for every kind at once, are not read from the bridge's file yet.
+// whatever the backend: one file serves them all). MEM's, PI's, Katalenic's and the linear
+// spring's through their parameter tables (the names hystloop-identify writes), but for their
+// lists: PI is the project's baseline (count plays over range_V, weights matched to the default
+// MEM) and Katalenic's shaping is linear or tanh, as a list could not be shown for every kind in
+// one file and still be refused when malformed. Explicit PI weights and polynomial shaping run in
+// the in-process simulation (SimulatedStageConfig::hysteresis).
 constexpr const char* kColemanHodgdonKeys[] = {"a", "b", "alpha", "s_max"};
 constexpr const char* kBoucWenKeys[] = {"d", "alpha", "beta", "gamma", "n", "rk4_substeps"};
 constexpr const char* kStageKeys[] = {"modes",         "zeros_hz",       "poles_hz",         "numerator_s",
@@ -88,10 +91,6 @@ HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
   validate_config_section(config, kHysteresisPrefix, [&] {
     h.kind = hysteresis_plant_kind_from_name(config.get<std::string>(kind_key, "coleman_hodgdon"), "kind");
   });
-  if (h.kind == HysteresisPlantKind::pi || h.kind == HysteresisPlantKind::katalenic) {
-    config.fail(kind_key, "the bridge reads coleman_hodgdon, mem, bouc_wen or linear (got " +
-                              std::string(to_string(h.kind)) + "; the in-process simulation runs it)");
-  }
   const std::string ch = kHysteresisPrefix + "coleman_hodgdon.";
   ColemanHodgdonParams& c = h.coleman_hodgdon;
   c.a = config.get<double>(ch + "a", c.a);
@@ -111,6 +110,13 @@ HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
   b.n = config.get<double>(bw + "n", b.n);
   b.rk4_substeps = config.get<int>(bw + "rk4_substeps", b.rk4_substeps);
   validate_config_section(config, bw, [&] { b.validate(); });
+  const std::string pi = kHysteresisPrefix + "pi";
+  validate_config_section(config, pi + ".", [&] { h.pi = params_from_config<PiDescriptor>(config, PiSettings{}, pi); });
+  const std::string kat = kHysteresisPrefix + "katalenic";
+  validate_config_section(config, kat + ".", [&] {
+    h.katalenic = params_from_config<KatalenicDescriptor>(config, h.katalenic, kat);
+    h.katalenic.validate();
+  });
   const std::string lin = kHysteresisPrefix + "linear";
   validate_config_section(config, lin + ".",
                           [&] { h.linear = params_from_config<LinearDescriptor>(config, h.linear, lin); });
@@ -278,6 +284,12 @@ const std::vector<std::string>& bridge_config_keys() {
     for (const char* f : kColemanHodgdonKeys) k.push_back(kHysteresisPrefix + "coleman_hodgdon." + f);
     append_config_keys(k, kHysteresisPrefix + "mem", MemDescriptor::table());
     k.push_back(kHysteresisPrefix + "mem_reversal_deadband_V");
+    for (const char* f : {"count", "range_V"}) k.push_back(kHysteresisPrefix + "pi." + f);
+    for (const auto& row : KatalenicDescriptor::table()) {
+      if (!std::string_view(row.name).ends_with("coefficients")) {
+        k.push_back(kHysteresisPrefix + "katalenic." + std::string(row.name));
+      }
+    }
     for (const char* f : kBoucWenKeys) k.push_back(kHysteresisPrefix + "bouc_wen." + f);
     append_config_keys(k, kHysteresisPrefix + "linear", LinearDescriptor::table());
     for (const char* f : kStageKeys) k.push_back(std::string("plant.stage.") + f);

@@ -234,6 +234,17 @@ TEST(BridgeSettings, TheSeriesPlantsKeys) {
   auto backend = make_stage_backend(s);
   EXPECT_TRUE(std::isfinite(backend->step(10.0, 0.0, s.dt_s()).y_m));
 
+  // PI (the baseline of `count` plays) and Katalenic through their tables.
+  const BridgeSettings pi = load_bridge_settings(
+      Config::from_string("plant: {hysteresis: {kind: pi, pi: {count: 10, range_V: 200}}}", "bridge.yaml"));
+  EXPECT_EQ(pi.stage.hysteresis.kind, HysteresisPlantKind::pi);
+  EXPECT_EQ(pi.stage.hysteresis.pi.count, 10U);
+  EXPECT_EQ(pi.stage.hysteresis.pi.thresholds[9], 180.0);
+  const BridgeSettings kat = load_bridge_settings(Config::from_string(
+      "plant: {hysteresis: {kind: katalenic, katalenic: {k1: 30, output_shaping: {gain: 4.0e-9}}}}", "bridge.yaml"));
+  EXPECT_EQ(kat.stage.hysteresis.katalenic.k1, 30.0);
+  EXPECT_EQ(kat.stage.hysteresis.katalenic.output_shaping.gain, 4e-9);
+
   // Zeros and poles in Hz (a conjugate pair listed once), and a transfer function in s.
   const BridgeSettings zp = load_bridge_settings(Config::from_string(
       "plant: {stage: {zeros_hz: [[-3000, 0]], poles_hz: [[-50, 1000], [-2000, 0]]}}", "bridge.yaml"));
@@ -254,7 +265,10 @@ TEST(BridgeSettings, TheSeriesPlantsKeys) {
 
 TEST(BridgeSettings, SeriesPlantRefusalsNameTheKey) {
   EXPECT_TRUE(contains(refusal("plant: {hysteresis: {kind: preisach}}"), "bridge.yaml: plant.hysteresis.kind"));
-  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {kind: pi}}"), "plant.hysteresis.kind"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {pi: {weights: [1.0e-9, 2.0e-9]}}}"),
+                       "plant.hysteresis.pi.weights: unknown key"));  // the baseline only
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {pi: {count: 0}}}"), "plant.hysteresis.pi.count"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {katalenic: {k1: -1}}}"), "plant.hysteresis.katalenic.k1"));
   EXPECT_TRUE(contains(refusal("plant: {hysteresis: {bouc_wen: {gamma: 1.0}}}"), "plant.hysteresis.bouc_wen.gamma"));
   EXPECT_TRUE(
       contains(refusal("plant: {hysteresis: {coleman_hodgdon: {b: 9.0e-9}}}"), "plant.hysteresis.coleman_hodgdon.b"));
