@@ -99,7 +99,10 @@ HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
   c.s_max = config.get<double>(ch + "s_max", c.s_max);
   validate_config_section(config, ch, [&] { c.validate(); });
   const std::string mem = kHysteresisPrefix + "mem";
-  validate_config_section(config, mem + ".", [&] { h.mem = params_from_config<MemDescriptor>(config, h.mem, mem); });
+  validate_config_section(config, mem + ".", [&] {
+    h.mem = params_from_config<MemDescriptor>(config, h.mem, mem);
+    h.mem.validate();
+  });
   h.mem_reversal_deadband_V = config.get_non_negative(kHysteresisPrefix + "mem_reversal_deadband_V", 0.0);
   const std::string bw = kHysteresisPrefix + "bouc_wen.";
   BoucWenParams& b = h.bouc_wen;
@@ -118,8 +121,10 @@ HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
     h.katalenic.validate();
   });
   const std::string lin = kHysteresisPrefix + "linear";
-  validate_config_section(config, lin + ".",
-                          [&] { h.linear = params_from_config<LinearDescriptor>(config, h.linear, lin); });
+  validate_config_section(config, lin + ".", [&] {
+    h.linear = params_from_config<LinearDescriptor>(config, h.linear, lin);
+    h.linear.validate();
+  });
   return h;
 }
 

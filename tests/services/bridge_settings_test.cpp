@@ -256,6 +256,20 @@ TEST(BridgeSettings, TheSeriesPlantsKeys) {
       Config::from_string("plant: {stage: {numerator_s: [1.0e8], denominator_s: [1, 2000, 1.0e8]}}", "bridge.yaml"));
   ASSERT_EQ(tf.stage.linear.form, LinearStageSpec::Form::kTransferFunction);
   EXPECT_EQ(tf.stage.linear.denominator_s.size(), 3U);
+  // An XY stage of it: each axis the same plant, its own noise seed.
+  const BridgeSettings xy = load_bridge_settings(
+      Config::from_string("bridge: {backend: series, axes: 2}\nplant: {stage: {delay_s: 1.5e-4}}", "bridge.yaml"));
+  const MultiAxisStageConfig stages = multi_axis_stage(xy);
+  EXPECT_EQ(stages.axis[1].plant, PlantKind::kSeries);
+  EXPECT_EQ(stages.axis[1].tick_s, xy.dt_s());
+  EXPECT_EQ(stages.axis[1].linear.delay_s, 1.5e-4);
+  auto xy_backend = make_stage_backend(xy);
+  EXPECT_EQ(xy_backend->axes(), 2);
+  std::array<StageReading, 2> readings{};
+  const std::array<double, 2> u{10.0, -10.0};
+  xy_backend->step_axes(u, 0.0, xy.dt_s(), readings);
+  EXPECT_TRUE(std::isfinite(readings[0].y_m) && std::isfinite(readings[1].y_m));
+
   // No stage given: Banning's Table 2.
   const BridgeSettings d = load_bridge_settings(Config());
   EXPECT_EQ(d.stage.hysteresis.kind, HysteresisPlantKind::coleman_hodgdon);
@@ -269,6 +283,7 @@ TEST(BridgeSettings, SeriesPlantRefusalsNameTheKey) {
                        "plant.hysteresis.pi.weights: unknown key"));  // the baseline only
   EXPECT_TRUE(contains(refusal("plant: {hysteresis: {pi: {count: 0}}}"), "plant.hysteresis.pi.count"));
   EXPECT_TRUE(contains(refusal("plant: {hysteresis: {katalenic: {k1: -1}}}"), "plant.hysteresis.katalenic.k1"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {linear: {gain: 0}}}"), "plant.hysteresis.linear.gain"));
   EXPECT_TRUE(contains(refusal("plant: {hysteresis: {bouc_wen: {gamma: 1.0}}}"), "plant.hysteresis.bouc_wen.gamma"));
   EXPECT_TRUE(
       contains(refusal("plant: {hysteresis: {coleman_hodgdon: {b: 9.0e-9}}}"), "plant.hysteresis.coleman_hodgdon.b"));
