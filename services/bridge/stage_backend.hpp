@@ -99,8 +99,9 @@ class MultiAxisSimulatedBackend final : public StageBackend {
 // `config` is set from the name. Throws ParameterError("bridge.backend") otherwise.
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config);
 
-// The backend bridge.backend names: sim, ro, series (an XY(Z) stage of them when bridge.axes > 1), or comedi (ComediBackend:
-// opens the card; throws ConfigError for a config the card refuses, std::runtime_error when it cannot be opened).
+// The backend bridge.backend names: sim, ro, series (an XY(Z) stage of them when bridge.axes > 1), or comedi
+// (ComediBackend: opens the card; throws ConfigError for a config the card refuses, std::runtime_error when it cannot
+// be opened).
 std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings);
 
 }  // namespace hystloop
