@@ -1,5 +1,6 @@
 #include "core/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -7,6 +8,7 @@
 #include <type_traits>
 
 #include "core/config_impl.hpp"
+#include "core/edit_distance.hpp"
 
 namespace hystloop {
 namespace {
@@ -125,6 +127,26 @@ T convert_value(const Config& cfg, const YAML::Node& node, const std::string& fi
   }
 }
 
+std::string join_fields(const std::vector<std::string>& fields) {
+  std::string out;
+  for (const auto& f : fields) out += (out.empty() ? "" : ", ") + f;
+  return out;
+}
+
+// The field a misspelt key meant, or empty when none is close.
+std::string closest_key(const std::string& key, const std::vector<std::string>& fields) {
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(2, key.size() / 5) + 1;
+  for (const auto& f : fields) {
+    const std::size_t d = edit_distance(ascii_lower(key), ascii_lower(f));
+    if (d < best_distance) {
+      best_distance = d;
+      best = f;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 ConfigError::ConfigError(std::string source, std::string field, const std::string& reason)
@@ -134,7 +156,9 @@ ConfigError::ConfigError(std::string source, std::string field, const std::strin
 
 const std::string& Config::Impl::source_for(std::string_view path) const {
   for (const auto& key : overridden) {
-    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key && path[key.size()] == '.')) {
+    // A key below it, or an entry of its list ("gains[1]"), came from the override too.
+    if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key &&
+                        (path[key.size()] == '.' || path[key.size()] == '['))) {
       return kOverrideSource;
     }
   }
@@ -271,6 +295,59 @@ std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t defaul
     fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
   }
   return v;
+}
+
+std::vector<std::vector<double>> Config::get_rows(std::string_view path, std::size_t width) const {
+  const auto parts = split_config_path(path);
+  require_valid_path(*this, path, parts);
+  std::string walked;
+  const auto node = find_node(*this, impl_->root, parts, 0, walked);
+  if (!node) return {};
+  const std::string field(path);
+  if (!node->IsSequence()) fail(path, "expected a list of lists, got " + describe(*node));
+  std::vector<std::vector<double>> out;
+  out.reserve(node->size());
+  for (std::size_t i = 0; i < node->size(); ++i) {
+    const std::string entry = field + "[" + std::to_string(i) + "]";
+    auto row = convert_value<std::vector<double>>(*this, (*node)[i], entry);
+    if (width > 0 && row.size() != width) {
+      fail(entry, "expected " + std::to_string(width) + " numbers, got " + std::to_string(row.size()));
+    }
+    if (row.empty()) fail(entry, "expected at least one number, got an empty list");
+    out.push_back(std::move(row));
+  }
+  return out;
+}
+
+std::vector<std::vector<double>> Config::get_records(std::string_view path,
+                                                     const std::vector<std::string>& fields) const {
+  const auto parts = split_config_path(path);
+  require_valid_path(*this, path, parts);
+  std::string walked;
+  const auto node = find_node(*this, impl_->root, parts, 0, walked);
+  if (!node) return {};
+  const std::string field(path);
+  if (!node->IsSequence()) fail(path, "expected a list of maps, got " + describe(*node));
+  std::vector<std::vector<double>> out;
+  out.reserve(node->size());
+  for (std::size_t i = 0; i < node->size(); ++i) {
+    const std::string entry = field + "[" + std::to_string(i) + "]";
+    const YAML::Node item = (*node)[i];
+    if (!item.IsMap()) fail(entry, "expected a map of " + join_fields(fields) + ", got " + describe(item));
+    std::vector<double> row(fields.size(), std::numeric_limits<double>::quiet_NaN());
+    for (const auto& kv : item) {
+      const std::string key = kv.first.as<std::string>();
+      const auto at = std::find(fields.begin(), fields.end(), key);
+      if (at == fields.end()) {
+        const std::string near = closest_key(key, fields);
+        fail(entry + "." + key, "unknown key" + (near.empty() ? " (expected " + join_fields(fields) + ")"
+                                                              : "; did you mean '" + near + "'?"));
+      }
+      row[static_cast<std::size_t>(at - fields.begin())] = convert_scalar<double>(*this, kv.second, entry + "." + key);
+    }
+    out.push_back(std::move(row));
+  }
+  return out;
 }
 
 void Config::apply_override(std::string_view assignment) {

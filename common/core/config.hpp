@@ -82,6 +82,16 @@ class Config {
   std::int64_t get_int_in_range(std::string_view path, std::int64_t default_value, std::int64_t lo,
                                 std::int64_t hi) const;
 
+  // A list of rows of numbers, [[1, 2], [3, 4]] (a lab's [[re, im], ...] roots): each row a list of
+  // `width` numbers (any length >= 1 when width is 0). Absent: empty. A refusal names the entry
+  // ("stage.poles[1]: expected 2 numbers, got 3").
+  std::vector<std::vector<double>> get_rows(std::string_view path, std::size_t width = 0) const;
+  // A list of maps of numbers, [{frequency_hz: 780, damping_ratio: 0.03}, ...]: each entry's keys
+  // among `fields` (an unknown one refused naming it, "modes[0].dampin_ratio", with the one meant),
+  // each entry's value NaN for a field it does not give (the caller refuses or defaults it). Absent:
+  // empty.
+  std::vector<std::vector<double>> get_records(std::string_view path, const std::vector<std::string>& fields) const;
+
   // Merges one "dotted.key=value" over the tree; the value is parsed as YAML
   // ("3" a number, "[1, 2]" a list, "abc" a string). Intermediate maps are created.
   // Throws ConfigError (source "--set") for a malformed assignment.

@@ -6,12 +6,21 @@
 #include "core/errors.hpp"
 
 namespace hystloop {
+namespace {
+
+// The series plant is sampled at the loop's tick (the others take dt per step).
+SimulatedStageConfig at_tick(SimulatedStageConfig stage, double dt_s) {
+  stage.tick_s = dt_s;
+  return stage;
+}
+
+}  // namespace
 
 LoopSimulation::LoopSimulation(const LoopSimulationConfig& config)
     : config_(config),
       dt_s_(config.compensator.dt_s),
       bridge_(config.limits, config.servo, config.compensator.dt_s),
-      stage_(config.stage),
+      stage_(at_tick(config.stage, config.compensator.dt_s)),
       compensator_(config.compensator),
       plan_(1000) {
   require_in_range("loop.block_ticks", config.block_ticks, 1, 1000);

@@ -17,9 +17,15 @@ std::span<const FeedbackGains> first(const std::array<FeedbackGains, kScanAxes>&
   return {a.data(), static_cast<std::size_t>(n)};
 }
 
+// The series plant is sampled at the loop's tick (the others take dt per step).
+MultiAxisStageConfig at_tick(MultiAxisStageConfig stage, double dt_s) {
+  for (SimulatedStageConfig& axis : stage.axis) axis.tick_s = dt_s;
+  return stage;
+}
+
 double common_dt(const MultiAxisLoopConfig& c) {
-  c.stage.validate();
   const double dt = c.compensator[0].dt_s;
+  at_tick(c.stage, dt).validate();
   for (int i = 1; i < c.axes(); ++i) {
     if (c.compensator[static_cast<std::size_t>(i)].dt_s != dt) {
       throw ParameterError(std::string(axis_name(i)) + ".compensator.dt_s",
@@ -36,7 +42,7 @@ MultiAxisLoopSimulation::MultiAxisLoopSimulation(const MultiAxisLoopConfig& conf
     : config_(config),
       dt_s_(common_dt(config)),
       bridge_(config.axes(), first(config.limits, config.axes()), first(config.servo, config.axes()), dt_s_),
-      stage_(config.stage),
+      stage_(at_tick(config.stage, dt_s_)),
       plan_(1000) {
   compensators_.reserve(static_cast<std::size_t>(axes()));
   for (int i = 0; i < axes(); ++i) {

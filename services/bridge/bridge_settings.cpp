@@ -70,6 +70,132 @@ FeedbackGains load_servo(const Config& config, int axis, FeedbackGains g, const 
   return g;
 }
 
+// The series plant's hysteresis: plant.hysteresis.kind names the model; every model's section
+// plant.hysteresis.<kind>.* is read and validated whatever the kind (as banning.* and ro.* are
+// whatever the backend: one file serves them all). MEM's, PI's, Katalenic's and the linear
+// spring's through their parameter tables (the names hystloop-identify writes), but for their
+// lists: PI is the project's baseline (count plays over range_V, weights matched to the default
+// MEM) and Katalenic's shaping is linear or tanh, as a list could not be shown for every kind in
+// one file and still be refused when malformed. Explicit PI weights and polynomial shaping run in
+// the in-process simulation (SimulatedStageConfig::hysteresis).
+constexpr const char* kColemanHodgdonKeys[] = {"a", "b", "alpha", "s_max"};
+constexpr const char* kBoucWenKeys[] = {"d", "alpha", "beta", "gamma", "n", "rk4_substeps"};
+constexpr const char* kStageKeys[] = {"modes",         "zeros_hz",       "poles_hz",         "numerator_s",
+                                      "denominator_s", "numerator_zinv", "denominator_zinv", "discrete_dt_s",
+                                      "delay_s"};
+const std::string kHysteresisPrefix = "plant.hysteresis.";
+
+HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
+  HysteresisPlantSpec h;
+  const std::string kind_key = kHysteresisPrefix + "kind";
+  validate_config_section(config, kHysteresisPrefix, [&] {
+    h.kind = hysteresis_plant_kind_from_name(config.get<std::string>(kind_key, "coleman_hodgdon"), "kind");
+  });
+  const std::string ch = kHysteresisPrefix + "coleman_hodgdon.";
+  ColemanHodgdonParams& c = h.coleman_hodgdon;
+  c.a = config.get<double>(ch + "a", c.a);
+  c.b = config.get<double>(ch + "b", c.b);
+  c.alpha = config.get<double>(ch + "alpha", c.alpha);
+  c.s_max = config.get<double>(ch + "s_max", c.s_max);
+  validate_config_section(config, ch, [&] { c.validate(); });
+  const std::string mem = kHysteresisPrefix + "mem";
+  validate_config_section(config, mem + ".", [&] {
+    h.mem = params_from_config<MemDescriptor>(config, h.mem, mem);
+    h.mem.validate();
+  });
+  h.mem_reversal_deadband_V = config.get_non_negative(kHysteresisPrefix + "mem_reversal_deadband_V", 0.0);
+  const std::string bw = kHysteresisPrefix + "bouc_wen.";
+  BoucWenParams& b = h.bouc_wen;
+  b.d = config.get<double>(bw + "d", b.d);
+  b.alpha = config.get<double>(bw + "alpha", b.alpha);
+  b.beta = config.get<double>(bw + "beta", b.beta);
+  b.gamma = config.get<double>(bw + "gamma", b.gamma);
+  b.n = config.get<double>(bw + "n", b.n);
+  b.rk4_substeps = config.get<int>(bw + "rk4_substeps", b.rk4_substeps);
+  validate_config_section(config, bw, [&] { b.validate(); });
+  const std::string pi = kHysteresisPrefix + "pi";
+  validate_config_section(config, pi + ".", [&] { h.pi = params_from_config<PiDescriptor>(config, PiSettings{}, pi); });
+  const std::string kat = kHysteresisPrefix + "katalenic";
+  validate_config_section(config, kat + ".", [&] {
+    h.katalenic = params_from_config<KatalenicDescriptor>(config, h.katalenic, kat);
+    h.katalenic.validate();
+  });
+  const std::string lin = kHysteresisPrefix + "linear";
+  validate_config_section(config, lin + ".", [&] {
+    h.linear = params_from_config<LinearDescriptor>(config, h.linear, lin);
+    h.linear.validate();
+  });
+  return h;
+}
+
+// The series plant's linear stage in one of the forms a lab prints (models/linear_stage.hpp):
+// modes, zeros_hz/poles_hz, numerator_s/denominator_s or numerator_zinv/denominator_zinv with
+// discrete_dt_s; plus delay_s. None of them: Banning's Table 2 stage.
+LinearStageSpec load_plant_stage(const Config& config, LinearStageSpec stage) {
+  const std::string p = "plant.stage.";
+  // An empty list is a form not given: the deploy file shows every form's keys, all but one empty.
+  const auto given = [&](const char* key) {
+    const std::string k = p + key;
+    if (!config.has(k)) return false;
+    if (std::string_view(key) == "modes")
+      return !config.get_records(k, {"frequency_hz", "damping_ratio", "weight"}).empty();
+    if (std::string_view(key) == "zeros_hz" || std::string_view(key) == "poles_hz")
+      return !config.get_rows(k, 2).empty();
+    if (std::string_view(key) == "discrete_dt_s") return config.get<double>(k) != 0.0;
+    return !config.get<std::vector<double>>(k).empty();
+  };
+  std::string form;  // the first key of the form given, to name a second one
+  const auto choose = [&](const char* key) {
+    if (!form.empty()) config.fail(p + key, "give one form of the stage; " + p + form + " is given too");
+    form = key;
+  };
+  const auto require_with = [&](const char* key, const char* needed) {
+    if (!given(needed)) config.fail(p + needed, std::string("required with ") + p + key);
+  };
+  if (given("modes")) {
+    choose("modes");
+    const auto rows = config.get_records(p + "modes", {"frequency_hz", "damping_ratio", "weight"});
+    std::vector<LinearStageSpec::Mode> modes;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const std::string entry = p + "modes[" + std::to_string(i) + "]";
+      if (std::isnan(rows[i][0])) config.fail(entry + ".frequency_hz", "required");
+      if (std::isnan(rows[i][1])) config.fail(entry + ".damping_ratio", "required");
+      modes.push_back({rows[i][0], rows[i][1], std::isnan(rows[i][2]) ? 1.0 : rows[i][2]});
+    }
+    stage = LinearStageSpec::sum_of_modes(std::move(modes));
+  }
+  if (given("zeros_hz") || given("poles_hz")) {  // no zeros is a stage too
+    choose(given("poles_hz") ? "poles_hz" : "zeros_hz");
+    require_with("zeros_hz", "poles_hz");
+    const auto roots = [&](const char* key) {
+      std::vector<LinearStageSpec::Root> out;
+      for (const auto& r : config.get_rows(p + key, 2)) out.push_back({r[0], r[1]});
+      return out;
+    };
+    stage = LinearStageSpec::zero_pole(roots("zeros_hz"), roots("poles_hz"));
+  }
+  if (given("numerator_s") || given("denominator_s")) {
+    choose(given("numerator_s") ? "numerator_s" : "denominator_s");
+    require_with("numerator_s", "denominator_s");
+    require_with("denominator_s", "numerator_s");
+    stage = LinearStageSpec::transfer_function(config.get<std::vector<double>>(p + "numerator_s"),
+                                               config.get<std::vector<double>>(p + "denominator_s"));
+  }
+  if (given("numerator_zinv") || given("denominator_zinv") || given("discrete_dt_s")) {
+    choose(given("numerator_zinv")     ? "numerator_zinv"
+           : given("denominator_zinv") ? "denominator_zinv"
+                                       : "discrete_dt_s");
+    require_with("denominator_zinv", "numerator_zinv");
+    require_with("numerator_zinv", "denominator_zinv");
+    require_with("numerator_zinv", "discrete_dt_s");
+    stage = LinearStageSpec::discrete(config.get<std::vector<double>>(p + "numerator_zinv"),
+                                      config.get<std::vector<double>>(p + "denominator_zinv"),
+                                      config.get<double>(p + "discrete_dt_s"));
+  }
+  stage.delay_s = config.get<double>(p + "delay_s", 0.0);
+  return stage;
+}
+
 }  // namespace
 
 const ActuatorLimits& BridgeSettings::limits_of(int axis) const noexcept {
@@ -158,6 +284,20 @@ const std::vector<std::string>& bridge_config_keys() {
     k.insert(k.end(), comedi_config_keys().begin(), comedi_config_keys().end());
     append_config_keys(k, BanningDescriptor::name, BanningDescriptor::table());  // the simulated stage
     append_config_keys(k, "ro", MemDescriptor::table());                         // the Ramberg-Osgood plant
+    // The series plant: plant.hysteresis.<kind>.* and plant.stage.*.
+    k.push_back(kHysteresisPrefix + "kind");
+    for (const char* f : kColemanHodgdonKeys) k.push_back(kHysteresisPrefix + "coleman_hodgdon." + f);
+    append_config_keys(k, kHysteresisPrefix + "mem", MemDescriptor::table());
+    k.push_back(kHysteresisPrefix + "mem_reversal_deadband_V");
+    for (const char* f : {"count", "range_V"}) k.push_back(kHysteresisPrefix + "pi." + f);
+    for (const auto& row : KatalenicDescriptor::table()) {
+      if (!std::string_view(row.name).ends_with("coefficients")) {
+        k.push_back(kHysteresisPrefix + "katalenic." + std::string(row.name));
+      }
+    }
+    for (const char* f : kBoucWenKeys) k.push_back(kHysteresisPrefix + "bouc_wen." + f);
+    append_config_keys(k, kHysteresisPrefix + "linear", LinearDescriptor::table());
+    for (const char* f : kStageKeys) k.push_back(std::string("plant.stage.") + f);
     return k;
   }();
   return all;
@@ -169,8 +309,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
   config.check_no_unknown_keys(known);
   BridgeSettings s;
   s.backend = config.get<std::string>("bridge.backend", s.backend);
-  if (s.backend != "sim" && s.backend != "ro" && s.backend != "comedi") {
-    config.fail("bridge.backend", "must be sim, ro or comedi (got '" + s.backend + "')");
+  if (s.backend != "sim" && s.backend != "ro" && s.backend != "series" && s.backend != "comedi") {
+    config.fail("bridge.backend", "must be sim, ro, series or comedi (got '" + s.backend + "')");
   }
   s.axes = static_cast<int>(config.get_int_in_range("bridge.axes", s.axes, 1, kMaxAxes));
   for (const CouplingEntry& c : kCouplingEntries) {  // coupling.<from>_to_<to>: C(to, from)
@@ -202,7 +342,16 @@ BridgeSettings load_bridge_settings(const Config& config) {
   // The Ramberg-Osgood plant is a MEM: its keys are the MEM's (ro.c1, ro.c2, ro.c3).
   validate_config_section(
       config, "ro.", [&] { st.ramberg_osgood = params_from_config<MemDescriptor>(config, st.ramberg_osgood, "ro"); });
+  // The series plant (plant.*), sampled at the bridge's tick; validated whatever the backend, as above.
+  st.hysteresis = load_plant_hysteresis(config);
+  st.linear = load_plant_stage(config, st.linear);
+  st.tick_s = s.dt_s();
   validate_config_section(config, "", [&] { st.validate(); });
+  validate_config_section(config, "", [&] {
+    SimulatedStageConfig series = st;
+    series.plant = PlantKind::kSeries;
+    series.validate();
+  });
   if (s.axes > 1 && s.backend != "comedi") {
     // The coupling's conditioning, the seeds: everything the XY(Z) stage checks, named by its field.
     validate_config_section(config, "", [&] { multi_axis_stage(s).validate(); });
@@ -290,6 +439,12 @@ std::vector<std::string> describe(const BridgeSettings& s) {
     for (std::string& line : describe(s.comedi)) lines.push_back(std::move(line));
   } else if (s.backend == "sim") {
     lines.push_back("banning: " + BanningDescriptor::summary_of(st.banning));
+  } else if (s.backend == "series") {
+    const DiscreteLinearStage d = discretise(st.linear, st.tick_s);
+    lines.push_back(
+        fmt::format("plant: {} hysteresis, then a linear stage of {} states (unit DC gain) with "
+                    "{:.4g} s of input delay ({:.4g} ticks)",
+                    to_string(st.hysteresis.kind), d.states(), st.linear.delay_s, st.linear.delay_s / st.tick_s));
   } else {
     lines.push_back("ro: " + MemDescriptor::summary_of(st.ramberg_osgood));
   }

@@ -32,7 +32,7 @@ struct RtSettings {
 AxisMatrix default_stage_coupling() noexcept;
 
 struct BridgeSettings {
-  std::string backend = "sim";  // sim (Banning stage) | ro (Ramberg-Osgood) | comedi (a DAQ card)
+  std::string backend = "sim";  // sim (Banning stage) | ro (Ramberg-Osgood) | series (plant.*) | comedi (a DAQ card)
   // Axes on the one clock (1..kMaxAxes: x, y, z), each with its actuator limits and servo
   // (limits_of, servo_of), all in one safe state (MultiAxisBridge).
   int axes = 1;
@@ -41,7 +41,7 @@ struct BridgeSettings {
   // block is used; an AxisCoupling is built from it (validated) when axes > 1.
   AxisMatrix coupling = default_stage_coupling();
   double rate_hz = 10000.0;      // the loop's clock
-  SimulatedStageConfig stage{};  // noise, seed, drift and the plants' parameters
+  SimulatedStageConfig stage{};  // noise, seed, drift and the plants' parameters (the series plant's tick: dt_s())
   ComediSettings comedi{};       // the comedi.* keys (used when backend is comedi)
   ActuatorLimits limits{};       // axis x's (actuator.*), and every other axis's unless it has its own
   FeedbackGains servo{};         // axis x's servo on y_ref - y (servo.*; all gains 0 = feedforward only), likewise

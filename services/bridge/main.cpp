@@ -27,7 +27,8 @@ int main(int argc, char** argv) try {
   bool auto_arm = false;
   app.add_option(
       "--backend", backend,
-      "Stage backend: sim (Banning stage), ro (Ramberg-Osgood) or comedi (a DAQ card: comedi.*) [bridge.backend]");
+      "Stage backend: sim (Banning stage), ro (Ramberg-Osgood), series (any hysteresis, then any linear stage with a "
+      "delay: plant.*) or comedi (a DAQ card: comedi.*) [bridge.backend]");
   app.add_option("--noise-rms-m", noise, "Sensor noise RMS [m] [bridge.noise_rms_m]");
   app.add_option("--drift", drift, "Gain drift over bridge.drift_duration_s, e.g. 0.1 = +10 % [bridge.drift_fraction]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [bridge.run_seconds]");

@@ -95,12 +95,13 @@ class MultiAxisSimulatedBackend final : public StageBackend {
   std::array<double, kMaxAxes> u_last_V_{};  // what step() holds the axes other than x at
 };
 
-// The backend `name` names: "sim" (Banning) or "ro" (Ramberg-Osgood); the plant kind in
+// The backend `name` names: "sim" (Banning), "ro" (Ramberg-Osgood) or "series"; the plant kind in
 // `config` is set from the name. Throws ParameterError("bridge.backend") otherwise.
 std::unique_ptr<StageBackend> make_stage_backend(const std::string& name, SimulatedStageConfig config);
 
-// The backend bridge.backend names: sim, ro (an XY(Z) stage of them when bridge.axes > 1), or comedi (ComediBackend:
-// opens the card; throws ConfigError for a config the card refuses, std::runtime_error when it cannot be opened).
+// The backend bridge.backend names: sim, ro, series (an XY(Z) stage of them when bridge.axes > 1), or comedi
+// (ComediBackend: opens the card; throws ConfigError for a config the card refuses, std::runtime_error when it cannot
+// be opened).
 std::unique_ptr<StageBackend> make_stage_backend(const BridgeSettings& settings);
 
 }  // namespace hystloop

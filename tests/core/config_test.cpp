@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "support/refusal.hpp"
 
@@ -241,6 +243,39 @@ TEST(Config, DumpRoundTrips) {
   const Config again = Config::from_string(cfg.dump(), "dump");
   EXPECT_EQ(again.get<double>("bridge.u_max_V", 0.0), 77.0);
   EXPECT_EQ(again.keys(), cfg.keys());
+}
+
+TEST(Config, ReadsListsOfRowsAndListsOfRecords) {
+  Config cfg = Config::from_string(
+      "stage:\n"
+      "  poles_hz: [[-50, 1000], [-2000, 0]]\n"
+      "  modes: [{frequency_hz: 780, damping_ratio: 0.03}, {frequency_hz: 2400, damping_ratio: 0.02, weight: 0.08}]\n",
+      "stage.yaml");
+  const auto rows = cfg.get_rows("stage.poles_hz", 2);
+  ASSERT_EQ(rows.size(), 2U);
+  EXPECT_EQ(rows[0], (std::vector<double>{-50.0, 1000.0}));
+  EXPECT_EQ(rows[1], (std::vector<double>{-2000.0, 0.0}));
+  EXPECT_TRUE(cfg.get_rows("stage.zeros_hz", 2).empty());  // absent
+  const auto modes = cfg.get_records("stage.modes", {"frequency_hz", "damping_ratio", "weight"});
+  ASSERT_EQ(modes.size(), 2U);
+  EXPECT_EQ(modes[0][0], 780.0);
+  EXPECT_TRUE(std::isnan(modes[0][2]));  // not given: the caller's default
+  EXPECT_EQ(modes[1][2], 0.08);
+  EXPECT_EQ(error_of([&] { cfg.get_rows("stage.poles_hz", 3); }),
+            "stage.yaml: stage.poles_hz[0]: expected 3 numbers, got 2");
+  EXPECT_EQ(error_of([&] { cfg.get_rows("stage.modes", 2); }),
+            "stage.yaml: stage.modes[0]: expected a list, got a map");
+  EXPECT_EQ(error_of([&] {
+              cfg.get_records("stage.modes", {"frequency_hz", "damping"});
+            }),
+            "stage.yaml: stage.modes[0].damping_ratio: unknown key (expected frequency_hz, damping)");
+  EXPECT_EQ(error_of([&] {
+              cfg.get_records("stage.poles_hz", {"re", "im"});
+            }),
+            "stage.yaml: stage.poles_hz[0]: expected a map of re, im, got a list");
+  cfg.apply_override("stage.poles_hz=[[-50, abc]]");
+  EXPECT_EQ(error_of([&] { cfg.get_rows("stage.poles_hz", 2); }),
+            "--set: stage.poles_hz[0][1]: expected a number, got 'abc'");
 }
 
 }  // namespace

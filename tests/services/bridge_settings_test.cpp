@@ -203,6 +203,140 @@ TEST(BridgeSettings, TheBanningSectionIsTheTables) {
   EXPECT_TRUE(contains(refusal("banning: {stage: {m: 1}}"), "banning.stage.m"));
 }
 
+// The series plant (bridge.backend series): plant.hysteresis.* and plant.stage.* in the forms a lab
+// prints, every refusal naming its key, and the two-mode example loading as its comment says.
+TEST(BridgeSettings, TheSeriesPlantsKeys) {
+  const BridgeSettings s = load_bridge_settings(Config::from_string(
+      "bridge: {backend: series, rate_hz: 20000}\n"
+      "plant:\n"
+      "  hysteresis: {kind: bouc_wen, bouc_wen: {d: 7.4e-9, beta: 0.006, gamma: 0.002}}\n"
+      "  stage:\n"
+      "    modes: [{frequency_hz: 780, damping_ratio: 0.03, weight: 0.92}, {frequency_hz: 2400, damping_ratio: 0.02}]\n"
+      "    delay_s: 75.0e-6\n",
+      "bridge.yaml"));
+  EXPECT_EQ(s.backend, "series");
+  EXPECT_EQ(s.stage.tick_s, 5e-5);
+  EXPECT_EQ(s.stage.hysteresis.kind, HysteresisPlantKind::bouc_wen);
+  EXPECT_EQ(s.stage.hysteresis.bouc_wen.d, 7.4e-9);
+  EXPECT_EQ(s.stage.hysteresis.bouc_wen.gamma, 0.002);
+  EXPECT_EQ(s.stage.hysteresis.bouc_wen.alpha, BoucWenParams{}.alpha);
+  ASSERT_EQ(s.stage.linear.form, LinearStageSpec::Form::kModes);
+  ASSERT_EQ(s.stage.linear.modes.size(), 2U);
+  EXPECT_EQ(s.stage.linear.modes[0].frequency_hz, 780.0);
+  EXPECT_EQ(s.stage.linear.modes[0].weight, 0.92);
+  EXPECT_EQ(s.stage.linear.modes[1].damping_ratio, 0.02);
+  EXPECT_EQ(s.stage.linear.modes[1].weight, 1.0);  // the default
+  EXPECT_EQ(s.stage.linear.delay_s, 75e-6);
+  const auto lines = describe(s);
+  EXPECT_NE(std::find_if(lines.begin(), lines.end(),
+                         [](const std::string& l) { return contains(l, "plant: bouc_wen hysteresis"); }),
+            lines.end());
+  auto backend = make_stage_backend(s);
+  EXPECT_TRUE(std::isfinite(backend->step(10.0, 0.0, s.dt_s()).y_m));
+
+  // PI (the baseline of `count` plays) and Katalenic through their tables.
+  const BridgeSettings pi = load_bridge_settings(
+      Config::from_string("plant: {hysteresis: {kind: pi, pi: {count: 10, range_V: 200}}}", "bridge.yaml"));
+  EXPECT_EQ(pi.stage.hysteresis.kind, HysteresisPlantKind::pi);
+  EXPECT_EQ(pi.stage.hysteresis.pi.count, 10U);
+  EXPECT_EQ(pi.stage.hysteresis.pi.thresholds[9], 180.0);
+  const BridgeSettings kat = load_bridge_settings(Config::from_string(
+      "plant: {hysteresis: {kind: katalenic, katalenic: {k1: 30, output_shaping: {gain: 4.0e-9}}}}", "bridge.yaml"));
+  EXPECT_EQ(kat.stage.hysteresis.katalenic.k1, 30.0);
+  EXPECT_EQ(kat.stage.hysteresis.katalenic.output_shaping.gain, 4e-9);
+
+  // Zeros and poles in Hz (a conjugate pair listed once), and a transfer function in s.
+  const BridgeSettings zp = load_bridge_settings(Config::from_string(
+      "plant: {stage: {zeros_hz: [[-3000, 0]], poles_hz: [[-50, 1000], [-2000, 0]]}}", "bridge.yaml"));
+  ASSERT_EQ(zp.stage.linear.form, LinearStageSpec::Form::kZeroPoleGain);
+  ASSERT_EQ(zp.stage.linear.poles.size(), 2U);
+  EXPECT_EQ(zp.stage.linear.poles[0].imag_hz, 1000.0);
+  EXPECT_EQ(zp.stage.linear.zeros[0].real_hz, -3000.0);
+  const BridgeSettings tf = load_bridge_settings(
+      Config::from_string("plant: {stage: {numerator_s: [1.0e8], denominator_s: [1, 2000, 1.0e8]}}", "bridge.yaml"));
+  ASSERT_EQ(tf.stage.linear.form, LinearStageSpec::Form::kTransferFunction);
+  EXPECT_EQ(tf.stage.linear.denominator_s.size(), 3U);
+  // An XY stage of it: each axis the same plant, its own noise seed.
+  const BridgeSettings xy = load_bridge_settings(
+      Config::from_string("bridge: {backend: series, axes: 2}\nplant: {stage: {delay_s: 1.5e-4}}", "bridge.yaml"));
+  const MultiAxisStageConfig stages = multi_axis_stage(xy);
+  EXPECT_EQ(stages.axis[1].plant, PlantKind::kSeries);
+  EXPECT_EQ(stages.axis[1].tick_s, xy.dt_s());
+  EXPECT_EQ(stages.axis[1].linear.delay_s, 1.5e-4);
+  auto xy_backend = make_stage_backend(xy);
+  EXPECT_EQ(xy_backend->axes(), 2);
+  std::array<StageReading, 2> readings{};
+  const std::array<double, 2> u{10.0, -10.0};
+  xy_backend->step_axes(u, 0.0, xy.dt_s(), readings);
+  EXPECT_TRUE(std::isfinite(readings[0].y_m) && std::isfinite(readings[1].y_m));
+
+  // No stage given: Banning's Table 2.
+  const BridgeSettings d = load_bridge_settings(Config());
+  EXPECT_EQ(d.stage.hysteresis.kind, HysteresisPlantKind::coleman_hodgdon);
+  EXPECT_EQ(d.stage.linear.denominator_s,
+            LinearStageSpec::second_order(d.stage.banning.stage.k, d.stage.banning.stage.c).denominator_s);
+}
+
+TEST(BridgeSettings, SeriesPlantRefusalsNameTheKey) {
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {kind: preisach}}"), "bridge.yaml: plant.hysteresis.kind"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {pi: {weights: [1.0e-9, 2.0e-9]}}}"),
+                       "plant.hysteresis.pi.weights: unknown key"));  // the baseline only
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {pi: {count: 0}}}"), "plant.hysteresis.pi.count"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {katalenic: {k1: -1}}}"), "plant.hysteresis.katalenic.k1"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {linear: {gain: 0}}}"), "plant.hysteresis.linear.gain"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {bouc_wen: {gamma: 1.0}}}"), "plant.hysteresis.bouc_wen.gamma"));
+  EXPECT_TRUE(
+      contains(refusal("plant: {hysteresis: {coleman_hodgdon: {b: 9.0e-9}}}"), "plant.hysteresis.coleman_hodgdon.b"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {mem: {c1: 0}}}"), "plant.hysteresis.mem.c1"));
+  EXPECT_TRUE(contains(refusal("plant: {hysteresis: {bouc_wen: {gama: 0.001}}}"),
+                       "did you mean 'plant.hysteresis.bouc_wen.gamma'"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {pole_hz: [[-50, 1000]]}}"), "did you mean 'plant.stage.poles_hz'"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {modes: [{frequency_hz: 780, dampin_ratio: 0.03}]}}"),
+                       "plant.stage.modes[0].dampin_ratio: unknown key; did you mean 'damping_ratio'"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {modes: [{frequency_hz: 780}]}}"),
+                       "plant.stage.modes[0].damping_ratio: required"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {modes: [{frequency_hz: -780, damping_ratio: 0.03}]}}"),
+                       "plant.stage.modes[0]"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {poles_hz: [[-50, 1000, 3]]}}"),
+                       "plant.stage.poles_hz[0]: expected 2 numbers, got 3"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {poles_hz: [[50, 1000]]}}"), "plant.stage.poles"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {zeros_hz: [[-50, 0]]}}"), "plant.stage.poles_hz: required"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {numerator_s: [1]}}"), "plant.stage.denominator_s: required"));
+  EXPECT_TRUE(
+      contains(refusal("plant: {stage: {poles_hz: [[-50, 1000]], modes: [{frequency_hz: 780, damping_ratio: 0.03}]}}"),
+               "give one form"));
+  EXPECT_TRUE(contains(refusal("plant: {stage: {delay_s: 0.01}}"), "plant.stage.delay_s"));  // 100 ticks
+  EXPECT_TRUE(contains(refusal("plant: {stage: {delay_s: -1.0e-4}}"), "plant.stage.delay_s"));
+  EXPECT_EQ(refusal("bridge: {backend: series}\nplant: {stage: {delay_s: 1.5e-4}}"), "accepted");
+}
+
+TEST(BridgeSettings, TheTwoModeExampleIsTheSeriesPlantItDescribes) {
+  const BridgeSettings s = load_bridge_settings(Config::load_file(kConfigDir + "two-mode/bridge.yaml"));
+  EXPECT_EQ(s.backend, "series");
+  EXPECT_EQ(s.stage.noise_rms_m, 1e-9);
+  EXPECT_EQ(s.stage.hysteresis.kind, HysteresisPlantKind::coleman_hodgdon);
+  EXPECT_EQ(s.stage.hysteresis.coleman_hodgdon.a, ColemanHodgdonParams{}.a);  // Table 1
+  EXPECT_EQ(s.stage.hysteresis.coleman_hodgdon.alpha, ColemanHodgdonParams{}.alpha);
+  ASSERT_EQ(s.stage.linear.modes.size(), 2U);
+  EXPECT_EQ(s.stage.linear.modes[0].frequency_hz, 780.0);
+  EXPECT_EQ(s.stage.linear.modes[1].frequency_hz, 2400.0);
+  EXPECT_NEAR(s.stage.linear.delay_s / s.dt_s(), 1.5, 1e-12);
+  EXPECT_NEAR(std::abs(discretise(s.stage.linear, s.dt_s()).dc_gain()), 1.0, 1e-12);
+  // It runs as the bridge runs it.
+  auto backend = make_stage_backend(s);
+  double y = 0.0;
+  for (int k = 0; k < 20000; ++k) y = backend->step(100.0, k * s.dt_s(), s.dt_s()).y_true_m;
+  SimulatedStageConfig banning = s.stage;
+  banning.plant = PlantKind::kBanning;
+  SimulatedStage reference(banning);
+  double y_banning = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    reference.step(100.0, k * s.dt_s(), s.dt_s());
+    y_banning = reference.true_position_m();
+  }
+  EXPECT_NEAR(y, y_banning, 1e-6 * std::abs(y_banning));  // the same hysteresis, unit DC gain stages
+}
+
 TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("servo: {ki: -1}"), "bridge.yaml: servo.ki"));
   EXPECT_TRUE(contains(refusal("servo: {kp: -0.1}"), "bridge.yaml: servo.kp"));
