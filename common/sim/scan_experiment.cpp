@@ -34,6 +34,9 @@ LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const Identif
     c.compensator.stage.kind = StageModel::Kind::kSecondOrder;
     c.compensator.stage.second_order = c.stage.banning.stage;
     c.compensator.stage.order = c.stage.banning.order;
+  } else if (o.stage_inverse && e.plant == PlantKind::kSeries) {
+    c.compensator.stage.kind = StageModel::Kind::kLinear;  // the plant's own stage, delay included
+    c.compensator.stage.linear = o.stage_model ? *o.stage_model : e.series_stage;
   }
   c.compensator.learning.enabled = o.learning;
   c.compensator.servo_slew_reserve = o.servo_slew_reserve;

@@ -20,8 +20,17 @@ LoopSimulationConfig tracking_loop_config(const TrackingExperiment& e) {
   c.stage.seed = e.seed;
   c.stage.plant = e.plant;
   c.stage.ramberg_osgood = e.ramberg_osgood;
+  c.stage.hysteresis = e.series_hysteresis;
+  c.stage.linear = e.series_stage;
   c.compensator.mode = FeedforwardMode::kOff;
   return c;
+}
+
+TrackingExperiment two_mode_experiment() {
+  TrackingExperiment e;
+  e.plant = PlantKind::kSeries;
+  e.series_stage = LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, 1.5e-4);
+  return e;
 }
 
 void use_models(LoopSimulationConfig& c, const IdentifiedModels& models, const MemParams& mem) {

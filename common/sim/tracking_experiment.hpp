@@ -32,7 +32,14 @@ struct TrackingExperiment {
   // +drift_fraction over drift_duration_s from the start of the tracking run.
   double drift_fraction = 0.0;
   double drift_duration_s = 30.0;
+  // The series plant's (plant kSeries): its hysteresis, then its linear stage with delay.
+  HysteresisPlantSpec series_hysteresis{};
+  LinearStageSpec series_stage = SimulatedStageConfig{}.linear;
 };
+
+// A typical lab stage under a load: Banning's Table 1 hysteresis, then two lightly damped modes
+// (780 Hz, zeta 0.03, 92 % of the DC gain; 2.4 kHz, zeta 0.02, 8 %) and 1.5 ticks of I/O delay.
+TrackingExperiment two_mode_experiment();
 
 struct IdentifiedModels {
   MemParams mem;

@@ -13,6 +13,7 @@
 #include "models/param_config.hpp"
 #include "runtime/config_validation.hpp"
 #include "runtime/rig_auth_config.hpp"
+#include "runtime/stage_config.hpp"
 
 namespace hystloop {
 namespace {
@@ -80,9 +81,6 @@ FeedbackGains load_servo(const Config& config, int axis, FeedbackGains g, const 
 // the in-process simulation (SimulatedStageConfig::hysteresis).
 constexpr const char* kColemanHodgdonKeys[] = {"a", "b", "alpha", "s_max"};
 constexpr const char* kBoucWenKeys[] = {"d", "alpha", "beta", "gamma", "n", "rk4_substeps"};
-constexpr const char* kStageKeys[] = {"modes",         "zeros_hz",       "poles_hz",         "numerator_s",
-                                      "denominator_s", "numerator_zinv", "denominator_zinv", "discrete_dt_s",
-                                      "delay_s"};
 const std::string kHysteresisPrefix = "plant.hysteresis.";
 
 HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
@@ -126,74 +124,6 @@ HysteresisPlantSpec load_plant_hysteresis(const Config& config) {
     h.linear.validate();
   });
   return h;
-}
-
-// The series plant's linear stage in one of the forms a lab prints (models/linear_stage.hpp):
-// modes, zeros_hz/poles_hz, numerator_s/denominator_s or numerator_zinv/denominator_zinv with
-// discrete_dt_s; plus delay_s. None of them: Banning's Table 2 stage.
-LinearStageSpec load_plant_stage(const Config& config, LinearStageSpec stage) {
-  const std::string p = "plant.stage.";
-  // An empty list is a form not given: the deploy file shows every form's keys, all but one empty.
-  const auto given = [&](const char* key) {
-    const std::string k = p + key;
-    if (!config.has(k)) return false;
-    if (std::string_view(key) == "modes")
-      return !config.get_records(k, {"frequency_hz", "damping_ratio", "weight"}).empty();
-    if (std::string_view(key) == "zeros_hz" || std::string_view(key) == "poles_hz")
-      return !config.get_rows(k, 2).empty();
-    if (std::string_view(key) == "discrete_dt_s") return config.get<double>(k) != 0.0;
-    return !config.get<std::vector<double>>(k).empty();
-  };
-  std::string form;  // the first key of the form given, to name a second one
-  const auto choose = [&](const char* key) {
-    if (!form.empty()) config.fail(p + key, "give one form of the stage; " + p + form + " is given too");
-    form = key;
-  };
-  const auto require_with = [&](const char* key, const char* needed) {
-    if (!given(needed)) config.fail(p + needed, std::string("required with ") + p + key);
-  };
-  if (given("modes")) {
-    choose("modes");
-    const auto rows = config.get_records(p + "modes", {"frequency_hz", "damping_ratio", "weight"});
-    std::vector<LinearStageSpec::Mode> modes;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const std::string entry = p + "modes[" + std::to_string(i) + "]";
-      if (std::isnan(rows[i][0])) config.fail(entry + ".frequency_hz", "required");
-      if (std::isnan(rows[i][1])) config.fail(entry + ".damping_ratio", "required");
-      modes.push_back({rows[i][0], rows[i][1], std::isnan(rows[i][2]) ? 1.0 : rows[i][2]});
-    }
-    stage = LinearStageSpec::sum_of_modes(std::move(modes));
-  }
-  if (given("zeros_hz") || given("poles_hz")) {  // no zeros is a stage too
-    choose(given("poles_hz") ? "poles_hz" : "zeros_hz");
-    require_with("zeros_hz", "poles_hz");
-    const auto roots = [&](const char* key) {
-      std::vector<LinearStageSpec::Root> out;
-      for (const auto& r : config.get_rows(p + key, 2)) out.push_back({r[0], r[1]});
-      return out;
-    };
-    stage = LinearStageSpec::zero_pole(roots("zeros_hz"), roots("poles_hz"));
-  }
-  if (given("numerator_s") || given("denominator_s")) {
-    choose(given("numerator_s") ? "numerator_s" : "denominator_s");
-    require_with("numerator_s", "denominator_s");
-    require_with("denominator_s", "numerator_s");
-    stage = LinearStageSpec::transfer_function(config.get<std::vector<double>>(p + "numerator_s"),
-                                               config.get<std::vector<double>>(p + "denominator_s"));
-  }
-  if (given("numerator_zinv") || given("denominator_zinv") || given("discrete_dt_s")) {
-    choose(given("numerator_zinv")     ? "numerator_zinv"
-           : given("denominator_zinv") ? "denominator_zinv"
-                                       : "discrete_dt_s");
-    require_with("denominator_zinv", "numerator_zinv");
-    require_with("numerator_zinv", "denominator_zinv");
-    require_with("numerator_zinv", "discrete_dt_s");
-    stage = LinearStageSpec::discrete(config.get<std::vector<double>>(p + "numerator_zinv"),
-                                      config.get<std::vector<double>>(p + "denominator_zinv"),
-                                      config.get<double>(p + "discrete_dt_s"));
-  }
-  stage.delay_s = config.get<double>(p + "delay_s", 0.0);
-  return stage;
 }
 
 }  // namespace
@@ -297,7 +227,7 @@ const std::vector<std::string>& bridge_config_keys() {
     }
     for (const char* f : kBoucWenKeys) k.push_back(kHysteresisPrefix + "bouc_wen." + f);
     append_config_keys(k, kHysteresisPrefix + "linear", LinearDescriptor::table());
-    for (const char* f : kStageKeys) k.push_back(std::string("plant.stage.") + f);
+    for (std::string& key : linear_stage_keys("plant.stage")) k.push_back(std::move(key));
     return k;
   }();
   return all;
@@ -344,7 +274,7 @@ BridgeSettings load_bridge_settings(const Config& config) {
       config, "ro.", [&] { st.ramberg_osgood = params_from_config<MemDescriptor>(config, st.ramberg_osgood, "ro"); });
   // The series plant (plant.*), sampled at the bridge's tick; validated whatever the backend, as above.
   st.hysteresis = load_plant_hysteresis(config);
-  st.linear = load_plant_stage(config, st.linear);
+  st.linear = read_linear_stage(config, "plant.stage", st.linear);
   st.tick_s = s.dt_s();
   validate_config_section(config, "", [&] { st.validate(); });
   validate_config_section(config, "", [&] {

@@ -1,5 +1,6 @@
 #include "runtime/stage_config.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <numbers>
 #include <string>
@@ -15,50 +16,77 @@ namespace {
 
 std::string key(std::string_view prefix, const char* name) { return std::string(prefix) + "." + name; }
 
-// A flat list read as tuples of `width` numbers: the YAML lists of the section are lists of numbers.
-std::vector<double> tuples(const Config& config, const std::string& k, std::size_t width, const char* what) {
-  std::vector<double> v = config.get<std::vector<double>>(k, {});
-  if (v.size() % width != 0) {
-    config.fail(k, "must list " + std::string(what) + " (" + std::to_string(width) + " numbers each; got " +
-                       std::to_string(v.size()) + " numbers)");
-  }
-  return v;
-}
-
-std::vector<LinearStageSpec::Root> roots(const Config& config, const std::string& k) {
-  const std::vector<double> v = tuples(config, k, 2, "[re, im] pairs in Hz");
-  std::vector<LinearStageSpec::Root> out;
-  for (std::size_t i = 0; i < v.size(); i += 2) out.push_back({v[i], v[i + 1]});
-  return out;
-}
-
 }  // namespace
 
-LinearStageSpec read_linear_stage(const Config& config, std::string_view prefix) {
-  const std::string modes = key(prefix, "modes"), poles = key(prefix, "poles_hz"), zeros = key(prefix, "zeros_hz"),
-                    num = key(prefix, "numerator_s"), den = key(prefix, "denominator_s");
-  const int forms =
-      int{config.has(modes)} + int{config.has(poles) || config.has(zeros)} + int{config.has(num) || config.has(den)};
-  if (forms != 1) {
-    config.fail(modes, "a linear stage takes exactly one form: " + modes + ", " + poles + " (with " + zeros + "), or " +
-                           num + " with " + den);
+LinearStageSpec read_linear_stage(const Config& config, std::string_view prefix, LinearStageSpec stage) {
+  const std::string p = std::string(prefix) + ".";
+  // An empty list is a form not given: the deploy file shows every form's keys, all but one empty.
+  const auto given = [&](const char* key) {
+    const std::string k = p + key;
+    if (!config.has(k)) return false;
+    if (std::string_view(key) == "modes")
+      return !config.get_records(k, {"frequency_hz", "damping_ratio", "weight"}).empty();
+    if (std::string_view(key) == "zeros_hz" || std::string_view(key) == "poles_hz")
+      return !config.get_rows(k, 2).empty();
+    if (std::string_view(key) == "discrete_dt_s") return config.get<double>(k) != 0.0;
+    return !config.get<std::vector<double>>(k).empty();
+  };
+  std::string form;  // the first key of the form given, to name a second one
+  const auto choose = [&](const char* key) {
+    if (!form.empty()) config.fail(p + key, "give one form of the stage; " + p + form + " is given too");
+    form = key;
+  };
+  const auto require_with = [&](const char* key, const char* needed) {
+    if (!given(needed)) config.fail(p + needed, std::string("required with ") + p + key);
+  };
+  if (given("modes")) {
+    choose("modes");
+    const auto rows = config.get_records(p + "modes", {"frequency_hz", "damping_ratio", "weight"});
+    std::vector<LinearStageSpec::Mode> modes;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const std::string entry = p + "modes[" + std::to_string(i) + "]";
+      if (std::isnan(rows[i][0])) config.fail(entry + ".frequency_hz", "required");
+      if (std::isnan(rows[i][1])) config.fail(entry + ".damping_ratio", "required");
+      modes.push_back({rows[i][0], rows[i][1], std::isnan(rows[i][2]) ? 1.0 : rows[i][2]});
+    }
+    stage = LinearStageSpec::sum_of_modes(std::move(modes));
   }
-  const double delay_s = config.get_non_negative(key(prefix, "delay_s"), 0.0);
-  if (config.has(modes)) {
-    const std::vector<double> v = tuples(config, modes, 3, "modes as [frequency_Hz, damping_ratio, weight]");
-    std::vector<LinearStageSpec::Mode> m;
-    for (std::size_t i = 0; i < v.size(); i += 3) m.push_back({v[i], v[i + 1], v[i + 2]});
-    return LinearStageSpec::sum_of_modes(std::move(m), delay_s);
+  if (given("zeros_hz") || given("poles_hz")) {  // no zeros is a stage too
+    choose(given("poles_hz") ? "poles_hz" : "zeros_hz");
+    require_with("zeros_hz", "poles_hz");
+    const auto roots = [&](const char* key) {
+      std::vector<LinearStageSpec::Root> out;
+      for (const auto& r : config.get_rows(p + key, 2)) out.push_back({r[0], r[1]});
+      return out;
+    };
+    stage = LinearStageSpec::zero_pole(roots("zeros_hz"), roots("poles_hz"));
   }
-  if (config.has(poles) || config.has(zeros))
-    return LinearStageSpec::zero_pole(roots(config, zeros), roots(config, poles), delay_s);
-  return LinearStageSpec::transfer_function(config.get<std::vector<double>>(num, {}),
-                                            config.get<std::vector<double>>(den, {}), delay_s);
+  if (given("numerator_s") || given("denominator_s")) {
+    choose(given("numerator_s") ? "numerator_s" : "denominator_s");
+    require_with("numerator_s", "denominator_s");
+    require_with("denominator_s", "numerator_s");
+    stage = LinearStageSpec::transfer_function(config.get<std::vector<double>>(p + "numerator_s"),
+                                               config.get<std::vector<double>>(p + "denominator_s"));
+  }
+  if (given("numerator_zinv") || given("denominator_zinv") || given("discrete_dt_s")) {
+    choose(given("numerator_zinv")     ? "numerator_zinv"
+           : given("denominator_zinv") ? "denominator_zinv"
+                                       : "discrete_dt_s");
+    require_with("denominator_zinv", "numerator_zinv");
+    require_with("numerator_zinv", "denominator_zinv");
+    require_with("numerator_zinv", "discrete_dt_s");
+    stage = LinearStageSpec::discrete(config.get<std::vector<double>>(p + "numerator_zinv"),
+                                      config.get<std::vector<double>>(p + "denominator_zinv"),
+                                      config.get<double>(p + "discrete_dt_s"));
+  }
+  stage.delay_s = config.get<double>(p + "delay_s", stage.delay_s);
+  return stage;
 }
 
 std::vector<std::string> linear_stage_keys(std::string_view prefix) {
   std::vector<std::string> keys;
-  for (const char* name : {"modes", "poles_hz", "zeros_hz", "numerator_s", "denominator_s", "delay_s"}) {
+  for (const char* name : {"modes", "poles_hz", "zeros_hz", "numerator_s", "denominator_s", "numerator_zinv",
+                           "denominator_zinv", "discrete_dt_s", "delay_s"}) {
     keys.push_back(key(prefix, name));
   }
   return keys;
@@ -113,7 +141,15 @@ StageModel read_stage_model(const Config& config, const StageModel& defaults, do
     for (const char* key : {"stage.k", "stage.c"}) {
       if (config.has(key)) config.fail(key, "is Banning's second order: with stage.kind linear give the stage's form");
     }
-    stage.linear = read_linear_stage(config, "stage");
+    stage.linear = read_linear_stage(config, "stage", LinearStageSpec{});
+    bool given = false;
+    for (const std::string& key : linear_stage_keys("stage"))
+      given = given || (key != "stage.delay_s" && config.has(key));
+    if (!given) {
+      config.fail("stage.modes",
+                  "stage.kind linear needs the stage: stage.modes, stage.poles_hz (with "
+                  "stage.zeros_hz), stage.numerator_s with stage.denominator_s, or the discrete form");
+    }
     stage.preview_ticks = config.get<std::int64_t>("stage.preview_ticks", 0);
     stage.reference_bandwidth_hz = config.get_non_negative("stage.reference_bandwidth_hz", 0.0);
   } else {

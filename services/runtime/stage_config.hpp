@@ -18,14 +18,14 @@ namespace hystloop {
 // be invertible at (StageModel::validate).
 StageModel read_stage_model(const Config& config, const StageModel& defaults, double dt_s);
 
-// A linear stage under `prefix` ("stage", "plant.stage"), exactly one form of:
-//   <prefix>.modes: [f_Hz, zeta, weight, ...]               a sum of modes (weights: shares of DC)
-//   <prefix>.poles_hz / zeros_hz: [re, im, re, im, ...]     s = 2 pi (re + i im); im != 0 stands
-//                                                           for the conjugate pair, listed once
-//   <prefix>.numerator_s / denominator_s: [...]             coefficients, highest power of s first
-// and <prefix>.delay_s (input delay, fractional ticks allowed). Unit DC gain (the hysteresis
-// carries the gain). Not validated here (StageModel::validate or the plant's validate does it).
-LinearStageSpec read_linear_stage(const Config& config, std::string_view prefix);
+// A linear stage under `prefix` ("stage", "plant.stage") in one of the forms a lab prints
+// (models/linear_stage.hpp): <prefix>.modes as [{frequency_hz, damping_ratio, weight}, ...] (weight:
+// share of DC gain, default 1), <prefix>.zeros_hz / poles_hz as [[re, im], ...] in Hz (conjugate
+// pairs listed once), <prefix>.numerator_s / denominator_s (highest power of s first), or
+// <prefix>.numerator_zinv / denominator_zinv with discrete_dt_s; plus <prefix>.delay_s (fractional
+// ticks allowed). An empty list is a form not given; two forms, or half of a pair, are refused
+// naming the key; none: `stage` as given. Unit DC gain. Validated by the caller.
+LinearStageSpec read_linear_stage(const Config& config, std::string_view prefix, LinearStageSpec stage);
 // The keys read_linear_stage reads under `prefix`.
 std::vector<std::string> linear_stage_keys(std::string_view prefix);
 // One line for status and start-up: "second order k ... (1.72 kHz, zeta 0.094), inverted" or a

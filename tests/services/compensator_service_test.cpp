@@ -939,6 +939,30 @@ TEST(CompensatorSettings, TheStageTheLearningAndTheActuatorComeFromTheConfig) {
   EXPECT_FALSE(none.control.stage.has_dynamics());
 }
 
+// A linear stage of any order with delay, in the forms the bridge's plant takes: read, inverted
+// with the preview it needs, and refused naming the key.
+TEST(CompensatorSettings, ALinearStageIsReadInEveryFormAndRefusedByItsKey) {
+  const auto two_modes = load_compensator_settings(Config::from_string(
+      "stage: {kind: linear, delay_s: 1.5e-4, modes: [{frequency_hz: 780, damping_ratio: 0.03, weight: 0.92}, "
+      "{frequency_hz: 2400, damping_ratio: 0.02, weight: 0.08}]}",
+      "compensator.yaml"));
+  ASSERT_TRUE(two_modes.control.stage.is_linear());
+  EXPECT_EQ(two_modes.control.stage.linear.order(), 4);
+  EXPECT_DOUBLE_EQ(two_modes.control.stage.linear.delay_s, 1.5e-4);
+  const auto zpk = load_compensator_settings(Config::from_string(
+      "stage: {kind: linear, poles_hz: [[-23.4, 779.6], [-48, 2400]], zeros_hz: [[3000, 0]]}", "compensator.yaml"));
+  EXPECT_EQ(zpk.control.stage.linear.order(), 4);
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear}"), "stage.modes"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear, poles_hz: [[10, 100]]}"), "stage.poles"));  // unstable
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear, modes: [{frequency_hz: 780, damping_ratio: 0.03}], "
+                                        "k: 1.0e8}"),
+                       "stage.k"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: second_order, delay_s: 1.0e-4}"), "stage.delay_s"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear, preview_ticks: 1, delay_s: 1.5e-4, modes: "
+                                        "[{frequency_hz: 780, damping_ratio: 0.03}]}"),
+                       "stage.preview_ticks"));
+}
+
 }  // namespace
 }  // namespace hystloop
 
