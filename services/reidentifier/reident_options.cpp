@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "models/axis_coupling.hpp"
 #include "models/model_descriptors.hpp"
 #include "models/param_config.hpp"
@@ -52,8 +53,8 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
       const std::string name = models.substr(from, comma - from);
       const std::optional<ModelKind> kind = parse_model_kind(name);
       if (!kind)
-        config.fail("reidentifier.models",
-                    "expected off, auto or a list of mem,pi,katalenic,linear (got \"" + name + "\")");
+        config.fail("reidentifier.models", "expected off, auto or a comma-separated list of " +
+                                               choice_list(model_kind_names()) + " (got \"" + name + "\")");
       if (std::find(kinds.begin(), kinds.end(), *kind) != kinds.end())
         config.fail("reidentifier.models", "lists " + name + " twice");
       kinds.push_back(*kind);
@@ -72,7 +73,8 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   if (pin != "none") {
     m.pinned = parse_model_kind(pin);
     if (!m.pinned)
-      config.fail("reidentifier.pin_model", "expected none, mem, pi, katalenic or linear (got \"" + pin + "\")");
+      config.fail("reidentifier.pin_model",
+                  "expected none or " + choice_list(model_kind_names()) + " (got \"" + pin + "\")");
   }
   validate_config_section(config, "reident.", [&] { m.selector.validate(); });
 }

@@ -56,6 +56,7 @@
 #include "lcm/status_counters.hpp"
 #include "loop/trajectory.hpp"
 #include "models/axis_coupling.hpp"
+#include "models/feedforward_mode.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -327,10 +328,10 @@ int run(int argc, char** argv) {
   add_wait_options(reset, o);
 
   CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
-  mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
+  mode->add_option("mode", o.mode, selectable_mode_choices())->required();
   std::string pin_model;
   CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
-  pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
+  pin->add_option("model", pin_model, pin_model_choices() + " (alias off: choose again)")->required();
   int reident_axis = 0;
   add_axis_option(pin, "--axis", reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
   add_wait_options(pin, o);
