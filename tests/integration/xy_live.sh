@@ -51,6 +51,18 @@ grep -q "servo y gains in force: kp 0.03," "$dir/ctl-gains.out" &&
 [ "$(grep -c "gains in force: kp 0.05," "$dir/ctl-gains-all.out")" = 2 ] ||
   fail "every axis's kp should be 0.05: $(cat "$dir/ctl-gains-all.out")"
 
+# The loop time [s] (seq * 1e-4) of the newest sample x's recorder has written. sensor.csv is written
+# in 4 kB chunks, so a line may be cut short: only whole seqs (lines with all 8 fields) count.
+recorded_loop_time() {
+  tail -c 4096 "$dir/x/sensor.csv" 2>/dev/null |
+    awk -F, 'NF == 8 && $1 ~ /^[0-9]+$/ { last = $1 } END { if (last == "") exit 1; printf "%.4f\n", last * 1e-4 }'
+}
+loop_time_reached() {  # t_s
+  local now
+  now="$(recorded_loop_time)" || return 1
+  awk -v now="$now" -v t="$1" 'BEGIN { exit !(now >= t) }'
+}
+
 # Each figure's loop time from the compensator's verdict: "... from loop time A s to B s".
 figure() {  # label ctl-args...
   local label="$1"; shift
@@ -64,9 +76,13 @@ read -r dec_from dec_to < <(figure decoupled)
 sleep 1.2
 read -r cou_from cou_to < <(figure coupled --no-decouple)
 sleep 1.2
-# A fault of the command path in the middle of a third figure: the compensator dies.
-figure fault >/dev/null
-sleep 0.2
+# A fault of the command path in the middle of a third figure: the compensator dies once the loop
+# is half-way through it, as x's recording shows (it trails the loop by a few ms, never leads it).
+read -r fault_from fault_to < <(figure fault)
+[ -n "${fault_to:-}" ] || fail "the fault figure was not taken, or its loop time not reported"
+fault_mid=$(awk -v a="$fault_from" -v b="$fault_to" 'BEGIN { printf "%.4f", (a + b) / 2 }')
+wait_until 10 "the loop is half-way through the fault figure (loop time $fault_mid s; the figure $fault_from to $fault_to s)" \
+  loop_time_reached "$fault_mid"
 kill -KILL $cpid
 sleep 0.5
 kill -TERM $bpid; wait $bpid || true
@@ -128,5 +144,11 @@ awk -v r="$yd" -v b="$y_bound_m" 'BEGIN { exit !(r < b) }' || fail "y RMS $yd m 
 awk -v c="$kc" 'BEGIN { exit !(c > 0.002) }' || fail "without decoupling y's error holds only $kc of r_x: is x coupled into y?"
 awk -v c="$kc" -v d="$kd" -v g="$gain" 'BEGIN { exit !(c >= g * d) }' ||
   fail "decoupling left $kd of r_x in y's error ($kc without): less than a factor $gain"
+# The killed compensator's last command answered a sample inside the fault figure: the kill landed
+# in it, not before the figure began or after it ended.
+last_answered=$(awk -F, 'FNR > 1 && $2 > last { last = $2 } END { print last + 0 }' "$dir/x/command.csv")
+awk -v t="$(awk -v s="$last_answered" 'BEGIN { printf "%.4f", s * 1e-4 }')" -v from="$fault_from" -v to="$fault_to" \
+  'BEGIN { exit !(t >= from && t < to) }' ||
+  fail "the compensator's last command answered tick $last_answered, (loop time), not inside the fault figure ($fault_from to $fault_to s)"
 [ -n "$safe_x" ] && [ -n "$safe_y" ] || fail "an axis never entered the safe state after the compensator died"
 [ "$safe_x" = "$safe_y" ] || fail "the axes entered the safe state on different ticks: x $safe_x, y $safe_y"
