@@ -5,13 +5,13 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "core/cli.hpp"
 #include "core/config.hpp"
-#include "core/errors.hpp"
 #include "core/logging.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/connection.hpp"
@@ -24,6 +24,9 @@
 
 int main(int argc, char** argv) try {
   using namespace hystloop;
+  std::string model_list;  // "mem, pi, katalenic, linear": the registry's, for the description
+  for (const std::string_view name : model_kind_names())
+    model_list += (model_list.empty() ? "" : ", ") + std::string(name);
   CLI::App app{
       std::string(
           "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
@@ -41,9 +44,9 @@ int main(int argc, char** argv) try {
           "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
           "max_solver_time_s, reversal_dead_band_V, publish_invalid, stale_after_s, degraded_after_poisoned,\n"
           "lcm_queue, models, model_margin, model_period_s, model_decimation, pin_model}\n"
-          "With reidentifier.models on, it also ranks the ") +
-      choice_list(model_kind_names()) +
-      " fits of its window on a held-out\n"
+          "With reidentifier.models on, it also ranks fits of every online model (") +
+      model_list +
+      ") of its window on a held-out\n"
       "branch and publishes a model change on <rig>MODEL when another model wins by reidentifier.model_margin;\n"
       "hystloop-ctl pin-model pins the choice\n"
       "(see deploy/config/reidentifier.yaml). Exit codes: 0 clean stop, 1 runtime error, 2 bad configuration."};
