@@ -51,18 +51,6 @@ grep -q "servo y gains in force: kp 0.03," "$dir/ctl-gains.out" &&
 [ "$(grep -c "gains in force: kp 0.05," "$dir/ctl-gains-all.out")" = 2 ] ||
   fail "every axis's kp should be 0.05: $(cat "$dir/ctl-gains-all.out")"
 
-# The loop time [s] (seq * 1e-4) of the newest sample x's recorder has written. sensor.csv is written
-# in 4 kB chunks, so a line may be cut short: only whole seqs (lines with all 8 fields) count.
-recorded_loop_time() {
-  tail -c 4096 "$dir/x/sensor.csv" 2>/dev/null |
-    awk -F, 'NF == 8 && $1 ~ /^[0-9]+$/ { last = $1 } END { if (last == "") exit 1; printf "%.4f\n", last * 1e-4 }'
-}
-loop_time_reached() {  # t_s
-  local now
-  now="$(recorded_loop_time)" || return 1
-  awk -v now="$now" -v t="$1" 'BEGIN { exit !(now >= t) }'
-}
-
 # Each figure's loop time from the compensator's verdict: "... from loop time A s to B s".
 figure() {  # label ctl-args...
   local label="$1"; shift
@@ -77,12 +65,13 @@ sleep 1.2
 read -r cou_from cou_to < <(figure coupled --no-decouple)
 sleep 1.2
 # A fault of the command path in the middle of a third figure: the compensator dies once the loop
-# is half-way through it, as x's recording shows (it trails the loop by a few ms, never leads it).
+# is half-way through it, as HX_SENSOR shows (loop_probe wait-tick, bounded).
 read -r fault_from fault_to < <(figure fault)
 [ -n "${fault_to:-}" ] || fail "the fault figure was not taken, or its loop time not reported"
-fault_mid=$(awk -v a="$fault_from" -v b="$fault_to" 'BEGIN { printf "%.4f", (a + b) / 2 }')
-wait_until 10 "the loop is half-way through the fault figure (loop time $fault_mid s; the figure $fault_from to $fault_to s)" \
-  loop_time_reached "$fault_mid"
+fault_mid_tick=$(awk -v a="$fault_from" -v b="$fault_to" 'BEGIN { printf "%d", (a + b) / 2 * 1e4 }')
+"$probe" wait-tick --seq "$fault_mid_tick" --timeout 10 >"$dir/wait-fault.out" 2>&1 ||
+  fail "the loop did not reach the middle of the fault figure (tick $fault_mid_tick; the figure $fault_from to" \
+    "$fault_to s): $(cat "$dir/wait-fault.out")"
 kill -KILL $cpid
 sleep 0.5
 kill -TERM $bpid; wait $bpid || true
