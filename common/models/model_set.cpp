@@ -18,6 +18,13 @@ std::string describe_model(const ModelParamSet& set) {
   return std::string(to_string(set.kind)) + ": " + summary;
 }
 
+std::vector<std::string_view> model_kind_names() {
+  std::vector<std::string_view> names;
+  names.reserve(kModelKindCount);
+  for (int i = 0; i < kModelKindCount; ++i) names.push_back(to_string(static_cast<ModelKind>(i)));
+  return names;
+}
+
 std::optional<ModelKind> parse_model_kind(std::string_view name) noexcept {
   for (int i = 0; i < kModelKindCount; ++i) {
     const auto kind = static_cast<ModelKind>(i);

@@ -246,7 +246,11 @@ using OnlineModels = ModelList<OnlineModel<MemDescriptor, ModelKind::mem, &Model
                                OnlineModel<LinearDescriptor, ModelKind::linear, &ModelParams::linear, 1>>;
 
 std::string_view to_string(ModelKind kind) noexcept;
-// "mem|pi|katalenic|linear"; nullopt for anything else.
+// Every ModelKind's name, in ModelKind order ("mem", "pi", "katalenic", "linear"): what help texts
+// and refusals list as the models to choose from, so a model added to OnlineModels is listed
+// without editing them.
+std::vector<std::string_view> model_kind_names();
+// One of model_kind_names(); nullopt for anything else.
 std::optional<ModelKind> parse_model_kind(std::string_view name) noexcept;
 // The wire's number; nullopt when it names no model.
 std::optional<ModelKind> model_kind_from_int(std::int64_t value) noexcept;

@@ -8,6 +8,7 @@
 #include "core/cli.hpp"
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
+#include "models/feedforward_mode.hpp"
 #include "runtime/service_main.hpp"
 #include "runtime/service_options.hpp"
 
@@ -26,7 +27,7 @@ int main(int argc, char** argv) try {
   app.add_option("--params", params_files,
                  "Model parameters as `hystloop-identify --out` writes them (merged over the config; repeatable)")
       ->check(CLI::ExistingFile);
-  app.add_option("--mode", mode, "Feedforward: mem, pi, katalenic, linear or off [compensator.mode]");
+  app.add_option("--mode", mode, "Feedforward: " + selectable_mode_choices() + " [compensator.mode]");
   app.add_option("--seconds", seconds, "Stop after this many seconds [compensator.run_seconds]");
   app.add_option("--summary-json", summary_json,
                  "At exit, write the run's figures (samples, command ticks and blocks, ticks planned too late, gaps, "

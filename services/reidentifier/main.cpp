@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
@@ -23,22 +24,29 @@
 
 int main(int argc, char** argv) try {
   using namespace hystloop;
+  std::string model_list;  // "mem, pi, katalenic, linear": the registry's, for the description
+  for (const std::string_view name : model_kind_names())
+    model_list += (model_list.empty() ? "" : ", ") + std::string(name);
   CLI::App app{
-      "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
-      "to the online MEM estimator, refits every reidentifier.refit_period_s on a worker thread, and publishes\n"
-      "on <rig>PARAMS only candidates that pass validation (signs, ranges, residual, a held-out branch\n"
-      "better than the set in use), with their held-out residual. The initial set in use is the mem section\n"
-      "(the compensator's keys, version 1); a newer valid set published by anyone else on <rig>PARAMS\n"
-      "replaces it, and new versions are numbered above every one seen there or applied by the\n"
-      "compensator on <rig>COMMAND. Status on <rig>STATUS\n"
-      "(process \"reidentifier\" for axis x, \"reidentifier-y\" / \"reidentifier-z\" for the others) at 1 Hz.\n"
-      "One process fits one axis (--axis, reidentifier.axis: x, y or z; a lab runs one per axis): the axis's ticks\n"
-      "of every sensor block, the sets for it on <rig>PARAMS, and its sets carry it.\n"
-      "Configuration keys: mem.*, reidentifier.{axis, rate_hz, refit_period_s,\n"
-      "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
-      "max_solver_time_s, reversal_dead_band_V, publish_invalid, stale_after_s, degraded_after_poisoned,\n"
-      "lcm_queue, models, model_margin, model_period_s, model_decimation, pin_model}\n"
-      "With reidentifier.models on, it also ranks MEM, PI, Katalenic and linear fits of its window on a held-out\n"
+      std::string(
+          "hystloop-reidentifier: feeds <rig>SENSOR blocks (applied voltage and measured position per tick)\n"
+          "to the online MEM estimator, refits every reidentifier.refit_period_s on a worker thread, and publishes\n"
+          "on <rig>PARAMS only candidates that pass validation (signs, ranges, residual, a held-out branch\n"
+          "better than the set in use), with their held-out residual. The initial set in use is the mem section\n"
+          "(the compensator's keys, version 1); a newer valid set published by anyone else on <rig>PARAMS\n"
+          "replaces it, and new versions are numbered above every one seen there or applied by the\n"
+          "compensator on <rig>COMMAND. Status on <rig>STATUS\n"
+          "(process \"reidentifier\" for axis x, \"reidentifier-y\" / \"reidentifier-z\" for the others) at 1 Hz.\n"
+          "One process fits one axis (--axis, reidentifier.axis: x, y or z; a lab runs one per axis): the axis's "
+          "ticks\n"
+          "of every sensor block, the sets for it on <rig>PARAMS, and its sets carry it.\n"
+          "Configuration keys: mem.*, reidentifier.{axis, rate_hz, refit_period_s,\n"
+          "window_s, capacity_s, holdout_branches, min_relative_improvement, max_residual_rms_m,\n"
+          "max_solver_time_s, reversal_dead_band_V, publish_invalid, stale_after_s, degraded_after_poisoned,\n"
+          "lcm_queue, models, model_margin, model_period_s, model_decimation, pin_model}\n"
+          "With reidentifier.models on, it also ranks fits of every online model (") +
+      model_list +
+      ") of its window on a held-out\n"
       "branch and publishes a model change on <rig>MODEL when another model wins by reidentifier.model_margin;\n"
       "hystloop-ctl pin-model pins the choice\n"
       "(see deploy/config/reidentifier.yaml). Exit codes: 0 clean stop, 1 runtime error, 2 bad configuration."};

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "models/axis_coupling.hpp"
 #include "models/model_descriptors.hpp"
 #include "models/param_config.hpp"
@@ -40,6 +42,14 @@ constexpr const char* kReidentKeys[] = {
     "reidentifier.plausible_gain_factor",
 };
 
+// What reidentifier.pin_model accepts: "none, mem, pi, katalenic or linear".
+std::string pin_model_choices() {
+  std::vector<std::string_view> names{"none"};
+  const std::vector<std::string_view> models = model_kind_names();
+  names.insert(names.end(), models.begin(), models.end());
+  return choice_list(names);
+}
+
 // reidentifier.models, model_margin, model_period_s, model_regime_factor, model_decimation, pin_model.
 void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   const std::string models = config.get<std::string>("reidentifier.models", "off");
@@ -52,8 +62,8 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
       const std::string name = models.substr(from, comma - from);
       const std::optional<ModelKind> kind = parse_model_kind(name);
       if (!kind)
-        config.fail("reidentifier.models",
-                    "expected off, auto or a list of mem,pi,katalenic,linear (got \"" + name + "\")");
+        config.fail("reidentifier.models", "expected off, auto or a comma-separated list of models, each " +
+                                               choice_list(model_kind_names()) + " (got \"" + name + "\")");
       if (std::find(kinds.begin(), kinds.end(), *kind) != kinds.end())
         config.fail("reidentifier.models", "lists " + name + " twice");
       kinds.push_back(*kind);
@@ -71,8 +81,7 @@ void read_model_choice(const Config& config, ModelChoiceOptions& m) {
   const std::string pin = config.get<std::string>("reidentifier.pin_model", "none");
   if (pin != "none") {
     m.pinned = parse_model_kind(pin);
-    if (!m.pinned)
-      config.fail("reidentifier.pin_model", "expected none, mem, pi, katalenic or linear (got \"" + pin + "\")");
+    if (!m.pinned) config.fail("reidentifier.pin_model", "expected " + pin_model_choices() + " (got \"" + pin + "\")");
   }
   validate_config_section(config, "reident.", [&] { m.selector.validate(); });
 }

@@ -16,6 +16,8 @@
 //                      checks the recorded samples: never outside [u_min, u_max], never a step
 //                      above max(slew, ramp) * dt, every watchdog trip within watchdog_s + 5 ticks
 //                      of the last command applied; prints key=value figures. Exit 1 on a violation.
+//   loop_probe wait-tick --seq N [--timeout S]   exit 0 (printing the tick) once HX_SENSOR carries tick N or
+//                      later, 1 after S seconds (10) without it
 //   loop_probe status-value --dir D --process P --key K   the last (not STOPPING) report's value of K
 //                      (a counter name, or state/late/rejected/latency_p50_us/... or detail)
 #include <CLI/CLI.hpp>
@@ -56,6 +58,25 @@ std::int64_t now_utime() {
 }
 
 void pause_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+
+// Returns 0 as soon as a sensor block carries a tick >= seq (printing it), 1 after timeout_s
+// without one. A script waits on the loop itself this way: a file the recorder writes trails it,
+// and a shell poll forks per look, which on a loaded machine overshoots by tenths of a second.
+int wait_tick(lcm::LCM& lcm, const ChannelNames& ch, std::int64_t seq, double timeout_s) {
+  std::int64_t newest = -1;
+  Subscription<sensor_block_t> s(lcm, ch.sensor, [&](const sensor_block_t& m, std::int64_t) {
+    for_each_tick(m, [&](const SensorTick& t) { newest = std::max(newest, t.seq); });
+  });
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (newest < seq && std::chrono::steady_clock::now() < end) handle_pending(lcm, std::chrono::milliseconds(5));
+  if (newest < seq) {
+    std::fprintf(stderr, "loop_probe: no tick %lld within %g s (newest seen: %lld)\n", static_cast<long long>(seq),
+                 timeout_s, static_cast<long long>(newest));
+    return 1;
+  }
+  std::printf("%lld\n", static_cast<long long>(newest));
+  return 0;
+}
 
 int record(lcm::LCM& lcm, const ChannelNames& ch, const std::string& dir, double seconds, int rt_priority,
            std::size_t axis) {
@@ -472,6 +493,12 @@ int run_probe(int argc, char** argv) {
   an->add_option("--dt", dt);
   an->add_option("--watchdog", watchdog);
 
+  std::int64_t wait_seq = 0;
+  double wait_timeout_s = 10;
+  auto* wt = app.add_subcommand("wait-tick");
+  wt->add_option("--seq", wait_seq)->required();
+  wt->add_option("--timeout", wait_timeout_s, "give up after this long [s]");
+
   std::string process, key;
   auto* sv = app.add_subcommand("status-value");
   sv->add_option("--dir", dir)->required();
@@ -487,6 +514,7 @@ int run_probe(int argc, char** argv) {
     if (*rec) return record(*lcm, ch, dir, seconds, rt_priority, axis);
     if (*ctl) return control(*lcm, ch, ca);
     if (*inj) return inject(*lcm, ch, target, count);
+    if (*wt) return wait_tick(*lcm, ch, wait_seq, wait_timeout_s);
     if (*tr) {
       traj.utime = now_utime();
       traj.shape = static_cast<std::int8_t>(shape);

@@ -64,9 +64,14 @@ read -r dec_from dec_to < <(figure decoupled)
 sleep 1.2
 read -r cou_from cou_to < <(figure coupled --no-decouple)
 sleep 1.2
-# A fault of the command path in the middle of a third figure: the compensator dies.
-figure fault >/dev/null
-sleep 0.2
+# A fault of the command path in the middle of a third figure: the compensator dies once the loop
+# is half-way through it, as HX_SENSOR shows (loop_probe wait-tick, bounded).
+read -r fault_from fault_to < <(figure fault)
+[ -n "${fault_to:-}" ] || fail "the fault figure was not taken, or its loop time not reported"
+fault_mid_tick=$(awk -v a="$fault_from" -v b="$fault_to" 'BEGIN { printf "%d", (a + b) / 2 * 1e4 }')
+"$probe" wait-tick --seq "$fault_mid_tick" --timeout 10 >"$dir/wait-fault.out" 2>&1 ||
+  fail "the loop did not reach the middle of the fault figure (tick $fault_mid_tick; the figure $fault_from to" \
+    "$fault_to s): $(cat "$dir/wait-fault.out")"
 kill -KILL $cpid
 sleep 0.5
 kill -TERM $bpid; wait $bpid || true
@@ -128,5 +133,11 @@ awk -v r="$yd" -v b="$y_bound_m" 'BEGIN { exit !(r < b) }' || fail "y RMS $yd m 
 awk -v c="$kc" 'BEGIN { exit !(c > 0.002) }' || fail "without decoupling y's error holds only $kc of r_x: is x coupled into y?"
 awk -v c="$kc" -v d="$kd" -v g="$gain" 'BEGIN { exit !(c >= g * d) }' ||
   fail "decoupling left $kd of r_x in y's error ($kc without): less than a factor $gain"
+# The killed compensator's last command answered a sample inside the fault figure: the kill landed
+# in it, not before the figure began or after it ended.
+last_answered=$(awk -F, 'FNR > 1 && $2 > last { last = $2 } END { print last + 0 }' "$dir/x/command.csv")
+awk -v t="$(awk -v s="$last_answered" 'BEGIN { printf "%.4f", s * 1e-4 }')" -v from="$fault_from" -v to="$fault_to" \
+  'BEGIN { exit !(t >= from && t < to) }' ||
+  fail "the compensator's last command answered tick $last_answered, (loop time), not inside the fault figure ($fault_from to $fault_to s)"
 [ -n "$safe_x" ] && [ -n "$safe_y" ] || fail "an axis never entered the safe state after the compensator died"
 [ "$safe_x" = "$safe_y" ] || fail "the axes entered the safe state on different ticks: x $safe_x, y $safe_y"

@@ -79,7 +79,9 @@ TEST(ReidentCore, AdoptsABetterSetWithTheNextVersion) {
   ASSERT_EQ(d.kind, Kind::accepted) << to_string(d.status);
   EXPECT_EQ(d.version, 2);
   EXPECT_TRUE(d.fitted);
-  EXPECT_LT(testdata::rel_err(d.candidate.c1, rig.truth.c1), 0.01);
+  // The fit lands 2.7e-4 from the true c1 on this record (1 nm noise); 1e-3 leaves room for another
+  // standard library's normal_distribution drawing other noise, and still fails a fit that is off.
+  EXPECT_LT(testdata::rel_err(d.candidate.c1, rig.truth.c1), 1e-3);
   EXPECT_GT(d.holdout_rms_candidate_m, 0.0);
   EXPECT_LT(d.holdout_rms_candidate_m, 0.5 * d.holdout_rms_in_use_m);
   EXPECT_EQ(d.window_samples, 5000u);
@@ -107,7 +109,7 @@ TEST(ReidentCore, HeldItJudgesAndCountsABetterSetButAdoptsNothingUntilReleased) 
   rig.advance();
   const RefitDecision held = rig.refit();
   ASSERT_EQ(held.kind, Kind::held) << to_string(held.status);
-  EXPECT_LT(testdata::rel_err(held.candidate.c1, rig.truth.c1), 0.01);  // fitted and reported
+  EXPECT_LT(testdata::rel_err(held.candidate.c1, rig.truth.c1), 1e-3);  // fitted (as above) and reported
   EXPECT_LT(held.holdout_rms_candidate_m, 0.5 * held.holdout_rms_in_use_m);
   EXPECT_EQ(rig.core.in_use().version(), 1);  // the set in use stays
   EXPECT_DOUBLE_EQ(rig.core.in_use().params().c1, rig.initial.c1);

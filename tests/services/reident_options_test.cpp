@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include "core/errors.hpp"
 #include "models/model_descriptors.hpp"
 
 namespace hystloop {
@@ -71,6 +74,24 @@ TEST(ReidentOptions, RefusalsNameTheField) {
   const std::string typo = refusal("reidentifier: {refit_period: 2}");
   EXPECT_NE(typo.find("reidentifier.refit_period: unknown key"), std::string::npos) << typo;
   EXPECT_NE(typo.find("reidentifier.refit_period_s"), std::string::npos) << typo;
+}
+
+// The model choice's refusals list the models from the registry (models/model_set.hpp): every
+// online model, so one added there is named without editing the message.
+TEST(ReidentOptions, ModelChoiceRefusalsListEveryOnlineModel) {
+  const std::string models = refusal("reidentifier: {models: \"mem,foo\"}");
+  const std::string pin = refusal("reidentifier: {pin_model: foo}");
+  EXPECT_NE(models.find("reidentifier.models: expected off, auto or a comma-separated list of models, each " +
+                        choice_list(model_kind_names()) + " (got \"foo\")"),
+            std::string::npos)
+      << models;
+  std::vector<std::string_view> pins{"none"};
+  for (const std::string_view name : model_kind_names()) pins.push_back(name);
+  EXPECT_NE(pin.find("reidentifier.pin_model: expected " + choice_list(pins) + " (got \"foo\")"), std::string::npos)
+      << pin;
+  for (const std::string_view name : model_kind_names()) {
+    EXPECT_EQ(refusal("reidentifier: {pin_model: " + std::string(name) + "}"), "accepted") << name;
+  }
 }
 
 // mem: is read through the MEM's parameter table, as the compensator reads it: every key (and

@@ -11,11 +11,13 @@ namespace hystloop::ctl {
 std::int8_t pin_model_mode(const std::string& name) {
   if (name == "auto" || name == "off") return to_wire(FeedforwardMode::kOff);
   if (const auto kind = parse_model_kind(name)) return to_wire(mode_of(*kind));
-  std::vector<std::string_view> names;
-  names.reserve(kModelKindCount + 1);
-  for (int i = 0; i < kModelKindCount; ++i) names.push_back(to_string(static_cast<ModelKind>(i)));
+  throw ParameterError("model", "expected " + pin_model_choices() + " (got \"" + name + "\")");
+}
+
+std::string pin_model_choices() {
+  std::vector<std::string_view> names = model_kind_names();
   names.emplace_back("auto");
-  throw ParameterError("model", "expected " + choice_list(names) + " (got \"" + name + "\")");
+  return choice_list(names);
 }
 
 std::string reidentifier_process(int axis) {

@@ -4,9 +4,12 @@
 //
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
-//   mode off|linear|mem|pi|katalenic                 gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--target bridge]
+//   mode off|MODEL                                   gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--target bridge]
 //   learn on|off|reset [--target compensator]        learning for periodic references (SET_LEARNING)
-//   pin-model mem|pi|katalenic|linear|auto           the re-identifier's model choice (ctl_pin_model.hpp)
+//   pin-model MODEL|auto [--axis x|y|z]              the re-identifier's model choice (ctl_pin_model.hpp)
+//   hold on|off [--axis x|y|z]                       the re-identifier keeps the set and model in use
+//                                                    (fits and reports on, publishes nothing) or lets go
+//   (MODEL: an online model, models/model_set.hpp; mode --help and pin-model --help list them)
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
@@ -56,6 +59,7 @@
 #include "lcm/status_counters.hpp"
 #include "loop/trajectory.hpp"
 #include "models/axis_coupling.hpp"
+#include "models/feedforward_mode.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -92,6 +96,12 @@ struct Options {
   StatusOptions status;
   WatchOptions watch;
   AckOptions ack;
+  ConfigGetOptions config_get;
+  std::string keygen_out;
+  bool keygen_force = false;
+  std::string pin_model;  // pin-model's argument
+  std::string hold;       // hold's argument: on or off
+  int reident_axis = 0;   // pin-model's and hold's --axis
 };
 
 int send_control(const Options& o, std::int8_t command, const std::string& target, const std::string& what,
@@ -278,25 +288,45 @@ CLI::App* control_subcommand(CLI::App& app, const char* name, const char* help, 
   return sub;
 }
 
-int run(int argc, char** argv) {
-  Options o;
-  CLI::App app{
-      "hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
-      "learning, experiments, trajectories, parameters, live tracking error)"};
-  app.require_subcommand(1);
-  app.fallthrough();
-  app.add_option("--lcm-url", o.link.lcm_url,
-                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
-  app.add_flag("--allow-network", o.link.allow_network, "Accept an LCM URL whose packets can leave this host");
-  app.add_option("--rig", o.link.rig, "Channel prefix of the rig")->capture_default_str();
-  std::string key_file, keygen_out;
-  bool keygen_force = false;
-  app.add_option("--key-file", key_file,
-                 "The rig key (auth.key_file of the services): sign requests, trajectories and parameters with it");
-  CLI::App* keygen = app.add_subcommand("keygen", "Write a new rig key (mode 0600) for auth.key_file (no LCM)");
-  keygen->add_option("--out", keygen_out, "Key file to create")->required();
-  keygen->add_flag("--force", keygen_force, "Replace an existing file (every host of the rig then needs the new key)");
+// A command group's dispatch, made when its subcommands are added: the exit code of the one given,
+// or nullopt when none of the group's was.
+using CommandRun = std::function<std::optional<int>()>;
 
+// keygen: a new rig key file (no LCM).
+CommandRun add_keygen_command(CLI::App& app, Options& o) {
+  CLI::App* keygen = app.add_subcommand("keygen", "Write a new rig key (mode 0600) for auth.key_file (no LCM)");
+  keygen->add_option("--out", o.keygen_out, "Key file to create")->required();
+  keygen->add_flag("--force", o.keygen_force,
+                   "Replace an existing file (every host of the rig then needs the new key)");
+
+  return [&o, keygen]() -> std::optional<int> {
+    if (!*keygen) return std::nullopt;
+    write_rig_key(o.keygen_out, generate_rig_key(), o.keygen_force);
+    std::printf(
+        "wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
+        "auth.key_file in every service's config\n",
+        o.keygen_out.c_str());
+    return 0;
+  };
+}
+
+// config-get: a YAML file's value for scripts (no LCM).
+CommandRun add_config_get_command(CLI::App& app, Options& o) {
+  CLI::App* config_get = app.add_subcommand("config-get",
+                                            "Print a YAML file's value: a scalar, a list's elements or a "
+                                            "map's keys, one per line (no LCM)");
+  config_get->add_option("file", o.config_get.file, "YAML file (e.g. deploy/rig.yaml)")->required();
+  config_get->add_option("key", o.config_get.key, "Dotted key path (e.g. hosts.stage-pc.services)")->required();
+  config_get->add_option("--default", o.config_get.default_value, "Print this when the key is absent");
+
+  return [&o, config_get]() -> std::optional<int> {
+    if (!*config_get) return std::nullopt;
+    return run_config_get(o.config_get);
+  };
+}
+
+// status: the processes' latest reports, or a wait until they are healthy.
+CommandRun add_status_command(CLI::App& app, Options& o) {
   CLI::App* status = app.add_subcommand("status", "Print the latest HX_STATUS of each process, or wait until healthy");
   status->add_option("--wait-healthy", o.status.wait_healthy,
                      "Exit 0 as soon as each of these processes reports HEALTHY; 1 after --timeout");
@@ -308,14 +338,16 @@ int run(int argc, char** argv) {
   with_default(status, "--listen", o.status.listen_s, "Without --wait-healthy: how long to collect reports [s]");
   status->add_flag("--counters", o.status.all_counters, "Also print every named counter");
 
-  ConfigGetOptions config_get_options;
-  CLI::App* config_get = app.add_subcommand("config-get",
-                                            "Print a YAML file's value: a scalar, a list's elements or a "
-                                            "map's keys, one per line (no LCM)");
-  config_get->add_option("file", config_get_options.file, "YAML file (e.g. deploy/rig.yaml)")->required();
-  config_get->add_option("key", config_get_options.key, "Dotted key path (e.g. hosts.stage-pc.services)")->required();
-  config_get->add_option("--default", config_get_options.default_value, "Print this when the key is absent");
+  return [&o, status]() -> std::optional<int> {
+    if (!*status) return std::nullopt;
+    if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
+    CtlLink link(o.link);
+    return run_status(link, o.status);
+  };
+}
 
+// arm, disarm, stop-experiment, shutdown, reset-counters: one control_t command each, no argument.
+CommandRun add_process_commands(CLI::App& app, Options& o) {
   CLI::App* arm = control_subcommand(app, "arm", "Bridge: leave the safe state and apply commands", o);
   CLI::App* disarm = control_subcommand(app, "disarm", "Bridge: enter the safe state now", o);
   CLI::App* stop_exp = control_subcommand(app, "stop-experiment", "Compensator: stop the identification experiment", o);
@@ -326,24 +358,58 @@ int run(int argc, char** argv) {
   reset->add_option("process", o.process, "Process (default: all)");
   add_wait_options(reset, o);
 
+  return [&o, arm, disarm, stop_exp, shutdown, reset]() -> std::optional<int> {
+    if (*arm) return send_control(o, control_t::ARM, o.target, "ARM", "bridge", counter_is("armed", 1));
+    if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM", "bridge", counter_is("armed", 0));
+    if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT", "compensator");
+    if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN", nullptr);
+    if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
+    return std::nullopt;
+  };
+}
+
+// mode (the compensator's feedforward), pin-model and hold (the re-identifier's model and parameters).
+CommandRun add_model_choice_commands(CLI::App& app, Options& o) {
   CLI::App* mode = control_subcommand(app, "mode", "Compensator: switch the feedforward model", o);
-  mode->add_option("mode", o.mode, "off, linear, mem, pi or katalenic")->required();
-  std::string pin_model;
+  mode->add_option("mode", o.mode, selectable_mode_choices())->required();
+
   CLI::App* pin = app.add_subcommand("pin-model", "Re-identifier: pin the model (no automatic change), or auto");
-  pin->add_option("model", pin_model, "mem, pi, katalenic, linear, or auto (alias off: choose again)")->required();
-  int reident_axis = 0;
-  add_axis_option(pin, "--axis", reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
+  pin->add_option("model", o.pin_model, pin_model_choices() + " (alias off: choose again)")->required();
+  add_axis_option(pin, "--axis", o.reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
   add_wait_options(pin, o);
-  std::string hold_what;
+
   CLI::App* hold = app.add_subcommand(
       "hold",
       "Re-identifier: hold the parameters and model in use (it keeps fitting and reporting, publishes nothing)");
-  hold->add_option("what", hold_what, "on (hold) or off (release: publish what it fits from now on)")
+  hold->add_option("what", o.hold, "on (hold) or off (release: publish what it fits from now on)")
       ->required()
       ->check(CLI::IsMember({"on", "off"}));
-  add_axis_option(hold, "--axis", reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
+  add_axis_option(hold, "--axis", o.reident_axis, "The re-identifier of this axis (default x: 'reidentifier')");
   add_wait_options(hold, o);
 
+  return [&o, mode, pin, hold]() -> std::optional<int> {
+    if (*pin) {
+      const std::int8_t m = ctl::pin_model_mode(o.pin_model);
+      return send_control(o, control_t::SET_MODE, reidentifier_process(o.reident_axis), "PIN_MODEL " + o.pin_model,
+                          nullptr, {}, [m](control_t& msg) { msg.mode = m; });
+    }
+    if (*hold) {
+      const bool on = o.hold == "on";
+      return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS,
+                          reidentifier_process(o.reident_axis), on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr,
+                          counter_is("params_held", on ? 1 : 0));
+    }
+    if (*mode) {
+      const std::int8_t m = parse_mode(o.mode);
+      return send_control(o, control_t::SET_MODE, o.target, "SET_MODE " + o.mode, "compensator", counter_is("mode", m),
+                          [m](control_t& msg) { msg.mode = m; });
+    }
+    return std::nullopt;
+  };
+}
+
+// gains: the bridge's servo, set or printed.
+CommandRun add_gains_command(CLI::App& app, Options& o) {
   CLI::App* gains = app.add_subcommand(
       "gains",
       "Bridge: change the servo's gains given (the others stay as in force), or print the gains in force "
@@ -360,12 +426,32 @@ int run(int argc, char** argv) {
                   "given); printing: every axis's");
   add_wait_options(gains, o);
 
+  return [&o, gains]() -> std::optional<int> {
+    if (!*gains) return std::nullopt;
+    if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
+    return run_gains(o);
+  };
+}
+
+// learn: the compensator's learning of the feedforward.
+CommandRun add_learn_command(CLI::App& app, Options& o) {
   CLI::App* learn = app.add_subcommand("learn", "Compensator: learning of the feedforward for periodic references");
   learn->add_option("what", o.learning, "on, off (drops the correction, ramped out) or reset (starts again)")
       ->required();
   with_default(learn, "--target", o.learn_target, "Process that learns (the compensator)");
   add_wait_options(learn, o);
 
+  return [&o, learn]() -> std::optional<int> {
+    if (!*learn) return std::nullopt;
+    const std::int8_t l = parse_learning(o.learning);
+    if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
+    return send_control(o, control_t::SET_LEARNING, o.learn_target, "SET_LEARNING " + o.learning, nullptr, {},
+                        [l](control_t& msg) { msg.learning = l; });
+  };
+}
+
+// experiment: a sine, the MEM paper's input, Banning's series or an XY(Z) stage's coupling.
+CommandRun add_experiment_command(CLI::App& app, Options& o) {
   CLI::App* experiment = control_subcommand(
       app, "experiment",
       "Compensator: run an identification experiment (a sine, the MEM paper's input, or Banning's series); "
@@ -409,7 +495,7 @@ int run(int argc, char** argv) {
       ->needs(series);
   experiment->add_flag(
       "--no-wait",
-      [&](std::int64_t) {
+      [&o](std::int64_t) {
         o.series.wait = false;
         o.ack.wait = false;
       },
@@ -430,6 +516,36 @@ int run(int argc, char** argv) {
   with_default(experiment, "--rest", o.coupling_run.rest_s, "coupling: rest between the axes' experiments [s]")
       ->needs(coupling);
 
+  return [&o, experiment, amplitude, frequency, duration]() -> std::optional<int> {
+    if (!*experiment) return std::nullopt;
+    if (o.banning_series) return run_banning_series(o);
+    if (o.coupling) {
+      CouplingRunOptions& c = o.coupling_run;
+      if (amplitude->count() > 0) c.amplitude_V = o.experiment.amplitude_V;
+      if (frequency->count() > 0) c.frequency_Hz = o.experiment.frequency_Hz;
+      if (duration->count() > 0) c.duration_s = o.experiment.duration_s;
+      c.timeout_s = o.ack.timeout_s;
+      CtlLink link(o.link);
+      return run_coupling_experiment(link, c);
+    }
+    if (o.experiment_mem_paper) {
+      o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
+    } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
+      throw ParameterError("experiment",
+                           "give --amplitude, --frequency and --duration, or --mem-paper, or "
+                           "--banning-series");
+    }
+    o.experiment.validate();
+    return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
+                        [&o](control_t& msg) {
+                          apply(o.experiment, msg);
+                          msg.axis = static_cast<std::int8_t>(o.experiment_axis);
+                        });
+  };
+}
+
+// trajectory and scan: a reference for one axis or a path of every axis, then the compensator's verdict.
+CommandRun add_reference_commands(CLI::App& app, Options& o) {
   CLI::App* trajectory = app.add_subcommand("trajectory", "Send the reference trajectory (HX_TRAJECTORY)");
   trajectory->add_option("--shape", o.trajectory.shape, trajectory_shape_choices());
   with_default(trajectory, "--amplitude", o.trajectory.amplitude_m, "Peak amplitude [m] (may be negative)");
@@ -450,7 +566,7 @@ int run(int argc, char** argv) {
                        "If the feedforward would leave the actuator's range or slew limit, let the compensator "
                        "shape the trajectory (smaller amplitude, rounder corners) instead of refusing it");
   auto* no_wait = trajectory->add_flag(
-      "--no-wait", [&](std::int64_t) { o.verdict.wait = false; },
+      "--no-wait", [&o](std::int64_t) { o.verdict.wait = false; },
       "Send and return at once, without waiting for the compensator's verdict");
   with_default(trajectory, "--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
       ->excludes(no_wait);
@@ -483,16 +599,25 @@ int run(int argc, char** argv) {
   with_default(scan, "--duration", o.scan.duration_s, "lissajous: how long it runs [s]");
   scan->add_option("--centre", o.scan.centre_m, "the path's centre per axis x,y[,z] [m] (default 0)")->delimiter(',');
   scan->add_flag(
-      "--no-decouple", [&](std::int64_t) { o.scan.decouple = false; },
+      "--no-decouple", [&o](std::int64_t) { o.scan.decouple = false; },
       "Give each axis its own reference alone, not its share of C^-1 r (to see the coupling)");
   with_default(scan, "--blend", o.scan.blend_s, "The approach from where each axis is [s]");
   auto* scan_no_wait = scan->add_flag(
-      "--no-wait", [&](std::int64_t) { o.verdict.wait = false; },
+      "--no-wait", [&o](std::int64_t) { o.verdict.wait = false; },
       "Send and return at once, without waiting for the compensator's verdict");
   with_default(scan, "--timeout", o.verdict.timeout_s, "How long to wait for the compensator's verdict [s]")
       ->excludes(scan_no_wait);
   with_default(scan, "--compensator", o.verdict.compensator_process, "Process name of the compensator in HX_STATUS");
 
+  return [trajectory, scan, &o]() -> std::optional<int> {
+    if (*trajectory) return send_trajectory(o);
+    if (*scan) return send_scan(o);
+    return std::nullopt;
+  };
+}
+
+// params: a MEM parameter set, then its adoption.
+CommandRun add_params_command(CLI::App& app, Options& o) {
   CLI::App* params = app.add_subcommand("params", "Send a MEM parameter set (HX_PARAMS, valid, source hystloop-ctl)");
   params->add_option("--c1", o.params.c1, "Slope at a branch point [m/V], > 0")->required();
   params->add_option("--c2", o.params.c2, "Growth of the slope [m/V^(1+c3)], >= 0")->required();
@@ -506,6 +631,14 @@ int run(int argc, char** argv) {
   add_axis_option(params, "--axis", o.params.axis, "The axis whose hysteresis it models (default x)");
   add_wait_options(params, o);
 
+  return [params, &o]() -> std::optional<int> {
+    if (!*params) return std::nullopt;
+    return send_params(o);
+  };
+}
+
+// watch: the tracking error and the loop's health, once a second.
+CommandRun add_watch_command(CLI::App& app, Options& o) {
   CLI::App* watch = app.add_subcommand("watch",
                                        "Print the tracking error (from HX_SENSOR), params version, late "
                                        "commands and the bridge's lowest buffer depth once a second");
@@ -514,85 +647,47 @@ int run(int argc, char** argv) {
   with_default(watch, "--compensator", o.watch.compensator_process, "Process name of the compensator in HX_STATUS");
   add_axis_option(watch, "--axis", o.watch.axis, "The axis watched on a stage of several (default x)");
 
-  if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
-
-  if (*config_get) return run_config_get(config_get_options);
-  if (*keygen) {
-    write_rig_key(keygen_out, generate_rig_key(), keygen_force);
-    std::printf(
-        "wrote a new rig key to %s (mode 0600): copy it to each host of the rig (keep it 0600) and set "
-        "auth.key_file in every service's config\n",
-        keygen_out.c_str());
-    return 0;
-  }
-  if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
-  if (*status) {
-    if (o.status.timeout_s <= 0 || o.status.listen_s <= 0) throw ParameterError("timeout", "must be > 0");
-    CtlLink link(o.link);
-    return run_status(link, o.status);
-  }
-  if (*arm) return send_control(o, control_t::ARM, o.target, "ARM", "bridge", counter_is("armed", 1));
-  if (*disarm) return send_control(o, control_t::DISARM, o.target, "DISARM", "bridge", counter_is("armed", 0));
-  if (*stop_exp) return send_control(o, control_t::STOP_EXPERIMENT, o.target, "STOP_EXPERIMENT", "compensator");
-  if (*shutdown) return send_control(o, control_t::SHUTDOWN, o.process, "SHUTDOWN", nullptr);
-  if (*reset) return send_control(o, control_t::RESET_COUNTERS, o.process, "RESET_COUNTERS", nullptr);
-  if (*pin) {
-    const std::int8_t m = ctl::pin_model_mode(pin_model);
-    return send_control(o, control_t::SET_MODE, reidentifier_process(reident_axis), "PIN_MODEL " + pin_model, nullptr,
-                        {}, [m](control_t& msg) { msg.mode = m; });
-  }
-  if (*hold) {
-    const bool on = hold_what == "on";
-    return send_control(o, on ? control_t::HOLD_PARAMS : control_t::RELEASE_PARAMS, reidentifier_process(reident_axis),
-                        on ? "HOLD_PARAMS" : "RELEASE_PARAMS", nullptr, counter_is("params_held", on ? 1 : 0));
-  }
-  if (*mode) {
-    const std::int8_t m = parse_mode(o.mode);
-    return send_control(o, control_t::SET_MODE, o.target, "SET_MODE " + o.mode, "compensator", counter_is("mode", m),
-                        [m](control_t& msg) { msg.mode = m; });
-  }
-  if (*gains) {
-    if (o.gains_target.empty()) throw ParameterError("target", "gains go to the bridge's servo: name its process");
-    return run_gains(o);
-  }
-  if (*learn) {
-    const std::int8_t l = parse_learning(o.learning);
-    if (o.learn_target.empty()) throw ParameterError("target", "learning is the compensator's: name its process");
-    return send_control(o, control_t::SET_LEARNING, o.learn_target, "SET_LEARNING " + o.learning, nullptr, {},
-                        [l](control_t& msg) { msg.learning = l; });
-  }
-  if (*experiment) {
-    if (o.banning_series) return run_banning_series(o);
-    if (o.coupling) {
-      CouplingRunOptions& c = o.coupling_run;
-      if (amplitude->count() > 0) c.amplitude_V = o.experiment.amplitude_V;
-      if (frequency->count() > 0) c.frequency_Hz = o.experiment.frequency_Hz;
-      if (duration->count() > 0) c.duration_s = o.experiment.duration_s;
-      c.timeout_s = o.ack.timeout_s;
-      CtlLink link(o.link);
-      return run_coupling_experiment(link, c);
-    }
-    if (o.experiment_mem_paper) {
-      o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
-    } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
-      throw ParameterError("experiment",
-                           "give --amplitude, --frequency and --duration, or --mem-paper, or "
-                           "--banning-series");
-    }
-    o.experiment.validate();
-    return send_control(o, control_t::START_EXPERIMENT, o.target, "START_EXPERIMENT", "compensator", {},
-                        [&](control_t& msg) {
-                          apply(o.experiment, msg);
-                          msg.axis = static_cast<std::int8_t>(o.experiment_axis);
-                        });
-  }
-  if (*trajectory) return send_trajectory(o);
-  if (*scan) return send_scan(o);
-  if (*params) return send_params(o);
-  if (*watch) {
+  return [&o, watch]() -> std::optional<int> {
+    if (!*watch) return std::nullopt;
     require_non_negative("seconds", o.watch.seconds);
     CtlLink link(o.link);
     return run_watch(link, o.watch);
+  };
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "hystloop-ctl: operate a running hystloop rig over LCM (status, arm/disarm, modes, servo gains, "
+      "learning, experiments, trajectories, parameters, live tracking error)"};
+  app.require_subcommand(1);
+  app.fallthrough();
+  app.add_option("--lcm-url", o.link.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
+  app.add_flag("--allow-network", o.link.allow_network, "Accept an LCM URL whose packets can leave this host");
+  app.add_option("--rig", o.link.rig, "Channel prefix of the rig")->capture_default_str();
+  std::string key_file;
+  app.add_option("--key-file", key_file,
+                 "The rig key (auth.key_file of the services): sign requests, trajectories and parameters with it");
+
+  // In the order --help lists them. keygen and config-get run before the key is read: keygen makes
+  // one, config-get reads a file and needs none.
+  const CommandRun keygen = add_keygen_command(app, o);
+  CommandRun status = add_status_command(app, o);
+  const CommandRun config_get = add_config_get_command(app, o);
+  std::vector<CommandRun> rig_commands{std::move(status)};
+  for (const auto add : {add_process_commands, add_model_choice_commands, add_gains_command, add_learn_command,
+                         add_experiment_command, add_reference_commands, add_params_command, add_watch_command}) {
+    rig_commands.push_back(add(app, o));
+  }
+
+  if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
+
+  if (const auto exit_code = config_get()) return *exit_code;
+  if (const auto exit_code = keygen()) return *exit_code;
+  if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
+  for (const CommandRun& run_command : rig_commands) {
+    if (const auto exit_code = run_command()) return *exit_code;
   }
   return kExitUsage;
 }

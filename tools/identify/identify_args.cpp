@@ -2,9 +2,13 @@
 
 #include <map>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/cli.hpp"
+#include "core/errors.hpp"
 #include "log_samples.hpp"
+#include "models/model_descriptors.hpp"
 
 namespace hystloop {
 
@@ -12,7 +16,7 @@ std::optional<ModelChoice> parse_model_choice(const std::string& name) {
   ModelChoice c;
   c.name = name;
   if (name == "auto") return c;
-  if (name == "banning") {
+  if (name == BanningDescriptor::name) {
     c.mode = ModelChoice::Mode::banning;
     return c;
   }
@@ -23,12 +27,19 @@ std::optional<ModelChoice> parse_model_choice(const std::string& name) {
   return c;
 }
 
+std::string model_choices() {
+  std::vector<std::string_view> names = model_kind_names();
+  names.push_back(BanningDescriptor::name);
+  names.emplace_back("auto");
+  return choice_list(names);
+}
+
 void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   app.add_option("files", args.files,
                  "CSV file(s) (for banning one per experiment, or one with an 'experiment' column), or LCM log file(s)")
       ->required()
       ->check(CLI::ExistingFile);
-  app.add_option("--model", args.model, "mem, banning, katalenic, pi, linear, or auto (fit all, rank on held-out data)")
+  app.add_option("--model", args.model, model_choices() + " (auto: fit all, rank on held-out data)")
       ->check([](const std::string& v) { return parse_model_choice(v) ? std::string() : "unknown model '" + v + "'"; })
       ->capture_default_str();
   app.add_option("--form", args.form, "MEM data form: integrated branches or the paper's derivative")

@@ -24,8 +24,10 @@ struct ModelChoice {
   ModelKind kind = ModelKind::mem;  // when mode == single
   std::string name = "auto";        // as given
 };
-// "mem", "pi", "katalenic", "linear" (parse_model_kind), "banning" or "auto"; nullopt otherwise.
+// An online model's name (parse_model_kind), "banning" or "auto"; nullopt otherwise.
 std::optional<ModelChoice> parse_model_choice(const std::string& name);
+// "mem, pi, katalenic, linear, banning or auto": what parse_model_choice accepts, from the registry.
+std::string model_choices();
 
 struct IdentifyArgs {
   std::vector<std::string> files;

@@ -12,11 +12,11 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/errors.hpp"
+#include "decode.hpp"
 #include "hystloop/command_block_t.hpp"
 #include "hystloop/control_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/blocks.hpp"
-#include "lcm/message_checks.hpp"
 #include "log_samples.hpp"
 
 namespace hystloop {
@@ -68,7 +68,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   sensor_block_t sensor{};
   for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
     if (event.channel == o.sensor_channel) {
-      if (decode_logged(event, sensor) && check_message(sensor) == Verdict::kOk) {
+      if (report::decode_checked(event, sensor)) {
         require_axis_in(sensor, o.axis, event.channel + " event " + std::to_string(event.eventnum));
         for_each_tick(
             sensor,
@@ -78,8 +78,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
             static_cast<std::size_t>(o.axis));
       }
     } else if (event.channel == o.command_channel) {
-      if (decode_logged(event, command) && check_message(command) == Verdict::kOk &&
-          o.axis < static_cast<int>(axes_of(command))) {
+      if (report::decode_checked(event, command) && o.axis < static_cast<int>(axes_of(command))) {
         for_each_tick(
             command,
             [&](const CommandTick& t) {
@@ -88,7 +87,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
             static_cast<std::size_t>(o.axis));
       }
     } else if (event.channel == o.control_channel) {
-      if (!decode_logged(event, control) || check_message(control) != Verdict::kOk) return;
+      if (!report::decode_checked(event, control)) return;
       if (!for_compensator(control, o)) return;
       if (control.command == control_t::STOP_EXPERIMENT) return r.stops.push_back(event.timestamp);
       if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) return;
@@ -320,7 +319,7 @@ std::size_t count_experiment_requests(const std::vector<std::string>& files, con
   try {
     for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
       if (event.channel != o.control_channel) return;
-      if (!decode_logged(event, control) || check_message(control) != Verdict::kOk) return;
+      if (!report::decode_checked(event, control)) return;
       if (for_compensator(control, o) && control.command == control_t::START_EXPERIMENT) ids.insert(control.request_id);
     });
   } catch (const SampleLogError&) {

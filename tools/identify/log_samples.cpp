@@ -8,6 +8,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/errors.hpp"
+#include "decode.hpp"
+#include "event_file.hpp"
 #include "hystloop/sensor_block_t.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/message_checks.hpp"
@@ -132,10 +134,13 @@ void LogReadOptions::validate() const {
 void for_each_log_event(const std::vector<std::string>& files,
                         const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
   for (const auto& file : files) {
-    if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
-    lcm::LogFile log(file, "r");
-    if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
-    while (const lcm::LogEvent* event = log.readNextEvent()) on_event(file, *event);
+    std::optional<report::EventFileReader> log;
+    try {
+      log.emplace(file);
+    } catch (const std::runtime_error& e) {  // "<file>: no such log file", or cannot be opened
+      throw SampleLogError(e.what());
+    }
+    while (const lcm::LogEvent* event = log->next()) on_event(file, *event);
   }
 }
 
@@ -151,7 +156,7 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
     ++out.events;
     if (event.channel != options.sensor_channel) return;
     ++out.sensor_events;
-    if (!decode_logged(event, block)) return void(++out.undecodable);
+    if (!report::decode_unchecked(event, block)) return void(++out.undecodable);
     record.add(file, event.eventnum, block);
   });
   out.files = files.size();

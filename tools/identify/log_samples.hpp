@@ -1,9 +1,10 @@
 #pragma once
 // Identification samples from LCM event logs: the ticks of one axis of the rig's HX_SENSOR
-// sensor_block_t messages (common/lcm/blocks.hpp; x unless LogReadOptions::axis says another), read with lcm::LogFile
-// from one or several files in the order given (a rotated recording is one record), into the same SampleTable the CSV
-// reader makes: one sample per tick, u = u_V, y = y_m, and t = (seq - seq of the first tick) * dt, or from the tick's
-// utime.
+// sensor_block_t messages (common/lcm/blocks.hpp; x unless LogReadOptions::axis says another), from one or several
+// files in the order given (a rotated recording is one record), into the same SampleTable the CSV reader makes: one
+// sample per tick, u = u_V, y = y_m, and t = (seq - seq of the first tick) * dt, or from the tick's utime. The files
+// are read and the messages decoded by hystloop-report's reader (tools/report/event_file.hpp, decode.hpp), so both
+// tools see the same events in a log.
 //
 // What a recording may hold and what becomes of it:
 //  - ticks flagged SAFE_STATE (the bridge holding the safe voltage, not the experiment) or
@@ -17,6 +18,8 @@
 //  - a non-finite u or y: refused like a malformed CSV field, naming file, event and seq;
 //  - an event on the sensor channel that does not decode as sensor_block_t, or whose values
 //    break the message contract (range, flag bits, array sizes): skipped whole and counted;
+//  - bytes that are not a complete event (a torn write): passed over, reading goes on at the
+//    next event;
 //  - other channels: ignored.
 
 #include <cstddef>
@@ -31,9 +34,6 @@
 
 #include "hystloop/sensor_block_t.hpp"
 #include "ident/sample_csv.hpp"
-#include "lcm/message_storage.hpp"
-#include "lcm/rig_auth.hpp"
-#include "lcm/wire_layout.hpp"
 
 namespace hystloop {
 
@@ -88,25 +88,6 @@ struct LogSamples {
   // Ticks skipped (the undecodable events are counted apart).
   std::size_t skipped() const noexcept { return safe_state + sensor_fault + duplicates; }
 };
-
-// Decodes one logged event as T exactly as a Subscription would (fingerprint, length fields,
-// whole buffer used), but without the contract's value check, which the caller makes (a
-// non-finite sample is refused, an out-of-contract one counted). The arrays of a message
-// that decodes hold their counts.
-template <class T>
-bool decode_logged(const lcm::LogEvent& event, T& msg) noexcept {
-  if (event.datalen < 8) return false;
-  const auto size = static_cast<std::size_t>(event.datalen);
-  if (wire_fingerprint(event.data, size) != T::getHash()) return false;
-  const std::int64_t body = lcm_body_size(wire_layout_of<T>(), event.data, size);  // a signed message's trailer ignored
-  if (body < 0) return false;
-  clear_arrays(msg);
-  try {
-    return msg.decode(event.data, 0, static_cast<int>(body)) == static_cast<int>(body);
-  } catch (...) {
-    return false;
-  }
-}
 
 // Calls on_event(file, event) for every event of the files, in order. Throws SampleLogError for
 // a file that is not there or does not open as an LCM event log.

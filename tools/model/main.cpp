@@ -80,7 +80,8 @@ int transform(Args& args) try {
   if (args.inverse && !entry->has_inverse) {
     return refuse("--inverse: model " + args.model +
                   " has no inverse (a dynamic stage, not a static hysteresis map); run it --forward, or use an "
-                  "invertible model (mem, katalenic, pi, linear) for feedforward");
+                  "invertible model (" +
+                  invertible_model_names() + ") for feedforward");
   }
 
   std::unique_ptr<ModelRun> runner;

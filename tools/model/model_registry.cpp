@@ -73,6 +73,16 @@ std::string model_names(std::string_view separator) {
   return out;
 }
 
+std::string invertible_model_names(std::string_view separator) {
+  std::string out;
+  for (const ModelEntry* m : kRegistry) {
+    if (!m->has_inverse) continue;
+    if (!out.empty()) out += separator;
+    out += m->name;
+  }
+  return out;
+}
+
 std::string models_help() {
   std::string out =
       "Models and their parameters (--param NAME=VALUE, repeatable; SI units, 'x' = the Katalenic operator's units):\n";

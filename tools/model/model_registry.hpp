@@ -45,6 +45,8 @@ std::span<const ModelEntry* const> model_registry();
 const ModelEntry* find_model(std::string_view name);
 // "mem, pi, katalenic, linear, banning"
 std::string model_names(std::string_view separator = ", ");
+// The models with an inverse (feedforward), in the same order: "mem, pi, katalenic, linear".
+std::string invertible_model_names(std::string_view separator = ", ");
 
 // The --help section: every model, its parameters with unit, default and meaning.
 std::string models_help();

@@ -7,7 +7,8 @@
 // the original commanded, every axis the blocks carry (each with its own report); compares u_ff_V, y_ref_m, mode,
 // params_version (exact by default: bitwise equal doubles). Prints the first divergence (tick, field, expected, got)
 // and a summary. Exit 0: equal; 1: diverged, nothing compared, or the replay lost samples in transport with no
-// divergence before the first loss (the verdict line tells which); 2: bad arguments or unreadable log.
+// divergence before the first loss (the verdict line tells which); 2: bad arguments, or a log that cannot be read or
+// holds no command (tools/replay-check reads 1 as a verdict on the compensator, so these must not exit 1).
 
 #include <CLI/CLI.hpp>
 
@@ -23,7 +24,22 @@
 #include "core/errors.hpp"
 #include "models/axis_coupling.hpp"
 
-int main(int argc, char** argv) try {
+namespace {
+
+// read() with whatever it throws turned into a ParameterError naming `argument` ("expected: run.lcmlog: no such
+// log file"), which run_tool exits 2 on: a log that cannot be read is refused input, not a divergence.
+template <class Read>
+auto read_argument(const char* argument, Read&& read) {
+  try {
+    return read();
+  } catch (const hystloop::ParameterError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw hystloop::ParameterError(argument, e.what());
+  }
+}
+
+int run_compare(int argc, char** argv) {
   CLI::App app{"Compares a replayed compensator's commands with a recorded log's (tools/replay-check)."};
   std::string expected_log, actual_log, inputs_log, rig = std::string(hystloop::kDefaultRigPrefix);
   hystloop::replay::CompareTolerance tolerance;
@@ -39,44 +55,45 @@ int main(int argc, char** argv) try {
   app.add_option("--rig", rig, "Channel prefix of the rig")->capture_default_str();
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
-  try {
-    tolerance.validate();
-    const hystloop::ChannelNames channels(rig);
-    std::optional<std::set<std::int64_t>> played;
-    if (!inputs_log.empty()) played = hystloop::replay::read_sample_seqs(inputs_log, channels);
-    // Every axis the recorded blocks carry, each compared on its own (a one-axis log: x, as always).
-    int axes = 1;
-    int exit_code = hystloop::kExitOk;
-    for (int axis = 0; axis < axes; ++axis) {
-      const auto expected = hystloop::replay::read_commands(expected_log, channels, axis);
-      const auto actual = hystloop::replay::read_commands(actual_log, channels, axis);
-      axes = std::max(expected.axes, 1);
-      if (expected.by_seq.empty()) {
-        std::fprintf(stderr, "hystloop-replay-compare: %s holds no %s command\n", expected_log.c_str(),
-                     channels.command.c_str());
-        return hystloop::kExitUsage;
-      }
-      if (axes > 1) std::printf("axis %s:\n", std::string(hystloop::axis_name(axis)).c_str());
-      if (actual.axes != expected.axes) {
-        std::printf("verdict: the replay's blocks carry %d axes, the log's %d\n", actual.axes, expected.axes);
-        return 1;
-      }
-      const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
-      if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
-        std::printf(
-            "note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu "
-            "undecodable blocks\n",
-            static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
-            static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
-      }
-      std::fputs(hystloop::replay::format_report(report, tolerance).c_str(), stdout);
-      if (exit_code == hystloop::kExitOk) exit_code = report.exit_code();
-    }
-    return exit_code;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-replay-compare: %s\n", e.what());
-    return hystloop::kExitUsage;
+  tolerance.validate();
+  const hystloop::ChannelNames channels(rig);
+  std::optional<std::set<std::int64_t>> played;
+  if (!inputs_log.empty()) {
+    played = read_argument("--inputs", [&] { return hystloop::replay::read_sample_seqs(inputs_log, channels); });
   }
-} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
-  return hystloop::exit_on_escaped_exception("hystloop-replay-compare");
+  // Every axis the recorded blocks carry, each compared on its own (a one-axis log: x, as always).
+  int axes = 1;
+  int exit_code = hystloop::kExitOk;
+  for (int axis = 0; axis < axes; ++axis) {
+    const auto expected =
+        read_argument("expected", [&] { return hystloop::replay::read_commands(expected_log, channels, axis); });
+    const auto actual =
+        read_argument("actual", [&] { return hystloop::replay::read_commands(actual_log, channels, axis); });
+    axes = std::max(expected.axes, 1);
+    if (expected.by_seq.empty()) {
+      throw hystloop::ParameterError("expected", expected_log + " holds no " + channels.command + " command");
+    }
+    if (axes > 1) std::printf("axis %s:\n", std::string(hystloop::axis_name(axis)).c_str());
+    if (actual.axes != expected.axes) {
+      std::printf("verdict: the replay's blocks carry %d axes, the log's %d\n", actual.axes, expected.axes);
+      return 1;
+    }
+    const auto report = hystloop::replay::compare_commands(expected, actual, played ? &*played : nullptr, tolerance);
+    if (expected.duplicates + expected.undecodable + actual.duplicates + actual.undecodable > 0) {
+      std::printf(
+          "note: ignored: expected %llu repeated ticks / %llu undecodable blocks, actual %llu repeated ticks / %llu "
+          "undecodable blocks\n",
+          static_cast<unsigned long long>(expected.duplicates), static_cast<unsigned long long>(expected.undecodable),
+          static_cast<unsigned long long>(actual.duplicates), static_cast<unsigned long long>(actual.undecodable));
+    }
+    std::fputs(hystloop::replay::format_report(report, tolerance).c_str(), stdout);
+    if (exit_code == hystloop::kExitOk) exit_code = report.exit_code();
+  }
+  return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hystloop::run_tool("hystloop-replay-compare", [&] { return run_compare(argc, argv); });
 }

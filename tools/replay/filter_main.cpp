@@ -7,20 +7,23 @@
 //   hystloop-replay-filter alter LOG OUT (--seq N | --nth K) [--delta-V D]
 //       OUT = LOG with the command for tick N (or the K-th tick commanded in the log) changed
 //       (u_ff_V + D, default: 1 ulp flipped), to prove that a replay notices.
-// Exit 0 on success, 2 on bad arguments or unreadable logs.
+// Exit 0 on success, 1 when a log cannot be read or written (or holds no command), 2 on bad
+// arguments. tools/replay-check stops on any non-zero exit.
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <exception>
 #include <optional>
 #include <string>
 
 #include "core/cli.hpp"
+#include "core/errors.hpp"
 #include "command_alteration.hpp"
 #include "replay_inputs.hpp"
 
-int main(int argc, char** argv) try {
+namespace {
+
+int run_filter(int argc, char** argv) {
   CLI::App app{"Prepares LCM event logs for a replay regression (tools/replay-check)."};
   app.require_subcommand(1);
   std::string log, out, rig = std::string(hystloop::kDefaultRigPrefix);
@@ -51,24 +54,23 @@ int main(int argc, char** argv) try {
                     "Add this to u_ff_V [V] (default: flip its least significant bit)");
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
-  try {
-    const hystloop::ChannelNames channels(rig);
-    if (inputs->parsed()) {
-      const auto selection = hystloop::replay::write_replay_inputs(log, out, channels, input_options);
-      std::fputs(hystloop::replay::describe(selection).c_str(), stdout);
-      std::printf("first-sample %lld\n", static_cast<long long>(selection.first_answered_sample.value_or(-1)));
-    } else {
-      if (!seq && !alteration.nth) throw std::runtime_error("alter: --seq or --nth is required");
-      alteration.seq = seq.value_or(0);
-      const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
-      std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V,
-                  r.new_u_ff_V);
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-replay-filter: %s\n", e.what());
-    return hystloop::kExitUsage;
+  const hystloop::ChannelNames channels(rig);
+  if (inputs->parsed()) {
+    const auto selection = hystloop::replay::write_replay_inputs(log, out, channels, input_options);
+    std::fputs(hystloop::replay::describe(selection).c_str(), stdout);
+    std::printf("first-sample %lld\n", static_cast<long long>(selection.first_answered_sample.value_or(-1)));
+  } else {
+    if (!seq && !alteration.nth) throw hystloop::ParameterError("--seq", "alter needs --seq or --nth");
+    alteration.seq = seq.value_or(0);
+    const auto r = hystloop::replay::write_altered_log(log, out, channels, alteration);
+    std::printf("altered tick %lld: u_ff_V %.17g -> %.17g\n", static_cast<long long>(r.seq), r.old_u_ff_V,
+                r.new_u_ff_V);
   }
-  return 0;
-} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
-  return hystloop::exit_on_escaped_exception("hystloop-replay-filter");
+  return hystloop::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hystloop::run_tool("hystloop-replay-filter", [&] { return run_filter(argc, argv); });
 }

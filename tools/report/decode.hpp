@@ -23,20 +23,28 @@ bool has_fingerprint_of(const lcm::LogEvent& event) noexcept {
   return wire_fingerprint(event.data, size) == T::getHash();
 }
 
+// `event` decoded as T the way a Subscription decodes it (fingerprint, length fields, whole buffer
+// used), without the contract's value check: for a caller that treats a value out of contract
+// differently from a message that does not decode (hystloop-identify refuses a non-finite sample
+// but counts a corrupt block). The arrays of a message that decodes hold their counts.
 template <class T>
-bool decode_checked(const lcm::LogEvent& event, T& msg) noexcept {
+bool decode_unchecked(const lcm::LogEvent& event, T& msg) noexcept {
   if (!has_fingerprint_of<T>(event)) return false;
   const auto size = static_cast<std::size_t>(event.datalen);
   const std::int64_t body = lcm_body_size(wire_layout_of<T>(), event.data, size);  // a signed message's trailer ignored
   if (body < 0) return false;
   clear_arrays(msg);
-  int used = -1;
   try {
-    used = msg.decode(event.data, 0, static_cast<int>(body));
+    return msg.decode(event.data, 0, static_cast<int>(body)) == static_cast<int>(body);
   } catch (...) {
     return false;
   }
-  return used == static_cast<int>(body) && check_message(msg) == Verdict::kOk;
+}
+
+// decode_unchecked, and the values pass the contract's check.
+template <class T>
+bool decode_checked(const lcm::LogEvent& event, T& msg) noexcept {
+  return decode_unchecked(event, msg) && check_message(msg) == Verdict::kOk;
 }
 
 }  // namespace hystloop::report

@@ -9,7 +9,6 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <optional>
 
 #include "core/cli.hpp"
@@ -63,9 +62,9 @@ bool consistent(const Result& r, std::uint64_t wanted) {
          l.p50_ns <= l.p99_ns && l.p99_ns <= l.p999_ns && l.p999_ns <= l.max_ns;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) try {
+// The whole run: parse, set up, tick, print. What it throws run_tool prints; a refused set-up
+// (set_cpu_affinity's ParameterError) exits 2, any other failure 1.
+int run_timer_check(int argc, char** argv) {
   Options opt;
   CLI::App app{"Runs the hystloop periodic timer and reports its wake-up lateness and missed ticks."};
   app.add_option("--rate", opt.rate_hz, "Tick rate [Hz]")->check(CLI::Range(0.1, 1e6))->capture_default_str();
@@ -77,44 +76,42 @@ int main(int argc, char** argv) try {
   app.add_flag("--check", opt.check, "Exit 1 unless every deadline is accounted for and the percentiles are ordered");
   if (const auto exit_code = hystloop::parse_cli(app, argc, argv)) return *exit_code;
 
-  try {
-    hystloop::init_logging("timer-check", "info");
-    hystloop::install_stop_handlers();
-    if (opt.lock_memory) hystloop::lock_memory();
-    if (opt.cpu) hystloop::set_cpu_affinity({*opt.cpu});
-    if (opt.rt_priority) hystloop::set_realtime_priority(*opt.rt_priority);
+  hystloop::init_logging("timer-check", "info");
+  hystloop::install_stop_handlers();
+  if (opt.lock_memory) hystloop::lock_memory();
+  if (opt.cpu) hystloop::set_cpu_affinity({*opt.cpu});
+  if (opt.rt_priority) hystloop::set_realtime_priority(*opt.rt_priority);
 
-    const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
-    const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
-    const Result r = run(period, wanted);
-    const auto& l = r.lateness;
-    const auto usage = hystloop::read_resource_usage();
+  const std::int64_t period = hystloop::period_ns_from_rate_hz(opt.rate_hz);
+  const auto wanted = static_cast<std::uint64_t>(std::llround(opt.seconds * 1e9 / static_cast<double>(period)));
+  const Result r = run(period, wanted);
+  const auto& l = r.lateness;
+  const auto usage = hystloop::read_resource_usage();
 
-    std::printf("rate %.0f Hz (period %" PRId64 " ns), %.3f s\n", opt.rate_hz, period, r.elapsed_s);
-    std::printf("deadlines %" PRIu64 ": served %" PRIu64 ", skipped %" PRIu64 " (%.3f %%)\n", r.deadlines, r.served,
-                r.skipped,
-                r.deadlines ? 100.0 * static_cast<double>(r.skipped) / static_cast<double>(r.deadlines) : 0.0);
-    std::printf("lateness [us]: p50 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  mean %.1f\n", l.p50_ns / 1e3, l.p99_ns / 1e3,
-                l.p999_ns / 1e3, l.max_ns / 1e3, l.mean_ns / 1e3);
-    std::printf("worst overrun: %.1f us after the first deadline it missed\n",
-                static_cast<double>(r.worst_overdue_ns) / 1e3);
-    std::printf("cpu %.3f s user + %.3f s system, peak rss %.1f MiB, involuntary switches %" PRId64 "\n",
-                usage.user_cpu_s, usage.system_cpu_s, static_cast<double>(usage.peak_rss_bytes) / (1 << 20),
-                usage.involuntary_switches);
-    if (hystloop::stop_requested()) {
-      std::printf("stopped early by signal\n");
-      return 130;
-    }
-    if (opt.check && !consistent(r, wanted)) {
-      std::printf("check FAILED: deadlines not accounted for or percentiles out of order\n");
-      return 1;
-    }
-    if (opt.check) std::printf("check passed\n");
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "hystloop-timer-check: %s\n", e.what());
-    return hystloop::kExitUsage;
+  std::printf("rate %.0f Hz (period %" PRId64 " ns), %.3f s\n", opt.rate_hz, period, r.elapsed_s);
+  std::printf("deadlines %" PRIu64 ": served %" PRIu64 ", skipped %" PRIu64 " (%.3f %%)\n", r.deadlines, r.served,
+              r.skipped, r.deadlines ? 100.0 * static_cast<double>(r.skipped) / static_cast<double>(r.deadlines) : 0.0);
+  std::printf("lateness [us]: p50 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  mean %.1f\n", l.p50_ns / 1e3, l.p99_ns / 1e3,
+              l.p999_ns / 1e3, l.max_ns / 1e3, l.mean_ns / 1e3);
+  std::printf("worst overrun: %.1f us after the first deadline it missed\n",
+              static_cast<double>(r.worst_overdue_ns) / 1e3);
+  std::printf("cpu %.3f s user + %.3f s system, peak rss %.1f MiB, involuntary switches %" PRId64 "\n",
+              usage.user_cpu_s, usage.system_cpu_s, static_cast<double>(usage.peak_rss_bytes) / (1 << 20),
+              usage.involuntary_switches);
+  if (hystloop::stop_requested()) {
+    std::printf("stopped early by signal\n");
+    return 130;
   }
-} catch (...) {  // CLI11's set-up and what the handler above does not take: nothing escapes main
-  return hystloop::exit_on_escaped_exception("hystloop-timer-check");
+  if (opt.check && !consistent(r, wanted)) {
+    std::printf("check FAILED: deadlines not accounted for or percentiles out of order\n");
+    return 1;
+  }
+  if (opt.check) std::printf("check passed\n");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hystloop::run_tool("hystloop-timer-check", [&] { return run_timer_check(argc, argv); });
 }

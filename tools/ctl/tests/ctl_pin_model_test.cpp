@@ -38,6 +38,20 @@ TEST(CtlPinModel, TheRefusalListsEveryModelAndAuto) {
   }
 }
 
+// The list the help and the refusal print comes from the model registry: every online model is in
+// it and is accepted, and so is auto.
+TEST(CtlPinModel, TheChoicesAreEveryOnlineModelAndAuto) {
+  EXPECT_EQ(pin_model_choices(), "mem, pi, katalenic, linear or auto");
+  for (const std::string_view name : model_kind_names()) {
+    EXPECT_NE(pin_model_choices().find(name), std::string::npos) << name;
+    const auto kind = parse_model_kind(name);
+    ASSERT_TRUE(kind.has_value()) << name;
+    EXPECT_EQ(to_string(*kind), name);
+    EXPECT_EQ(pin_model_mode(std::string(name)), to_wire(mode_of(*kind))) << name;
+  }
+  EXPECT_EQ(model_kind_names().size(), static_cast<std::size_t>(kModelKindCount));
+}
+
 // The wire's mode numbers and FeedforwardMode are one numbering (lcm/feedforward_mode.hpp): every
 // MODE_* round-trips, a number beyond them is refused, and the modes a config may name are listed.
 TEST(FeedforwardModeWire, EveryModeRoundTripsAndOthersAreRefused) {

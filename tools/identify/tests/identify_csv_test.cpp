@@ -11,9 +11,13 @@
 #include <fstream>
 #include <numbers>
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include "core/errors.hpp"
 #include "ident/banning_experiments.hpp"
 #include "ident/mem_test_data.hpp"
+#include "models/model_set.hpp"
 #include "sample_budget.hpp"
 #include "support/tool_run.hpp"
 
@@ -232,7 +236,10 @@ TEST_F(IdentifyTool, HelpDescribesTheModels) {
   const ToolRun r = run_tool("--help");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--model"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("banning"), std::string::npos) << r.output;
+  // --model's choices, from the model registry: every online model, then banning and auto.
+  std::vector<std::string_view> models = model_kind_names();
+  models.insert(models.end(), {"banning", "auto"});
+  EXPECT_NE(r.output.find(choice_list(models)), std::string::npos) << r.output;
   // LCM logs and publishing (tested on logs in tools/identify/tests/).
   EXPECT_NE(r.output.find(".lcmlog"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--from"), std::string::npos) << r.output;

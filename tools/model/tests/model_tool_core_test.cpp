@@ -249,6 +249,17 @@ TEST(ModelRegistry, BanningRefusesInverseInProcessToo) {
   EXPECT_THROW(run->inverse({0.0}, {0.0}), std::logic_error);
 }
 
+// The hint a refused --inverse gives lists the registry's models that have an inverse, no other.
+TEST(ModelRegistry, InvertibleNamesAreTheModelsWithAnInverse) {
+  std::string expected;
+  for (const ModelEntry* m : model_registry()) {
+    if (m->has_inverse) expected += (expected.empty() ? "" : ", ") + std::string(m->name);
+  }
+  EXPECT_EQ(invertible_model_names(), expected);
+  EXPECT_EQ(invertible_model_names(), "mem, pi, katalenic, linear");
+  EXPECT_EQ(invertible_model_names("|"), "mem|pi|katalenic|linear");
+}
+
 TEST(ModelRegistry, HelpListsEveryModelParameterUnitAndDefault) {
   const std::string help = models_help();
   for (const ModelEntry* m : model_registry()) {
