@@ -1,5 +1,8 @@
 #include "log_samples.hpp"
 
+#include "lcm/rig_auth.hpp"
+#include "record/record_auth.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -129,14 +132,23 @@ void LogReadOptions::validate() const {
   }
 }
 
-void for_each_log_event(const std::vector<std::string>& files,
-                        const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
+std::vector<std::string> for_each_log_event(
+    const std::vector<std::string>& files,
+    const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
+  std::vector<std::string> notes;
+  RecordCheck check(process_rig_auth());
   for (const auto& file : files) {
     if (!std::filesystem::is_regular_file(file)) throw SampleLogError(file + ": no such log file");
     lcm::LogFile log(file, "r");
     if (!log.good()) throw SampleLogError(file + ": cannot open as an LCM event log");
-    while (const lcm::LogEvent* event = log.readNextEvent()) on_event(file, *event);
+    while (const lcm::LogEvent* event = log.readNextEvent()) {
+      if (check.admit(event->channel, event->data, static_cast<std::size_t>(event->datalen), event->timestamp)) {
+        on_event(file, *event);
+      }
+    }
+    for (const std::string& note : check.take_notes()) notes.push_back(file + ": " + note);
   }
+  return notes;
 }
 
 bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
@@ -147,7 +159,7 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
   RecordBuilder record(options);
   LogSamples& out = record.result();
   sensor_block_t block{};
-  for_each_log_event(files, [&](const std::string& file, const lcm::LogEvent& event) {
+  out.signature_notes = for_each_log_event(files, [&](const std::string& file, const lcm::LogEvent& event) {
     ++out.events;
     if (event.channel != options.sensor_channel) return;
     ++out.sensor_events;
@@ -175,6 +187,7 @@ std::string describe(const LogSamples& s, const LogReadOptions& options) {
     << " outside the time range\n";
   o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
     << " repeated seq, " << s.undecodable << " block(s) undecodable or out of contract\n";
+  for (const std::string& note : s.signature_notes) o << "warning: " << note << "\n";
   o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";
   for (const auto& g : s.first_gaps) o << "; seq " << g.first_missing << " +" << g.missing;
   if (s.gaps > s.first_gaps.size()) o << "; ...";
