@@ -20,6 +20,7 @@
 
 #include "lcm/channels.hpp"
 #include "core/sequence_gap_detector.hpp"
+#include "record/record_auth.hpp"
 #include "record/unknown_channels.hpp"
 
 namespace hystloop {
@@ -41,6 +42,10 @@ struct ChannelSlot {
   std::uint64_t dropped_queue_full = 0;  // the disk thread fell behind: the ring was full
   std::uint64_t dropped_oversize = 0;    // larger than the ring's largest record
   std::uint64_t undecodable = 0;  // kind != kNone but not a valid block of that type: recorded, ticks not checked
+  // A keyed rig's signed channel: messages whose signature failed, by AuthResult (index 0, kOk,
+  // stays 0). Counted in `received`, never recorded nor checked for gaps (record/record_auth.hpp).
+  bool verified = false;
+  std::array<std::uint64_t, kAuthResults> refused{};
   SequenceGapDetector sequence;
 
   // Disk thread.
@@ -49,6 +54,11 @@ struct ChannelSlot {
   std::atomic<std::uint64_t> write_failed{0};   // the file refused it (disk full, I/O error)
 
   std::string_view name_view() const noexcept { return {name.data(), name_length}; }
+  std::uint64_t refused_total() const noexcept {
+    std::uint64_t n = 0;
+    for (const std::uint64_t r : refused) n += r;
+    return n;
+  }
   std::uint64_t dropped() const noexcept {
     return dropped_queue_full + dropped_oversize + write_failed.load(std::memory_order_relaxed);
   }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -20,6 +21,7 @@
 #include "event_file.hpp"
 #include "lcm/blocks.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/rig_auth.hpp"
 #include "log_reader.hpp"
 #include "py_common.hpp"
 
@@ -249,7 +251,8 @@ ChannelTable truth_table(const std::string& channel, const std::vector<TruthRow>
 }
 
 Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, const std::vector<std::string>& wanted,
-             std::optional<double> from_s, std::optional<double> to_s, const std::string& rig, bool warn) {
+             std::optional<double> from_s, std::optional<double> to_s, const std::string& rig, bool warn,
+             const std::optional<std::string>& key_file) {
   if (axis && (*axis < 0 || *axis >= kMaxAxes))
     throw PyParameterError("axis", "axis: " + std::to_string(*axis) + " is not 0 (x), 1 (y) or 2 (z)");
   if (from_s && to_s && !(*from_s < *to_s)) throw PyParameterError("to_s", "to_s: must be after from_s");
@@ -260,6 +263,14 @@ Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, con
     throw PyParameterError("rig", std::string("rig: ") + e.what());
   }
   const ChannelNames& names = *names_or;
+  std::shared_ptr<const RigAuth> auth;  // nullptr: signatures not checked (a keyed log says so in warnings)
+  if (key_file) {
+    try {
+      auth = rig_auth_from_key_file(*key_file, "key_file");
+    } catch (const ParameterError& e) {
+      throw PyParameterError("key_file", e.what());
+    }
+  }
   if (paths.empty()) throw PyParameterError("path", "no log file given");
   std::vector<fs::path> files;
   for (const auto& p : paths) {
@@ -291,14 +302,14 @@ Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, con
   std::uint64_t truth_events = 0, truth_skipped = 0;
   {
     const py::gil_scoped_release unlocked;
-    log.t0_utime_us = report::log_time_zero_utime(files, names.sensor);
+    log.t0_utime_us = report::log_time_zero_utime(files, names.sensor, auth);
     for (const int a : axes) {
       builders.push_back(std::make_unique<report::TableBuilder>(take, log.t0_utime_us, from_s.value_or(-1e300),
                                                                 to_s.value_or(1e300), a));
     }
     std::map<std::string, std::array<std::size_t, kMaxAxes>> rows_so_far;
     sim_truth_t block;
-    scans = report::for_each_event(files, [&](const lcm::LogEvent& e) {
+    const auto visit = [&](const lcm::LogEvent& e) {
       if (e.channel == names.sim_truth && take(e.channel)) {
         ++truth_events;
         if (!report::decode_checked(e, block)) {
@@ -328,7 +339,8 @@ Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, con
         any = any || rows.count[b] > 0;
       }
       if (any && builders.size() > 1) event_rows[e.channel].push_back(rows);
-    });
+    };
+    scans = report::for_each_event(files, visit, auth);
   }
   log.channel_counts = builders.front()->channel_counts();
   std::vector<std::vector<ChannelTable>> tables;
@@ -379,6 +391,8 @@ Log read_log(const std::vector<std::string>& paths, std::optional<int> axis, con
     d["events"] = s.events;
     d["skipped_bytes"] = s.skipped_bytes;
     d["trailing_bytes"] = s.trailing_bytes;
+    d["recorded_keyed"] = s.recorded_keyed;
+    d["unverified_left_out"] = s.unverified_left_out;
     log.scans.append(d);
   }
   for (const ChannelTable& t : out) {
@@ -460,18 +474,19 @@ void register_log(py::module_& m) {
   m.def(
       "read_log",
       [](const py::object& path, std::optional<int> axis, const std::optional<std::vector<std::string>>& channels,
-         std::optional<double> from_s, std::optional<double> to_s, const std::string& rig, bool warn) {
+         std::optional<double> from_s, std::optional<double> to_s, const std::string& rig, bool warn,
+         const std::optional<std::string>& key_file) {
         std::vector<std::string> paths;
         if (py::isinstance<py::str>(path) || py::hasattr(path, "__fspath__")) {
           paths.push_back(py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>());
         } else {
           for (py::handle p : path) paths.push_back(py::str(py::module_::import("os").attr("fspath")(p)));
         }
-        return read_log(paths, axis, channels.value_or(std::vector<std::string>{}), from_s, to_s, rig, warn);
+        return read_log(paths, axis, channels.value_or(std::vector<std::string>{}), from_s, to_s, rig, warn, key_file);
       },
       py::arg("path"), py::arg("axis") = py::none(), py::arg("channels") = py::none(), py::arg("from_s") = py::none(),
-      py::arg("to_s") = py::none(), py::arg("rig") = "HX_", py::arg("warn") = true,
-      R"doc(read_log(path, axis=None, channels=None, from_s=None, to_s=None, rig="HX_", warn=True) -> Log
+      py::arg("to_s") = py::none(), py::arg("rig") = "HX_", py::arg("warn") = true, py::arg("key_file") = py::none(),
+      R"doc(read_log(path, axis=None, channels=None, from_s=None, to_s=None, rig="HX_", warn=True, key_file=None) -> Log
 
 Reads an LCM event log the logger wrote (or several, a rotated recording, as one record) with
 hystloop-report's reader: a damaged or truncated file is read up to and around the damage, and
@@ -482,6 +497,9 @@ what was not read is said in Log.warnings (and as a RuntimeWarning when warn=Tru
   channels  channels to read, as logged (HX_SENSOR) or by suffix (SENSOR); None: every channel of the rig
   from_s, to_s  rows with from_s <= t_s <= to_s only [s after the first sensor tick]
   rig       the rig's channel prefix
+  key_file  the rig key (auth.key_file): messages on the signed channels whose signature fails (what
+            the rig refused) are left out and counted in Log.warnings and Log.scans; without it a
+            log its keyed logger marked is read unverified, which Log.warnings says
 log["SENSOR"] (HX_SENSOR) has one row per tick and axis: t_s [s] (receive time, back-dated per tick,
 after the first sensor tick), seq, axis, u_V, u_ff_V, u_fb_V [V], y_ref_m, y_m [m], flags, ...
 and y_true_m [m] when the log has HX_SIM_TRUTH (the simulated stage's true position; NaN where none).

@@ -3,6 +3,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "hystloop/service_status_t.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop {
 
@@ -54,6 +55,31 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
     degraded(fmt::format("{} ticks clamped in the last second (range {}, slew {})", c.either, c.range, c.slew));
   }
   return h;
+}
+
+std::string watchdog_reason(const DryBufferFigures& f) {
+  std::string why;
+  const auto add = [&why](const std::string& what) { why += (why.empty() ? "" : "; ") + what; };
+  if (f.since_last_command_s < 0.0) {
+    add("no command block received since the start");
+  } else {
+    add(fmt::format("the last command block arrived {:.1f} ms before", f.since_last_command_s * 1e3));
+  }
+  if (f.commands_rejected > 0) {
+    add(fmt::format("{} HX_COMMAND message(s) refused in the last {:.3g} s ({:.3g}/s; see command.rejected_*)",
+                    f.commands_rejected, f.period_s,
+                    f.period_s > 0.0 ? static_cast<double>(f.commands_rejected) / f.period_s : 0.0));
+  }
+  if (f.command_queue_full > 0) {
+    add(fmt::format("{} command ticks found the real-time queue full (command_queue_full)", f.command_queue_full));
+  }
+  add(fmt::format("the I/O thread's longest pass {:.1f} ms, longest wait {:.1f} ms", f.io_longest_pass_s * 1e3,
+                  f.io_longest_wait_s * 1e3));
+  return fmt::format(
+      "watchdog: no command buffered for more than {} s{}, tripped at tick {} ({}){}; re-arm via "
+      "HX_CONTROL",
+      f.watchdog_s, f.axes > 1 && f.tripped_by >= 0 ? fmt::format(" on {}", axis_name(f.tripped_by)) : std::string(),
+      f.trip_tick, why, f.axes > 1 ? ", every axis to the safe state" : "");
 }
 
 }  // namespace hystloop

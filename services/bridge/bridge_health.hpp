@@ -36,4 +36,26 @@ struct BridgeHealth {
 
 BridgeHealth assess_bridge_health(const BridgeHealthInput& in);
 
+// What the bridge can tell about why its command buffer ran dry, when the watchdog tripped: the
+// compensator went quiet (no command block for long before the trip), its blocks were refused
+// (forged, replayed, malformed: counted per reason on HX_STATUS), the real-time queue was full,
+// or the bridge's own I/O thread was held up. Figures of the report period that saw the trip.
+struct DryBufferFigures {
+  double watchdog_s = 0.0;
+  std::int64_t trip_tick = -1;
+  int axes = 1;
+  int tripped_by = -1;                   // the axis that ran dry first (-1: unknown)
+  double since_last_command_s = -1.0;    // the last command block received -> the trip (< 0: none yet)
+  double period_s = 0.0;                 // the report period these counts are of
+  std::uint64_t commands_rejected = 0;   // HX_COMMAND messages refused in the period (every reason)
+  std::uint64_t command_queue_full = 0;  // command ticks the real-time queue had no room for
+  double io_longest_pass_s = 0.0;        // the I/O thread's longest pass (dispatch, publish) in the period
+  double io_longest_wait_s = 0.0;        // its longest time between two passes
+};
+
+// "watchdog: no command buffered for more than 0.002 s, tripped at tick 1234 (the last command
+// block arrived 57.3 ms before; 120 HX_COMMAND messages refused in the last 1 s (120/s); the I/O
+// thread's longest pass 0.4 ms, longest wait 20.1 ms); re-arm via HX_CONTROL"
+std::string watchdog_reason(const DryBufferFigures& f);
+
 }  // namespace hystloop

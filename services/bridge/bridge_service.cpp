@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <chrono>
@@ -52,6 +53,7 @@ void BridgeService::on_command(const command_block_t& msg) noexcept {
     latency_.add(*elapsed);
     latency_total_.add(*elapsed);
   }
+  last_command_ns_ = monotonic_ns();
   std::array<CommandTick, kMaxAxes> tick{};
   const auto axes = static_cast<std::size_t>(settings_.axes);
   for (std::size_t i = 0, n = ticks_of(msg); i < n; ++i) {
@@ -207,6 +209,8 @@ void BridgeService::serve(bool stopping) {
   const nfds_t nfds = stop_fd() >= 0 && !stopping ? 3 : 2;
   const timespec timeout{0, stopping ? 2'000'000 : 20'000'000};  // status, --seconds and the ramp checked this often
   const int ready = ppoll(fds, nfds, &timeout, nullptr);
+  const std::int64_t pass_start_ns = monotonic_ns();
+  if (last_pass_end_ns_ >= 0) longest_wait_ns_ = std::max(longest_wait_ns_, pass_start_ns - last_pass_end_ns_);
   if (ready < 0 && errno != EINTR) ++lcm_errors_;
   if (fds[1].revents & POLLIN) {
     std::uint64_t count = 0;
@@ -228,6 +232,8 @@ void BridgeService::serve(bool stopping) {
       awaiting_report_ = false;
     }
   }
+  last_pass_end_ns_ = monotonic_ns();
+  longest_pass_ns_ = std::max(longest_pass_ns_, last_pass_end_ns_ - pass_start_ns);
 }
 
 int BridgeService::run() {
@@ -372,16 +378,33 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   }
   previous_core_ = core;
   previous_dropped_ = rt.samples_dropped;
+  const std::int64_t now_ns = monotonic_ns();
+  const std::uint64_t command_rejected = commands_.counters().rejected_total();
   if (core.watchdog_trips != trips_reported_) {
     trips_reported_ = core.watchdog_trips;
     // With several axes, which one ran dry: all of them went to the safe state on that tick.
-    safe_reason_ =
-        fmt::format("watchdog: no command buffered for more than {} s{}, tripped at tick {}{}; re-arm via HX_CONTROL",
-                    settings_.limits.watchdog_s,
-                    rt.axes > 1 && rt.tripped_by >= 0 ? fmt::format(" on {}", axis_name(rt.tripped_by)) : std::string(),
-                    rt.last_trip_tick, rt.axes > 1 ? ", every axis to the safe state" : "");
+    DryBufferFigures dry{.watchdog_s = settings_.limits.watchdog_s,
+                         .trip_tick = rt.last_trip_tick,
+                         .axes = rt.axes,
+                         .tripped_by = rt.tripped_by,
+                         .period_s = static_cast<double>(now_ns - last_report_ns_) * 1e-9,
+                         .commands_rejected = command_rejected - previous_command_rejected_,
+                         .command_queue_full = command_queue_full_ - previous_queue_full_,
+                         .io_longest_pass_s = static_cast<double>(longest_pass_ns_) * 1e-9,
+                         .io_longest_wait_s = static_cast<double>(longest_wait_ns_) * 1e-9};
+    if (last_command_ns_ >= 0) {
+      // The trip was (last_tick - trip_tick) ticks before this report.
+      const double trip_ago_s = static_cast<double>(rt.last_tick - rt.last_trip_tick) * settings_.dt_s();
+      dry.since_last_command_s = std::max(0.0, static_cast<double>(now_ns - last_command_ns_) * 1e-9 - trip_ago_s);
+    }
+    safe_reason_ = watchdog_reason(dry);
     spdlog::warn("{}", safe_reason_);
   }
+  last_report_ns_ = now_ns;
+  previous_command_rejected_ = command_rejected;
+  previous_queue_full_ = command_queue_full_;
+  longest_pass_ns_ = 0;
+  longest_wait_ns_ = 0;
 
   const BridgeHealthInput health{.stopping = stopping,
                                  .armed = rt.armed,

@@ -115,6 +115,15 @@ class BridgeService {
   std::uint64_t previous_unpublished_ = 0;  // sensor_ticks_unpublished_ at the last report
   bool reset_pending_ = false;
   CounterSet counters_;
+  // Why the buffer may have run dry (watchdog_reason): the last command block pushed, and the
+  // I/O thread's longest pass and wait in the report period, monotonic [ns].
+  std::int64_t last_command_ns_ = -1;
+  std::int64_t last_pass_end_ns_ = -1;
+  std::int64_t longest_pass_ns_ = 0;
+  std::int64_t longest_wait_ns_ = 0;
+  std::int64_t last_report_ns_ = monotonic_ns();
+  std::uint64_t previous_command_rejected_ = 0;
+  std::uint64_t previous_queue_full_ = 0;
 };
 
 }  // namespace hystloop

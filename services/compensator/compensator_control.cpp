@@ -120,7 +120,7 @@ void CompensatorService::on_control(const control_t& msg) {
   } catch (const std::exception& e) {
     refuse(e.what());
   }
-  if (verdict_due_) report(wall_utime(), false, false);
+  report_if_due();
 }
 
 }  // namespace hystloop

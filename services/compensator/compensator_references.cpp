@@ -101,7 +101,7 @@ void CompensatorService::on_scan(const scan_t& msg) {
       spdlog::warn("scan v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
     }
   }
-  if (verdict_due_) report(wall_utime(), false, false);
+  report_if_due();
 }
 
 Compensator& CompensatorService::law(int axis, const char* field) {
@@ -181,7 +181,7 @@ void CompensatorService::on_trajectory(const trajectory_t& msg) {
       spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
     }
   }
-  if (verdict_due_) report(wall_utime(), false, false);
+  report_if_due();
 }
 
 }  // namespace hystloop

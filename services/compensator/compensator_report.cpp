@@ -82,34 +82,54 @@ CounterSet::Entries CompensatorService::collect_counters() const {
   return entries;
 }
 
-// Off the sensor path: what the SequenceGuard decided since the last report.
+// Off the sensor path: what the SequenceGuard decided since the last line of each kind. Forged
+// blocks can make these at every report, so each kind goes through the limiter; the count
+// since the last line written is kept until one is.
 void CompensatorService::log_sequence_events() {
   const SequenceGuard::Counters& g = guard_.counters();
   constexpr int kHeld = SequenceGuard::kConfirmBlocks - 1;
+  const std::int64_t now_ns = monotonic_ns();
   if (g.restarts != restarts_logged_) {
-    const Discontinuity& d = discontinuities_.last_restart();
-    spdlog::warn(
-        "bridge restart: sensor ticks went back: tick {} was expected, the stream continues from tick {} "
-        "(confirmed by {} blocks, the first {} of them held): control law restarted ({} restarts in all)",
-        d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.restarts);
+    if (const LogLimiter::Gate gate = log_limiter_.allow(kLogSensorRestart, now_ns)) {
+      const Discontinuity& d = discontinuities_.last_restart();
+      spdlog::warn(
+          "bridge restart: sensor ticks went back: tick {} was expected, the stream continues from tick {} "
+          "(confirmed by {} blocks, the first {} of them held): control law restarted ({} restarts in all){}",
+          d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.restarts, suppressed_note(gate));
+      restarts_logged_ = g.restarts;
+    }
   }
   if (g.jumps != jumps_logged_) {
-    const Discontinuity& d = discontinuities_.last_jump();
-    spdlog::warn(
-        "sensor ticks jumped ahead: tick {} was expected, the stream continues from tick {} (confirmed by {} "
-        "blocks, the first {} of them held; {} jumps in all)",
-        d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.jumps);
+    if (const LogLimiter::Gate gate = log_limiter_.allow(kLogSensorJump, now_ns)) {
+      const Discontinuity& d = discontinuities_.last_jump();
+      spdlog::warn(
+          "sensor ticks jumped ahead: tick {} was expected, the stream continues from tick {} (confirmed by {} "
+          "blocks, the first {} of them held; {} jumps in all){}",
+          d.expected_tick, d.resumed_tick, SequenceGuard::kConfirmBlocks, kHeld, g.jumps, suppressed_note(gate));
+      jumps_logged_ = g.jumps;
+    }
   }
   if (g.ignored != ignored_logged_) {
-    spdlog::warn(
-        "{} jump(s) or restart(s) of the sensor ticks not believed since the last report: not confirmed "
-        "by the blocks that followed (a forged or corrupted block?); sensor_jumps_ignored {}, "
-        "sensor_blocks_held {} in all",
-        g.ignored - ignored_logged_, g.ignored, g.held);
+    if (const LogLimiter::Gate gate = log_limiter_.allow(kLogSensorIgnored, now_ns)) {
+      spdlog::warn(
+          "{} jump(s) or restart(s) of the sensor ticks not believed since the last such line: not confirmed "
+          "by the blocks that followed (a forged or corrupted block?); sensor_jumps_ignored {}, "
+          "sensor_blocks_held {} in all{}",
+          g.ignored - ignored_logged_, g.ignored, g.held, suppressed_note(gate));
+      ignored_logged_ = g.ignored;
+    }
   }
-  restarts_logged_ = g.restarts;
-  jumps_logged_ = g.jumps;
-  ignored_logged_ = g.ignored;
+}
+
+bool CompensatorService::report_if_due() noexcept {
+  if (!verdict_due_ || !status_.immediate_allowed(monotonic_ns())) return false;
+  try {
+    report(wall_utime(), false, false);
+  } catch (...) {  // the periodic report says it within a second
+    verdict_due_ = false;
+    return false;
+  }
+  return true;
 }
 
 void CompensatorService::report(std::int64_t utime, bool stopping, bool end_period) {

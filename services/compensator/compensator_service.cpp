@@ -139,12 +139,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
         ++counters_.trajectory_refused;
         decide_trajectory(pending_version_, e.what(), true, false);
       }
-      if (verdict_due_) {
-        try {
-          report(wall_utime(), false, false);
-        } catch (...) {  // the periodic report says it a second later
-        }
-      }
+      report_if_due();
     }
   }
   publish_plan();
@@ -206,7 +201,14 @@ int CompensatorService::run() {
   const double started_s = monotonic_s();
   IoLoopOptions options;
   options.poll_timeout = std::chrono::microseconds(20000);
+  // Ticks of StatusReporter's immediate interval, so that a report a verdict asked for while
+  // the interval had not passed goes out when it has; every tenth is the periodic report.
+  options.period = std::chrono::milliseconds(StatusReporter::kMinImmediateInterval_ns / 1'000'000);
+  constexpr int kTicksPerReport = 1'000'000'000 / StatusReporter::kMinImmediateInterval_ns;
+  int ticks = 0;
   const int errors = run_io_loop(lcm_, options, [&](std::int64_t utime) {
+    if (++ticks < kTicksPerReport) return void(report_if_due());
+    ticks = 0;
     report(utime, false);
     if (settings_.run_seconds > 0 && monotonic_s() - started_s >= settings_.run_seconds) {
       spdlog::info("--seconds {} reached", settings_.run_seconds);

@@ -23,7 +23,9 @@
 //   feedforward at the next reversal; a kind or format this build does not know is counted
 //   (model_unknown_kind, model_unknown_format). model_switches and reanchors count the swaps.
 // - Lines triggered by messages are rate-limited (LogLimiter, one per reason a second) and text
-//   off the wire is escaped (escape_wire).
+//   off the wire is escaped (escape_wire). HX_STATUS goes out once a second, and at once after a
+//   verdict its sender waits for, but then at most every StatusReporter::kMinImmediateInterval_ns
+//   (100 ms): verdicts within it are answered by the one report that follows it.
 //
 // One file per concern: compensator_service.cpp (the sensor path, the plan, a restarted bridge,
 // run), compensator_references.cpp (trajectories and scans), compensator_params.cpp (parameter
@@ -122,6 +124,11 @@ class CompensatorService {
   // HX_STATUS; end_period false: an extra report between the periodic ones (a trajectory's
   // verdict), which leaves the period's timing and sample counts running.
   void report(std::int64_t utime, bool stopping, bool end_period = true);
+  // The extra report a verdict asked for, if one is due and StatusReporter's interval allows it
+  // now; else it stays due (the I/O loop sends it when the interval has passed). True if sent.
+  bool report_if_due() noexcept;
+  // HX_STATUS reports published so far.
+  std::uint64_t reports_published() const noexcept { return status_.published(); }
 
   const Compensator& compensator() const noexcept { return *laws_[0]; }  // x's
   const Compensator& compensator(int axis) const noexcept { return *laws_[static_cast<std::size_t>(axis)]; }
@@ -160,7 +167,10 @@ class CompensatorService {
     kLogParamsInvalid,
     kLogParamsStale,
     kLogParamsRefused,
-    kLogModelUnknown
+    kLogModelUnknown,
+    kLogSensorRestart,
+    kLogSensorJump,
+    kLogSensorIgnored
   };
   CounterSet::Entries collect_counters() const;
 

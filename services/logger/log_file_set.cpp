@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 
 #include <spdlog/fmt/chrono.h>
 #include <spdlog/fmt/fmt.h>
@@ -119,10 +120,11 @@ void LogFileSet::commit(std::uint32_t tag, std::uint64_t bytes, std::size_t payl
     writing_.store(true, std::memory_order_release);
     recoveries_.fetch_add(1, std::memory_order_relaxed);
   }
-  if (listener_ != nullptr) listener_->written(tag, payload_bytes);
+  if (listener_ != nullptr && tag != kFileHeaderTag) listener_->written(tag, payload_bytes);
 }
 
 void LogFileSet::lose(std::uint32_t tag) noexcept {
+  if (tag == kFileHeaderTag) return;  // not an event of the record
   events_lost_.fetch_add(1, std::memory_order_relaxed);
   if (listener_ != nullptr) listener_->lost(tag);
 }
@@ -250,13 +252,29 @@ bool LogFileSet::write(const char* channel, std::size_t channel_length, const vo
   }
   // After a fault, nothing for kRetryInterval_s (each refused event is counted), then a new file.
   // An event larger than the buffer is written on its own, after what the buffer holds.
+  if (fd_ < 0 && (now_s < retry_at_s_ || !open_next(now_s))) {
+    lose(tag);
+    return false;
+  }
+  // A new file's buffer is empty, so the header always fits.
+  if (file_events_taken_ == 0 && !header_data_.empty()) {
+    buffer_event(header_channel_.data(), header_channel_.size(), header_data_.data(), header_data_.size(), utime,
+                 kFileHeaderTag);
+  }
   const bool direct = bytes > kBufferBytes;
   const bool full = direct || buffer_used_ + bytes > kBufferBytes || buffered_count_ == kMaxBufferedEvents;
-  if ((fd_ < 0 && (now_s < retry_at_s_ || !open_next(now_s))) || (full && !flush_buffer())) {
+  if (full && !flush_buffer()) {
     lose(tag);
     return false;
   }
   if (direct) return write_direct(channel, channel_length, data, size, utime, tag);
+  buffer_event(channel, channel_length, data, size, utime, tag);
+  return true;
+}
+
+void LogFileSet::buffer_event(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
+                              std::int64_t utime, std::uint32_t tag) noexcept {
+  const std::uint64_t bytes = event_bytes(channel_length, size);
   std::uint8_t* at = buffer_.get() + buffer_used_;
   frame(at, channel_length, size, utime);
   std::memcpy(at + kEventHeaderBytes, channel, channel_length);
@@ -266,7 +284,11 @@ bool LogFileSet::write(const char* channel, std::size_t channel_length, const vo
       Buffered{static_cast<std::uint32_t>(buffer_used_), tag, static_cast<std::uint32_t>(size)};
   ++file_events_taken_;
   file_bytes_taken_ += bytes;
-  return true;
+}
+
+void LogFileSet::set_file_header(std::string channel, std::vector<std::uint8_t> data) {
+  header_channel_ = std::move(channel);
+  header_data_ = std::move(data);
 }
 
 void LogFileSet::flush() noexcept {

@@ -96,6 +96,11 @@ class LogFileSet {
   bool write(const char* channel, std::size_t channel_length, const void* data, std::size_t size, std::int64_t utime,
              double now_s, std::uint32_t tag = 0) noexcept;
 
+  // An event to write first in each file opened from now on (the keyed rig's marker,
+  // record/record_auth.hpp), stamped with the time of the event that follows it. The listener
+  // is not told about it, nor is it counted as lost. Call before the first write().
+  void set_file_header(std::string channel, std::vector<std::uint8_t> data);
+
   // Hands the buffered events to the kernel (a crash then loses at most one flush interval).
   void flush() noexcept;
   // Flushes, fsyncs and closes the current file (removed if it holds no event); write()
@@ -119,6 +124,7 @@ class LogFileSet {
 
  private:
   static constexpr std::size_t kEventHeaderBytes = 28;
+  static constexpr std::uint32_t kFileHeaderTag = UINT32_MAX;
   struct Buffered {
     std::uint32_t end;  // offset in buffer_ just past the event
     std::uint32_t tag;
@@ -131,6 +137,8 @@ class LogFileSet {
   bool write_direct(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
                     std::int64_t utime, std::uint32_t tag) noexcept;
   std::size_t write_all(const void* data, std::size_t size, int& error) noexcept;
+  void buffer_event(const char* channel, std::size_t channel_length, const void* data, std::size_t size,
+                    std::int64_t utime, std::uint32_t tag) noexcept;
   void frame(std::uint8_t* at, std::size_t channel_length, std::size_t size, std::int64_t utime) noexcept;
   void commit(std::uint32_t tag, std::uint64_t bytes, std::size_t payload_bytes) noexcept;
   void lose(std::uint32_t tag) noexcept;
@@ -149,6 +157,8 @@ class LogFileSet {
   std::uint64_t file_events_taken_ = 0;  // in the current file, buffered ones included (the next event number)
   std::uint64_t file_bytes_taken_ = 0;
   std::vector<LogFileInfo> files_;
+  std::string header_channel_;
+  std::vector<std::uint8_t> header_data_;
   double now_s_ = 0.0;  // the latest time write() was given
   double opened_s_ = 0.0;
   double retry_at_s_ = 0.0;

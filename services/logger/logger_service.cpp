@@ -18,6 +18,7 @@
 #include "runtime/summary_file.hpp"
 #include "lcm/message_storage.hpp"
 #include "lcm/wire_layout.hpp"
+#include "record/record_auth.hpp"
 #include "runtime/io_loop.hpp"
 
 namespace hystloop {
@@ -42,13 +43,24 @@ bool decode_block(Block& block, const void* data, std::size_t size) noexcept {
   return used == static_cast<int>(body) && block.n_ticks >= 1;
 }
 
+// "870 unsigned, 2 bad_mac": a channel's refusals by reason.
+std::string refused_reasons(const ChannelSlot& c) {
+  std::string out;
+  for (std::size_t r = 1; r < kAuthResults; ++r) {
+    if (c.refused[r] == 0) continue;
+    out += fmt::format("{}{} {}", out.empty() ? "" : ", ", c.refused[r], to_string(static_cast<AuthResult>(r)));
+  }
+  return out;
+}
+
 std::string append(std::string detail, const std::string& what) {
   if (what.empty()) return detail;
   return detail.empty() ? what : detail + "; " + what;
 }
 }  // namespace
 
-LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options)
+LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options,
+                             std::shared_ptr<const RigAuth> auth)
     : lcm_(lcm),
       options_(options),
       channels_regex_(options.channels.empty() ? names.all_channels_regex() : options.channels),
@@ -74,12 +86,23 @@ LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const Log
     const RotationPolicy policy{static_cast<std::uint64_t>(options.max_file_mb * 1e6), options.max_file_s};
     files_ = std::make_unique<LogFileSet>(options.out_dir, options.file_prefix, policy, std::time(nullptr), start_s_,
                                           write_counter_.get());
+    if (auth != nullptr) {
+      keyed_ = true;
+      for (std::size_t i = 0; i < ChannelTable::kRigChannels; ++i) {
+        ChannelSlot& slot = (*channels_)[i];
+        if (!is_authenticated_channel(slot.name_view())) continue;
+        // Nothing signed before the logger started is recorded, as no service takes it.
+        verifiers_[i] = std::make_unique<MessageVerifier>(auth->key, auth->max_skew_us, start_utime_);
+        slot.verified = true;
+      }
+      files_->set_file_header(channel_name(names.prefix, kRecordSuffix), keyed_record_marker(start_utime_));
+    }
     writer_ = std::make_unique<LogWriter>(*ring_, *channels_, *files_, options.flush_interval_s);
     writer_->start();
 
     control_ = std::make_unique<Subscription<control_t>>(
         lcm_, names.control, [this](const control_t& msg, std::int64_t) { on_control(msg); },
-        Subscription<control_t>::Options{.queue_capacity = 64, .on_reject = {}});
+        Subscription<control_t>::Options{.queue_capacity = 64, .on_reject = {}, .auth = auth});
   } catch (...) {
     unsubscribe();
     if (writer_) writer_->stop();
@@ -103,6 +126,15 @@ void LoggerService::receive(const char* channel, const void* data, std::size_t s
   ChannelSlot& slot = (*channels_)[*index];
   ++slot.received;
   slot.bytes_received += size;
+  if (*index < verifiers_.size() && verifiers_[*index] != nullptr) {
+    // What every service refuses stays out of the record and out of the gap arithmetic.
+    const AuthResult result = verify_recorded(*verifiers_[*index], slot.name_view(), data, size, recv_utime);
+    if (result != AuthResult::kOk) {
+      ++slot.refused[static_cast<std::size_t>(result)];
+      handling_.add(monotonic_ns() - t0);
+      return;
+    }
+  }
   if (slot.kind != SequenceKind::kNone) check_sequence(slot, data, size, recv_utime);
   switch (ring_->try_push(*index, recv_utime, data, size)) {
     case RecordRing::PushResult::kOk: break;
@@ -202,12 +234,14 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   std::string detail = fault_detail(faults);
   std::uint64_t bytes_written = 0;
   std::uint64_t dropped = 0;
+  std::uint64_t refused_total = 0;
   std::uint64_t other_channels = 0, other_received = 0, other_written = 0, other_dropped = 0;
   for (std::size_t i = 0; i < channels_->size(); ++i) {
     const ChannelSlot& c = (*channels_)[i];
     // Counts fed by the wire: every sum saturates rather than wrap to a plausible small number.
     add_saturating(bytes_written, c.bytes_written.load(std::memory_order_relaxed));
     add_saturating(dropped, c.dropped());
+    add_saturating(refused_total, c.refused_total());
     if (!c.rig) {  // names off the wire: summed, never put in the detail one by one
       ++other_channels;
       add_saturating(other_received, c.received);
@@ -217,7 +251,8 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     }
     const SequenceGapDetector& q = c.sequence;
     const std::uint64_t overlaps = saturating_add(q.overlaps(), q.duplicates());
-    const Seen now{c.dropped(), q.gap_events(), q.missing(), overlaps, q.resumes(), q.skipped(), q.violations()};
+    const Seen now{c.dropped(), q.gap_events(), q.missing(),    overlaps,
+                   q.resumes(), q.skipped(),    q.violations(), c.refused_total()};
     Seen& before = seen_[i];
     const std::string_view name = c.name_view();
     // What went wrong on the channel since the last report: "<what> on <channel>".
@@ -234,6 +269,14 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     say(now.violations > before.violations,
         fmt::format("{} block(s) breaking the channel contract (seq or n_ticks out of range; not checked for gaps)",
                     now.violations - before.violations));
+    if (now.refused > before.refused) {
+      const std::string what = fmt::format("refused {} message(s) whose signature failed ({}; not recorded)",
+                                           now.refused - before.refused, refused_reasons(c));
+      say(true, what);
+      if (const LogLimiter::Gate g = slow_log_.allow(kLogRefused, monotonic_ns())) {
+        spdlog::warn("{} on {}{}", what, name, suppressed_note(g));
+      }
+    }
     before = now;
   }
   if (other_dropped > seen_other_dropped_) {
@@ -257,6 +300,11 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
     reporter_.counter(name + ".received", c.received);
     reporter_.counter(name + ".written", c.written.load(std::memory_order_relaxed));
     reporter_.counter(name + ".dropped", c.dropped());
+    if (c.verified) {
+      for (std::size_t r = 1; r < kAuthResults; ++r) {
+        reporter_.counter(name + ".rejected_" + std::string(to_string(static_cast<AuthResult>(r))), c.refused[r]);
+      }
+    }
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
       reporter_.counter(name + ".gaps", q.gap_events());
@@ -292,6 +340,8 @@ void LoggerService::report(std::int64_t utime, std::int8_t state_override) {
   reporter_.counter("queue_used_bytes", ring_->used_bytes());
   reporter_.counter("queue_high_water_bytes", writer_->queue_high_water_bytes());
   reporter_.counter("unrecorded_channel", unrecorded);
+  reporter_.counter("keyed", keyed_ ? 1 : 0);
+  reporter_.counter("rejected_auth", refused_total);
   reporter_.counter("unknown_channel_names", channels_->unknown().distinct());
   reporter_.endpoint("control", control_->counters());
   reporter_.loop_timing(handling_);
@@ -356,6 +406,7 @@ RecordingSummary LoggerService::finish() {
   s.files = files_->files();
   s.disk = files_->faults();
   s.unrecorded_channel = channels_->unrecorded_channels();
+  s.keyed = keyed_;
   s.queue_capacity_bytes = ring_->capacity_bytes();
   s.queue_high_water_bytes = writer_->queue_high_water_bytes();
   const ResourceUsage usage = read_resource_usage();

@@ -13,8 +13,10 @@
 // HX_COMMAND, see SequenceGapDetector); other recorded channels summed under "other.*";
 // channels without a slot as unrecorded_channel (messages) and unknown_channel_names; files,
 // bytes, dropped and the disk faults (disk_errors, disk_events_lost, ...; see LogFileSet).
-// DEGRADED with a detail when something was dropped, a gap, overlap, resume or contract
-// violation seen in the last period. A disk fault is DEGRADED with a detail starting "FAULT: "
+// On a keyed rig, per signed rig channel rejected_<reason> (unsigned, malformed, bad_mac,
+// replayed, skewed: messages not recorded), and rejected_auth in all.
+// DEGRADED with a detail when something was dropped or refused, a gap, overlap, resume or
+// contract violation seen in the last period. A disk fault is DEGRADED with a detail starting "FAULT: "
 // and the reason ("FAULT: disk full (write: No space left on device); ...") for as long as
 // nothing can be written (service_status_t has no FAULT state; DEGRADED + this prefix needs no
 // type change).
@@ -52,8 +54,11 @@ class LoggerService {
   static constexpr const char* kProcessName = "logger";
 
   // Subscribes and opens the first log file. Throws ParameterError (logger.channels not a
-  // regular expression LCM accepts) / std::runtime_error.
-  LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options);
+  // regular expression LCM accepts) / std::runtime_error. With `auth` (a keyed rig) the rig's
+  // signed channels are verified as the services verify them: what fails is counted by reason,
+  // not recorded; each file starts with the keyed marker (record/record_auth.hpp).
+  LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options,
+                std::shared_ptr<const RigAuth> auth = process_rig_auth());
   ~LoggerService();
   LoggerService(const LoggerService&) = delete;
   LoggerService& operator=(const LoggerService&) = delete;
@@ -88,6 +93,10 @@ class LoggerService {
   std::unique_ptr<RecordRing> ring_;
   std::unique_ptr<LogFileSet> files_;
   std::unique_ptr<LogWriter> writer_;
+  // The rig's signed channels' verifiers, by slot (null: not verified); one per channel, as one
+  // Subscription per channel in the services. Made before the first message, never after.
+  std::array<std::unique_ptr<MessageVerifier>, ChannelTable::kRigChannels> verifiers_;
+  bool keyed_ = false;
   lcm_subscription_t* raw_ = nullptr;
   sensor_block_t sensor_block_{};  // storage reserved for MAX_VALUES (MAX_TICKS of MAX_AXES)
   command_block_t command_block_{};
@@ -108,6 +117,7 @@ class LoggerService {
     std::uint64_t resumes = 0;
     std::uint64_t skipped = 0;
     std::uint64_t violations = 0;  // blocks breaking the channel contract, all reasons
+    std::uint64_t refused = 0;     // signatures that failed
   };
   std::array<Seen, ChannelTable::kMaxChannels> seen_{};
   std::uint64_t seen_other_dropped_ = 0;
@@ -116,7 +126,7 @@ class LoggerService {
   DiskFaults seen_faults_{};
   std::int64_t last_report_utime_ = 0;
   // Unknown channels and ignored RESET_COUNTERS (anyone can send them) are logged at most every 10 s.
-  enum LogReason : std::size_t { kLogUnknownChannels, kLogResetIgnored };
+  enum LogReason : std::size_t { kLogUnknownChannels, kLogResetIgnored, kLogRefused };
   LogLimiter slow_log_{10'000'000'000};
 };
 

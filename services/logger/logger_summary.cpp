@@ -59,6 +59,13 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
                {"dropped_queue_full", c.dropped_queue_full},
                {"dropped_oversize", c.dropped_oversize},
                {"write_failed", c.write_failed.load()}};
+    if (c.verified) {
+      Json refused = Json::object();
+      for (std::size_t r = 1; r < kAuthResults; ++r) {
+        refused[std::string(to_string(static_cast<AuthResult>(r)))] = c.refused[r];
+      }
+      ch["refused"] = refused;
+    }
     if (c.kind != SequenceKind::kNone) {
       const SequenceGapDetector& q = c.sequence;
       Json violations = Json::object();
@@ -91,6 +98,7 @@ std::string summary_json(const RecordingSummary& s, const ChannelTable& channels
   }
   const Json j = {
       {"recording", s.recording},
+      {"keyed", s.keyed},
       {"start_utime", s.start_utime},
       {"stop_utime", s.stop_utime},
       {"duration_s", s.duration_s},

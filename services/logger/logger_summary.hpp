@@ -3,7 +3,7 @@
 // a few lines for the process log. Built once, after the disk thread has stopped.
 //
 // JSON layout (counts are integers; times in us since the epoch; durations in s):
-//   { "recording", "start_utime", "stop_utime", "duration_s", "stop_reason",
+//   { "recording", "keyed", "start_utime", "stop_utime", "duration_s", "stop_reason",
 //     "files": [ {"path", "events", "bytes"} ],
 //     "totals": { "received", "written", "dropped", "bytes_written", "gap_events", "missing", "skipped",
 //                 "contract_violations" },
@@ -15,6 +15,7 @@
 //     "process": { "cpu_user_s", "cpu_system_s", "peak_rss_bytes" },
 //     "channels": { "<name>": { "received", "bytes_received", "written", "bytes_written",
 //                               "dropped", "dropped_queue_full", "dropped_oversize", "write_failed",
+//                               ["refused": { "unsigned", "malformed", "bad_mac", "replayed", "skewed" }],
 //                               ["sequence": { "blocks", "ticks", "first_seq", "last_seq", "gap_events", "missing",
 //                                              "resumes", "skipped", "overlaps", "overlap_ticks",
 //                                              "duplicates", "out_of_order", "restarts", "undecodable",
@@ -28,7 +29,8 @@
 // gaps of a channel; "sequence" is present for the channels checked for gaps (the rig's
 // sensor and command channels). "disk.ok" is false after any disk fault (LogFileSet): then
 // "events_lost" events were not written (also in dropped.write_failed) and the process exits 1.
-// "unknown_channels" are the channels the table had no slot for (UnknownChannels).
+// "refused" (a keyed rig's signed channels) counts the messages whose signature failed: counted
+// in "received", never recorded. "unknown_channels" are the channels the table had no slot for (UnknownChannels).
 
 #include <cstdint>
 #include <filesystem>
@@ -49,6 +51,7 @@ struct RecordingSummary {
   std::vector<LogFileInfo> files;
   DiskFaults disk;
   std::uint64_t unrecorded_channel = 0;  // messages of channels the table had no room for
+  bool keyed = false;                    // signatures verified (record/record_auth.hpp)
   std::uint64_t queue_capacity_bytes = 0;
   std::uint64_t queue_high_water_bytes = 0;
   double cpu_user_s = 0.0;  // the whole process, all threads

@@ -208,7 +208,9 @@ void ReidentService::on_control(const control_t& msg) {
                       " is not the re-identifier's (pin-model, hold, reset-counters, shutdown)",
                   wall_utime());
   }
-  if (acks_.due()) publish_status(steady_us(), false);  // its sender waits for the answer
+  // Its sender waits for the answer: at once, unless a report went out within StatusReporter's
+  // interval; then on_tick sends it when the interval has passed.
+  if (acks_.due() && status_.immediate_allowed(monotonic_ns())) publish_status(steady_us(), false);
 }
 
 void ReidentService::publish_decision(const RefitDecision& d) {
@@ -374,6 +376,8 @@ void ReidentService::on_tick(std::int64_t /*wall_us*/) {
     publish_status(now, false);
     next_status_us_ += 1'000'000;
     if (next_status_us_ <= now) next_status_us_ = now + 1'000'000;
+  } else if (acks_.due() && status_.immediate_allowed(monotonic_ns())) {
+    publish_status(now, false);
   }
 }
 

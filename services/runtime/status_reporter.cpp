@@ -112,6 +112,8 @@ bool StatusReporter::publish(std::int64_t utime) {
     }
   }
   status_.utime = utime;
+  last_publish_ns_ = monotonic_ns();
+  ++published_;
   return publisher_.publish(status_);
 }
 

@@ -35,6 +35,19 @@ class StatusReporter {
 
   const service_status_t& status() const noexcept { return status_; }
 
+  // A report that is not the periodic one (the verdict a sender waits for, a disk fault) goes
+  // out at once only if none went out within this interval; otherwise it is due and goes out
+  // when the interval has passed, however many asked meanwhile (one report says it all). With
+  // the periodic report a process then sends at most 1 s / interval + 1 reports a second,
+  // whatever floods it.
+  static constexpr std::int64_t kMinImmediateInterval_ns = 100'000'000;
+  // True if an immediate report may be published at now_ns (monotonic_ns()).
+  bool immediate_allowed(std::int64_t now_ns) const noexcept {
+    return published_ == 0 || now_ns - last_publish_ns_ >= kMinImmediateInterval_ns;
+  }
+  // Reports published so far.
+  std::uint64_t published() const noexcept { return published_; }
+
   // Counters beyond service_status_t::MAX_COUNTERS are not silently lost: the report's last
   // counter becomes `counters_dropped` (how many did not fit, that one included), and the first
   // report that overflows logs their names.
@@ -48,6 +61,8 @@ class StatusReporter {
   std::uint64_t dropped_ = 0;  // counters of this report that did not fit
   std::string first_dropped_;  // ... the first of them, for the log
   bool overflow_logged_ = false;
+  std::int64_t last_publish_ns_ = 0;
+  std::uint64_t published_ = 0;
   Publisher<service_status_t> publisher_;
 };
 

@@ -5,6 +5,7 @@
 // back to the same size. What follows the walked encoding goes through a keyed rig's check
 // (common/auth/message_auth.hpp): no input can carry a trailer the verifier takes, since the
 // fuzzer does not know the key; one that did would be a hole in the MAC check or its framing.
+// The same holds for the logger's check of the whole message (record/record_auth.hpp).
 // A MEM parameter set the contract accepts then meets the receivers' plausibility check
 // (common/models/gain_plausibility.hpp): refused with a ParameterError, or let through only with
 // a finite small-signal gain inside the band: nothing else may escape it.
@@ -23,6 +24,7 @@
 #include "lcm/wire_layout.hpp"
 #include "models/gain_plausibility.hpp"
 #include "models/model_set.hpp"
+#include "record/record_auth.hpp"
 
 namespace {
 
@@ -66,6 +68,12 @@ void receive(const std::uint8_t* data, std::size_t size) {
   const auto body = static_cast<std::size_t>(walked);
   if (body < buffer.size() && verifier().verify("HX_SENSOR", buffer.data(), body, buffer.data() + body,
                                                 buffer.size() - body, 1'800'000'000'000'000) == AuthResult::kOk) {
+    std::abort();
+  }
+  // The logger's and the log readers' check (record/record_auth.hpp), which takes the trailer
+  // from the end of the message whatever its layout: nothing it can be given verifies either.
+  if (verify_recorded(verifier(), "HX_COMMAND", buffer.data(), buffer.size(), 1'800'000'000'000'000) ==
+      AuthResult::kOk) {
     std::abort();
   }
   static T msg = [] {

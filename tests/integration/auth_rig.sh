@@ -7,10 +7,14 @@
 # from the running rig and replayed (at once: replayed; after the skew window: skewed) is refused.
 # The sensor stream is signed too: three forged blocks 5000 ticks ahead (which the sequence guard
 # would confirm as a jump) and a replayed real block are refused before the guard sees them.
+# A keyed logger records none of what the services refused (no gap, no out-of-order block, no
+# foreign parameter set: counted by reason instead), and hystloop-report reads its record with
+# the key, and warns without it.
 # Inside tools/netns-run.
 #   auth_rig.sh <hystloop-bridge> <hystloop-compensator> <loop_probe> <auth_probe> <hystloop-ctl>
+#               <hystloop-logger> <hystloop-report>
 source "$(dirname "$0")/loop_common.sh" "$1" "$2" "$3"
-authp="$4"; ctl="$5"
+authp="$4"; ctl="$5"; logger="$6"; report="$7"
 key="$dir/rig.key"
 
 "$ctl" keygen --out "$key" >/dev/null || fail "keygen failed"
@@ -26,6 +30,8 @@ chmod 600 "$key"
 
 auth=(--set auth.key_file="$key")
 start_recording
+"$logger" "${auth[@]}" --out-dir "$dir/rec" --summary "$dir/rec.json" >"$dir/logger.log" 2>&1 & lpid=$!; pids+=($lpid)
+wait_log "$dir/logger.log" "recording"
 "$compensator" "${compensator_args[@]}" "${auth[@]}" >"$dir/compensator.log" 2>&1 & cpid=$!; pids+=($cpid)
 "$bridge" "${bridge_args[@]}" "${auth[@]}" >"$dir/bridge.log" 2>&1 & bpid=$!; pids+=($bpid)   # not armed
 wait_log "$dir/compensator.log" "channels:"
@@ -67,7 +73,33 @@ wait_until 20 "both services reported every refused message" refusals_reported
 kill -TERM $bpid $cpid
 wait $bpid || fail "the bridge exited with $?"
 wait $cpid || fail "the compensator exited with $?"
+kill -TERM $lpid
+wait $lpid || fail "the logger exited with $?"
 stop_recording
+
+# The record holds what the rig took: what it refused is counted by the logger, not recorded.
+rec() { jq -r "$1" "$dir/rec.json"; }
+[ "$(rec .keyed)" = true ] || fail "the logger's summary does not say keyed"
+[ "$(rec .channels.HX_COMMAND.refused.unsigned)" -ge 10 ] || fail "logger HX_COMMAND refused unsigned $(rec .channels.HX_COMMAND.refused.unsigned)"
+[ "$(rec .channels.HX_SENSOR.refused.unsigned)" -ge 3 ] || fail "logger HX_SENSOR refused unsigned $(rec .channels.HX_SENSOR.refused.unsigned)"
+[ "$(rec .channels.HX_SENSOR.refused.replayed)" -ge 1 ] || fail "logger HX_SENSOR refused replayed $(rec .channels.HX_SENSOR.refused.replayed)"
+[ "$(rec .channels.HX_PARAMS.refused.unsigned)" -ge 1 ] || fail "logger HX_PARAMS refused unsigned $(rec .channels.HX_PARAMS.refused.unsigned)"
+[ "$(rec .channels.HX_PARAMS.written)" = 0 ] || fail "the logger recorded an unsigned parameter set"
+for ch in HX_SENSOR HX_COMMAND; do
+  for what in missing out_of_order; do
+    [ "$(rec ".channels.$ch.sequence.$what")" = 0 ] || fail "logger $ch $what $(rec ".channels.$ch.sequence.$what")"
+  done
+done
+logs=("$dir"/rec/*.lcmlog)
+"$report" "${logs[@]}" --out "$dir/report_nokey" --no-plots --quiet 2>"$dir/report_nokey.err" ||
+  fail "hystloop-report without the key: $(cat "$dir/report_nokey.err")"
+grep -q "recorded on a keyed rig; signatures not checked" "$dir/report_nokey.err" ||
+  fail "hystloop-report did not warn that it read a keyed log unverified: $(cat "$dir/report_nokey.err")"
+"$report" "${logs[@]}" --out "$dir/report_key" --no-plots --quiet --key-file "$key" 2>"$dir/report_key.err" ||
+  fail "hystloop-report with the key: $(cat "$dir/report_key.err")"
+[ "$(jq .signatures_verified "$dir/report_key/summary.json")" = true ] || fail "the report did not verify"
+[ "$(jq .unverified_events_left_out "$dir/report_key/summary.json")" = 0 ] || fail "the keyed record held unverified events"
+[ "$(jq .params_updates "$dir/report_key/summary.json")" = 0 ] || fail "the report lists a parameter set the rig refused"
 
 expect_value bridge command.rejected_unsigned 10
 expect_value bridge command.rejected_replayed 1

@@ -100,5 +100,36 @@ TEST(BridgeHealth, APeriodWithRepairedSamplesIsDegradedAndSaysWhy) {
   EXPECT_NE(h.detail.find("missing from the record"), std::string::npos) << h.detail;
 }
 
+// A dry buffer names its cause as far as the bridge can tell: how long before the trip the last
+// command block arrived, how many were refused and at what rate, a full real-time queue, and
+// how long the I/O thread was held up.
+TEST(BridgeHealth, TheWatchdogsReasonSaysWhyTheBufferRanDry) {
+  DryBufferFigures f{.watchdog_s = 0.002,
+                     .trip_tick = 1234,
+                     .since_last_command_s = 0.0573,
+                     .period_s = 0.5,
+                     .commands_rejected = 60,
+                     .command_queue_full = 0,
+                     .io_longest_pass_s = 0.0004,
+                     .io_longest_wait_s = 0.0201};
+  const std::string why = watchdog_reason(f);
+  EXPECT_NE(why.find("no command buffered for more than 0.002 s, tripped at tick 1234"), std::string::npos) << why;
+  EXPECT_NE(why.find("the last command block arrived 57.3 ms before"), std::string::npos) << why;
+  EXPECT_NE(why.find("60 HX_COMMAND message(s) refused in the last 0.5 s (120/s"), std::string::npos) << why;
+  EXPECT_EQ(why.find("queue full"), std::string::npos) << why;
+  EXPECT_NE(why.find("the I/O thread's longest pass 0.4 ms, longest wait 20.1 ms"), std::string::npos) << why;
+  EXPECT_NE(why.find("re-arm via HX_CONTROL"), std::string::npos) << why;
+
+  f.since_last_command_s = -1.0;
+  f.command_queue_full = 7;
+  f.axes = 2;
+  f.tripped_by = 1;
+  const std::string two = watchdog_reason(f);
+  EXPECT_NE(two.find("on y, tripped at tick 1234"), std::string::npos) << two;
+  EXPECT_NE(two.find("no command block received since the start"), std::string::npos) << two;
+  EXPECT_NE(two.find("7 command ticks found the real-time queue full"), std::string::npos) << two;
+  EXPECT_NE(two.find("every axis to the safe state"), std::string::npos) << two;
+}
+
 }  // namespace
 }  // namespace hystloop

@@ -23,6 +23,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "compensator/compensator_service.hpp"
@@ -617,6 +618,56 @@ TEST(CompensatorService, AppliesATrajectoryVersionOnceFromTheFirstTickNotSentAnd
   EXPECT_NEAR(h.tick(first + 100).y_ref_m, -3e-7, 1e-15);
   EXPECT_EQ(h.tick(first + 101).y_ref_m, -3e-7);
   EXPECT_EQ(h.service.counters().trajectories, 2u);
+}
+
+// 100 forged sensor blocks and refused trajectories a second made ~95 log lines a second of one
+// reason and 488 status reports in 5 s: each verdict sent a report at once, and each report
+// logged the jumps not believed. An extra report now goes out at most every 100 ms (what asked
+// for one meanwhile is in the next), and the sequence lines go through the limiter.
+TEST(CompensatorService, AFloodOfForgedBlocksAndRefusedTrajectoriesIsReportedAndLoggedAtABoundedRate) {
+  auto out = std::make_shared<std::ostringstream>();
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(*out);
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", sink));
+  double elapsed_s = 0.0;
+  std::uint64_t reports = 0;
+  {
+    Harness h;
+    Subscription<service_status_t> status(*h.lcm, h.channels.status);
+    h.send(0);
+    const double start_s = monotonic_s();
+    double periodic_s = start_s;
+    std::int64_t seq = 10;
+    std::int32_t version = 2;
+    while (monotonic_s() - start_s < 1.5) {
+      h.send(seq + 900);  // forged: far ahead, never confirmed
+      trajectory_t bad = hold(version++, 0.0);
+      bad.shape = trajectory_t::POINTS;  // POINTS without points: refused
+      h.service.on_trajectory(bad);
+      h.send(seq);
+      seq += 10;
+      if (monotonic_s() - periodic_s >= 1.0) {  // as the I/O loop does
+        h.service.report(wall_utime(), false);
+        periodic_s = monotonic_s();
+      }
+      h.drain();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    elapsed_s = monotonic_s() - start_s;
+    EXPECT_GE(h.service.counters().trajectory_refused, 50u);
+    EXPECT_GE(h.service.sequence_counters().ignored, 50u);
+    reports = status.counters().received;
+  }
+  spdlog::set_default_logger(previous);
+  // At most one extra report per 100 ms and the periodic one a second (+1: the first is at once).
+  EXPECT_LE(static_cast<double>(reports), elapsed_s / 0.1 + elapsed_s + 1.0);
+  EXPECT_GE(reports, 5u);  // verdicts are still answered
+  const std::string log = out->str();
+  std::size_t not_believed = 0, lines = 0;
+  for (std::size_t at = 0; (at = log.find("not believed", at)) != std::string::npos; ++at) ++not_believed;
+  for (const char c : log) lines += c == '\n';
+  EXPECT_LE(not_believed, 2u) << log.substr(0, 3000);  // one a second
+  EXPECT_LE(lines, 8u) << log.substr(0, 3000);
 }
 
 // The reference of tick k for a hold at 1e-7 starting at tick 1000, approached from 0 over 10 ms.

@@ -17,6 +17,9 @@
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_storage.hpp"
+#include "lcm/publisher.hpp"
+#include "lcm/rig_auth.hpp"
+#include "record/record_auth.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
@@ -271,6 +274,113 @@ TEST_F(LoggerServiceTest, JunkChannelsSentFirstDoNotBlindTheLogger) {
   // A name with a control character is kept, escaped for the JSON (and for a terminal that cats it).
   EXPECT_NE(summary.find("\"HX_JUNK60\\u001b[2J\""), std::string::npos) << summary;
   EXPECT_EQ(json["disk"]["ok"], true);
+}
+
+std::shared_ptr<const RigAuth> rig_key(unsigned char seed) {
+  auto auth = std::make_shared<RigAuth>();
+  for (std::size_t i = 0; i < auth->key.bytes.size(); ++i)
+    auth->key.bytes[i] = static_cast<unsigned char>(static_cast<std::size_t>(seed) * 3 + i);
+  return auth;
+}
+
+// The process's rig key for one test (a service's main sets it).
+struct ProcessAuth {
+  explicit ProcessAuth(std::shared_ptr<const RigAuth> a) { set_process_rig_auth(std::move(a)); }
+  ~ProcessAuth() { set_process_rig_auth(nullptr); }
+};
+
+// On a keyed rig the record holds what the rig would take: unsigned blocks far ahead, command
+// blocks signed with another key and a replayed block are not recorded, not counted as gaps or
+// out-of-order blocks, and are counted by channel and reason on HX_STATUS and in the summary;
+// the log starts with the keyed marker.
+TEST_F(LoggerServiceTest, OnAKeyedRigWhatFailsItsSignatureIsCountedNotRecorded) {
+  const ProcessAuth keyed(rig_key(1));
+  LoggerService service(*lcm_, names_, options_);
+  Publisher<sensor_block_t> sensor(*lcm_, names_.sensor);
+  Publisher<command_block_t> command(*lcm_, names_.command);
+  Publisher<sensor_block_t> unsigned_sensor(*lcm_, names_.sensor, default_message_check<sensor_block_t>(), nullptr);
+  Publisher<command_block_t> foreign_command(*lcm_, names_.command, default_message_check<command_block_t>(),
+                                             rig_key(2));
+  std::vector<std::uint8_t> last_signed;
+  lcm_subscription_t* keep = lcm_subscribe(
+      lcm_->getUnderlyingLCM(), names_.sensor.c_str(),
+      [](const lcm_recv_buf_t* rbuf, const char*, void* out) {
+        const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+        static_cast<std::vector<std::uint8_t>*>(out)->assign(b, b + rbuf->data_size);
+      },
+      &last_signed);
+  constexpr int kTicks = 10, kBlocks = 100;
+  for (std::int64_t k = 0; k < kBlocks; ++k) {
+    ASSERT_TRUE(sensor.publish(sensor_block(kTicks * k, kTicks)));
+    ASSERT_TRUE(command.publish(command_block(kTicks * k + 200, kTicks, kTicks * k + kTicks - 1)));
+    if (k == 50) {
+      dispatch_all();
+      const std::vector<std::uint8_t> replay = last_signed;
+      for (int i = 0; i < 3; ++i) ASSERT_TRUE(unsigned_sensor.publish(sensor_block(kTicks * k + 5000, kTicks)));
+      for (int i = 0; i < 7; ++i) ASSERT_TRUE(foreign_command.publish(command_block(kTicks * k + 9000, kTicks, 0)));
+      lcm_->publish(names_.sensor, replay.data(), static_cast<unsigned>(replay.size()));
+    }
+    dispatch_all();
+  }
+  lcm_unsubscribe(lcm_->getUnderlyingLCM(), keep);
+
+  const ChannelTable& channels = service.channels();
+  EXPECT_EQ(channels[0].received, static_cast<std::uint64_t>(kBlocks + 4));
+  EXPECT_EQ(channels[0].sequence.gap_events(), 0u);
+  EXPECT_EQ(channels[0].sequence.missing(), 0u);
+  EXPECT_EQ(channels[0].sequence.out_of_order(), 0u);
+  EXPECT_EQ(channels[0].sequence.duplicates(), 0u);
+  EXPECT_EQ(channels[1].sequence.gap_events(), 0u);
+  EXPECT_EQ(channels[1].sequence.out_of_order(), 0u);
+  EXPECT_EQ(channels[0].refused[static_cast<std::size_t>(AuthResult::kUnsigned)], 3u);
+  EXPECT_EQ(channels[0].refused[static_cast<std::size_t>(AuthResult::kReplayed)], 1u);
+  EXPECT_EQ(channels[1].refused[static_cast<std::size_t>(AuthResult::kBadMac)], 7u);
+
+  request_stop();
+  EXPECT_EQ(service.run(), 0);
+
+  std::vector<fs::path> logs, summaries;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".lcmlog")) logs.push_back(entry.path());
+    if (name.ends_with(".summary.json")) summaries.push_back(entry.path());
+  }
+  ASSERT_EQ(logs.size(), 1u);
+  lcm::LogFile log(logs[0].string(), "r");
+  int sensor_events = 0, command_events = 0, events = 0, status_events = 0;
+  bool marker_first = false;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    if (events++ == 0) marker_first = is_keyed_record_marker(ev->channel, ev->data, ev->datalen);
+    sensor_events += ev->channel == names_.sensor;
+    command_events += ev->channel == names_.command;
+    if (ev->channel == names_.status) {
+      service_status_t status;
+      ASSERT_GT(status.decode(ev->data, 0, ev->datalen), 0);
+      if (status.process != "logger") continue;
+      std::map<std::string, std::int64_t> counters;
+      for (int i = 0; i < status.n_counters; ++i) counters[status.counter_names[i]] = status.counter_values[i];
+      EXPECT_EQ(counters["keyed"], 1);
+      EXPECT_EQ(counters["HX_SENSOR.rejected_unsigned"], 3);
+      EXPECT_EQ(counters["HX_SENSOR.rejected_replayed"], 1);
+      EXPECT_EQ(counters["HX_COMMAND.rejected_bad_mac"], 7);
+      EXPECT_EQ(counters["rejected_auth"], 11);
+      EXPECT_NE(status.detail.find("refused 7 message(s) whose signature failed (7 bad_mac; not recorded) on "
+                                   "HX_COMMAND"),
+                std::string::npos)
+          << status.detail;
+      ++status_events;
+    }
+  }
+  EXPECT_TRUE(marker_first);
+  EXPECT_EQ(sensor_events, kBlocks);
+  EXPECT_EQ(command_events, kBlocks);
+  EXPECT_EQ(status_events, 1);
+  ASSERT_EQ(summaries.size(), 1u);
+  const auto json = nlohmann::json::parse(read_text(summaries[0]));
+  EXPECT_EQ(json["keyed"], true);
+  EXPECT_EQ(json["channels"]["HX_SENSOR"]["refused"]["unsigned"], 3);
+  EXPECT_EQ(json["channels"]["HX_COMMAND"]["refused"]["bad_mac"], 7);
+  EXPECT_EQ(json["totals"]["gap_events"], 0);
 }
 
 TEST_F(LoggerServiceTest, ShutdownForTheLoggerStopsIt) {

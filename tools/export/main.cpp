@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 
+#include "lcm/rig_auth.hpp"
 #include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "export_run.hpp"
@@ -46,6 +47,10 @@ int export_main(int argc, char** argv) {
   app.add_option("--config", o.configs,
                  "A YAML configuration file of the run, stored verbatim (repeatable), e.g. deploy/config/*.yaml");
   app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();
+  std::string key_file;
+  app.add_option("--key-file", key_file,
+                 "The rig key (auth.key_file of the services): verify the signed channels' messages and leave out "
+                 "(and count, in the warnings) those whose signature fails, as the rig refused them");
   std::string mat_version = "5";
   app.add_option("--mat-version", mat_version,
                  "MAT file level: 5 (compressed, MATLAB's -v7 and scipy.io.loadmat) or 7.3 (HDF5-based, for "
@@ -55,6 +60,8 @@ int export_main(int argc, char** argv) {
   app.add_flag("--quiet", o.quiet, "No progress on stderr and no summary on stdout (warnings and errors still)");
   if (const auto exit_code = parse_cli(app, argc, argv)) return *exit_code;
   o.mat_version = mat_version == "7.3" ? MatVersion::kV73 : MatVersion::kV5;
+  // The log's readers (report::for_each_event) verify with the process's key.
+  if (!key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(key_file, "--key-file"));
   return run_export(o, stderr, stdout);
 }
 

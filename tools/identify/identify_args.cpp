@@ -120,7 +120,9 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   pub->add_option("--lcm-url", args.link.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else udpm with ttl=0)");
   pub->add_flag("--allow-network", args.link.allow_network,
                 "allow an LCM URL whose packets leave this host (ttl > 0, tcpq)");
-  pub->add_option("--key-file", args.key_file, "the rig key (auth.key_file of the services): sign the published set");
+  pub->add_option("--key-file", args.key_file,
+                  "the rig key (auth.key_file of the services): sign the published set; verify the logs read (what "
+                  "fails its signature is left out and counted)");
   auto* bounds = app.add_option_group("bounds", "memory and progress of long fits");
   bounds
       ->add_option("--max-samples", args.max_samples,

@@ -475,8 +475,9 @@ std::string heading_of(const IdentifyArgs& args) {
 
 int fit_inputs(const IdentifyArgs& args) {
   std::unique_ptr<ParamsLink> link;
+  // The key signs a published set and verifies the logs read (for_each_log_event).
+  if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));
   if (args.publish) {
-    if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));
     PublishOptions p = args.link;
     if (args.timeout_s) p.timeout_s = *args.timeout_s;
     p.axis = args.axis;                      // the set models the axis the samples were of

@@ -66,7 +66,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
   control_t control{};
   command_block_t command{};
   sensor_block_t sensor{};
-  for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
+  const auto signature_notes = for_each_log_event(files, [&](const std::string&, const lcm::LogEvent& event) {
     if (event.channel == o.sensor_channel) {
       if (report::decode_checked(event, sensor)) {
         require_axis_in(sensor, o.axis, event.channel + " event " + std::to_string(event.eventnum));
@@ -102,6 +102,7 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
       }
     }
   });
+  out.notes.insert(out.notes.end(), signature_notes.begin(), signature_notes.end());
   out.files = files.size();
   out.requests = r.starts.size();
   auto by_seq = [](const auto& a, const auto& b) { return a.seq < b.seq; };

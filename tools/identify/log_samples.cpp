@@ -1,5 +1,8 @@
 #include "log_samples.hpp"
 
+#include "lcm/rig_auth.hpp"
+#include "record/record_auth.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -131,8 +134,11 @@ void LogReadOptions::validate() const {
   }
 }
 
-void for_each_log_event(const std::vector<std::string>& files,
-                        const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
+std::vector<std::string> for_each_log_event(
+    const std::vector<std::string>& files,
+    const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event) {
+  std::vector<std::string> notes;
+  RecordCheck check(process_rig_auth());
   for (const auto& file : files) {
     std::optional<report::EventFileReader> log;
     try {
@@ -140,8 +146,14 @@ void for_each_log_event(const std::vector<std::string>& files,
     } catch (const std::runtime_error& e) {  // "<file>: no such log file", or cannot be opened
       throw SampleLogError(e.what());
     }
-    while (const lcm::LogEvent* event = log->next()) on_event(file, *event);
+    while (const lcm::LogEvent* event = log->next()) {
+      if (check.admit(event->channel, event->data, static_cast<std::size_t>(event->datalen), event->timestamp)) {
+        on_event(file, *event);
+      }
+    }
+    for (const std::string& note : check.take_notes()) notes.push_back(file + ": " + note);
   }
+  return notes;
 }
 
 bool looks_like_lcm_log(const std::string& path) { return std::filesystem::path(path).extension() == ".lcmlog"; }
@@ -152,7 +164,7 @@ LogSamples read_sample_logs(const std::vector<std::string>& files, const LogRead
   RecordBuilder record(options);
   LogSamples& out = record.result();
   sensor_block_t block{};
-  for_each_log_event(files, [&](const std::string& file, const lcm::LogEvent& event) {
+  out.signature_notes = for_each_log_event(files, [&](const std::string& file, const lcm::LogEvent& event) {
     ++out.events;
     if (event.channel != options.sensor_channel) return;
     ++out.sensor_events;
@@ -180,6 +192,7 @@ std::string describe(const LogSamples& s, const LogReadOptions& options) {
     << " outside the time range\n";
   o << "skipped: " << s.safe_state << " SAFE_STATE, " << s.sensor_fault << " SENSOR_FAULT, " << s.duplicates
     << " repeated seq, " << s.undecodable << " block(s) undecodable or out of contract\n";
+  for (const std::string& note : s.signature_notes) o << "warning: " << note << "\n";
   o << "seq gaps: " << s.gaps << " (" << s.missing << " samples missing)";
   for (const auto& g : s.first_gaps) o << "; seq " << g.first_missing << " +" << g.missing;
   if (s.gaps > s.first_gaps.size()) o << "; ...";

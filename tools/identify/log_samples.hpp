@@ -79,6 +79,7 @@ struct LogSamples {
   std::size_t sensor_fault = 0;                     // skipped ticks: flagged SENSOR_FAULT (and not SAFE_STATE)
   std::size_t duplicates = 0;                       // skipped ticks: the same seq again
   std::size_t undecodable = 0;                      // skipped events: not a sensor_block_t, or out of contract
+  std::vector<std::string> signature_notes;         // for_each_log_event's
   std::size_t gaps = 0;                             // seq jumps among the samples in range
   std::size_t missing = 0;                          // ticks missing in those jumps
   std::vector<SeqGap> first_gaps;                   // the first few, for the report
@@ -90,9 +91,13 @@ struct LogSamples {
 };
 
 // Calls on_event(file, event) for every event of the files, in order. Throws SampleLogError for
-// a file that is not there or does not open as an LCM event log.
-void for_each_log_event(const std::vector<std::string>& files,
-                        const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event);
+// a file that is not there or does not open as an LCM event log. With the process's rig key
+// (--key-file) an event on a signed channel whose signature fails is left out; returns what to
+// tell the user about signatures, per file ("run.000.lcmlog: 3 message(s) failed signature
+// verification and were left out (...)", or that a keyed log was read unverified).
+std::vector<std::string> for_each_log_event(
+    const std::vector<std::string>& files,
+    const std::function<void(const std::string& file, const lcm::LogEvent& event)>& on_event);
 
 // True for a path that names an LCM event log by its ending (".lcmlog").
 bool looks_like_lcm_log(const std::string& path);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -13,6 +14,7 @@
 #include "lcm/blocks.hpp"
 #include "models/axis_coupling.hpp"
 #include "models/model_set.hpp"
+#include "record/record_auth.hpp"
 
 namespace hystloop::report {
 
@@ -21,12 +23,22 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 std::vector<LogFileScan> for_each_event(const std::vector<std::filesystem::path>& files,
-                                        const std::function<void(const lcm::LogEvent&)>& visit) {
+                                        const std::function<void(const lcm::LogEvent&)>& visit,
+                                        std::shared_ptr<const RigAuth> auth) {
   std::vector<LogFileScan> scans;
+  RecordCheck check(std::move(auth));  // one for the recording: a replay across its files is caught
   for (const auto& file : files) {
     EventFileReader reader(file);
-    while (const lcm::LogEvent* event = reader.next()) visit(*event);
-    scans.push_back(reader.scan());
+    while (const lcm::LogEvent* event = reader.next()) {
+      if (check.admit(event->channel, event->data, static_cast<std::size_t>(event->datalen), event->timestamp)) {
+        visit(*event);
+      }
+    }
+    LogFileScan scan = reader.scan();
+    scan.recorded_keyed = check.marked_keyed();
+    scan.unverified_left_out = check.left_out();
+    scan.signature_notes = check.take_notes();
+    scans.push_back(std::move(scan));
   }
   return scans;
 }
@@ -61,6 +73,7 @@ std::vector<std::string> describe_scan_problems(const std::vector<LogFileScan>& 
                       std::to_string(s.events) + " are not a complete event (truncated log?)");
       }
     }
+    for (const auto& note : s.signature_notes) out.push_back(s.file + ": " + note);
   }
   return out;
 }
@@ -71,12 +84,15 @@ std::int64_t tick_recv_utime(std::int64_t block_recv_utime, std::int32_t n_ticks
   return block_recv_utime - static_cast<std::int64_t>(std::llround(back_us));
 }
 
-std::int64_t log_time_zero_utime(const std::vector<std::filesystem::path>& files, const std::string& sensor_channel) {
+std::int64_t log_time_zero_utime(const std::vector<std::filesystem::path>& files, const std::string& sensor_channel,
+                                 std::shared_ptr<const RigAuth> auth) {
   std::optional<std::int64_t> first_event;
   sensor_block_t block;
+  RecordCheck check(std::move(auth));  // a block the rig refused does not set the time axis either
   for (const auto& file : files) {
     EventFileReader reader(file);
     while (const lcm::LogEvent* e = reader.next()) {
+      if (!check.admit(e->channel, e->data, static_cast<std::size_t>(e->datalen), e->timestamp)) continue;
       if (!first_event) first_event = e->timestamp;
       if (e->channel == sensor_channel && decode_checked(*e, block)) {
         return tick_recv_utime(e->timestamp, block.n_ticks, 0, block.dt_s);
@@ -103,9 +119,11 @@ void require_axis(const RunData& run, const std::string& sensor_channel) {
                                      ", not " + std::string(axis_name(run.axis)));
 }
 
-RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels, int axis) {
+RunData read_logs(const std::vector<std::filesystem::path>& files, const ChannelNames& channels, int axis,
+                  std::shared_ptr<const RigAuth> auth) {
   RunData run;
   run.axis = axis;
+  run.signatures_verified = auth != nullptr;
   const auto a = static_cast<std::size_t>(axis);
   sensor_block_t sensor;
   command_block_t command;
@@ -127,7 +145,7 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
     for (std::size_t i = 0; i < b.n; ++i) run.samples[b.first + i].y_true_m = y[i];
     run.truth_ticks += b.n;
   };
-  run.files = for_each_event(files, [&](const lcm::LogEvent& event) {
+  const auto visit = [&](const lcm::LogEvent& event) {
     ++run.events;
     ++run.channel_counts[event.channel];
     run.event_times[event.channel].push_back(event.timestamp);
@@ -194,7 +212,8 @@ RunData read_logs(const std::vector<std::filesystem::path>& files, const Channel
         run.safe_requests.push_back({t, control.target});
       }
     }
-  });
+  };
+  run.files = for_each_event(files, visit, std::move(auth));
   return run;
 }
 

@@ -35,6 +35,7 @@
 #include "core/errors.hpp"
 #include "csv_export.hpp"
 #include "lcm/channels.hpp"
+#include "lcm/rig_auth.hpp"
 #include "log_reader.hpp"
 #include "models/axis_coupling.hpp"
 #include "path_report.hpp"
@@ -57,6 +58,7 @@ struct Options {
   std::vector<std::string> csv;
   ReportOptions range;  // --from, --to, --skip-initial, --bridge-process, --logger-process
   std::string rig = std::string(kDefaultRigPrefix);
+  std::string key_file;  // --key-file: verify signatures, leave out what fails
   bool quiet = false;
   bool no_plots = false;
   PlotOptions plots;
@@ -102,6 +104,8 @@ int run(const Options& o) {
   std::snprintf(what, sizeof what, "reading %zu log file(s), %.1f MB", o.logs.size(),
                 static_cast<double>(progress.bytes()) * 1e-6);
   progress.phase(what);
+  // Every reader of the log below (figures, scans, paths, CSV) verifies with it.
+  if (!o.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(o.key_file, "--key-file"));
   const RunData data = read_logs(o.logs, channels, o.axis);
   for (const auto& problem : describe_scan_problems(data.files)) {
     std::fprintf(stderr, "hystloop-report: warning: %s\n", problem.c_str());
@@ -201,6 +205,9 @@ int report_main(int argc, char** argv) {
   app.add_option("--skip-initial", o.range.skip_initial_s, "Exclude this warm-up at the start of the range [s]")
       ->capture_default_str();
   app.add_option("--rig", o.rig, "Channel prefix of the rig")->capture_default_str();
+  app.add_option("--key-file", o.key_file,
+                 "The rig key (auth.key_file of the services): verify the signed channels' messages and leave out "
+                 "(and count) those whose signature fails, as the rig refused them");
   app.add_option("--bridge-process", o.range.bridge_process, "Process name of the bridge in HX_STATUS")
       ->capture_default_str();
   app.add_option("--logger-process", o.range.logger_process, "Process name of the logger in HX_STATUS")

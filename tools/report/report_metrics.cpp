@@ -146,6 +146,11 @@ ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options) 
   m.channels = run.channel_counts;
   m.events = run.events;
   m.undecodable = run.undecodable;
+  m.signatures_verified = run.signatures_verified;
+  for (const LogFileScan& f : run.files) {
+    m.unverified_left_out += f.unverified_left_out;
+    m.recorded_keyed = m.recorded_keyed || f.recorded_keyed;
+  }
 
   const std::int64_t t0 = run.time_zero_utime();
   const double lo = options.lower_s(), hi = options.upper_s();

@@ -124,6 +124,11 @@ struct ReportMetrics {
   std::map<std::string, std::uint64_t> channels;
   std::uint64_t events = 0;
   std::uint64_t undecodable = 0;
+  // Signatures (record/record_auth.hpp): read with the rig's key; events left out because their
+  // signature failed; a file of the log says it was recorded on a keyed rig.
+  bool signatures_verified = false;
+  std::uint64_t unverified_left_out = 0;
+  bool recorded_keyed = false;
 };
 
 ReportMetrics compute_metrics(const RunData& run, const ReportOptions& options);

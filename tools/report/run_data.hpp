@@ -116,6 +116,11 @@ struct LogFileScan {
   std::uint64_t events = 0;          // complete events read
   std::uint64_t skipped_bytes = 0;   // bytes before or between events that were not an event
   std::uint64_t trailing_bytes = 0;  // bytes after the last complete event (truncated, or junk)
+  // Signatures (record/record_auth.hpp): the file starts as a keyed rig's logger writes it; events
+  // left out because their signature failed (only when a key was given); what to tell the user.
+  bool recorded_keyed = false;
+  std::uint64_t unverified_left_out = 0;
+  std::vector<std::string> signature_notes;
   bool clean() const noexcept { return bytes > 0 && skipped_bytes == 0 && trailing_bytes == 0; }
 };
 
@@ -137,7 +142,8 @@ struct RunData {
   std::map<std::string, std::uint64_t> channel_counts;           // every event of every channel
   std::map<std::string, std::vector<std::int64_t>> event_times;  // receive time of every event, by channel
   std::uint64_t events = 0;
-  std::uint64_t undecodable = 0;  // events on a known channel that failed to decode or validate
+  std::uint64_t undecodable = 0;     // events on a known channel that failed to decode or validate
+  bool signatures_verified = false;  // read with the rig's key: LogFileScan::unverified_left_out were left out
   std::optional<std::int64_t> first_event_utime;
   std::vector<LogFileScan> files;  // one per file read, in order
 

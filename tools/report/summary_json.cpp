@@ -141,6 +141,9 @@ std::string summary_json(const ReportMetrics& m, const ReportOptions& options,
 
   j["events"] = m.events;
   j["undecodable_events"] = m.undecodable;
+  j["recorded_keyed"] = m.recorded_keyed;
+  j["signatures_verified"] = m.signatures_verified;
+  j["unverified_events_left_out"] = m.unverified_left_out;
   j["channels"] = map_json(m.channels);
   j["messages_per_s_definition"] =
       "events of each channel received between the first and the last sensor tick of the range, divided by "
