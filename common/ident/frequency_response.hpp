@@ -1,5 +1,5 @@
 #pragma once
-// Nonparametric FRF of a stage from a periodic multisine record (multisine.hpp), by the "robust
+// Nonparametric FRF of a stage from a periodic multisine record (models/multisine.hpp), by the "robust
 // method" of Pintelon & Schoukens (System Identification, 2nd ed., sec. 3.7 and 4.3): per
 // realisation the DFT of u and y at the excited lines, averaged over the periods after the
 // transient ones; G_r = Y_r / U_r; the noise variance from the period-to-period spread; across the

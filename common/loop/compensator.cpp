@@ -1,5 +1,6 @@
 #include "loop/compensator.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -136,9 +137,17 @@ void Compensator::set_mode(FeedforwardMode mode) {
   planner_.set_mode(mode);
 }
 
-void Compensator::start_experiment(const ExperimentSpec& spec) {
-  spec.validate();
+void Compensator::start_experiment(const ExperimentSpec& requested) {
+  requested.validate();
   const CompensatorConfig& c = config();
+  if (requested.multisine) {
+    ExperimentSpec spec = requested;
+    prepare_experiment(spec, c.dt_s);
+    check_multisine(spec);
+    planner_.start_experiment(spec);
+    return;
+  }
+  const ExperimentSpec& spec = requested;
   // An excitation is a voltage: it must fit the actuator as it is, not be clamped by the bridge.
   if (spec.offset_V - spec.amplitude_V < c.u_min_V || spec.offset_V + spec.amplitude_V > c.u_max_V) {
     throw ParameterError("experiment", "offset " + si(spec.offset_V, "V") + " +- amplitude " +
@@ -157,6 +166,25 @@ void Compensator::start_experiment(const ExperimentSpec& spec) {
             " at this amplitude");
   }
   planner_.start_experiment(spec);
+}
+
+void Compensator::check_multisine(const ExperimentSpec& spec) const {
+  const CompensatorConfig& c = config();
+  const std::vector<double>& u = spec.samples->u_V;
+  const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
+  if (*lo < c.u_min_V || *hi > c.u_max_V) {
+    throw ParameterError("experiment", "the multisine spans " + si(*lo, "V") + " to " + si(*hi, "V") +
+                                           ", outside the actuator's range " + si(c.u_min_V, "V") + " to " +
+                                           si(c.u_max_V, "V") + " (actuator.u_min_V/u_max_V)");
+  }
+  double rate = 0.0;
+  for (std::size_t k = 1; k < u.size(); ++k) rate = std::max(rate, std::abs(u[k] - u[k - 1]) / c.dt_s);
+  if (rate > c.plan_slew_fraction * c.slew_V_per_s) {
+    throw ParameterError("experiment", "the multisine needs " + si(rate, "V/s") + ", above " +
+                                           si(100.0 * c.plan_slew_fraction, "%") + " of the slew limit " +
+                                           si(c.slew_V_per_s, "V/s") +
+                                           " (actuator.slew_V_per_s): a lower amplitude or f_max");
+  }
 }
 
 void Compensator::stop_experiment() noexcept { planner_.stop_experiment(); }

@@ -129,7 +129,8 @@ class Compensator {
   // Starts the experiment at the next planned tick, or queues it behind the running one.
   // Validated here (throws ParameterError; also when the queue is full, and when the excitation
   // leaves the actuator's range or plan_slew_fraction of its slew limit). A jump between two
-  // excitations (or from the tracking voltage) is ramped at that rate.
+  // excitations (or from the tracking voltage) is ramped at that rate. A multisine is designed
+  // here at the tick (prepare_experiment), and its every sample checked against both limits.
   void start_experiment(const ExperimentSpec& spec);
   // Ends the running experiment at the next planned tick and drops the queue.
   void stop_experiment() noexcept;
@@ -163,6 +164,10 @@ class Compensator {
   Compensator restarted(CompensatorConfig config, std::string& refusal) const;
 
  private:
+  // A prepared multisine's voltage against the actuator's range and slew limit (ParameterError
+  // naming the limit).
+  void check_multisine(const ExperimentSpec& spec) const;
+
   // offer_model (switch_model) and offer_mem_params: validated, checked, counted, then waiting.
   void offer(const ModelParamSet& set, bool switch_model, std::int32_t version);
 

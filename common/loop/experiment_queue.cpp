@@ -1,6 +1,7 @@
 #include "loop/experiment_queue.hpp"
 
 #include <string>
+#include <utility>
 
 #include "core/errors.hpp"
 
@@ -8,6 +9,9 @@ namespace hystloop {
 
 void ExperimentQueue::add(const ExperimentSpec& spec) {
   spec.validate();
+  if (spec.multisine && !spec.samples) {
+    throw ParameterError("experiment", "a multisine is designed at the loop's tick before it is queued");
+  }
   if (!has_running_) {
     running_ = Running{spec};
     has_running_ = true;
@@ -42,10 +46,14 @@ ExperimentQueue::Step ExperimentQueue::step(double t_s) noexcept {
   while (t_s >= running_.end_s && queued_ > 0) {
     // Back to back: the next starts where this one ended, at a whole period (phase 0).
     const double start = running_.end_s;
-    const ExperimentSpec& next = waiting_[head_];
+    // Swapped, not copied: the finished spec's multisine samples then wait in the free slot and are
+    // freed by the add() that reuses it, not here on the per-tick path.
+    std::swap(running_.spec, waiting_[head_]);
     head_ = (head_ + 1) % kCapacity;
     --queued_;
-    running_ = Running{next, true, start, experiment_end_s(start, next)};
+    running_.started = true;
+    running_.start_s = start;
+    running_.end_s = experiment_end_s(start, running_.spec);
   }
   if (t_s < running_.end_s) {
     out.active = true;

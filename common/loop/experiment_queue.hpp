@@ -23,7 +23,8 @@ class ExperimentQueue {
   };
 
   // Starts with the next step() or waits behind the running one. Throws ParameterError
-  // ("experiment") when the spec is invalid or kCapacity already wait.
+  // ("experiment") when the spec is invalid or kCapacity already wait. A multisine must be
+  // prepared (prepare_experiment): step() only reads its samples.
   void add(const ExperimentSpec& spec);
   // Ends the running experiment at loop time end_s (if it started; else drops it) and drops
   // the waiting ones.

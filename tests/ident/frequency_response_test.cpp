@@ -11,7 +11,7 @@
 #include <random>
 
 #include "core/errors.hpp"
-#include "ident/multisine.hpp"
+#include "models/multisine.hpp"
 #include "ident/two_mode_stage.hpp"
 
 namespace hystloop {

@@ -1,6 +1,6 @@
 // The multisine's spectrum (only the excited lines, all at one amplitude), its periodicity, its
 // amplitude scaling and its refusals.
-#include "ident/multisine.hpp"
+#include "models/multisine.hpp"
 
 #include <gtest/gtest.h>
 

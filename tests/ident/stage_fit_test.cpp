@@ -14,7 +14,7 @@
 
 #include "core/errors.hpp"
 #include "ident/frequency_response.hpp"
-#include "ident/multisine.hpp"
+#include "models/multisine.hpp"
 #include "ident/two_mode_stage.hpp"
 
 namespace hystloop {

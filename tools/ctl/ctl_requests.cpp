@@ -1,5 +1,9 @@
 #include "ctl_requests.hpp"
 
+#include <charconv>
+#include <cmath>
+#include <string>
+
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -71,8 +75,45 @@ std::int8_t parse_learning(std::string_view name) {
   throw ParameterError("learning", "must be one of on|off|reset (got '" + std::string(name) + "')");
 }
 
+void parse_band(std::string_view band, ExperimentRequest& request) {
+  const std::size_t colon = band.find(':');
+  auto number = [&](std::string_view text) {
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v) || v <= 0.0) {
+      throw ParameterError("band", "expected F_MIN:F_MAX in Hz, both > 0 (got '" + std::string(band) + "')");
+    }
+    return v;
+  };
+  if (colon == std::string_view::npos) number({});
+  const double lo = number(band.substr(0, colon));
+  const double hi = number(band.substr(colon + 1));
+  if (!(lo < hi)) throw ParameterError("band", "F_MIN must be below F_MAX (got '" + std::string(band) + "')");
+  request.multisine.f_min_hz = lo;
+  request.frequency_Hz = hi;
+}
+
 void ExperimentRequest::validate() const {
   if (kind.empty()) throw ParameterError("kind", "must not be empty");
+  if (kind == "multisine") {
+    if (!(multisine.f_min_hz > 0.0)) throw ParameterError("band", "a multisine needs its band (--band F_MIN:F_MAX)");
+    // What the compensator will parse, checked here with the option names it maps to.
+    try {
+      make_experiment_spec(format_multisine_kind(multisine), amplitude_V, offset_V, frequency_Hz, duration_s);
+    } catch (const ParameterError& e) {
+      const std::string& f = e.field();
+      const std::string option = f == "experiment.f_min" || f == "experiment.frequency_hz" ? "band"
+                                 : f == "experiment.periods"                               ? "periods"
+                                 : f == "experiment.realisations"                          ? "realisations"
+                                 : f == "experiment.amplitude_V"                           ? "amplitude"
+                                 : f == "experiment.duration_s"                            ? "period"
+                                 : f == "experiment.offset_V"                              ? "offset"
+                                                                                           : "kind";
+      throw ParameterError(option, e.what());
+    }
+  } else if (kind != "sine" && kind != "settle") {
+    throw ParameterError("kind", "must be sine, settle or multisine (got '" + kind + "')");
+  }
   require_positive("amplitude", amplitude_V);
   require_in_range("amplitude", amplitude_V, 0.0, kMaxAbsVoltage_V);
   require_positive("frequency", frequency_Hz);
@@ -95,7 +136,7 @@ void apply(const GainsRequest& gains, control_t& msg) {
 
 void apply(const ExperimentRequest& experiment, control_t& msg) {
   experiment.validate();
-  msg.experiment = experiment.kind;
+  msg.experiment = experiment.kind == "multisine" ? format_multisine_kind(experiment.multisine) : experiment.kind;
   msg.experiment_amplitude_V = experiment.amplitude_V;
   msg.experiment_frequency_Hz = experiment.frequency_Hz;
   msg.experiment_duration_s = experiment.duration_s;

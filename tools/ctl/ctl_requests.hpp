@@ -15,6 +15,7 @@
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/scan_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "loop/experiment.hpp"
 
 namespace hystloop::ctl {
 
@@ -48,13 +49,18 @@ struct GainsRequest {
 };
 
 struct ExperimentRequest {
-  std::string kind = "sine";  // control_t.experiment
-  double amplitude_V = 0.0;   // > 0
-  double frequency_Hz = 0.0;  // > 0
-  double duration_s = 0.0;    // > 0
-  double offset_V = 0.0;      // finite
+  std::string kind = "sine";        // sine | settle | multisine; control_t.experiment
+  double amplitude_V = 0.0;         // > 0 (a multisine's rms, or peak with multisine.peak)
+  double frequency_Hz = 0.0;        // > 0 (a multisine's f_max)
+  double duration_s = 0.0;          // > 0 (a multisine's period: its frequency resolution is 1 / it)
+  double offset_V = 0.0;            // finite
+  MultisineExperiment multisine{};  // kind multisine: f_min and the rest (loop/experiment.hpp)
   void validate() const;
 };
+
+// --band F_MIN:F_MAX [Hz] of a multisine: sets request.multisine.f_min_hz and request.frequency_Hz.
+// Throws ParameterError("band").
+void parse_band(std::string_view band, ExperimentRequest& request);
 
 // "on"|"off"|"reset" -> control_t::LEARNING_*; throws ParameterError("learning").
 std::int8_t parse_learning(std::string_view name);

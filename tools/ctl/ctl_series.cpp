@@ -21,7 +21,8 @@ ExperimentRequest sine(const char* kind, double offset_V, double amplitude_V, do
 }  // namespace
 
 ExperimentSpec to_spec(const ExperimentRequest& r) {
-  return make_experiment_spec(r.kind, r.amplitude_V, r.offset_V, r.frequency_Hz, r.duration_s);
+  const std::string kind = r.kind == "multisine" ? format_multisine_kind(r.multisine) : r.kind;  // as on the wire
+  return make_experiment_spec(kind, r.amplitude_V, r.offset_V, r.frequency_Hz, r.duration_s);
 }
 
 std::vector<SeriesStep> banning_series(const BanningPlanOptions& plan) {

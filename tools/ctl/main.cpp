@@ -11,6 +11,9 @@
 //                                                    (fits and reports on, publishes nothing) or lets go
 //   (MODEL: an online model, models/model_set.hpp; mode --help and pin-model --help list them)
 //   experiment --amplitude V --frequency HZ --duration S [--offset V] [--kind sine|settle]
+//   experiment [multisine] --kind multisine --band F_MIN:F_MAX --amplitude V_RMS [--offset V] [--period S]
+//              [--periods P] [--realisations R] [--seed N] [--peak] [--odd-lines] [--ramp S]
+//              a random-phase multisine for the stage's dynamics (hystloop-identify --model stage)
 //   experiment --mem-paper [--duration S]           the MEM paper's 250 sin(20 pi t) V
 //   experiment --banning-series [plan options] [--list] [--no-wait]   Banning et al.'s sine series
 //   experiment --coupling [--amplitude V] [--out FILE]   an XY(Z) stage's cross-coupling (ctl_coupling.hpp)
@@ -75,6 +78,7 @@ struct Options {
   GainsRequest gains;
   std::string gains_target = "bridge";  // the servo runs in the bridge
   ExperimentRequest experiment;
+  double multisine_period_s = 0.2;  // 5 Hz lines
   bool experiment_mem_paper = false;
   bool banning_series = false;
   bool series_list = false;
@@ -464,8 +468,31 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
   auto* offset = with_default(experiment, "--offset", o.experiment.offset_V, "Offset [V]");
   auto* kind = experiment
                    ->add_option("--kind", o.experiment.kind,
-                                "sine, or settle (the same sine, marked for identification to skip)")
+                                "sine, settle (the same sine, marked for identification to skip), or multisine")
                    ->capture_default_str();
+  experiment->add_option("which", o.experiment.kind, "the experiment's kind, as --kind (e.g. multisine)")
+      ->excludes(kind);
+  auto* band = experiment->add_option_function<std::string>(
+      "--band", [&o](const std::string& b) { ctl::parse_band(b, o.experiment); },
+      "multisine: the band F_MIN:F_MAX [Hz] (lines every 1 / --period Hz in it)");
+  auto* period = experiment
+                     ->add_option("--period", o.multisine_period_s,
+                                  "multisine: one period [s], a whole number of ticks; the frequency resolution is "
+                                  "its inverse")
+                     ->capture_default_str();
+  auto multisine_option = [&](const char* name, auto& value, const char* help) {
+    experiment->add_option(name, value, help)->capture_default_str()->needs(band);
+  };
+  multisine_option("--periods", o.experiment.multisine.periods,
+                   "multisine: periods per realisation (the first is the transient's), >= 3");
+  multisine_option("--realisations", o.experiment.multisine.realisations,
+                   "multisine: realisations (new random phases; 2 or more measure the nonlinear distortion)");
+  multisine_option("--seed", o.experiment.multisine.seed, "multisine: seed of the phases");
+  experiment->add_flag("--peak", o.experiment.multisine.peak, "multisine: --amplitude is the peak, not the rms")
+      ->needs(band);
+  experiment->add_flag("--odd-lines", o.experiment.multisine.odd, "multisine: odd lines only")->needs(band);
+  experiment->add_option("--ramp", o.experiment.multisine.ramp_s, "multisine: fade in and out [s] (default one period)")
+      ->needs(band);
   auto* mem_paper_exp = experiment
                             ->add_flag("--mem-paper", o.experiment_mem_paper,
                                        "The MEM paper's identification input u = 250 sin(20 pi t) V")
@@ -516,7 +543,7 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
   with_default(experiment, "--rest", o.coupling_run.rest_s, "coupling: rest between the axes' experiments [s]")
       ->needs(coupling);
 
-  return [&o, experiment, amplitude, frequency, duration]() -> std::optional<int> {
+  return [&o, experiment, amplitude, frequency, duration, band, period]() -> std::optional<int> {
     if (!*experiment) return std::nullopt;
     if (o.banning_series) return run_banning_series(o);
     if (o.coupling) {
@@ -528,7 +555,20 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
       CtlLink link(o.link);
       return run_coupling_experiment(link, c);
     }
-    if (o.experiment_mem_paper) {
+    if (o.experiment.kind == "multisine" || band->count() > 0) {
+      if (o.experiment.kind != "multisine") {
+        throw ParameterError("band", "only for a multisine (--kind multisine), not " + o.experiment.kind);
+      }
+      if (amplitude->count() == 0 || band->count() == 0) {
+        throw ParameterError("experiment", "a multisine needs --band F_MIN:F_MAX and --amplitude");
+      }
+      if (frequency->count() > 0 || duration->count() > 0) {
+        throw ParameterError("experiment", "a multisine takes --band and --period, not --frequency or --duration");
+      }
+      o.experiment.duration_s = o.multisine_period_s;
+    } else if (period->count() > 0) {
+      throw ParameterError("period", "only for a multisine (--kind multisine)");
+    } else if (o.experiment_mem_paper) {
       o.experiment = mem_paper_experiment(o.experiment.duration_s > 0.0 ? o.experiment.duration_s : 2.0);
     } else if (amplitude->count() == 0 || frequency->count() == 0 || duration->count() == 0) {
       throw ParameterError("experiment",

@@ -16,6 +16,10 @@ std::optional<ModelChoice> parse_model_choice(const std::string& name) {
   ModelChoice c;
   c.name = name;
   if (name == "auto") return c;
+  if (name == "stage") {
+    c.mode = ModelChoice::Mode::stage;
+    return c;
+  }
   if (name == BanningDescriptor::name) {
     c.mode = ModelChoice::Mode::banning;
     return c;
@@ -30,6 +34,7 @@ std::optional<ModelChoice> parse_model_choice(const std::string& name) {
 std::string model_choices() {
   std::vector<std::string_view> names = model_kind_names();
   names.push_back(BanningDescriptor::name);
+  names.emplace_back("stage");
   names.emplace_back("auto");
   return choice_list(names);
 }
@@ -39,7 +44,9 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                  "CSV file(s) (for banning one per experiment, or one with an 'experiment' column), or LCM log file(s)")
       ->required()
       ->check(CLI::ExistingFile);
-  app.add_option("--model", args.model, model_choices() + " (auto: fit all, rank on held-out data)")
+  app.add_option("--model", args.model,
+                 model_choices() + " (auto: fit all, rank on held-out data; stage: the linear stage's dynamics "
+                                   "from a multisine experiment: FRF, poles, zeros, delay)")
       ->check([](const std::string& v) { return parse_model_choice(v) ? std::string() : "unknown model '" + v + "'"; })
       ->capture_default_str();
   app.add_option("--form", args.form, "MEM data form: integrated branches or the paper's derivative")
@@ -98,6 +105,41 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "banning: skip a hysteresis-loop experiment if more than this fraction of its ticks has no sample "
                    "(a frequency-response experiment may miss none)")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  auto* stage = app.add_option_group("stage",
+                                     "--model stage: the multisine's record (CSV t,u,y or u,y; or a log's "
+                                     "multisine experiment, which gives its layout)");
+  stage->add_option("--sample-rate", args.sample_rate_Hz, "sample rate [Hz] (default: from t; required for a u,y CSV)")
+      ->check(CLI::PositiveNumber);
+  stage->add_option("--period-samples", args.period_samples, "samples per period N (a CSV: required)");
+  stage->add_option("--periods", args.periods, "periods per realisation P (a CSV: required)");
+  stage->add_option("--realisations", args.realisations, "realisations R (a CSV: default 1)");
+  stage->add_option("--transient-periods", args.transient_periods, "periods dropped per realisation")
+      ->capture_default_str();
+  stage->add_option("--skip", args.skip_samples, "CSV: samples before the record (e.g. a fade-in)")
+      ->capture_default_str();
+  stage->add_option("--band", args.band, "F_MIN:F_MAX [Hz]: the excited lines (default: those u excites)");
+  stage->add_flag("--odd-lines", args.odd_lines, "with --band: odd lines only");
+  stage
+      ->add_option("--order", args.order,
+                   "NUM/DEN (numerator/denominator order, e.g. 2/4), or auto: the lowest denominator order "
+                   "whose chi-square per line the uncertainty explains")
+      ->capture_default_str();
+  stage->add_option("--max-order", args.max_order, "auto: largest denominator order tried")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  stage->add_option("--max-delay", args.max_delay_s, "largest input delay searched [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  stage->add_flag("--continuous", args.continuous,
+                  "the record was not held and sampled at the sample rate: fit the continuous response (default: "
+                  "the exact zero-order-hold response, as a bridge drives and samples)");
+  stage
+      ->add_option("--sample-at", args.sample_at,
+                   "end: y_k is the position at the end of tick k, after u_k was held over it (the rig's "
+                   "convention, models/linear_stage.hpp: the delay written is the compensator's); start: y_k was "
+                   "sampled as u_k was applied (a conventional DAQ)")
+      ->check(CLI::IsMember({"end", "start"}))
       ->capture_default_str();
   auto* pub = app.add_option_group("publishing", "sending the fitted set to a running compensator");
   pub->add_flag("--publish", args.publish,
@@ -158,6 +200,11 @@ std::optional<std::string> check_identify_args(IdentifyArgs& args) {
   if (!args.from_logs && range) return "--from/--to select a range of an LCM log";
   if (!args.from_logs && args.experiment) return "--experiment selects an experiment of an LCM log";
   const bool mem = args.choice.mode == ModelChoice::Mode::single && args.choice.kind == ModelKind::mem;
+  if (args.choice.mode == ModelChoice::Mode::stage) {
+    if (args.publish) return "--publish: a stage model goes into the compensator's config (write it with --out)";
+    if (args.files.size() != 1 && !args.from_logs) return "--model stage takes one CSV file";
+    if (range) return "--from/--to: --model stage reads the whole multisine record (--skip for a CSV)";
+  }
   if (args.publish && banning) {
     return "--publish: Banning's model is identified offline only and has no kind on HX_MODEL; write it with --out "
            "and give it to the compensator's config (--params)";

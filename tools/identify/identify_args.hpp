@@ -19,14 +19,15 @@ namespace hystloop {
 // What --model asks for: one model of the set (ModelKind), the Banning recipe (several
 // experiments, not a ModelKind), or every model of the set ranked on held-out data.
 struct ModelChoice {
-  enum class Mode { single, banning, automatic };
+  enum class Mode { single, banning, automatic, stage };
   Mode mode = Mode::automatic;
   ModelKind kind = ModelKind::mem;  // when mode == single
   std::string name = "auto";        // as given
 };
-// An online model's name (parse_model_kind), "banning" or "auto"; nullopt otherwise.
+// An online model's name (parse_model_kind), "banning", "stage" (the linear stage's dynamics from a
+// multisine, identify_stage.hpp) or "auto"; nullopt otherwise.
 std::optional<ModelChoice> parse_model_choice(const std::string& name);
-// "mem, pi, katalenic, linear, banning or auto": what parse_model_choice accepts, from the registry.
+// "mem, pi, katalenic, linear, banning, stage or auto": what parse_model_choice accepts, from the registry.
 std::string model_choices();
 
 struct IdentifyArgs {
@@ -58,6 +59,20 @@ struct IdentifyArgs {
   bool publish_on_params = false;   // by check_identify_args
   std::optional<double> timeout_s;  // link.timeout_s when given
   bool no_wait = false;
+  // --model stage (identify_stage.hpp): the multisine's layout, given or from the log's experiment
+  std::optional<double> sample_rate_Hz;  // default: from the CSV's t, or 1 / --dt for a log
+  std::size_t period_samples = 0;        // N; 0: from the log's experiment
+  std::size_t periods = 0;               // P per realisation
+  std::size_t realisations = 0;          // R
+  std::size_t transient_periods = 1;     // dropped at the start of each realisation
+  std::size_t skip_samples = 0;          // CSV: samples before the record (a ramp)
+  std::string band;                      // F_MIN:F_MAX [Hz]; empty: the lines u excites
+  bool odd_lines = false;                // with --band: odd lines only
+  std::string order = "auto";            // NUM/DEN (e.g. 2/4), or auto
+  int max_order = 8;                     // auto: largest denominator order tried
+  double max_delay_s = 1e-3;
+  bool continuous = false;        // the data were not held and sampled at the sample rate (no ZOH in the model)
+  std::string sample_at = "end";  // y_k measured at the end of tick k (the rig's, linear_stage.hpp) or its start
   // bounds
   std::size_t max_samples = kDefaultMaxSamples;
   std::size_t decimate = 1;

@@ -26,6 +26,7 @@
 #include "models/model_descriptors.hpp"
 #include "ident/sample_csv.hpp"
 #include "identify_output.hpp"
+#include "identify_stage.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/rig_auth.hpp"
 #include "log_experiments.hpp"
@@ -474,6 +475,10 @@ std::string heading_of(const IdentifyArgs& args) {
 }
 
 int fit_inputs(const IdentifyArgs& args) {
+  if (args.choice.mode == ModelChoice::Mode::stage) {
+    validate_rig_prefix(args.link.rig);
+    return identify_stage(args, experiment_options(args));
+  }
   std::unique_ptr<ParamsLink> link;
   // The key signs a published set and verifies the logs read (for_each_log_event).
   if (!args.key_file.empty()) set_process_rig_auth(rig_auth_from_key_file(args.key_file, "--key-file"));

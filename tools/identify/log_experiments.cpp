@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -50,9 +51,11 @@ struct Record {
 };
 
 std::string label(const LoggedExperiment& e) {
-  return std::string(e.spec.settle ? "settle" : "sine") + " " + number_text(e.spec.offset_V) + " V + " +
-         number_text(e.spec.amplitude_V) + " V at " + number_text(e.spec.frequency_hz) + " Hz (request " +
-         std::to_string(e.request_id) + ")";
+  return std::string(e.spec.multisine ? "multisine"
+                     : e.spec.settle  ? "settle"
+                                      : "sine") +
+         " " + number_text(e.spec.offset_V) + " V + " + number_text(e.spec.amplitude_V) + " V at " +
+         number_text(e.spec.frequency_hz) + " Hz (request " + std::to_string(e.request_id) + ")";
 }
 
 // A request the compensator takes as its own (addressed to it, or to everyone).
@@ -92,10 +95,11 @@ Record read_record(const std::vector<std::string>& files, const ExperimentLogOpt
       if (control.command == control_t::STOP_EXPERIMENT) return r.stops.push_back(event.timestamp);
       if (control.command != control_t::START_EXPERIMENT || !ids.insert(control.request_id).second) return;
       try {  // what the compensator accepts (CompensatorService::on_control)
-        r.starts.push_back(
-            {event.timestamp, control.request_id,
-             make_experiment_spec(control.experiment, control.experiment_amplitude_V, control.experiment_offset_V,
-                                  control.experiment_frequency_Hz, control.experiment_duration_s)});
+        ExperimentSpec spec =
+            make_experiment_spec(control.experiment, control.experiment_amplitude_V, control.experiment_offset_V,
+                                 control.experiment_frequency_Hz, control.experiment_duration_s);
+        prepare_experiment(spec, o.dt_s);  // a multisine's samples, as the compensator designed them
+        r.starts.push_back({event.timestamp, control.request_id, std::move(spec)});
       } catch (const ParameterError& e) {
         out.notes.push_back("request " + std::to_string(control.request_id) +
                             ": refused by the compensator's rules: " + e.what());
@@ -360,7 +364,7 @@ std::string list_experiments(const LoggedExperiments& logged, const ExperimentLo
   char line[256];
   for (std::size_t i = 0; i < logged.experiments.size(); ++i) {
     const LoggedExperiment& e = logged.experiments[i];
-    const char* kind = e.spec.settle ? "settle" : "sine";
+    const char* kind = e.spec.multisine ? "msine" : e.spec.settle ? "settle" : "sine";
     const double from_s = static_cast<double>(e.begin_tick - logged.first_sample_seq) * options.dt_s;
     const double to_s = static_cast<double>(e.end_tick - logged.first_sample_seq) * options.dt_s;
     std::snprintf(line, sizeof line, "  %3zu  %-6s  %10.4g  %13.4g  %14.4g  %12.4g  %9.4f .. %-9.4f  ", i, kind,

@@ -82,6 +82,43 @@ TEST(CtlRequests, GainsAndExperimentAreCheckedAndPassTheContract) {
   EXPECT_EQ(field_of([&] { x.validate(); }), "duration");
 }
 
+// experiment --kind multisine --band 5:3000 --amplitude 5 --periods 4 --realisations 3: the band
+// parsed, the request on the wire in the grammar the compensator parses back (loop/experiment.hpp).
+TEST(CtlRequests, AMultisineTravelsInTheExperimentsFields) {
+  ExperimentRequest x;
+  x.kind = "multisine";
+  parse_band("5:3000", x);
+  EXPECT_EQ(x.multisine.f_min_hz, 5.0);
+  EXPECT_EQ(x.frequency_Hz, 3000.0);
+  x.amplitude_V = 5.0;
+  x.offset_V = 1.0;
+  x.duration_s = 0.2;
+  x.multisine.periods = 4;
+  x.multisine.realisations = 3;
+  control_t msg = make_control(control_t::START_EXPERIMENT, "", 9, 1);
+  apply(x, msg);
+  EXPECT_EQ(check_message(msg), Verdict::kOk);
+  EXPECT_EQ(msg.experiment, "multisine f_min=5 periods=4 realisations=3");
+  EXPECT_EQ(msg.experiment_frequency_Hz, 3000.0);
+  EXPECT_EQ(msg.experiment_duration_s, 0.2);
+  const ExperimentSpec back = make_experiment_spec(msg.experiment, msg.experiment_amplitude_V, msg.experiment_offset_V,
+                                                   msg.experiment_frequency_Hz, msg.experiment_duration_s);
+  EXPECT_TRUE(back.multisine);
+  EXPECT_EQ(back.ms.realisations, 3u);
+  EXPECT_EQ(back.offset_V, 1.0);
+  for (const char* bad : {"3000", "5:", ":3000", "3000:5", "a:b", "0:10"}) {
+    ExperimentRequest y;
+    EXPECT_EQ(field_of([&] { parse_band(bad, y); }), "band") << bad;
+  }
+  x.multisine.periods = 2;  // the first period is the transient's: too few left
+  EXPECT_EQ(field_of([&] { x.validate(); }), "periods");
+  x.multisine.periods = 4;
+  x.multisine.f_min_hz = 0.0;
+  EXPECT_EQ(field_of([&] { x.validate(); }), "band");
+  x.kind = "square";
+  EXPECT_EQ(field_of([&] { x.validate(); }), "kind");
+}
+
 TEST(CtlRequests, GainsCarryANotchWithinItsBounds) {
   GainsRequest g{0.1, 600, 0, 1700.0, 4.0};
   control_t msg = make_control(control_t::SET_GAINS, "bridge", 9, 1);

@@ -1,4 +1,4 @@
-#include "ident/multisine.hpp"
+#include "models/multisine.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,403 @@
+#include "identify_stage.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/cli.hpp"
+#include "core/errors.hpp"
+#include "ident/sample_csv.hpp"
+#include "identify_output.hpp"
+#include "log_samples.hpp"
+#include "models/csv_columns.hpp"
+#include "models/multisine.hpp"
+#include "plot_series.hpp"  // tools/report: write_text_file
+#include "plots.hpp"
+
+namespace hystloop {
+namespace {
+
+namespace fs = std::filesystem;
+using C = std::complex<double>;
+
+struct StageRecord {
+  std::vector<double> u, y;  // R P N samples in design_multisine's layout
+  double sample_rate_Hz = 0.0;
+  std::size_t period_samples = 0, periods = 0, realisations = 0;
+  std::vector<std::size_t> lines;
+  std::string source;  // what the layout came from, for the output
+};
+
+std::string num(double v, int digits = 6) { return std::isfinite(v) ? number_text(v, digits) : "NaN"; }
+
+std::pair<double, double> parse_band(const std::string& band) {
+  const std::size_t colon = band.find(':');
+  auto number = [&](std::string_view t) {
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (t.empty() || ec != std::errc() || end != t.data() + t.size() || !(v > 0.0)) {
+      throw ParameterError("band", "expected F_MIN:F_MAX in Hz, both > 0 (got '" + band + "')");
+    }
+    return v;
+  };
+  if (colon == std::string::npos) number({});
+  return {number(std::string_view(band).substr(0, colon)), number(std::string_view(band).substr(colon + 1))};
+}
+
+// The lines u excites: one steady period of the first realisation (averaged over its used
+// periods), every line with at least a tenth of the largest amplitude.
+std::vector<std::size_t> excited_lines(const StageRecord& r, std::size_t transient) {
+  const std::size_t n = r.period_samples;
+  std::vector<double> mean(n, 0.0);
+  const std::size_t used = r.periods - transient;
+  for (std::size_t p = transient; p < r.periods; ++p) {
+    for (std::size_t j = 0; j < n; ++j) mean[j] += r.u[p * n + j] / static_cast<double>(used);
+  }
+  std::vector<double> amp(n / 2, 0.0);
+  for (std::size_t k = 1; k < (n + 1) / 2; ++k) {
+    C x = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      x += mean[j] *
+           std::polar(1.0, -2.0 * std::numbers::pi * static_cast<double>((k * j) % n) / static_cast<double>(n));
+    }
+    amp[k] = std::abs(x);
+  }
+  double top = 0.0;
+  for (const double a : amp) top = std::max(top, a);
+  std::vector<std::size_t> lines;
+  for (std::size_t k = 1; k < amp.size(); ++k) {
+    if (amp[k] >= 0.1 * top && top > 0.0) lines.push_back(k);
+  }
+  return lines;
+}
+
+// A CSV: t,u,y (sample rate from t unless given) or u,y (--sample-rate).
+StageRecord read_csv_record(const IdentifyArgs& args) {
+  const std::string& file = args.files.front();
+  std::ifstream in(file);
+  if (!in) throw CsvError(file, 0, "cannot open the file");
+  static constexpr std::array<std::string_view, 2> kUy{"u", "y"};
+  CsvColumns c = read_csv_columns(in, file, kUy, {.any_case = true, .text_column = {}});
+  StageRecord r;
+  const bool has_t =
+      std::any_of(c.ignored.begin(), c.ignored.end(), [](const std::string& n) { return n == "t" || n == "T"; });
+  if (args.sample_rate_Hz) {
+    r.sample_rate_Hz = *args.sample_rate_Hz;
+  } else if (has_t) {
+    std::ifstream again(file);
+    static constexpr std::array<std::string_view, 1> kT{"t"};
+    const CsvColumns t = read_csv_columns(again, file, kT, {.any_case = true, .text_column = {}});
+    r.sample_rate_Hz = sample_rate_Hz(t.values[0]);
+  }
+  if (!(r.sample_rate_Hz > 0.0)) {
+    throw ParameterError("sample-rate", file + " has no t column (or t does not increase): give --sample-rate");
+  }
+  if (args.period_samples == 0 || args.periods == 0) {
+    throw ParameterError("period-samples",
+                         "a CSV's multisine layout: give --period-samples N and --periods P "
+                         "(and --realisations R, --skip S)");
+  }
+  r.period_samples = args.period_samples;
+  r.periods = args.periods;
+  r.realisations = std::max<std::size_t>(1, args.realisations);
+  const std::size_t need = args.skip_samples + r.period_samples * r.periods * r.realisations;
+  if (c.rows() < need) {
+    throw ParameterError("periods", file + " holds " + std::to_string(c.rows()) + " samples; the layout needs " +
+                                        std::to_string(need) + " (--skip + N P R)");
+  }
+  const auto begin = static_cast<std::ptrdiff_t>(args.skip_samples);
+  const auto end = static_cast<std::ptrdiff_t>(need);
+  r.u.assign(c.values[0].begin() + begin, c.values[0].begin() + end);
+  r.y.assign(c.values[1].begin() + begin, c.values[1].begin() + end);
+  r.source = file + ": N " + std::to_string(r.period_samples) + ", P " + std::to_string(r.periods) + ", R " +
+             std::to_string(r.realisations) + " from the command line, " + num(r.sample_rate_Hz) + " Hz";
+  return r;
+}
+
+// A log: the compensator's multisine experiment (--experiment N, or the only one).
+StageRecord read_log_record(const IdentifyArgs& args, const ExperimentLogOptions& o) {
+  LoggedExperiments logged = read_logged_experiments(args.files, o);
+  std::cout << describe(logged);
+  std::vector<std::size_t> multisines;
+  for (std::size_t i = 0; i < logged.experiments.size(); ++i) {
+    if (logged.experiments[i].spec.multisine) multisines.push_back(i);
+  }
+  std::size_t pick = 0;
+  if (args.experiment) {
+    pick = *args.experiment;
+    if (pick >= logged.experiments.size() || !logged.experiments[pick].spec.multisine) {
+      throw SampleLogError("--experiment " + std::to_string(pick) + ": not a multisine experiment of the log");
+    }
+  } else if (multisines.size() == 1) {
+    pick = multisines.front();
+  } else {
+    throw SampleLogError(std::to_string(multisines.size()) +
+                         " multisine experiments in the log: choose one with --experiment N (numbered as listed)");
+  }
+  LoggedExperiment& e = logged.experiments[pick];
+  if (!e.usable()) throw SampleLogError("experiment " + std::to_string(pick) + " cannot be used: " + e.problem);
+  const MultisineSamples& m = *e.spec.samples;
+  StageRecord r;
+  r.sample_rate_Hz = args.sample_rate_Hz.value_or(1.0 / o.dt_s);
+  r.period_samples = m.period_samples;
+  r.periods = e.spec.ms.periods;
+  r.realisations = e.spec.ms.realisations;
+  r.lines = m.lines;
+  if (e.samples.u.size() < m.ramp_samples + m.record_samples) {
+    throw SampleLogError("experiment " + std::to_string(pick) + ": " + std::to_string(e.samples.u.size()) +
+                         " samples, fewer than its record");
+  }
+  const auto begin = static_cast<std::ptrdiff_t>(m.ramp_samples);
+  const auto end = static_cast<std::ptrdiff_t>(m.ramp_samples + m.record_samples);
+  r.u.assign(e.samples.u.begin() + begin, e.samples.u.begin() + end);
+  r.y.assign(e.samples.y.begin() + begin, e.samples.y.begin() + end);
+  r.source = "experiment " + std::to_string(pick) + " (request " + std::to_string(e.request_id) + "): N " +
+             std::to_string(r.period_samples) + ", P " + std::to_string(r.periods) + ", R " +
+             std::to_string(r.realisations) + ", " + std::to_string(r.lines.size()) + " lines, " +
+             num(r.sample_rate_Hz) + " Hz";
+  return r;
+}
+
+std::vector<double> unwrapped_deg(const std::vector<C>& g) {
+  std::vector<double> out;
+  double previous = 0.0, offset = 0.0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const double a = std::arg(g[i]);
+    if (i > 0) {
+      while (a + offset - previous > std::numbers::pi) offset -= 2.0 * std::numbers::pi;
+      while (a + offset - previous < -std::numbers::pi) offset += 2.0 * std::numbers::pi;
+    }
+    previous = a + offset;
+    out.push_back(previous * 180.0 / std::numbers::pi);
+  }
+  return out;
+}
+
+std::string roots_yaml(const std::vector<C>& roots_hz) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < roots_hz.size(); ++i) {
+    s += (i ? ", [" : "[") + num(roots_hz[i].real(), 10) + ", " + num(roots_hz[i].imag(), 10) + "]";
+  }
+  return s + "]";
+}
+
+std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
+                       const std::string& heading) {
+  std::ostringstream y;
+  y << "# hystloop-identify --model stage: " << heading << "\n"
+    << "# " << r.source << "\n"
+    << "# " << frf.frequency_Hz.size() << " lines " << num(frf.frequency_Hz.front()) << " .. "
+    << num(frf.frequency_Hz.back()) << " Hz, " << frf.periods_used << " periods used x " << frf.realisations
+    << " realisations; distortion ratio (sigma_total^2 / sigma_noise^2) " << num(frf.distortion_ratio, 3) << "\n"
+    << "# measured DC gain u -> y: " << num(fit.dc_gain, 8)
+    << " per V (the hysteresis model carries it: the stage below has unit DC gain)\n"
+    << "# model: orders " << fit.numerator_order << "/" << fit.denominator_order
+    << (fit.zoh_sample_rate_Hz > 0.0 ? ", exact zero-order hold at " + num(fit.zoh_sample_rate_Hz) + " Hz"
+                                     : ", continuous")
+    << "; chi2 per line " << num(fit.chi2_per_line, 4) << " (expected " << num(fit.chi2_expected, 4) << ")"
+    << (fit.order_consistent ? "" : ": NOT explained by the uncertainty") << "\n";
+  if (!fit.orders.empty()) {
+    y << "# orders tried (numerator/denominator: chi2 per line):";
+    for (const StageOrderTrial& t : fit.orders) {
+      y << " " << t.numerator_order << "/" << t.denominator_order << ": " << num(t.chi2_per_line, 4)
+        << (t.accepted ? " (accepted)" : "");
+    }
+    y << "\n";
+  }
+  y << "stage:\n"
+    << "  zeros_hz: " << roots_yaml(roots_hz_once(fit.zeros_rad_s)) << "\n"
+    << "  poles_hz: " << roots_yaml(roots_hz_once(fit.poles_rad_s)) << "\n"
+    << "  delay_s: " << num(fit.delay_s, 8) << "\n";
+  return y.str();
+}
+
+void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
+  std::printf("FRF: %zu lines %.6g .. %.6g Hz, %zu periods used x %zu realisations, distortion ratio %.3g\n",
+              frf.frequency_Hz.size(), frf.frequency_Hz.front(), frf.frequency_Hz.back(), frf.periods_used,
+              frf.realisations, frf.distortion_ratio);
+  if (!fit.orders.empty()) {
+    std::printf("  order  chi2/line  accepted\n");
+    for (const StageOrderTrial& t : fit.orders) {
+      std::printf("  %2d/%-2d  %9.4g  %s\n", t.numerator_order, t.denominator_order, t.chi2_per_line,
+                  t.accepted ? "yes" : "no");
+    }
+  }
+  std::printf("stage model: orders %d/%d, delay %.6g s, chi2 per line %.4g (expected %.4g)%s\n", fit.numerator_order,
+              fit.denominator_order, fit.delay_s, fit.chi2_per_line, fit.chi2_expected,
+              fit.order_consistent ? "" : " -- not explained by the uncertainty");
+  std::printf("measured DC gain u -> y: %.8g per V (carried by the hysteresis model)\n", fit.dc_gain);
+  for (const C p : fit.poles_rad_s) {
+    if (p.imag() < 0.0) continue;
+    const double w = std::abs(p);
+    std::printf("  pole %.6g Hz, damping %.4g\n", w / (2.0 * std::numbers::pi), -p.real() / w);
+  }
+}
+
+report::PlotResult write_stage_plots(const FrequencyResponse& frf, const StageFitResult& fit,
+                                     const std::string& heading, const fs::path& dir, const std::string& gnuplot) {
+  report::PlotResult result;
+  const double g0 = std::abs(fit.dc_gain) > 0.0 ? std::abs(fit.dc_gain) : 1.0;
+  std::vector<C> model;
+  for (double f : frf.frequency_Hz) model.push_back(fit.sampled_response(f));
+  const std::vector<double> ph = unwrapped_deg(frf.G), phm = unwrapped_deg(model);
+  std::ostringstream d;
+  d << "# hystloop-identify --model stage: " << heading << "\n"
+    << "# magnitudes normalised by the DC gain " << num(fit.dc_gain, 8) << " per V; phases unwrapped [deg];\n"
+    << "# measured and model as fitted: through the zero-order hold, y_k at the start of tick k\n"
+    << "# f_Hz mag_dB mag_lo_dB mag_hi_dB phase_deg phase_band_deg model_dB model_phase_deg residual_dB "
+       "two_sigma_total_dB sigma_noise_dB\n";
+  auto db = [&](double a) { return a > 0.0 ? 20.0 * std::log10(a / g0) : std::nan(""); };
+  for (std::size_t i = 0; i < frf.frequency_Hz.size(); ++i) {
+    const double a = std::abs(frf.G[i]), s = frf.sigma_total[i];
+    const double band = a > 2.0 * s ? std::asin(2.0 * s / a) * 180.0 / std::numbers::pi : 180.0;
+    d << num(frf.frequency_Hz[i], 10) << ' ' << num(db(a)) << ' ' << num(db(std::max(a - 2.0 * s, 1e-6 * a))) << ' '
+      << num(db(a + 2.0 * s)) << ' ' << num(ph[i]) << ' ' << num(band) << ' ' << num(db(std::abs(model[i]))) << ' '
+      << num(phm[i]) << ' ' << num(db(std::abs(frf.G[i] - model[i]))) << ' ' << num(db(2.0 * s)) << ' '
+      << num(db(frf.sigma_noise[i])) << '\n';
+  }
+  report::write_text_file(dir / "stage_frf.dat", d.str());
+  result.data_files.push_back(dir / "stage_frf.dat");
+  std::ostringstream gp;
+  gp << "# Re-plot with: cd <this folder> && gnuplot stage_plots.gp\n"
+     << "set terminal @TERMINAL@ size 1000,800 noenhanced\nset encoding utf8\nset grid\nset logscale x\n"
+     << "set xlabel 'f [Hz]'\n"
+     << "\nset output 'stage_bode.png'\nset multiplot layout 2,1 title \"" << heading
+     << ": measured response (+-2 sigma_total) and model, / DC gain\"\n"
+     << "set ylabel 'magnitude [dB]'\nset key bottom left\n"
+     << "plot 'stage_frf.dat' using 1:3:4 with filledcurves lc rgb '#c6dbef' title 'measured +-2 sigma_total', \\\n"
+     << "  '' using 1:2 with lines lw 2 lc rgb '#1f77b4' title 'measured', \\\n"
+     << "  '' using 1:7 with lines lw 1 lc rgb '#d62728' title 'model " << fit.numerator_order << "/"
+     << fit.denominator_order << ", delay " << num(fit.delay_s * 1e6, 4) << " us'\n"
+     << "set ylabel 'phase [deg]'\n"
+     << "plot 'stage_frf.dat' using 1:($5-$6):($5+$6) with filledcurves lc rgb '#c6dbef' title 'measured +-2 "
+        "sigma_total', \\\n"
+     << "  '' using 1:5 with lines lw 2 lc rgb '#1f77b4' title 'measured', \\\n"
+     << "  '' using 1:8 with lines lw 1 lc rgb '#d62728' title 'model'\n"
+     << "unset multiplot\n"
+     << "\nset output 'stage_residual.png'\nset title \"" << heading << ": |measured - model| / DC gain, chi2 per line "
+     << num(fit.chi2_per_line, 4) << "\"\nset ylabel '[dB]'\nset key top left\n"
+     << "plot 'stage_frf.dat' using 1:9 with points pt 7 ps 0.4 lc rgb '#1f77b4' title '|measured - model|', \\\n"
+     << "  '' using 1:10 with lines lc rgb '#ff7f0e' title '2 sigma_total', \\\n"
+     << "  '' using 1:11 with lines lc rgb '#2ca02c' title 'sigma_noise'\n"
+     << "set output\n";
+  report::PlotOptions render;
+  render.gnuplot = gnuplot;
+  report::render_script(
+      {"stage_plots.gp", gp.str(), {"stage_bode.png", "stage_residual.png"}, "gnuplot.log", "stage plots", ""}, dir,
+      render, result);
+  if (result.warning.empty()) fs::remove(dir / "gnuplot.log");
+  return result;
+}
+
+StageFitOptions fit_options(const IdentifyArgs& args, const StageRecord& r, const FrequencyResponse& frf) {
+  StageFitOptions o;
+  o.unit_dc_gain = false;  // the data carry the actuator's gain: reported, then normalised away
+  o.zoh_sample_rate_Hz = args.continuous ? 0.0 : r.sample_rate_Hz;
+  o.max_delay_s = args.max_delay_s;
+  o.max_order = args.max_order;
+  // E[1 / sigma^2] of an estimated variance: its degrees of freedom.
+  o.sigma_dof = frf.total_available ? 2.0 * static_cast<double>(frf.realisations - 1)
+                                    : 2.0 * static_cast<double>(frf.realisations * (frf.periods_used - 1));
+  if (o.sigma_dof <= 2.0) o.sigma_dof = 0.0;
+  if (args.order == "auto") {
+    o.auto_order = true;
+  } else {
+    const std::size_t slash = args.order.find('/');
+    int m = -1, n = -1;
+    if (slash != std::string::npos) {
+      std::from_chars(args.order.data(), args.order.data() + slash, m);
+      std::from_chars(args.order.data() + slash + 1, args.order.data() + args.order.size(), n);
+    }
+    if (m < 0 || n < 1 || m > n) {
+      throw ParameterError("order",
+                           "NUM/DEN with 0 <= NUM <= DEN, DEN >= 1 (e.g. 2/4), or auto (got '" + args.order + "')");
+    }
+    o.numerator_order = m;
+    o.denominator_order = n;
+  }
+  return o;
+}
+
+}  // namespace
+
+std::vector<C> roots_hz_once(const std::vector<C>& roots_rad_s) {
+  std::vector<C> out;
+  for (const C r : roots_rad_s) {
+    const C hz = r / (2.0 * std::numbers::pi);
+    if (std::abs(hz.imag()) <= 1e-9 * std::abs(hz)) {
+      out.emplace_back(hz.real(), 0.0);
+    } else if (hz.imag() > 0.0) {
+      out.push_back(hz);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](C a, C b) { return std::abs(a) < std::abs(b); });
+  return out;
+}
+
+int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_options) {
+  StageRecord r = args.from_logs ? read_log_record(args, log_options) : read_csv_record(args);
+  if (args.transient_periods >= r.periods || r.periods - args.transient_periods < 2) {
+    throw ParameterError("transient-periods", "at least 2 of the " + std::to_string(r.periods) +
+                                                  " periods must remain after the transient ones");
+  }
+  if (!args.band.empty()) {
+    const auto [lo, hi] = parse_band(args.band);
+    MultisineOptions mo;
+    mo.sample_rate_Hz = r.sample_rate_Hz;
+    mo.period_samples = r.period_samples;
+    mo.f_min_Hz = lo;
+    mo.f_max_Hz = hi;
+    mo.lines = args.odd_lines ? MultisineLines::odd : MultisineLines::all;
+    r.lines = multisine_lines(mo);
+  } else if (r.lines.empty()) {
+    r.lines = excited_lines(r, args.transient_periods);
+  }
+  if (r.lines.empty()) throw ParameterError("band", "no line excited in the record");
+  std::printf("stage record: %s\n", r.source.c_str());
+  FrfOptions fo;
+  fo.sample_rate_Hz = r.sample_rate_Hz;
+  fo.period_samples = r.period_samples;
+  fo.periods = r.periods;
+  fo.realisations = r.realisations;
+  fo.transient_periods = args.transient_periods;
+  const FrequencyResponse estimated = estimate_frequency_response(r.u, r.y, r.lines, fo);
+  if (!estimated.ok()) {
+    std::cerr << "hystloop-identify: no frequency response: " << estimated.reason << "\n";
+    return kExitFailure;
+  }
+  FrequencyResponse frf = estimated;
+  if (!args.continuous && args.sample_at == "end") {
+    // y_k at the end of tick k is the conventional hold's sample k + 1: one tick earlier than the
+    // zero-order hold the fit models. Delaying the data by that tick (z^-1, exact on the lines) makes
+    // the fitted delay the rig's own (LinearStageSpec::delay_s), which may be under a tick.
+    for (std::size_t i = 0; i < frf.G.size(); ++i) {
+      frf.G[i] *= std::polar(1.0, -2.0 * std::numbers::pi * frf.frequency_Hz[i] / r.sample_rate_Hz);
+    }
+  }
+  const StageFitOptions o = fit_options(args, r, frf);
+  const std::vector<double>& sigma = frf.total_available ? frf.sigma_total : frf.sigma_noise;
+  const StageFitResult fit = fit_stage_model({frf.frequency_Hz, frf.G, sigma}, o);
+  if (!fit.ok()) {
+    std::cerr << "hystloop-identify: no stage model: " << fit.reason << "\n";
+    return kExitFailure;
+  }
+  print_fit(frf, fit);
+  std::string heading = fs::path(args.files.front()).filename().string();
+  const OutputTarget target = output_target(args.out);
+  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading)); rc != 0) return rc;
+  if (target.plots_dir) {
+    const report::PlotResult plots = write_stage_plots(frf, fit, heading, *target.plots_dir, args.gnuplot);
+    for (const auto& f : plots.images) std::printf("plot: %s\n", f.string().c_str());
+    if (!plots.warning.empty()) std::printf("plots: %s\n", plots.warning.c_str());
+  }
+  return 0;
+}
+
+}  // namespace hystloop

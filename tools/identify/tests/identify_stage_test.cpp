@@ -1,0 +1,134 @@
+// hystloop-identify --model stage end to end: a CSV made here from a known two-mode stage with a
+// delay of 1.5 ticks (LinearStageSimulator, the rig's convention: y_k at the end of tick k), driven
+// by design_multisine's record, times an actuator gain, plus sensor noise; the tool run as a
+// process; its YAML's poles and delay against the true ones, and the Bode plots.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <complex>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "models/linear_stage.hpp"
+#include "models/multisine.hpp"
+#include "support/tool_run.hpp"
+
+namespace hystloop {
+namespace {
+
+const std::string kTool = HYSTLOOP_IDENTIFY_EXE;
+using C = std::complex<double>;
+
+constexpr double kGain_m_per_V = 2e-7;
+constexpr double kDelay_s = 150e-6;
+
+LinearStageSpec truth() { return LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.8}, {2400.0, 0.02, 0.2}}, kDelay_s); }
+
+// The true poles in Hz, conjugate pairs once: -zeta f + i f sqrt(1 - zeta^2).
+std::vector<C> true_poles_hz() {
+  std::vector<C> p;
+  for (auto [f, z] : {std::pair{780.0, 0.03}, std::pair{2400.0, 0.02}})
+    p.emplace_back(-z * f, f * std::sqrt(1 - z * z));
+  return p;
+}
+
+class IdentifyStage : public ::testing::Test {
+ protected:
+  std::string path(const std::string& name) const { return scratch_.path(name); }
+  testing::ScratchDir scratch_{"hystloop_identify_stage"};
+
+  // 300 samples at rest before the record (--skip), then R P N samples.
+  void write_record(const std::string& file, bool with_t) {
+    MultisineOptions o;
+    o.period_samples = 2000;
+    o.f_min_Hz = 5.0;
+    o.f_max_Hz = 3000.0;
+    o.amplitude_V = 2.0;
+    o.offset_V = 10.0;
+    o.periods = 4;
+    o.realisations = 3;
+    o.seed = 11;
+    const Multisine m = design_multisine(o);
+    std::vector<double> u(300, o.offset_V);
+    u.insert(u.end(), m.u_V.begin(), m.u_V.end());
+    LinearStageSimulator sim(discretise(truth(), 1e-4));
+    sim.reset(o.offset_V);
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> noise(0.0, 1e-10);
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, with_t ? "t,u,y\n" : "u,y\n");
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      const double y = kGain_m_per_V * sim.step(u[k]) + noise(rng);
+      if (with_t) std::fprintf(f, "%.9g,", static_cast<double>(k) * 1e-4);
+      std::fprintf(f, "%.17g,%.17g\n", u[k], y);
+    }
+    std::fclose(f);
+  }
+};
+
+std::vector<C> roots(const YAML::Node& list) {
+  std::vector<C> out;
+  for (const auto& r : list) out.emplace_back(r[0].as<double>(), r[1].as<double>());
+  return out;
+}
+
+TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
+  write_record(path("stage.csv"), true);
+  const std::string out = path("fit") + "/";
+  const testing::ToolRun r = testing::run_tool(kTool + " " + path("stage.csv") +
+                                               " --model stage --period-samples 2000 --periods 4 --realisations 3 "
+                                               "--skip 300 --max-order 5 --out " +
+                                               out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("chi2/line"), std::string::npos) << r.output;  // the orders tried
+  EXPECT_NE(r.output.find("measured DC gain"), std::string::npos) << r.output;
+  const YAML::Node doc = YAML::LoadFile(out + "config.yaml");
+  const std::vector<C> poles = roots(doc["stage"]["poles_hz"]);
+  ASSERT_EQ(poles.size(), 2u) << r.output;  // two conjugate pairs, listed once
+  for (const C t : true_poles_hz()) {
+    const C nearest =
+        *std::min_element(poles.begin(), poles.end(), [&](C a, C b) { return std::abs(a - t) < std::abs(b - t); });
+    EXPECT_LT(std::abs(nearest - t) / std::abs(t), 1e-3) << nearest << " vs " << t;
+  }
+  EXPECT_EQ(doc["stage"]["zeros_hz"].size(), 1u);  // the pair two modes in parallel have
+  EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
+  // The gain is reported beside the stage, not in it.
+  const std::string gain_label = "measured DC gain u -> y: ";
+  const std::size_t at = r.output.find(gain_label);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_NEAR(std::stod(r.output.substr(at + gain_label.size())), kGain_m_per_V, 1e-4 * kGain_m_per_V);
+  // The fitted order: the stage's 2/4, the lower ones refused by their chi-square.
+  EXPECT_NE(r.output.find("stage model: orders 2/4,"), std::string::npos) << r.output;
+  for (const char* png : {"stage_bode.png", "stage_residual.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + png)) << png << "\n" << r.output;
+  }
+  EXPECT_TRUE(std::filesystem::exists(out + "stage_frf.dat"));
+}
+
+TEST_F(IdentifyStage, AUyCsvNeedsItsSampleRateAndAGivenOrderIsKept) {
+  write_record(path("uy.csv"), false);
+  const std::string layout = " --model stage --period-samples 2000 --periods 4 --realisations 3 --skip 300";
+  const testing::ToolRun no_rate = testing::run_tool(kTool + " " + path("uy.csv") + layout);
+  EXPECT_EQ(no_rate.exit_code, 2) << no_rate.output;
+  EXPECT_NE(no_rate.output.find("--sample-rate"), std::string::npos) << no_rate.output;
+  const testing::ToolRun r =
+      testing::run_tool(kTool + " " + path("uy.csv") + layout +
+                        " --sample-rate 10000 --order 2/4 --band 5:3000 --out " + path("stage.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const YAML::Node doc = YAML::LoadFile(path("stage.yaml"));
+  EXPECT_EQ(doc["stage"]["poles_hz"].size(), 2u);
+  EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
+  const testing::ToolRun bad =
+      testing::run_tool(kTool + " " + path("uy.csv") + layout + " --sample-rate 1e4 --order 4/2");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("order"), std::string::npos) << bad.output;
+}
+
+}  // namespace
+}  // namespace hystloop
