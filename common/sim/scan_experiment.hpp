@@ -34,9 +34,9 @@ IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude
 
 struct ScanOptions {
   std::optional<FeedforwardMode> mode;  // nullopt: the identification's best (hystloop-identify --model auto)
-  bool stage_inverse = true;            // Banning's k, c (a series plant: its linear stage) inverted beside the hysteresis
+  bool stage_inverse = true;  // Banning's k, c (a series plant: its linear stage) inverted beside the hysteresis
   std::optional<LinearStageSpec> stage_model;  // a series plant: the stage model inverted (nullopt: the plant's own)
-  bool servo = true;                    // the bridge's servo as deploy/config/bridge.yaml sets it:
+  bool servo = true;                           // the bridge's servo as deploy/config/bridge.yaml sets it:
   double kp = 0.05, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
   bool learning = false;
   // A line outside the actuator's limits (the servo's reserve included) is scaled to fit, as

@@ -45,8 +45,9 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--model", args.model,
-                 model_choices() + " (auto: fit all, rank on held-out data; stage: the linear stage's dynamics "
-                                   "from a multisine experiment: FRF, poles, zeros, delay)")
+                 model_choices() +
+                     " (auto: fit all, rank on held-out data; stage: the linear stage's dynamics "
+                     "from a multisine experiment: FRF, poles, zeros, delay)")
       ->check([](const std::string& v) { return parse_model_choice(v) ? std::string() : "unknown model '" + v + "'"; })
       ->capture_default_str();
   app.add_option("--form", args.form, "MEM data form: integrated branches or the paper's derivative")
