@@ -21,6 +21,7 @@
 #include "lcm/connection.hpp"
 #include "lcm/message_checks.hpp"
 #include "lcm/servo_gains_status.hpp"
+#include "runtime/rig_auth_config.hpp"
 #include "runtime/summary_file.hpp"
 
 namespace hystloop {
@@ -249,8 +250,13 @@ int BridgeService::run() {
   using clock = std::chrono::steady_clock;
   const auto started = clock::now();
   next_report_ = started + std::chrono::seconds(1);
+  auto next_network_check = started + std::chrono::seconds(1);
   while (!stop_requested()) {
     serve(false);
+    if (clock::now() >= next_network_check) {  // a keyless bridge that finds itself on a network stops, ramped
+      next_network_check += std::chrono::seconds(1);
+      keyless_network_reached();
+    }
     if (settings_.run_seconds > 0 && clock::now() - started >= std::chrono::duration<double>(settings_.run_seconds)) {
       spdlog::info("--seconds {} reached", settings_.run_seconds);
       request_stop();

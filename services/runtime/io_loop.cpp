@@ -4,6 +4,7 @@
 
 #include "core/process.hpp"
 #include "lcm/connection.hpp"
+#include "runtime/rig_auth_config.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -20,6 +21,7 @@ int run_io_loop(lcm::LCM& lcm, const IoLoopOptions& options, const std::function
     if (n > 0 && after_dispatch) after_dispatch();
     if (clock::now() >= next) {
       next += options.period;
+      keyless_network_reached();  // a keyless service that finds itself on a network stops
       if (on_period) on_period(wall_utime());
     }
   }

@@ -17,8 +17,9 @@ struct IoLoopOptions {
 };
 
 // Runs until stop_requested(). on_period is called every options.period (first after one
-// period) with the wall time in us; `after_dispatch` (optional) after each batch of
-// messages. Returns the number of LCM errors seen.
+// period) with the wall time in us, after the keyless service's network watch
+// (keyless_network_reached, runtime/rig_auth_config.hpp), which may request the stop; `after_dispatch` (optional) after
+// each batch of messages. Returns the number of LCM errors seen.
 int run_io_loop(lcm::LCM& lcm, const IoLoopOptions& options, const std::function<void(std::int64_t)>& on_period,
                 const std::function<void()>& after_dispatch = {});
 

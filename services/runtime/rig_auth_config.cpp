@@ -4,6 +4,7 @@
 #include <net/if.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 
@@ -12,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/errors.hpp"
+#include "core/process.hpp"
 #include "lcm/url.hpp"
 #include "runtime/config_validation.hpp"
 
@@ -91,10 +93,37 @@ void check_keyless_choice(const Config& config, bool have_key, std::string_view 
   });
 }
 
+namespace {
+std::atomic<bool> g_watch_network{false};
+std::atomic<bool> g_network_reached{false};
+}  // namespace
+
+void set_keyless_network_watch(bool on) noexcept {
+  g_watch_network.store(on);
+  g_network_reached.store(false);
+}
+
+std::string keyless_network_reached(std::vector<std::string> (*interfaces)()) {
+  if (!g_watch_network.load() || g_network_reached.load()) return {};
+  const std::vector<std::string> up = interfaces();
+  if (up.empty()) return {};
+  g_network_reached.store(true);
+  std::string why = fmt::format(
+      "a keyless service on a network other hosts reach: interfaces {} came up after the start, and any host "
+      "there could now arm the bridge; stopping (set auth.key_file, or auth.allow_keyless_network: true)",
+      fmt::join(up, ", "));
+  spdlog::error("auth: {}", why);
+  request_stop();
+  return why;
+}
+
 void configure_rig_auth(const Config& config, std::string_view url) {
   std::shared_ptr<const RigAuth> auth = load_rig_auth(config);
   const bool env_keyless = keyless_from_environment();
   check_keyless_choice(config, auth != nullptr, url, shared_network_interfaces(), env_keyless);
+  // Passed the check keyless and off the network: it must stay off it.
+  set_keyless_network_watch(auth == nullptr && !config.get<bool>("auth.allow_keyless_network", false) &&
+                            parse_lcm_url(url).provider != "memq");
   if (auth != nullptr) {
     spdlog::info(
         "auth: sensor blocks, commands, control, trajectories and parameters signed and checked with the rig "

@@ -52,7 +52,18 @@ bool keyless_from_environment();
 
 // load_rig_auth and check_keyless_choice, installed as the process's (set_process_rig_auth),
 // with the start-up log line (a keyless rig warns at every start). Call after logging is set
-// up, before any endpoint is made.
+// up, before any endpoint is made. A keyless service that may run only off the network has its
+// network watched from then on (keyless_network_reached).
 void configure_rig_auth(const Config& config, std::string_view url);
+
+// A keyless service started inside a private namespace must not stay keyless once a network
+// other hosts reach appears (a link brought up after the start check): its I/O loop calls this
+// about once a second. The first time an interface besides loopback is up, it logs why, asks the
+// process to stop (request_stop: the bridge's stop ramps to the safe state first) and returns the
+// reason; later calls, and calls in a process that is keyed, allowed on the network or not
+// watched, return an empty string. `interfaces` is for tests (default: shared_network_interfaces).
+std::string keyless_network_reached(std::vector<std::string> (*interfaces)() = &shared_network_interfaces);
+// Watch (or not) from now on: what configure_rig_auth decides, settable for tests.
+void set_keyless_network_watch(bool on) noexcept;
 
 }  // namespace hystloop

@@ -7,7 +7,7 @@ target_link_libraries(loop_probe PRIVATE hystloop::lcm CLI11::CLI11 hystloop::wa
 target_include_directories(loop_probe PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
 
 if(TARGET hystloop-bridge AND TARGET hystloop-compensator)
-  foreach(_script loop_run loop_watchdog loop_reject bridge_cli compensator_cli bridge_safe_stop)
+  foreach(_script loop_run loop_watchdog loop_reject bridge_cli compensator_cli bridge_safe_stop keyless_network)
     add_test(NAME ${_script}
       COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/${_script}.sh
               $<TARGET_FILE:hystloop-bridge> $<TARGET_FILE:hystloop-compensator> $<TARGET_FILE:loop_probe>)

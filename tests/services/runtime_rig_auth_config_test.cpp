@@ -8,8 +8,10 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "auth/rig_key.hpp"
+#include "core/process.hpp"
 
 namespace hystloop {
 namespace {
@@ -125,6 +127,26 @@ TEST(RigAuthConfig, UrlsThatLeaveTheHost) {
   EXPECT_TRUE(lcm_url_leaves_host("udpm://239.255.76.67:7667?ttl=1"));
   EXPECT_TRUE(lcm_url_leaves_host("udpm://239.255.76.67:7667?recv_buf_size=4194304&ttl=1"));
   EXPECT_TRUE(lcm_url_leaves_host("tcpq://hub:7700"));
+}
+
+std::vector<std::string> no_interfaces() { return {}; }
+std::vector<std::string> veth_up() { return {"veth0"}; }
+
+// A keyless service watched after its start: nothing while only loopback is up; the first
+// interface up stops the process, once, naming it; a keyed or allowed service is not watched.
+TEST(RigAuthKeyless, AnInterfaceComingUpStopsAWatchedKeylessService) {
+  install_stop_handlers();
+  set_keyless_network_watch(false);
+  EXPECT_EQ(keyless_network_reached(&veth_up), "");
+  EXPECT_FALSE(stop_requested());
+  set_keyless_network_watch(true);
+  EXPECT_EQ(keyless_network_reached(&no_interfaces), "");
+  EXPECT_FALSE(stop_requested());
+  const std::string why = keyless_network_reached(&veth_up);
+  EXPECT_NE(why.find("veth0"), std::string::npos) << why;
+  EXPECT_TRUE(stop_requested());
+  EXPECT_EQ(keyless_network_reached(&veth_up), "");  // said once
+  set_keyless_network_watch(false);
 }
 
 }  // namespace
