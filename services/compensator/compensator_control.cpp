@@ -61,10 +61,17 @@ void CompensatorService::on_control(const control_t& msg) {
         const bool queued = driven.experiment_running();
         driven.start_experiment(e);
         if (const LogLimiter::Gate g = acted()) {
-          spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
-                       e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s,
-                       queued ? "queued, " + std::to_string(driven.experiments_queued()) + " waiting" : "started",
-                       msg.request_id, suppressed_note(g));
+          const std::string when =
+              queued ? "queued, " + std::to_string(driven.experiments_queued()) + " waiting" : "started";
+          if (e.multisine) {
+            spdlog::info("experiment {}: {} V {} about {} V, {} .. {} Hz, period {} s {} (request {}){}",
+                         escape_wire(msg.experiment), e.amplitude_V, e.ms.peak ? "peak" : "rms", e.offset_V,
+                         e.ms.f_min_hz, e.frequency_hz, e.duration_s, when, msg.request_id, suppressed_note(g));
+          } else {
+            spdlog::info("experiment {} {} V + {} V at {} Hz for {} s {} (request {}){}", escape_wire(msg.experiment),
+                         e.amplitude_V, e.offset_V, e.frequency_hz, e.duration_s, when, msg.request_id,
+                         suppressed_note(g));
+          }
         }
         break;
       }

@@ -5,6 +5,9 @@
 //                   [--publish [--publish-on params|model] [--version N] [--listen-s 0.5] [--lcm-url URL]
 //                              [--allow-network] [--key-file F] [--timeout 5 | --no-wait]]
 //                   [--max-samples 2000000] [--decimate K] [--progress]
+// hystloop-identify data.csv|run.lcmlog --model stage [--period-samples N --periods P --realisations R
+//                   --skip S --sample-rate HZ] [--band F1:F2] [--order NUM/DEN | auto] [--out DIR/]
+//                   the stage's linear dynamics from a multisine record (identify_stage.hpp)
 // Input: CSV t,u,y (sample_csv.hpp), or LCM event logs (files ending in .lcmlog, or --log): the
 // rig's HX_SENSOR samples, several rotated files concatenated in the order given (log_samples.hpp);
 // for --model banning, the experiments the loop ran, found by their requests (log_experiments.hpp).
