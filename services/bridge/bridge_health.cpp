@@ -60,7 +60,9 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
 std::string watchdog_reason(const DryBufferFigures& f) {
   std::string why;
   const auto add = [&why](const std::string& what) { why += (why.empty() ? "" : "; ") + what; };
-  if (f.since_last_command_s < 0.0) {
+  if (f.command_after_trip) {
+    add("command blocks kept arriving after it: too late for their ticks (stale)");
+  } else if (f.since_last_command_s < 0.0) {
     add("no command block received since the start");
   } else {
     add(fmt::format("the last command block arrived {:.1f} ms before", f.since_last_command_s * 1e3));

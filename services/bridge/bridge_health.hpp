@@ -46,6 +46,7 @@ struct DryBufferFigures {
   int axes = 1;
   int tripped_by = -1;                   // the axis that ran dry first (-1: unknown)
   double since_last_command_s = -1.0;    // the last command block received -> the trip (< 0: none yet)
+  bool command_after_trip = false;       // command blocks kept arriving after the trip (too late for their ticks)
   double period_s = 0.0;                 // the report period these counts are of
   std::uint64_t commands_rejected = 0;   // HX_COMMAND messages refused in the period (every reason)
   std::uint64_t command_queue_full = 0;  // command ticks the real-time queue had no room for

@@ -165,6 +165,10 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   std::array<BridgeTick, kMaxAxes> decided{};
   stage_.tick(k, std::span(y_last_m_).first(axes), decided);
   arming_.after_tick(k, stage_);
+  if (const std::uint64_t trips = stage_.counters().watchdog_trips; trips != trips_seen_) {
+    trips_seen_ = trips;
+    last_trip_ns_ = start_ns;
+  }
   std::int64_t depth = decided[0].buffer_depth;
   for (std::size_t a = 1; a < axes; ++a) depth = std::min(depth, decided[a].buffer_depth);
   if (stage_.armed() && commands_seen_) {
@@ -238,6 +242,7 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     r.commands_processed = commands_processed_;
     r.last_tick = last_tick_;
     r.last_trip_tick = arming_.last_trip_tick();
+    r.last_trip_ns = last_trip_ns_;
     r.min_depth_period = min_depth_period_;
     r.min_depth_total = min_depth_total_;
     r.buffer_depth = stage_.buffer_depth();

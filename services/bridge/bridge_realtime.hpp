@@ -135,6 +135,8 @@ class BridgeRealtime {
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;
   std::int64_t last_tick_ = -1;
+  std::uint64_t trips_seen_ = 0;             // watchdog trips when last looked at
+  std::int64_t last_trip_ns_ = -1;           // monotonic time of the tick that tripped last
   std::array<double, kMaxAxes> y_last_m_{};  // each axis's last measured position
   std::int64_t min_depth_period_ = -1;       // lowest buffer depth at an armed tick this report period
   std::int64_t min_depth_total_ = -1;        // ... since start (after the first command)

@@ -398,10 +398,9 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
                          .command_queue_full = command_queue_full_ - previous_queue_full_,
                          .io_longest_pass_s = static_cast<double>(longest_pass_ns_) * 1e-9,
                          .io_longest_wait_s = static_cast<double>(longest_wait_ns_) * 1e-9};
-    if (last_command_ns_ >= 0) {
-      // The trip was (last_tick - trip_tick) ticks before this report.
-      const double trip_ago_s = static_cast<double>(rt.last_tick - rt.last_trip_tick) * settings_.dt_s();
-      dry.since_last_command_s = std::max(0.0, static_cast<double>(now_ns - last_command_ns_) * 1e-9 - trip_ago_s);
+    if (last_command_ns_ >= 0 && rt.last_trip_ns >= 0) {
+      dry.since_last_command_s = static_cast<double>(rt.last_trip_ns - last_command_ns_) * 1e-9;
+      dry.command_after_trip = dry.since_last_command_s < 0.0;
     }
     safe_reason_ = watchdog_reason(dry);
     spdlog::warn("{}", safe_reason_);

@@ -29,6 +29,7 @@ struct RtReport {
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue
   std::int64_t last_tick = -1;
   std::int64_t last_trip_tick = -1;    // tick of the last watchdog trip
+  std::int64_t last_trip_ns = -1;      // ... its monotonic time (a simulator's ticks may lag the wall clock)
   std::int64_t min_depth_period = -1;  // lowest buffer depth at an armed tick this period (-1: none)
   std::int64_t min_depth_total = -1;   // ... since the first command arrived
   std::int64_t buffer_depth = 0;       // now

@@ -129,6 +129,10 @@ TEST(BridgeHealth, TheWatchdogsReasonSaysWhyTheBufferRanDry) {
   EXPECT_NE(two.find("no command block received since the start"), std::string::npos) << two;
   EXPECT_NE(two.find("7 command ticks found the real-time queue full"), std::string::npos) << two;
   EXPECT_NE(two.find("every axis to the safe state"), std::string::npos) << two;
+
+  f.command_after_trip = true;
+  const std::string late = watchdog_reason(f);
+  EXPECT_NE(late.find("command blocks kept arriving after it: too late for their ticks"), std::string::npos) << late;
 }
 
 }  // namespace
