@@ -297,14 +297,23 @@ std::int64_t Config::get_int_in_range(std::string_view path, std::int64_t defaul
   return v;
 }
 
-std::vector<std::vector<double>> Config::get_rows(std::string_view path, std::size_t width) const {
+namespace {
+// The list at `path` (nothing when absent); anything else is refused naming it.
+std::optional<YAML::Node> find_list(const Config& cfg, const YAML::Node& root, std::string_view path,
+                                    const std::string& of_what) {
   const auto parts = split_config_path(path);
-  require_valid_path(*this, path, parts);
+  require_valid_path(cfg, path, parts);
   std::string walked;
-  const auto node = find_node(*this, impl_->root, parts, 0, walked);
+  const auto node = find_node(cfg, root, parts, 0, walked);
+  if (node && !node->IsSequence()) cfg.fail(path, "expected a list of " + of_what + ", got " + describe(*node));
+  return node;
+}
+}  // namespace
+
+std::vector<std::vector<double>> Config::get_rows(std::string_view path, std::size_t width) const {
+  const auto node = find_list(*this, impl_->root, path, "lists");
   if (!node) return {};
   const std::string field(path);
-  if (!node->IsSequence()) fail(path, "expected a list of lists, got " + describe(*node));
   std::vector<std::vector<double>> out;
   out.reserve(node->size());
   for (std::size_t i = 0; i < node->size(); ++i) {
@@ -321,13 +330,9 @@ std::vector<std::vector<double>> Config::get_rows(std::string_view path, std::si
 
 std::vector<std::vector<double>> Config::get_records(std::string_view path,
                                                      const std::vector<std::string>& fields) const {
-  const auto parts = split_config_path(path);
-  require_valid_path(*this, path, parts);
-  std::string walked;
-  const auto node = find_node(*this, impl_->root, parts, 0, walked);
+  const auto node = find_list(*this, impl_->root, path, "maps");
   if (!node) return {};
   const std::string field(path);
-  if (!node->IsSequence()) fail(path, "expected a list of maps, got " + describe(*node));
   std::vector<std::vector<double>> out;
   out.reserve(node->size());
   for (std::size_t i = 0; i < node->size(); ++i) {
