@@ -212,6 +212,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     y << "\n";
   }
   y << "stage:\n"
+    << "  kind: linear\n"
     << "  zeros_hz: " << roots_yaml(roots_hz_once(fit.zeros_rad_s)) << "\n"
     << "  poles_hz: " << roots_yaml(roots_hz_once(fit.poles_rad_s)) << "\n"
     << "  delay_s: " << num(fit.delay_s, 8) << "\n";

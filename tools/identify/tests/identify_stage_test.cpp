@@ -96,6 +96,7 @@ TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
         *std::min_element(poles.begin(), poles.end(), [&](C a, C b) { return std::abs(a - t) < std::abs(b - t); });
     EXPECT_LT(std::abs(nearest - t) / std::abs(t), 1e-3) << nearest << " vs " << t;
   }
+  EXPECT_EQ(doc["stage"]["kind"].as<std::string>(), "linear");  // the compensator's stage section as it is
   EXPECT_EQ(doc["stage"]["zeros_hz"].size(), 1u);  // the pair two modes in parallel have
   EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
   // The gain is reported beside the stage, not in it.
