@@ -77,6 +77,12 @@ RecordCheck::~RecordCheck() = default;
 bool RecordCheck::admit(std::string_view channel, const void* data, std::size_t size, std::int64_t utime) {
   if (is_keyed_record_marker(channel, data, size)) marked_keyed_ = true;
   if (auth_ == nullptr || !is_authenticated_channel(channel)) return true;
+  // A file that does not start keyed was recorded without the key: it holds no signatures to
+  // check (every message would fail), and nothing recorded it as a keyed rig's.
+  if (!marked_keyed_) {
+    unmarked_ = true;
+    return true;
+  }
   auto v = verifiers_.find(channel);
   if (v == verifiers_.end()) {
     // A recorded message is checked at the time it was received (its event time); anything the
@@ -113,6 +119,8 @@ std::vector<std::string> RecordCheck::take_notes() {
   if (marked_keyed_ && auth_ == nullptr) {
     notes.emplace_back("recorded on a keyed rig; signatures not checked (give the rig key, --key-file, to verify)");
   }
+  if (unmarked_) notes.emplace_back("recorded without a rig key (no keyed marker): nothing to verify, read as it is");
+  unmarked_ = false;
   refused_.clear();
   left_out_ = 0;
   marked_keyed_ = false;

@@ -46,9 +46,10 @@ std::vector<std::uint8_t> keyed_record_marker(std::int64_t utime);
 bool is_keyed_record_marker(std::string_view channel, const void* data, std::size_t size) noexcept;
 
 // A log reader's check of what it reads, in the order it was recorded (across the files of one
-// recording): with the rig's key (auth non-null), an event on an authenticated channel whose
-// signature fails is left out and counted; without, nothing is left out. Either way the
-// markers are noticed. Allocates (readers only; the logger keeps its own fixed counters).
+// recording): with the rig's key (auth non-null), an event on an authenticated channel of a file
+// that starts with the keyed marker whose signature fails is left out and counted; without, or in
+// a file recorded without a key (no marker: no signatures to check), nothing is left out, and the
+// notes say which. Allocates (readers only; the logger keeps its own fixed counters).
 class RecordCheck {
  public:
   explicit RecordCheck(std::shared_ptr<const RigAuth> auth);
@@ -78,6 +79,7 @@ class RecordCheck {
   std::uint64_t left_out_ = 0;
   std::uint64_t left_out_total_ = 0;
   bool marked_keyed_ = false;
+  bool unmarked_ = false;  // events of a file not marked keyed read with a key: not verified
 };
 
 }  // namespace hystloop

@@ -79,7 +79,7 @@ TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal(c + "comedi: {sensor: {scale_m: 1}}"), "comedi.sensor.scale_m: unknown key"));
   // A card cannot run ticks back to back.
   EXPECT_TRUE(contains(refusal("bridge: {backend: comedi}\nrt: {ticks_per_wake: 20}"), "rt.ticks_per_wake"));
-  EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "must be sim, ro or comedi"));
+  EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "must be sim, ro, series or comedi"));
   // The simulators ignore the comedi keys.
   EXPECT_EQ(refusal("bridge: {backend: sim}\ncomedi: {device: /dev/comedi1}"), "accepted");
 }

@@ -24,6 +24,7 @@ constexpr double kNm = 1e-9;
 constexpr double kSigma = 1e-9;
 constexpr std::int64_t kPeriod = 200;
 constexpr std::int64_t kPeriods = 60;
+constexpr double kRatio = 1.05;  // what deploy/config/two-mode sets
 
 struct LearningRun {
   double off_rms = 0.0;    // period 1: no table yet
@@ -57,7 +58,7 @@ LearningRun run_learning(const LinearPlant& plant, double monitor_ratio, double 
 TEST(LearningMonitor, StopsALineWhoseLearningMakesTheErrorWorse) {
   for (const LinearPlant& plant : {LinearPlant{-1.0, 0}, LinearPlant{1.0, 8}, LinearPlant{3.2, 0}}) {
     const LearningRun unguarded = run_learning(plant, 0.0);
-    const LearningRun guarded = run_learning(plant, LearningConfig{}.monitor_ratio);
+    const LearningRun guarded = run_learning(plant, kRatio);
     std::printf(
         "gain %.1f, delay %lld: off %.2f nm; unguarded worst %.2f nm, last %.2f; guarded worst %.2f, last %.2f\n",
         plant.gain, static_cast<long long>(plant.delay), guarded.off_rms / kNm, unguarded.worst_rms / kNm,
@@ -76,7 +77,7 @@ TEST(LearningMonitor, StopsALineWhoseLearningMakesTheErrorWorse) {
 TEST(LearningMonitor, LeavesALineThatConvergesAlone) {
   for (const LinearPlant& plant :
        {LinearPlant{1.0, 0}, LinearPlant{0.5, 0}, LinearPlant{1.5, 0}, LinearPlant{1.0, 3}}) {
-    const LearningRun guarded = run_learning(plant, LearningConfig{}.monitor_ratio);
+    const LearningRun guarded = run_learning(plant, kRatio);
     const LearningRun unguarded = run_learning(plant, 0.0);
     EXPECT_EQ(guarded.figures.divergences, 0U) << plant.gain << " " << plant.delay;
     EXPECT_FALSE(guarded.figures.diverged);
@@ -89,6 +90,7 @@ TEST(LearningMonitor, LeavesALineThatConvergesAlone) {
 // A restart (a new line) learns again after the monitor stopped the last one.
 TEST(LearningMonitor, ANewLineLearnsAgain) {
   LearningConfig config;
+  config.monitor_ratio = kRatio;
   PeriodicLearner learner(config, kLearnDt, testing::kMaxLag);
   LearningLoop loop(
       learner, 2 * kPeriods * kPeriod, LinearPlant{-1.0, 0},

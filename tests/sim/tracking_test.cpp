@@ -31,8 +31,8 @@ namespace {
 using TrackRun = TrackingRun;
 
 const TrackingExperiment kExperiment{};
-constexpr double kSettleSeconds = TrackingExperiment{}.settle_s;
-constexpr double kTrackSeconds = TrackingExperiment{}.track_s;
+const double kSettleSeconds = kExperiment.settle_s;
+const double kTrackSeconds = kExperiment.track_s;
 
 const IdentifiedModels& identified() {
   static const IdentifiedModels models = [] {

@@ -196,11 +196,11 @@ TEST_F(CtlLcmTest, EveryControlKindArrivesThreeTimesWithOneRequestId) {
        "compensator",
        [](const control_t& c) { EXPECT_EQ(c.learning, control_t::LEARNING_RESET); }},
       {{"experiment", "--amplitude", "50", "--frequency", "2", "--duration", "10", "--offset", "-5", "--kind",
-        "triangle"},
+        "settle"},
        control_t::START_EXPERIMENT,
        "",
        [](const control_t& c) {
-         EXPECT_EQ(c.experiment, "triangle");
+         EXPECT_EQ(c.experiment, "settle");
          EXPECT_EQ(c.experiment_amplitude_V, 50.0);
          EXPECT_EQ(c.experiment_frequency_Hz, 2.0);
          EXPECT_EQ(c.experiment_duration_s, 10.0);

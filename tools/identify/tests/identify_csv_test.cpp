@@ -236,9 +236,9 @@ TEST_F(IdentifyTool, HelpDescribesTheModels) {
   const ToolRun r = run_tool("--help");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--model"), std::string::npos) << r.output;
-  // --model's choices, from the model registry: every online model, then banning and auto.
+  // --model's choices, from the model registry: every online model, then banning, stage and auto.
   std::vector<std::string_view> models = model_kind_names();
-  models.insert(models.end(), {"banning", "auto"});
+  models.insert(models.end(), {"banning", "stage", "auto"});
   EXPECT_NE(r.output.find(choice_list(models)), std::string::npos) << r.output;
   // LCM logs and publishing (tested on logs in tools/identify/tests/).
   EXPECT_NE(r.output.find(".lcmlog"), std::string::npos) << r.output;
