@@ -304,7 +304,7 @@ std::optional<YAML::Node> find_list(const Config& cfg, const YAML::Node& root, s
   const auto parts = split_config_path(path);
   require_valid_path(cfg, path, parts);
   std::string walked;
-  const auto node = find_node(cfg, root, parts, 0, walked);
+  auto node = find_node(cfg, root, parts, 0, walked);
   if (node && !node->IsSequence()) cfg.fail(path, "expected a list of " + of_what + ", got " + describe(*node));
   return node;
 }
@@ -345,8 +345,20 @@ std::vector<std::vector<double>> Config::get_records(std::string_view path,
       const auto at = std::find(fields.begin(), fields.end(), key);
       if (at == fields.end()) {
         const std::string near = closest_key(key, fields);
-        fail(entry + "." + key, "unknown key" + (near.empty() ? " (expected " + join_fields(fields) + ")"
-                                                              : "; did you mean '" + near + "'?"));
+        std::string why = "unknown key";
+        if (near.empty()) {
+          why += " (expected ";
+          why += join_fields(fields);
+          why += ")";
+        } else {
+          why += "; did you mean '";
+          why += near;
+          why += "'?";
+        }
+        std::string at_key = entry;
+        at_key += ".";
+        at_key += key;
+        fail(at_key, why);
       }
       row[static_cast<std::size_t>(at - fields.begin())] = convert_scalar<double>(*this, kv.second, entry + "." + key);
     }

@@ -108,8 +108,10 @@ std::vector<std::string> RecordCheck::take_notes() {
       std::string reasons;
       for (std::size_t i = 1; i < kAuthResults; ++i) {
         if (counts[i] == 0) continue;
-        reasons += (reasons.empty() ? "" : ", ") + std::to_string(counts[i]) + " " +
-                   std::string(to_string(static_cast<AuthResult>(i)));
+        if (!reasons.empty()) reasons += ", ";
+        reasons += std::to_string(counts[i]);
+        reasons += " ";
+        reasons += to_string(static_cast<AuthResult>(i));
       }
       detail += (detail.empty() ? "" : "; ") + channel + ": " + reasons;
     }

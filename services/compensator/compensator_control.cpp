@@ -20,10 +20,6 @@
 
 namespace hystloop {
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
 void CompensatorService::on_control(const control_t& msg) {
   if (!filter_.accept(msg)) return;
   auto refuse = [&](const std::string& why) {

@@ -21,10 +21,6 @@
 
 namespace hystloop {
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
 CounterSet::Entries CompensatorService::collect_counters() const {
   CompensatorCounters c = retired_;
   for (int a = 0; a < settings_.axes; ++a) c += laws_[static_cast<std::size_t>(a)]->counters();

@@ -166,7 +166,8 @@ TEST(ReidentOptions, ReadsAndChecksTheStage) {
   EXPECT_DOUBLE_EQ(o.stage.second_order.k, 2.0e8);
   EXPECT_DOUBLE_EQ(o.stage.second_order.c, 3.0e3);
   EXPECT_EQ(o.stage.order, BanningOrder::kStageThenHysteresis);
-  EXPECT_NE(refusal("stage: {kind: third_order}").find("stage.kind: must be none, second_order or linear"), std::string::npos);
+  EXPECT_NE(refusal("stage: {kind: third_order}").find("stage.kind: must be none, second_order or linear"),
+            std::string::npos);
   EXPECT_NE(refusal("stage: {kind: second_order, k: -1}").find("stage.k"), std::string::npos);
   EXPECT_NE(refusal("stage: {k: 1.0e8}").find("stage.kind: is none"), std::string::npos);
   EXPECT_NE(refusal("stage: {kind: second_order, order: sideways}").find("stage.order"), std::string::npos);

@@ -97,7 +97,7 @@ TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
     EXPECT_LT(std::abs(nearest - t) / std::abs(t), 1e-3) << nearest << " vs " << t;
   }
   EXPECT_EQ(doc["stage"]["kind"].as<std::string>(), "linear");  // the compensator's stage section as it is
-  EXPECT_EQ(doc["stage"]["zeros_hz"].size(), 1u);  // the pair two modes in parallel have
+  EXPECT_EQ(doc["stage"]["zeros_hz"].size(), 1u);               // the pair two modes in parallel have
   EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
   // The gain is reported beside the stage, not in it.
   const std::string gain_label = "measured DC gain u -> y: ";
