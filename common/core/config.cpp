@@ -360,7 +360,10 @@ std::vector<std::vector<double>> Config::get_records(std::string_view path,
         at_key += key;
         fail(at_key, why);
       }
-      row[static_cast<std::size_t>(at - fields.begin())] = convert_scalar<double>(*this, kv.second, entry + "." + key);
+      std::string at_field = entry;
+      at_field += ".";
+      at_field += key;
+      row[static_cast<std::size_t>(at - fields.begin())] = convert_scalar<double>(*this, kv.second, at_field);
     }
     out.push_back(std::move(row));
   }

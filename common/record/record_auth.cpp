@@ -113,7 +113,10 @@ std::vector<std::string> RecordCheck::take_notes() {
         reasons += " ";
         reasons += to_string(static_cast<AuthResult>(i));
       }
-      detail += (detail.empty() ? "" : "; ") + channel + ": " + reasons;
+      if (!detail.empty()) detail += "; ";
+      detail += channel;
+      detail += ": ";
+      detail += reasons;
     }
     notes.push_back(std::to_string(left_out_) + " message(s) failed signature verification and were left out (" +
                     detail + ")");

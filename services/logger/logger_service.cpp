@@ -60,7 +60,7 @@ std::string append(std::string detail, const std::string& what) {
 }  // namespace
 
 LoggerService::LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options,
-                             std::shared_ptr<const RigAuth> auth)
+                             const std::shared_ptr<const RigAuth>& auth)
     : lcm_(lcm),
       options_(options),
       channels_regex_(options.channels.empty() ? names.all_channels_regex() : options.channels),

@@ -58,7 +58,7 @@ class LoggerService {
   // signed channels are verified as the services verify them: what fails is counted by reason,
   // not recorded; each file starts with the keyed marker (record/record_auth.hpp).
   LoggerService(lcm::LCM& lcm, const ChannelNames& names, const LoggerOptions& options,
-                std::shared_ptr<const RigAuth> auth = process_rig_auth());
+                const std::shared_ptr<const RigAuth>& auth = process_rig_auth());
   ~LoggerService();
   LoggerService(const LoggerService&) = delete;
   LoggerService& operator=(const LoggerService&) = delete;

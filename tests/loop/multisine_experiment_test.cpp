@@ -86,8 +86,8 @@ TEST(MultisineExperiment, PowerOnlyAtTheLinesAndRampsAtBothEnds) {
   const std::size_t n = 200;
   ASSERT_EQ(m.period_samples, n);
   ASSERT_EQ(m.ramp_samples, n);
-  ASSERT_EQ(m.record_samples, 3u * 4u * n);
-  ASSERT_EQ(m.u_V.size(), m.record_samples + 2 * n);
+  ASSERT_EQ(m.record_samples, n * 3 * 4);  // realisations x periods x the period
+  ASSERT_EQ(m.u_V.size(), m.record_samples + std::size_t{2} * n);
   ASSERT_EQ(m.lines.size(), 20u);  // 50 .. 1000 Hz every 50 Hz
   // Starts and ends at the offset, and moves little per tick there (no step).
   EXPECT_DOUBLE_EQ(m.u_V.front(), 10.0);

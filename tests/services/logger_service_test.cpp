@@ -315,7 +315,7 @@ TEST_F(LoggerServiceTest, OnAKeyedRigWhatFailsItsSignatureIsCountedNotRecorded) 
     ASSERT_TRUE(command.publish(command_block(kTicks * k + 200, kTicks, kTicks * k + kTicks - 1)));
     if (k == 50) {
       dispatch_all();
-      const std::vector<std::uint8_t> replay = last_signed;
+      const std::vector<std::uint8_t>& replay = last_signed;
       for (int i = 0; i < 3; ++i) ASSERT_TRUE(unsigned_sensor.publish(sensor_block(kTicks * k + 5000, kTicks)));
       for (int i = 0; i < 7; ++i) ASSERT_TRUE(foreign_command.publish(command_block(kTicks * k + 9000, kTicks, 0)));
       lcm_->publish(names_.sensor, replay.data(), static_cast<unsigned>(replay.size()));

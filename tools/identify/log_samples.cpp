@@ -151,7 +151,12 @@ std::vector<std::string> for_each_log_event(
         on_event(file, *event);
       }
     }
-    for (const std::string& note : check.take_notes()) notes.push_back(file + ": " + note);
+    for (const std::string& note : check.take_notes()) {
+      std::string line = file;
+      line += ": ";
+      line += note;
+      notes.push_back(std::move(line));
+    }
   }
   return notes;
 }
