@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "loop/reference_admission.hpp"
@@ -37,18 +38,30 @@ void Compensator::reset_learning() noexcept { learner_.reset(); }
 bool Compensator::set_trajectory(TrajectorySpec spec, double start_s) { return take_trajectory(spec, start_s).started; }
 
 TrajectoryVerdict Compensator::take_trajectory(TrajectorySpec spec, double start_s) {
-  spec.validate();
-  if (!std::isnan(start_s)) require_finite("trajectory.start_s", start_s);
-  const ReferenceAdmission admission(planner_);
   TrajectoryVerdict v;
   try {
-    v = admission.admit_trajectory(spec, start_s, learner_.enabled());
+    v = check_trajectory(planner_, std::move(spec), start_s, learner_.enabled());
   } catch (const ParameterError&) {
-    ++planner_.counters().trajectories_refused;
+    count_refused_trajectory();
     throw;
   }
+  return commit_trajectory(std::move(v), start_s);
+}
+
+TrajectoryVerdict Compensator::check_trajectory(const FeedforwardPlanner& snapshot, TrajectorySpec spec, double start_s,
+                                                bool learning_enabled) {
+  spec.validate();
+  if (!std::isnan(start_s)) require_finite("trajectory.start_s", start_s);
+  return ReferenceAdmission(snapshot).admit_trajectory(std::move(spec), start_s, learning_enabled);
+}
+
+TrajectoryVerdict Compensator::commit_trajectory(TrajectoryVerdict checked, double start_s) {
+  TrajectoryVerdict v = std::move(checked);
   if (v.shaped) ++planner_.counters().trajectories_shaped;
+  const ReferenceAdmission admission(planner_);
   planner_.set_learning_room(admission.leaves_room_for_learning(v.extent));
+  const std::int64_t next = planner_.next_tick();
+  v.started = std::isnan(start_s) || next < 0 || start_s - v.spec.blend_s >= planner_.loop_time(next);
   planner_.apply_trajectory(v.spec, start_s);
   v.spec = planner_.trajectory();
   return v;

@@ -80,6 +80,18 @@ class Compensator {
   bool set_trajectory(TrajectorySpec spec, double start_s);
   // The same, saying how it was taken (the corner chosen, the shaping).
   TrajectoryVerdict take_trajectory(TrajectorySpec spec, double start_s);
+  // take_trajectory in two steps, for a service whose plan must go on while a reference is
+  // checked (a dry run covers the approach and 1.25 periods: 125,000 ticks for a 0.1 Hz line, and
+  // a refusal searches for the largest feasible amplitude with more of them, longer than the
+  // horizon the bridge holds). plan_snapshot() copies the plan as it stands; check_trajectory
+  // decides on that copy (const, on any thread: throws ParameterError as take_trajectory does);
+  // commit_trajectory takes what it decided into this law, where the plan is then (a start time
+  // that has passed meanwhile starts as soon as possible, `started` false).
+  FeedforwardPlanner plan_snapshot() const { return planner_; }
+  static TrajectoryVerdict check_trajectory(const FeedforwardPlanner& snapshot, TrajectorySpec spec, double start_s,
+                                            bool learning_enabled);
+  TrajectoryVerdict commit_trajectory(TrajectoryVerdict checked, double start_s);
+  void count_refused_trajectory() noexcept { ++planner_.counters().trajectories_refused; }
   // This axis's share of a multi-axis path (loop/scan_path.hpp: a raster or a Lissajous figure,
   // decoupled by the row of C^{-1} it carries). The path is fixed in loop time, every axis on the
   // same clock: it starts at share.start_s(), which must be at least blend_s after the next tick

@@ -114,17 +114,16 @@ Compensator& CompensatorService::law(int axis, const char* field) {
   return *laws_[static_cast<std::size_t>(axis)];
 }
 
-void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version,
-                                          int axis) {
+void CompensatorService::apply_trajectory(TrajectorySpec spec, std::int64_t start_utime, std::int64_t version, int axis,
+                                          bool check_elsewhere) {
   Compensator& c = law(axis, "trajectory.axis");
   if (settings_.axes > 1 && scan_running()) {
     // One axis leaving the path would leave the others following their shares of a motion that no
     // longer happens (each share holds the others' coupling).
     throw ParameterError("trajectory", "a scan is running on every axis: wait for its end (or send a scan)");
   }
-  TrajectoryVerdict v;
+  double start_s = kNaN;
   if (start_utime == 0) {
-    v = c.take_trajectory(spec, kNaN);
     pending_trajectory_.reset();  // a newer trajectory replaces one waiting for the first sample
   } else if (!have_sample_) {
     spec.validate();
@@ -132,14 +131,76 @@ void CompensatorService::apply_trajectory(const TrajectorySpec& spec, std::int64
     pending_start_utime_ = start_utime;
     pending_version_ = version;
     pending_axis_ = axis;
+    checking_version_ = version;  // its repeats wait with it
     return;
   } else {
-    const double start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
-    v = c.take_trajectory(spec, start_s);
-    if (!v.started) ++counters_.trajectory_late_start;
+    start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
   }
+  if (!check_elsewhere || !have_sample_) {  // before the first sample the bridge holds no commands of ours
+    taken(c.take_trajectory(spec, start_s), version, spec);
+    return;
+  }
+  spec.validate();  // what is refused at once needs no thread
+  checking_version_ = version;
+  std::optional<TrajectoryChecker::Request> replaced =
+      checker_.submit({c.plan_snapshot(), spec, start_s, c.learner().enabled(), version, axis, law_epoch_});
+  if (replaced) {
+    refuse_trajectory(replaced->version, fmt::format("superseded by trajectory {} before it was checked", version));
+  }
+}
+
+void CompensatorService::take_checked_trajectories() {
+  bool decided = false;
+  while (std::optional<TrajectoryChecker::Outcome> o = checker_.poll()) {
+    decided = true;
+    try {
+      if (o->epoch != law_epoch_) {
+        throw ParameterError("trajectory", "the bridge restarted while it was checked: send it again");
+      }
+      if (!o->verdict) {  // the check's own words (ParameterError's, its field named)
+        law(o->axis, "trajectory.axis").count_refused_trajectory();
+        refuse_trajectory(o->version, o->refusal);
+        continue;
+      }
+      if (settings_.axes > 1 && scan_running()) {
+        throw ParameterError("trajectory", "a scan started on every axis while it was checked: wait for its end");
+      }
+      taken(law(o->axis, "trajectory.axis").commit_trajectory(std::move(*o->verdict), o->start_s), o->version, o->spec);
+    } catch (const std::exception& e) {
+      refuse_trajectory(o->version, e.what());
+    }
+  }
+  if (decided) report_if_due();
+}
+
+void CompensatorService::taken(const TrajectoryVerdict& v, std::int64_t version, const TrajectorySpec& requested) {
+  if (!v.started) ++counters_.trajectory_late_start;
   ++counters_.trajectories;
+  trajectory_version_ = version;
   decide_trajectory(version, v.note, false, v.shaped);
+  if (version <= 0) return;  // the configured reference: logged at the start
+  if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_ns())) {
+    spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", version,
+                 static_cast<int>(requested.shape), requested.amplitude_m, requested.offset_m, requested.frequency_hz,
+                 requested.blend_s, suppressed_note(g));
+    if (!verdict_.empty()) spdlog::info("{}", verdict_);
+  }
+}
+
+void CompensatorService::refuse_trajectory(std::int64_t version, const std::string& why) {
+  ++counters_.trajectory_refused;
+  refused_version_ = version;  // its repeats are the same refusal
+  decide_trajectory(version, why, true, false);
+  if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_ns())) {
+    spdlog::warn("trajectory v{} refused: {}{}", version, escape_wire(why, 600), suppressed_note(g));
+  }
+}
+
+void CompensatorService::settle_trajectories() {
+  while (checker_.busy()) {
+    checker_.wait_ready();
+    take_checked_trajectories();
+  }
 }
 
 void CompensatorService::decide_trajectory(std::int64_t version, const std::string& verdict, bool refused,
@@ -161,25 +222,15 @@ void CompensatorService::decide_trajectory(std::int64_t version, const std::stri
 }
 
 void CompensatorService::on_trajectory(const trajectory_t& msg) {
-  if (msg.version == trajectory_version_ || msg.version == refused_version_) {  // UDP repeats: decided once
+  // UDP repeats: decided once (or being decided)
+  if (msg.version == trajectory_version_ || msg.version == refused_version_ || msg.version == checking_version_) {
     ++counters_.trajectory_repeats;
     return;
   }
   try {
     apply_trajectory(trajectory_from_message(msg), msg.start_utime, msg.version, msg.axis);
-    trajectory_version_ = msg.version;
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectory, monotonic_ns())) {
-      spdlog::info("trajectory v{}: shape {}, amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s{}", msg.version,
-                   msg.shape, msg.amplitude_m, msg.offset_m, msg.frequency_Hz, msg.blend_s, suppressed_note(g));
-      if (!verdict_.empty()) spdlog::info("{}", verdict_);
-    }
   } catch (const std::exception& e) {
-    ++counters_.trajectory_refused;
-    refused_version_ = msg.version;  // its repeats are the same refusal
-    decide_trajectory(msg.version, e.what(), true, false);
-    if (const LogLimiter::Gate g = log_limiter_.allow(kLogTrajectoryRefused, monotonic_ns())) {
-      spdlog::warn("trajectory v{} refused: {}{}", msg.version, escape_wire(e.what(), 600), suppressed_note(g));
-    }
+    refuse_trajectory(msg.version, e.what());
   }
   report_if_due();
 }

@@ -134,7 +134,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
       const TrajectorySpec spec = *pending_trajectory_;
       pending_trajectory_.reset();
       try {
-        apply_trajectory(spec, pending_start_utime_, pending_version_, pending_axis_);
+        apply_trajectory(spec, pending_start_utime_, pending_version_, pending_axis_, false);
       } catch (const std::exception& e) {
         ++counters_.trajectory_refused;
         decide_trajectory(pending_version_, e.what(), true, false);
@@ -142,6 +142,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
       report_if_due();
     }
   }
+  take_checked_trajectories();
   publish_plan();
   // recv_utime is LCM's receive time on this host's clock; a value outside [0, 10 s) is not a latency.
   const std::int64_t latency_us = wall_utime() - recv_utime;
@@ -191,6 +192,7 @@ void CompensatorService::restart_control_law() {
     law.emplace(std::move(next));
   }
   have_sample_ = false;
+  ++law_epoch_;
   ++counters_.bridge_restarts;
 }
 
@@ -207,6 +209,7 @@ int CompensatorService::run() {
   constexpr int kTicksPerReport = 1'000'000'000 / StatusReporter::kMinImmediateInterval_ns;
   int ticks = 0;
   const int errors = run_io_loop(lcm_, options, [&](std::int64_t utime) {
+    take_checked_trajectories();  // a check that ended while no sensor block came
     if (++ticks < kTicksPerReport) return void(report_if_due());
     ticks = 0;
     report(utime, false);

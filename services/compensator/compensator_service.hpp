@@ -1,5 +1,6 @@
 #pragma once
-// hystloop-compensator: one I/O thread. Each HX_SENSOR block is observed tick by tick and
+// hystloop-compensator: one I/O thread, and one that checks trajectories (TrajectoryChecker: a
+// dry run can outlast the horizon the bridge holds). Each HX_SENSOR block is observed tick by tick and
 // answered in its handler with HX_COMMAND blocks for every tick not yet planned up to the
 // horizon ahead (Compensator::plan); HX_TRAJECTORY, HX_PARAMS and HX_CONTROL change the
 // reference, the MEM parameters, the mode and the experiments. The commands are a
@@ -39,6 +40,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "compensator/compensator_settings.hpp"
+#include "compensator/trajectory_checker.hpp"
 #include "core/latency_stats.hpp"
 #include <array>
 
@@ -114,7 +116,11 @@ class CompensatorService {
 
   // The handlers, public so that tests can drive the service without a network.
   void on_sensor(const sensor_block_t& msg, std::int64_t recv_utime) noexcept;
+  // HX_TRAJECTORY: checked off this thread (TrajectoryChecker), taken or refused when the check
+  // ends (at the next sensor block or I/O period after it).
   void on_trajectory(const trajectory_t& msg);
+  // For tests: waits for every trajectory being checked and takes (or refuses) it.
+  void settle_trajectories();
   // HX_SCAN: a path of every axis (its verdict reported as a trajectory's, under its version).
   void on_scan(const scan_t& msg);
   void on_params(const mem_params_t& msg);
@@ -137,10 +143,17 @@ class CompensatorService {
   const SequenceGuard::Counters& sequence_counters() const noexcept { return guard_.counters(); }
 
  private:
-  void apply_trajectory(const TrajectorySpec& spec, std::int64_t start_utime, std::int64_t version, int axis);
+  // Checks `spec` on the checker's thread (check_elsewhere), or here and at once (the first
+  // sample's: no command of ours is buffered yet), and takes it; throws ParameterError when refused here.
+  void apply_trajectory(TrajectorySpec spec, std::int64_t start_utime, std::int64_t version, int axis,
+                        bool check_elsewhere = true);
   // The axis a message names, when this stage has it; else throws ParameterError naming `field`.
   Compensator& law(int axis, const char* field);
   void decide_trajectory(std::int64_t version, const std::string& verdict, bool refused, bool shaped);
+  void refuse_trajectory(std::int64_t version, const std::string& why);  // counted, logged, reported
+  void taken(const TrajectoryVerdict& v, std::int64_t version, const TrajectorySpec& requested);  // the same
+  // Commits (or refuses) the trajectories whose check has ended. On the I/O thread.
+  void take_checked_trajectories();
   // What HX_PARAMS and HX_MODEL sets share: admit() refuses a diagnostic or stale set (counted,
   // logged once per reason and publisher); offer() validates and offers an admitted one.
   struct ParamsHeader {
@@ -214,9 +227,13 @@ class CompensatorService {
   std::optional<TrajectorySpec> pending_trajectory_;  // a timed start that arrived before the first sample
   std::int64_t pending_start_utime_ = 0;
   std::int64_t trajectory_version_ = 0;
-  std::int64_t pending_version_ = 0;  // of pending_trajectory_
-  int pending_axis_ = 0;              // of pending_trajectory_
-  std::int64_t refused_version_ = 0;  // the last trajectory_t.version refused
+  std::int64_t pending_version_ = 0;   // of pending_trajectory_
+  int pending_axis_ = 0;               // of pending_trajectory_
+  std::int64_t refused_version_ = 0;   // the last trajectory_t.version refused
+  std::int64_t checking_version_ = 0;  // the last trajectory_t.version sent to the checker
+  // The laws' generation: a bridge restart replaces them, and a check of the old ones is void.
+  std::uint64_t law_epoch_ = 0;
+  TrajectoryChecker checker_;  // declared late: its thread ends before the members it never touches
   // The last verdict on a trajectory, in HX_STATUS's detail for a while after it was decided.
   std::string verdict_;
   std::int64_t verdict_until_ns_ = 0;

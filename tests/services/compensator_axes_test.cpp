@@ -312,6 +312,7 @@ TEST(CompensatorAxes, ATrajectoryMovesTheAxisItNames) {
   t.blend_s = 0.01;
   t.axis = 1;
   h.service.on_trajectory(t);
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_version, 3);
   h.run(200, 2000);
   double x_span = 0, y_span = 0;
@@ -324,6 +325,7 @@ TEST(CompensatorAxes, ATrajectoryMovesTheAxisItNames) {
   t.version = 4;
   t.axis = 2;
   h.service.on_trajectory(t);
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_refused_version, 4);
   EXPECT_EQ(h.service.counters().wrong_axis, 1u);
 }
@@ -364,6 +366,7 @@ TEST(CompensatorAxes, WhileAScanRunsNoAxisLeavesItAlone) {
   t.shape = trajectory_t::HOLD;
   t.blend_s = 0.05;
   h.service.on_trajectory(t);  // x alone would stop while y follows its share of x's motion
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_refused_version, 6);
   control_t start = request(3, control_t::START_EXPERIMENT);
   start.experiment = "sine";
@@ -376,6 +379,7 @@ TEST(CompensatorAxes, WhileAScanRunsNoAxisLeavesItAlone) {
   h.run(200, 3000);  // past the raster's end: both may move again
   t.version = 7;
   h.service.on_trajectory(t);
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_version, 7);
 }
 

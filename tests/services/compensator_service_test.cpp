@@ -346,6 +346,7 @@ void script(Harness& h) {
   t.blend_s = 0.01;
   h.run(100, 500);
   h.service.on_trajectory(t);
+  h.service.settle_trajectories();
   h.service.on_params(params(2, 5.5e-9));
   h.run(600, 3000, 10);
   control_t c = request(1, control_t::SET_MODE);
@@ -593,13 +594,17 @@ TEST(CompensatorService, AppliesATrajectoryVersionOnceFromTheFirstTickNotSentAnd
   Harness h;
   h.send(0);  // planned through 309
   h.service.on_trajectory(hold(1, 2e-7));
+  h.service.settle_trajectories();
   h.service.on_trajectory(hold(1, 2e-7));
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_repeats, 1u);
   trajectory_t bad = hold(2, 0.0);
   bad.shape = trajectory_t::POINTS;  // POINTS without points
   h.service.on_trajectory(bad);
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_refused, 1u);
   h.service.on_trajectory(hold(1, 2e-7));  // v1 is still the one in force
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_repeats, 2u);
   EXPECT_EQ(h.service.counters().trajectories, 1u);
 
@@ -612,12 +617,49 @@ TEST(CompensatorService, AppliesATrajectoryVersionOnceFromTheFirstTickNotSentAnd
   // With a blend, from where the reference was, monotone over blend_s.
   const std::int64_t first = h.sent_through() + 1;
   h.service.on_trajectory(hold(4, -3e-7, 0.01));
+  h.service.settle_trajectories();
   h.run(2020, 200);
   EXPECT_EQ(h.tick(first).y_ref_m, 2e-7);
   for (std::int64_t k = first + 1; k <= first + 100; ++k) EXPECT_LT(h.tick(k).y_ref_m, h.tick(k - 1).y_ref_m) << k;
   EXPECT_NEAR(h.tick(first + 100).y_ref_m, -3e-7, 1e-15);
   EXPECT_EQ(h.tick(first + 101).y_ref_m, -3e-7);
   EXPECT_EQ(h.service.counters().trajectories, 2u);
+}
+
+// The dry runs deciding a trajectory run off the I/O thread: a refusal searching for the largest
+// feasible amplitude of a 1 Hz line took 65 ms on a busy machine, longer than the bridge's buffer,
+// and its watchdog took the stage to the safe state. The plan goes on under the trajectory in
+// force while the check runs; its verdict is taken at a sensor block after the check ends.
+TEST(CompensatorService, ATrajectoryIsCheckedWhileThePlanGoesOn) {
+  CompensatorSettings s = cosine();
+  const CompensatorConfig real = deployed().control;  // the actuator's limits, which refuse 1 mm
+  s.control.u_min_V = real.u_min_V;
+  s.control.u_max_V = real.u_max_V;
+  s.control.slew_V_per_s = real.slew_V_per_s;
+  s.control.slew_fraction = real.slew_fraction;
+  Harness h(s);
+  h.send(0);  // planned through 309
+  trajectory_t huge = hold(7, 0.0);
+  huge.shape = trajectory_t::SINE;
+  huge.amplitude_m = 1e-3;  // far beyond the actuator's range
+  huge.frequency_Hz = 1.0;
+  h.service.on_trajectory(huge);
+  EXPECT_EQ(h.service.counters().trajectory_refused, 0u);  // not decided in the handler
+  h.service.on_trajectory(huge);                           // a UDP repeat while it is checked
+  EXPECT_EQ(h.service.counters().trajectory_repeats, 1u);
+  h.send(10);  // planned on under the cosine in force
+  EXPECT_LT(h.tick(319).y_ref_m, 0.0);
+  h.service.settle_trajectories();
+  EXPECT_EQ(h.service.counters().trajectory_refused, 1u);
+  EXPECT_EQ(h.service.counters().trajectories, 0u);
+  EXPECT_EQ(h.service.counters().trajectory_refused_version, 7);
+  EXPECT_EQ(h.service.compensator().counters().trajectories_refused, 1u);
+  // The next one is checked and taken.
+  h.service.on_trajectory(hold(8, 2e-7, 0.05));
+  h.service.settle_trajectories();
+  EXPECT_EQ(h.service.counters().trajectories, 1u);
+  h.run(20, 1000);
+  EXPECT_EQ(h.tick(h.sent_through()).y_ref_m, 2e-7);
 }
 
 // 100 forged sensor blocks and refused trajectories a second made ~95 log lines a second of one
@@ -644,6 +686,7 @@ TEST(CompensatorService, AFloodOfForgedBlocksAndRefusedTrajectoriesIsReportedAnd
       trajectory_t bad = hold(version++, 0.0);
       bad.shape = trajectory_t::POINTS;  // POINTS without points: refused
       h.service.on_trajectory(bad);
+      h.service.settle_trajectories();
       h.send(seq);
       seq += 10;
       if (monotonic_s() - periodic_s >= 1.0) {  // as the I/O loop does
@@ -692,10 +735,12 @@ TEST(CompensatorService, ATimedTrajectoryStartsAtItsLoopTime) {
   // Tick 1000's wall time on the bridge's clock (taken from the samples' utime): approach over
   // ticks 900..1000.
   h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  h.service.settle_trajectories();
   h.run(10, 1100);
   expect_starts_at_tick_1000(h);
   EXPECT_EQ(h.service.counters().trajectory_late_start, 0u);
   h.service.on_trajectory(hold(6, 1e-7, 0.01, utime_of(100)));  // already past: started now, counted
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectory_late_start, 1u);
   EXPECT_EQ(h.service.counters().trajectories, 2u);
 }
@@ -703,6 +748,7 @@ TEST(CompensatorService, ATimedTrajectoryStartsAtItsLoopTime) {
 TEST(CompensatorService, ATimedTrajectoryBeforeTheFirstSampleWaitsForItsLoopTime) {
   Harness h(holding());
   h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectories, 0u);  // waits for a sample to map its start time
   h.run(0, 1110);
   EXPECT_EQ(h.service.counters().trajectories, 1u);
@@ -713,7 +759,9 @@ TEST(CompensatorService, ATimedTrajectoryBeforeTheFirstSampleWaitsForItsLoopTime
 TEST(CompensatorService, ANewerTrajectoryReplacesOneWaitingForTheFirstSample) {
   Harness h(holding());
   h.service.on_trajectory(hold(5, 1e-7, 0.01, utime_of(1000)));
+  h.service.settle_trajectories();
   h.service.on_trajectory(hold(6, 3e-7));  // untimed, newer: in force from the first tick planned
+  h.service.settle_trajectories();
   h.run(0, 1200);
   EXPECT_EQ(h.tick(10).y_ref_m, 3e-7);
   EXPECT_EQ(h.tick(1100).y_ref_m, 3e-7);
