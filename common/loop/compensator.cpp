@@ -22,7 +22,7 @@ Compensator::Compensator(const CompensatorConfig& config)
     : planner_((config.validate(), config)),
       // Samples arrive up to the horizon after their tick was planned, plus a block or two; a
       // stage inverted with preview asks the learning for its correction that much earlier.
-      learner_(config.learning, config.dt_s,
+      learner_(learning_for_stage(config.learning, config.stage, config.dt_s), config.dt_s,
                config.horizon_ticks + 2000 + (config.stage.is_linear() ? PreviewStageInverse::kMaxPreviewTicks : 0)) {}
 
 void Compensator::observe(const CompensatorInput& sample) noexcept {

@@ -26,6 +26,21 @@ inline LearningConfig default_learning() {
   return l;
 }
 
+// The learning a law runs beside its stage model. The update assumes the inverse makes the plant
+// from correction to position about 1 where its filter passes (loop/periodic_learner.hpp); near a
+// lightly damped mode a model a few percent off is not (a mode 10 % off puts |1 - T| near 3 at the
+// true resonance), and past an anti-resonance the inverse multiplies what is learned there, the
+// sensor noise included, by tens. A linear stage is therefore learned only below
+// kLearningShareOfResonance of its lowest lightly damped pole or zero (LinearStageSpec's modes;
+// a 780 Hz mode: up to 390 Hz, where such a mode 10 % off makes |1 - T| 0.06 and the filter is
+// down to 0.03 at the mode). The configured cutoff stays when it is lower; Banning's second order
+// keeps it (the 2 kHz filter converges on it: bench/tracking_table --scan).
+inline constexpr double kLearningShareOfResonance = 0.5;
+LearningConfig learning_for_stage(const LearningConfig& learning, const StageModel& stage, double dt_s);
+// The lowest lightly damped (zeta < 0.5) pole or zero of a linear stage [Hz] (0: none, or not a
+// linear stage).
+double lowest_linear_feature_hz(const StageModel& stage, double dt_s);
+
 // The shortest rounding of a line's corners the compensator chooses with a stage model: two periods
 // of its resonance, what neither the stage's model nor the servo knows well (0 without dynamics).
 double resonance_corner_s(const StageModel& stage) noexcept;

@@ -395,9 +395,15 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   } else {
     lines.push_back("stage: none (the hysteresis inverse alone)");
   }
-  lines.push_back(fmt::format("learning: {} (gain {}, filter {} Hz, |correction| <= {:.3g} m, periods up to {} s{})",
-                              c.learning.enabled ? "on for periodic references" : "off", c.learning.gain,
-                              c.learning.cutoff_hz, c.learning.max_correction_m, c.learning.max_period_s,
+  const LearningConfig learning = learning_for_stage(c.learning, c.stage, c.dt_s);
+  const std::string filter =
+      learning.cutoff_hz < c.learning.cutoff_hz
+          ? fmt::format("{:.4g} Hz, half the stage's lowest resonance {:.4g} Hz (learning.cutoff_hz {} Hz)",
+                        learning.cutoff_hz, lowest_linear_feature_hz(c.stage, c.dt_s), c.learning.cutoff_hz)
+          : fmt::format("{} Hz", learning.cutoff_hz);
+  lines.push_back(fmt::format("learning: {} (gain {}, filter {}, |correction| <= {:.3g} m, periods up to {} s{})",
+                              c.learning.enabled ? "on for periodic references" : "off", c.learning.gain, filter,
+                              c.learning.max_correction_m, c.learning.max_period_s,
                               c.learning.lag_compensated ? ", lag-compensated" : ""));
   lines.push_back(fmt::format("rt: priority {}, lock_memory {}", s.rt_priority, s.lock_memory));
   lines.push_back(fmt::format("trajectory: {} amplitude {:.4g} m, offset {:.4g} m, {} Hz, blend {} s, {} points",
