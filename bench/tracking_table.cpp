@@ -13,7 +13,8 @@
 //
 // Then the line-rate scans (sim/scan_experiment.hpp): triangles and sines at 10-200 Hz with the
 // models identified from a 10 Hz sine of the line's loops and the best of them (--model auto), without and
-// with the stage's inverse, then with learning; RMS and max against the true position over the
+// with the stage's inverse (with it, the hysteresis fitted on the samples with the stage taken
+// out), then with learning; RMS and max against the true position over the
 // periods [20, 30) after the shape is entered, the bridge's clamped ticks and the periods until
 // every period is at most 1 nm RMS.
 //
@@ -73,17 +74,20 @@ bool scan_table(int block_ticks, const hystloop::TrackingExperiment& experiment,
       "[20, 30) | periods to <= 1 nm |\n| --- | --- | --- | --- | --- | --- | --- |\n");
   bool all_taken = true;
   for (const ScanReference& r : scan_references()) {
-    const IdentifiedModels id = identify_for_scan(experiment, r.amplitude_m);
-    if (id.ranking.empty()) return false;
     ScanOptions o;
     o.block_ticks = block_ticks;
     o.servo = servo;
+    // Without the stage's inverse the hysteresis model is fitted u -> y, the stage's lag in it; with
+    // it, on the samples with that stage taken out, so that the lag is not corrected twice.
     o.stage_inverse = false;
+    const IdentifiedModels id = identify_for_scan(experiment, r.amplitude_m);
     const ScanRun plain = run_scan(experiment, id, r, o);
     o.stage_inverse = true;
-    const ScanRun inverse = run_scan(experiment, id, r, o);
+    const IdentifiedModels id_removed = identify_for_scan(experiment, r.amplitude_m, scan_stage(experiment, o));
+    if (id.ranking.empty() || id_removed.ranking.empty()) return false;
+    const ScanRun inverse = run_scan(experiment, id_removed, r, o);
     o.learning = true;
-    const ScanRun learned = run_scan(experiment, id, r, o);
+    const ScanRun learned = run_scan(experiment, id_removed, r, o);
     all_taken = all_taken && !inverse.refused && !learned.refused;
     char corner[32] = "—";
     if (r.shape == TrajectoryShape::kTriangle) std::snprintf(corner, sizeof corner, "%.2f ms", inverse.corner_s * 1e3);

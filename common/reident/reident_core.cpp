@@ -48,7 +48,7 @@ void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcep
   const std::int64_t seq = tick.seq;
   const std::uint64_t missing_before = ticks_.missing();
   const SequenceGapDetector::Outcome step = ticks_.observe(seq, 1);
-  // The stage's removal looks at neighbouring samples: any break hands out the held one as it is.
+  // The stage's removal looks at neighbouring samples: any break hands out what it holds (flush).
   if (step != SequenceGapDetector::Outcome::kInOrder) flush_stage_removal();
   if (step == SequenceGapDetector::Outcome::kGap) {
     // Ticks refused on the wire since the last one were not lost: they are no gap.

@@ -115,7 +115,9 @@ class ReidentCore {
   RefitWorker& worker() noexcept { return worker_; }
 
  private:
-  void flush_stage_removal() noexcept;  // a break in the stream: the held sample goes to the estimator as measured
+  // A break in the stream: the oldest held sample goes to the estimator with the last measured
+  // position, the younger ones a delayed stage holds are dropped (ident/stage_removal.hpp).
+  void flush_stage_removal() noexcept;
   RefitDecision decide(const RefitResult& result) noexcept;
   // A set in MEM's domain whose gain leaves options_.plausibility (the reason kept).
   bool implausible(const MemParams& params) noexcept;

@@ -17,12 +17,26 @@ std::vector<ScanReference> scan_references() {
           {"sine 200 Hz 0.25 um", TrajectoryShape::kSine, 0.25e-6, 200.0}};
 }
 
-IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude_m) {
+IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude_m, const StageModel& removed) {
   ExperimentSpec input;
   input.amplitude_V = 160.0 * std::abs(amplitude_m) / 1e-6;
   input.frequency_hz = 10.0;
   input.duration_s = 2.0;
-  return identify_models_through_loop(e, input);
+  return identify_models_through_loop(e, input, removed);
+}
+
+StageModel scan_stage(const TrackingExperiment& e, const ScanOptions& o) {
+  StageModel stage;
+  if (o.stage_inverse && e.plant == PlantKind::kBanning) {
+    const SimulatedStageConfig plant = tracking_loop_config(e).stage;
+    stage.kind = StageModel::Kind::kSecondOrder;
+    stage.second_order = plant.banning.stage;
+    stage.order = plant.banning.order;
+  } else if (o.stage_inverse && e.plant == PlantKind::kSeries) {
+    stage.kind = StageModel::Kind::kLinear;  // the plant's own stage, delay included
+    stage.linear = o.stage_model ? *o.stage_model : e.series_stage;
+  }
+  return stage;
 }
 
 LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const IdentifiedModels& models,
@@ -30,13 +44,13 @@ LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const Identif
   LoopSimulationConfig c = tracking_loop_config(e);
   c.compensator.mode = o.mode.value_or(models.ranking.empty() ? FeedforwardMode::kPi : mode_of(models.ranking.front()));
   use_models(c, models, models.mem);
-  if (o.stage_inverse && e.plant == PlantKind::kBanning) {
-    c.compensator.stage.kind = StageModel::Kind::kSecondOrder;
-    c.compensator.stage.second_order = c.stage.banning.stage;
-    c.compensator.stage.order = c.stage.banning.order;
-  } else if (o.stage_inverse && e.plant == PlantKind::kSeries) {
-    c.compensator.stage.kind = StageModel::Kind::kLinear;  // the plant's own stage, delay included
-    c.compensator.stage.linear = o.stage_model ? *o.stage_model : e.series_stage;
+  if (o.stage_inverse) {
+    // Only the stage's own fields: preview and reference bandwidth stay as the config sets them.
+    const StageModel stage = scan_stage(e, o);
+    c.compensator.stage.kind = stage.kind;
+    c.compensator.stage.second_order = stage.second_order;
+    c.compensator.stage.order = stage.order;
+    c.compensator.stage.linear = stage.linear;
   }
   c.compensator.learning.enabled = o.learning;
   c.compensator.servo_slew_reserve = o.servo_slew_reserve;

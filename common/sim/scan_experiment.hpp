@@ -30,7 +30,9 @@ std::vector<ScanReference> scan_references();
 // fits the major loop, whose slopes near a reversal are not those of a 1 um loop: PI-15 tracks a
 // 10 Hz, 1 um sine at 1.2 nm fitted there, at 0.55 nm fitted here). Online, the re-identifier's
 // model choice refits on the line's own data, which is what this stands for.
-IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude_m);
+// With `removed` (scan_stage(): the stage the scan's compensator inverts), the hysteresis is
+// fitted on the samples with that stage taken out (identify_models_through_loop).
+IdentifiedModels identify_for_scan(const TrackingExperiment& e, double amplitude_m, const StageModel& removed = {});
 
 struct ScanOptions {
   std::optional<FeedforwardMode> mode;  // nullopt: the identification's best (hystloop-identify --model auto)
@@ -62,6 +64,11 @@ struct ScanRun {
   CompensatorCounters counters{};
   FeedforwardMode mode = FeedforwardMode::kOff;  // the model used
 };
+
+// The stage the scan's compensator inverts beside the hysteresis (kind none without
+// o.stage_inverse): Banning's second order on the Banning plant, the series plant's linear stage
+// (o.stage_model when given) on a series plant.
+StageModel scan_stage(const TrackingExperiment& e, const ScanOptions& o);
 
 // The loop run_scan runs: the models (o.mode or the ranking's best), the stage's inverse, learning,
 // the servo and the block size as `o` asks.

@@ -11,6 +11,7 @@
 #include "ident/model_selection.hpp"
 #include "ident/online_mem_estimator.hpp"
 #include "ident/pi_fit.hpp"
+#include "ident/stage_removal.hpp"
 
 namespace hystloop {
 
@@ -49,17 +50,26 @@ IdentifiedModels identify_models_through_loop(const TrackingExperiment& e) {
   return identify_models_through_loop(e, input);
 }
 
-IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input) {
+IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input,
+                                              const StageModel& removed) {
   constexpr double kLeadIn = 0.01;  // the first ticks hold 0 V while the compensator starts
-  LoopSimulation sim(tracking_loop_config(e));
+  const LoopSimulationConfig config = tracking_loop_config(e);
+  LoopSimulation sim(config);
   sim.compensator().start_experiment(input);
   sim.run(input.duration_s + kLeadIn);
   std::vector<double> u, y;
+  StageRemoval removal(removed, config.compensator.dt_s);
+  HysteresisSample ready[2];
+  auto keep = [&](const HysteresisSample& s) {
+    u.push_back(s.u);
+    y.push_back(s.y);
+  };
   for (const LoopTick& t : sim.history()) {
     if (t.t_s < kLeadIn || t.t_s > input.duration_s) continue;
-    u.push_back(t.u_V);
-    y.push_back(t.y_m);
+    const std::size_t n = removal.feed(t.u_V, t.y_m, ready);
+    for (std::size_t i = 0; i < n; ++i) keep(ready[i]);
   }
+  if (const auto held = removal.reset()) keep(*held);
   IdentifiedModels m;
   m.mem_fit = fit_mem(u, y);
   m.mem = m.mem_fit.params;

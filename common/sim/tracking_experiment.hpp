@@ -100,8 +100,12 @@ void use_models(LoopSimulationConfig& c, const IdentifiedModels& models, const M
 // Runs the identification input through the loop and fits MEM, PI-15, Katalenic and linear.
 IdentifiedModels identify_models_through_loop(const TrackingExperiment& e);
 // The same with another excitation (its duration_s is the record's length), e.g. one sized to
-// the loops a scan will make.
-IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input);
+// the loops a scan will make. With a stage that has dynamics (removed), the hysteresis is fitted
+// on the samples with that stage taken out (ident/stage_removal.hpp), as a compensator that
+// inverts that stage needs: fitted u -> y, the hysteresis would carry the stage's lag and delay as
+// width, which the compensator would then correct on top of the stage's own inverse.
+IdentifiedModels identify_models_through_loop(const TrackingExperiment& e, const ExperimentSpec& input,
+                                              const StageModel& removed = {});
 
 // Tracks the MEM paper's reference for e.track_s; the error is measured over [e.settle_s, e.track_s).
 TrackingRun run_tracking(const TrackingExperiment& e, const IdentifiedModels& models, const TrackingOptions& options);

@@ -5,14 +5,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
 
+#include "ident/mem_fit.hpp"
 #include "ident/mem_test_data.hpp"
 #include "ident/online_mem_estimator.hpp"
+#include "models/linear_stage.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace hystloop {
@@ -188,6 +192,266 @@ TEST(StageRemoval, AFitOfTheRemovedSamplesFindsTheHysteresis) {
   EXPECT_GT(after_removal.holdout_rms_in_use_m, 0.0);
   EXPECT_LT(after_removal.holdout_rms_in_use_m, 0.5 * as_measured.holdout_rms_in_use_m)
       << "the true hysteresis explains the removed samples better than the measured ones";
+}
+
+// ---- A linear stage of any order with an input delay ----
+
+StageModel linear_stage(const LinearStageSpec& spec) {
+  StageModel s;
+  s.kind = StageModel::Kind::kLinear;
+  s.linear = spec;
+  return s;
+}
+
+// The test plant of sim/tracking_experiment.cpp (two_mode_experiment): 1.5 ticks of delay.
+LinearStageSpec two_mode() {
+  return LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, 1.5 * kDt);
+}
+// A mode that moves the other way first: a right-half-plane zero at +3 kHz, poles at 900 Hz, zeta 0.05.
+LinearStageSpec non_minimum_phase() {
+  const double zeta = 0.05, f_hz = 900.0;
+  return LinearStageSpec::zero_pole({{3000.0, 0.0}}, {{-zeta * f_hz, f_hz * std::sqrt(1.0 - zeta * zeta)}});
+}
+// One mode behind a long delay: 12.3 ticks.
+LinearStageSpec long_delay() { return LinearStageSpec::sum_of_modes({{1200.0, 0.04, 1.0}}, 12.3 * kDt); }
+
+std::vector<double> through_linear_stage(const LinearStageSpec& spec, const std::vector<double>& w) {
+  LinearStageSimulator stage(discretise(spec, kDt));
+  stage.reset(w.front());
+  std::vector<double> y;
+  y.reserve(w.size());
+  for (const double wk : w) y.push_back(stage.step(wk));
+  return y;
+}
+
+// Power series in x = s dt, to kOrder, computed here from the sampled model's polynomials in
+// q = z^-1 = e^{-x} (the removal works from the realisation instead): q^j = sum (-j x)^n / n!.
+constexpr int kOrder = 7;
+using Series = std::array<double, kOrder + 1>;
+
+Series series_of(const DiscreteLinearStage::Coefficients& c, int skip) {
+  Series s{};
+  for (Eigen::Index j = skip; j < c.size(); ++j) {
+    double term = c(j);  // c_j (-j)^n / n!
+    const double jj = static_cast<double>(j - skip);
+    for (int n = 0; n <= kOrder; ++n) {
+      s[static_cast<std::size_t>(n)] += term;
+      term *= -jj / static_cast<double>(n + 1);
+    }
+  }
+  return s;
+}
+Series product(const Series& a, const Series& b) {
+  Series p{};
+  for (int i = 0; i <= kOrder; ++i)
+    for (int j = 0; i + j <= kOrder; ++j)
+      p[static_cast<std::size_t>(i + j)] += a[static_cast<std::size_t>(i)] * b[static_cast<std::size_t>(j)];
+  return p;
+}
+Series quotient(const Series& a, const Series& b) {  // a / b, b[0] != 0
+  Series q{};
+  for (int n = 0; n <= kOrder; ++n) {
+    double r = a[static_cast<std::size_t>(n)];
+    for (int j = 1; j <= n; ++j) r -= b[static_cast<std::size_t>(j)] * q[static_cast<std::size_t>(n - j)];
+    q[static_cast<std::size_t>(n)] = r / b[0];
+  }
+  return q;
+}
+
+// The stage without its whole ticks of delay, G_r(e^{-x}), normalised to unit DC gain.
+Series rational_part(const DiscreteLinearStage& stage) {
+  Series g = quotient(series_of(stage.numerator, stage.delay_ticks), series_of(stage.denominator, 0));
+  const double dc = g[0];
+  for (double& v : g) v /= dc;
+  return g;
+}
+
+// What the removal leaves of a sine of amplitude 1 at theta = 2 pi f dt: with the whole ticks
+// shifted out, the removal is R(x) = 1 + (lead / dt) sinh x + curvature (2 cosh x - 2) (the
+// central differences) and the error E(x) = R(x) G_r(x) - 1 = c3 x^3 + c4 x^4 + ...: the Taylor
+// remainder of 1 / G_r past its second order, with the differences' own third- and fourth-order
+// error. |E(i theta)| <= sum |c_n| theta^n; the series is summed to x^7 and, since the nearest
+// singularity of 1 / G_r (its zero nearest DC: the two-mode stage's antiresonance at 1.85 kHz,
+// theta = 1.17; the non-minimum-phase zero's theta = 1.88; the sampling zeros at |x| >= pi)
+// lies at least 5.8 times further out than 200 Hz (theta = 0.126), the terms beyond x^7 add
+// under (1 / 5.8)^8 of the first one: the 10 % margin covers them with room.
+double remainder_bound(const DiscreteLinearStage& stage, double lead_s, double curvature, double theta) {
+  Series r{};
+  r[0] = 1.0;
+  double factorial = 1.0;
+  for (int n = 1; n <= kOrder; ++n) {
+    factorial *= n;
+    if (n % 2 == 1) r[static_cast<std::size_t>(n)] += lead_s / kDt / factorial;     // sinh
+    if (n % 2 == 0) r[static_cast<std::size_t>(n)] += curvature * 2.0 / factorial;  // 2 cosh - 2
+  }
+  Series e = product(r, rational_part(stage));
+  e[0] -= 1.0;
+  EXPECT_LT(std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2]), 1e-9) << "the removal is exact to second order";
+  double bound = 0.0, power = theta * theta;
+  for (int n = 3; n <= kOrder; ++n) {
+    power *= theta;
+    bound += std::abs(e[static_cast<std::size_t>(n)]) * power;
+  }
+  return 1.1 * bound;
+}
+
+// The removal's terms are the moments of the sampled model: here from its polynomials in z^-1,
+// there from its realisation.
+TEST(StageRemoval, ALinearStagesTermsAreItsMoments) {
+  for (const LinearStageSpec& spec : {two_mode(), non_minimum_phase(), long_delay()}) {
+    const DiscreteLinearStage stage = discretise(spec, kDt);
+    const Series inverse = quotient(Series{1.0}, rational_part(stage));  // 1 / G_r = 1 + b1 x + b2 x^2 + ...
+    StageRemoval removal(linear_stage(spec), kDt);
+    EXPECT_TRUE(removal.delays());
+    EXPECT_EQ(removal.delay_samples(), stage.delay_ticks + 1);
+    EXPECT_NEAR(removal.lead_s(), inverse[1] * kDt, 1e-9 * kDt);
+    EXPECT_NEAR(removal.curvature(), inverse[2], 1e-9 * std::max(1.0, std::abs(inverse[2])));
+  }
+  EXPECT_EQ(StageRemoval(linear_stage(two_mode()), kDt).delay_samples(), 2) << "1.5 ticks: one whole, shifted out";
+  EXPECT_EQ(StageRemoval(linear_stage(long_delay()), kDt).delay_samples(), 13);
+}
+
+// Banning's stage: its terms are the moments of its exact sampled model, discretise_zoh()'s
+// G(q) = (b1 + b2 q) / (1 + a1 q + a2 q^2) (computed here from the polynomials), as the linear
+// stage's removal_terms() of its realisation finds them. The continuous closed form (the inverse
+// y + (c/k) y' + y''/k moved half a tick back, less the hold's averaging) is close but not these:
+// it integrates the response over continuous time where the samples sum it (0.1 % and 0.6 %).
+TEST(StageRemoval, BanningsTermsAreTheMomentsOfItsSampledStage) {
+  const SecondOrderStageParams p = banning_stage().second_order;
+  const StageRemoval removal(banning_stage(), kDt);
+  EXPECT_EQ(removal.delay_samples(), 1);
+  const DiscreteStage zoh = discretise_zoh(p, kDt);
+  // m1 = G'(1) / G(1), m2 = (G''(1) + G'(1)) / G(1) with G'/G = N'/N - D'/D and
+  // G''/G = N''/N - 2 (N'/N)(D'/D) - D''/D + 2 (D'/D)^2.
+  const double n0 = zoh.b1 + zoh.b2, n1 = zoh.b2 / n0;
+  const double d0 = 1.0 + zoh.a1 + zoh.a2, d1 = (zoh.a1 + 2.0 * zoh.a2) / d0, d2 = 2.0 * zoh.a2 / d0;
+  const double m1 = n1 - d1;
+  const double m2 = (-2.0 * n1 * d1 - d2 + 2.0 * d1 * d1) + m1;
+  EXPECT_NEAR(removal.lead_s(), m1 * kDt, 1e-9 * std::abs(m1 * kDt));
+  EXPECT_NEAR(removal.curvature(), m1 * m1 - 0.5 * m2, 1e-9 * std::abs(m1 * m1 - 0.5 * m2));
+  const StageRemovalTerms linear = removal_terms(discretise(LinearStageSpec::second_order(p.k, p.c), kDt));
+  EXPECT_EQ(linear.delay_ticks, 0);
+  EXPECT_NEAR(linear.lead_s, removal.lead_s(), 1e-9 * std::abs(removal.lead_s()));
+  EXPECT_NEAR(linear.curvature, removal.curvature(), 1e-9 * std::abs(removal.curvature()));
+
+  const double lag_s = p.c / p.k, h = 0.5 * kDt;
+  const double closed_lead_s = lag_s - h;
+  const double closed_curvature = (1.0 / p.k - lag_s * h + 0.5 * h * h - kDt * kDt / 24.0) / (kDt * kDt);
+  EXPECT_NEAR(removal.lead_s(), closed_lead_s, 2e-3 * std::abs(closed_lead_s));
+  EXPECT_NEAR(removal.curvature(), closed_curvature, 1e-2 * closed_curvature);
+  EXPECT_GT(std::abs(removal.curvature() - closed_curvature), 1e-3 * closed_curvature) << "not the same terms";
+}
+
+// w a sine at line rates through the stage; the recovered w against the true one, d + 1 samples
+// late, within the Taylor remainder (remainder_bound) and far inside what the stage does to y.
+TEST(StageRemoval, RecoversALinearStagesInputWithinTheTaylorRemainder) {
+  struct Case {
+    const char* name;
+    LinearStageSpec spec;
+  };
+  for (const Case& c : {Case{"two modes, 1.5 ticks", two_mode()}, Case{"right-half-plane zero", non_minimum_phase()},
+                        Case{"one mode, 12.3 ticks", long_delay()}}) {
+    const DiscreteLinearStage stage = discretise(c.spec, kDt);
+    for (const double f_hz : {10.0, 50.0, 100.0, 200.0}) {
+      const double amplitude = 0.5e-6;
+      const std::size_t n = static_cast<std::size_t>(0.3 / kDt);
+      const auto w = sine(amplitude, f_hz, n);
+      const auto y = through_linear_stage(c.spec, w);
+      std::vector<double> u(n);
+      for (std::size_t k = 0; k < n; ++k) u[k] = static_cast<double>(k);  // tags each sample
+      StageRemoval removal(linear_stage(c.spec), kDt);
+      const auto out = run(removal, u, y);
+      const std::size_t late = static_cast<std::size_t>(removal.delay_samples());
+      ASSERT_EQ(out.size(), n - late + 1) << c.name << ": all but the held, and the oldest held at the end";
+      double worst_raw = 0.0, worst_removed = 0.0;
+      for (std::size_t k = 1500; k + 1 < out.size(); ++k) {  // past the modes' start-up ring (<= 6.8 ms)
+        ASSERT_EQ(out[k].u, u[k]) << c.name << ": each output keeps its own tick's input";
+        worst_raw = std::max(worst_raw, std::abs(y[k] - w[k]));
+        worst_removed = std::max(worst_removed, std::abs(out[k].y - w[k]));
+      }
+      const double theta = 2.0 * std::numbers::pi * f_hz * kDt;
+      const double bound = amplitude * remainder_bound(stage, removal.lead_s(), removal.curvature(), theta);
+      EXPECT_LT(worst_removed, bound) << c.name << ", " << f_hz << " Hz";
+      EXPECT_LT(bound, 0.02 * worst_raw) << c.name << ", " << f_hz << " Hz: the stage's lag is in the raw samples";
+    }
+  }
+}
+
+TEST(StageRemoval, ALinearStageHandsOutTheOldestHeldSampleAtABreak) {
+  StageRemoval removal(linear_stage(long_delay()), kDt);
+  ASSERT_EQ(removal.delay_samples(), 13);
+  HysteresisSample ready[2];
+  for (int k = 0; k < 12; ++k) EXPECT_EQ(removal.feed(k, 1e-9, ready), 0u) << k;
+  EXPECT_FALSE(removal.reset().has_value()) << "12 samples: the stage's response to none of them was measured";
+  for (int k = 0; k < 13; ++k) EXPECT_EQ(removal.feed(k, 1e-9 * k, ready), 0u) << k;
+  ASSERT_EQ(removal.feed(13.0, 13e-9, ready), 1u);
+  EXPECT_EQ(ready[0].u, 0.0);
+  EXPECT_NEAR(ready[0].y, 12e-9 + removal.lead_s() * 1e-9 / kDt, 1e-22)
+      << "the position 12 ticks on and its slope (a ramp: no curvature)";
+  for (int k = 14; k < 40; ++k) ASSERT_EQ(removal.feed(k, 1e-9 * k, ready), 1u) << k;
+  EXPECT_EQ(ready[0].u, 26.0);
+  const auto held = removal.reset();
+  ASSERT_TRUE(held.has_value());
+  EXPECT_EQ(held->u, 27.0) << "the oldest of the 13 held";
+  EXPECT_EQ(held->y, 1e-9 * 39) << "with the last position as measured, 12 ticks on";
+  EXPECT_FALSE(removal.reset().has_value()) << "the 12 younger ones are dropped, nothing is held twice";
+  for (int k = 0; k < 13; ++k) EXPECT_EQ(removal.feed(k, 1e-9, ready), 0u) << k << ": held again after a break";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_EQ(removal.feed(nan, nan, ready), 2u) << "a non-finite sample is a break: the oldest held, then itself";
+  EXPECT_EQ(ready[0].u, 0.0);
+  EXPECT_TRUE(std::isnan(ready[1].y));
+}
+
+TEST(StageRemoval, ALinearStagesFeedAndResetAllocateNothing) {
+  StageRemoval removal(linear_stage(long_delay()), kDt);
+  HysteresisSample ready[2];
+  std::size_t out = 0;
+  const testing::AllocationCounter allocations;
+  for (int k = 0; k < 1000; ++k) {
+    out += removal.feed(static_cast<double>(k), 1e-9 * k, ready);
+    if (k % 100 == 99) out += removal.reset().has_value() ? 1 : 0;
+  }
+  EXPECT_EQ(allocations.allocations(), 0u);
+  EXPECT_EQ(out, 10u * (100u - 13u + 1u));
+}
+
+// Behind the two-mode stage (1.5 ticks of delay, its modes' lag: 0.5 degree at 10 Hz), a fit of
+// u -> y reads the stage as hysteresis: a wider loop. Fitted on the removed samples it finds the
+// hysteresis itself: its branches are closer to the true ones, on the loop it was fitted on.
+TEST(StageRemoval, AFitBehindALinearStageFindsTheHysteresisAfterTheRemoval) {
+  const MemParams truth = testdata::piezo_truth();
+  for (const double f_hz : {10.0, 100.0}) {
+    const auto u = testdata::sine_input(160.0, f_hz, 1e4, f_hz < 50.0 ? 1.0 : 0.3);
+    const auto w = testdata::mem_branches(u, truth);
+    auto y = through_linear_stage(two_mode(), w);
+    testdata::add_noise(y, 1e-9, 3);
+    StageRemoval removal(linear_stage(two_mode()), kDt);
+    const auto removed = run(removal, u, y);
+    std::vector<double> u_removed, y_removed;
+    for (const auto& s : removed) {
+      u_removed.push_back(s.u);
+      y_removed.push_back(s.y);
+    }
+    const MemFitResult as_measured = fit_mem(u, y);
+    const MemFitResult after_removal = fit_mem(u_removed, y_removed);
+    ASSERT_TRUE(as_measured.ok()) << f_hz << " Hz";
+    ASSERT_TRUE(after_removal.ok()) << f_hz << " Hz";
+    // Each fit's branches against the true ones, each up to its best constant offset (a fit does not
+    // know the loop's centre).
+    auto distance = [&](const MemParams& p) {
+      const auto fitted = testdata::mem_branches(u, p);
+      double mean = 0.0;
+      for (std::size_t k = 0; k < u.size(); ++k) mean += fitted[k] - w[k];
+      mean /= static_cast<double>(u.size());
+      double ss = 0.0;
+      for (std::size_t k = 0; k < u.size(); ++k) ss += (fitted[k] - w[k] - mean) * (fitted[k] - w[k] - mean);
+      return std::sqrt(ss / static_cast<double>(u.size()));
+    };
+    const double raw_m = distance(as_measured.params), removed_m = distance(after_removal.params);
+    EXPECT_LT(removed_m, 0.5 * raw_m) << f_hz << " Hz: " << removed_m * 1e9 << " nm against " << raw_m * 1e9 << " nm";
+    EXPECT_LT(testdata::rel_err(after_removal.params.c1, truth.c1), testdata::rel_err(as_measured.params.c1, truth.c1))
+        << f_hz << " Hz";
+  }
 }
 
 }  // namespace
