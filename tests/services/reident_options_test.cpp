@@ -173,5 +173,18 @@ TEST(ReidentOptions, ReadsAndChecksTheStage) {
   EXPECT_NE(refusal("stage: {kind: second_order, order: sideways}").find("stage.order"), std::string::npos);
 }
 
+// The two-mode example's re-identifier takes out the stage its compensator inverts (the same
+// modes and delay), not Banning's: fitted behind it, the hysteresis would carry its lag as width.
+TEST(ReidentOptions, TheTwoModeExampleRemovesTheStageItsCompensatorInverts) {
+  const std::string dir = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/";
+  const ReidentOptions o = read_reident_options(Config::load_file(dir + "reidentifier.yaml"));
+  const Config compensator = Config::load_file(dir + "compensator.yaml");
+  ASSERT_TRUE(o.stage.is_linear());
+  ASSERT_EQ(o.stage.linear.modes.size(), 2u);
+  EXPECT_EQ(o.stage.linear.modes[0].frequency_hz, 780.0);
+  EXPECT_EQ(o.stage.linear.modes[1].frequency_hz, 2400.0);
+  EXPECT_EQ(o.stage.linear.delay_s, compensator.get<double>("stage.delay_s", 0.0));
+}
+
 }  // namespace
 }  // namespace hystloop
