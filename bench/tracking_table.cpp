@@ -120,8 +120,8 @@ bool wrong_model_table() {
   const std::vector<Wrong> wrongs = {
       {"dominant mode 10 % high", LinearStageSpec::sum_of_modes({{858.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, delay_s)},
       {"dominant mode 10 % low", LinearStageSpec::sum_of_modes({{702.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, delay_s)},
-      {"one tick of delay left out", LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}},
-                                                                   delay_s - 1e-4)},
+      {"one tick of delay left out",
+       LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, delay_s - 1e-4)},
       {"second mode left out", LinearStageSpec::sum_of_modes({{780.0, 0.03, 1.0}}, delay_s)},
       {"hysteresis gain x 1.5", e.series_stage, 1.5},
   };
@@ -184,7 +184,8 @@ int main(int argc, char** argv) {
       return scan_table(block_ticks, TrackingExperiment{}, true) ? 0 : 1;
     }
     std::printf(
-        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models]]] [--help]\nPrints the tracking tables of "
+        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models]]] [--help]\nPrints the tracking "
+        "tables of "
         "docs/BENCHMARKS.md and docs/TRACKING.md (--scan: the line-rate scan table only; --block-ticks: "
         "sensor blocks of N ticks, default 10; --two-mode: the scan table on a two-mode stage with 1.5 ticks "
         "of delay, its linear stage inverted with preview, the servo off; --wrong-models: learning beside a "

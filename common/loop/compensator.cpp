@@ -40,7 +40,7 @@ bool Compensator::set_trajectory(TrajectorySpec spec, double start_s) { return t
 TrajectoryVerdict Compensator::take_trajectory(TrajectorySpec spec, double start_s) {
   TrajectoryVerdict v;
   try {
-    v = check_trajectory(planner_, std::move(spec), start_s, learner_.enabled());
+    v = check_trajectory(planner_, spec, start_s, learner_.enabled());
   } catch (const ParameterError&) {
     count_refused_trajectory();
     throw;
@@ -52,7 +52,7 @@ TrajectoryVerdict Compensator::check_trajectory(const FeedforwardPlanner& snapsh
                                                 bool learning_enabled) {
   spec.validate();
   if (!std::isnan(start_s)) require_finite("trajectory.start_s", start_s);
-  return ReferenceAdmission(snapshot).admit_trajectory(std::move(spec), start_s, learning_enabled);
+  return ReferenceAdmission(snapshot).admit_trajectory(spec, start_s, learning_enabled);
 }
 
 TrajectoryVerdict Compensator::commit_trajectory(TrajectoryVerdict checked, double start_s) {

@@ -65,7 +65,7 @@ void TrajectoryChecker::run(const std::stop_token& stop) {
     } catch (const std::exception& e) {
       outcome.refusal = e.what();
     }
-    outcome.spec = std::move(request.spec);
+    outcome.spec = request.spec;
     outcome.start_s = request.start_s;
     outcome.version = request.version;
     outcome.axis = request.axis;

@@ -243,9 +243,8 @@ Series series_of(const DiscreteLinearStage::Coefficients& c, int skip) {
 }
 Series product(const Series& a, const Series& b) {
   Series p{};
-  for (int i = 0; i <= kOrder; ++i)
-    for (int j = 0; i + j <= kOrder; ++j)
-      p[static_cast<std::size_t>(i + j)] += a[static_cast<std::size_t>(i)] * b[static_cast<std::size_t>(j)];
+  for (std::size_t i = 0; i <= static_cast<std::size_t>(kOrder); ++i)
+    for (std::size_t j = 0; i + j <= static_cast<std::size_t>(kOrder); ++j) p[i + j] += a[i] * b[j];
   return p;
 }
 Series quotient(const Series& a, const Series& b) {  // a / b, b[0] != 0

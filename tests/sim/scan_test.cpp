@@ -152,7 +152,7 @@ TEST(Scan, TheLearningFilterStaysBelowALinearStagesLowestModeOrAntiResonance) {
   const double dt_s = 1e-4;
   StageModel stage;
   EXPECT_EQ(learning_for_stage(default_learning(), stage, dt_s).cutoff_hz, 2000.0);  // none: as configured
-  stage.kind = StageModel::Kind::kSecondOrder;                                          // Banning's: as configured
+  stage.kind = StageModel::Kind::kSecondOrder;                                       // Banning's: as configured
   EXPECT_EQ(learning_for_stage(default_learning(), stage, dt_s).cutoff_hz, 2000.0);
   stage.kind = StageModel::Kind::kLinear;
   stage.linear = two_mode_experiment().series_stage;
