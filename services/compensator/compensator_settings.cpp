@@ -398,8 +398,10 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   const LearningConfig learning = learning_for_stage(c.learning, c.stage, c.dt_s);
   const std::string filter =
       learning.cutoff_hz < c.learning.cutoff_hz
-          ? fmt::format("{:.4g} Hz, half the stage's lowest resonance {:.4g} Hz (learning.cutoff_hz {} Hz)",
-                        learning.cutoff_hz, lowest_linear_feature_hz(c.stage, c.dt_s), c.learning.cutoff_hz)
+          ? fmt::format(
+                "{:.4g} Hz, {} of the stage's lowest mode or anti-resonance {:.4g} Hz (learning.cutoff_hz {} Hz)",
+                learning.cutoff_hz, kLearningShareOfResonance, lowest_linear_feature_hz(c.stage, c.dt_s),
+                c.learning.cutoff_hz)
           : fmt::format("{} Hz", learning.cutoff_hz);
   lines.push_back(fmt::format("learning: {} (gain {}, filter {}, |correction| <= {:.3g} m, periods up to {} s{})",
                               c.learning.enabled ? "on for periodic references" : "off", c.learning.gain, filter,

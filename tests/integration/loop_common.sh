@@ -4,7 +4,8 @@ set -euo pipefail
 bridge="$1"; compensator="$2"; probe="$3"
 [ "${HYSTLOOP_NETNS:-0}" = 1 ] || { echo "run me inside tools/netns-run" >&2; exit 2; }
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-config="$here/../../deploy/config"
+# HYSTLOOP_CONFIG_DIR: another example of deploy/config (the two-mode stage, ...).
+config="${HYSTLOOP_CONFIG_DIR:-$here/../../deploy/config}"
 dir="$(mktemp -d)"
 pids=()
 cleanup() {
