@@ -49,6 +49,15 @@ Complex evaluate(const Poly& p, Complex z_inv) {
 // The stage's ZOH transfer function from its first Markov parameters: h_n = C Phi^(n-1) Gamma
 // is the response to one tick of unit input, and h_(n+2) = tr(Phi) h_(n+1) - det(Phi) h_n.
 void stage_zoh(const ServoLoopModel& m, Poly& num, Poly& den) {
+  if (m.linear) {
+    // G(z) maps the voltage held over tick k to the position at its end; the servo uses that
+    // position at tick k + 1: one more z^-1, as h_0 below.
+    const DiscreteLinearStage d = discretise(*m.linear, m.dt_s);
+    num.assign(1, 0.0);
+    num.insert(num.end(), d.numerator.begin(), d.numerator.end());
+    den.assign(d.denominator.begin(), d.denominator.end());
+    return;
+  }
   SecondOrderStage stage(m.stage);
   double h[4];
   for (int i = 0; i < 4; ++i) h[i] = stage.step(i == 0 ? 1.0 : 0.0, m.dt_s);
@@ -77,8 +86,12 @@ double bisect(F&& f, double lo, double hi) {
 }  // namespace
 
 void ServoLoopModel::validate() const {
-  stage.validate();
   require_positive("loop.dt_s", dt_s);
+  if (linear) {
+    linear->validate(dt_s);
+  } else {
+    stage.validate();
+  }
   require_positive("loop.slope_ratio", slope_ratio);
   require_in_range("loop.extra_delay_ticks", extra_delay_ticks, 0, 100);
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The bridge's servo loop as a discrete linear system, for choosing its gains: the loop gain
 //   L(z) = r * N(z) * C(z) * P(z) * z^-d
-// with P the exact zero-order-hold discretisation of the second-order stage (unit DC gain; it
+// with P the exact zero-order-hold discretisation of the second-order stage, or of any linear stage
+// with its delay (ServoLoopModel::linear), (unit DC gain; it
 // includes the tick between a voltage and the position sampled at the tick's end, what the
 // simulator hands the next tick), C the PID of FeedbackController (backward-Euler integral, the
 // filtered backward-difference derivative), N its notch, r the stage's local slope over
@@ -13,18 +14,24 @@
 // the same SecondOrderStage the simulator steps, so the figures are the simulated loop's.
 
 #include <complex>
+#include <optional>
 #include <vector>
 
 #include "loop/feedback.hpp"
+#include "models/linear_stage.hpp"
 #include "models/second_order_stage.hpp"
 
 namespace hystloop {
 
 struct ServoLoopModel {
   SecondOrderStageParams stage{};  // Banning et al., Table 2
-  double dt_s = 1e-4;              // the tick
-  double slope_ratio = 1.0;        // the stage's local dy/du over the servo's nominal gain [-]
-  int extra_delay_ticks = 0;       // beyond the ZOH's tick (0: the simulator; 1: read-after-write on a card)
+  // Any other stage (models/linear_stage.hpp: modes, zeros and poles, a delay), in place of
+  // `stage` when set: P is then its exact sampled model, with the same tick before the servo sees
+  // the position.
+  std::optional<LinearStageSpec> linear;
+  double dt_s = 1e-4;         // the tick
+  double slope_ratio = 1.0;   // the stage's local dy/du over the servo's nominal gain [-]
+  int extra_delay_ticks = 0;  // beyond the ZOH's tick (0: the simulator; 1: read-after-write on a card)
 
   void validate() const;  // throws ParameterError naming the field
 };

@@ -131,6 +131,35 @@ TEST(ServoLoopResponse, MarginsOfAStableLoopAreConsistent) {
   EXPECT_GE(1.01 * m.sensitivity_peak, 1.0 / (1.0 - std::pow(10.0, -m.gain_margin_dB / 20.0)));
 }
 
+// Any stage: Banning's written as a linear stage gives Banning's loop, and a lightly damped mode
+// the servo's notch is not at makes the product's defaults unstable (why deploy/config/two-mode
+// runs the servo off) where a notch on that mode makes them stable again.
+TEST(ServoLoopResponse, AnyLinearStageGivesItsLoop) {
+  FeedbackGains g;
+  g.kp = 0.05;
+  g.ki = 2000.0;
+  g.notch_hz = 1720.0;
+  g.notch_q = 0.7;
+  g.nominal_gain_m_per_V = 1.0;
+  ServoLoopModel banning;
+  ServoLoopModel as_linear;
+  as_linear.linear = LinearStageSpec::second_order(banning.stage.k, banning.stage.c);
+  for (const double f : {10.0, 300.0, 1000.0, 4000.0}) {  // not at the notch, where L is 0 to rounding
+    const std::complex<double> a = ServoLoopResponse(g, banning).loop_gain(f);
+    const std::complex<double> b = ServoLoopResponse(g, as_linear).loop_gain(f);
+    EXPECT_NEAR(std::abs(a - b), 0.0, 1e-9 * std::abs(a)) << f;
+  }
+  ServoLoopModel two_mode;
+  two_mode.linear = LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, 1.5e-4);
+  g.kp = 0.2;                                             // a servo meant to do something at line rates
+  EXPECT_FALSE(ServoLoopResponse(g, two_mode).stable());  // the 780 Hz mode, |P| ~ 17, unnotched
+  g.notch_hz = 780.0;
+  g.notch_q = 0.5;
+  const ServoLoopResponse notched(g, two_mode);
+  ASSERT_TRUE(notched.stable());
+  EXPECT_GT(notched.margins().gain_margin_dB, 0.0);
+}
+
 TEST(ServoLoopResponse, RefusesAModelNamingTheField) {
   ServoLoopModel m;
   m.slope_ratio = 0.0;
