@@ -9,6 +9,7 @@ arrays in and out, in SI units (s, V, m):
     u_ff = m.inverse(y_ref)                                   # y_ref [m] -> u [V]
     fit = hystloop.identify(t, u, y, model="auto")           # fit.model, fit.params, fit.ranking
     ban = hystloop.identify_banning("series.lcmlog")         # ban.a, ban.b, ban.alpha, ban.k, ban.c, ban.yaml
+    st = hystloop.identify_stage(u, y, period_samples=2000, periods=4)  # st["poles_hz"], st["delay_s"], Bode data
     log = hystloop.read_log("run.lcmlog", axis=0)            # log["HX_SENSOR"]["y_m"], .units
     exp = hystloop.read_export("run.h5")                     # hystloop-export's .h5/.mat, as read_log
     rig = hystloop.Rig()                                      # a running rig (ttl=0: this host)
@@ -30,6 +31,7 @@ from ._core import (
     RigError,
     identify,
     identify_banning,
+    identify_stage,
     model_info,
     models,
     read_log,
@@ -70,6 +72,7 @@ __all__ = [
     "RigError",
     "identify",
     "identify_banning",
+    "identify_stage",
     "model_info",
     "models",
     "read_export",

@@ -60,4 +60,5 @@ PYBIND11_MODULE(_core, m) {
   register_banning(m);
   register_log(m);
   register_rig(m);
+  register_stage(m);
 }

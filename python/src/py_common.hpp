@@ -84,5 +84,6 @@ void register_identify(py::module_& m);
 void register_banning(py::module_& m);
 void register_log(py::module_& m);
 void register_rig(py::module_& m);
+void register_stage(py::module_& m);
 
 }  // namespace hystloop::python

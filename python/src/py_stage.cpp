@@ -1,0 +1,145 @@
+// hystloop.identify_stage: a stage's linear dynamics from a periodic multisine record on numpy
+// arrays, with common/ident's estimator (ident/frequency_response.hpp: the robust method's FRF and
+// its uncertainty) and fit (ident/stage_fit.hpp: Sanathanan-Koerner iterations refined by Ceres,
+// with delay and the exact zero-order hold), the steps hystloop-identify --model stage takes on a
+// log or a CSV (tools/identify/identify_stage.cpp).
+#include <pybind11/complex.h>
+#include <pybind11/stl.h>
+
+#include <complex>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "ident/frequency_response.hpp"
+#include "ident/stage_fit.hpp"
+#include "models/multisine.hpp"
+#include "py_common.hpp"
+
+namespace hystloop::python {
+namespace {
+
+using C = std::complex<double>;
+
+std::vector<C> roots_hz(const std::vector<C>& roots_rad_s) {
+  std::vector<C> out;
+  for (const C r : roots_rad_s) out.push_back(r / (2.0 * std::numbers::pi));
+  return out;
+}
+
+py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_rate_Hz, std::size_t period_samples,
+                        std::size_t periods, std::size_t realisations, std::size_t transient_periods,
+                        const std::optional<std::pair<double, double>>& band, const std::string& order, int max_order,
+                        double max_delay_s, bool continuous, bool sampled_at_tick_end) {
+  const std::span<const double> u = view_1d(u_in, "u"), y = view_1d(y_in, "y");
+  StageFitOptions o;
+  if (order == "auto") {
+    o.auto_order = true;
+  } else {
+    const std::size_t slash = order.find('/');
+    try {
+      if (slash == std::string::npos) throw std::invalid_argument(order);
+      o.numerator_order = std::stoi(order.substr(0, slash));
+      o.denominator_order = std::stoi(order.substr(slash + 1));
+    } catch (const std::exception&) {
+      throw PyParameterError("order", "order: NUM/DEN (e.g. \"2/4\") or \"auto\" (got '" + order + "')");
+    }
+  }
+  FrfOptions fo;
+  fo.sample_rate_Hz = sample_rate_Hz;
+  fo.period_samples = period_samples;
+  fo.periods = periods;
+  fo.realisations = realisations;
+  fo.transient_periods = transient_periods;
+  std::vector<std::size_t> lines;
+  try {
+    fo.validate();
+    MultisineOptions mo;
+    mo.sample_rate_Hz = sample_rate_Hz;
+    mo.period_samples = period_samples;
+    if (band) {
+      mo.f_min_Hz = band->first;
+      mo.f_max_Hz = band->second;
+    } else {
+      mo.f_min_Hz = sample_rate_Hz / static_cast<double>(period_samples);
+      mo.f_max_Hz = 0.45 * sample_rate_Hz;
+    }
+    lines = multisine_lines(mo);
+  } catch (const ParameterError& e) {
+    throw PyParameterError(e.field(), e.what());
+  }
+  FrequencyResponse frf = estimate_frequency_response(u, y, lines, fo);
+  if (!frf.ok()) throw PyParameterError("u", "no frequency response: " + frf.reason);
+  if (!continuous && sampled_at_tick_end) {
+    // y_k at the end of tick k is the conventional hold's sample k + 1 (as hystloop-identify does):
+    // one tick earlier than the hold the fit models, so the fitted delay is the rig's own.
+    for (std::size_t i = 0; i < frf.G.size(); ++i)
+      frf.G[i] *= std::polar(1.0, -2.0 * std::numbers::pi * frf.frequency_Hz[i] / sample_rate_Hz);
+  }
+  o.unit_dc_gain = false;  // the data carry the actuator's gain: reported as dc_gain
+  o.zoh_sample_rate_Hz = continuous ? 0.0 : sample_rate_Hz;
+  o.max_delay_s = max_delay_s;
+  o.max_order = max_order;
+  o.sigma_dof = frf.total_available ? 2.0 * static_cast<double>(frf.realisations - 1)
+                                    : 2.0 * static_cast<double>(frf.realisations * (frf.periods_used - 1));
+  if (o.sigma_dof <= 2.0) o.sigma_dof = 0.0;
+  const std::vector<double>& sigma = frf.total_available ? frf.sigma_total : frf.sigma_noise;
+  StageFitResult fit;
+  try {
+    fit = fit_stage_model({frf.frequency_Hz, frf.G, sigma}, o);
+  } catch (const ParameterError& e) {
+    throw PyParameterError(e.field(), e.what());
+  }
+  if (!fit.ok()) throw PyParameterError("u", "no stage model: " + fit.reason);
+  std::vector<C> model;
+  for (const double f : frf.frequency_Hz) model.push_back(fit.sampled_response(f));
+  py::dict d;
+  d["frequency_Hz"] = frf.frequency_Hz;
+  d["G"] = frf.G;
+  d["sigma"] = sigma;
+  d["sigma_noise"] = frf.sigma_noise;
+  d["coherence"] = frf.coherence;
+  d["model_G"] = model;
+  d["dc_gain"] = fit.dc_gain;
+  d["poles_hz"] = roots_hz(fit.poles_rad_s);
+  d["zeros_hz"] = roots_hz(fit.zeros_rad_s);
+  d["delay_s"] = fit.delay_s;
+  d["order"] = std::to_string(fit.numerator_order) + "/" + std::to_string(fit.denominator_order);
+  d["chi2_per_line"] = fit.chi2_per_line;
+  d["chi2_expected"] = fit.chi2_expected;
+  d["order_consistent"] = fit.order_consistent;
+  d["distortion_ratio"] = frf.distortion_ratio;
+  return d;
+}
+
+}  // namespace
+
+void register_stage(py::module_& m) {
+  m.def("identify_stage", &identify_stage, py::arg("u"), py::arg("y"), py::kw_only(), py::arg("sample_rate_Hz") = 1e4,
+        py::arg("period_samples"), py::arg("periods"), py::arg("realisations") = 1, py::arg("transient_periods") = 1,
+        py::arg("band") = py::none(), py::arg("order") = "auto", py::arg("max_order") = 8,
+        py::arg("max_delay_s") = 1e-3, py::arg("continuous") = false, py::arg("sampled_at_tick_end") = true,
+        R"doc(identify_stage(u, y, *, sample_rate_Hz=1e4, period_samples, periods, realisations=1,
+               transient_periods=1, band=None, order="auto", max_order=8, max_delay_s=1e-3,
+               continuous=False, sampled_at_tick_end=True) -> dict
+
+A stage's linear dynamics from a periodic multisine record (hystloop-ctl experiment multisine,
+or any periodic excitation), the steps of hystloop-identify --model stage:
+  u [V], y [m]          1-D arrays of realisations * periods * period_samples samples
+  band                  (f_min_Hz, f_max_Hz) of the excited lines; None: every line up to 0.45 fs
+  transient_periods     dropped at the start of each realisation
+  order                 "NUM/DEN" (e.g. "2/4") or "auto" (the lowest order whose residual is the
+                        uncertainty's, up to max_order)
+  continuous            the data were not held and sampled (no zero-order hold in the model)
+  sampled_at_tick_end   y_k measured at the end of tick k (a hystloop bridge): the data are moved
+                        by that tick so that delay_s is the rig's own
+Returns frequency_Hz, G [m/V] and sigma (its standard deviation, from periods and realisations),
+sigma_noise, coherence, model_G (the fitted model's response, as sampled), dc_gain [m/V],
+poles_hz and zeros_hz (s / 2 pi, complex), delay_s [s], order, chi2_per_line against
+chi2_expected, order_consistent, distortion_ratio. Refusals raise hystloop.ParameterError.)doc");
+}
+
+}  // namespace hystloop::python
