@@ -48,6 +48,12 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
                     "stream the bridge did not send",
                     in.commands_too_far_ahead, in.max_lead_s));
   }
+  if (in.ticks_skipped > 0) {
+    degraded(
+        fmt::format("{} ticks ({:.3g} ms) skipped this period: the bridge's own clock fell behind and the outputs "
+                    "held stale voltages (ticks_skipped; real time on this host: docs/TIMING.md)",
+                    in.ticks_skipped, static_cast<double>(in.ticks_skipped) * in.dt_s * 1e3));
+  }
   // A clamped command is not what the compensator and the servo asked for: the rig tracks worse
   // than its figures say, whatever else is well.
   const ClampCounts& c = in.clamped_last_second;
@@ -55,6 +61,14 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
     degraded(fmt::format("{} ticks clamped in the last second (range {}, slew {})", c.either, c.range, c.slew));
   }
   return h;
+}
+
+std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick) {
+  return fmt::format(
+      "the bridge's own clock stalled: {} ticks ({:.3g} ms) skipped within one second, beyond bridge.max_stall_s "
+      "{} s: the outputs held stale voltages; every axis to the safe state at tick {} (real time on this host: "
+      "docs/TIMING.md); re-arm via HX_CONTROL",
+      skipped_ticks, static_cast<double>(skipped_ticks) / rate_hz * 1e3, max_stall_s, tick);
 }
 
 std::string watchdog_reason(const DryBufferFigures& f) {

@@ -27,6 +27,8 @@ struct BridgeHealthInput {
   std::uint64_t commands_too_far_ahead = 0;  // this period: refused beyond bridge.max_lead_s (rejected_future)
   double max_lead_s = 0.0;                   // bridge.max_lead_s
   ClampCounts clamped_last_second{};
+  std::uint64_t ticks_skipped = 0;  // this period: deadlines the hardware clock passed (outputs held stale)
+  double dt_s = 1e-4;               // the tick
 };
 
 struct BridgeHealth {
@@ -58,5 +60,10 @@ struct DryBufferFigures {
 // block arrived 57.3 ms before; 120 HX_COMMAND messages refused in the last 1 s (120/s); the I/O
 // thread's longest pass 0.4 ms, longest wait 20.1 ms); re-arm via HX_CONTROL"
 std::string watchdog_reason(const DryBufferFigures& f);
+
+// "the bridge's own clock stalled: 250 ticks (25 ms) skipped within one second, beyond
+// bridge.max_stall_s 0.01 s: the outputs held stale voltages; every axis to the safe state at tick
+// 81234 (real time on this host: docs/TIMING.md); re-arm via HX_CONTROL"
+std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick);
 
 }  // namespace hystloop

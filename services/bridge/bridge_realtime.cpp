@@ -40,6 +40,7 @@ BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<S
       dt_s_(settings.dt_s()),
       safe_u_V_(settings.safe_voltages()) {
   stage_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
+  max_stall_ticks_ = std::llround(settings.max_stall_s * settings.rate_hz);
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
 }
@@ -130,6 +131,7 @@ void BridgeRealtime::run() noexcept {
       skipped = static_cast<std::uint64_t>(due - per_wake - next);
       ticks_skipped_ += skipped;
       next = due - per_wake;
+      note_skipped(next, skipped);
     }
     const std::int64_t end = catch_up ? std::min(due, next + 2 * per_wake) : due;
     if (end - next > per_wake) ticks_caught_up_ += static_cast<std::uint64_t>(end - next - per_wake);
@@ -139,6 +141,24 @@ void BridgeRealtime::run() noexcept {
     RtReport& report = reports_.current();
     report.lateness.add(info.lateness_ns);
   }
+}
+
+void BridgeRealtime::note_skipped(std::int64_t k, std::uint64_t skipped) noexcept {
+  const auto window_ticks = static_cast<std::int64_t>(std::llround(settings_.rate_hz));
+  if (k - stall_window_start_ >= window_ticks) {
+    stall_window_start_ = k;
+    skipped_in_window_ = 0;
+  }
+  skipped_in_window_ += skipped;
+  if (static_cast<std::int64_t>(skipped_in_window_) <= max_stall_ticks_ || !stage_.armed()) return;
+  // The outputs held stale voltages for longer than the rig allows: every axis ramps to its safe
+  // voltage from this tick (BridgeCore's safe state), until re-armed.
+  arming_.request(ArmRequest::kDisarm, k, stage_);
+  ++stall_trips_;
+  last_stall_tick_ = k;
+  last_stall_ticks_ = skipped_in_window_;
+  stall_window_start_ = k;
+  skipped_in_window_ = 0;
 }
 
 std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t start_ns) noexcept {
@@ -237,6 +257,9 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
       r.axis_u_V[a] = stage_.axis(static_cast<int>(a)).last_applied_V();
     }
     r.ticks_skipped = ticks_skipped_;
+    r.stall_trips = stall_trips_;
+    r.last_stall_tick = last_stall_tick_;
+    r.last_stall_ticks = last_stall_ticks_;
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;

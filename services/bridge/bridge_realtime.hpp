@@ -131,6 +131,14 @@ class BridgeRealtime {
   std::int64_t stop_ramp_ticks_ = 0;
   std::int64_t stop_reached_ns_ = 0;
   std::uint64_t ticks_skipped_ = 0;
+  // Skipped ticks within the current second of the clock (bridge.max_stall_s).
+  void note_skipped(std::int64_t k, std::uint64_t skipped) noexcept;
+  std::int64_t max_stall_ticks_ = 0;
+  std::int64_t stall_window_start_ = 0;
+  std::uint64_t skipped_in_window_ = 0;
+  std::uint64_t stall_trips_ = 0;
+  std::int64_t last_stall_tick_ = -1;
+  std::uint64_t last_stall_ticks_ = 0;
   std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;

@@ -323,6 +323,7 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
       {"watchdog_trips", core.watchdog_trips},
       {"safe_ticks", core.safe_ticks},
       {"ticks_skipped", rt.ticks_skipped},
+      {"stall_trips", rt.stall_trips},
       {"ticks_caught_up", rt.ticks_caught_up},
       {"samples_dropped", rt.samples_dropped},
       {"command_queue_full", command_queue_full_},
@@ -405,6 +406,11 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     safe_reason_ = watchdog_reason(dry);
     spdlog::warn("{}", safe_reason_);
   }
+  if (rt.stall_trips != stall_trips_reported_) {
+    stall_trips_reported_ = rt.stall_trips;
+    safe_reason_ = stall_reason(rt.last_stall_ticks, settings_.max_stall_s, settings_.rate_hz, rt.last_stall_tick);
+    spdlog::warn("{}", safe_reason_);
+  }
   last_report_ns_ = now_ns;
   previous_command_rejected_ = command_rejected;
   previous_queue_full_ = command_queue_full_;
@@ -423,7 +429,10 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
                                  .samples_unpublished = sensor_ticks_unpublished_ - previous_unpublished_,
                                  .commands_too_far_ahead = too_far_ahead,
                                  .max_lead_s = settings_.max_lead_s,
-                                 .clamped_last_second = rt.clamped_last_second};
+                                 .clamped_last_second = rt.clamped_last_second,
+                                 .ticks_skipped = rt.ticks_skipped - previous_skipped_,
+                                 .dt_s = settings_.dt_s()};
+  previous_skipped_ = rt.ticks_skipped;
   previous_repaired_ = sensor_ticks_repaired_;
   previous_unpublished_ = sensor_ticks_unpublished_;
   auto [state, detail] = assess_bridge_health(health);

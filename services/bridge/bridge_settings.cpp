@@ -198,6 +198,7 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "bridge.command_queue_capacity",
                                                 "bridge.block_ticks",
                                                 "bridge.max_lead_s",
+                                                "bridge.max_stall_s",
                                                 "actuator.watchdog_s",
                                                 "rt.ticks_per_wake",
                                                 "rt.priority",
@@ -257,6 +258,7 @@ BridgeSettings load_bridge_settings(const Config& config) {
   s.command_queue_capacity =
       static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 16, 100000));
   s.block_ticks = static_cast<int>(config.get_int_in_range("bridge.block_ticks", s.block_ticks, 1, 1000));
+  s.max_stall_s = config.get_in_range("bridge.max_stall_s", s.max_stall_s, 1.0 / s.rate_hz, 1.0);
   s.max_lead_s = config.get_in_range("bridge.max_lead_s", s.max_lead_s, 2.0 / s.rate_hz,
                                      static_cast<double>(CommandBuffer::kCapacityTicks) / s.rate_hz);
 

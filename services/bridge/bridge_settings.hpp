@@ -63,6 +63,12 @@ struct BridgeSettings {
   // compensator plans compensator.horizon_s (0.05) ahead of the last sample, which is behind the
   // clock, so 10 ms of margin takes every honest plan and a forged sensor stream moves none.
   double max_lead_s = 0.06;
+  // A hardware backend's own clock: ticks whose deadline passed are skipped, and the outputs hold
+  // the last voltage meanwhile, whatever the plan and the servo asked. Any skipped tick makes the
+  // rig DEGRADED; more than this much time skipped within one second (a single stall, or many
+  // short ones) takes every axis to the safe state, ramped, until re-armed. 10 ms: a fifth of the
+  // plan's horizon, 20 ms of a 50 Hz line's period.
+  double max_stall_s = 0.01;
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
   // Axis i's actuator and servo (0 <= i < kMaxAxes).

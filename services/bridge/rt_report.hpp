@@ -24,6 +24,9 @@ struct RtReport {
   // Cumulative since start (the I/O thread subtracts a baseline for RESET_COUNTERS).
   BridgeCounters core{};
   std::uint64_t ticks_skipped = 0;       // timer deadlines passed over (overruns; hardware)
+  std::uint64_t stall_trips = 0;         // ... beyond bridge.max_stall_s in a second: the safe state
+  std::int64_t last_stall_tick = -1;     // the tick the last of those took effect at
+  std::uint64_t last_stall_ticks = 0;    // ticks skipped within the second that tripped it
   std::uint64_t ticks_caught_up = 0;     // ticks run late, back to back, after an overrun (a simulator)
   std::uint64_t samples_dropped = 0;     // outgoing queue full: the I/O thread fell behind
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue

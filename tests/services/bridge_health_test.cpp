@@ -135,5 +135,22 @@ TEST(BridgeHealth, TheWatchdogsReasonSaysWhyTheBufferRanDry) {
   EXPECT_NE(late.find("command blocks kept arriving after it: too late for their ticks"), std::string::npos) << late;
 }
 
+// The hardware clock skipped ticks: the outputs held a stale voltage, whatever else is well.
+TEST(BridgeHealth, SkippedTicksAreDegradedAndSayHowLong) {
+  BridgeHealthInput in;
+  in.armed = true;
+  in.ticks_skipped = 50;
+  in.dt_s = 1e-4;
+  const BridgeHealth h = assess_bridge_health(in);
+  EXPECT_EQ(h.state, service_status_t::DEGRADED);
+  EXPECT_NE(h.detail.find("50 ticks (5 ms) skipped"), std::string::npos) << h.detail;
+  in.ticks_skipped = 0;
+  EXPECT_EQ(assess_bridge_health(in).state, service_status_t::HEALTHY);
+  const std::string why = stall_reason(250, 0.01, 1e4, 81234);
+  EXPECT_NE(why.find("250 ticks (25 ms) skipped within one second"), std::string::npos) << why;
+  EXPECT_NE(why.find("bridge.max_stall_s 0.01 s"), std::string::npos) << why;
+  EXPECT_NE(why.find("re-arm via HX_CONTROL"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace hystloop

@@ -10,7 +10,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -34,15 +36,21 @@ struct Record {
 
 class RecordingBackend final : public StageBackend {
  public:
-  explicit RecordingBackend(Record& r) : r_(r) { r_.u_V.reserve(1 << 20); }
+  // simulated false: a hardware backend, whose missed deadlines are skipped. stall_at_step >= 0:
+  // that step takes stall_ms (the bridge's own thread held up).
+  explicit RecordingBackend(Record& r, bool simulated = true, std::size_t stall_at_step = SIZE_MAX, int stall_ms = 0)
+      : r_(r), simulated_(simulated), stall_at_step_(stall_at_step), stall_ms_(stall_ms) {
+    r_.u_V.reserve(1 << 20);
+  }
   StageReading step(double u_V, double, double) noexcept override {
+    if (r_.steps.load() == stall_at_step_) std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms_));
     if (r_.u_V.size() < r_.u_V.capacity()) r_.u_V.push_back(u_V);
     r_.last_u_V.store(u_V);
     r_.steps.fetch_add(1);
     return {0.0, 4};
   }
   const std::string& name() const noexcept override { return name_; }
-  bool simulated() const noexcept override { return true; }  // ticks run late, never skipped: no gaps
+  bool simulated() const noexcept override { return simulated_; }  // true: ticks run late, never skipped
   void hold_safe(std::span<const double> safe_u_V) noexcept override {
     if (r_.holds.fetch_add(1) == 0) {
       r_.steps_at_first_hold = r_.u_V.size();
@@ -53,6 +61,9 @@ class RecordingBackend final : public StageBackend {
 
  private:
   Record& r_;
+  bool simulated_;
+  std::size_t stall_at_step_;
+  int stall_ms_;
   std::string name_ = "recording";
 };
 
@@ -156,6 +167,54 @@ TEST(BridgeRealtimeStop, GivesUpAfterTheTimeoutAndStillHoldsSafe) {
   EXPECT_LT(record.u_V.back(), 200.0);  // it was ramping
   EXPECT_EQ(record.holds.load(), 1);    // told to hold safe at the end anyway
   EXPECT_EQ(record.hold_arg_V, 0.0);
+}
+
+// A hardware backend whose bridge thread is held up for longer than bridge.max_stall_s: the
+// outputs held a stale voltage, so every axis ramps to the safe voltage from the tick after the
+// stall, counted and reported (the service names the reason: stall_reason).
+TEST(BridgeRealtimeStop, AStallOfItsOwnClockBeyondTheBoundRampsToSafe) {
+  BridgeSettings s = fast_ramp_settings();
+  s.rt.ticks_per_wake = 1;
+  s.max_stall_s = 0.01;  // 100 ticks; the stall below is 40 ms, 400 at least
+  Record record;
+  auto rt = std::make_unique<BridgeRealtime>(s, std::make_unique<RecordingBackend>(record, false, 3000, 40));
+  for (std::int64_t k = 0; k < 16000; ++k) ASSERT_TRUE(rt->push_command({k, 200.0, std::nan(""), 1, 2}));
+  rt->start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 3000 && record.last_u_V.load() == 0.0; }))
+      << "the stage did not go back to the safe voltage after the stall";
+  rt->reports().request();
+  const RtReport* report = nullptr;
+  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  EXPECT_EQ(report->stall_trips, 1u);
+  EXPECT_GE(report->ticks_skipped, 300u);
+  EXPECT_GT(report->last_stall_ticks, 100u);  // beyond the bound (a busy machine may trip it earlier)
+  EXPECT_FALSE(report->armed);
+  EXPECT_EQ(report->core.watchdog_trips, 0u);  // commands were there: the stall, not the compensator
+  rt->reports().release();
+  rt->stop();
+  // Up to 200 V at the slew limit, then down at the safe ramp (1 V a tick), never a step.
+  expect_safe_ramp(record, s, 200.0);
+}
+
+// A stall within the bound is skipped and counted, and the rig stays armed (DEGRADED on HX_STATUS:
+// bridge_health_test).
+TEST(BridgeRealtimeStop, AShortStallOfItsOwnClockIsCountedAndStaysArmed) {
+  BridgeSettings s = fast_ramp_settings();
+  s.rt.ticks_per_wake = 1;
+  s.max_stall_s = 1.0;  // the bound's upper end: a 20 ms stall is within it on any machine
+  Record record;
+  auto rt = std::make_unique<BridgeRealtime>(s, std::make_unique<RecordingBackend>(record, false, 3000, 20));
+  for (std::int64_t k = 0; k < 16000; ++k) ASSERT_TRUE(rt->push_command({k, 200.0, std::nan(""), 1, 2}));
+  rt->start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 3500; }));
+  rt->reports().request();
+  const RtReport* report = nullptr;
+  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  EXPECT_EQ(report->stall_trips, 0u);
+  EXPECT_GE(report->ticks_skipped, 150u);
+  EXPECT_TRUE(report->armed);
+  rt->reports().release();
+  EXPECT_EQ(record.last_u_V.load(), 200.0);
 }
 
 }  // namespace
