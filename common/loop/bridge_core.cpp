@@ -30,6 +30,9 @@ void ActuatorLimits::validate() const {
   require_in_range("actuator.safe_u_V", safe_u_V, u_min_V, u_max_V);
   require_positive("actuator.safe_ramp_V_per_s", safe_ramp_V_per_s);
   require_positive("actuator.watchdog_s", watchdog_s);
+  if (std::isnan(position_min_m) || std::isnan(position_max_m) || !(position_max_m > position_min_m)) {
+    throw ParameterError("actuator.position_max_m", "must be greater than actuator.position_min_m");
+  }
 }
 
 BridgeCore::BridgeCore(const ActuatorLimits& limits, const FeedbackGains& servo, double dt_s)

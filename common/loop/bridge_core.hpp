@@ -9,6 +9,7 @@
 // the safe voltage. Time is an argument, so all of it is tested faster than real time.
 
 #include <cstdint>
+#include <limits>
 
 #include "core/ticks.hpp"
 #include "loop/command_buffer.hpp"
@@ -33,6 +34,11 @@ struct ActuatorLimits {
   double safe_u_V = 0.0;             // where the watchdog takes the actuator
   double safe_ramp_V_per_s = 1.0e3;  // how fast it goes there (250 V in 0.25 s)
   double watchdog_s = 2.0e-3;        // the buffer empty for this long -> safe state
+  // Soft limits on the measured position [m] (the bridge's real-time thread checks them: beyond
+  // either for kPositionLimitTicks ticks in a row, every axis goes to the safe state); none by default.
+  double position_min_m = -std::numeric_limits<double>::infinity();
+  double position_max_m = std::numeric_limits<double>::infinity();
+  static constexpr int kPositionLimitTicks = 3;  // one noisy sample is no excursion
 
   void validate() const;  // throws ParameterError naming the field
   // The rate the safe state ramps at: safe_ramp_V_per_s, never faster than the slew limit.

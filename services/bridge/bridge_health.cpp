@@ -63,6 +63,16 @@ BridgeHealth assess_bridge_health(const BridgeHealthInput& in) {
   return h;
 }
 
+std::string position_reason(int axis, double y_m, const ActuatorLimits& limits, int axes, std::int64_t tick) {
+  const bool above = y_m > limits.position_max_m;
+  const std::string key = axis_field(above ? "actuator.position_max_m" : "actuator.position_min_m", axis);
+  return fmt::format(
+      "{}'s measured position {:.4g} um beyond {} {:.4g} um for {} ticks: {} to the safe state at tick {}; re-arm "
+      "via HX_CONTROL",
+      axis_name(axis), y_m * 1e6, key, (above ? limits.position_max_m : limits.position_min_m) * 1e6,
+      ActuatorLimits::kPositionLimitTicks, axes > 1 ? "every axis" : "the actuator", tick);
+}
+
 std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick) {
   return fmt::format(
       "the bridge's own clock stalled: {} ticks ({:.3g} ms) skipped within one second, beyond bridge.max_stall_s "

@@ -64,6 +64,10 @@ std::string watchdog_reason(const DryBufferFigures& f);
 // "the bridge's own clock stalled: 250 ticks (25 ms) skipped within one second, beyond
 // bridge.max_stall_s 0.01 s: the outputs held stale voltages; every axis to the safe state at tick
 // 81234 (real time on this host: docs/TIMING.md); re-arm via HX_CONTROL"
+// "axis x's measured position 1.23 um beyond actuator.position_max_m 1 um for 3 ticks: every axis to
+// the safe state at tick 4567; re-arm via HX_CONTROL"
+std::string position_reason(int axis, double y_m, const ActuatorLimits& limits, int axes, std::int64_t tick);
+
 std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick);
 
 }  // namespace hystloop

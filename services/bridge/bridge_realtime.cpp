@@ -41,6 +41,10 @@ BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<S
       safe_u_V_(settings.safe_voltages()) {
   stage_.set_max_lead_ticks(std::llround(settings.max_lead_s * settings.rate_hz));
   max_stall_ticks_ = std::llround(settings.max_stall_s * settings.rate_hz);
+  for (int a = 0; a < settings.axes; ++a) {
+    position_min_m_[static_cast<std::size_t>(a)] = settings.limits_of(a).position_min_m;
+    position_max_m_[static_cast<std::size_t>(a)] = settings.limits_of(a).position_max_m;
+  }
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
 }
@@ -161,6 +165,23 @@ void BridgeRealtime::note_skipped(std::int64_t k, std::uint64_t skipped) noexcep
   skipped_in_window_ = 0;
 }
 
+void BridgeRealtime::check_positions(std::int64_t k, std::span<const StageReading> readings) noexcept {
+  for (std::size_t a = 0; a < readings.size(); ++a) {
+    const double y = readings[a].y_m;  // NaN (a failed read) is no excursion: the backend counts it
+    if (!(y < position_min_m_[a] || y > position_max_m_[a])) {
+      beyond_ticks_[a] = 0;
+      continue;
+    }
+    if (++beyond_ticks_[a] < ActuatorLimits::kPositionLimitTicks || !stage_.armed()) continue;
+    arming_.request(ArmRequest::kDisarm, k, stage_);  // every axis ramps to safe from the next tick
+    ++position_trips_;
+    position_axis_ = static_cast<int>(a);
+    position_m_ = y;
+    position_tick_ = k;
+    beyond_ticks_[a] = 0;
+  }
+}
+
 std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t start_ns) noexcept {
   const auto axes = static_cast<std::size_t>(stage_.axes());
   if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
@@ -208,6 +229,7 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     y_last_m_[a] = readings[a].y_m;
   }
   if (go_safe && stage_.armed()) arming_.request(ArmRequest::kDisarm, k, stage_);  // from the next tick
+  check_positions(k, std::span<const StageReading>(readings).first(axes));
   last_tick_ = k;
   bool reached_now = false;
   if (arming_.stopping() && !safe_reached_.load(std::memory_order_relaxed)) {
@@ -260,6 +282,10 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     r.stall_trips = stall_trips_;
     r.last_stall_tick = last_stall_tick_;
     r.last_stall_ticks = last_stall_ticks_;
+    r.position_trips = position_trips_;
+    r.position_axis = position_axis_;
+    r.position_m = position_m_;
+    r.position_tick = position_tick_;
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;

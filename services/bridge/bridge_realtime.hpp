@@ -139,6 +139,15 @@ class BridgeRealtime {
   std::uint64_t stall_trips_ = 0;
   std::int64_t last_stall_tick_ = -1;
   std::uint64_t last_stall_ticks_ = 0;
+  // The soft position limits (ActuatorLimits::position_*): ticks in a row beyond, per axis.
+  void check_positions(std::int64_t k, std::span<const StageReading> readings) noexcept;
+  std::array<double, kMaxAxes> position_min_m_{};
+  std::array<double, kMaxAxes> position_max_m_{};
+  std::array<int, kMaxAxes> beyond_ticks_{};
+  std::uint64_t position_trips_ = 0;
+  int position_axis_ = -1;
+  double position_m_ = 0.0;
+  std::int64_t position_tick_ = -1;
   std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;

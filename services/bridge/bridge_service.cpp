@@ -324,6 +324,7 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
       {"safe_ticks", core.safe_ticks},
       {"ticks_skipped", rt.ticks_skipped},
       {"stall_trips", rt.stall_trips},
+      {"position_trips", rt.position_trips},
       {"ticks_caught_up", rt.ticks_caught_up},
       {"samples_dropped", rt.samples_dropped},
       {"command_queue_full", command_queue_full_},
@@ -409,6 +410,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   if (rt.stall_trips != stall_trips_reported_) {
     stall_trips_reported_ = rt.stall_trips;
     safe_reason_ = stall_reason(rt.last_stall_ticks, settings_.max_stall_s, settings_.rate_hz, rt.last_stall_tick);
+    spdlog::warn("{}", safe_reason_);
+  }
+  if (rt.position_trips != position_trips_reported_ && rt.position_axis >= 0) {
+    position_trips_reported_ = rt.position_trips;
+    safe_reason_ = position_reason(rt.position_axis, rt.position_m, settings_.limits_of(rt.position_axis), rt.axes,
+                                   rt.position_tick);
     spdlog::warn("{}", safe_reason_);
   }
   last_report_ns_ = now_ns;

@@ -109,7 +109,8 @@ class BridgeService {
   // Report bookkeeping.
   std::string safe_reason_ = "not armed";
   std::uint64_t stall_trips_reported_ = 0;  // RtReport::stall_trips when last reported
-  std::uint64_t previous_skipped_ = 0;      // RtReport::ticks_skipped at the last report
+  std::uint64_t position_trips_reported_ = 0;
+  std::uint64_t previous_skipped_ = 0;  // RtReport::ticks_skipped at the last report
   std::uint64_t trips_reported_ = 0;
   BridgeCounters previous_core_{};
   std::uint64_t previous_dropped_ = 0;

@@ -19,7 +19,8 @@ namespace hystloop {
 namespace {
 
 // An axis's own keys: actuator.<field> and servo.<field> for x, actuator.y.<field> ... for y and z.
-constexpr const char* kAxisActuatorKeys[] = {"u_min_V", "u_max_V", "slew_V_per_s", "safe_u_V", "safe_ramp_V_per_s"};
+constexpr const char* kAxisActuatorKeys[] = {"u_min_V",           "u_max_V",        "slew_V_per_s",  "safe_u_V",
+                                             "safe_ramp_V_per_s", "position_min_m", "position_max_m"};
 constexpr const char* kAxisServoKeys[] = {"kp",          "ki",       "kd",     "nominal_gain_m_per_V",
                                           "d_filter_hz", "notch_hz", "notch_q"};
 
@@ -39,6 +40,9 @@ ActuatorLimits load_limits(const Config& config, int axis, ActuatorLimits a) {
   a.slew_V_per_s = config.get_positive(p + "slew_V_per_s", a.slew_V_per_s);
   a.safe_u_V = config.get_in_range(p + "safe_u_V", a.safe_u_V, -1e4, 1e4);
   a.safe_ramp_V_per_s = config.get_positive(p + "safe_ramp_V_per_s", a.safe_ramp_V_per_s);
+  // Soft position limits: absent, none (a stage's sensor range is the lab's to give).
+  if (config.has(p + "position_min_m")) a.position_min_m = config.get_in_range(p + "position_min_m", 0.0, -1.0, 1.0);
+  if (config.has(p + "position_max_m")) a.position_max_m = config.get_in_range(p + "position_max_m", 0.0, -1.0, 1.0);
   try {
     a.validate();
   } catch (const ParameterError& e) {

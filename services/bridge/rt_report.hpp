@@ -27,6 +27,10 @@ struct RtReport {
   std::uint64_t stall_trips = 0;         // ... beyond bridge.max_stall_s in a second: the safe state
   std::int64_t last_stall_tick = -1;     // the tick the last of those took effect at
   std::uint64_t last_stall_ticks = 0;    // ticks skipped within the second that tripped it
+  std::uint64_t position_trips = 0;      // a measured position beyond its soft limit: the safe state
+  int position_axis = -1;                // the last of those: its axis,
+  double position_m = 0.0;               // the position that tripped it,
+  std::int64_t position_tick = -1;       // and the tick
   std::uint64_t ticks_caught_up = 0;     // ticks run late, back to back, after an overrun (a simulator)
   std::uint64_t samples_dropped = 0;     // outgoing queue full: the I/O thread fell behind
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue

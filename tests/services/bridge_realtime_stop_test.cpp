@@ -4,10 +4,12 @@
 // ramp and at the end, and gives up after bridge's stop_ramp_timeout_s. Real threads, real time,
 // a fast ramp: a few tenths of a second in all.
 #include "bridge/bridge_realtime.hpp"
+#include "bridge/bridge_health.hpp"
 #include "support/eventually.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <climits>
@@ -47,10 +49,12 @@ class RecordingBackend final : public StageBackend {
     if (r_.u_V.size() < r_.u_V.capacity()) r_.u_V.push_back(u_V);
     r_.last_u_V.store(u_V);
     r_.steps.fetch_add(1);
-    return {0.0, 4};
+    return {u_V * y_per_V, 4};
   }
   const std::string& name() const noexcept override { return name_; }
   bool simulated() const noexcept override { return simulated_; }  // true: ticks run late, never skipped
+  double y_per_V = 0.0;                                            // the position it reports [m/V]
+
   void hold_safe(std::span<const double> safe_u_V) noexcept override {
     if (r_.holds.fetch_add(1) == 0) {
       r_.steps_at_first_hold = r_.u_V.size();
@@ -215,6 +219,40 @@ TEST(BridgeRealtimeStop, AShortStallOfItsOwnClockIsCountedAndStaysArmed) {
   EXPECT_TRUE(report->armed);
   rt->reports().release();
   EXPECT_EQ(record.last_u_V.load(), 200.0);
+}
+
+// A soft position limit: the stage (1 um per 100 V here) driven towards 2 um with a limit at 1 um
+// goes to the safe state three ticks beyond it, ramped, and says so.
+TEST(BridgeRealtimeStop, APositionBeyondItsSoftLimitRampsToSafe) {
+  BridgeSettings s = fast_ramp_settings();
+  s.limits.position_max_m = 1e-6;
+  Record record;
+  auto backend = std::make_unique<RecordingBackend>(record);
+  backend->y_per_V = 1e-8;
+  auto rt = std::make_unique<BridgeRealtime>(s, std::move(backend));
+  for (std::int64_t k = 0; k < 8000; ++k) ASSERT_TRUE(rt->push_command({k, 200.0, std::nan(""), 1, 2}));
+  rt->start();
+  ASSERT_TRUE(eventually([&] { return record.steps.load() > 400; }));
+  rt->reports().request();
+  const RtReport* report = nullptr;
+  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  EXPECT_EQ(report->position_trips, 1u);
+  EXPECT_EQ(report->position_axis, 0);
+  EXPECT_GT(report->position_m, 1e-6);
+  EXPECT_FALSE(report->armed);
+  rt->reports().release();
+  rt->stop();
+  // Up at the slew limit (5 V a tick) past 100 V for the three ticks and the one the disarm
+  // takes effect after, then down at the safe ramp (1 V a tick) to 0 V.
+  double peak = 0.0;
+  for (const double u : record.u_V) peak = std::max(peak, u);
+  EXPECT_GT(peak, 100.0);
+  EXPECT_LE(peak, 125.0);
+  expect_safe_ramp(record, s, peak);
+  EXPECT_NE(position_reason(0, 1.2e-6, s.limits, 1, 25)
+                .find("x's measured position 1.2 um beyond "
+                      "actuator.position_max_m 1 um for 3 ticks"),
+            std::string::npos);
 }
 
 }  // namespace

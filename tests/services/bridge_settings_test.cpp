@@ -161,6 +161,10 @@ TEST(BridgeSettings, RefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("actuator: {u_min_V: 10, u_max_V: 5}"), "actuator.u_max_V"));
   EXPECT_TRUE(contains(refusal("actuator: {safe_u_V: 300}"), "actuator.safe_u_V"));
   EXPECT_TRUE(contains(refusal("actuator: {watchdog_s: 0.00015}"), "two ticks"));
+  EXPECT_TRUE(contains(refusal("actuator: {position_min_m: 1e-6, position_max_m: -1e-6}"), "actuator.position_max_m"));
+  EXPECT_TRUE(contains(refusal("actuator: {position_max_m: 5}"), "actuator.position_max_m"));  // beyond 1 m
+  EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\nactuator: {y: {position_min_m: 2e-6, position_max_m: 1e-6}}"),
+                       "actuator.y.position_max_m"));
   EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "bridge.backend"));
   EXPECT_TRUE(contains(refusal("bridge: {noise_rms_m: .nan}"), "bridge.noise_rms_m"));
   EXPECT_TRUE(contains(refusal("banning: {hysteresis: {b: 9.0e-9}}"), "banning.hysteresis.b"));
