@@ -26,6 +26,7 @@ using C = std::complex<double>;
 
 std::vector<C> roots_hz(const std::vector<C>& roots_rad_s) {
   std::vector<C> out;
+  out.reserve(roots_rad_s.size());
   for (const C r : roots_rad_s) out.push_back(r / (2.0 * std::numbers::pi));
   return out;
 }
@@ -95,6 +96,7 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
   }
   if (!fit.ok()) throw PyParameterError("u", "no stage model: " + fit.reason);
   std::vector<C> model;
+  model.reserve(frf.frequency_Hz.size());
   for (const double f : frf.frequency_Hz) model.push_back(fit.sampled_response(f));
   py::dict d;
   d["frequency_Hz"] = frf.frequency_Hz;
