@@ -37,6 +37,9 @@ BridgeSettings comedi_settings() {
   s.limits.safe_ramp_V_per_s = 1e4;  // 1 V per tick at the piezo
   s.limits.watchdog_s = 1.0;
   s.stop_ramp_timeout_s = 2.0;
+  // These exits are not the stall guard's (BridgeRealtimeStop tests it): on a busy machine the
+  // fake card's thread may miss 10 ms in a second, which would go safe before what is tested.
+  s.max_stall_s = 1.0;
   s.comedi.ao = {1, 0, 0, AREF_GROUND};
   s.comedi.ai = {0, 0, 0, AREF_GROUND};
   s.comedi.amplifier_gain_V_per_V = kGain;
