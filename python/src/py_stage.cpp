@@ -1,8 +1,7 @@
 // hystloop.identify_stage: a stage's linear dynamics from a periodic multisine record on numpy
-// arrays, with common/ident's estimator (ident/frequency_response.hpp: the robust method's FRF and
-// its uncertainty) and fit (ident/stage_fit.hpp: Sanathanan-Koerner iterations refined by Ceres,
-// with delay and the exact zero-order hold), the steps hystloop-identify --model stage takes on a
-// log or a CSV (tools/identify/identify_stage.cpp).
+// arrays, by ident/stage_identification.hpp (the robust method's FRF and its uncertainty, then
+// Sanathanan-Koerner iterations refined by Ceres, with delay and the exact zero-order hold): the
+// same steps hystloop-identify --model stage takes on a log or a CSV.
 #include <pybind11/complex.h>
 #include <pybind11/stl.h>
 
@@ -14,8 +13,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "ident/frequency_response.hpp"
-#include "ident/stage_fit.hpp"
+#include "ident/stage_identification.hpp"
 #include "models/multisine.hpp"
 #include "py_common.hpp"
 
@@ -37,26 +35,19 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
                         double max_delay_s, bool continuous, bool sampled_at_tick_end) {
   const std::span<const double> u = view_1d(u_in, "u"), y = view_1d(y_in, "y");
   StageFitOptions o;
-  if (order == "auto") {
-    o.auto_order = true;
-  } else {
-    const std::size_t slash = order.find('/');
-    try {
-      if (slash == std::string::npos) throw std::invalid_argument(order);
-      o.numerator_order = std::stoi(order.substr(0, slash));
-      o.denominator_order = std::stoi(order.substr(slash + 1));
-    } catch (const std::exception&) {
-      throw PyParameterError("order", "order: NUM/DEN (e.g. \"2/4\") or \"auto\" (got '" + order + "')");
-    }
-  }
+  o.unit_dc_gain = false;  // the data carry the actuator's gain: reported as dc_gain
+  o.zoh_sample_rate_Hz = continuous ? 0.0 : sample_rate_Hz;
+  o.max_delay_s = max_delay_s;
+  o.max_order = max_order;
   FrfOptions fo;
   fo.sample_rate_Hz = sample_rate_Hz;
   fo.period_samples = period_samples;
   fo.periods = periods;
   fo.realisations = realisations;
   fo.transient_periods = transient_periods;
-  std::vector<std::size_t> lines;
+  StageIdentification id;
   try {
+    set_stage_order(order, o);
     fo.validate();
     MultisineOptions mo;
     mo.sample_rate_Hz = sample_rate_Hz;
@@ -68,33 +59,15 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
       mo.f_min_Hz = sample_rate_Hz / static_cast<double>(period_samples);
       mo.f_max_Hz = 0.45 * sample_rate_Hz;
     }
-    lines = multisine_lines(mo);
+    const std::vector<std::size_t> lines = multisine_lines(mo);
+    id = identify_stage_dynamics(u, y, lines, fo, o, sampled_at_tick_end);
   } catch (const ParameterError& e) {
     throw PyParameterError(e.field(), e.what());
   }
-  FrequencyResponse frf = estimate_frequency_response(u, y, lines, fo);
-  if (!frf.ok()) throw PyParameterError("u", "no frequency response: " + frf.reason);
-  if (!continuous && sampled_at_tick_end) {
-    // y_k at the end of tick k is the conventional hold's sample k + 1 (as hystloop-identify does):
-    // one tick earlier than the hold the fit models, so the fitted delay is the rig's own.
-    for (std::size_t i = 0; i < frf.G.size(); ++i)
-      frf.G[i] *= std::polar(1.0, -2.0 * std::numbers::pi * frf.frequency_Hz[i] / sample_rate_Hz);
-  }
-  o.unit_dc_gain = false;  // the data carry the actuator's gain: reported as dc_gain
-  o.zoh_sample_rate_Hz = continuous ? 0.0 : sample_rate_Hz;
-  o.max_delay_s = max_delay_s;
-  o.max_order = max_order;
-  o.sigma_dof = frf.total_available ? 2.0 * static_cast<double>(frf.realisations - 1)
-                                    : 2.0 * static_cast<double>(frf.realisations * (frf.periods_used - 1));
-  if (o.sigma_dof <= 2.0) o.sigma_dof = 0.0;
-  const std::vector<double>& sigma = frf.total_available ? frf.sigma_total : frf.sigma_noise;
-  StageFitResult fit;
-  try {
-    fit = fit_stage_model({frf.frequency_Hz, frf.G, sigma}, o);
-  } catch (const ParameterError& e) {
-    throw PyParameterError(e.field(), e.what());
-  }
-  if (!fit.ok()) throw PyParameterError("u", "no stage model: " + fit.reason);
+  if (!id.ok()) throw PyParameterError("u", id.reason());
+  const FrequencyResponse& frf = id.frf;
+  const StageFitResult& fit = id.fit;
+  const std::vector<double>& sigma = id.sigma();
   std::vector<C> model;
   model.reserve(frf.frequency_Hz.size());
   for (const double f : frf.frequency_Hz) model.push_back(fit.sampled_response(f));

@@ -14,6 +14,7 @@
 #include "core/cli.hpp"
 #include "core/errors.hpp"
 #include "ident/sample_csv.hpp"
+#include "ident/stage_identification.hpp"
 #include "identify_output.hpp"
 #include "log_samples.hpp"
 #include "models/csv_columns.hpp"
@@ -297,32 +298,13 @@ report::PlotResult write_stage_plots(const FrequencyResponse& frf, const StageFi
   return result;
 }
 
-StageFitOptions fit_options(const IdentifyArgs& args, const StageRecord& r, const FrequencyResponse& frf) {
+StageFitOptions fit_options(const IdentifyArgs& args, const StageRecord& r) {
   StageFitOptions o;
   o.unit_dc_gain = false;  // the data carry the actuator's gain: reported, then normalised away
   o.zoh_sample_rate_Hz = args.continuous ? 0.0 : r.sample_rate_Hz;
   o.max_delay_s = args.max_delay_s;
   o.max_order = args.max_order;
-  // E[1 / sigma^2] of an estimated variance: its degrees of freedom.
-  o.sigma_dof = frf.total_available ? 2.0 * static_cast<double>(frf.realisations - 1)
-                                    : 2.0 * static_cast<double>(frf.realisations * (frf.periods_used - 1));
-  if (o.sigma_dof <= 2.0) o.sigma_dof = 0.0;
-  if (args.order == "auto") {
-    o.auto_order = true;
-  } else {
-    const std::size_t slash = args.order.find('/');
-    int m = -1, n = -1;
-    if (slash != std::string::npos) {
-      std::from_chars(args.order.data(), args.order.data() + slash, m);
-      std::from_chars(args.order.data() + slash + 1, args.order.data() + args.order.size(), n);
-    }
-    if (m < 0 || n < 1 || m > n) {
-      throw ParameterError("order",
-                           "NUM/DEN with 0 <= NUM <= DEN, DEN >= 1 (e.g. 2/4), or auto (got '" + args.order + "')");
-    }
-    o.numerator_order = m;
-    o.denominator_order = n;
-  }
+  set_stage_order(args.order, o);
   return o;
 }
 
@@ -368,27 +350,14 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   fo.periods = r.periods;
   fo.realisations = r.realisations;
   fo.transient_periods = args.transient_periods;
-  const FrequencyResponse estimated = estimate_frequency_response(r.u, r.y, r.lines, fo);
-  if (!estimated.ok()) {
-    std::cerr << "hystloop-identify: no frequency response: " << estimated.reason << "\n";
+  const StageIdentification id = identify_stage_dynamics(r.u, r.y, r.lines, fo, fit_options(args, r),
+                                                         !args.continuous && args.sample_at == "end");
+  if (!id.ok()) {
+    std::cerr << "hystloop-identify: " << id.reason() << "\n";
     return kExitFailure;
   }
-  FrequencyResponse frf = estimated;
-  if (!args.continuous && args.sample_at == "end") {
-    // y_k at the end of tick k is the conventional hold's sample k + 1: one tick earlier than the
-    // zero-order hold the fit models. Delaying the data by that tick (z^-1, exact on the lines) makes
-    // the fitted delay the rig's own (LinearStageSpec::delay_s), which may be under a tick.
-    for (std::size_t i = 0; i < frf.G.size(); ++i) {
-      frf.G[i] *= std::polar(1.0, -2.0 * std::numbers::pi * frf.frequency_Hz[i] / r.sample_rate_Hz);
-    }
-  }
-  const StageFitOptions o = fit_options(args, r, frf);
-  const std::vector<double>& sigma = frf.total_available ? frf.sigma_total : frf.sigma_noise;
-  const StageFitResult fit = fit_stage_model({frf.frequency_Hz, frf.G, sigma}, o);
-  if (!fit.ok()) {
-    std::cerr << "hystloop-identify: no stage model: " << fit.reason << "\n";
-    return kExitFailure;
-  }
+  const FrequencyResponse& frf = id.frf;
+  const StageFitResult& fit = id.fit;
   print_fit(frf, fit);
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
