@@ -11,24 +11,8 @@ namespace hystloop {
 
 double lowest_linear_feature_hz(const StageModel& stage, double dt_s) {
   if (!stage.is_linear()) return 0.0;
-  // From the sampled stage (its poles and the zeros of its rational part), without the delay,
-  // which moves neither: omega_n = |ln z| / dt and zeta = -Re(ln z) / |ln z| for z = e^{s dt}. The
-  // sampling zeros sit near z = -1, at half the tick rate, and never set the minimum.
-  LinearStageSpec no_delay = stage.linear;
-  no_delay.delay_s = 0.0;
-  const DiscreteLinearStage d = discretise(no_delay, dt_s);
-  constexpr double kLightDamping = 0.5;
-  double lowest = 0.0;
-  const auto consider = [&](const std::complex<double>& z) {
-    if (std::abs(z.imag()) < 1e-12 || std::abs(z) == 0.0) return;
-    const std::complex<double> s = std::log(z) / dt_s;
-    if (-s.real() / std::abs(s) >= kLightDamping) return;
-    const double f = std::abs(s) / (2.0 * std::numbers::pi);
-    if (lowest == 0.0 || f < lowest) lowest = f;
-  };
-  for (const auto& p : d.poles) consider(p);
-  for (const auto& z : d.zeros) consider(z);
-  return lowest;
+  constexpr double kLightDamping = 0.5;  // a pole or zero pair damped more bends |T| by at most 1.25 dB
+  return stage.lowest_resonance_rad_s(dt_s, true, kLightDamping) / (2.0 * std::numbers::pi);
 }
 
 LearningConfig learning_for_stage(const LearningConfig& learning, const StageModel& stage, double dt_s) {

@@ -35,7 +35,7 @@ inline LearningConfig default_learning() {
 // 546 Hz, where the filter is down to 0.22 at the mode, so that a mode 10 % off (|1 - T| up to
 // ~3.6 there) keeps Q (1 - gain + gain |1 - T|) below 0.5, inside the update's bound. Measured on
 // the two-mode stage with such models (bench/tracking_table --scan --two-mode --wrong-models):
-// every line converges, none clamps; 0.5 converged the same with 0.1-0.4 nm more left at 50 Hz.
+// every line converges, none clamps.
 // The configured cutoff stays when it is lower; Banning's second order keeps it (the 2 kHz filter
 // converges on it: bench/tracking_table --scan).
 inline constexpr double kLearningShareOfResonance = 0.7;

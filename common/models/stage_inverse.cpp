@@ -54,19 +54,27 @@ void StageModel::validate(double dt_s) const {
   const StageInverse check(second_order, dt_s);
 }
 
-double StageModel::lowest_resonance_rad_s(double dt_s) const {
-  if (kind == Kind::kSecondOrder) return second_order.natural_frequency();
+double StageModel::lowest_resonance_rad_s(double dt_s, bool with_zeros, double max_damping) const {
+  if (kind == Kind::kSecondOrder) {
+    return second_order.damping_ratio() < max_damping ? second_order.natural_frequency() : 0.0;
+  }
   if (kind != Kind::kLinear) return 0.0;
-  // From the sampled stage's complex poles: omega_n = |ln z| / dt = |p| for z = e^{p dt} (the delay
-  // moves no pole, and is left out so that a fine dt_s is never refused for it).
+  // From the sampled stage: s = ln(z) / dt, omega_n = |s|, zeta = -Re(s) / |s| (the delay moves no
+  // pole or zero, and is left out so that a fine dt_s is never refused for it). The sampling zeros
+  // sit near z = -1, at half the tick rate, and never set the minimum.
   LinearStageSpec no_delay = linear;
   no_delay.delay_s = 0.0;
   const DiscreteLinearStage d = discretise(no_delay, dt_s);
   double lowest = 0.0;
-  for (const auto& p : d.poles) {
-    if (std::abs(p.imag()) < 1e-12 || std::abs(p) == 0.0) continue;
-    const double w = std::abs(std::log(p)) / dt_s;
-    if (lowest == 0.0 || w < lowest) lowest = w;
+  const auto consider = [&](const std::complex<double>& z) {
+    if (std::abs(z.imag()) < 1e-12 || std::abs(z) == 0.0) return;
+    const std::complex<double> s = std::log(z) / dt_s;
+    if (-s.real() / std::abs(s) >= max_damping) return;
+    if (lowest == 0.0 || std::abs(s) < lowest) lowest = std::abs(s);
+  };
+  for (const auto& p : d.poles) consider(p);
+  if (with_zeros) {
+    for (const auto& z : d.zeros) consider(z);
   }
   return lowest;
 }

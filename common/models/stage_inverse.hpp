@@ -73,8 +73,10 @@ struct StageModel {
   // at tick dt_s, see StageInverse), or the linear stage's field ("stage.poles[1]", "stage.delay_s",
   // "stage.preview_ticks" when the preview is too short to invert it).
   void validate(double dt_s) const;
-  // The stage's lowest resonance [rad/s] (0: none): what corner roundings and servo notches start from.
-  double lowest_resonance_rad_s(double dt_s) const;
+  // The stage's lowest resonance [rad/s] (0: none): what corner roundings and servo notches start
+  // from. Of the complex poles (with_zeros: and the complex zeros of a linear stage) whose damping
+  // ratio is under max_damping, the lowest natural frequency, from the stage sampled at dt_s.
+  double lowest_resonance_rad_s(double dt_s, bool with_zeros = false, double max_damping = 1.0) const;
 };
 
 // The preview a linear stage's inverse needs at tick dt_s: `wanted` when it is enough (throws the
