@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -84,6 +85,16 @@ BridgeSettings fast_ramp_settings() {
 }
 
 using testing::eventually;
+
+// The real-time thread's next report, copied: requested, waited for and released.
+std::optional<RtReport> next_report(BridgeRealtime& rt) {
+  rt.reports().request();
+  const RtReport* report = nullptr;
+  if (!eventually([&] { return (report = rt.reports().take()) != nullptr; })) return std::nullopt;
+  const RtReport copy = *report;
+  rt.reports().release();
+  return copy;
+}
 
 // Started, armed by the first command and driven to `u_V` (the slew limit: 5 V per tick).
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, Record& record, double u_V) {
@@ -186,15 +197,13 @@ TEST(BridgeRealtimeStop, AStallOfItsOwnClockBeyondTheBoundRampsToSafe) {
   rt->start();
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 3000 && record.last_u_V.load() == 0.0; }))
       << "the stage did not go back to the safe voltage after the stall";
-  rt->reports().request();
-  const RtReport* report = nullptr;
-  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  const std::optional<RtReport> report = next_report(*rt);
+  ASSERT_TRUE(report) << "no report from the real-time thread";
   EXPECT_EQ(report->stall_trips, 1u);
   EXPECT_GE(report->ticks_skipped, 300u);
   EXPECT_GT(report->last_stall_ticks, 100u);  // beyond the bound (a busy machine may trip it earlier)
   EXPECT_FALSE(report->armed);
   EXPECT_EQ(report->core.watchdog_trips, 0u);  // commands were there: the stall, not the compensator
-  rt->reports().release();
   rt->stop();
   // Up at the slew limit (to 200 V, unless a busy machine stalled the thread earlier), then down
   // at the safe ramp (1 V a tick), never a step.
@@ -214,13 +223,11 @@ TEST(BridgeRealtimeStop, AShortStallOfItsOwnClockIsCountedAndStaysArmed) {
   for (std::int64_t k = 0; k < 16000; ++k) ASSERT_TRUE(rt->push_command({k, 200.0, std::nan(""), 1, 2}));
   rt->start();
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 3500; }));
-  rt->reports().request();
-  const RtReport* report = nullptr;
-  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  const std::optional<RtReport> report = next_report(*rt);
+  ASSERT_TRUE(report) << "no report from the real-time thread";
   EXPECT_EQ(report->stall_trips, 0u);
   EXPECT_GE(report->ticks_skipped, 150u);
   EXPECT_TRUE(report->armed);
-  rt->reports().release();
   EXPECT_EQ(record.last_u_V.load(), 200.0);
 }
 
@@ -236,14 +243,12 @@ TEST(BridgeRealtimeStop, APositionBeyondItsSoftLimitRampsToSafe) {
   for (std::int64_t k = 0; k < 8000; ++k) ASSERT_TRUE(rt->push_command({k, 200.0, std::nan(""), 1, 2}));
   rt->start();
   ASSERT_TRUE(eventually([&] { return record.steps.load() > 400; }));
-  rt->reports().request();
-  const RtReport* report = nullptr;
-  ASSERT_TRUE(eventually([&] { return (report = rt->reports().take()) != nullptr; }));
+  const std::optional<RtReport> report = next_report(*rt);
+  ASSERT_TRUE(report) << "no report from the real-time thread";
   EXPECT_EQ(report->position_trips, 1u);
   EXPECT_EQ(report->position_axis, 0);
   EXPECT_GT(report->position_m, 1e-6);
   EXPECT_FALSE(report->armed);
-  rt->reports().release();
   rt->stop();
   // Up at the slew limit (5 V a tick) past 100 V for the three ticks and the one the disarm
   // takes effect after, then down at the safe ramp (1 V a tick) to 0 V.
