@@ -5,6 +5,7 @@
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
 //   mode off|MODEL                                   gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--target bridge]
+//                                                    [--stage-config FILE [--extra-delay-ticks N] [--force]]
 //   learn on|off|reset [--target compensator]        learning for periodic references (SET_LEARNING)
 //   pin-model MODEL|auto [--axis x|y|z]              the re-identifier's model choice (ctl_pin_model.hpp)
 //   hold on|off [--axis x|y|z]                       the re-identifier keeps the set and model in use
@@ -48,6 +49,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "core/cli.hpp"
+#include "core/config.hpp"
 #include "core/errors.hpp"
 #include "ctl_ack.hpp"
 #include "ctl_config_get.hpp"
@@ -56,6 +58,7 @@
 #include "ctl_link.hpp"
 #include "ctl_pin_model.hpp"
 #include "ctl_requests.hpp"
+#include "ctl_servo_check.hpp"
 #include "auth/rig_key.hpp"
 #include "lcm/rig_auth.hpp"
 #include "lcm/servo_gains_status.hpp"
@@ -63,6 +66,7 @@
 #include "loop/trajectory.hpp"
 #include "models/axis_coupling.hpp"
 #include "models/feedforward_mode.hpp"
+#include "runtime/stage_config.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace {
@@ -77,6 +81,9 @@ struct Options {
   std::string mode;
   GainsRequest gains;
   std::string gains_target = "bridge";  // the servo runs in the bridge
+  std::string gains_stage_config;       // a YAML with the stage: section the margins are computed on
+  int gains_extra_delay_ticks = 0;      // a card's read after its write: 1
+  bool gains_force = false;             // send gains the loop is unstable with on that stage
   ExperimentRequest experiment;
   double multisine_period_s = 0.2;  // 5 Hz lines
   bool experiment_mem_paper = false;
@@ -139,6 +146,63 @@ bool print_gains(const std::string& bridge, const service_status_t& report) {
   return any;
 }
 
+// The gains as they will be in force on each axis the request sets, checked on the stage model of
+// --stage-config (ctl_servo_check.hpp): margins printed, a warning for each bound missed. 0: send;
+// 1: no status to learn the gains in force from; 2: unstable on that stage and not --force.
+int check_gains_on_stage(const Options& o) {
+  const std::string& file = o.gains_stage_config;
+  const Config config = Config::load_file(file);
+  const double dt_s = config.get_in_range("compensator.dt_s", 1e-4, 1e-6, 1.0);
+  const std::optional<ServoLoopModel> model =
+      servo_loop_model(read_stage_model(config, StageModel{}, dt_s), dt_s, o.gains_extra_delay_ticks);
+  if (!model) {
+    fmt::print("hystloop-ctl: margins not checked: {} gives a stage without dynamics (stage.kind none)\n", file);
+    return 0;
+  }
+  const std::string& bridge = o.gains_target;
+  CtlLink link(o.link);
+  const StatusWait w = wait_for_status(
+      link, bridge, [](const service_status_t&) { return true; }, o.ack.timeout_s);
+  if (!w.satisfied) {
+    std::fprintf(stderr,
+                 "hystloop-ctl: no status from '%s' on %s within %g s (the gains in force, to check the "
+                 "new ones with): is a rig running?\n",
+                 bridge.c_str(), link.channels().status.c_str(), o.ack.timeout_s);
+    return 1;
+  }
+  const service_status_t& report = w.last.at(bridge);
+  bool unstable = false, any = false;
+  for (int axis = 0; axis < kMaxAxes; ++axis) {
+    std::optional<ServoGainsFigures> g =
+        servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); }, axis);
+    if (!g) break;  // a one-axis bridge reports x's only
+    if (o.gains.axis != control_t::EVERY_AXIS && axis != o.gains.axis) continue;
+    any = true;
+    g->kp = o.gains.kp.value_or(g->kp);
+    g->ki_per_s = o.gains.ki.value_or(g->ki_per_s);
+    g->kd_s = o.gains.kd.value_or(g->kd_s);
+    g->notch_hz = o.gains.notch_hz.value_or(g->notch_hz);
+    g->notch_q = o.gains.notch_q.value_or(g->notch_q);
+    const ServoCheck c = check_servo(*g, *model);
+    fmt::print("hystloop-ctl: servo {} on the stage of {}{}: {}\n", axis_name(axis), file,
+               o.gains_extra_delay_ticks > 0 ? fmt::format(" (+{} ticks)", o.gains_extra_delay_ticks) : "",
+               describe_margins(c.margins));
+    for (const std::string& warning : c.warnings) fmt::print(stderr, "hystloop-ctl: WARNING: {}\n", warning);
+    unstable = unstable || !c.stable();
+  }
+  if (!any) {
+    fmt::print("hystloop-ctl: margins not checked: '{}' reports no servo gains for that axis\n", bridge);
+    return 0;
+  }
+  if (unstable && !o.gains_force) {
+    std::fprintf(stderr,
+                 "hystloop-ctl: not sent: the loop would be unstable on that stage (--force sends the gains "
+                 "anyway)\n");
+    return 2;
+  }
+  return 0;
+}
+
 int run_gains(Options& o) {
   const std::string bridge = o.gains_target;
   if (o.gains.empty()) {  // a question: the gains in force
@@ -155,6 +219,13 @@ int run_gains(Options& o) {
     return 1;
   }
   o.gains.validate();
+  if (o.gains_stage_config.empty()) {
+    fmt::print(
+        "hystloop-ctl: margins not checked (give --stage-config: the compensator's config, whose stage: section is "
+        "the model to check them on)\n");
+  } else if (const int rc = check_gains_on_stage(o); rc != 0) {
+    return rc;
+  }
   std::map<std::string, service_status_t> last;
   const int rc = send_control(
       o, control_t::SET_GAINS, bridge, "SET_GAINS", nullptr, {}, [&](control_t& msg) { apply(o.gains, msg); }, &last);
@@ -428,6 +499,15 @@ CommandRun add_gains_command(CLI::App& app, Options& o) {
   add_axis_option(gains, "--axis", o.gains.axis,
                   "The axis whose servo it sets (default: every axis, each keeping its own value of a gain not "
                   "given); printing: every axis's");
+  gains
+      ->add_option("--stage-config", o.gains_stage_config,
+                   "Before sending, the loop's margins on the stage: section of this YAML (the compensator's "
+                   "config; env HYSTLOOP_STAGE_CONFIG, which deploy/hystloop ctl sets): a warning under 6 dB / 40 "
+                   "deg, refused when unstable")
+      ->envname("HYSTLOOP_STAGE_CONFIG");
+  gains->add_option("--extra-delay-ticks", o.gains_extra_delay_ticks,
+                    "Ticks of delay the margins add to the simulator's one (a card's read after its write: 1)");
+  gains->add_flag("--force", o.gains_force, "Send gains the loop is unstable with on the stage model");
   add_wait_options(gains, o);
 
   return [&o, gains]() -> std::optional<int> {

@@ -303,6 +303,47 @@ TEST_F(CtlLcmTest, ControlsWaitForTheAnswerOfTheProcessTheyAreFor) {
   r = run({"gains", "--kp", "0.2"}, {{"bridge", A::kAct}});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("kp 0.2, ki 600 1/s, kd 0 s, notch at 1720 Hz (Q 3)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("margins not checked"), std::string::npos) << r.out;
+
+  // With the stage model the compensator inverts (here a two-mode stage with 1.5 ticks of delay):
+  // the margins of the gains as they will be, before anything is sent. Banning's servo there is
+  // unstable: refused, nothing sent, unless forced; a notch on the first mode is stable but short
+  // of phase: sent, with a warning.
+  const std::filesystem::path stage_yaml =
+      std::filesystem::temp_directory_path() / ("ctl_gains_stage_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(stage_yaml) << "stage:\n  kind: linear\n  modes:\n"
+                               "    - {frequency_hz: 780, damping_ratio: 0.03, weight: 0.92}\n"
+                               "    - {frequency_hz: 2400, damping_ratio: 0.02, weight: 0.08}\n"
+                               "  delay_s: 1.5e-4\n";
+  const std::vector<std::string> banning_servo{"gains",
+                                               "--kp",
+                                               "0.05",
+                                               "--ki",
+                                               "2000",
+                                               "--notch-hz",
+                                               "1720",
+                                               "--notch-q",
+                                               "0.7",
+                                               "--stage-config",
+                                               stage_yaml.string()};
+  r = run(banning_servo, {{"bridge", A::kAct}});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.out.find("servo x on the stage of " + stage_yaml.string() + ": UNSTABLE"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("not sent: the loop would be unstable"), std::string::npos) << r.err;
+  EXPECT_EQ(last_id, 0) << "a SET_GAINS went out";
+  std::vector<std::string> forced = banning_servo;
+  forced.push_back("--force");
+  r = run(forced, {{"bridge", A::kAct}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(last_id, 0);
+  r = run({"gains", "--notch-hz", "780", "--notch-q", "0.5", "--kp", "0.05", "--ki", "2000", "--stage-config",
+           stage_yaml.string()},
+          {{"bridge", A::kAct}});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(last_id, 0);
+  EXPECT_NE(r.err.find("WARNING: phase margin"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("WARNING: gain margin"), std::string::npos) << r.err;
+  std::filesystem::remove(stage_yaml);
 
   // --no-wait: today's fire and forget.
   r = run({"arm", "--no-wait"}, {});
