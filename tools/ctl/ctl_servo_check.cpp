@@ -41,7 +41,7 @@ ServoCheck check_servo(const ServoGainsFigures& gains, const ServoLoopModel& mod
                                      m.gain_margin_hz, kMinGainMargin_dB));
   }
   if (m.phase_margin_deg < kMinPhaseMargin_deg) {
-    c.warnings.push_back(fmt::format("phase margin {:.0f} deg at {:.4g} Hz is under {:g} deg", m.phase_margin_deg,
+    c.warnings.push_back(fmt::format("phase margin {:.1f} deg at {:.4g} Hz is under {:g} deg", m.phase_margin_deg,
                                      m.crossover_hz, kMinPhaseMargin_deg));
   }
   return c;
