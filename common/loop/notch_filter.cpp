@@ -19,4 +19,18 @@ BiquadCoefficients design_notch(double centre_hz, double q, double rate_hz) noex
   return c;
 }
 
+BiquadCoefficients design_highpass(double corner_hz, double rate_hz) noexcept {
+  // H(s) = s^2 / (s^2 + sqrt(2) W s + W^2), W prewarped: K = tan(pi fc T).
+  const double K = std::tan(std::numbers::pi * corner_hz / rate_hz);
+  const double K2 = K * K;
+  const double norm = 1.0 + std::numbers::sqrt2 * K + K2;
+  BiquadCoefficients c;
+  c.b0 = 1.0 / norm;
+  c.b1 = -2.0 / norm;
+  c.b2 = 1.0 / norm;
+  c.a1 = 2.0 * (K2 - 1.0) / norm;
+  c.a2 = (1.0 - std::numbers::sqrt2 * K + K2) / norm;
+  return c;
+}
+
 }  // namespace hystloop

@@ -17,6 +17,10 @@ struct BiquadCoefficients {
 // Requires 0 < centre_hz < rate_hz / 2 and q > 0 (the caller validates; FeedbackGains does).
 BiquadCoefficients design_notch(double centre_hz, double q, double rate_hz) noexcept;
 
+// A second-order Butterworth high-pass at corner_hz (-3 dB, prewarped) by the same transform;
+// NotchFilter runs any such biquad. Requires 0 < corner_hz < rate_hz / 2 (the caller validates).
+BiquadCoefficients design_highpass(double corner_hz, double rate_hz) noexcept;
+
 class NotchFilter {
  public:
   NotchFilter() = default;

@@ -73,6 +73,16 @@ std::string position_reason(int axis, double y_m, const ActuatorLimits& limits, 
       ActuatorLimits::kPositionLimitTicks, axes > 1 ? "every axis" : "the actuator", tick);
 }
 
+std::string oscillation_reason(int axis, double hz, double rms_V, const OscillationLimit& limit, int axes,
+                               std::int64_t tick) {
+  return fmt::format(
+      "{}'s servo oscillates at {:.0f} Hz: its output {:.3g} V RMS above {:g} Hz for {:g} ms, beyond "
+      "bridge.oscillation_rms_V {:g} V: {} to the safe state at tick {} (its gains or notch do not suit the stage: "
+      "hystloop-ctl gains --stage-config checks them); re-arm via HX_CONTROL",
+      axis_name(axis), hz, rms_V, limit.above_hz, limit.hold_s * 1e3, limit.rms_V,
+      axes > 1 ? "every axis" : "the actuator", tick);
+}
+
 std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick) {
   return fmt::format(
       "the bridge's own clock stalled: {} ticks ({:.3g} ms) skipped within one second, beyond bridge.max_stall_s "

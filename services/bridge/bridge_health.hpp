@@ -10,6 +10,7 @@
 #include <string>
 
 #include "loop/bridge_core.hpp"
+#include "loop/oscillation_detector.hpp"
 
 namespace hystloop {
 
@@ -67,6 +68,12 @@ std::string watchdog_reason(const DryBufferFigures& f);
 // "axis x's measured position 1.23 um beyond actuator.position_max_m 1 um for 3 ticks: every axis to
 // the safe state at tick 4567; re-arm via HX_CONTROL"
 std::string position_reason(int axis, double y_m, const ActuatorLimits& limits, int axes, std::int64_t tick);
+
+// "axis x's servo oscillates at 5000 Hz: its output 7.1 V RMS above 300 Hz for 20 ms, beyond
+// bridge.oscillation_rms_V 5 V: every axis to the safe state at tick 4567 (its gains or notch do not
+// suit the stage: hystloop-ctl gains --stage-config checks them); re-arm via HX_CONTROL"
+std::string oscillation_reason(int axis, double hz, double rms_V, const OscillationLimit& limit, int axes,
+                               std::int64_t tick);
 
 std::string stall_reason(std::uint64_t skipped_ticks, double max_stall_s, double rate_hz, std::int64_t tick);
 

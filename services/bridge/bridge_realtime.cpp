@@ -44,6 +44,7 @@ BridgeRealtime::BridgeRealtime(const BridgeSettings& settings, std::unique_ptr<S
   for (int a = 0; a < settings.axes; ++a) {
     position_min_m_[static_cast<std::size_t>(a)] = settings.limits_of(a).position_min_m;
     position_max_m_[static_cast<std::size_t>(a)] = settings.limits_of(a).position_max_m;
+    oscillation_[static_cast<std::size_t>(a)] = OscillationDetector(settings.oscillation, settings.rate_hz);
   }
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw std::system_error(errno, std::generic_category(), "eventfd");
@@ -182,6 +183,22 @@ void BridgeRealtime::check_positions(std::int64_t k, std::span<const StageReadin
   }
 }
 
+void BridgeRealtime::check_oscillation(std::int64_t k, std::span<const BridgeTick> decided) noexcept {
+  if (!stage_.armed()) {  // disarmed, the servo is off: a re-armed loop is watched afresh
+    for (std::size_t a = 0; a < decided.size(); ++a) oscillation_[a].reset();
+    return;
+  }
+  for (std::size_t a = 0; a < decided.size(); ++a) {
+    if (!oscillation_[a].observe(decided[a].u_fb_V)) continue;
+    arming_.request(ArmRequest::kDisarm, k, stage_);  // every axis ramps to safe from the next tick
+    ++oscillation_trips_;
+    oscillation_axis_ = static_cast<int>(a);
+    oscillation_hz_ = oscillation_[a].frequency_hz();
+    oscillation_rms_V_ = oscillation_[a].tripped_rms_V();
+    oscillation_tick_ = k;
+  }
+}
+
 std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::int64_t start_ns) noexcept {
   const auto axes = static_cast<std::size_t>(stage_.axes());
   if (!arming_.stopping() && safe_stop_.load(std::memory_order_acquire)) {
@@ -206,6 +223,7 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   std::array<BridgeTick, kMaxAxes> decided{};
   stage_.tick(k, std::span(y_last_m_).first(axes), decided);
   arming_.after_tick(k, stage_);
+  check_oscillation(k, std::span<const BridgeTick>(decided).first(axes));
   if (const std::uint64_t trips = stage_.counters().watchdog_trips; trips != trips_seen_) {
     trips_seen_ = trips;
     last_trip_ns_ = start_ns;
@@ -286,6 +304,11 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
     r.position_axis = position_axis_;
     r.position_m = position_m_;
     r.position_tick = position_tick_;
+    r.oscillation_trips = oscillation_trips_;
+    r.oscillation_axis = oscillation_axis_;
+    r.oscillation_hz = oscillation_hz_;
+    r.oscillation_rms_V = oscillation_rms_V_;
+    r.oscillation_tick = oscillation_tick_;
     r.ticks_caught_up = ticks_caught_up_;
     r.samples_dropped = samples_dropped_;
     r.commands_processed = commands_processed_;

@@ -148,6 +148,14 @@ class BridgeRealtime {
   int position_axis_ = -1;
   double position_m_ = 0.0;
   std::int64_t position_tick_ = -1;
+  // The servo's oscillation detector per axis (BridgeSettings::oscillation), watching armed ticks.
+  void check_oscillation(std::int64_t k, std::span<const BridgeTick> decided) noexcept;
+  std::array<OscillationDetector, kMaxAxes> oscillation_{};
+  std::uint64_t oscillation_trips_ = 0;
+  int oscillation_axis_ = -1;
+  double oscillation_hz_ = 0.0;
+  double oscillation_rms_V_ = 0.0;
+  std::int64_t oscillation_tick_ = -1;
   std::uint64_t ticks_caught_up_ = 0;
   std::uint64_t samples_dropped_ = 0;
   std::uint64_t commands_processed_ = 0;

@@ -325,6 +325,7 @@ CounterSet::Entries BridgeService::counter_entries(const RtReport& rt) const {
       {"ticks_skipped", rt.ticks_skipped},
       {"stall_trips", rt.stall_trips},
       {"position_trips", rt.position_trips},
+      {"oscillation_trips", rt.oscillation_trips},
       {"ticks_caught_up", rt.ticks_caught_up},
       {"samples_dropped", rt.samples_dropped},
       {"command_queue_full", command_queue_full_},
@@ -416,6 +417,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     position_trips_reported_ = rt.position_trips;
     safe_reason_ = position_reason(rt.position_axis, rt.position_m, settings_.limits_of(rt.position_axis), rt.axes,
                                    rt.position_tick);
+    spdlog::warn("{}", safe_reason_);
+  }
+  if (rt.oscillation_trips != oscillation_trips_reported_ && rt.oscillation_axis >= 0) {
+    oscillation_trips_reported_ = rt.oscillation_trips;
+    safe_reason_ = oscillation_reason(rt.oscillation_axis, rt.oscillation_hz, rt.oscillation_rms_V,
+                                      settings_.oscillation, rt.axes, rt.oscillation_tick);
     spdlog::warn("{}", safe_reason_);
   }
   last_report_ns_ = now_ns;

@@ -110,6 +110,7 @@ class BridgeService {
   std::string safe_reason_ = "not armed";
   std::uint64_t stall_trips_reported_ = 0;  // RtReport::stall_trips when last reported
   std::uint64_t position_trips_reported_ = 0;
+  std::uint64_t oscillation_trips_reported_ = 0;
   std::uint64_t previous_skipped_ = 0;  // RtReport::ticks_skipped at the last report
   std::uint64_t trips_reported_ = 0;
   BridgeCounters previous_core_{};

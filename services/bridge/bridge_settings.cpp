@@ -203,6 +203,9 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "bridge.block_ticks",
                                                 "bridge.max_lead_s",
                                                 "bridge.max_stall_s",
+                                                "bridge.oscillation_rms_V",
+                                                "bridge.oscillation_above_hz",
+                                                "bridge.oscillation_hold_s",
                                                 "actuator.watchdog_s",
                                                 "rt.ticks_per_wake",
                                                 "rt.priority",
@@ -263,6 +266,15 @@ BridgeSettings load_bridge_settings(const Config& config) {
       static_cast<int>(config.get_int_in_range("bridge.command_queue_capacity", s.command_queue_capacity, 16, 100000));
   s.block_ticks = static_cast<int>(config.get_int_in_range("bridge.block_ticks", s.block_ticks, 1, 1000));
   s.max_stall_s = config.get_in_range("bridge.max_stall_s", s.max_stall_s, 1.0 / s.rate_hz, 1.0);
+  OscillationLimit& osc = s.oscillation;
+  osc.rms_V = config.get_non_negative("bridge.oscillation_rms_V", osc.rms_V);
+  osc.above_hz = config.get_positive("bridge.oscillation_above_hz", osc.above_hz);
+  osc.hold_s = config.get_positive("bridge.oscillation_hold_s", osc.hold_s);
+  try {
+    osc.validate(s.rate_hz);
+  } catch (const ParameterError& e) {
+    config.fail(e.field(), e.reason());
+  }
   s.max_lead_s = config.get_in_range("bridge.max_lead_s", s.max_lead_s, 2.0 / s.rate_hz,
                                      static_cast<double>(CommandBuffer::kCapacityTicks) / s.rate_hz);
 

@@ -13,6 +13,7 @@
 #include "core/config.hpp"
 #include "loop/bridge_core.hpp"
 #include "loop/multi_axis_stage.hpp"
+#include "loop/oscillation_detector.hpp"
 #include "loop/simulated_stage.hpp"
 #include "models/axis_coupling.hpp"
 
@@ -69,6 +70,10 @@ struct BridgeSettings {
   // short ones) takes every axis to the safe state, ramped, until re-armed. 10 ms: a fifth of the
   // plan's horizon, 20 ms of a 50 Hz line's period.
   double max_stall_s = 0.01;
+  // A servo that oscillates (loop/oscillation_detector.hpp): its output's RMS above a corner beyond
+  // a bound for a hold time, on any axis, takes every axis to the safe state, ramped, naming the
+  // axis and the frequency, until re-armed.
+  OscillationLimit oscillation{};
 
   double dt_s() const noexcept { return 1.0 / rate_hz; }
   // Axis i's actuator and servo (0 <= i < kMaxAxes).

@@ -31,6 +31,11 @@ struct RtReport {
   int position_axis = -1;                // the last of those: its axis,
   double position_m = 0.0;               // the position that tripped it,
   std::int64_t position_tick = -1;       // and the tick
+  std::uint64_t oscillation_trips = 0;   // a servo that oscillated (bridge.oscillation_*): the safe state
+  int oscillation_axis = -1;             // the last of those: its axis,
+  double oscillation_hz = 0.0;           // its frequency,
+  double oscillation_rms_V = 0.0;        // the servo output's RMS above the corner,
+  std::int64_t oscillation_tick = -1;    // and the tick
   std::uint64_t ticks_caught_up = 0;     // ticks run late, back to back, after an overrun (a simulator)
   std::uint64_t samples_dropped = 0;     // outgoing queue full: the I/O thread fell behind
   std::uint64_t commands_processed = 0;  // commands taken from the incoming queue

@@ -263,5 +263,48 @@ TEST(BridgeRealtimeStop, APositionBeyondItsSoftLimitRampsToSafe) {
             std::string::npos);
 }
 
+// A servo whose loop is unstable on the stage (kp 1.5 on a stage of the nominal gain with the
+// tick between a voltage and its sample: a closed-loop pole at -1.5) rings at half the tick rate
+// and grows; the detector finds it within its hold and every axis ramps to safe, the frequency named.
+TEST(BridgeRealtimeStop, AnOscillatingServoRampsToSafeNamingTheFrequency) {
+  BridgeSettings s = fast_ramp_settings();
+  s.servo.kp = 1.5;
+  s.servo.ki = 0.0;
+  Record record;
+  auto backend = std::make_unique<RecordingBackend>(record);
+  backend->y_per_V = s.servo.nominal_gain_m_per_V;
+  auto rt = std::make_unique<BridgeRealtime>(s, std::move(backend));
+  // 0.5 V off the feedforward's own position: the error the loop amplifies, 1.5 times a tick,
+  // until the slew limit (5 V a tick) bounds it: the servo's output then swings about +-3.75 V.
+  const double y_ref_m = 10.5 * s.servo.nominal_gain_m_per_V;
+  for (std::int64_t k = 0; k < 8000; ++k) ASSERT_TRUE(rt->push_command({k, 10.0, y_ref_m, 1, 2}));
+  rt->start();
+  std::optional<RtReport> report;
+  ASSERT_TRUE(eventually([&] { return (report = next_report(*rt)) && report->oscillation_trips > 0; }))
+      << "the oscillation was not found";
+  EXPECT_EQ(report->oscillation_trips, 1u);
+  EXPECT_EQ(report->oscillation_axis, 0);
+  EXPECT_NEAR(report->oscillation_hz, 5000.0, 250.0);
+  EXPECT_GT(report->oscillation_rms_V, s.oscillation.rms_V);
+  EXPECT_FALSE(report->armed);
+  ASSERT_TRUE(eventually([&] { return record.last_u_V.load() == s.limits.safe_u_V; }));
+  rt->stop();
+  // Armed at the first tick: beyond the bound for the hold (200 ticks) after the mean square's rise.
+  const std::int64_t trip = report->oscillation_tick;
+  EXPECT_GE(trip, 200);
+  EXPECT_LE(trip, 600);
+  // From the tick after the one the disarm takes effect at: down at the safe ramp (1 V a tick).
+  ASSERT_GT(record.u_V.size(), static_cast<std::size_t>(trip) + 3);
+  for (std::size_t i = static_cast<std::size_t>(trip) + 3; i < record.u_V.size(); ++i) {
+    ASSERT_LE(std::abs(record.u_V[i] - record.u_V[i - 1]), s.limits.safe_ramp_V_per_s * kDt * (1 + 1e-12))
+        << "step " << i;
+  }
+  EXPECT_EQ(record.u_V.back(), s.limits.safe_u_V);
+  EXPECT_NE(oscillation_reason(0, 5000.0, 7.1, s.oscillation, 1, 4567)
+                .find("x's servo oscillates at 5000 Hz: its output 7.1 V RMS above 300 Hz for 20 ms, beyond "
+                      "bridge.oscillation_rms_V 1 V: the actuator to the safe state at tick 4567"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace hystloop

@@ -150,6 +150,8 @@ TEST(BridgeSettings, EveryDeployedBridgeConfigLoads) {
   EXPECT_EQ(demo.servo.kp, 0.1);
   EXPECT_EQ(demo.servo.ki, 600.0);
   EXPECT_EQ(demo.servo.nominal_gain_m_per_V, 6.3e-9);
+  EXPECT_EQ(demo.oscillation.rms_V, 1.0);
+  EXPECT_EQ(demo.oscillation.hold_s, 0.02);
   EXPECT_EQ(demo.block_ticks, 50);
   EXPECT_LE(demo.rt.ticks_per_wake, demo.block_ticks);
   EXPECT_TRUE(demo.rt.lock_memory);
@@ -166,6 +168,9 @@ TEST(BridgeSettings, RefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\nactuator: {y: {position_min_m: 2e-6, position_max_m: 1e-6}}"),
                        "actuator.y.position_max_m"));
   EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "bridge.backend"));
+  EXPECT_TRUE(contains(refusal("bridge: {oscillation_rms_V: -1}"), "bridge.oscillation_rms_V"));
+  EXPECT_TRUE(contains(refusal("bridge: {oscillation_above_hz: 5000}"), "bridge.oscillation_above_hz"));
+  EXPECT_TRUE(contains(refusal("bridge: {oscillation_hold_s: 0.001}"), "bridge.oscillation_hold_s"));
   EXPECT_TRUE(contains(refusal("bridge: {noise_rms_m: .nan}"), "bridge.noise_rms_m"));
   EXPECT_TRUE(contains(refusal("banning: {hysteresis: {b: 9.0e-9}}"), "banning.hysteresis.b"));
   EXPECT_TRUE(contains(refusal("banning: {order: sideways}"), "banning.order"));
