@@ -28,8 +28,8 @@ void set_stage_order(std::string_view order, StageFitOptions& options) {
     if (em != std::errc{} || pm != order.data() + slash || en != std::errc{} || pn != end) m = n = -1;
   }
   if (m < 0 || n < 1 || m > n) {
-    throw ParameterError("order", "NUM/DEN with 0 <= NUM <= DEN, DEN >= 1 (e.g. 2/4), or auto (got '" +
-                                      std::string(order) + "')");
+    throw ParameterError(
+        "order", "NUM/DEN with 0 <= NUM <= DEN, DEN >= 1 (e.g. 2/4), or auto (got '" + std::string(order) + "')");
   }
   options.auto_order = false;
   options.numerator_order = m;

@@ -350,8 +350,8 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   fo.periods = r.periods;
   fo.realisations = r.realisations;
   fo.transient_periods = args.transient_periods;
-  const StageIdentification id = identify_stage_dynamics(r.u, r.y, r.lines, fo, fit_options(args, r),
-                                                         !args.continuous && args.sample_at == "end");
+  const StageIdentification id =
+      identify_stage_dynamics(r.u, r.y, r.lines, fo, fit_options(args, r), !args.continuous && args.sample_at == "end");
   if (!id.ok()) {
     std::cerr << "hystloop-identify: " << id.reason() << "\n";
     return kExitFailure;
