@@ -11,11 +11,21 @@ namespace hystloop::ctl {
 
 void CouplingRunOptions::validate() const {
   require_in_range("amplitude", amplitude_V, 1.0, 1000.0);
+  require_in_range("offset", offset_V, -1000.0, 1000.0);
   require_in_range("frequency", frequency_Hz, 0.1, 1000.0);
   require_positive("duration", duration_s);
   if (duration_s * frequency_Hz < 1.0) throw ParameterError("duration", "must cover at least one period");
   require_non_negative("rest", rest_s);
   require_positive("timeout", timeout_s);
+}
+
+ExperimentRequest coupling_experiment(const CouplingRunOptions& o) {
+  ExperimentRequest e;
+  e.amplitude_V = o.amplitude_V;
+  e.frequency_Hz = o.frequency_Hz;
+  e.duration_s = o.duration_s;
+  e.offset_V = o.offset_V;
+  return e;
 }
 
 CouplingFitResult fit_records(const std::vector<CouplingRecord>& records, int axes) {

@@ -17,6 +17,9 @@ namespace hystloop::ctl {
 
 struct CouplingRunOptions {
   double amplitude_V = 100.0;  // each axis's sine [V]
+  // ... about this voltage [V]: a unipolar stage (e.g. -20 .. +150 V) runs it inside its range.
+  // The fit takes the slopes between the sensors, so the offset changes nothing but where.
+  double offset_V = 0.0;
   double frequency_Hz = 5.0;
   double duration_s = 0.8;  // four periods at 5 Hz
   double rest_s = 1.0;      // after an axis's experiment, before the next: the axis comes back to rest
@@ -26,6 +29,9 @@ struct CouplingRunOptions {
   double timeout_s = 5.0;  // for each answer and beyond each experiment's duration
   void validate() const;   // throws ParameterError naming the option
 };
+
+// One axis's experiment of the run: the sine the options give (its axis set by the caller).
+ExperimentRequest coupling_experiment(const CouplingRunOptions& o);
 
 // The samples of one axis's experiment: every axis's sensor at the ticks the moved axis ran it
 // (no reference: y_ref NaN, and a voltage applied).

@@ -154,10 +154,7 @@ int run_coupling_experiment(CtlLink& link, const CouplingRunOptions& o) {
 
   // One axis's experiment: 0 done, else the exit status.
   const auto excite = [&](int a) -> int {
-    ExperimentRequest e;
-    e.amplitude_V = o.amplitude_V;
-    e.frequency_Hz = o.frequency_Hz;
-    e.duration_s = o.duration_s;
+    const ExperimentRequest e = coupling_experiment(o);
     const std::int64_t now = wall_utime();
     control_t msg =
         make_control(control_t::START_EXPERIMENT, o.compensator_process, new_request_id(now, ::getpid()), now);

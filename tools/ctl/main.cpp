@@ -614,16 +614,16 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
       experiment
           ->add_flag("--coupling", o.coupling,
                      "The cross-coupling of an XY(Z) stage: each axis in turn a sine (--amplitude, default "
-                     "100 V; --frequency, 5 Hz; --duration, 0.8 s) with the bridge's servo off (its gains "
+                     "100 V; --frequency, 5 Hz; --duration, 0.8 s; about --offset, 0 V) with the bridge's servo off (its gains "
                      "put back after), every sensor recorded; prints C and, with --out, writes the "
                      "compensator's decoupling.* keys")
-          ->excludes(mem_paper_exp, series, kind, offset, axis_option);
+          ->excludes(mem_paper_exp, series, kind, axis_option);
   experiment->add_option("--out", o.coupling_run.out, "coupling: YAML file for hystloop-compensator --params")
       ->needs(coupling);
   with_default(experiment, "--rest", o.coupling_run.rest_s, "coupling: rest between the axes' experiments [s]")
       ->needs(coupling);
 
-  return [&o, experiment, amplitude, frequency, duration, band, period]() -> std::optional<int> {
+  return [&o, experiment, amplitude, frequency, duration, offset, band, period]() -> std::optional<int> {
     if (!*experiment) return std::nullopt;
     if (o.banning_series) return run_banning_series(o);
     if (o.coupling) {
@@ -631,6 +631,7 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
       if (amplitude->count() > 0) c.amplitude_V = o.experiment.amplitude_V;
       if (frequency->count() > 0) c.frequency_Hz = o.experiment.frequency_Hz;
       if (duration->count() > 0) c.duration_s = o.experiment.duration_s;
+      if (offset->count() > 0) c.offset_V = o.experiment.offset_V;
       c.timeout_s = o.ack.timeout_s;
       CtlLink link(o.link);
       return run_coupling_experiment(link, c);

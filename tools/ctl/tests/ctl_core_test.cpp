@@ -379,6 +379,25 @@ TEST(CtlCoupling, RecordsOfEachAxisGiveTheCouplingAndTheCompensatorsKeys) {
   EXPECT_EQ(field_of([&] { o.validate(); }), "duration");
 }
 
+// A unipolar stage (-20 .. +150 V) runs each axis's sine about an offset inside its range: the
+// request carries it, and the message the compensator gets too.
+TEST(CtlCoupling, EachAxisSineRunsAboutTheOffsetGiven) {
+  CouplingRunOptions o;
+  o.amplitude_V = 60.0;
+  o.offset_V = 65.0;
+  ASSERT_NO_THROW(o.validate());
+  const ExperimentRequest e = coupling_experiment(o);
+  EXPECT_EQ(e.offset_V, 65.0);
+  EXPECT_EQ(e.amplitude_V, 60.0);
+  EXPECT_EQ(e.frequency_Hz, o.frequency_Hz);
+  EXPECT_EQ(e.duration_s, o.duration_s);
+  control_t msg = make_control(control_t::START_EXPERIMENT, "compensator", 1, 1);
+  apply(e, msg);
+  EXPECT_EQ(msg.experiment_offset_V, 65.0);
+  o.offset_V = std::nan("");
+  EXPECT_EQ(field_of([&] { o.validate(); }), "offset");
+}
+
 namespace {
 service_status_t report(const std::string& process, std::int8_t state, const std::string& detail = "") {
   service_status_t s{};
