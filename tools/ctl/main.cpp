@@ -614,7 +614,8 @@ CommandRun add_experiment_command(CLI::App& app, Options& o) {
       experiment
           ->add_flag("--coupling", o.coupling,
                      "The cross-coupling of an XY(Z) stage: each axis in turn a sine (--amplitude, default "
-                     "100 V; --frequency, 5 Hz; --duration, 0.8 s; about --offset, 0 V) with the bridge's servo off (its gains "
+                     "100 V; --frequency, 5 Hz; --duration, 0.8 s; about --offset, 0 V) with the bridge's servo off "
+                     "(its gains "
                      "put back after), every sensor recorded; prints C and, with --out, writes the "
                      "compensator's decoupling.* keys")
           ->excludes(mem_paper_exp, series, kind, axis_option);
