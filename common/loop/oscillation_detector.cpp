@@ -1,18 +1,16 @@
 #include "loop/oscillation_detector.hpp"
 
 #include <cmath>
-#include <string>
 
 #include "core/errors.hpp"
 
 namespace hystloop {
 
-void OscillationLimit::validate(double rate_hz, const char* prefix) const {
-  const std::string p(prefix);
-  require_non_negative(p + "oscillation_rms_V", rms_V);
+void OscillationLimit::validate(double rate_hz) const {
+  require_non_negative("bridge.oscillation_rms_V", rms_V);
   if (!enabled()) return;
-  require_in_range(p + "oscillation_above_hz", above_hz, 10.0, 0.45 * rate_hz);
-  require_in_range(p + "oscillation_hold_s", hold_s, 2.0 * kWindow_s, 1.0);
+  require_in_range("bridge.oscillation_above_hz", above_hz, 10.0, 0.45 * rate_hz);
+  require_in_range("bridge.oscillation_hold_s", hold_s, 2.0 * kWindow_s, 1.0);
 }
 
 OscillationDetector::OscillationDetector(const OscillationLimit& limit, double rate_hz) noexcept
@@ -20,9 +18,7 @@ OscillationDetector::OscillationDetector(const OscillationLimit& limit, double r
       alpha_(1.0 / (OscillationLimit::kWindow_s * rate_hz)),
       threshold2_(limit.rms_V * limit.rms_V),
       dt_s_(1.0 / rate_hz),
-      hold_ticks_(std::llround(limit.hold_s * rate_hz)) {
-  if (!limit.enabled()) threshold2_ = 0.0;
-}
+      hold_ticks_(std::llround(limit.hold_s * rate_hz)) {}
 
 bool OscillationDetector::observe(double u_V) noexcept {
   if (threshold2_ == 0.0 || tripped_) return false;
@@ -48,7 +44,5 @@ void OscillationDetector::reset() noexcept {
   beyond_ = crossings_ = 0;
   tripped_ = false;
 }
-
-double OscillationDetector::rms_V() const noexcept { return std::sqrt(mean_square_); }
 
 }  // namespace hystloop

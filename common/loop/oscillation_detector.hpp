@@ -27,9 +27,9 @@ struct OscillationLimit {
   double above_hz = 300.0;                    // the high-pass corner: above the tracking band [Hz]
   double hold_s = 0.02;                       // beyond the bound this long in a row [s]
   static constexpr double kWindow_s = 0.005;  // the mean square's time constant
-  // Throws ParameterError naming the field (prefix + "oscillation_rms_V", ...): rms_V >= 0, above_hz
-  // in [10, 0.45 rate_hz], hold_s in [2 kWindow_s, 1].
-  void validate(double rate_hz, const char* prefix = "bridge.") const;
+  // Throws ParameterError naming the key ("bridge.oscillation_rms_V", ...): rms_V >= 0, above_hz in
+  // [10, 0.45 rate_hz], hold_s in [2 kWindow_s, 1].
+  void validate(double rate_hz) const;
   bool enabled() const noexcept { return rms_V > 0.0; }
 };
 
@@ -43,7 +43,6 @@ class OscillationDetector {
   bool observe(double u_V) noexcept;
   void reset() noexcept;
 
-  double rms_V() const noexcept;  // the windowed RMS above the corner, now
   // Of the oscillation found: its frequency [Hz] and its RMS when found [V] (0 before).
   double frequency_hz() const noexcept { return frequency_hz_; }
   double tripped_rms_V() const noexcept { return tripped_rms_V_; }

@@ -70,7 +70,7 @@ std::string watchdog_reason(const DryBufferFigures& f);
 std::string position_reason(int axis, double y_m, const ActuatorLimits& limits, int axes, std::int64_t tick);
 
 // "axis x's servo oscillates at 5000 Hz: its output 7.1 V RMS above 300 Hz for 20 ms, beyond
-// bridge.oscillation_rms_V 5 V: every axis to the safe state at tick 4567 (its gains or notch do not
+// bridge.oscillation_rms_V 1 V: every axis to the safe state at tick 4567 (its gains or notch do not
 // suit the stage: hystloop-ctl gains --stage-config checks them); re-arm via HX_CONTROL"
 std::string oscillation_reason(int axis, double hz, double rms_V, const OscillationLimit& limit, int axes,
                                std::int64_t tick);

@@ -20,12 +20,7 @@ void CouplingRunOptions::validate() const {
 }
 
 ExperimentRequest coupling_experiment(const CouplingRunOptions& o) {
-  ExperimentRequest e;
-  e.amplitude_V = o.amplitude_V;
-  e.frequency_Hz = o.frequency_Hz;
-  e.duration_s = o.duration_s;
-  e.offset_V = o.offset_V;
-  return e;
+  return sine_experiment(o.offset_V, o.amplitude_V, o.frequency_Hz, o.duration_s);
 }
 
 CouplingFitResult fit_records(const std::vector<CouplingRecord>& records, int axes) {

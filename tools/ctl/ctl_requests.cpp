@@ -123,6 +123,26 @@ void ExperimentRequest::validate() const {
   require_in_range("offset", offset_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
 }
 
+ServoGainsFigures GainsRequest::applied_to(ServoGainsFigures in_force) const noexcept {
+  in_force.kp = kp.value_or(in_force.kp);
+  in_force.ki_per_s = ki.value_or(in_force.ki_per_s);
+  in_force.kd_s = kd.value_or(in_force.kd_s);
+  in_force.notch_hz = notch_hz.value_or(in_force.notch_hz);
+  in_force.notch_q = notch_q.value_or(in_force.notch_q);
+  return in_force;
+}
+
+ExperimentRequest sine_experiment(double offset_V, double amplitude_V, double frequency_Hz, double duration_s,
+                                  std::string kind) {
+  ExperimentRequest r;
+  r.kind = std::move(kind);
+  r.offset_V = offset_V;
+  r.amplitude_V = amplitude_V;
+  r.frequency_Hz = frequency_Hz;
+  r.duration_s = duration_s;
+  return r;
+}
+
 void apply(const GainsRequest& gains, control_t& msg) {
   gains.validate();
   const double keep = std::numeric_limits<double>::quiet_NaN();  // the bridge keeps that one

@@ -15,6 +15,7 @@
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/scan_t.hpp"
 #include "hystloop/trajectory_t.hpp"
+#include "lcm/servo_gains_status.hpp"
 #include "loop/experiment.hpp"
 
 namespace hystloop::ctl {
@@ -43,6 +44,8 @@ struct GainsRequest {
   static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
   // Nothing given: the request is a question (print the gains in force).
   bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q; }
+  // The gains in force with those this request changes.
+  ServoGainsFigures applied_to(ServoGainsFigures in_force) const noexcept;
   // Given gains finite, >= 0 and within the servo's plausibility bounds at 10 kHz (kp <= 2, ki <= 1e4 1/s,
   // kd <= 5.2e-4 s: loop/feedback.hpp); the notch as above ("notch-hz", "notch-q").
   void validate() const;
@@ -57,6 +60,10 @@ struct ExperimentRequest {
   MultisineExperiment multisine{};  // kind multisine: f_min and the rest (loop/experiment.hpp)
   void validate() const;
 };
+
+// A sine experiment (or a settle: the same sine, marked for identification to skip).
+ExperimentRequest sine_experiment(double offset_V, double amplitude_V, double frequency_Hz, double duration_s,
+                                  std::string kind = "sine");
 
 // --band F_MIN:F_MAX [Hz] of a multisine: sets request.multisine.f_min_hz and request.frequency_Hz.
 // Throws ParameterError("band").

@@ -9,13 +9,8 @@ namespace hystloop::ctl {
 namespace {
 
 ExperimentRequest sine(const char* kind, double offset_V, double amplitude_V, double frequency_Hz, double periods) {
-  ExperimentRequest r;
-  r.kind = kind;
-  r.offset_V = offset_V;
-  r.amplitude_V = amplitude_V;
-  r.frequency_Hz = frequency_Hz;
-  r.duration_s = periods / frequency_Hz;  // the compensator rounds up to whole periods: exactly these
-  return r;
+  // The compensator rounds the duration up to whole periods: exactly these.
+  return sine_experiment(offset_V, amplitude_V, frequency_Hz, periods / frequency_Hz, kind);
 }
 
 }  // namespace

@@ -44,6 +44,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <spdlog/fmt/fmt.h>
@@ -146,6 +147,21 @@ bool print_gains(const std::string& bridge, const service_status_t& report) {
   return any;
 }
 
+// The servo's process's status report (its gains in force); nullopt, said on stderr with `why`, when
+// none came within the timeout.
+std::optional<service_status_t> servo_status(const Options& o, const char* why) {
+  const std::string& bridge = o.gains_target;
+  CtlLink link(o.link);
+  StatusWait w = wait_for_status(
+      link, bridge, [](const service_status_t&) { return true; }, o.ack.timeout_s);
+  if (!w.satisfied) {
+    std::fprintf(stderr, "hystloop-ctl: no status from '%s' on %s within %g s%s: is a rig running?\n", bridge.c_str(),
+                 link.channels().status.c_str(), o.ack.timeout_s, why);
+    return std::nullopt;
+  }
+  return std::move(w.last.at(bridge));
+}
+
 // The gains as they will be in force on each axis the request sets, checked on the stage model of
 // --stage-config (ctl_servo_check.hpp): margins printed, a warning for each bound missed. 0: send;
 // 1: no status to learn the gains in force from; 2: unstable on that stage and not --force.
@@ -160,30 +176,17 @@ int check_gains_on_stage(const Options& o) {
     return 0;
   }
   const std::string& bridge = o.gains_target;
-  CtlLink link(o.link);
-  const StatusWait w = wait_for_status(
-      link, bridge, [](const service_status_t&) { return true; }, o.ack.timeout_s);
-  if (!w.satisfied) {
-    std::fprintf(stderr,
-                 "hystloop-ctl: no status from '%s' on %s within %g s (the gains in force, to check the "
-                 "new ones with): is a rig running?\n",
-                 bridge.c_str(), link.channels().status.c_str(), o.ack.timeout_s);
-    return 1;
-  }
-  const service_status_t& report = w.last.at(bridge);
+  const std::optional<service_status_t> status = servo_status(o, " (the gains in force, to check the new ones with)");
+  if (!status) return 1;
+  const service_status_t& report = *status;
   bool unstable = false, any = false;
   for (int axis = 0; axis < kMaxAxes; ++axis) {
-    std::optional<ServoGainsFigures> g =
+    const std::optional<ServoGainsFigures> in_force =
         servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); }, axis);
-    if (!g) break;  // a one-axis bridge reports x's only
+    if (!in_force) break;  // a one-axis bridge reports x's only
     if (o.gains.axis != control_t::EVERY_AXIS && axis != o.gains.axis) continue;
     any = true;
-    g->kp = o.gains.kp.value_or(g->kp);
-    g->ki_per_s = o.gains.ki.value_or(g->ki_per_s);
-    g->kd_s = o.gains.kd.value_or(g->kd_s);
-    g->notch_hz = o.gains.notch_hz.value_or(g->notch_hz);
-    g->notch_q = o.gains.notch_q.value_or(g->notch_q);
-    const ServoCheck c = check_servo(*g, *model);
+    const ServoCheck c = check_servo(o.gains.applied_to(*in_force), *model);
     fmt::print("hystloop-ctl: servo {} on the stage of {}{}: {}\n", axis_name(axis), file,
                o.gains_extra_delay_ticks > 0 ? fmt::format(" (+{} ticks)", o.gains_extra_delay_ticks) : "",
                describe_margins(c.margins));
@@ -206,15 +209,9 @@ int check_gains_on_stage(const Options& o) {
 int run_gains(Options& o) {
   const std::string bridge = o.gains_target;
   if (o.gains.empty()) {  // a question: the gains in force
-    CtlLink link(o.link);
-    const StatusWait w = wait_for_status(
-        link, bridge, [](const service_status_t&) { return true; }, o.ack.timeout_s);
-    if (!w.satisfied) {
-      std::fprintf(stderr, "hystloop-ctl: no status from '%s' on %s within %g s: is a rig running?\n", bridge.c_str(),
-                   link.channels().status.c_str(), o.ack.timeout_s);
-      return 1;
-    }
-    if (print_gains(bridge, w.last.at(bridge))) return 0;
+    const std::optional<service_status_t> report = servo_status(o, "");
+    if (!report) return 1;
+    if (print_gains(bridge, *report)) return 0;
     std::fprintf(stderr, "hystloop-ctl: '%s' reports no servo gains (a build that does not?)\n", bridge.c_str());
     return 1;
   }
