@@ -50,6 +50,7 @@ void LearningConfig::validate(double dt_s) const {
   require_in_range("learning.cutoff_hz", cutoff_hz, 1.0 / max_period_s, 0.25 / dt_s);
   require_in_range("learning.fade_s", fade_s, dt_s, 10.0);
   require_in_range("learning.blend_s", blend_s, 0.0, 1.0);
+  require_in_range("learning.ramp_periods", ramp_periods, 0.0, 100.0);
   if (hold_params_after < 0) throw ParameterError("learning.hold_params_after", "must be >= 0 (0: never hold)");
   if (monitor_ratio != 0.0) require_in_range("learning.monitor_ratio", monitor_ratio, 1.0, 100.0);
 }
@@ -61,6 +62,7 @@ PeriodicLearner::PeriodicLearner(const LearningConfig& config, double dt_s, std:
       max_correction_m_(config.max_correction_m),
       lag_compensated_(config.lag_compensated),
       enabled_(config.enabled),
+      ramp_periods_(config.ramp_periods),
       monitor_ratio_(config.monitor_ratio) {
   config.validate(dt_s);
   require_in_range("learning.max_lag_ticks", static_cast<double>(max_lag_ticks), 0.0, 1e6);
@@ -134,6 +136,8 @@ void PeriodicLearner::begin_again() noexcept {
   figures_.period_ticks = n_;
   if ((mode_ == Mode::kLearning || mode_ == Mode::kHolding) && have_table_) {
     // A table in use is faded out, never dropped: dropping it would step the reference.
+    // From what was applied last: a learning line under its ramp, a held table as it is.
+    fade_from_ = mode_ == Mode::kLearning && last_planned_ != kNoTick ? ramp(last_planned_) : 1.0;
     mode_ = Mode::kFading;
     scale_ = 1.0;
     fade_left_ = fade_ticks_;
@@ -148,10 +152,13 @@ void PeriodicLearner::begin_again() noexcept {
 void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
   have_table_ = false;
   have_prev_ = false;
+  prev_scale_ = 1.0;
   blend_n_ = 0;
+  ramp_ticks_ = 0;
   pending_ = false;
   cur_open_ = false;
   scale_ = 1.0;
+  fade_from_ = 1.0;
   table_rms_m_ = 0.0;
   figures_.correction_rms_m = 0.0;
   figures_.tables_this_line = 0;
@@ -195,20 +202,24 @@ double PeriodicLearner::correction(std::int64_t k, double r_k_m) noexcept {
         std::swap(prev_, table_);
         std::swap(table_, next_);
         have_prev_ = have_table_;
+        prev_scale_ = 1.0;
         have_table_ = true;
         adopted_k_ = k;
         blend_n_ = std::min(blend_ticks_, table_n_);
         pending_ = false;
         ++figures_.tables_adopted;
-        ++figures_.tables_this_line;
+        if (++figures_.tables_this_line == 1) {
+          ramp_k0_ = k;
+          ramp_ticks_ = std::llround(ramp_periods_ * static_cast<double>(table_n_));
+        }
         table_rms_m_ = pending_rms_m_;
         figures_.correction_rms_m = table_rms_m_;
       }
-      if (have_table_) c = in_use(k, i);
+      if (have_table_) c = ramp(k) * in_use(k, i);
     }
   } else if (mode_ == Mode::kFading) {
-    c = scale_ * in_use(k, phase(k));
-    figures_.correction_rms_m = scale_ * table_rms_m_;
+    c = fade_from_ * scale_ * in_use(k, phase(k));
+    figures_.correction_rms_m = fade_from_ * scale_ * table_rms_m_;
   } else if (mode_ == Mode::kHolding && k >= table_k0_) {
     c = in_use(k, phase(k));
   }
@@ -224,8 +235,15 @@ double PeriodicLearner::in_use(std::int64_t k, std::int64_t i) const noexcept {
   const double now = table_[static_cast<std::size_t>(i)];
   const std::int64_t into = k - adopted_k_;
   if (into < 0 || into + 1 >= blend_n_) return now;
-  const double before = have_prev_ ? prev_[static_cast<std::size_t>(i)] : 0.0;
+  const double before = have_prev_ ? prev_scale_ * prev_[static_cast<std::size_t>(i)] : 0.0;
   return before + (now - before) * static_cast<double>(into + 1) / static_cast<double>(blend_n_);
+}
+
+double PeriodicLearner::ramp(std::int64_t k) const noexcept {
+  if (ramp_ticks_ <= 0) return 1.0;
+  const std::int64_t into = k - ramp_k0_ + 1;
+  if (into >= ramp_ticks_) return 1.0;
+  return into <= 0 ? 0.0 : static_cast<double>(into) / static_cast<double>(ramp_ticks_);
 }
 
 void PeriodicLearner::hold(std::int64_t k) noexcept {
@@ -313,7 +331,9 @@ bool PeriodicLearner::monitor(double e_rms_m) noexcept {
   pending_ = false;
   cur_open_ = false;
   if (have_good_) {
-    // Hold the best period's corrections, taking over from the table in use along the blend.
+    // Hold the best period's corrections, taking over from the table in use (as its ramp applies
+    // it) along the blend.
+    prev_scale_ = ramp(last_planned_ + 1);
     std::swap(prev_, table_);
     std::swap(table_, good_);
     have_prev_ = have_table_;

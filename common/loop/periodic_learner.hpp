@@ -99,6 +99,22 @@
 // over 50 ticks the same step is a kink of 1/50 of it. What was applied is what the update
 // reads (c_applied per tick), so the blend changes the path to the fixed point, not the point.
 //
+// A line's first tables enter gradually: the correction applied is the table in use times a ramp
+// rising linearly from 0 to 1 over ramp_periods periods from the line's first adoption. The first
+// table cannot have seen T: it was learned from the L periods before any correction acted, which
+// the lag-compensated update composes (taking T = 1) into nearly the whole learning-off error
+// d, and with a wrong T, or a plant whose hysteresis answers a change of its input over several
+// cycles, that whole table lands in one period. Measured on the two-mode stage (bench/tracking_table
+// --scan --two-mode --wrong-models), a 100 Hz, 0.5 um sine under a model with its dominant mode
+// 10 % low: learning off 1.16 nm RMS; the first table at once made periods 7 and 8 1.36 and 1.65 nm
+// (1.43 times), most of it a mean offset (1.1 nm in period 8) that Coleman-Hodgdon's slowly
+// relaxing branches made of a zero-mean correction, learned away over three more periods; a plain
+// update's half table did almost the same (1.52). Ramped in over 4 periods the worst period is
+// 1.25 nm (1.08 times), and the lines converge to the same error 0-2 periods later (the scan
+// tables' periods [20, 30) are unchanged). It also gives the monitor below a period under a
+// fraction of the table to see a plant the update cannot learn. The update reads what was
+// applied, so the ramp changes the path to the fixed point, not the point.
+//
 // Stop, off, restart and reset never step the reference: the correction in use fades out
 // linearly over fade_s (a step of at most max_correction_m / fade_ticks per tick on the fade's
 // account, beside the table's own tick-to-tick change), then a new learning starts from zero at
@@ -135,6 +151,7 @@ struct LearningConfig {
   double max_period_s = 1.0;         // longest period learned; a longer one is not learned
   double fade_s = 0.05;              // stop/off/restart/reset: the correction fades out over this time
   double blend_s = 0.005;            // a new table takes over from the one in use over this time (0: at once)
+  double ramp_periods = 4.0;  // a line's correction rises from 0 to its tables over this many periods (0: at once)
   // A line that has taken this many tables (its table under half of max_correction_m) keeps the
   // parameter set it learned under: a set for its model that arrives later waits
   // (Compensator::params_held_by_learning) until learning stops, is reset or the line ends.
@@ -213,6 +230,7 @@ class PeriodicLearner {
   double filter_null_hz() const noexcept;
   double filter_norm_sq() const noexcept;
   std::int64_t fade_ticks() const noexcept { return fade_ticks_; }
+  double ramp_periods() const noexcept { return ramp_periods_; }
   std::int64_t blend_ticks() const noexcept { return blend_ticks_; }
   std::int64_t max_period_ticks() const noexcept { return max_period_; }
   double gain() const noexcept { return gain_; }
@@ -231,6 +249,7 @@ class PeriodicLearner {
   bool monitor(double e_rms_m) noexcept;
   std::int64_t phase(std::int64_t k) const noexcept;             // of k in the table's period [0, n)
   double in_use(std::int64_t k, std::int64_t i) const noexcept;  // table_ at phase i, blended at tick k
+  double ramp(std::int64_t k) const noexcept;                    // the line's ramp at tick k, in [0, 1]
   std::size_t slot(std::int64_t k) const noexcept;
 
   double dt_s_, gain_;
@@ -252,7 +271,12 @@ class PeriodicLearner {
   bool pending_ = false;                                   // next_ holds one waiting for a boundary
   double pending_rms_m_ = 0.0, table_rms_m_ = 0.0;         // RMS of next_ and of table_
   double scale_ = 1.0;                                     // of the table while fading
-  std::int64_t fade_left_ = 0;                             // ticks until the fade reaches 0
+  double fade_from_ = 1.0;                                 // the ramp the fade started from
+  // The ramp: from the line's first adoption (ramp_k0_) over ramp_ticks_ (0: none).
+  double ramp_periods_;
+  std::int64_t ramp_k0_ = 0, ramp_ticks_ = 0;
+  double prev_scale_ = 1.0;     // of prev_ in the blend (the ramp prev_ was applied at when a hold began)
+  std::int64_t fade_left_ = 0;  // ticks until the fade reaches 0
   // The blend from prev_ (the table in use before, zero for the first) to table_, from tick
   // adopted_k_ over blend_n_ ticks.
   bool have_prev_ = false;

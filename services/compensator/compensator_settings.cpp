@@ -221,6 +221,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "learning.lag_compensated",
                                   "learning.fade_s",
                                   "learning.blend_s",
+                                  "learning.ramp_periods",
                                   "learning.hold_params_after",
                                   "rt.priority",
                                   "rt.lock_memory",
@@ -321,6 +322,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   l.lag_compensated = config.get<bool>("learning.lag_compensated", l.lag_compensated);
   l.fade_s = config.get_positive("learning.fade_s", l.fade_s);
   l.blend_s = config.get_in_range("learning.blend_s", l.blend_s, 0.0, 1.0);
+  l.ramp_periods = config.get_in_range("learning.ramp_periods", l.ramp_periods, 0.0, 100.0);
   l.hold_params_after = config.get_int_in_range("learning.hold_params_after", l.hold_params_after, 0, 1'000'000);
   l.monitor_ratio = config.get_non_negative("learning.monitor_ratio", l.monitor_ratio);
   validate_config_section(config, "", [&] { l.validate(c.dt_s); });  // its fields are named learning.*

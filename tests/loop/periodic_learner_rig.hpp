@@ -40,6 +40,7 @@ inline constexpr double kLearnDt = 1e-4;
 inline LearningConfig stepwise() {
   LearningConfig c;
   c.blend_s = 0.0;
+  c.ramp_periods = 0.0;
   c.monitor_ratio = 0.0;
   return c;
 }

@@ -201,7 +201,8 @@ TEST(PeriodicLearner, ANewTableTakesOverAlongTheBlend) {
   const double delta = 10 * kNm;
   for (const std::int64_t n : {200, 20}) {
     for (const bool blended : {true, false}) {
-      LearningConfig config;
+      LearningConfig config;  // the deployed blend, without the ramp (tested below)
+      config.ramp_periods = 0.0;
       if (!blended) config.blend_s = 0.0;
       PeriodicLearner l(config, kLearnDt, 0);
       EXPECT_EQ(l.blend_ticks(), blended ? 50 : 0);
@@ -220,6 +221,43 @@ TEST(PeriodicLearner, ANewTableTakesOverAlongTheBlend) {
       EXPECT_NEAR(largest_step, std::abs(c0) / static_cast<double>(over), 1e-22);
     }
   }
+}
+
+// A line's first table comes in along the ramp, one ramp_periods-th of it per period, and a stop
+// part way up fades out from what was applied, not from the whole table.
+TEST(PeriodicLearner, ALinesFirstTablesComeInAlongTheRamp) {
+  const double delta = 10 * kNm;
+  const std::int64_t n = 20;
+  LearningConfig config = testing::stepwise();
+  config.ramp_periods = 4.0;
+  EXPECT_EQ(LearningConfig{}.ramp_periods, 4.0);  // the deployed one
+  PeriodicLearner l(config, kLearnDt, 0);
+  l.restart(0, n);
+  for (std::int64_t k = 0; k < n; ++k) ASSERT_EQ(tick(l, k, delta), 0.0);
+  const double c0 = -l.gain() * delta;  // the first table (no more samples: it stays in use)
+  const std::int64_t ramp = 4 * n;
+  for (std::int64_t j = 0; j < ramp + n; ++j) {
+    const double expected = c0 * static_cast<double>(std::min(j + 1, ramp)) / static_cast<double>(ramp);
+    ASSERT_NEAR(l.correction(n + j, 0.0), expected, 1e-22) << "tick " << j << " of the ramp";
+  }
+
+  // Stopped half way up: the fade starts at what the ramp applied and never steps.
+  PeriodicLearner m(config, kLearnDt, 0);
+  m.restart(0, n);
+  for (std::int64_t k = 0; k < n; ++k) tick(m, k, delta);
+  double previous = 0.0;
+  std::int64_t k = n;
+  for (; k < n + ramp / 2; ++k) previous = m.correction(k, 0.0);
+  EXPECT_NEAR(previous, c0 / 2.0, 1e-22);
+  m.stop();
+  double largest_step = 0.0;
+  for (std::int64_t j = 0; j < m.fade_ticks() + 1; ++j, ++k) {
+    const double c = m.correction(k, 0.0);
+    largest_step = std::max(largest_step, std::abs(c - previous));
+    previous = c;
+  }
+  EXPECT_EQ(previous, 0.0);
+  EXPECT_NEAR(largest_step, std::abs(c0) / 2.0 / static_cast<double>(m.fade_ticks()), 1e-22);
 }
 
 TEST(PeriodicLearner, TheTableIsClampedToTheBound) {
@@ -350,6 +388,8 @@ TEST(PeriodicLearner, ValidationNamesTheField) {
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.max_period_s = 60.0; })), "learning.max_period_s");
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.fade_s = 0.0; })), "learning.fade_s");
   EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.blend_s = -1e-3; })), "learning.blend_s");
+  EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.ramp_periods = -1.0; })), "learning.ramp_periods");
+  EXPECT_EQ(refused_field(with([](LearningConfig& c) { c.ramp_periods = kNaN; })), "learning.ramp_periods");
   EXPECT_EQ(refused_field([] { PeriodicLearner l({}, 0.0, 500); }), "compensator.dt_s");
   EXPECT_EQ(refused_field([] { PeriodicLearner l(testing::stepwise(), kLearnDt, -1); }), "learning.max_lag_ticks");
   try {
