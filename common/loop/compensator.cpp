@@ -86,7 +86,7 @@ PlanExtent Compensator::check_scan(const ScanShare& share, double blend_s) {
   try {
     return ReferenceAdmission(planner_).admit_scan(share, blend_s);
   } catch (const ParameterError&) {
-    ++planner_.counters().trajectories_refused;
+    ++planner_.counters().plan_refusals;
     throw;
   }
 }

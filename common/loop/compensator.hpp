@@ -91,7 +91,7 @@ class Compensator {
   static TrajectoryVerdict check_trajectory(const FeedforwardPlanner& snapshot, TrajectorySpec spec, double start_s,
                                             bool learning_enabled);
   TrajectoryVerdict commit_trajectory(TrajectoryVerdict checked, double start_s);
-  void count_refused_trajectory() noexcept { ++planner_.counters().trajectories_refused; }
+  void count_refused_trajectory() noexcept { ++planner_.counters().plan_refusals; }
   // This axis's share of a multi-axis path (loop/scan_path.hpp: a raster or a Lissajous figure,
   // decoupled by the row of C^{-1} it carries). The path is fixed in loop time, every axis on the
   // same clock: it starts at share.start_s(), which must be at least blend_s after the next tick

@@ -3,6 +3,7 @@
 // what a dry run of its plan finds: the vocabulary its planner, its reference admission and its
 // parameter exchange share (loop/compensator.hpp puts them together).
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -111,19 +112,58 @@ struct CompensatorCounters {
   std::uint64_t params_accepted = 0;
   std::uint64_t params_rejected = 0;
   std::uint64_t params_swapped = 0;
-  std::uint64_t reversals = 0;             // of the planned reference
-  std::uint64_t nonfinite_outputs = 0;     // model produced NaN/Inf: the last voltage was held
-  std::uint64_t model_switches = 0;        // swaps that changed the model (offer_model)
-  std::uint64_t reanchors = 0;             // swaps re-anchored at the measured position
-  std::uint64_t reanchors_skipped = 0;     // not re-anchored: the branch ended (or the mode changed) first
-  std::uint64_t u_clamped = 0;             // feedforward ticks held inside [u_min_V, u_max_V]
-  std::uint64_t u_slew_clamped = 0;        // feedforward ticks held within the slew limit
-  std::uint64_t learning_held = 0;         // ticks whose learned correction the limits held back
-  std::uint64_t trajectories_refused = 0;  // infeasible (or invalid) trajectories not taken
-  std::uint64_t trajectories_shaped = 0;   // taken after shaping to feasibility
-  std::uint64_t stage_swaps = 0;           // stage models swapped in
-  std::uint64_t experiment_ramped = 0;     // experiment ticks ramped towards the excitation (a jump between two)
+  std::uint64_t reversals = 0;            // of the planned reference
+  std::uint64_t nonfinite_outputs = 0;    // model produced NaN/Inf: the last voltage was held
+  std::uint64_t model_switches = 0;       // swaps that changed the model (offer_model)
+  std::uint64_t reanchors = 0;            // swaps re-anchored at the measured position
+  std::uint64_t reanchors_skipped = 0;    // not re-anchored: the branch ended (or the mode changed) first
+  std::uint64_t u_clamped = 0;            // feedforward ticks held inside [u_min_V, u_max_V]
+  std::uint64_t u_slew_clamped = 0;       // feedforward ticks held within the slew limit
+  std::uint64_t learning_held = 0;        // ticks whose learned correction the limits held back
+  std::uint64_t plan_refusals = 0;        // trajectories and scans the plan refused (outside the limits, invalid)
+  std::uint64_t trajectories_shaped = 0;  // taken after shaping to feasibility
+  std::uint64_t stage_swaps = 0;          // stage models swapped in
+  std::uint64_t experiment_ramped = 0;    // experiment ticks ramped towards the excitation (a jump between two)
+
+  // Every counter with the name the compensator's status gives it. The sum over axes and the
+  // status walk this list, and a field above that is not in it fails the static_assert below: no
+  // counter is counted and not reported.
+  template <class F>
+  static constexpr void for_each(F&& f) {
+    f("samples", &CompensatorCounters::samples);
+    f("out_of_order", &CompensatorCounters::out_of_order);
+    f("gaps", &CompensatorCounters::gaps);
+    f("planned", &CompensatorCounters::planned);
+    f("ticks_behind", &CompensatorCounters::ticks_behind);
+    f("params_accepted", &CompensatorCounters::params_accepted);
+    f("params_rejected", &CompensatorCounters::params_rejected);
+    f("params_swapped", &CompensatorCounters::params_swapped);
+    f("reversals", &CompensatorCounters::reversals);
+    f("nonfinite_outputs", &CompensatorCounters::nonfinite_outputs);
+    f("model_switches", &CompensatorCounters::model_switches);
+    f("reanchors", &CompensatorCounters::reanchors);
+    f("reanchors_skipped", &CompensatorCounters::reanchors_skipped);
+    f("u_clamped", &CompensatorCounters::u_clamped);
+    f("u_slew_clamped", &CompensatorCounters::u_slew_clamped);
+    f("learning_held", &CompensatorCounters::learning_held);
+    f("plan_refusals", &CompensatorCounters::plan_refusals);
+    f("trajectories_shaped", &CompensatorCounters::trajectories_shaped);
+    f("stage_swaps", &CompensatorCounters::stage_swaps);
+    f("experiment_ramped", &CompensatorCounters::experiment_ramped);
+  }
+  // The sum over several axes' laws.
+  CompensatorCounters& operator+=(const CompensatorCounters& b) noexcept {
+    for_each([&](const char*, auto field) { this->*field += b.*field; });
+    return *this;
+  }
 };
+inline constexpr std::size_t kCompensatorCounterCount = [] {
+  std::size_t n = 0;
+  CompensatorCounters::for_each([&](const char*, auto) { ++n; });
+  return n;
+}();
+static_assert(sizeof(CompensatorCounters) == kCompensatorCounterCount * sizeof(std::uint64_t),
+              "a counter of CompensatorCounters is missing from for_each");
 
 // What the feedforward of a trajectory needs, from a dry run of the plan.
 struct PlanExtent {

@@ -25,49 +25,38 @@ CounterSet::Entries CompensatorService::collect_counters() const {
   CompensatorCounters c = retired_;
   for (int a = 0; a < settings_.axes; ++a) c += laws_[static_cast<std::size_t>(a)]->counters();
   const CompensatorServiceCounters& s = counters_;
-  CounterSet::Entries entries = {{"samples", c.samples},
-                                 {"command_blocks_published", s.command_blocks_published},
-                                 {"command_ticks_published", s.command_ticks_published},
-                                 {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
-                                 {"planned", c.planned},
-                                 {"ticks_behind", c.ticks_behind},
-                                 {"gaps", c.gaps},
-                                 {"out_of_order", c.out_of_order},
-                                 {"nonfinite_outputs", c.nonfinite_outputs},
-                                 {"reversals", c.reversals},
-                                 {"params_accepted", c.params_accepted},
-                                 {"params_rejected", c.params_rejected + s.params_refused},
-                                 {"params_invalid", s.params_invalid},
-                                 {"params_stale", s.params_stale},
-                                 {"params_stale_repeat", s.params_stale_repeat},
-                                 {"params_stale_below", s.params_stale_below},
-                                 {"params_swapped", c.params_swapped},
-                                 {"model_switches", c.model_switches},
-                                 {"model_unknown_kind", s.model_unknown_kind},
-                                 {"model_unknown_format", s.model_unknown_format},
-                                 {"reanchors", c.reanchors},
-                                 {"reanchors_skipped", c.reanchors_skipped},
-                                 {"u_clamped", c.u_clamped},
-                                 {"u_slew_clamped", c.u_slew_clamped},
-                                 {"learning_held", c.learning_held},
-                                 {"trajectories_shaped", c.trajectories_shaped},
-                                 {"stage_swaps", c.stage_swaps},
-                                 {"experiment_ramped", c.experiment_ramped},
-                                 {"trajectories", s.trajectories},
-                                 {"trajectory_repeats", s.trajectory_repeats},
-                                 {"trajectory_refused", s.trajectory_refused},
-                                 {"trajectory_late_start", s.trajectory_late_start},
-                                 {"control_acted", s.control_acted},
-                                 {"control_refused", s.control_refused},
-                                 {"bridge_restarts", s.bridge_restarts},
-                                 {"sensor_jumps", guard_.counters().jumps},
-                                 {"sensor_jumps_ignored", guard_.counters().ignored},
-                                 {"sensor_blocks_held", guard_.counters().held},
-                                 {"params_publishers_evicted", admission_.evictions()},
-                                 {"log_lines_suppressed", log_limiter_.suppressed_total()}};
+  // The plan's counters, each axis's summed (samples: every axis's), as CompensatorCounters lists
+  // them; the sets refused before they reached a law count with those the laws rejected.
+  CounterSet::Entries entries;
+  CompensatorCounters::for_each([&](const char* name, auto field) { entries.emplace_back(name, c.*field); });
+  for (auto& [name, value] : entries) {
+    if (name == "params_rejected") value += s.params_refused;
+  }
+  for (const auto& entry : CounterSet::Entries{{"command_blocks_published", s.command_blocks_published},
+                                               {"command_ticks_published", s.command_ticks_published},
+                                               {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
+                                               {"params_invalid", s.params_invalid},
+                                               {"params_stale", s.params_stale},
+                                               {"params_stale_repeat", s.params_stale_repeat},
+                                               {"params_stale_below", s.params_stale_below},
+                                               {"model_unknown_kind", s.model_unknown_kind},
+                                               {"model_unknown_format", s.model_unknown_format},
+                                               {"trajectories", s.trajectories},
+                                               {"trajectory_repeats", s.trajectory_repeats},
+                                               {"trajectory_refused", s.trajectory_refused},
+                                               {"trajectory_late_start", s.trajectory_late_start},
+                                               {"control_acted", s.control_acted},
+                                               {"control_refused", s.control_refused},
+                                               {"bridge_restarts", s.bridge_restarts},
+                                               {"sensor_jumps", guard_.counters().jumps},
+                                               {"sensor_jumps_ignored", guard_.counters().ignored},
+                                               {"sensor_blocks_held", guard_.counters().held},
+                                               {"params_publishers_evicted", admission_.evictions()},
+                                               {"log_lines_suppressed", log_limiter_.suppressed_total()}}) {
+    entries.push_back(entry);
+  }
   // Scans and what named an axis this stage lacks (a one-axis stage counts them too); with several
-  // axes the counters above are summed over the axes' laws (samples: every axis's), and these say
-  // how the axes planned together.
+  // axes these say how the axes planned together.
   entries.emplace_back("scans", s.scans);
   entries.emplace_back("scans_refused", s.scans_refused);
   entries.emplace_back("wrong_axis", s.wrong_axis);

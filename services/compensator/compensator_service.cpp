@@ -22,30 +22,6 @@
 
 namespace hystloop {
 
-CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounters& b) noexcept {
-  a.samples += b.samples;
-  a.out_of_order += b.out_of_order;
-  a.gaps += b.gaps;
-  a.planned += b.planned;
-  a.ticks_behind += b.ticks_behind;
-  a.params_accepted += b.params_accepted;
-  a.params_rejected += b.params_rejected;
-  a.params_swapped += b.params_swapped;
-  a.reversals += b.reversals;
-  a.nonfinite_outputs += b.nonfinite_outputs;
-  a.model_switches += b.model_switches;
-  a.reanchors += b.reanchors;
-  a.reanchors_skipped += b.reanchors_skipped;
-  a.u_clamped += b.u_clamped;
-  a.u_slew_clamped += b.u_slew_clamped;
-  a.learning_held += b.learning_held;
-  a.trajectories_refused += b.trajectories_refused;
-  a.trajectories_shaped += b.trajectories_shaped;
-  a.stage_swaps += b.stage_swaps;
-  a.experiment_ramped += b.experiment_ramped;
-  return a;
-}
-
 namespace {
 
 // Consecutive blocks of a new numbering whose sample times (utime) are further apart than this

@@ -66,8 +66,6 @@
 
 namespace hystloop {
 
-CompensatorCounters& operator+=(CompensatorCounters& a, const CompensatorCounters& b) noexcept;
-
 // The compensator's own counters (cumulative; RESET_COUNTERS reports them from a baseline).
 struct CompensatorServiceCounters {
   std::uint64_t command_blocks_published = 0;

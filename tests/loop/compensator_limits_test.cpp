@@ -123,7 +123,7 @@ TEST(CompensatorLimits, ASineBeyondTheSlewLimitIsRefusedNamingTheLimitAndWhatWou
     EXPECT_NE(what.find("highest feasible frequency"), std::string::npos) << what;
     EXPECT_NE(what.find("--shape-to-feasible"), std::string::npos) << what;
   }
-  EXPECT_EQ(c.counters().trajectories_refused, 1u);
+  EXPECT_EQ(c.counters().plan_refusals, 1u);
   EXPECT_EQ(c.trajectory().shape, TrajectoryShape::kHold);  // the plan is unchanged
   // What the closed form says fits does: kShare x 5e4 V/s at 200 Hz, through the stage's inverse.
   FeedforwardLimits limits;

@@ -136,7 +136,7 @@ TEST(CompensatorPreview, AReferenceBeyondTheActuatorIsRefusedByTheDryRun) {
   compensator.observe({0, 0.0, 0.0, 0.0});
   // 3 um at 700 Hz: far beyond the slew limit through a resonance the inverse must undo.
   EXPECT_THROW(compensator.set_trajectory(sine(3e-6, 700.0), std::numeric_limits<double>::quiet_NaN()), ParameterError);
-  EXPECT_EQ(compensator.counters().trajectories_refused, 1U);
+  EXPECT_EQ(compensator.counters().plan_refusals, 1U);
 }
 
 TEST(CompensatorPreview, AStageTheInverseCannotTakeIsRefusedNamingThePreview) {

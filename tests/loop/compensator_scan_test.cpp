@@ -80,7 +80,7 @@ TEST(CompensatorScan, AStartTheApproachCannotReachIsRefusedAndNothingChanges) {
   const ScanShare share(raster(), 0, AxisVector(1.0, 0.0, 0.0));
   EXPECT_EQ(refused_field([&] { loop.comp.take_scan(share, 0.2); }), "scan.start_s");
   EXPECT_EQ(loop.comp.scan(), nullptr);
-  EXPECT_EQ(loop.comp.counters().trajectories_refused, 1u);
+  EXPECT_EQ(loop.comp.counters().plan_refusals, 1u);
 }
 
 TEST(CompensatorScan, AnInfeasibleScanIsRefusedNamingTheAxisAndTheLimit) {

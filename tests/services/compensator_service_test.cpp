@@ -653,13 +653,24 @@ TEST(CompensatorService, ATrajectoryIsCheckedWhileThePlanGoesOn) {
   EXPECT_EQ(h.service.counters().trajectory_refused, 1u);
   EXPECT_EQ(h.service.counters().trajectories, 0u);
   EXPECT_EQ(h.service.counters().trajectory_refused_version, 7);
-  EXPECT_EQ(h.service.compensator().counters().trajectories_refused, 1u);
+  EXPECT_EQ(h.service.compensator().counters().plan_refusals, 1u);
   // The next one is checked and taken.
   h.service.on_trajectory(hold(8, 2e-7, 0.05));
   h.service.settle_trajectories();
   EXPECT_EQ(h.service.counters().trajectories, 1u);
   h.run(20, 1000);
   EXPECT_EQ(h.tick(h.sent_through()).y_ref_m, 2e-7);
+  // The plan's refusal is on HX_STATUS under its own name, as every counter of the plan is.
+  Subscription<service_status_t> status(*h.lcm, h.channels.status);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  ASSERT_EQ(status.counters().accepted, 1u);
+  const service_status_t& st = status.latest();
+  std::map<std::string, std::int64_t> reported;
+  for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+  EXPECT_EQ(reported["plan_refusals"], 1);
+  EXPECT_EQ(reported["trajectory_refused"], 1);
+  CompensatorCounters::for_each([&](const char* name, auto) { EXPECT_TRUE(reported.contains(name)) << name; });
 }
 
 // 100 forged sensor blocks and refused trajectories a second made ~95 log lines a second of one
