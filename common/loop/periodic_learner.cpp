@@ -147,6 +147,7 @@ void PeriodicLearner::begin_again() noexcept {
   // A fade under way goes on from where it is (no step) and starts the learning when it ends.
   figures_.active = mode_ == Mode::kLearning;
   figures_.fading = mode_ == Mode::kFading;
+  figures_.holding = false;
 }
 
 void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
@@ -345,6 +346,7 @@ bool PeriodicLearner::monitor(double e_rms_m) noexcept {
     table_rms_m_ = std::sqrt(sum_sq / static_cast<double>(table_n_));
     figures_.correction_rms_m = table_rms_m_;
     mode_ = Mode::kHolding;
+    figures_.holding = true;
     figures_.active = false;
     figures_.fading = false;
   } else {

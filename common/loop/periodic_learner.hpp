@@ -187,6 +187,7 @@ struct LearnerFigures {
   bool fading = false;
   std::uint64_t divergences = 0;  // lines whose learning the monitor stopped
   bool diverged = false;          // the line's learning was stopped by the monitor (holding or faded)
+  bool holding = false;           // ... and its best period's corrections are held (false: faded out)
   double baseline_rms_m = 0.0;    // the line's learning-off error RMS (0: not measured yet)
   double best_rms_m = 0.0;        // its best period under a table (0: none yet)
   std::int64_t period_ticks = 0;  // of the periodic reference (0: none, or refused)

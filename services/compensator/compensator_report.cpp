@@ -172,6 +172,19 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
           c.params_version());
     }
   }
+  // A line whose learning the monitor stopped tracks on its best table (or none), no worse than
+  // without learning, but not as the learning would: degraded, with the reason, until the line is
+  // restarted, reset or learning is turned on again.
+  for (int a = 0; a < settings_.axes; ++a) {
+    const LearnerFigures& l = laws_[static_cast<std::size_t>(a)]->learner().figures();
+    if (!l.diverged) continue;
+    if (state == service_status_t::HEALTHY) state = service_status_t::DEGRADED;
+    detail += fmt::format(
+        "learning stopped{}: it made the line's error worse than without (a period at more than {} x the {:.3g} nm "
+        "RMS without learning), {}; ",
+        settings_.axes > 1 ? fmt::format(" on {}", axis_name(a)) : std::string(), c.config().learning.monitor_ratio,
+        l.baseline_rms_m * 1e9, l.holding ? "its best period's corrections held" : "its correction faded out");
+  }
   const MemParams& m = c.mem_params();
   detail += fmt::format("mode {}, params v{} c1={:.6g} c2={:.6g} c3={:.6g}, planning {} ticks ahead{}",
                         to_string(c.experiment_running() ? FeedforwardMode::kExperiment : c.mode()), c.params_version(),
@@ -184,12 +197,6 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
   if (learner.active) {
     detail += fmt::format("; learning a {}-tick period ({} periods learned, last {:.3g} nm RMS)", learner.period_ticks,
                           learner.periods_learned, learner.last_error_rms_m * 1e9);
-  }
-  if (learner.diverged) {
-    detail += fmt::format(
-        "; learning stopped: it made the line's error worse than without (a period at more than "
-        "{} x the {:.3g} nm RMS without learning), the best table held",
-        c.config().learning.monitor_ratio, learner.baseline_rms_m * 1e9);
   }
   for (int a = 1; a < settings_.axes; ++a) {  // the other axes' sets and learning, each in a few words
     const Compensator& law = *laws_[static_cast<std::size_t>(a)];
@@ -231,6 +238,7 @@ void CompensatorService::report(std::int64_t utime, bool stopping, bool end_peri
     const std::string p = a == 0 ? std::string() : std::string(axis_name(a)) + "_";
     status_.counter(p + "learning_active", l.active ? 1u : 0u);
     status_.counter(p + "learning_periods", l.periods_learned);
+    status_.counter(p + "learning_divergences", l.divergences);
     status_.counter(p + "params_held_by_learning", law.params_held_by_learning() ? 1u : 0u);
     status_.counter(p + "learning_rms_pm", static_cast<std::uint64_t>(std::llround(l.last_error_rms_m * 1e12)));
   }

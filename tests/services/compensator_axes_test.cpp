@@ -427,7 +427,7 @@ TEST(CompensatorAxes, TheStatusOfThreeAxesWithAScanHasEveryCounter) {
   EXPECT_TRUE(cpu);
   // Each axis's learning and its set, the others' behind their axis.
   for (const char* name : {"learning_active", "y_learning_active", "z_learning_periods", "z_params_held_by_learning",
-                           "y_learning_rms_pm", "z_params_version"}) {
+                           "y_learning_rms_pm", "z_params_version", "z_learning_divergences"}) {
     EXPECT_TRUE(find_counter(r, name).has_value()) << name;
   }
   EXPECT_NE(r.detail.find("; z: params v"), std::string::npos) << r.detail;

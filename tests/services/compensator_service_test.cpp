@@ -122,6 +122,7 @@ struct Harness {
   std::map<std::int64_t, std::size_t> latest;  // tick -> its last entry in `ticks`
   Subscription<command_block_t> commands;
   sensor_block_t sensor{};
+  double plant_gain = kGain;  // y = plant_gain u [m/V]
 
   explicit Harness(const CompensatorSettings& s = cosine())
       : service(s, *lcm, channels),
@@ -144,7 +145,7 @@ struct Harness {
       const auto it = latest.find(k);
       const double u = it == latest.end() ? 0.0 : ticks[it->second].u_ff_V;
       const double y_ref = it == latest.end() ? std::nan("") : ticks[it->second].y_ref_m;
-      append_tick(sensor, SensorTick{utime_of(k), k, u, u, 0.0, y_ref, kGain * u, flags});
+      append_tick(sensor, SensorTick{utime_of(k), k, u, u, 0.0, y_ref, plant_gain * u, flags});
     }
     return sensor;
   }
@@ -671,6 +672,33 @@ TEST(CompensatorService, ATrajectoryIsCheckedWhileThePlanGoesOn) {
   EXPECT_EQ(reported["plan_refusals"], 1);
   EXPECT_EQ(reported["trajectory_refused"], 1);
   CompensatorCounters::for_each([&](const char* name, auto) { EXPECT_TRUE(reported.contains(name)) << name; });
+}
+
+// A line whose learning makes its error worse (the plant's sign the opposite of the model's) is
+// stopped by the monitor: the status is DEGRADED, says why, and counts it.
+TEST(CompensatorService, ALineWhoseLearningTheMonitorStoppedIsDegradedWithTheReason) {
+  CompensatorSettings s = holding();
+  s.trajectory.shape = TrajectoryShape::kSine;
+  s.trajectory.amplitude_m = 1e-7;
+  s.trajectory.frequency_hz = 100.0;
+  s.trajectory.blend_s = 0.01;
+  s.control.learning.monitor_ratio = 1.05;
+  Harness h(s);
+  h.plant_gain = -kGain;
+  Subscription<service_status_t> status(*h.lcm, h.channels.status);
+  h.run(0, 5000);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  ASSERT_EQ(status.counters().accepted, 1u);
+  const service_status_t& st = status.latest();
+  EXPECT_EQ(h.service.compensator().learner().figures().divergences, 1u);
+  EXPECT_EQ(st.state, service_status_t::DEGRADED) << st.detail;
+  EXPECT_NE(st.detail.find("learning stopped: it made the line's error worse than without"), std::string::npos)
+      << st.detail;
+  std::map<std::string, std::int64_t> reported;
+  for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+  EXPECT_EQ(reported["learning_divergences"], 1);
+  EXPECT_EQ(reported["learning_active"], 0);
 }
 
 // 100 forged sensor blocks and refused trajectories a second made ~95 log lines a second of one
