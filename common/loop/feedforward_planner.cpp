@@ -160,6 +160,8 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
   // set's error, which its first table would carry over to the new one. It learns from here.
   if (learning != nullptr && learning->figures().active && learning->figures().tables_this_line == 0) {
     learning->reset();
+  } else if (learning != nullptr) {
+    learning->params_swapped(k);  // under a table: the swap's step is no divergence of the learning
   }
   // At a reversal the inverse starts a new branch from its last point: new parameters change
   // the slope of what follows, never the voltage already reached. MEM remembers nothing else;

@@ -164,6 +164,11 @@ void PeriodicLearner::start_learning(std::int64_t from_k) noexcept {
   figures_.correction_rms_m = 0.0;
   figures_.tables_this_line = 0;
   baseline_rms_m_ = 0.0;
+  baseline_sum_sq_ = 0.0;
+  baseline_periods_ = 0;
+  baseline_closed_ = false;
+  above_once_ = false;
+  compare_from_ = kNoTick;
   best_rms_m_ = 0.0;
   have_good_ = false;
   figures_.baseline_rms_m = 0.0;
@@ -312,20 +317,48 @@ void PeriodicLearner::observe(std::int64_t k, double y_m) noexcept {
   }
 }
 
+void PeriodicLearner::params_swapped(std::int64_t k) noexcept {
+  if (mode_ != Mode::kLearning) return;
+  // The swap steps the error the tables had learned; the step is first learned from periods
+  // observed a lag later and then goes by (1 - gain) a period: the periods planned up to the
+  // lag and five more periods after the swap (3 % of the step left at the default gain) are not
+  // compared.
+  const auto lag = static_cast<std::int64_t>(ring_k_.size()) - 1;
+  compare_from_ = std::max(compare_from_, k + lag + 5 * table_n_);
+}
+
 bool PeriodicLearner::monitor(double e_rms_m) noexcept {
   if (monitor_ratio_ == 0.0) return true;
   if (!cur_under_table_) {
-    // The line's own error, nothing learned applied: its first such period is the baseline.
-    if (baseline_rms_m_ == 0.0) baseline_rms_m_ = figures_.baseline_rms_m = e_rms_m;
+    // The line's own error, nothing learned applied: pooled into the baseline until a period
+    // under a table has been observed (the plan adopts the first table a lag before that).
+    if (!baseline_closed_) {
+      baseline_sum_sq_ += e_rms_m * e_rms_m;
+      ++baseline_periods_;
+      baseline_rms_m_ = figures_.baseline_rms_m = std::sqrt(baseline_sum_sq_ / static_cast<double>(baseline_periods_));
+    }
     return true;
   }
+  baseline_closed_ = true;
   if (baseline_rms_m_ == 0.0) return true;  // a fade from the line before: nothing to compare with
+  if (compare_from_ != kNoTick && cur_start_ < compare_from_) return true;
   if (e_rms_m < baseline_rms_m_ && (!have_good_ || e_rms_m < best_rms_m_)) {
     best_rms_m_ = figures_.best_rms_m = e_rms_m;
     std::swap(applied_, good_);  // the corrections of this period: the table to fall back to
     have_good_ = true;
   }
-  if (!(e_rms_m > monitor_ratio_ * baseline_rms_m_)) return true;
+  // A period's RMS of noise alone scatters by about 1 / sqrt(2n) of itself: twice the pooled
+  // baseline's and the period's scatter once is a margin one noisy period may pass, twice it one
+  // that only a growing error does.
+  const double margin = 2.0 / std::sqrt(static_cast<double>(table_n_));
+  if (!(e_rms_m > (monitor_ratio_ + margin) * baseline_rms_m_)) {
+    above_once_ = false;
+    return true;
+  }
+  if (!above_once_ && !(e_rms_m > (monitor_ratio_ + 2.0 * margin) * baseline_rms_m_)) {
+    above_once_ = true;  // the next period says whether it grows
+    return true;
+  }
   ++figures_.divergences;
   figures_.diverged = true;
   stopped_by_monitor_ = true;

@@ -127,12 +127,18 @@
 // Learning that makes things worse is stopped. The model the inverse uses may be wrong where Q is
 // not small (a mode off in frequency, a delay left out, a gain far off), and then |1 - T| exceeds
 // the bound above and the tables grow period after period; the clamp at max_correction_m only
-// bounds the damage. So each line's first period learned without a table is its learning-off error
-// (the baseline), and a period learned under a table whose error RMS exceeds monitor_ratio times
-// the baseline ends the learning of that line: the table it falls back to is the corrections that
-// were applied over its best period (when that period was better than the baseline), held as they
-// are, or none (faded out). It is counted (divergences) and shown (diverged, until the line is
-// restarted, reset or learning is turned on again), and it does not learn that line again.
+// bounds the damage. So the periods a line learns from before any table acts (the L periods of the
+// lag) give its learning-off error, the baseline B (their RMS pooled), and a period learned under
+// a table with an error RMS above B (monitor_ratio + 4 / sqrt(n)), n the period's ticks, or two in
+// a row above B (monitor_ratio + 2 / sqrt(n)), end the learning of that line: the table it falls back to is the
+// corrections that were applied over its best period (when that period was better than the baseline), held as they are,
+// or none (faded out). It is counted (divergences) and shown (diverged, until the line is
+// restarted, reset or learning is turned on again), and it does not learn that line again. The
+// margin and the second period are the sensor noise's: a period's RMS of white noise alone
+// scatters by about 1 / sqrt(2n) of itself (7 % at n = 100), and a divergence grows period after
+// period while a noisy period does not repeat. A parameter set swapped in under a table (one the
+// line does not hold) steps the error for a few periods while the tables learn the new set's error
+// (params_swapped): the periods until a lag and five periods after the swap are not compared.
 //
 // Everything is allocated in the constructor; correction(), observe() and the state changes are
 // noexcept and allocate, lock and log nothing.
@@ -163,11 +169,9 @@ struct LearningConfig {
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;
-  // A period learned under a table with an error RMS above this many times the line's learning-off
-  // error stops the learning of that line (see above); 0: never, the default for now: on the
-  // simulated stage a parameter set swapped in mid-line stops a line that would have converged
-  // (the golden log's), so it is set where learning can run away (an uncertain stage model: 1.05).
-  double monitor_ratio = 0.0;
+  // Two periods in a row learned under a table with an error RMS above this many times the line's
+  // learning-off error (plus the noise's margin, see above) stop the learning of that line; 0: never.
+  double monitor_ratio = 1.05;
   // Throws ParameterError naming the field ("learning.gain", ...).
   void validate(double dt_s) const;
 };
@@ -217,6 +221,9 @@ class PeriodicLearner {
   // plan; ticks may be missing; NaN = no sample. Completing a period computes the next table,
   // adopted at the next period boundary of the plan.
   void observe(std::int64_t k, double y_m) noexcept;
+  // A parameter set was swapped in at tick k: the periods up to a lag and five periods after it
+  // are not compared with the baseline (the swap's step of the error, which the tables then learn).
+  void params_swapped(std::int64_t k) noexcept;
   // Planned tick k (the last correction() asked for) was held back by a limit of the plan: its
   // error is not the table's to remove, and learning it would only grow the table there tick
   // after tick (the learning's windup). Its phase keeps what was applied (e taken as 0).
@@ -295,6 +302,11 @@ class PeriodicLearner {
   // The monitor: its ratio (0: off), the line's baseline and best period, and that period's table.
   double monitor_ratio_;
   double baseline_rms_m_ = 0.0, best_rms_m_ = 0.0;
+  double baseline_sum_sq_ = 0.0;  // of the learning-off periods' RMS, pooled into baseline_rms_m_
+  std::int64_t baseline_periods_ = 0;
+  bool baseline_closed_ = false;   // a period under a table was observed: the baseline is what it is
+  bool above_once_ = false;        // the last period compared was above the limit
+  std::int64_t compare_from_ = 0;  // periods starting before this tick are not compared (a swap)
   bool have_good_ = false, stopped_by_monitor_ = false;
   std::vector<double> applied_, good_;  // per phase: c_applied in the period being observed, in the best
 

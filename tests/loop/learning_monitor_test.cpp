@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "loop/periodic_learner.hpp"
 #include "periodic_learner_rig.hpp"
@@ -84,6 +86,54 @@ TEST(LearningMonitor, LeavesALineThatConvergesAlone) {
     EXPECT_DOUBLE_EQ(guarded.last_rms, unguarded.last_rms);
     EXPECT_LT(guarded.last_rms, 0.5 * guarded.off_rms);
     EXPECT_GT(guarded.figures.baseline_rms_m, 0.0);
+  }
+}
+
+// A line whose error is the sensor's noise alone (a perfect model) is never stopped: the learned
+// noise raises its RMS by a few percent and a period's RMS of noise scatters by ~1/sqrt(2n) (7 %
+// at n = 100), which the monitor's margin and its second period leave to a growing error. Three
+// hundred 100-tick periods, ten seeds: a rule of one period above 1.05 times the first stops it.
+TEST(LearningMonitor, NeverStopsALineOfNoiseAlone) {
+  constexpr std::int64_t kShort = 100;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    PeriodicLearner learner(LearningConfig{}, kLearnDt, testing::kMaxLag);
+    ASSERT_EQ(LearningConfig{}.monitor_ratio, kRatio);  // on by default
+    LearningLoop loop(
+        learner, 300 * kShort, LinearPlant{1.0, 0}, [](std::int64_t) { return 0.0; }, [](std::int64_t) { return 0.0; },
+        kSigma, seed);
+    learner.restart(0, kShort);
+    loop.run(300 * kShort);
+    EXPECT_EQ(learner.figures().divergences, 0U)
+        << "seed " << seed << " baseline " << learner.figures().baseline_rms_m << " last "
+        << learner.figures().last_error_rms_m << " periods " << learner.figures().periods_learned;
+    EXPECT_GT(learner.figures().periods_learned, 250U);
+  }
+}
+
+// A parameter set swapped in under a converged table steps the repeating error (here by a third
+// harmonic of 60 nm, twice the baseline's RMS) for the lag and a few periods while the tables learn
+// it: told of the swap, the monitor does not take that for a divergence; not told, it does.
+TEST(LearningMonitor, ASwapsStepOfTheErrorIsNotADivergence) {
+  constexpr std::int64_t kSwap = 40 * kPeriod;
+  for (const bool told : {true, false}) {
+    PeriodicLearner learner(LearningConfig{}, kLearnDt, testing::kMaxLag);
+    LearningLoop loop(
+        learner, kPeriods * kPeriod, LinearPlant{1.0, 0}, [](std::int64_t k) { return raster(k, kPeriod, 100 * kNm); },
+        [](std::int64_t k) {
+          const double step =
+              k >= kSwap ? 60e-9 * std::sin(2.0 * std::numbers::pi * 3.0 * static_cast<double>(k) / kPeriod + 0.3)
+                         : 0.0;
+          return disturbance(k, kPeriod) + step;
+        },
+        kSigma, 3);
+    learner.restart(0, kPeriod);
+    loop.run(kSwap - testing::kHorizon);  // planned up to the swap
+    if (told) learner.params_swapped(kSwap);
+    loop.run(kPeriods * kPeriod - loop.now);
+    EXPECT_EQ(learner.figures().divergences, told ? 0U : 1U) << (told ? "told" : "not told");
+    if (told) {
+      EXPECT_LT(loop.error_rms((kPeriods - 1) * kPeriod, kPeriods * kPeriod), 3 * kNm);
+    }
   }
 }
 
