@@ -20,25 +20,23 @@ FeedforwardPlanner::FeedforwardPlanner(const CompensatorConfig& config)
 void FeedforwardPlanner::set_stage(const StageModel& stage) noexcept {
   stage_model_ = stage;
   stage_inverse_.reset();
-  servo_share_stage_.reset();
-  servo_share_linear_.reset();
+  servo_share_.set_none();
   preview_.reset();
   preview_ticks_ = 0;
   if (stage.is_second_order()) {
     stage_inverse_.emplace(stage.second_order, config_.dt_s);  // validated by the caller
-    servo_share_stage_.emplace(stage.second_order);
+    servo_share_.set_second_order(stage.second_order);
   } else if (stage.is_linear()) {
     // Validated by the caller (StageModel::validate checks that this preview inverts it), so
     // nothing here throws; a linear stage arrives from the configuration, not per tick.
     const DiscreteLinearStage sampled = discretise(stage.linear, config_.dt_s);
     preview_ticks_ = stage_preview_ticks(sampled, stage.preview_ticks, stage.reference_bandwidth_hz);
     preview_.emplace(sampled, preview_ticks_, stage.reference_bandwidth_hz);
-    servo_share_linear_.emplace(sampled);
+    servo_share_.set_linear(sampled);
     if (ahead_.size() < static_cast<std::size_t>(preview_ticks_ + 1)) {
       ahead_.resize(static_cast<std::size_t>(preview_ticks_ + 1));
     }
   }
-  servo_share_seq_ = -1;
   stage_fresh_ = true;
   ++counters_.stage_swaps;
 }
@@ -221,30 +219,7 @@ std::optional<double> FeedforwardPlanner::observe(const CompensatorInput& sample
   if (exchange_.anchor().observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) {
     ++counters_.reanchors;
   }
-  return sample.y_m - servo_share_m(sample);
-}
-
-double FeedforwardPlanner::servo_share_m(const CompensatorInput& sample) noexcept {
-  // The learning corrects the feedforward, so it must see the feedforward's own error. The servo
-  // on y_ref - y works against every correction (what reaches the position is the correction
-  // times the loop's sensitivity S, 0.16 at 50 Hz with the default gains), which would slow the
-  // learning to a crawl where S is small and leave the update's premise, a plant from correction
-  // to position near 1, untrue. The position the servo's voltage bought, the stage (linearised at
-  // the linear model's gain) driven by u_V - u_ff_V, is taken out of the measurement: what is left
-  // is y_ff, the position the feedforward alone would have made, and r - y_ff is what the
-  // learning removes. Noise is untouched (it enters y, not u_ff), so the noise bound holds as is.
-  const double du = sample.u_V - sample.u_ff_V;
-  const bool consecutive = servo_share_seq_ >= 0 && sample.seq == servo_share_seq_ + 1;
-  servo_share_seq_ = sample.seq;
-  if (!std::isfinite(du)) return 0.0;
-  const double w = inverses_.linear_params().gain * du;
-  if (servo_share_linear_) {
-    if (!consecutive) servo_share_linear_->reset(w);
-    return servo_share_linear_->step(w);
-  }
-  if (!servo_share_stage_) return w;
-  if (!consecutive) servo_share_stage_->reset(w);
-  return servo_share_stage_->step(w, config_.dt_s);
+  return sample.y_m - servo_share_.position_m(sample, inverses_.linear_params().gain, config_.dt_s);
 }
 
 void FeedforwardPlanner::restart_reference(double t_s, double from_m) noexcept {
@@ -450,55 +425,6 @@ CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, 
   last_w_ = w_ref;
   last_u_ = u;
   return {k, u, y_ref, exchange_.version(), static_cast<std::int8_t>(mode_)};
-}
-
-void FeedforwardPlanner::plan_reference(std::int64_t j, PeriodicLearner* learning, bool start_inverse) noexcept {
-  const ReferencePoint ref = reference_tick(j, loop_time(j), learning);
-  PlannedReference& p = ahead(j);
-  p.y_ref = ref.sensor_m;
-  p.y_aim = ref.aim_m;
-  p.reversal = reversals_.update(ref.aim_m) == ReversalDetector::Event::kReversal;
-  p.correction = learning != nullptr ? learning->correction(j, ref.sensor_m) : 0.0;
-  p.w = p.y_aim;  // until the inverse's output for this tick arrives, preview_ticks later
-  last_ref_ = ref.sensor_m;
-  const double r = p.y_aim + p.correction;
-  if (start_inverse) preview_->reset(r);
-  // The inverse's output is the stage input of the tick preview_ticks back.
-  const double w = preview_->step(r);
-  if (j - preview_ticks_ >= 0) ahead(j - preview_ticks_).w = w;
-}
-
-CommandTick FeedforwardPlanner::preview_tick(std::int64_t k, PeriodicLearner* learning) noexcept {
-  bool start_inverse = false;
-  if (ref_next_ < k) {
-    // The reference side starts at this tick (a new reference, the first, or the plan fell behind
-    // the bridge): the inverse at rest at its first point, its outputs before this tick unused.
-    ref_next_ = k;
-    start_inverse = true;
-  } else if (stage_fresh_ && ref_next_ == k) {
-    start_inverse = true;  // a stage without preview: nothing planned ahead to feed again
-  } else if (stage_fresh_) {
-    // A new stage under a reference already planned ahead: the inverse restarted at rest and fed
-    // what was planned, so that its output reaches this tick again.
-    preview_->reset(ahead(k).y_aim + ahead(k).correction);
-    for (std::int64_t j = k; j < ref_next_; ++j) {
-      const double w = preview_->step(ahead(j).y_aim + ahead(j).correction);
-      if (j - preview_ticks_ >= k) ahead(j - preview_ticks_).w = w;
-    }
-  }
-  stage_fresh_ = false;
-  for (; ref_next_ <= k + preview_ticks_; ++ref_next_) {
-    plan_reference(ref_next_, learning, start_inverse);
-    start_inverse = false;
-  }
-  const PlannedReference p = ahead(k);
-  if (p.reversal) at_reversal(k, learning);
-  if (inverse_fresh_) restart_inverse(p.w);
-  FeedforwardAnchor& anchor = exchange_.anchor();
-  shift_m_ = anchor.y_offset(k);
-  const double shift_V = anchor.u_offset(k);
-  const double u = feedforward(p.w - shift_m_) + shift_V;
-  return command(k, u, p.y_ref, p.correction, p.w, shift_V, learning);
 }
 
 }  // namespace hystloop

@@ -31,6 +31,7 @@
 #include "loop/parameter_exchange.hpp"
 #include "loop/periodic_learner.hpp"
 #include "loop/scan_path.hpp"
+#include "loop/servo_share.hpp"
 #include "loop/trajectory.hpp"
 #include "models/linear_stage.hpp"
 #include "models/preview_inverse.hpp"
@@ -101,7 +102,6 @@ class FeedforwardPlanner {
   std::int64_t next_tick() const noexcept { return next_tick_; }
 
  private:
-  double servo_share_m(const CompensatorInput& sample) noexcept;
   // The reference at t: what the sensor must read (`sensor_m`: the trajectory plus, during a scan,
   // the axis's own path from its start) and what the inverse aims the axis's own displacement at
   // (`aim_m`: the same plus, during a scan, what the decoupling adds, w_a - r_a, faded in over the
@@ -181,16 +181,13 @@ class FeedforwardPlanner {
   StageModel stage_model_;
   std::optional<StageInverse> stage_inverse_;
   bool stage_fresh_ = true;  // the stage inverse starts at rest at the next reference
-  // The stage driven by the servo's share of the voltage (u_V - u_ff_V, times the linear gain):
-  // where the servo has moved the stage, which the learning adds back to the measured error.
-  std::optional<SecondOrderStage> servo_share_stage_;
-  std::optional<LinearStageSimulator> servo_share_linear_;
+  // Where the servo's share of the voltage has moved the stage, taken out of what the learning sees.
+  ServoShare servo_share_;
   // A linear stage: its inverse with preview, and the reference planned ahead of the commands.
   std::optional<PreviewStageInverse> preview_;
   std::int64_t preview_ticks_ = 0;
   std::vector<PlannedReference> ahead_;  // a ring over preview_ticks_ + 1 ticks
   std::int64_t ref_next_ = -1;           // the next reference tick to plan (-1: start at the next command)
-  std::int64_t servo_share_seq_ = -1;    // the last sample it was stepped with
   bool learner_restart_ = true;          // the trajectory or its start changed: restart learning at the next tick
   bool learning_room_ = true;            // the trajectory leaves room for learning's corrections
   double last_w_ = 0.0;                  // the stage-inverted reference last planned (the hysteresis model's target)
