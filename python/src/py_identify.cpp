@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ident/fit_checks.hpp"
@@ -121,10 +122,10 @@ IdentifyResult identify(const InArray& t_in, const InArray& u_in, const InArray&
   if (a.model != "auto") {
     kind = parse_model_kind(a.model);
     if (!kind) {
-      const std::string hint =
-          a.model == "banning"
-              ? "Banning's model is fitted on a series of experiments: hystloop-identify --model banning"
-              : "one of auto, mem, pi, katalenic, linear";
+      std::string hint = "one of auto";  // and every model parse_model_kind knows
+      for (const std::string_view name : model_kind_names()) hint += ", " + std::string(name);
+      if (a.model == "banning")
+        hint = "Banning's model is fitted on a series of experiments: hystloop-identify --model banning";
       throw PyParameterError("model", "model " + a.model + ": unknown here (" + hint + ")");
     }
   }

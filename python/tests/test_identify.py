@@ -97,8 +97,13 @@ class IdentifyTest(TempDirTest):
         bad[7] = 2e4
         with self.assertRaisesRegex(hystloop.ParameterError, "sample 7: u = 20000 V is beyond the sanity bound"):
             hystloop.identify(t, bad, y)
-        with self.assertRaisesRegex(hystloop.ParameterError, "unknown"):
+        with self.assertRaises(hystloop.ParameterError) as e:
             hystloop.identify(t, u, y, model="nonsense")
+        # The models it names are the library's, every one of them.
+        self.assertIn("unknown here (one of auto, ", str(e.exception))
+        for name in hystloop.models():
+            if name != "banning":
+                self.assertIn(name, str(e.exception))
         with self.assertRaisesRegex(hystloop.ParameterError, "operators"):
             hystloop.identify(t, u, y, model="pi", operators=40)
         p, _ = self.tool_fit({"t": t, "u": u, "y": y}, "--max-samples", "100")
