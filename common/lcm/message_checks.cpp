@@ -136,10 +136,13 @@ Verdict check_message(const mem_params_t& msg) noexcept {
   f.require(msg.axis >= 0 && msg.axis < kWireAxes);
   f.text(msg.source);
   f.finite(msg.c1);
-  f.require(!(msg.c1 <= 0.0) && !(msg.c1 > 1.0));  // [m/V]
   f.within(msg.c2, 0.0, kHuge);
   f.finite(msg.c3);
-  f.require(!(msg.c3 <= 0.0) && !(msg.c3 > 50.0));  // beyond ~50, p^c3 overflows for p of 100s of volts
+  // MEM's bounds are its descriptor's, as on HX_MODEL.
+  struct {
+    double mem_c1, mem_c2, mem_c3;
+  } const wire{msg.c1, msg.c2, msg.c3};
+  MemDescriptor::check_wire(wire, [&](bool ok) { f.require(ok); });
   f.within(msg.residual_m, 0.0, kMaxAbsPosition_m);
   f.within(msg.window_s, 0.0, kMaxDuration_s);
   return f.verdict();

@@ -247,6 +247,16 @@ TEST(MessageChecks, MemParams) {
   m = fixtures::params(2);
   m.c2 = -1e-12;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  // The upper bounds are MEM's descriptor's, as on HX_MODEL: c1 up to 1 m/V, c3 up to 50.
+  m = fixtures::params(2);
+  m.c1 = 1.5;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.c1 = 1.0;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.c3 = 60.0;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.c3 = 50.0;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
   m = fixtures::params(2);
   m.c2 = 0.0;  // a purely linear element is a valid set
   EXPECT_EQ(check_message(m), Verdict::kOk);
