@@ -130,15 +130,14 @@
 // bounds the damage. So the periods a line learns from before any table acts (the L periods of the
 // lag) give its learning-off error, the baseline B (their RMS pooled), and a period learned under
 // a table with an error RMS above B (monitor_ratio + 4 / sqrt(n)), n the period's ticks, or two in
-// a row above B (monitor_ratio + 2 / sqrt(n)), end the learning of that line: the table it falls back to is the
-// corrections that were applied over its best period (when that period was better than the baseline), held as they are,
-// or none (faded out). It is counted (divergences) and shown (diverged, until the line is
-// restarted, reset or learning is turned on again), and it does not learn that line again. The
-// margin and the second period are the sensor noise's: a period's RMS of white noise alone
-// scatters by about 1 / sqrt(2n) of itself (7 % at n = 100), and a divergence grows period after
-// period while a noisy period does not repeat. A parameter set swapped in under a table (one the
-// line does not hold) steps the error for a few periods while the tables learn the new set's error
-// (params_swapped): the periods until a lag and five periods after the swap are not compared.
+// a row above B (monitor_ratio + 2 / sqrt(n)), end the learning of that line: the table it falls
+// back to is the corrections that were applied over its best period (when that period was better
+// than the baseline), held as they are, or none (faded out). It is counted (divergences) and shown (diverged, until the
+// line is restarted, reset or learning is turned on again), and it does not learn that line again. The margin and the
+// second period are the sensor noise's: a period's RMS of white noise alone scatters by about 1 / sqrt(2n) of itself (7
+// % at n = 100), and a divergence grows period after period while a noisy period does not repeat. A parameter set
+// swapped in under a table (one the line does not hold) steps the error for a few periods while the tables learn the
+// new set's error (params_swapped): the periods until a lag and five periods after the swap are not compared.
 //
 // Everything is allocated in the constructor; correction(), observe() and the state changes are
 // noexcept and allocate, lock and log nothing.
@@ -169,8 +168,9 @@ struct LearningConfig {
   // Learn from every period through the lag (c_new = Q((1 - gain) c_cur + gain (c_applied + e)));
   // false: the plain update, one step per L periods, for a plant with |1 - T| > 1 where Q is not small.
   bool lag_compensated = true;
-  // Two periods in a row learned under a table with an error RMS above this many times the line's
-  // learning-off error (plus the noise's margin, see above) stop the learning of that line; 0: never.
+  // A period learned under a table with an error RMS above this many times the line's learning-off
+  // error plus 4 / sqrt(n), or two in a row above it plus 2 / sqrt(n) (the noise's margins, see
+  // above), stop the learning of that line; 0: never.
   double monitor_ratio = 1.05;
   // Throws ParameterError naming the field ("learning.gain", ...).
   void validate(double dt_s) const;

@@ -27,34 +27,30 @@ CounterSet::Entries CompensatorService::collect_counters() const {
   const CompensatorServiceCounters& s = counters_;
   // The plan's counters, each axis's summed (samples: every axis's), as CompensatorCounters lists
   // them; the sets refused before they reached a law count with those the laws rejected.
+  c.params_rejected += s.params_refused;
   CounterSet::Entries entries;
   CompensatorCounters::for_each([&](const char* name, auto field) { entries.emplace_back(name, c.*field); });
-  for (auto& [name, value] : entries) {
-    if (name == "params_rejected") value += s.params_refused;
-  }
-  for (const auto& entry : CounterSet::Entries{{"command_blocks_published", s.command_blocks_published},
-                                               {"command_ticks_published", s.command_ticks_published},
-                                               {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
-                                               {"params_invalid", s.params_invalid},
-                                               {"params_stale", s.params_stale},
-                                               {"params_stale_repeat", s.params_stale_repeat},
-                                               {"params_stale_below", s.params_stale_below},
-                                               {"model_unknown_kind", s.model_unknown_kind},
-                                               {"model_unknown_format", s.model_unknown_format},
-                                               {"trajectories", s.trajectories},
-                                               {"trajectory_repeats", s.trajectory_repeats},
-                                               {"trajectory_refused", s.trajectory_refused},
-                                               {"trajectory_late_start", s.trajectory_late_start},
-                                               {"control_acted", s.control_acted},
-                                               {"control_refused", s.control_refused},
-                                               {"bridge_restarts", s.bridge_restarts},
-                                               {"sensor_jumps", guard_.counters().jumps},
-                                               {"sensor_jumps_ignored", guard_.counters().ignored},
-                                               {"sensor_blocks_held", guard_.counters().held},
-                                               {"params_publishers_evicted", admission_.evictions()},
-                                               {"log_lines_suppressed", log_limiter_.suppressed_total()}}) {
-    entries.push_back(entry);
-  }
+  entries.insert(entries.end(), {{"command_blocks_published", s.command_blocks_published},
+                                 {"command_ticks_published", s.command_ticks_published},
+                                 {"sensor_blocks_wrong_axes", s.sensor_blocks_wrong_axes},
+                                 {"params_invalid", s.params_invalid},
+                                 {"params_stale", s.params_stale},
+                                 {"params_stale_repeat", s.params_stale_repeat},
+                                 {"params_stale_below", s.params_stale_below},
+                                 {"model_unknown_kind", s.model_unknown_kind},
+                                 {"model_unknown_format", s.model_unknown_format},
+                                 {"trajectories", s.trajectories},
+                                 {"trajectory_repeats", s.trajectory_repeats},
+                                 {"trajectory_refused", s.trajectory_refused},
+                                 {"trajectory_late_start", s.trajectory_late_start},
+                                 {"control_acted", s.control_acted},
+                                 {"control_refused", s.control_refused},
+                                 {"bridge_restarts", s.bridge_restarts},
+                                 {"sensor_jumps", guard_.counters().jumps},
+                                 {"sensor_jumps_ignored", guard_.counters().ignored},
+                                 {"sensor_blocks_held", guard_.counters().held},
+                                 {"params_publishers_evicted", admission_.evictions()},
+                                 {"log_lines_suppressed", log_limiter_.suppressed_total()}});
   // Scans and what named an axis this stage lacks (a one-axis stage counts them too); with several
   // axes these say how the axes planned together.
   entries.emplace_back("scans", s.scans);

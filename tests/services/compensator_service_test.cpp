@@ -174,6 +174,24 @@ struct Harness {
   std::int64_t sent_through() const { return ticks.empty() ? -1 : ticks.back().seq; }
 };
 
+// One HX_STATUS report of the service, as a listener on its channel receives it: the message and
+// its counters by name.
+struct Reported {
+  service_status_t status{};
+  std::map<std::string, std::int64_t> counters;
+};
+Reported report_status(Harness& h) {
+  Subscription<service_status_t> listener(*h.lcm, h.channels.status);
+  h.service.report(wall_utime(), false);
+  h.drain();
+  EXPECT_EQ(listener.counters().accepted, 1u);
+  Reported r{listener.latest(), {}};
+  for (std::size_t i = 0; i < r.status.counter_names.size(); ++i) {
+    r.counters[r.status.counter_names[i]] = r.status.counter_values[i];
+  }
+  return r;
+}
+
 // After a sensor block whose last tick is `last`, the blocks published since `from_block` carry
 // exactly the ticks after `before` (the last one sent) and after `last` (the bridge has passed
 // it) through last + horizon: consecutive, each once, at most MAX_TICKS per block, each stamped
@@ -544,13 +562,7 @@ TEST(CompensatorService, RepeatedWarningsAreRateLimitedAndWireTextIsEscaped) {
     EXPECT_EQ(h.service.counters().control_refused, 1000u);
     EXPECT_EQ(h.service.counters().params_invalid, 500u);
     EXPECT_EQ(h.service.counters().params_stale, 499u);
-    Subscription<service_status_t> status(*h.lcm, h.channels.status);
-    h.service.report(wall_utime(), false);
-    h.drain();
-    ASSERT_EQ(status.counters().accepted, 1u);
-    const service_status_t& st = status.latest();
-    std::map<std::string, std::int64_t> reported;
-    for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+    std::map<std::string, std::int64_t> reported = report_status(h).counters;
     EXPECT_EQ(reported["params_invalid"], 500);
     EXPECT_EQ(reported["params_stale"], 499);
     EXPECT_EQ(reported["control_refused"], 1000);
@@ -662,13 +674,7 @@ TEST(CompensatorService, ATrajectoryIsCheckedWhileThePlanGoesOn) {
   h.run(20, 1000);
   EXPECT_EQ(h.tick(h.sent_through()).y_ref_m, 2e-7);
   // The plan's refusal is on HX_STATUS under its own name, as every counter of the plan is.
-  Subscription<service_status_t> status(*h.lcm, h.channels.status);
-  h.service.report(wall_utime(), false);
-  h.drain();
-  ASSERT_EQ(status.counters().accepted, 1u);
-  const service_status_t& st = status.latest();
-  std::map<std::string, std::int64_t> reported;
-  for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+  std::map<std::string, std::int64_t> reported = report_status(h).counters;
   EXPECT_EQ(reported["plan_refusals"], 1);
   EXPECT_EQ(reported["trajectory_refused"], 1);
   CompensatorCounters::for_each([&](const char* name, auto) { EXPECT_TRUE(reported.contains(name)) << name; });
@@ -685,18 +691,14 @@ TEST(CompensatorService, ALineWhoseLearningTheMonitorStoppedIsDegradedWithTheRea
   s.control.learning.monitor_ratio = 1.05;
   Harness h(s);
   h.plant_gain = -kGain;
-  Subscription<service_status_t> status(*h.lcm, h.channels.status);
   h.run(0, 5000);
-  h.service.report(wall_utime(), false);
-  h.drain();
-  ASSERT_EQ(status.counters().accepted, 1u);
-  const service_status_t& st = status.latest();
+  const Reported r = report_status(h);
+  const service_status_t& st = r.status;
   EXPECT_EQ(h.service.compensator().learner().figures().divergences, 1u);
   EXPECT_EQ(st.state, service_status_t::DEGRADED) << st.detail;
   EXPECT_NE(st.detail.find("learning stopped: it made the line's error worse than without"), std::string::npos)
       << st.detail;
-  std::map<std::string, std::int64_t> reported;
-  for (std::size_t i = 0; i < st.counter_names.size(); ++i) reported[st.counter_names[i]] = st.counter_values[i];
+  std::map<std::string, std::int64_t> reported = r.counters;
   EXPECT_EQ(reported["learning_divergences"], 1);
   EXPECT_EQ(reported["learning_active"], 0);
 }
@@ -945,16 +947,9 @@ TEST(CompensatorService, AParameterSetWaitingForAReversalSurvivesABridgeRestart)
 
 // Blocks under one numbering, then a bridge restart's, then one HX_STATUS report: its counters by name.
 std::map<std::string, std::int64_t> status_after_a_restart(Harness& h) {
-  Subscription<service_status_t> status(*h.lcm, h.channels.status);
   h.run(50000, 100);
   h.run(0, 100);
-  h.service.report(wall_utime(), false);
-  h.drain();
-  EXPECT_EQ(status.counters().accepted, 1u);
-  std::map<std::string, std::int64_t> counters;
-  const service_status_t& s = status.latest();
-  for (std::size_t i = 0; i < s.counter_names.size(); ++i) counters[s.counter_names[i]] = s.counter_values[i];
-  return counters;
+  return report_status(h).counters;
 }
 
 // HX_STATUS counters only count up (CounterSet): a bridge restart replaces the control law but
