@@ -155,11 +155,12 @@ ConfigError::ConfigError(std::string source, std::string field, const std::strin
       message_(compose(source_, this->field(), reason)) {}
 
 const std::string& Config::Impl::source_for(std::string_view path) const {
-  for (const auto& key : overridden) {
-    // A key below it, or an entry of its list ("gains[1]"), came from the override too.
+  for (auto it = overridden.rbegin(); it != overridden.rend(); ++it) {  // the last one set it
+    const std::string& key = it->first;
+    // A key below it, or an entry of its list ("gains[1]"), came from the same place.
     if (path == key || (path.size() > key.size() && path.substr(0, key.size()) == key &&
                         (path[key.size()] == '.' || path[key.size()] == '['))) {
-      return kOverrideSource;
+      return it->second;
     }
   }
   return source;
@@ -390,7 +391,31 @@ void Config::apply_override(std::string_view assignment) {
   refuse_duplicate_keys(value, kOverrideSource, key);
   std::string walked;
   set_node(impl_->root, parts, 0, value, walked);
-  impl_->overridden.push_back(key);
+  impl_->overridden.emplace_back(key, kOverrideSource);
+}
+
+namespace {
+
+// Merges `layer` into `node` (both maps): a map into a map key by key, anything else (a value, a
+// list) replacing what was there whole, so a layer's list of modes is the list, never a mix.
+void merge_map(YAML::Node node, const YAML::Node& layer) {
+  for (const auto& kv : layer) {
+    const std::string key = kv.first.as<std::string>();
+    YAML::Node child = node[key];
+    if (kv.second.IsMap() && child.IsMap()) {
+      merge_map(child, kv.second);
+    } else {
+      child = YAML::Clone(kv.second);
+    }
+  }
+}
+
+}  // namespace
+
+void Config::layer(const Config& other) {
+  merge_map(impl_->root, other.impl_->root);
+  for (std::string& key : other.keys()) impl_->overridden.emplace_back(std::move(key), other.impl_->source);
+  for (const auto& o : other.impl_->overridden) impl_->overridden.push_back(o);
 }
 
 void Config::apply_overrides(const std::vector<std::string>& assignments) {

@@ -97,6 +97,10 @@ class Config {
   // Throws ConfigError (source "--set") for a malformed assignment.
   void apply_override(std::string_view assignment);
   void apply_overrides(const std::vector<std::string>& assignments);
+  // Merges another file's tree over this one (a scenario's or a rig's settings over a service's
+  // config): maps key by key, a value or a list replacing the one here whole. Errors about a key
+  // the layer gave name the layer's file.
+  void layer(const Config& other);
 
   // Throws ConfigError listing every key of the tree that is not in `known`,
   // with a "did you mean" suggestion when one is close. An entry "section.*"

@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/config.hpp"
@@ -13,9 +14,12 @@ namespace hystloop {
 struct Config::Impl {
   YAML::Node root{YAML::NodeType::Map};
   std::string source = "<empty>";
-  std::vector<std::string> overridden;  // keys set by apply_override, in order
+  // Keys set over the base file, in order, each with where it came from: "--set" (apply_override)
+  // or a layered file's name (layer).
+  std::vector<std::pair<std::string, std::string>> overridden;
 
-  // "--set" when `path` (or a parent of it) was overridden, else the file.
+  // Where `path`'s value came from: the last override or layer that set it (or a parent of it),
+  // else the base file.
   const std::string& source_for(std::string_view path) const;
 };
 

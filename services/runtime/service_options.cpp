@@ -9,7 +9,11 @@ void add_service_options(CLI::App& app, ServiceOptions& options) {
   app.footer(
       "Exit status: 0 stopped as asked (SIGINT/SIGTERM, SHUTDOWN, --seconds); 1 a runtime failure; 2 a bad "
       "option, configuration or key file (the message names the field).");
-  app.add_option("--config", options.config_file, "YAML configuration file")->check(CLI::ExistingFile);
+  app.add_option("--config", options.config_files,
+                 "YAML configuration file; repeat it to layer files, each later one's keys over the earlier ones' "
+                 "(a map merged key by key, a value or a list replaced whole)")
+      ->check(CLI::ExistingFile)
+      ->allow_extra_args(false);
   app.add_option("--set", options.overrides, "Override a configuration value, KEY=VALUE (repeatable)");
   app.add_option("--lcm-url", options.lcm_url,
                  "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
@@ -23,13 +27,21 @@ void add_service_options(CLI::App& app, ServiceOptions& options) {
 std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) { return parse_cli(app, argc, argv); }
 
 Config load_service_config(const ServiceOptions& options) {
-  Config config = options.config_file.empty() ? Config() : Config::load_file(options.config_file);
-  // An empty file is almost always the wrong file (or one being written): running on the defaults
-  // without a word would hide that.
-  if (!options.config_file.empty() && config.keys().empty()) {
-    throw ConfigError(options.config_file, "",
-                      "no keys in it (empty, or comments only): give the service's config (e.g. deploy/config/), or "
-                      "leave --config out to run on the defaults");
+  Config config;
+  for (std::size_t i = 0; i < options.config_files.size(); ++i) {
+    Config file = Config::load_file(options.config_files[i]);
+    // An empty file is almost always the wrong file (or one being written): running on the defaults
+    // without a word would hide that.
+    if (file.keys().empty()) {
+      throw ConfigError(options.config_files[i].string(), "",
+                        "no keys in it (empty, or comments only): give the service's config (e.g. deploy/config/), or "
+                        "leave --config out to run on the defaults");
+    }
+    if (i == 0) {
+      config = std::move(file);
+    } else {
+      config.layer(file);
+    }
   }
   config.apply_overrides(options.overrides);
   return config;

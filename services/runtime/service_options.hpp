@@ -20,7 +20,9 @@
 namespace hystloop {
 
 struct ServiceOptions {
-  std::filesystem::path config_file;
+  // The service's config, then files layered over it in order (Config::layer): a scenario's or a
+  // rig's settings without a copy of the whole file.
+  std::vector<std::filesystem::path> config_files;
   std::vector<std::string> overrides;
   std::string lcm_url;
   bool allow_network = false;

@@ -164,6 +164,42 @@ TEST(Config, OverriddenValuesAreReportedAsComingFromTheCommandLine) {
             "--set: bridge.typo: unknown key");
 }
 
+TEST(Config, ALayeredFileMergesMapsKeyByKeyAndReplacesValuesAndListsWhole) {
+  Config cfg = Config::from_string(kBridge, "bridge.yaml");
+  cfg.layer(Config::from_string("bridge: {u_max_V: 90, gains: [4]}\nstage: {delay_s: 1.5e-4}\nlearning: {gain: 0.3}\n",
+                                "scan.yaml"));
+  EXPECT_EQ(cfg.get<double>("bridge.u_max_V"), 90.0);
+  EXPECT_EQ(cfg.get<std::vector<double>>("bridge.gains"), (std::vector<double>{4}));  // not [4, 2, 3e-3]
+  EXPECT_EQ(cfg.get<double>("bridge.noise_rms_m"), 2.0e-9);                           // a sibling stays
+  EXPECT_EQ(cfg.get<std::string>("stage.model"), "banning");
+  EXPECT_EQ(cfg.get<double>("stage.delay_s"), 1.5e-4);
+  EXPECT_EQ(cfg.get<double>("learning.gain"), 0.3);  // a section only the layer has
+  // A map over a value replaces it, as a value over a map does.
+  cfg.layer(Config::from_string("bridge: {name: {first: a}}\nstage: 3\n", "more.yaml"));
+  EXPECT_EQ(cfg.get<std::string>("bridge.name.first"), "a");
+  EXPECT_EQ(cfg.get<int>("stage"), 3);
+}
+
+TEST(Config, ARefusedValueNamesTheFileThatGaveIt) {
+  Config cfg = Config::from_string(kBridge, "bridge.yaml");
+  cfg.layer(Config::from_string("bridge: {u_max_V: -5, typo: 1}\n", "scan.yaml"));
+  EXPECT_EQ(error_of([&] { (void)cfg.get_positive("bridge.u_max_V", 1.0); }),
+            "scan.yaml: bridge.u_max_V: must be > 0 (got -5)");
+  // A key the layer left alone is still the base file's.
+  EXPECT_EQ(error_of([&] {
+              (void)cfg.get_in_range("bridge.watchdog_ms", 5.0, 5.0, 10.0);
+            }).rfind("bridge.yaml: bridge.watchdog_ms: ", 0),
+            0u);
+  EXPECT_EQ(error_of([&] {
+              cfg.check_no_unknown_keys({"bridge.u_max_V", "bridge.noise_rms_m", "bridge.simulated", "bridge.name",
+                                         "bridge.watchdog_ms", "bridge.gains", "stage.model"});
+            }),
+            "scan.yaml: bridge.typo: unknown key");
+  cfg.apply_override("bridge.u_max_V=-6");  // the command line last, over every file
+  EXPECT_EQ(error_of([&] { (void)cfg.get_positive("bridge.u_max_V", 1.0); }),
+            "--set: bridge.u_max_V: must be > 0 (got -6)");
+}
+
 TEST(Config, MalformedOverridesAreRefused) {
   Config cfg = Config::from_string(kBridge, "bridge.yaml");
   EXPECT_EQ(error_of([&] { cfg.apply_override("bridge.u_max_V"); }), "--set: expected key=value, got 'bridge.u_max_V'");

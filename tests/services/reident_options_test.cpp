@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "models/model_descriptors.hpp"
+#include "runtime/stage_config.hpp"
 
 namespace hystloop {
 namespace {
@@ -132,15 +133,34 @@ TEST(ReidentOptions, TheDeployedDefaultsLoad) {
 // The stage the re-identifier takes out of the samples must be the one the compensator inverts:
 // a fit on samples with the stage left in (or taken out twice) is the stage's lag read as hysteresis.
 TEST(ReidentOptions, TheDeployedStageIsTheCompensators) {
-  for (const char* dir : {"/deploy/config/", "/deploy/config/scan/"}) {
-    const std::string root = std::string(HYSTLOOP_SOURCE_DIR) + dir;
-    const ReidentOptions o = read_reident_options(Config::load_file(root + "reidentifier.yaml"));
-    const Config compensator = Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/compensator.yaml");
-    EXPECT_TRUE(o.stage.has_dynamics()) << dir;
-    EXPECT_EQ(compensator.get<std::string>("stage.kind"), "second_order") << dir;
-    EXPECT_DOUBLE_EQ(o.stage.second_order.k, compensator.get<double>("stage.k")) << dir;
-    EXPECT_DOUBLE_EQ(o.stage.second_order.c, compensator.get<double>("stage.c")) << dir;
+  const std::string root = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
+  Config scan = Config::load_file(root + "reidentifier.yaml");
+  scan.layer(Config::load_file(root + "scan/reidentifier.layer.yaml"));  // as deploy/hystloop scan runs it
+  const Config compensator = Config::load_file(root + "compensator.yaml");
+  for (const Config& config : {Config::load_file(root + "reidentifier.yaml"), scan}) {
+    const ReidentOptions o = read_reident_options(config);
+    EXPECT_TRUE(o.stage.has_dynamics());
+    EXPECT_EQ(compensator.get<std::string>("stage.kind"), "second_order");
+    EXPECT_DOUBLE_EQ(o.stage.second_order.k, compensator.get<double>("stage.k"));
+    EXPECT_DOUBLE_EQ(o.stage.second_order.c, compensator.get<double>("stage.c"));
   }
+  EXPECT_TRUE(read_reident_options(scan).models.enabled);  // the scan chooses the model
+}
+
+// A scan's layer changes the re-identifier's model choice, never the stage it takes out: over the
+// two-mode rig's config the stage is the two-mode stage its compensator inverts.
+TEST(ReidentOptions, TheScansLayerKeepsTheRigsStage) {
+  const std::string root = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/";
+  const Config layer = Config::load_file(root + "scan/reidentifier.layer.yaml");
+  for (const std::string& key : layer.keys()) EXPECT_EQ(key.rfind("reidentifier.", 0), 0u) << key;
+  Config two_mode = Config::load_file(root + "two-mode/reidentifier.yaml");
+  two_mode.layer(layer);
+  const ReidentOptions o = read_reident_options(two_mode);
+  const StageModel compensator =
+      read_stage_model(Config::load_file(root + "two-mode/compensator.yaml"), StageModel{}, 1e-4);
+  EXPECT_EQ(o.stage.kind, StageModel::Kind::kLinear);
+  EXPECT_EQ(o.stage.linear.delay_s, compensator.linear.delay_s);
+  EXPECT_EQ(o.stage.linear.modes.size(), 2u);
 }
 
 // One re-identifier per axis: reidentifier.axis names it as hystloop-ctl's --axis does.
