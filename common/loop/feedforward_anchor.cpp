@@ -7,9 +7,10 @@
 
 namespace hystloop {
 
-FeedforwardAnchor::FeedforwardAnchor(std::int64_t measure_ticks, std::int64_t min_ramp_ticks, double max_du_per_tick,
-                                     double max_u_offset_per_tick)
+FeedforwardAnchor::FeedforwardAnchor(std::int64_t measure_ticks, std::int64_t max_measure_ticks,
+                                     std::int64_t min_ramp_ticks, double max_du_per_tick, double max_u_offset_per_tick)
     : measure_ticks_(measure_ticks),
+      max_measure_ticks_(std::max(measure_ticks, max_measure_ticks)),
       min_ramp_ticks_(min_ramp_ticks),
       max_du_per_tick_(max_du_per_tick),
       max_u_offset_per_tick_(max_u_offset_per_tick) {
@@ -17,7 +18,8 @@ FeedforwardAnchor::FeedforwardAnchor(std::int64_t measure_ticks, std::int64_t mi
   require_in_range("compensator.reanchor_ramp_ticks", static_cast<double>(min_ramp_ticks), 1.0, 100000.0);
   require_positive("compensator.slew_fraction", max_du_per_tick);
   require_positive("compensator.reanchor_u_rate_V_per_s", max_u_offset_per_tick);
-  for (auto* v : {&y_model_, &u_model_, &dy_, &du_}) v->assign(static_cast<std::size_t>(measure_ticks), 0.0);
+  require_in_range("the re-anchoring window", static_cast<double>(max_measure_ticks_), 1.0, 1e6);
+  for (auto* v : {&y_model_, &u_model_, &dy_, &du_}) v->assign(static_cast<std::size_t>(max_measure_ticks_), 0.0);
 }
 
 double FeedforwardAnchor::Ramp::at(std::int64_t k) const noexcept {
@@ -40,37 +42,53 @@ void FeedforwardAnchor::start_measuring(std::int64_t first_tick) noexcept {
   first_ = first_tick;
   have_planned_ = 0;
   have_observed_ = 0;
+  window_ = 0;
+  reversals_ = 0;
 }
 
-void FeedforwardAnchor::planned(std::int64_t k, double y_model, double u_model) noexcept {
+void FeedforwardAnchor::planned(std::int64_t k, double y_model, double u_model, bool reversal) noexcept {
   if (!measuring_) return;
   const std::int64_t i = k - first_;
-  if (i < 0) return;
-  if (i < measure_ticks_) {
-    y_model_[static_cast<std::size_t>(i)] = y_model;
-    u_model_[static_cast<std::size_t>(i)] = u_model;
-    have_planned_ = i + 1;
-    if (i == 0) u_first_ = u_model, y_first_ = y_model;
+  if (i < 0 || (window_ > 0 && i >= window_)) return;
+  if (i > 0 && reversal) {
+    ++reversals_;
+    // A whole period: the window ends before the second reversal after its first tick.
+    if (reversals_ % 2 == 0 && i >= measure_ticks_) {
+      window_ = i;
+      return;
+    }
   }
-  u_last_ = u_model;
-  y_last_ = y_model;
+  const auto j = static_cast<std::size_t>(i);
+  y_model_[j] = y_model;
+  u_model_[j] = u_model;
+  have_planned_ = i + 1;
+  if (i == 0) u_first_ = u_model, y_first_ = y_model;
+  if (reversals_ == 0) u_last_ = u_model, y_last_ = y_model;  // the secant along the first branch
+  // No period inside the window (a slow or aperiodic reference): its first ticks, as near the
+  // reversal as they are.
+  if (i + 1 == max_measure_ticks_) window_ = reversals_ >= 2 ? i + 1 : measure_ticks_;
 }
 
 bool FeedforwardAnchor::observe(std::int64_t seq, double y_measured, double u_applied, std::int64_t ramp_start,
                                 double fallback_slope) noexcept {
   if (!measuring_) return false;
   const std::int64_t i = seq - first_;
-  if (i < 0 || i >= have_planned_) return false;
-  const auto j = static_cast<std::size_t>(i);
-  dy_[j] = y_measured - y_model_[j];
-  du_[j] = u_applied - u_model_[j];
-  have_observed_ = std::max(have_observed_, i + 1);
-  if (i + 1 < measure_ticks_) return false;
+  if (i < 0) return false;
+  if (i < have_planned_ && (window_ == 0 || i < window_)) {
+    const auto j = static_cast<std::size_t>(i);
+    dy_[j] = y_measured - y_model_[j];
+    du_[j] = u_applied - u_model_[j];
+    have_observed_ = std::max(have_observed_, i + 1);
+  }
+  // Complete at the window's last tick, or at the first sample after its end became known (a
+  // slow reference's window is cut back to its first ticks once max_measure_ticks are planned).
+  if (window_ == 0 || i + 1 < window_) return false;
   // The window is complete (a tick lost on the way keeps its slot's older value: harmless noise).
   double sy = 0.0, su = 0.0;
-  for (std::size_t n = 0; n < dy_.size(); ++n) sy += dy_[n], su += du_[n];
-  const double y_target = sy / static_cast<double>(measure_ticks_);
-  const double u_target = su / static_cast<double>(measure_ticks_);
+  for (std::int64_t n = 0; n < window_; ++n)
+    sy += dy_[static_cast<std::size_t>(n)], su += du_[static_cast<std::size_t>(n)];
+  const double y_target = sy / static_cast<double>(window_);
+  const double u_target = su / static_cast<double>(window_);
   measuring_ = false;
   if (!std::isfinite(y_target) || !std::isfinite(u_target)) return false;
   ramp_to(y_target, u_target, ramp_start, fallback_slope);

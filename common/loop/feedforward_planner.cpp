@@ -350,7 +350,8 @@ CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* l
   const double y_ref = ref.sensor_m;
   const double y_aim = ref.aim_m;
   FeedforwardAnchor& anchor = exchange_.anchor();
-  if (reversals_.update(y_aim) == ReversalDetector::Event::kReversal) at_reversal(k, learning);
+  const bool reversal = reversals_.update(y_aim) == ReversalDetector::Event::kReversal;
+  if (reversal) at_reversal(k, learning);
   if (inverse_fresh_) restart_inverse(y_aim);
   // The reference the inverse aims at: with what the learning has found this point of the period
   // needs, and, for hysteresis then stage, through the stage's inverse first.
@@ -374,11 +375,11 @@ CommandTick FeedforwardPlanner::tracking_tick(std::int64_t k, PeriodicLearner* l
     u = stage_inverse_->step(u);
   }
   last_ref_ = y_ref;
-  return command(k, u, y_ref, correction, w_ref, shift_V, learning);
+  return command(k, u, y_ref, correction, w_ref, shift_V, reversal, learning);
 }
 
 CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, double correction, double w_ref,
-                                        double shift_V, PeriodicLearner* learning) noexcept {
+                                        double shift_V, bool reversal, PeriodicLearner* learning) noexcept {
   FeedforwardAnchor& anchor = exchange_.anchor();
   if (!std::isfinite(u)) {  // never hand a non-finite voltage on
     ++counters_.nonfinite_outputs;
@@ -421,7 +422,7 @@ CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, 
   }
   // The anchor compares the measured position with the reference the model was asked for (not
   // the learned correction: what the learning adds is meant to make y follow y_ref).
-  anchor.planned(k, y_ref - shift_m_, u - shift_V);
+  anchor.planned(k, y_ref - shift_m_, u - shift_V, reversal);
   last_w_ = w_ref;
   last_u_ = u;
   return {k, u, y_ref, exchange_.version(), static_cast<std::int8_t>(mode_)};

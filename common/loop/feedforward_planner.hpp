@@ -143,7 +143,7 @@ class FeedforwardPlanner {
   CommandTick preview_tick(std::int64_t k, PeriodicLearner* learning) noexcept;
   // The stage input u (after the hysteresis inverse) of tick k made safe, counted and recorded.
   CommandTick command(std::int64_t k, double u, double y_ref, double correction, double w_ref, double shift_V,
-                      PeriodicLearner* learning) noexcept;
+                      bool reversal, PeriodicLearner* learning) noexcept;
   double feedforward(double y_ref) noexcept;
   void reset_inverse(double y0) noexcept;
   // A reversal of the reference at tick k: the waiting set swapped in (unless learning holds it).

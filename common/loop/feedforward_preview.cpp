@@ -53,7 +53,7 @@ CommandTick FeedforwardPlanner::preview_tick(std::int64_t k, PeriodicLearner* le
   shift_m_ = anchor.y_offset(k);
   const double shift_V = anchor.u_offset(k);
   const double u = feedforward(p.w - shift_m_) + shift_V;
-  return command(k, u, p.y_ref, p.correction, p.w, shift_V, learning);
+  return command(k, u, p.y_ref, p.correction, p.w, shift_V, p.reversal, learning);
 }
 
 }  // namespace hystloop

@@ -1,9 +1,23 @@
 #include "loop/parameter_exchange.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace hystloop {
+namespace {
+
+// The re-anchoring window spans a whole period of the lines learning takes (learning.max_period_s,
+// 0.1 s by default: 1,000 ticks, 32 kB), and a tick more, so that the period's second reversal
+// falls inside it.
+std::int64_t reanchor_max_ticks(const CompensatorConfig& config) {
+  const double ticks = std::ceil(config.learning.max_period_s / config.dt_s) + 1.0;
+  return static_cast<std::int64_t>(std::clamp(ticks, 1.0, 100000.0));
+}
+
+}  // namespace
 
 ParameterExchange::ParameterExchange(const CompensatorConfig& config)
-    : anchor_(config.reanchor_ticks, config.reanchor_ramp_ticks,
+    : anchor_(config.reanchor_ticks, reanchor_max_ticks(config), config.reanchor_ramp_ticks,
               config.slew_fraction * config.slew_V_per_s * config.dt_s, config.reanchor_u_rate_V_per_s * config.dt_s) {}
 
 void ParameterExchange::offer(const ModelParamSet& params, bool switch_model, std::int32_t version) noexcept {
