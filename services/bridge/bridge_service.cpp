@@ -243,6 +243,12 @@ int BridgeService::run() {
   rt_.start();
   while (!rt_.started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   spdlog::info("real-time thread: {}; {}", rt_.priority_status().detail, rt_.affinity_status().detail);
+  // Never armed: the clock thread is stopped again through the safe state, and the bridge exits 1.
+  const bool real_time_missing = settings_.rt.required && !rt_.priority_status().ok;
+  if (real_time_missing) {
+    spdlog::error("{}", real_time_refused(rt_.priority_status().detail));
+    request_stop();
+  }
 
   spdlog::info("started in the safe state ({} V); {}", settings_.limits.safe_u_V,
                settings_.auto_arm ? "arms when commands flow" : "waiting for ARM on HX_CONTROL");
@@ -289,7 +295,7 @@ int BridgeService::run() {
     report(*last, wall_utime(), true);
     summarize(*last, safe);
   }
-  return lcm_errors_ > 0 || !safe.reached ? 1 : 0;
+  return lcm_errors_ > 0 || !safe.reached || real_time_missing ? 1 : 0;
 }
 
 void BridgeService::log_safe_stop(const SafeStopResult& r) const {

@@ -166,6 +166,14 @@ double BridgeSettings::longest_safe_ramp_s() const noexcept {
   return longest;
 }
 
+std::string real_time_refused(const std::string& what) {
+  return "rt.required: " + what +
+         ": the bridge does not run a hardware backend without real time (missed ticks hold stale voltages). Grant "
+         "it: run as root, or `sudo setcap cap_sys_nice,cap_ipc_lock+ep` on hystloop-bridge, or rtprio 99 and "
+         "memlock unlimited for the user (/etc/security/limits.d/), or LimitRTPRIO=99 and LimitMEMLOCK=infinity "
+         "in its systemd unit; or waive it with rt.required: false (docs/TIMING.md, \"Real-time host\")";
+}
+
 AxisMatrix default_stage_coupling() noexcept { return flexure_stage(kMaxAxes).coupling.matrix(); }
 
 MultiAxisStageConfig multi_axis_stage(const BridgeSettings& settings) {
@@ -211,7 +219,8 @@ const std::vector<std::string>& bridge_config_keys() {
                                                 "rt.priority",
                                                 "rt.io_priority",
                                                 "rt.lock_memory",
-                                                "rt.cpu"};
+                                                "rt.cpu",
+                                                "rt.required"};
   static const std::vector<std::string> all = [] {
     std::vector<std::string> k = keys;
     // actuator.* and servo.* for axis x, actuator.y.*, servo.y.* ... for the others.
@@ -346,6 +355,12 @@ BridgeSettings load_bridge_settings(const Config& config) {
   }
   s.rt.lock_memory = config.get<bool>("rt.lock_memory", s.rt.lock_memory);
   s.rt.cpu = static_cast<int>(config.get_int_in_range("rt.cpu", s.rt.cpu, -1, 1023));
+  s.rt.required = config.get<bool>("rt.required", s.backend == "comedi");
+  if (s.rt.required && (s.rt.priority == 0 || !s.rt.lock_memory)) {
+    config.fail("rt.required",
+                "real time is required (the default for a hardware backend): set rt.priority 1..99 and "
+                "rt.lock_memory: true, or waive it with rt.required: false (docs/TIMING.md, \"Real-time host\")");
+  }
   return s;
 }
 
@@ -408,8 +423,9 @@ std::vector<std::string> describe(const BridgeSettings& s) {
       fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s); commands taken up to {} s "
                   "ahead of the clock (bridge.max_lead_s)",
                   s.block_ticks, s.rate_hz / s.block_ticks, s.max_lead_s));
-  lines.push_back(fmt::format("rt: {} tick(s) per wake-up, priority {}, I/O priority {}, lock_memory {}, cpu {}",
-                              s.rt.ticks_per_wake, s.rt.priority, s.rt.io_priority, s.rt.lock_memory, s.rt.cpu));
+  lines.push_back(fmt::format("rt: {} tick(s) per wake-up, priority {}, I/O priority {}, lock_memory {}, cpu {}, {}",
+                              s.rt.ticks_per_wake, s.rt.priority, s.rt.io_priority, s.rt.lock_memory, s.rt.cpu,
+                              s.rt.required ? "required" : "not required"));
   return lines;
 }
 

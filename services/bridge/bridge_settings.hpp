@@ -26,11 +26,19 @@ struct RtSettings {
   int io_priority = 0;       // SCHED_FIFO priority of the I/O thread (below `priority`); 0 = normal scheduling
   bool lock_memory = false;  // mlockall at start
   int cpu = -1;              // pin the real-time thread to this CPU; -1 = no pinning
+  // SCHED_FIFO and locked memory must be granted, else the bridge refuses to run (exit 1, the fix
+  // named): a card's ticks on normal scheduling miss deadlines while the DAC holds stale voltages.
+  // Default: on for a hardware backend, off for the simulators; rt.required: false waives it.
+  bool required = false;
 };
 
 // The simulated XY(Z) stage's default coupling: x moves y by 3 %, and z by 3 % of x and of y, as
 // flexure stages show (flexure_stage()).
 AxisMatrix default_stage_coupling() noexcept;
+
+// Why the bridge will not run when rt.required and real time was refused (`what`: the refusal),
+// with the ways to grant it and to waive it.
+std::string real_time_refused(const std::string& what);
 
 struct BridgeSettings {
   std::string backend = "sim";  // sim (Banning stage) | ro (Ramberg-Osgood) | series (plant.*) | comedi (a DAQ card)

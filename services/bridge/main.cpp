@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
@@ -81,7 +82,11 @@ int main(int argc, char** argv) try {
   if (probe) return probe_hardware(settings, probe_options, stdout);
 
   return run_service([&] {
-    if (settings.rt.lock_memory) spdlog::info("memory: {}", lock_memory().detail);
+    if (settings.rt.lock_memory) {
+      const SetupStatus locked = lock_memory();
+      if (!locked.ok && settings.rt.required) throw std::runtime_error(real_time_refused(locked.detail));
+      spdlog::info("memory: {}", locked.detail);
+    }
     if (settings.rt.io_priority > 0) {
       // Before LCM starts: its receive thread inherits the I/O thread's scheduling.
       spdlog::info("I/O thread: {}", set_realtime_priority(settings.rt.io_priority).detail);

@@ -47,7 +47,7 @@ lsampl_t code(double V, double lo, double hi) {
 }
 double volts(lsampl_t counts, double lo, double hi) { return lo + (hi - lo) * counts / double(kMaxdata); }
 
-const std::string kCard = "bridge: {backend: comedi, axes: 2}\nrt: {ticks_per_wake: 1}\n";
+const std::string kCard = "bridge: {backend: comedi, axes: 2}\nrt: {ticks_per_wake: 1, required: false}\n";
 
 // ---- the keys ----
 
@@ -70,7 +70,7 @@ TEST(ComediAxesConfig, TwoAndThreeAxisConfigsLoadEachKeyDefaultingToAxisXs) {
   EXPECT_EQ(two.comedi.ai.channel, 2);  // axis x's are the settings' own: one-axis code reads them
 
   const BridgeSettings three = load(
-      "bridge: {backend: comedi, axes: 3}\nrt: {ticks_per_wake: 1}\n"
+      "bridge: {backend: comedi, axes: 3}\nrt: {ticks_per_wake: 1, required: false}\n"
       "comedi:\n  y: {ao: {channel: 1}, ai: {channel: 1}}\n"
       "  z: {ao: {subdevice: 1, channel: 2, range: 1, aref: ground}, ai: {subdevice: 0, channel: 7, range: 2, aref: "
       "common}, amplifier_gain_V_per_V: 50.0, sensor: {scale_m_per_V: 5.0e-8, offset_m: -2.0e-6}}\n"
@@ -96,7 +96,7 @@ TEST(ComediAxesConfig, TwoAndThreeAxisConfigsLoadEachKeyDefaultingToAxisXs) {
   for (const std::string& l : describe(three)) comedi_lines += l.starts_with("comedi") ? 1 : 0;
   EXPECT_EQ(comedi_lines, 4u);
   // A one-axis config is unchanged, and a simulator with several axes needs no comedi.y keys.
-  EXPECT_EQ(load("bridge: {backend: comedi}").comedi.axes, 1);
+  EXPECT_EQ(load("bridge: {backend: comedi}\nrt: {required: false}\n").comedi.axes, 1);
   EXPECT_EQ(refusal("bridge: {backend: sim, axes: 3}"), "accepted");
 }
 
@@ -106,7 +106,8 @@ TEST(ComediAxesConfig, AChannelOfAnotherAxisMustBeGivenAndIsRefusedByItsKey) {
   EXPECT_TRUE(contains(refusal(kCard + "comedi: {y: {ai: {channel: 1}}}"), "bridge.yaml: comedi.y.ao.channel"));
   // Other keys of its own do not stand in for the channel.
   EXPECT_TRUE(contains(refusal(kCard + "comedi: {y: {ao: {range: 0}, ai: {channel: 1}}}"), "comedi.y.ao.channel"));
-  const std::string three = "bridge: {backend: comedi, axes: 3}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}";
+  const std::string three =
+      "bridge: {backend: comedi, axes: 3}\nrt: {required: false}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}";
   EXPECT_TRUE(contains(refusal(three + "}"), "bridge.yaml: comedi.z.ao.channel"));
   EXPECT_EQ(refusal(three + ", z: {ao: {channel: 2}, ai: {channel: 2}}}"), "accepted");
   // Their values are validated as axis x's are.
@@ -128,11 +129,11 @@ TEST(ComediAxesConfig, TwoAxesOnOneChannelAreRefusedByTheLaterAxissKey) {
   r = refusal(kCard + "comedi: {y: {ao: {channel: 1}, ai: {channel: 0}}}");
   EXPECT_TRUE(contains(r, "bridge.yaml: comedi.y.ai.channel: axis x reads ai subdevice auto channel 0 already")) << r;
   r = refusal(
-      "bridge: {backend: comedi, axes: 3}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}, "
+      "bridge: {backend: comedi, axes: 3}\nrt: {required: false}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}, "
       "z: {ao: {channel: 1}, ai: {channel: 2}}}");
   EXPECT_TRUE(contains(r, "comedi.z.ao.channel: axis y drives")) << r;
   r = refusal(
-      "bridge: {backend: comedi, axes: 3}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}, "
+      "bridge: {backend: comedi, axes: 3}\nrt: {required: false}\ncomedi: {y: {ao: {channel: 1}, ai: {channel: 1}}, "
       "z: {ao: {channel: 2}, ai: {channel: 1}}}");
   EXPECT_TRUE(contains(r, "comedi.z.ai.channel: axis y reads")) << r;
   // The same channel number on another subdevice is another channel.
@@ -146,7 +147,7 @@ TEST(ComediAxesConfig, TwoAxesOnOneChannelAreRefusedByTheLaterAxissKey) {
 TEST(ComediAxesConfig, KeysOfAnAxisTheStageLacksAreRefused) {
   std::string r = refusal(kCard + "comedi: {y: {ao: {channel: 1}, ai: {channel: 1}}, z: {ao: {channel: 2}}}");
   EXPECT_TRUE(contains(r, "bridge.yaml: comedi.z: the stage has 2 axes")) << r;
-  r = refusal("bridge: {backend: comedi}\ncomedi: {y: {sensor: {offset_m: 0.0}}}");
+  r = refusal("bridge: {backend: comedi}\nrt: {required: false}\ncomedi: {y: {sensor: {offset_m: 0.0}}}");
   EXPECT_TRUE(contains(r, "bridge.yaml: comedi.y: the stage has 1 axis")) << r;
   r = refusal("bridge: {backend: sim}\ncomedi: {y: {ao: {channel: 1}}}");  // whatever the backend, as actuator.y
   EXPECT_TRUE(contains(r, "comedi.y: the stage has 1 axis")) << r;

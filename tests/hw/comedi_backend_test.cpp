@@ -66,7 +66,7 @@ TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {
   EXPECT_EQ(d.comedi.ai.aref, AREF_DIFF);
   EXPECT_EQ(d.comedi.amplifier_gain_V_per_V, 25.0);
   EXPECT_EQ(d.rt.ticks_per_wake, 1);
-  const std::string c = "bridge: {backend: comedi}\nrt: {ticks_per_wake: 1}\n";
+  const std::string c = "bridge: {backend: comedi}\nrt: {ticks_per_wake: 1, required: false}\n";
   EXPECT_EQ(refusal(c), "accepted");
   EXPECT_TRUE(contains(refusal(c + "comedi: {ai: {aref: floating}}"), "bridge.yaml: comedi.ai.aref"))
       << refusal(c + "comedi: {ai: {aref: floating}}");

@@ -54,7 +54,7 @@ TEST(BridgeAxes, SettingsTakeTheAxesAndTheCouplingAndNameWhatTheyRefuse) {
   EXPECT_TRUE(contains(refusal("bridge: {axes: 0}"), "bridge.axes"));
   // The card drives an axis per channel pair, each named: axis y's has no default.
   EXPECT_TRUE(contains(refusal("bridge: {backend: comedi, axes: 2}"), "bridge.yaml: comedi.y.ao.channel"));
-  EXPECT_EQ(refusal("bridge: {backend: comedi, axes: 2}\nrt: {ticks_per_wake: 1}\n"
+  EXPECT_EQ(refusal("bridge: {backend: comedi, axes: 2}\nrt: {ticks_per_wake: 1, required: false}\n"
                     "comedi: {y: {ao: {channel: 1}, ai: {channel: 1}}}"),
             "accepted");
   EXPECT_TRUE(contains(refusal("bridge: {axes: 2}\ncoupling: {x_to_y: 0.7}"), "coupling.x_to_y"));

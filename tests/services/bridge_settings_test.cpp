@@ -158,6 +158,23 @@ TEST(BridgeSettings, EveryDeployedBridgeConfigLoads) {
   EXPECT_NO_THROW(load_bridge_settings(Config::load_file(kConfigDir + "banning/bridge.yaml")));
 }
 
+// A card needs real time unless waived; the simulators do not (their stage has no wall clock).
+TEST(BridgeSettings, AHardwareBackendRequiresRealTimeUnlessWaived) {
+  const std::string card = "bridge: {backend: comedi}\n";
+  const std::string why = refusal(card + "rt: {ticks_per_wake: 1}\n");
+  EXPECT_TRUE(contains(why, "bridge.yaml: rt.required: real time is required")) << why;
+  EXPECT_TRUE(contains(why, "rt.required: false")) << why;
+  EXPECT_TRUE(contains(refusal(card + "rt: {ticks_per_wake: 1, priority: 80, lock_memory: false}\n"), "rt.required"));
+  EXPECT_EQ(refusal(card + "rt: {ticks_per_wake: 1, priority: 80, lock_memory: true}\n"), "accepted");
+  EXPECT_EQ(refusal(card + "rt: {ticks_per_wake: 1, required: false}\n"), "accepted");
+  EXPECT_FALSE(load_bridge_settings(Config()).rt.required);
+  EXPECT_TRUE(contains(refusal("rt: {required: true}\n"), "rt.required"));  // asked for on a simulator too
+  const BridgeSettings deployed = load_bridge_settings(Config::load_file(kConfigDir + "bridge-comedi.yaml"));
+  EXPECT_TRUE(deployed.rt.required);
+  EXPECT_TRUE(contains(real_time_refused("SCHED_FIFO priority 80 refused: Operation not permitted"),
+                       "setcap cap_sys_nice,cap_ipc_lock+ep"));
+}
+
 TEST(BridgeSettings, RefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("actuator: {watchdog_s: -1}"), "bridge.yaml: actuator.watchdog_s"));
   EXPECT_TRUE(contains(refusal("actuator: {u_min_V: 10, u_max_V: 5}"), "actuator.u_max_V"));
