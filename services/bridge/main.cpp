@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "bridge/bridge_service.hpp"
+#include "bridge/latency_test.hpp"
 #include "bridge/probe_hardware.hpp"
 #include "core/cli.hpp"
 #include "core/process.hpp"
@@ -54,6 +55,13 @@ int main(int argc, char** argv) try {
       ->check(CLI::Range(0.05, 60.0));
   add_axis_option(&app, "--axis", probe_options.axis,
                   "With --probe-hardware: the axis probed (default x; the others are held at their safe voltage)");
+  double latency_test_s = 0.0;
+  app.add_option("--latency-test", latency_test_s,
+                 "Run the backend's real tick (the card's write and read) for this many seconds, never armed (every "
+                 "output at its safe voltage, no LCM), then print the wake-up lateness and the tick's work "
+                 "(percentiles, histogram), the skipped ticks and a verdict; exit 0 fit to arm, 1 not "
+                 "(docs/TIMING.md, \"Real-time host\")")
+      ->check(CLI::Range(0.1, 86400.0));
   if (const auto exit_code = parse_command_line(app, argc, argv)) return *exit_code;
 
   // Flags are overrides of their config keys, so every value is validated in one place.
@@ -75,11 +83,20 @@ int main(int argc, char** argv) try {
     url = set_up_service("bridge", options,
                          {.adjust = {},
                           .read = [&](const Config& config) { settings = load_bridge_settings(config); },
-                          .rig_auth = !probe});
+                          .rig_auth = !probe && latency_test_s == 0.0});
   });
   if (refused) return *refused;
 
   if (probe) return probe_hardware(settings, probe_options, stdout);
+  if (latency_test_s > 0.0) {
+    return run_service([&] {
+      if (settings.rt.lock_memory) {
+        const SetupStatus locked = lock_memory();
+        if (!locked.ok && settings.rt.required) throw std::runtime_error(real_time_refused(locked.detail));
+      }
+      return run_latency_test(settings, latency_test_s, stdout);
+    });
+  }
 
   return run_service([&] {
     if (settings.rt.lock_memory) {

@@ -33,11 +33,12 @@ void expect_says(const BridgeRun& r, std::initializer_list<const char*> texts) {
   for (const char* text : texts) EXPECT_TRUE(contains(r.out, text)) << "no '" << text << "' in:\n" << r.out;
 }
 
-BridgeRun run(const std::string& fake, const std::string& args, const std::string& wrap = "") {
+BridgeRun run(const std::string& fake, const std::string& args, const std::string& wrap = "",
+              const std::string& config = kConfig) {
   const std::string log =
       ::testing::TempDir() + "/fake_comedi_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".log";
   std::remove(log.c_str());
-  const std::string bridge = std::string(HYSTLOOP_BRIDGE_EXE) + " --config " + kConfig + " " + args;
+  const std::string bridge = std::string(HYSTLOOP_BRIDGE_EXE) + " --config " + config + " " + args;
   const std::string cmd = "LD_LIBRARY_PATH=" HYSTLOOP_FAKE_LIBCOMEDI_DIR " HX_FAKE_COMEDI='" + fake +
                           "' HX_FAKE_COMEDI_LOG=" + log + " " + (wrap.empty() ? bridge : wrap + " '" + bridge + "'") +
                           " 2>&1";
@@ -131,6 +132,23 @@ TEST(ComediProbe, ABridgeRefusedRealTimeStopsSafelyNamingTheFix) {
           netns + " -- sh -c '" + unprivileged + " & pid=$!; sleep 1; kill -TERM $pid; wait $pid'");
   EXPECT_EQ(r.rc, 0) << r.out;
   expect_says(r, {"SCHED_FIFO priority 80", "not required", "stopping on signal 15"});
+}
+
+// The latency test runs the card's real tick, never armed: the output at its safe code from the
+// first write to the last; the figures and the verdict printed, the exit status the verdict's
+// (either may come out on a shared machine: the test checks they agree, not the machine).
+TEST(ComediProbe, TheLatencyTestRunsTheCardsTickAtTheSafeVoltageAndGivesAVerdict) {
+  const BridgeRun r = run("", "--latency-test 1 --set rt.cpu=-1");
+  ASSERT_TRUE(r.rc == 0 || r.rc == 1) << r.out;
+  expect_says(r, {"latency test: comedi backend, 10000 Hz", "timer wake-up lateness over", "p99.9",
+                  "1.0 us ..    2.0 us", "longer", "tick work", "ticks skipped:", "verdict: "});
+  EXPECT_TRUE(contains(r.out, r.rc == 0 ? "verdict: fit to arm" : "verdict: NOT fit to arm")) << r.out;
+  EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
+  // The simulator's tick too (its wake-ups run rt.ticks_per_wake ticks each).
+  const BridgeRun sim =
+      run("", "--latency-test 0.5", "", std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/bridge.yaml");
+  ASSERT_TRUE(sim.rc == 0 || sim.rc == 1) << sim.out;
+  expect_says(sim, {"latency test: sim backend, 10000 Hz", "timer wake-up lateness over", "verdict: "});
 }
 
 // Three axes, each on its own channel pair, y with a safe voltage of its own: the binary starts
