@@ -87,7 +87,10 @@ TEST(ComediProbe, WithYesReportsTheSensorsGainAndSign) {
 }
 
 TEST(ComediProbe, ACardThatRefusesTheConfigExitsTwoWithTheOutputSafe) {
-  BridgeRun r = run("", "--probe-hardware --yes --set comedi.amplifier_gain_V_per_V=10");
+  // +-250 V through a gain of 10: +-25 V at the card, beyond its +-10 V.
+  BridgeRun r = run("",
+                    "--probe-hardware --yes --set comedi.amplifier_gain_V_per_V=10 --set actuator.u_min_V=-250 "
+                    "--set actuator.u_max_V=250");
   EXPECT_EQ(r.rc, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "comedi.ao.range")) << r.out;
   EXPECT_TRUE(contains(r.log, "writes 1 first 32768 ")) << r.log;

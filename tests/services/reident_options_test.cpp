@@ -163,6 +163,19 @@ TEST(ReidentOptions, TheScansLayerKeepsTheRigsStage) {
   EXPECT_EQ(o.stage.linear.modes.size(), 2u);
 }
 
+// The hardware example publishes nothing until an operator releases it, and judges refits against
+// the actuator and the gain the compensator's hardware config gives.
+TEST(ReidentOptions, TheHardwareExampleHoldsItsRefitsAndSharesTheCompensatorsNumbers) {
+  const std::string root = std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/hardware/";
+  const ReidentOptions o = read_reident_options(Config::load_file(root + "reidentifier.yaml"));
+  const Config compensator = Config::load_file(root + "compensator.yaml");
+  EXPECT_TRUE(o.hold);
+  EXPECT_EQ(o.plausibility.u_min_V, compensator.get<double>("actuator.u_min_V"));
+  EXPECT_EQ(o.plausibility.u_max_V, compensator.get<double>("actuator.u_max_V"));
+  EXPECT_EQ(o.plausibility.nominal_gain_m_per_V, compensator.get<double>("linear.gain"));
+  EXPECT_FALSE(o.stage.has_dynamics());
+}
+
 // One re-identifier per axis: reidentifier.axis names it as hystloop-ctl's --axis does.
 TEST(ReidentOptions, TheAxisIsXByDefaultAndNamedXYOrZ) {
   EXPECT_EQ(read_reident_options(Config()).axis, 0);
