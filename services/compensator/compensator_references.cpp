@@ -136,7 +136,8 @@ void CompensatorService::apply_trajectory(TrajectorySpec spec, std::int64_t star
   } else {
     start_s = loop_time_of_utime(start_utime, last_sample_utime_, c.last_seq(), c.config().dt_s);
   }
-  if (!check_elsewhere || !have_sample_) {  // before the first sample the bridge holds no commands of ours
+  // Before the first sample the bridge holds no commands of ours; inline, as configured.
+  if (!check_elsewhere || !have_sample_ || !settings_.check_on_thread) {
     taken(c.take_trajectory(spec, start_s), version, spec);
     return;
   }

@@ -207,6 +207,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "compensator.dt_s",
                                   "compensator.run_seconds",
                                   "compensator.sample_queue_capacity",
+                                  "compensator.trajectory_check",
                                   "compensator.plan_slew_fraction",
                                   "compensator.servo_slew_reserve",
                                   "compensator.plausible_gain_factor",
@@ -291,6 +292,11 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   s.run_seconds = config.get_non_negative("compensator.run_seconds", s.run_seconds);
   s.sample_queue_capacity = static_cast<int>(
       config.get_int_in_range("compensator.sample_queue_capacity", s.sample_queue_capacity, 16, 100000));
+  const std::string check = config.get<std::string>("compensator.trajectory_check", "thread");
+  if (check != "thread" && check != "inline") {
+    config.fail("compensator.trajectory_check", "expected thread or inline, got '" + check + "'");
+  }
+  s.check_on_thread = check == "thread";
   s.rt_priority = static_cast<int>(config.get_int_in_range("rt.priority", s.rt_priority, 0, 99));
   s.lock_memory = config.get<bool>("rt.lock_memory", s.lock_memory);
 
@@ -379,9 +385,11 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
   const CompensatorConfig& c = s.control;
   const TrajectorySpec& t = s.trajectory;
   std::vector<std::string> lines;
-  lines.push_back(fmt::format("compensator: mode {}, plans {} ticks ({:.4g} s) ahead, dt {} s{}", to_string(c.mode),
-                              c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
-                              s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
+  lines.push_back(
+      fmt::format("compensator: mode {}, plans {} ticks ({:.4g} s) ahead, dt {} s, trajectories checked {}{}",
+                  to_string(c.mode), c.horizon_ticks, static_cast<double>(c.horizon_ticks) * c.dt_s, c.dt_s,
+                  s.check_on_thread ? "on their own thread" : "inline (replayable exactly)",
+                  s.run_seconds > 0 ? fmt::format(", stops after {} s", s.run_seconds) : std::string()));
   ModelParamSet models = configured_models(c);
   OnlineModels::for_each([&]<class D>() {
     models.kind = D::kind;

@@ -45,8 +45,15 @@ struct CompensatorSettings {
   TrajectorySpec trajectory{};      // the initial reference (default: hold at 0), started with the first sample
   double run_seconds = 0.0;         // stop after this long; 0 = until SIGINT/SIGTERM/SHUTDOWN
   int sample_queue_capacity = 256;  // LCM's queue for HX_SENSOR [blocks]
-  int rt_priority = 0;              // SCHED_FIFO priority 1..99 of the (only) thread; 0 = normal scheduling
-  bool lock_memory = false;         // mlockall at start
+  // compensator.trajectory_check: a trajectory's dry runs on the checker's thread (true, the
+  // default: a long one never holds up the commands the bridge waits for), or at once on the I/O
+  // thread (false: "inline"). Inline, the commands are a deterministic function of the messages in
+  // order, as an exact replay needs (tests/data/golden-loop.compensator.yaml); on the thread a
+  // trajectory takes effect at the first tick not yet planned when its check ends, which depends
+  // on how busy the machine is.
+  bool check_on_thread = true;
+  int rt_priority = 0;       // SCHED_FIFO priority 1..99 of the (only) thread; 0 = normal scheduling
+  bool lock_memory = false;  // mlockall at start
   // A parameter set (HX_PARAMS, HX_MODEL, or a model section of the file) whose gain leaves
   // [linear.gain / F, linear.gain * F] over the actuator's range is refused (models/gain_plausibility.hpp).
   double plausible_gain_factor = GainPlausibility{}.factor;  // compensator.plausible_gain_factor, F [-]

@@ -603,6 +603,25 @@ trajectory_t hold(std::int32_t version, double offset_m, double blend_s = 0.0, s
   return t;
 }
 
+// Checked inline (compensator.trajectory_check: inline, as the golden replay runs), a trajectory
+// takes effect in the handler of its own message, at the first tick not yet sent: where the
+// message came among the sensor blocks decides it, never how long a thread took.
+TEST(CompensatorService, ATrajectoryCheckedInlineTakesEffectAtOnce) {
+  CompensatorSettings s = cosine();
+  s.check_on_thread = false;
+  Harness h(s);
+  h.send(0);  // planned through 309
+  h.service.on_trajectory(hold(1, 2e-7));
+  EXPECT_EQ(h.service.counters().trajectories, 1u);  // no settle_trajectories(): nothing was left to a thread
+  h.send(10);
+  EXPECT_LT(h.tick(309).y_ref_m, 0.0);
+  EXPECT_EQ(h.tick(310).y_ref_m, 2e-7);
+  EXPECT_FALSE(
+      load_compensator_settings(Config::from_string("compensator: {trajectory_check: inline}\n")).check_on_thread);
+  EXPECT_TRUE(load_compensator_settings(Config()).check_on_thread);
+  EXPECT_THROW(load_compensator_settings(Config::from_string("compensator: {trajectory_check: later}\n")), ConfigError);
+}
+
 TEST(CompensatorService, AppliesATrajectoryVersionOnceFromTheFirstTickNotSentAndRefusesABadOne) {
   Harness h;
   h.send(0);  // planned through 309
