@@ -19,7 +19,7 @@ FeedforwardAnchor::FeedforwardAnchor(std::int64_t measure_ticks, std::int64_t ma
   require_positive("compensator.slew_fraction", max_du_per_tick);
   require_positive("compensator.reanchor_u_rate_V_per_s", max_u_offset_per_tick);
   require_in_range("the re-anchoring window", static_cast<double>(max_measure_ticks_), 1.0, 1e6);
-  for (auto* v : {&y_model_, &u_model_, &dy_, &du_}) v->assign(static_cast<std::size_t>(max_measure_ticks_), 0.0);
+  for (auto* v : {&y_model_, &u_model_}) v->assign(static_cast<std::size_t>(max_measure_ticks_), 0.0);
 }
 
 double FeedforwardAnchor::Ramp::at(std::int64_t k) const noexcept {
@@ -41,7 +41,7 @@ void FeedforwardAnchor::start_measuring(std::int64_t first_tick) noexcept {
   measuring_ = true;
   first_ = first_tick;
   have_planned_ = 0;
-  have_observed_ = 0;
+  all_ = first_ticks_ = Sums{};
   window_ = 0;
   reversals_ = 0;
 }
@@ -76,19 +76,18 @@ bool FeedforwardAnchor::observe(std::int64_t seq, double y_measured, double u_ap
   if (i < 0) return false;
   if (i < have_planned_ && (window_ == 0 || i < window_)) {
     const auto j = static_cast<std::size_t>(i);
-    dy_[j] = y_measured - y_model_[j];
-    du_[j] = u_applied - u_model_[j];
-    have_observed_ = std::max(have_observed_, i + 1);
+    const double dy = y_measured - y_model_[j], du = u_applied - u_model_[j];
+    all_.add(dy, du);
+    if (i < measure_ticks_) first_ticks_.add(dy, du);
   }
   // Complete at the window's last tick, or at the first sample after its end became known (a
-  // slow reference's window is cut back to its first ticks once max_measure_ticks are planned).
-  if (window_ == 0 || i + 1 < window_) return false;
-  // The window is complete (a tick lost on the way keeps its slot's older value: harmless noise).
-  double sy = 0.0, su = 0.0;
-  for (std::int64_t n = 0; n < window_; ++n)
-    sy += dy_[static_cast<std::size_t>(n)], su += du_[static_cast<std::size_t>(n)];
-  const double y_target = sy / static_cast<double>(window_);
-  const double u_target = su / static_cast<double>(window_);
+  // slow reference's window is cut back to its first ticks once max_measure_ticks are planned,
+  // when later ticks may have been observed already: their sums are kept apart). The mean over
+  // the ticks observed: a tick lost on the way is left out.
+  const Sums& s = window_ > measure_ticks_ ? all_ : first_ticks_;
+  if (window_ == 0 || i + 1 < window_ || s.n == 0) return false;
+  const double y_target = s.dy / static_cast<double>(s.n);
+  const double u_target = s.du / static_cast<double>(s.n);
   measuring_ = false;
   if (!std::isfinite(y_target) || !std::isfinite(u_target)) return false;
   ramp_to(y_target, u_target, ramp_start, fallback_slope);

@@ -73,11 +73,19 @@ class FeedforwardAnchor {
     double at(std::int64_t k) const noexcept;
   };
 
-  // [max_measure_ticks]: y_measured - y_model and u_applied - u_model at each measured tick
-  std::vector<double> y_model_, u_model_, dy_, du_;
+  // [max_measure_ticks]: the model's y and u at each planned tick of the window
+  std::vector<double> y_model_, u_model_;
   bool measuring_ = false;
   std::int64_t first_ = 0;  // first measured tick
-  std::int64_t have_planned_ = 0, have_observed_ = 0;
+  std::int64_t have_planned_ = 0;
+  // y_measured - y_model and u_applied - u_model summed over the observed ticks of the window, and
+  // over its first measure_ticks (the window of a reference without a period in it).
+  struct Sums {
+    double dy = 0.0, du = 0.0;
+    std::int64_t n = 0;
+    void add(double y, double u) noexcept { dy += y, du += u, ++n; }
+  };
+  Sums all_, first_ticks_;
   std::int64_t window_ = 0;  // the window's ticks once its end has been planned (0: not yet)
   int reversals_ = 0;        // reversals planned inside the window after its first tick
   double u_first_ = 0.0, y_first_ = 0.0, u_last_ = 0.0, y_last_ = 0.0;  // for the secant slope
