@@ -92,6 +92,14 @@ double LatencyStats::percentile(double q) const {
   return static_cast<double>(max_);  // unreachable: the buckets hold count_ samples
 }
 
+std::uint64_t LatencyStats::count_below(std::int64_t ns) const noexcept {
+  if (ns <= 0) return 0;
+  const std::size_t end = bucket_index(ns);
+  std::uint64_t n = 0;
+  for (std::size_t i = 0; i < end; ++i) n += buckets_[i];
+  return n;
+}
+
 LatencyStats::Summary LatencyStats::summary() const {
   Summary s;
   s.count = count_;

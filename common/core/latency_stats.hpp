@@ -42,6 +42,9 @@ class LatencyStats {
   // smallest sample, to the resolution above; q = 0 gives min, q = 1 gives max.
   // 0 when empty. Throws ParameterError("q") for q outside [0, 1] or NaN.
   double percentile(double q) const;
+  // Samples below `ns`, to the buckets' resolution: those in the buckets below the one `ns` falls
+  // in (a histogram's bins from it). Walks the buckets, as percentile() does.
+  std::uint64_t count_below(std::int64_t ns) const noexcept;
 
   std::uint64_t overflow_count() const noexcept { return overflow_; }
   std::uint64_t clamped_negative_count() const noexcept { return negative_; }

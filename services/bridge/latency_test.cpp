@@ -39,32 +39,11 @@ LatencyVerdict judge_latency(const LatencyStats& lateness, std::uint64_t ticks_s
 }
 
 void print_latency_histogram(const LatencyStats& stats, std::FILE* out) {
-  // Counted from the percentiles' buckets: the share of samples at or below each edge.
   std::array<std::uint64_t, kEdgesNs.size()> in_bin{};
-  const auto below = [&](std::int64_t edge_ns) -> std::uint64_t {
-    if (stats.count() == 0) return 0;
-    if (edge_ns >= stats.max_ns()) return stats.count();
-    if (edge_ns < stats.min_ns()) return 0;
-    // Bisection on the percentile: the largest rank whose value is <= edge.
-    std::uint64_t lo = 0, hi = stats.count();
-    while (lo < hi) {
-      const std::uint64_t mid = (lo + hi + 1) / 2;
-      const double q = static_cast<double>(mid) / static_cast<double>(stats.count());
-      if (stats.percentile(q) <= static_cast<double>(edge_ns)) {
-        lo = mid;
-      } else {
-        hi = mid - 1;
-      }
-    }
-    return lo;
-  };
-  std::uint64_t prev = 0;
   for (std::size_t i = 1; i < kEdgesNs.size(); ++i) {
-    const std::uint64_t n = below(kEdgesNs[i]);
-    in_bin[i] = n - std::min(n, prev);
-    prev = std::max(prev, n);
+    in_bin[i] = stats.count_below(kEdgesNs[i]) - stats.count_below(kEdgesNs[i - 1]);
   }
-  const std::uint64_t beyond = stats.count() - std::min(stats.count(), prev);
+  const std::uint64_t beyond = stats.count() - stats.count_below(kEdgesNs.back());
   const std::uint64_t most = std::max(beyond, *std::max_element(in_bin.begin(), in_bin.end()));
   const auto bar = [&](std::uint64_t n) {
     const int width =

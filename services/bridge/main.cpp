@@ -88,22 +88,22 @@ int main(int argc, char** argv) try {
   if (refused) return *refused;
 
   if (probe) return probe_hardware(settings, probe_options, stdout);
+  // mlockall as configured; refused where real time is required (before the card is opened).
+  const auto lock_memory_as_configured = [&] {
+    if (!settings.rt.lock_memory) return;
+    const SetupStatus locked = lock_memory();
+    if (!locked.ok && settings.rt.required) throw std::runtime_error(real_time_refused(locked.detail));
+    spdlog::info("memory: {}", locked.detail);
+  };
   if (latency_test_s > 0.0) {
     return run_service([&] {
-      if (settings.rt.lock_memory) {
-        const SetupStatus locked = lock_memory();
-        if (!locked.ok && settings.rt.required) throw std::runtime_error(real_time_refused(locked.detail));
-      }
+      lock_memory_as_configured();
       return run_latency_test(settings, latency_test_s, stdout);
     });
   }
 
   return run_service([&] {
-    if (settings.rt.lock_memory) {
-      const SetupStatus locked = lock_memory();
-      if (!locked.ok && settings.rt.required) throw std::runtime_error(real_time_refused(locked.detail));
-      spdlog::info("memory: {}", locked.detail);
-    }
+    lock_memory_as_configured();
     if (settings.rt.io_priority > 0) {
       // Before LCM starts: its receive thread inherits the I/O thread's scheduling.
       spdlog::info("I/O thread: {}", set_realtime_priority(settings.rt.io_priority).detail);

@@ -147,6 +147,17 @@ TEST(LatencyStats, NegativeAndHugeValuesAreCountedNotLost) {
   EXPECT_EQ(s.max_ns(), std::numeric_limits<std::int64_t>::max() / 4);
 }
 
+TEST(LatencyStats, CountBelowCountsTheSamplesUnderAnEdge) {
+  LatencyStats s;
+  for (const std::int64_t ns : {0, 50, 500, 1'500, 1'600, 7'000, 150'000}) s.add(ns);
+  EXPECT_EQ(s.count_below(0), 0u);
+  EXPECT_EQ(s.count_below(51), 2u);  // exact below 128 ns
+  EXPECT_EQ(s.count_below(1'000), 3u);
+  EXPECT_EQ(s.count_below(2'000), 5u);
+  EXPECT_EQ(s.count_below(100'000), 6u);
+  EXPECT_EQ(s.count_below(1'000'000), 7u);
+}
+
 TEST(LatencyStats, RefusesQuantileOutsideUnitInterval) {
   LatencyStats s;
   s.add(1);
