@@ -239,6 +239,10 @@ std::int64_t BridgeRealtime::tick(std::int64_t k, std::uint64_t skipped, std::in
   const double t_s = static_cast<double>(k) * dt_s_;
   std::array<double, kMaxAxes> u_V{};
   for (std::size_t a = 0; a < axes; ++a) u_V[a] = decided[a].u_applied_V;
+  // The amplifier enable: active while armed or on the way to the safe voltages, not once there.
+  bool enabled = stage_.armed();
+  for (std::size_t a = 0; a < axes; ++a) enabled = enabled || u_V[a] != safe_u_V_[a];
+  backend_->set_output_enabled(enabled);
   std::array<StageReading, kMaxAxes> readings{};
   backend_->step_axes(std::span(u_V).first(axes), t_s, step_s, std::span(readings).first(axes));
   bool go_safe = false;

@@ -265,8 +265,8 @@ BridgeSettings load_bridge_settings(const Config& config) {
         config.get_in_range("coupling." + std::string(c.name), s.coupling(c.to, c.from), -kMaxCoupling, kMaxCoupling);
   }
   // Validated whatever the backend (one config serves both); each axis's channels are required by comedi only.
-  s.comedi = load_comedi_settings(config, s.axes, s.backend == "comedi");
   s.rate_hz = config.get_in_range("bridge.rate_hz", s.rate_hz, 1.0, 100000.0);
+  s.comedi = load_comedi_settings(config, s.axes, s.backend == "comedi", s.rate_hz);
   s.auto_arm = config.get<bool>("bridge.auto_arm", s.auto_arm);
   s.rearm_after_trip_s = config.get_in_range("actuator.rearm_after_trip_s", s.rearm_after_trip_s, 0.0, 3600.0);
   s.degraded_late_fraction = config.get_in_range("bridge.degraded_late_fraction", s.degraded_late_fraction, 0.0, 1.0);

@@ -1,8 +1,11 @@
 #include "bridge/comedi_backend.hpp"
 
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
@@ -31,7 +34,9 @@ void write_stderr(const char* text) noexcept {
 
 void on_fatal_signal(int sig) {
   if (ComediBackend* b = g_live.load(); b != nullptr && b->emergency_safe()) {
-    write_stderr("hystloop-bridge: fatal signal: stepped the comedi output to the safe voltage\n");
+    write_stderr(
+        "hystloop-bridge: fatal signal: ramped the comedi outputs to the safe voltage, amplifier enable "
+        "dropped\n");
   }
   ::signal(sig, SIG_DFL);  // SA_RESETHAND did it already; be sure
   ::raise(sig);
@@ -39,7 +44,9 @@ void on_fatal_signal(int sig) {
 
 void on_terminate() {
   if (ComediBackend* b = g_live.load(); b != nullptr && b->emergency_safe()) {
-    write_stderr("hystloop-bridge: std::terminate: stepped the comedi output to the safe voltage\n");
+    write_stderr(
+        "hystloop-bridge: std::terminate: ramped the comedi outputs to the safe voltage, amplifier enable "
+        "dropped\n");
   }
   if (g_previous_terminate != nullptr) g_previous_terminate();
   std::abort();
@@ -58,6 +65,14 @@ void install_emergency_handlers() {
 }
 
 std::string comedi_error() { return comedi_strerror(comedi_errno()); }
+
+void add_ns(timespec& t, long ns) noexcept {
+  t.tv_nsec += ns;
+  while (t.tv_nsec >= 1'000'000'000L) {
+    t.tv_nsec -= 1'000'000'000L;
+    ++t.tv_sec;
+  }
+}
 
 // One write or read of `data` on a channel.
 comedi_insn instruction(unsigned insn, lsampl_t* data, unsigned subdevice, const ComediChannelSettings& c) {
@@ -174,13 +189,29 @@ ComediBackend::ComediBackend(const ComediSettings& settings, std::span<const Act
     u_held_V_[static_cast<std::size_t>(i)] = a.limits.safe_u_V;
   }
   check_against_card();  // writes the safe voltages of the usable outputs first, then throws
+  prepare_enable();      // the same
   const auto n = static_cast<std::size_t>(axes_);
+  std::size_t at = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Axis& a = axis_[i];
-    tick_insns_[i] = instruction(INSN_WRITE, &dac_words_[i], a.ao_subdevice, a.settings.ao);
-    tick_insns_[n + i] = instruction(INSN_READ, &adc_words_[i], a.ai_subdevice, a.settings.ai);
+    tick_insns_[at++] = instruction(INSN_WRITE, &dac_words_[i], a.ao_subdevice, a.settings.ao);
+    // The safe ramp's step in DAC counts: the actuator's rate through the amplifier, at least a count.
+    const double counts_per_V = static_cast<double>(a.dac.maxdata()) / (a.dac.max_V() - a.dac.min_V());
+    const double card_V = a.limits.safe_ramp_V_per_s * kRampTick_s / a.settings.amplifier_gain_V_per_V;
+    ramp_step_[i] =
+        static_cast<lsampl_t>(std::clamp(std::floor(card_V * counts_per_V), 1.0, static_cast<double>(a.dac.maxdata())));
   }
-  tick_list_.n_insns = static_cast<unsigned>(2 * n);
+  if (settings_.enable.configured()) {
+    enable_word_ = enable_idle_word_;
+    tick_insns_[at++] = instruction(INSN_WRITE, &enable_word_, enable_subdevice_,
+                                    ComediChannelSettings{settings_.enable.subdevice, settings_.enable.channel, 0, 0});
+  }
+  reads_at_ = at;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Axis& a = axis_[i];
+    tick_insns_[at++] = instruction(INSN_READ, &adc_words_[i], a.ai_subdevice, a.settings.ai);
+  }
+  tick_list_.n_insns = static_cast<unsigned>(at);
   tick_list_.insns = tick_insns_.data();
   write_safe({});  // before anything can arm
   g_live.store(this);
@@ -199,7 +230,8 @@ ComediBackend::ComediBackend(const ComediSettings& settings, std::span<const Act
 }
 
 ComediBackend::~ComediBackend() {
-  write_safe({});  // the last word (a step: the bridge's ramp ended before, or could not run)
+  set_safe_codes({});  // each actuator's own
+  ramp_to_safe();      // the last word (no ramp when the bridge's ended there)
   ComediBackend* self = this;
   g_live.compare_exchange_strong(self, nullptr);
 }
@@ -210,10 +242,55 @@ void ComediBackend::prepare_safe_list(const std::array<bool, kMaxAxes>& usable) 
   for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
     if (!usable[i]) continue;
     const Axis& a = axis_[i];
+    ramp_insns_[n] = instruction(INSN_WRITE, &ramp_data_[i], a.ao_subdevice, a.settings.ao);
     safe_insns_[n++] = instruction(INSN_WRITE, &safe_data_[i], a.ao_subdevice, a.settings.ao);
   }
   safe_list_.n_insns = n;
   safe_list_.insns = n > 0 ? safe_insns_.data() : nullptr;
+  ramp_list_.n_insns = n;
+  ramp_list_.insns = n > 0 ? ramp_insns_.data() : nullptr;
+}
+
+void ComediBackend::prepare_enable() {
+  const ComediEnableSettings& e = settings_.enable;
+  if (!e.configured()) return;
+  comedi_t* dev = handle_.device;
+  const auto refuse = [&](const std::string& field, const std::string& reason) {
+    write_safe({});
+    throw ConfigError(settings_.source, field, fmt::format("{} ({})", reason, settings_.device));
+  };
+  int s = e.subdevice;
+  if (s < 0) s = find_subdevice(dev, -1, COMEDI_SUBD_DIO);
+  if (s < 0) s = find_subdevice(dev, -1, COMEDI_SUBD_DO);
+  if (s < 0) refuse("comedi.enable.subdevice", "the card has no digital I/O or digital output subdevice");
+  if (s >= comedi_get_n_subdevices(dev)) {
+    refuse("comedi.enable.subdevice", fmt::format("the card has {} subdevices", comedi_get_n_subdevices(dev)));
+  }
+  const auto su = static_cast<unsigned>(s);
+  const int type = comedi_get_subdevice_type(dev, su);
+  if (type != COMEDI_SUBD_DIO && type != COMEDI_SUBD_DO) {
+    refuse("comedi.enable.subdevice", fmt::format("subdevice {} is not a digital output", s));
+  }
+  if (const int channels = comedi_get_n_channels(dev, su); e.channel >= channels) {
+    refuse("comedi.enable.channel", fmt::format("subdevice {} has {} channels", s, channels));
+  }
+  enable_subdevice_ = su;
+  enable_idle_word_ = enable_level(false);
+  // The latch first, then the direction: the line comes up inactive. Then once more, checked.
+  comedi_insn idle = instruction(INSN_WRITE, &enable_idle_word_, su, ComediChannelSettings{s, e.channel, 0, 0});
+  comedi_insnlist one{1, &idle};
+  comedi_do_insnlist(dev, &one);
+  if (type == COMEDI_SUBD_DIO && comedi_dio_config(dev, su, static_cast<unsigned>(e.channel), COMEDI_OUTPUT) < 0) {
+    refuse("comedi.enable.channel",
+           fmt::format("channel {} of subdevice {} cannot be made an output: {}", e.channel, s, comedi_error()));
+  }
+  if (comedi_do_insnlist(dev, &one) != 1) {
+    refuse("comedi.enable.channel",
+           fmt::format("the card refused a write to channel {} of subdevice {}: {}", e.channel, s, comedi_error()));
+  }
+  safe_insns_[safe_list_.n_insns++] = idle;
+  ramp_insns_[ramp_list_.n_insns++] =
+      instruction(INSN_WRITE, &ramp_enable_word_, su, ComediChannelSettings{s, e.channel, 0, 0});
 }
 
 void ComediBackend::check_against_card() {
@@ -322,6 +399,14 @@ void ComediBackend::check_against_card() {
   }
 }
 
+lsampl_t ComediBackend::enable_at(bool active, double t_s) const noexcept {
+  const ComediEnableSettings& e = settings_.enable;
+  // A heartbeat is active for the first half of each period from t = 0: a pure function of the
+  // time, so skipped ticks do not shift it.
+  const bool second_half = e.heartbeat && static_cast<std::int64_t>(std::floor(t_s * 2.0 * e.heartbeat_hz)) % 2 != 0;
+  return enable_level(active && !second_half);
+}
+
 lsampl_t ComediBackend::dac_code(int axis, double u_V) noexcept {
   const Axis& a = axis_[static_cast<std::size_t>(axis)];
   if (!(u_V >= a.limits.u_min_V)) u_V = a.limits.u_min_V;  // also NaN: the low end (BridgeCore never sends one)
@@ -348,23 +433,32 @@ StageReading ComediBackend::step(double u_V, double t_s, double dt_s) noexcept {
   return out[0];
 }
 
-void ComediBackend::step_axes(std::span<const double> u_V, double /*t_s*/, double /*dt_s*/,
+void ComediBackend::step_axes(std::span<const double> u_V, double t_s, double /*dt_s*/,
                               std::span<StageReading> out) noexcept {
   const auto n = static_cast<std::size_t>(axes_);
   for (std::size_t i = 0; i < n; ++i) {
     u_held_V_[i] = u_V[i];
     dac_words_[i] = dac_code(static_cast<int>(i), u_V[i]);
   }
-  // Every write, then every read: comedi stops at the first instruction that fails, so rc says
-  // which axes' reads happened (the reads after the n writes).
+  const ComediEnableSettings& e = settings_.enable;
+  if (e.configured()) {
+    enable_word_ = enable_at(enable_, t_s);
+  }
+  // Every write (the enable's last), then every read: comedi stops at the first instruction that
+  // fails, so rc says which writes and which axes' reads happened.
   const int rc = comedi_do_insnlist(handle_.device, &tick_list_);
   counters_.transfers.fetch_add(1, std::memory_order_relaxed);
   const std::size_t done = rc > 0 ? static_cast<std::size_t>(rc) : 0;
-  if (done < n) counters_.write_errors.fetch_add(n - done, std::memory_order_relaxed);
+  if (done < reads_at_) counters_.write_errors.fetch_add(reads_at_ - done, std::memory_order_relaxed);
+  for (std::size_t i = 0; i < n && i < done; ++i) last_code_[i].store(dac_words_[i], std::memory_order_relaxed);
+  if (e.configured() && done >= reads_at_ && enable_ != enable_active_.load(std::memory_order_relaxed)) {
+    enable_active_.store(enable_, std::memory_order_relaxed);
+    (enable_ ? counters_.enable_rises : counters_.enable_drops).fetch_add(1, std::memory_order_relaxed);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     Axis& a = axis_[i];
     bool fault = false;
-    if (done < n + i + 1) {
+    if (done < reads_at_ + i + 1) {
       fault = true;
       counters_.read_errors.fetch_add(1, std::memory_order_relaxed);
     } else {
@@ -397,26 +491,67 @@ void ComediBackend::step_axes(std::span<const double> u_V, double /*t_s*/, doubl
 }
 
 void ComediBackend::hold_safe(std::span<const double> safe_u_V) noexcept {
-  write_safe(safe_u_V);
+  set_safe_codes(safe_u_V);
   for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
     u_held_V_[i] = i < safe_u_V.size() ? safe_u_V[i] : axis_[i].limits.safe_u_V;
+  }
+  enable_ = false;
+  ramp_to_safe();
+}
+
+void ComediBackend::set_safe_codes(std::span<const double> safe_u_V) noexcept {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
+    if (!safe_axes_[i]) continue;
+    safe_data_[i] = dac_code(static_cast<int>(i), i < safe_u_V.size() ? safe_u_V[i] : axis_[i].limits.safe_u_V);
   }
 }
 
 void ComediBackend::write_safe(std::span<const double> safe_u_V) noexcept {
   if (safe_list_.n_insns == 0) return;  // no usable output (a refusal before any)
+  set_safe_codes(safe_u_V);
   for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
-    if (!safe_axes_[i]) continue;
-    safe_data_[i] = dac_code(static_cast<int>(i), i < safe_u_V.size() ? safe_u_V[i] : axis_[i].limits.safe_u_V);
+    if (safe_axes_[i]) last_code_[i].store(safe_data_[i], std::memory_order_relaxed);
   }
   comedi_do_insnlist(handle_.device, &safe_list_);
   counters_.safe_writes.fetch_add(1, std::memory_order_relaxed);
 }
 
-bool ComediBackend::emergency_safe() noexcept {
-  return safe_list_.insns != nullptr &&
-         comedi_do_insnlist(handle_.device, &safe_list_) == static_cast<int>(safe_list_.n_insns);
+bool ComediBackend::ramp_to_safe() noexcept {
+  if (safe_list_.n_insns == 0) return false;  // no usable output (a refusal before any)
+  const auto n = static_cast<std::size_t>(axes_);
+  for (std::size_t i = 0; i < n; ++i) ramp_data_[i] = last_code_[i].load(std::memory_order_relaxed);
+  timespec next{};
+  ::clock_gettime(CLOCK_MONOTONIC, &next);
+  const bool active = enable_active_.load(std::memory_order_relaxed);
+  bool ramped = false;
+  for (std::int64_t tick = 0;; ++tick) {
+    bool there = true;
+    for (std::size_t i = 0; i < n; ++i) {
+      lsampl_t& c = ramp_data_[i];
+      const lsampl_t target = safe_data_[i], step = ramp_step_[i];
+      if (!safe_axes_[i] || c == target) continue;
+      there = false;
+      c = c < target ? (target - c > step ? c + step : target) : (c - target > step ? c - step : target);
+    }
+    if (there) break;
+    ramped = true;
+    ramp_enable_word_ = enable_at(active, static_cast<double>(tick) * kRampTick_s);
+    comedi_do_insnlist(handle_.device, &ramp_list_);
+    for (std::size_t i = 0; i < n; ++i) last_code_[i].store(ramp_data_[i], std::memory_order_relaxed);
+    add_ns(next, static_cast<long>(kRampTick_s * 1e9));
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) == EINTR) {
+    }
+  }
+  if (ramped) counters_.safe_ramps.fetch_add(1, std::memory_order_relaxed);
+  const bool taken = comedi_do_insnlist(handle_.device, &safe_list_) == static_cast<int>(safe_list_.n_insns);
+  counters_.safe_writes.fetch_add(1, std::memory_order_relaxed);
+  if (enable_active_.exchange(false, std::memory_order_relaxed)) {
+    counters_.enable_drops.fetch_add(1, std::memory_order_relaxed);
+  }
+  return taken;
 }
+
+bool ComediBackend::emergency_safe() noexcept { return ramp_to_safe(); }
 
 void ComediBackend::append_counters(std::vector<std::pair<std::string, std::uint64_t>>& entries) const {
   const auto add = [&](std::string name, const std::atomic<std::uint64_t>& v) {
@@ -430,6 +565,9 @@ void ComediBackend::append_counters(std::vector<std::pair<std::string, std::uint
   add("sensor_fault_safe", counters_.fault_safe);
   add("comedi_dac_clamped", counters_.dac_clamped);
   add("comedi_safe_writes", counters_.safe_writes);
+  add("comedi_safe_ramps", counters_.safe_ramps);
+  add("amp_enable_rises", counters_.enable_rises);
+  add("amp_enable_drops", counters_.enable_drops);
   if (axes_ == 1) return;  // the totals are axis x's
   // Which axis's sensor fails, which one made the bridge go safe: x_sensor_faults, y_..., as the
   // bridge names its own per-axis counters (x_applied, ...).
@@ -453,6 +591,13 @@ std::vector<std::string> ComediBackend::describe() const {
                                 a.ai_subdevice, a.settings.ai.channel, aref_name(a.settings.ai.aref),
                                 a.adc.describe()));
   }
+  const ComediEnableSettings& e = settings_.enable;
+  lines.push_back(
+      !e.configured()
+          ? std::string("comedi enable: none (comedi.enable.channel -1)")
+          : fmt::format("comedi enable: subdevice {} channel {}, {} active {}", enable_subdevice_, e.channel,
+                        e.heartbeat ? fmt::format("a {:g} Hz heartbeat", e.heartbeat_hz) : std::string("a level"),
+                        e.active_low ? "low" : "high"));
   return lines;
 }
 

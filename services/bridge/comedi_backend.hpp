@@ -9,11 +9,13 @@
 // table (comedi_to_phys).
 //
 // Safety: the constructor writes every axis's safe voltage before returning (the bridge starts
-// disarmed); hold_safe() and the destructor step every output to it in one list; a fatal signal
-// (SIGSEGV, SIGABRT, ...) or std::terminate steps them there too before the process dies
-// (emergency_safe()). A read that fails or saturates sets SENSOR_FAULT on its axis and keeps
-// that axis's last good position; comedi.fault_limit of them in a row on one axis ask the bridge
-// to go safe (StageReading::go_safe). See services/bridge/README.md.
+// disarmed) and drops the amplifier enable (comedi.enable, when wired). Every later move to the
+// safe voltage ramps at each actuator's safe_ramp_V_per_s: hold_safe(), the destructor, and a
+// fatal signal (SIGSEGV, SIGABRT, ...) or std::terminate before the process dies (emergency_safe():
+// prepared lists, async-signal-safe); the enable drops once the outputs are there. A read that
+// fails or saturates sets SENSOR_FAULT on its axis and keeps that axis's last good position;
+// comedi.fault_limit of them in a row on one axis ask the bridge to go safe
+// (StageReading::go_safe). See services/bridge/README.md.
 
 #include <comedilib.h>
 
@@ -79,7 +81,10 @@ struct ComediCounters {
   std::atomic<std::uint64_t> sensor_faults{0};  // readings flagged SENSOR_FAULT (read error or saturated), every axis
   std::atomic<std::uint64_t> fault_safe{0};     // times comedi.fault_limit faults in a row asked for the safe state
   std::atomic<std::uint64_t> dac_clamped{0};    // card voltages clamped to a DAC's range (0 when the config is right)
-  std::atomic<std::uint64_t> safe_writes{0};    // hold_safe / start / emergency lists of the safe voltages
+  std::atomic<std::uint64_t> safe_writes{0};    // start, hold_safe and emergency lists of the safe voltages
+  std::atomic<std::uint64_t> safe_ramps{0};     // moves to the safe voltages that had to ramp (not there already)
+  std::atomic<std::uint64_t> enable_rises{0};   // times the amplifier enable went active
+  std::atomic<std::uint64_t> enable_drops{0};   // ... and inactive again (the safe state, a stop, an exit)
   std::array<std::atomic<std::uint64_t>, kMaxAxes> axis_sensor_faults{};  // sensor_faults, axis by axis
   std::array<std::atomic<std::uint64_t>, kMaxAxes> axis_fault_safe{};     // fault_safe, by the axis that asked
 };
@@ -94,7 +99,7 @@ class ComediBackend final : public StageBackend {
   // One axis (settings.axes 1): the probe's and the benchmark's.
   ComediBackend(const ComediSettings& settings, const ActuatorLimits& limits)
       : ComediBackend(settings, std::span<const ActuatorLimits>(&limits, 1)) {}
-  ~ComediBackend() override;  // steps every output to its safe voltage, then closes the device
+  ~ComediBackend() override;  // ramps every output to its safe voltage, drops the enable, closes the device
   ComediBackend(const ComediBackend&) = delete;
   ComediBackend& operator=(const ComediBackend&) = delete;
 
@@ -103,9 +108,11 @@ class ComediBackend final : public StageBackend {
   int axes() const noexcept override { return axes_; }
   void step_axes(std::span<const double> u_V, double t_s, double dt_s, std::span<StageReading> out) noexcept override;
   const std::string& name() const noexcept override { return name_; }
-  // Every axis's safe code in one list; an axis without an entry in `safe_u_V` gets its
-  // actuator's safe_u_V.
+  // Ramps every axis to its safe code (an axis without an entry in `safe_u_V` gets its actuator's
+  // safe_u_V) at its actuator's safe_ramp_V_per_s, one list per kRampTick_s, then writes the safe
+  // list: every safe code and the enable inactive. Blocks for the ramp (none when already there).
   void hold_safe(std::span<const double> safe_u_V) noexcept override;
+  void set_output_enabled(bool on) noexcept override { enable_ = on; }
   void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& entries) const override;
 
   // The DAC code for `u_V` at axis `axis`'s piezo: clamped to its actuator's range, divided by its
@@ -122,9 +129,14 @@ class ComediBackend final : public StageBackend {
   // The card's line, then one per axis (the start-up log, --probe-hardware).
   std::vector<std::string> describe() const;
 
-  // Async-signal-safe: writes every axis's last safe code with one comedi_do_insnlist (the
-  // fatal-signal and terminate handlers call it for the live backend). True when the card took it.
+  // Async-signal-safe: ramps every axis from the code it was last written to its last safe code
+  // and drops the enable, as hold_safe() (the fatal-signal and terminate handlers call it for the
+  // live backend). True when the card took the safe list.
   bool emergency_safe() noexcept;
+  // The enable line's level last written (true: active); false without an enable line.
+  bool enable_active() const noexcept { return enable_active_.load(std::memory_order_relaxed); }
+  // The period of the ramps to the safe voltage outside the bridge's clock [s].
+  static constexpr double kRampTick_s = 1e-4;
 
  private:
   struct Axis {
@@ -139,11 +151,20 @@ class ComediBackend final : public StageBackend {
   };
 
   void check_against_card();  // throws ConfigError
+  // Finds and configures the enable line (after the outputs: a refusal writes them safe first).
+  void prepare_enable();  // throws ConfigError
   // Prepares the safe list for the axes whose output is usable (`usable`), in axis order.
   void prepare_safe_list(const std::array<bool, kMaxAxes>& usable) noexcept;
   // Writes the safe codes of the axes in the safe list: each axis's actuator's safe_u_V, or
   // `safe_u_V[i]` where given.
   void write_safe(std::span<const double> safe_u_V) noexcept;
+  // safe_data_ of the axes in the safe list: `safe_u_V[i]`, or the actuator's safe_u_V.
+  void set_safe_codes(std::span<const double> safe_u_V) noexcept;
+  // From the codes last written to safe_data_ (ramped), then the safe list. Async-signal-safe.
+  bool ramp_to_safe() noexcept;
+  lsampl_t enable_level(bool active) const noexcept { return active != settings_.enable.active_low ? 1 : 0; }
+  // The enable line's word at time t_s: the level, or a heartbeat's half period, while `active`.
+  lsampl_t enable_at(bool active, double t_s) const noexcept;
 
   ComediSettings settings_;
   int axes_ = 1;
@@ -156,10 +177,29 @@ class ComediBackend final : public StageBackend {
   std::array<lsampl_t, kMaxAxes> adc_words_{};
   std::array<lsampl_t, kMaxAxes> safe_data_{};  // the safe codes (written by the constructor and hold_safe)
   std::array<bool, kMaxAxes> safe_axes_{};      // the axes in the safe list (all of them once constructed)
-  std::array<comedi_insn, std::size_t{2} * kMaxAxes> tick_insns_{};
-  std::array<comedi_insn, kMaxAxes> safe_insns_{};
+  // The per-tick list: every axis's write, the enable's (when wired), every axis's read.
+  std::array<comedi_insn, std::size_t{2} * kMaxAxes + 1> tick_insns_{};
+  std::size_t reads_at_ = 0;  // the first read's place in it
+  // The safe list: every usable axis's safe code, then the enable inactive (when wired).
+  std::array<comedi_insn, kMaxAxes + 1> safe_insns_{};
   comedi_insnlist tick_list_{};
   comedi_insnlist safe_list_{};
+  // The ramps' list: the safe list's outputs, with their codes on the way (ramp_data_), and the
+  // enable as it was (a heartbeat keeps beating until the outputs are safe).
+  std::array<lsampl_t, kMaxAxes> ramp_data_{};
+  lsampl_t ramp_enable_word_ = 0;
+  std::array<comedi_insn, kMaxAxes + 1> ramp_insns_{};
+  comedi_insnlist ramp_list_{};
+  std::array<lsampl_t, kMaxAxes> ramp_step_{};  // DAC counts per kRampTick_s at the safe ramp rate (>= 1)
+  // What each output was last written (the ramps start there; read by the fatal-signal handler).
+  std::array<std::atomic<lsampl_t>, kMaxAxes> last_code_{};
+  // The amplifier enable: what the bridge asks (real-time thread), the word the tick list writes,
+  // the word the safe list writes (inactive), and the level last written.
+  bool enable_ = false;
+  unsigned enable_subdevice_ = 0;
+  lsampl_t enable_word_ = 0;
+  lsampl_t enable_idle_word_ = 0;
+  std::atomic<bool> enable_active_{false};
   std::array<double, kMaxAxes> u_held_V_{};  // what step() holds the axes other than x at
   ComediCounters counters_;
 };

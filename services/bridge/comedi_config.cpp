@@ -53,7 +53,8 @@ const std::vector<std::string>& comedi_config_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k = {"comedi.device"};
     for (const char* field : kAxisFields) k.push_back(axis_key(0, field));
-    k.insert(k.end(), {"comedi.fault_limit", "comedi.calibration"});
+    k.insert(k.end(), {"comedi.fault_limit", "comedi.calibration", "comedi.enable.subdevice", "comedi.enable.channel",
+                       "comedi.enable.mode", "comedi.enable.heartbeat_hz", "comedi.enable.active"});
     for (int axis = 1; axis < kMaxAxes; ++axis) {
       for (const char* field : kAxisFields) k.push_back(axis_key(axis, field));
     }
@@ -64,7 +65,25 @@ const std::vector<std::string>& comedi_config_keys() {
 
 const char* aref_name(int aref) noexcept { return aref >= 0 && aref < 4 ? kArefs[aref] : "?"; }
 
-ComediSettings load_comedi_settings(const Config& config, int axes, bool required) {
+ComediEnableSettings load_enable(const Config& config, double rate_hz) {
+  ComediEnableSettings e;
+  e.subdevice = static_cast<int>(config.get_int_in_range("comedi.enable.subdevice", e.subdevice, -1, 255));
+  e.channel = static_cast<int>(config.get_int_in_range("comedi.enable.channel", e.channel, -1, 65535));
+  const std::string mode = config.get<std::string>("comedi.enable.mode", "level");
+  if (mode != "level" && mode != "heartbeat") {
+    config.fail("comedi.enable.mode", "must be level or heartbeat (got '" + mode + "')");
+  }
+  e.heartbeat = mode == "heartbeat";
+  e.heartbeat_hz = config.get_in_range("comedi.enable.heartbeat_hz", e.heartbeat_hz, 1.0, rate_hz / 2.0);
+  const std::string active = config.get<std::string>("comedi.enable.active", "high");
+  if (active != "high" && active != "low") {
+    config.fail("comedi.enable.active", "must be high or low (got '" + active + "')");
+  }
+  e.active_low = active == "low";
+  return e;
+}
+
+ComediSettings load_comedi_settings(const Config& config, int axes, bool required, double rate_hz) {
   ComediSettings s;
   s.source = config.source();
   s.axes = axes;
@@ -74,6 +93,7 @@ ComediSettings load_comedi_settings(const Config& config, int axes, bool require
   s.fault_limit = static_cast<int>(config.get_int_in_range("comedi.fault_limit", s.fault_limit, 1, 100000));
   s.calibration = config.get<std::string>("comedi.calibration", s.calibration);
   if (s.calibration.empty()) config.fail("comedi.calibration", "must be auto, none or a calibration file's path");
+  s.enable = load_enable(config, rate_hz);
 
   // Which axes' channels are known: x's always (defaults or keys), y's and z's when given. Only
   // those are compared; the card's backend needs them all (`required`).
@@ -139,6 +159,18 @@ std::vector<std::string> describe(const ComediSettings& s) {
       "comedi: {}, {} ax{}, one instruction list per tick, go safe after {} faulted reads in a row on an axis, "
       "calibration {}",
       s.device, s.axes, s.axes == 1 ? "is" : "es", s.fault_limit, s.calibration));
+  const ComediEnableSettings& e = s.enable;
+  lines.push_back(
+      !e.configured()
+          ? std::string("comedi: no amplifier enable line (comedi.enable.channel -1): the amplifier stays enabled "
+                        "when the bridge stops or dies")
+      : e.heartbeat ? fmt::format("comedi: amplifier enable on dio subdevice {} channel {}: a {} Hz heartbeat "
+                                  "while armed or ramping, idle {} otherwise",
+                                  subdevice_text(e.subdevice), e.channel, e.heartbeat_hz, e.active_low ? "high" : "low")
+                    : fmt::format("comedi: amplifier enable on dio subdevice {} channel {}: {} while armed or "
+                                  "ramping, {} otherwise",
+                                  subdevice_text(e.subdevice), e.channel, e.active_low ? "low" : "high",
+                                  e.active_low ? "high" : "low"));
   for (int axis = 0; axis < s.axes; ++axis) {
     const ComediAxisSettings& a = s.axis(axis);
     lines.push_back(fmt::format("comedi {}: ao {} (x{} V/V to the piezo), ai {} ({:+.6g} m/V, offset {:.6g} m)",

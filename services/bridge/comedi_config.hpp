@@ -26,6 +26,21 @@ struct ComediChannelSettings {
   int aref = 0;   // AREF_GROUND 0, AREF_COMMON 1, AREF_DIFF 2, AREF_OTHER 3 (ground | common | diff | other)
 };
 
+// The amplifier enable: one digital output the bridge holds active only while it runs and is not
+// in the safe state (armed, or ramping down to the safe voltage), for the amplifier's enable input
+// or an external watchdog relay in its enable chain. `level`: the line is the state; `heartbeat`:
+// while active the line toggles at heartbeat_hz (a relay that drops without edges also drops
+// when the process is killed, hangs or loses power: `level` leaves the line where it was then).
+// Every exit path drops it (docs/TIMING.md, "Amplifier enable").
+struct ComediEnableSettings {
+  int subdevice = -1;         // -1: the card's first digital I/O (or digital output) subdevice
+  int channel = -1;           // -1: no enable line (the amplifier is enabled by hand)
+  bool heartbeat = false;     // false: level
+  double heartbeat_hz = 500;  // the square wave's frequency while active [Hz], below bridge.rate_hz / 2
+  bool active_low = false;    // the line is low while active (level), and idles high
+  bool configured() const noexcept { return channel >= 0; }
+};
+
 // One axis's channel pair and scales.
 struct ComediAxisSettings {
   ComediChannelSettings ao{};            // -> the amplifier's input
@@ -47,6 +62,7 @@ struct ComediSettings : ComediAxisSettings {
   std::string device = "/dev/comedi0";
   int fault_limit = 10;              // this many faulted reads in a row on one axis -> the bridge goes safe
   std::string calibration = "auto";  // auto (comedilib's default file when the board has one) | none | a path
+  ComediEnableSettings enable{};     // comedi.enable.*: the amplifier enable line (none by default)
   int axes = 1;                      // axes driven (bridge.axes): x, then y, then z
   std::array<ComediAxisSettings, kMaxAxes - 1> other_axes{};  // y, z (comedi.y.*, comedi.z.*)
 
@@ -64,7 +80,8 @@ const std::vector<std::string>& comedi_config_keys();
 // ConfigError naming the key. Axis x's keys and every key given are validated whatever the
 // backend (one config serves the simulators and the card); `required` (bridge.backend comedi)
 // makes the channels of axes y and z mandatory. Keys of an axis beyond `axes` are refused.
-ComediSettings load_comedi_settings(const Config& config, int axes, bool required);
+// `rate_hz` (bridge.rate_hz) bounds comedi.enable.heartbeat_hz (two ticks per period at least).
+ComediSettings load_comedi_settings(const Config& config, int axes, bool required, double rate_hz);
 
 // "ground", "common", "diff", "other" for 0..3.
 const char* aref_name(int aref) noexcept;

@@ -127,6 +127,7 @@ int drive(const BridgeSettings& settings, const ProbeOptions& o, std::FILE* out)
   std::array<StageReading, kMaxAxes> readings{};
   const auto period = std::chrono::duration<double>(1.0 / o.rate_hz);
   auto next = std::chrono::steady_clock::now();
+  backend.set_output_enabled(true);  // the amplifier enable (comedi.enable), for the drive only
   for (int i = 0; i <= steps; ++i) {
     const double t = triangle(static_cast<double>(i) / steps);
     const double card_V = std::clamp(center_V + t * o.amplitude_V, lo_V, hi_V);

@@ -55,6 +55,10 @@ class StageBackend {
   // takes the actuator there the way the device allows, e.g. its own ramp or output disable).
   // May be called more than once; must not throw, allocate or block for long.
   virtual void hold_safe(std::span<const double> safe_u_V) noexcept = 0;
+  // The amplifier enable a hardware backend drives (comedi.enable): `on` while the bridge is armed
+  // or ramping to the safe voltage, off in the safe state. Called on the real-time thread before
+  // each step_axes(); the line follows in that tick's I/O. hold_safe() drops it too.
+  virtual void set_output_enabled(bool /*on*/) noexcept {}
   // The backend's own counters (cumulative; read on the I/O thread while step() runs, so kept
   // in atomics), appended to the bridge's HX_STATUS counters.
   virtual void append_counters(std::vector<std::pair<std::string, std::uint64_t>>& /*entries*/) const {}

@@ -88,13 +88,14 @@ TEST(ComediAxesConfig, TwoAndThreeAxisConfigsLoadEachKeyDefaultingToAxisXs) {
   EXPECT_EQ(z.sensor_scale_m_per_V, 5e-8);
   EXPECT_EQ(z.sensor_offset_m, -2e-6);
   EXPECT_DOUBLE_EQ(z.card_V(400.0), 8.0);
-  // The start-up log: the card's line, then one per axis.
+  // The start-up log: the card's line, the enable's, then one per axis.
   const std::vector<std::string> lines = describe(three.comedi);
-  ASSERT_EQ(lines.size(), 4u);
-  EXPECT_TRUE(contains(lines[3], "comedi z: ao subdevice 1 channel 2 range 1")) << lines[3];
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_TRUE(contains(lines[1], "no amplifier enable line")) << lines[1];
+  EXPECT_TRUE(contains(lines[4], "comedi z: ao subdevice 1 channel 2 range 1")) << lines[4];
   std::size_t comedi_lines = 0;
   for (const std::string& l : describe(three)) comedi_lines += l.starts_with("comedi") ? 1 : 0;
-  EXPECT_EQ(comedi_lines, 4u);
+  EXPECT_EQ(comedi_lines, 5u);
   // A one-axis config is unchanged, and a simulator with several axes needs no comedi.y keys.
   EXPECT_EQ(load("bridge: {backend: comedi}\nrt: {required: false}\n").comedi.axes, 1);
   EXPECT_EQ(refusal("bridge: {backend: sim, axes: 3}"), "accepted");
@@ -161,7 +162,7 @@ TEST(ComediAxesConfig, EveryAxissKeysAreListed) {
     EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
   }
   EXPECT_EQ(std::find(keys.begin(), keys.end(), "comedi.y.device"), keys.end()) << "the card's keys are shared";
-  EXPECT_EQ(keys.size(), 3u + 3u * 11u);
+  EXPECT_EQ(keys.size(), 3u + 5u + 3u * 11u);  // the card's, the enable's, each axis's
 }
 
 // deploy/config/bridge-comedi.yaml documents axis y with a commented example: uncommented, on a
@@ -394,7 +395,7 @@ TEST_F(ComediAxesTest, FaultLimitFaultsInARowOnAnyOneAxisAskForTheSafeState) {
   EXPECT_EQ(value("sensor_fault_safe"), 1);
   EXPECT_EQ(value("z_sensor_fault_safe"), 1);
   EXPECT_EQ(value("x_sensor_fault_safe"), 0);
-  EXPECT_EQ(entries.size(), 8u + 2u * 3u);
+  EXPECT_EQ(entries.size(), 11u + 2u * 3u);
 }
 
 TEST_F(ComediAxesTest, HoldSafeTheDestructorAndAnEmergencyWriteEachAxissOwnSafeCode) {
@@ -416,12 +417,13 @@ TEST_F(ComediAxesTest, HoldSafeTheDestructorAndAnEmergencyWriteEachAxissOwnSafeC
     b->step(50.0, 0.0, 1e-4);  // y and z hold the bridge's last tick
     expect_writes(fake().lists.back(), 0, {dac(2.0), dac(120.0 / 20.0), dac(180.0 / 50.0)});
     const long lists = static_cast<long>(fake().lists.size());
-    EXPECT_TRUE(b->emergency_safe());  // the fatal-signal path: the last safe codes, one list
-    ASSERT_EQ(static_cast<long>(fake().lists.size()), lists + 1);
+    EXPECT_TRUE(b->emergency_safe());  // the fatal-signal path: ramped to the last safe codes, then one list
+    ASSERT_GT(static_cast<long>(fake().lists.size()), lists + 1);
     expect_writes(fake().lists.back(), 0, {dac(-10.0 / 25.0), dac(0.0), dac(5.0 / 50.0)});
+    expect_writes(fake().lists[fake().lists.size() - 2], 0, {dac(-10.0 / 25.0), dac(0.0), dac(5.0 / 50.0)});
     b->step_axes(std::array{200.0, 120.0, 180.0}, 0.0, 1e-4, out);
   }
-  // The destructor's: each actuator's own safe voltage, one list.
+  // The destructor's: each actuator's own safe voltage, ramped there, then one list.
   expect_writes(fake().lists.back(), 0, kSafeCodes);
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(fake().ao_counts[i], kSafeCodes[i]) << i;
   EXPECT_EQ(fake().ao_writes[3], 0);

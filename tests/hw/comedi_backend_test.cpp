@@ -2,7 +2,8 @@
 // refusals, the safe write before anything else, one instruction list per tick (a write, then a
 // read), the conversions both ways (range tables and softcal), the clamp before the DAC, the
 // fault counting and the request to go safe, the refusal of a config the card cannot do after
-// the device was opened (the safe voltage written first), and no allocation per tick.
+// the device was opened (the safe voltage written first), no allocation per tick, the ramps to
+// the safe voltage, and the amplifier enable line (level, active low, heartbeat).
 #include <array>
 #include "bridge/comedi_backend.hpp"
 
@@ -80,6 +81,13 @@ TEST(ComediConfig, KeysAreValidatedAndRefusalsNameTheField) {
   // A card cannot run ticks back to back.
   EXPECT_TRUE(contains(refusal("bridge: {backend: comedi}\nrt: {ticks_per_wake: 20}"), "rt.ticks_per_wake"));
   EXPECT_TRUE(contains(refusal("bridge: {backend: daq}"), "must be sim, ro, series or comedi"));
+  // The amplifier enable: a mode, a polarity, a heartbeat a tick can carry (two ticks a period).
+  EXPECT_TRUE(contains(refusal(c + "comedi: {enable: {mode: pulse}}"), "bridge.yaml: comedi.enable.mode"));
+  EXPECT_TRUE(contains(refusal(c + "comedi: {enable: {active: middle}}"), "bridge.yaml: comedi.enable.active"));
+  EXPECT_TRUE(contains(refusal(c + "comedi: {enable: {channel: -2}}"), "bridge.yaml: comedi.enable.channel"));
+  EXPECT_TRUE(contains(refusal(c + "comedi: {enable: {heartbeat_hz: 5001}}"), "comedi.enable.heartbeat_hz"));
+  EXPECT_EQ(refusal(c + "comedi: {enable: {channel: 0, mode: heartbeat, heartbeat_hz: 5000, active: low}}"),
+            "accepted");
   // The simulators ignore the comedi keys.
   EXPECT_EQ(refusal("bridge: {backend: sim}\ncomedi: {device: /dev/comedi1}"), "accepted");
 }
@@ -217,17 +225,164 @@ TEST_F(ComediBackendTest, ATickDoesNotAllocate) {
   EXPECT_EQ(count.allocations(), 0u);
 }
 
-TEST_F(ComediBackendTest, HoldSafeAndTheDestructorStepToTheSafeVoltage) {
-  {
-    ComediBackend b(settings(), limits(-25.0));
-    b.step(200.0, 0, 1e-4);
-    b.hold_safe(std::array{-25.0});
-    EXPECT_EQ(fake().lists.back().n_insns, 1u);
-    EXPECT_EQ(fake().lists.back().insns[0].data, code(-1.0, -10, 10));
-    b.step(200.0, 0, 1e-4);
+// The output codes written since list `from` (every list writes the output first).
+std::vector<lsampl_t> codes_since(std::size_t from) {
+  std::vector<lsampl_t> codes;
+  for (std::size_t i = from; i < fake_comedi::state().lists.size(); ++i) {
+    codes.push_back(fake_comedi::state().lists[i].insns[0].data);
   }
-  EXPECT_EQ(fake().last_write, code(-1.0, -10, 10));  // the destructor's
+  return codes;
+}
+
+// The codes step by at most the safe ramp's (one count of rounding) and end at `safe`.
+void expect_ramp(const std::vector<lsampl_t>& codes, lsampl_t safe, double ramp_V_per_s) {
+  ASSERT_FALSE(codes.empty());
+  const double max_step = ramp_V_per_s * ComediBackend::kRampTick_s / 25.0 * kMaxdata / 20.0 + 1.0;
+  for (std::size_t i = 1; i < codes.size(); ++i) {
+    ASSERT_LE(std::abs(double(codes[i]) - double(codes[i - 1])), max_step) << i;
+  }
+  EXPECT_EQ(codes.back(), safe);
+}
+
+TEST_F(ComediBackendTest, HoldSafeAndTheDestructorRampToTheSafeVoltage) {
+  const ActuatorLimits a = limits(-25.0);  // 1e3 V/s: 0.1 V a ramp tick at the piezo
+  std::size_t from = 0;
+  {
+    ComediBackend b(settings(), a);
+    b.step(200.0, 0, 1e-4);
+    from = fake().lists.size();
+    b.hold_safe(std::array{-25.0});
+    std::vector<lsampl_t> codes = codes_since(from);
+    // 225 V in steps of 0.1 V at most (whole DAC counts: 13 of 13.1), then the safe list.
+    EXPECT_GE(codes.size(), 2251u);
+    EXPECT_LE(codes.size(), 2271u);
+    expect_ramp(codes, code(-1.0, -10, 10), a.safe_ramp_V_per_s);
+    EXPECT_EQ(fake().lists.back().n_insns, 1u);
+    EXPECT_EQ(b.counters().safe_ramps.load(), 1u);
+    from = fake().lists.size();
+    b.hold_safe(std::array{-25.0});  // there already: one list, no ramp
+    EXPECT_EQ(fake().lists.size(), from + 1);
+    EXPECT_EQ(b.counters().safe_ramps.load(), 1u);
+    b.step(0.0, 0, 1e-4);
+    from = fake().lists.size();
+  }
+  const std::vector<lsampl_t> codes = codes_since(from - 1);  // from the step to 0 V: the destructor's ramp
+  EXPECT_EQ(codes.front(), code(0.0, -10, 10));
+  EXPECT_GE(codes.size(), 252u);  // 25 V in 0.1 V steps at most
+  expect_ramp(codes, code(-1.0, -10, 10), a.safe_ramp_V_per_s);
   EXPECT_EQ(fake().closes, fake().opens);
+}
+
+ComediSettings with_enable(bool heartbeat = false, bool active_low = false) {
+  ComediSettings c = settings();
+  c.enable.channel = 3;  // on the digital I/O, subdevice 2 (the first)
+  c.enable.heartbeat = heartbeat;
+  c.enable.heartbeat_hz = 500.0;  // 1 ms high, 1 ms low
+  c.enable.active_low = active_low;
+  return c;
+}
+
+bool enable_line() { return (fake_comedi::shared().dio.load() & (1u << 3)) != 0; }
+
+TEST_F(ComediBackendTest, TheEnableLineIsAnOutputWrittenEveryTickAfterTheAnalogWrites) {
+  ComediBackend b(with_enable(), limits());
+  EXPECT_EQ(fake().dio_output, 1u << 3);
+  EXPECT_FALSE(enable_line());
+  const auto& first = fake().lists.front();  // the safe list: the outputs, then the enable inactive
+  ASSERT_EQ(fake().lists.back().n_insns, 2u);
+  EXPECT_EQ(fake().lists.back().insns[1].subdev, 2u);
+  EXPECT_EQ(fake().lists.back().insns[1].chanspec, CR_PACK(3, 0, 0));
+  EXPECT_EQ(first.insns[0].subdev, 2u);  // the latch set inactive before the line became an output
+  b.step(10.0, 0.0, 1e-4);
+  const auto& tick = fake().lists.back();
+  ASSERT_EQ(tick.n_insns, 3u);
+  EXPECT_EQ(tick.insns[0].subdev, 1u);
+  EXPECT_EQ(tick.insns[1].subdev, 2u);
+  EXPECT_EQ(tick.insns[2].insn, static_cast<unsigned>(INSN_READ));
+  EXPECT_FALSE(enable_line());  // the bridge has not asked
+  b.set_output_enabled(true);
+  b.step(10.0, 1e-4, 1e-4);
+  EXPECT_TRUE(enable_line());
+  EXPECT_TRUE(b.enable_active());
+  b.set_output_enabled(false);
+  b.step(10.0, 2e-4, 1e-4);
+  EXPECT_FALSE(enable_line());
+  EXPECT_EQ(b.counters().enable_rises.load(), 1u);
+  EXPECT_EQ(b.counters().enable_drops.load(), 1u);
+}
+
+TEST_F(ComediBackendTest, AnActiveLowEnableIdlesHigh) {
+  ComediBackend b(with_enable(false, true), limits());
+  EXPECT_TRUE(enable_line());
+  b.set_output_enabled(true);
+  b.step(0.0, 0.0, 1e-4);
+  EXPECT_FALSE(enable_line());
+  b.hold_safe(std::array{0.0});
+  EXPECT_TRUE(enable_line());
+}
+
+TEST_F(ComediBackendTest, AHeartbeatTogglesEveryHalfPeriodOfTheTicksTimeWhileActive) {
+  ComediBackend b(with_enable(true), limits());
+  b.set_output_enabled(true);
+  std::string levels;
+  for (int k = 0; k < 40; ++k) {
+    b.step(0.0, k * 1e-4, 1e-4);
+    levels += enable_line() ? '1' : '0';
+  }
+  EXPECT_EQ(levels, "1111111111000000000011111111110000000000");
+  // Ticks skipped: the phase is the time's, not a count of ticks.
+  b.step(0.0, 0.0115, 1e-4);
+  EXPECT_FALSE(enable_line());
+  b.step(0.0, 0.0125, 1e-4);
+  EXPECT_TRUE(enable_line());
+  b.set_output_enabled(false);
+  for (int k = 0; k < 20; ++k) {
+    b.step(0.0, 0.011 + k * 1e-4, 1e-4);
+    EXPECT_FALSE(enable_line()) << k;
+  }
+}
+
+TEST_F(ComediBackendTest, TheEnableDropsOnceTheRampHasReachedTheSafeVoltage) {
+  ComediBackend b(with_enable(), limits());
+  b.set_output_enabled(true);
+  b.step(20.0, 0.0, 1e-4);
+  ASSERT_TRUE(enable_line());
+  const auto& rec = fake_comedi::shared();
+  const std::uint64_t from = rec.events;
+  b.hold_safe(std::array{0.0});
+  // 20 V in steps of 0.1 V at most (13 DAC counts of 13.1), then the safe list.
+  ASSERT_GE(rec.events - from, 201u);
+  ASSERT_LE(rec.events - from, 204u);
+  for (std::uint64_t i = from; i + 1 < rec.events; ++i) EXPECT_NE(rec.event(i).dio & (1u << 3), 0u) << i;
+  EXPECT_EQ(rec.event(rec.events - 2).ao[0], code(0.0, -10, 10));  // there, still enabled
+  EXPECT_FALSE(enable_line());
+  EXPECT_EQ(b.counters().enable_drops.load(), 1u);
+}
+
+TEST_F(ComediBackendTest, AnEnableLineTheCardCannotDriveIsRefusedWithTheOutputSafe) {
+  const auto refused = [&](const ComediSettings& c) -> std::string {
+    fake_comedi::reset();
+    try {
+      ComediBackend b(c, limits());
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(fake().closes, fake().opens);
+      EXPECT_EQ(fake().writes, 1);  // the safe voltage, before the refusal
+      return e.what();
+    }
+    return "accepted";
+  };
+  ComediSettings c = with_enable();
+  c.enable.channel = 8;
+  std::string r = refused(c);
+  EXPECT_TRUE(contains(r, "comedi.enable.channel") && contains(r, "8 channels")) << r;
+  c = with_enable();
+  c.enable.subdevice = 1;
+  r = refused(c);
+  EXPECT_TRUE(contains(r, "comedi.enable.subdevice") && contains(r, "not a digital output")) << r;
+  c = with_enable();
+  c.enable.subdevice = 3;
+  EXPECT_TRUE(contains(refused(c), "comedi.enable.subdevice"));
+  EXPECT_EQ(refused(with_enable()), "accepted");
 }
 
 TEST_F(ComediBackendTest, AConfigTheCardRefusesAfterOpeningLeavesTheOutputSafe) {

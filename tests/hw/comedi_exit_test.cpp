@@ -1,16 +1,22 @@
 // The comedi backend under the bridge's real-time thread, against the fake card: the output is
-// safe at start, and ramps (or steps, where the process is going down) to the safe voltage at
-// every kind of exit: the stop a SIGINT/SIGTERM or SHUTDOWN begins, an exception unwinding the
-// bridge, the watchdog, a sensor failing comedi.fault_limit times in a row, a fatal signal.
-// Real threads, real time, a fast ramp: a few tenths of a second each.
+// safe at start, and ramps to the safe voltage at every kind of exit: the stop a SIGINT/SIGTERM or
+// SHUTDOWN begins, an exception unwinding the bridge, the watchdog, a sensor failing
+// comedi.fault_limit times in a row, a fatal signal. The amplifier enable line is active while
+// armed and drops once the output is safe, on each of those paths; a heartbeat stops when the
+// process is killed, which an external relay sees within its period. Real threads, real time, a
+// fast ramp: a few tenths of a second each.
 #include "bridge/bridge_realtime.hpp"
 
 #include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -26,6 +32,8 @@ using fake_comedi::kMaxdata;
 constexpr double kGain = 25.0;
 
 double written_V(const fake_comedi::Insn& insn) { return -10.0 + 20.0 * insn.data / double(kMaxdata); }
+// The DAC code of `card_V` in [-10, 10] V (comedi_from_phys).
+lsampl_t code(double card_V) { return static_cast<lsampl_t>(std::floor((card_V + 10.0) / 20.0 * kMaxdata + 0.5)); }
 
 BridgeSettings comedi_settings() {
   BridgeSettings s;
@@ -44,8 +52,11 @@ BridgeSettings comedi_settings() {
   s.comedi.ai = {0, 0, 0, AREF_GROUND};
   s.comedi.amplifier_gain_V_per_V = kGain;
   s.comedi.fault_limit = 10;
+  s.comedi.enable.channel = 3;  // the amplifier enable on digital line 3, a level
   return s;
 }
+
+constexpr unsigned kEnableBit = 1u << 3;
 
 // Started, armed by the first command and driven to `u_V`; the samples tell when it got there.
 std::unique_ptr<BridgeRealtime> drive_to(const BridgeSettings& s, double u_V, std::int64_t ticks = 8000) {
@@ -68,11 +79,12 @@ void expect_safe_ramp(const BridgeSettings& s, double peak_V) {
   const auto& lists = fake_comedi::state().lists;
   std::vector<double> card_V;
   card_V.reserve(lists.size());
-  for (const auto& l : lists) card_V.push_back(written_V(l.insns[0]));
+  for (const auto& l : lists) {
+    if (l.insns[0].subdev == 1) card_V.push_back(written_V(l.insns[0]));  // not the enable's first write
+  }
   ASSERT_GE(card_V.size(), 3u);
   const double count_V = 20.0 / kMaxdata;
   EXPECT_NEAR(card_V.front(), s.limits.safe_u_V / kGain, count_V) << "not safe before arming";
-  EXPECT_EQ(lists.front().n_insns, 1u);  // the start's write, before any tick
   bool past_peak = false;
   for (std::size_t i = 1; i < card_V.size(); ++i) {
     const double du = std::abs(card_V[i] - card_V[i - 1]) * kGain;
@@ -84,6 +96,41 @@ void expect_safe_ramp(const BridgeSettings& s, double peak_V) {
   }
   EXPECT_TRUE(past_peak);
   EXPECT_NEAR(card_V.back(), s.limits.safe_u_V / kGain, count_V / 2);
+}
+
+// The enable line in the card's record (its last kSharedEvents lists): active at some point, only
+// ever inactive with the output at its safe code, inactive at the end.
+void expect_enable_dropped_at_safe(const BridgeSettings& s) {
+  const auto& rec = fake_comedi::shared();
+  const std::uint64_t n = rec.events;
+  ASSERT_GT(n, 0u);
+  const lsampl_t safe = code(s.limits.safe_u_V / kGain);
+  bool was_active = false;
+  for (std::uint64_t i = n > fake_comedi::kSharedEvents ? n - fake_comedi::kSharedEvents : 0; i < n; ++i) {
+    const fake_comedi::OutputEvent& e = rec.event(i);
+    if (e.ao[0] == 0) continue;  // the enable's first write, before the output's
+    if ((e.dio & kEnableBit) != 0) {
+      was_active = true;
+    } else {
+      ASSERT_LE(std::abs(double(e.ao[0]) - double(safe)), 1.0) << "the enable was inactive away from safe, list " << i;
+    }
+  }
+  EXPECT_TRUE(was_active) << "the enable never went active";
+  EXPECT_EQ(rec.event(n - 1).dio & kEnableBit, 0u) << "the enable is still active";
+}
+
+// Runs `body` in a forked child (the card's record is shared with it); its wait status.
+int in_child(const std::function<void()>& body, const std::function<void(pid_t)>& meanwhile = {}) {
+  fake_comedi::shared();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    body();
+    ::_exit(0);
+  }
+  if (meanwhile) meanwhile(pid);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
 }
 
 class ComediExitTest : public ::testing::Test {
@@ -100,7 +147,8 @@ TEST_F(ComediExitTest, TheStopOfASignalRampsToSafeThenHolds) {  // SIGINT/SIGTER
   EXPECT_EQ(r.u_start_V, 150.0);
   EXPECT_EQ(r.ramp_ticks, 150);
   expect_safe_ramp(s, 150.0);
-  EXPECT_EQ(fake_comedi::state().lists.back().n_insns, 1u);  // hold_safe's write came last
+  EXPECT_EQ(fake_comedi::state().lists.back().n_insns, 2u);  // hold_safe's write came last, the enable with it
+  expect_enable_dropped_at_safe(s);
   rt.reset();
   EXPECT_EQ(fake_comedi::state().closes, 1);
 }
@@ -113,6 +161,7 @@ TEST_F(ComediExitTest, AnExceptionUnwindingTheBridgeRampsToSafe) {
   } catch (const std::runtime_error&) {
   }
   expect_safe_ramp(s, -120.0);
+  expect_enable_dropped_at_safe(s);
   EXPECT_EQ(fake_comedi::state().closes, 1);
 }
 
@@ -130,6 +179,10 @@ TEST_F(ComediExitTest, TheWatchdogRampsToSafe) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_TRUE(safe) << "the watchdog did not take it to the safe voltage";
+  // The bridge runs on, disarmed: the enable dropped when the output got there.
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(fake_comedi::shared().dio.load() & kEnableBit, 0u);
+  expect_enable_dropped_at_safe(s);
   rt->stop();
   expect_safe_ramp(s, 100.0);
 }
@@ -163,21 +216,85 @@ TEST_F(ComediExitTest, RepeatedSensorFaultsTakeTheBridgeToSafe) {
   EXPECT_EQ(c.fault_safe.load(), 1u);
 }
 
-TEST_F(ComediExitTest, AFatalSignalStepsTheOutputToSafe) {
+TEST_F(ComediExitTest, AFatalSignalRampsTheOutputToSafeThenDropsTheEnable) {
   const BridgeSettings s = comedi_settings();
+  const auto& rec = fake_comedi::shared();
+  std::uint64_t stepped = 0;
+  const int status = in_child([&] {
+    ComediBackend b(s.comedi, s.limits);
+    b.set_output_enabled(true);
+    b.step(150.0, 0, 1e-4);
+    ::raise(SIGSEGV);
+  });
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGSEGV) << status;
+  for (std::uint64_t i = 0; i < rec.events; ++i) {
+    if (rec.event(i).ao[0] == code(150.0 / kGain)) stepped = i;
+  }
+  ASSERT_GT(stepped, 0u);
+  const std::uint64_t last = rec.events - 1;
+  // 150 V at 1e4 V/s: 15 ms in 1 V steps (13 DAC counts) of 100 us each, then the safe list.
+  EXPECT_GE(last - stepped, 151u);
+  EXPECT_GE(rec.event(last - 1).t_ns - rec.event(stepped).t_ns, 149 * 100'000);
+  for (std::uint64_t i = stepped + 1; i <= last; ++i) {
+    const double du = std::abs(double(rec.event(i).ao[0]) - double(rec.event(i - 1).ao[0]));
+    ASSERT_LE(du, 1.0 / kGain / 20.0 * kMaxdata + 1.0) << i;
+    if (i < last) {
+      EXPECT_NE(rec.event(i).dio & kEnableBit, 0u) << "the enable dropped before the output was safe";
+    }
+  }
+  EXPECT_EQ(rec.event(last).ao[0], code(0.0));
+  EXPECT_EQ(rec.event(last).dio & kEnableBit, 0u);
   EXPECT_DEATH(
       {
         ComediBackend b(s.comedi, s.limits);
         b.step(200.0, 0, 1e-4);
         std::abort();
       },
-      "fatal signal: stepped the comedi output to the safe voltage");
+      "fatal signal: ramped the comedi outputs to the safe voltage, amplifier enable dropped");
   EXPECT_DEATH(
       {
         ComediBackend b(s.comedi, s.limits);
         std::terminate();
       },
-      "std::terminate: stepped the comedi output to the safe voltage");
+      "std::terminate: ramped the comedi outputs to the safe voltage, amplifier enable dropped");
+}
+
+// A heartbeat beats while armed; SIGKILL ends it (nothing of the process runs), and the external
+// relay (a retriggerable monostable of one heartbeat period, emulated here on the card's record)
+// opens within that period.
+TEST_F(ComediExitTest, AKilledBridgesHeartbeatStopsAndTheRelayOpensWithinItsPeriod) {
+  BridgeSettings s = comedi_settings();
+  s.comedi.enable.heartbeat = true;
+  s.comedi.enable.heartbeat_hz = 500.0;
+  const std::int64_t period_ns = 2'000'000;
+  const auto& rec = fake_comedi::shared();
+  const auto relay_closed = [&] {
+    const std::int64_t edge = rec.last_dio_edge_ns;
+    return edge > 0 && fake_comedi::monotonic_ns() - edge <= period_ns;
+  };
+  bool closed_while_running = false;
+  std::int64_t killed_ns = 0;
+  const int status = in_child(
+      [&] {
+        auto rt = drive_to(s, 100.0);  // 0.8 s of commands
+        std::this_thread::sleep_for(std::chrono::seconds(20));
+      },
+      [&](pid_t pid) {
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (!closed_while_running && std::chrono::steady_clock::now() < until) {
+          // Beating: the line has changed within the period, and the output has left the safe voltage.
+          closed_while_running = relay_closed() && rec.events > 200 && rec.event(rec.events - 1).ao[0] > 40000;
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+        ::kill(pid, SIGKILL);
+        killed_ns = fake_comedi::monotonic_ns();
+      });
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  EXPECT_TRUE(closed_while_running) << "the heartbeat never held the relay";
+  const std::int64_t wait_ns = killed_ns + period_ns - fake_comedi::monotonic_ns();
+  if (wait_ns > 0) std::this_thread::sleep_for(std::chrono::nanoseconds(wait_ns));
+  EXPECT_FALSE(relay_closed()) << "edges after SIGKILL";
+  EXPECT_NE(rec.event(rec.events - 1).ao[0], code(0.0));  // nothing ramped: the relay's job
 }
 
 }  // namespace

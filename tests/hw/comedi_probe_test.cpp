@@ -71,8 +71,14 @@ TEST(ComediProbe, WithYesReportsTheSensorsGainAndSign) {
   BridgeRun r = run("mirror_gain=0.5,calibration=1", "--probe-hardware --yes --duration-s 0.2");
   EXPECT_EQ(r.rc, 0) << r.out;
   expect_says(r, {"calibration: softcal file /var/lib/comedi/calibrations/fake_board_comedi0",
+                  "comedi enable: subdevice 2 channel 0, a 500 Hz heartbeat active high",
                   "triangle 0 V -> 1 V -> -1 V -> 0 V at the card (x25: -25..25 V at the piezo)",
                   "measured: sensor +0.5", "verdict: sign OK"});
+  // The amplifier enable beat during the drive (a write a step) and was dropped after it.
+  EXPECT_TRUE(contains(r.log, " dio=0 outputs=1 ")) << r.log;
+  const std::size_t at = r.log.rfind("dio_writes=");  // the drive's open (after the listing's)
+  ASSERT_NE(at, std::string::npos) << r.log;
+  EXPECT_GT(std::stol(r.log.substr(at + 11)), 200) << r.log;  // 0.2 s at 1 kHz, and the safe lists
   // The softcal code for 0 V (the fake's output is 2 mV high and 1 % steep): first and last.
   EXPECT_TRUE(contains(r.log, "first 32761 ") && contains(r.log, "last 32761 ")) << r.log;
   r = run("mirror_gain=-0.8", "--probe-hardware --yes --duration-s 0.2 --amplitude-V 2");
@@ -111,6 +117,7 @@ TEST(ComediProbe, SigtermLeavesTheOutputSafe) {
   EXPECT_EQ(r.rc, 0) << r.out;
   expect_says(r, {"the safe 0 V written (DAC code 32768)", "stopping on signal 15"});
   EXPECT_TRUE(contains(r.log, kSafeCode) && contains(r.log, "last 32768 ")) << r.log;
+  EXPECT_TRUE(contains(r.log, " dio=0 outputs=1 ")) << r.log;  // the enable: an output, never active unarmed
 }
 
 // A card needs real time: where the host refuses SCHED_FIFO (no CAP_SYS_NICE, rtprio 0: here made

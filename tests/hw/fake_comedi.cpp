@@ -2,9 +2,13 @@
 // comedilib documents it for a board like the one described there.
 #include "fake_comedi.hpp"
 
+#include <sys/mman.h>
+#include <time.h>
+
 #include <cerrno>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -96,6 +100,21 @@ State& state() {
   return s;
 }
 
+SharedRecord& shared() {
+  static SharedRecord* record = [] {
+    void* p = ::mmap(nullptr, sizeof(SharedRecord), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) std::abort();
+    return new (p) SharedRecord;
+  }();
+  return *record;
+}
+
+std::int64_t monotonic_ns() noexcept {
+  timespec t{};
+  ::clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
 void reset() {
   State& s = state();
   std::vector<InsnList> lists = std::move(s.lists);
@@ -105,6 +124,10 @@ void reset() {
   s = State{};
   s.lists = std::move(lists);
   s.reads = std::move(reads);
+  SharedRecord& r = shared();
+  r.events = 0;
+  r.dio = 0;
+  r.last_dio_edge_ns = 0;
 }
 
 double softcal_gain() noexcept { return 1.01; }
@@ -136,7 +159,8 @@ int comedi_close(comedi_t* it) {
       std::fprintf(f, "writes %ld first %u (%.6g V) last %u (%.6g V) holds", s.writes, s.first_write,
                    range_to_V(s.first_write, kAoRanges[0]), s.last_write, range_to_V(s.last_write, kAoRanges[0]));
       for (unsigned c = 0; c < kAoChannels; ++c) std::fprintf(f, " ao%u=%u/%ld", c, s.ao_counts[c], s.ao_writes[c]);
-      std::fprintf(f, "\n");
+      // The digital lines: their levels (bit c: channel c), which are outputs, and the writes.
+      std::fprintf(f, " dio=%u outputs=%u dio_writes=%ld\n", shared().dio.load(), s.dio_output, s.dio_writes);
       std::fclose(f);
     }
   }
@@ -212,6 +236,8 @@ int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
   record.n_insns = il->n_insns;
   int done = 0;
   bool read_failed = false;
+  bool wrote = false;
+  SharedRecord& shared_record = shared();
   for (unsigned i = 0; i < il->n_insns; ++i) {
     comedi_insn& insn = il->insns[i];
     const unsigned chan = CR_CHAN(insn.chanspec);
@@ -221,6 +247,15 @@ int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
       ++s.ao_writes[chan];
       if (s.writes++ == 0) s.first_write = insn.data[0];
       s.last_write = insn.data[0];
+      wrote = true;
+      ++done;
+    } else if (insn.insn == INSN_WRITE && insn.subdev == kDio && chan < kDioChannels) {
+      const unsigned before = shared_record.dio.load();
+      const unsigned after = insn.data[0] != 0 ? before | (1u << chan) : before & ~(1u << chan);
+      if (after != before) shared_record.last_dio_edge_ns = monotonic_ns();
+      shared_record.dio = after;
+      ++s.dio_writes;
+      wrote = true;
       ++done;
     } else if (insn.insn == INSN_READ && insn.subdev == kAi) {
       if (s.next_read < s.reads.size()) {
@@ -252,8 +287,27 @@ int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
     if (read_failed) break;
   }
   if (s.lists.size() < s.lists.capacity()) s.lists.push_back(record);
+  if (wrote) {
+    const std::uint64_t n = shared_record.events.load();
+    OutputEvent& e = shared_record.ring[n % kSharedEvents];
+    e.t_ns = monotonic_ns();
+    for (unsigned c = 0; c < kAoChannels; ++c) e.ao[c] = s.ao_counts[c];
+    e.dio = shared_record.dio.load();
+    shared_record.events = n + 1;
+  }
   if (read_failed) g_errno = EIO;
   return done;
+}
+
+int comedi_dio_config(comedi_t* it, unsigned int subdevice, unsigned int chan, unsigned int direction) {
+  State& s = state();
+  if (it != &g_device || subdevice != kDio || chan >= kDioChannels) return fail(EINVAL) ? 0 : -1;
+  if (direction == COMEDI_OUTPUT) {
+    s.dio_output |= 1u << chan;
+  } else {
+    s.dio_output &= ~(1u << chan);
+  }
+  return 0;
 }
 
 char* comedi_get_default_calibration_path(comedi_t*) { return strdup(g_calibration_path); }

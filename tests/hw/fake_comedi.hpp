@@ -14,11 +14,18 @@
 // I/O. Each input "mirrors" an output: ai channel c volts = mirror_gain * mirror_scale[c] *
 // (ao channel mirror_ao[c] volts) + mirror_offset_V (by default every input sees output 0, as on
 // a one-axis loopback; HX_FAKE_COMEDI="mirror_by_channel=1" makes input c see output c % 4),
-// unless scripted reads are queued.
+// unless scripted reads are queued. The digital lines (the amplifier enable) are written with
+// INSN_WRITE on subdevice 2, after comedi_dio_config made them outputs.
+//
+// What the outputs did is also kept in memory shared with forked children (shared(): a ring of
+// every list's output state, with its time), so that a test can see what a process that died of a
+// fatal signal or SIGKILL wrote on its way down.
 
 #include <comedilib.h>
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace fake_comedi {
@@ -33,7 +40,8 @@ struct Insn {
 
 inline constexpr unsigned kAiChannels = 16;
 inline constexpr unsigned kAoChannels = 4;
-inline constexpr unsigned kRecordedInsns = 8;  // a tick of 3 axes is 6
+inline constexpr unsigned kDioChannels = 8;
+inline constexpr unsigned kRecordedInsns = 8;  // a tick of 3 axes and an enable line is 7
 
 // One comedi_do_insnlist call (at most kRecordedInsns instructions recorded).
 struct InsnList {
@@ -68,7 +76,33 @@ struct State {
   long writes = 0;                    // output writes since reset, every channel (also past the record's capacity)
   lsampl_t first_write = 0;           // of any channel
   lsampl_t last_write = 0;
+  unsigned dio_output = 0;  // the digital lines comedi_dio_config made outputs (bit c: channel c)
+  long dio_writes = 0;      // writes to digital lines since reset
 };
+
+// The outputs after one instruction list that wrote any: every analog output's code and the
+// digital lines' levels (bit c: channel c), at CLOCK_MONOTONIC t_ns.
+struct OutputEvent {
+  std::int64_t t_ns = 0;
+  lsampl_t ao[kAoChannels]{};
+  unsigned dio = 0;
+};
+
+inline constexpr std::size_t kSharedEvents = std::size_t{1} << 15;
+
+struct SharedRecord {
+  std::atomic<std::uint64_t> events{0};           // lists recorded; the ring holds the last kSharedEvents
+  std::atomic<unsigned> dio{0};                   // the digital lines' levels now
+  std::atomic<std::int64_t> last_dio_edge_ns{0};  // when a digital line last changed (CLOCK_MONOTONIC)
+  OutputEvent ring[kSharedEvents];
+
+  // Event i (i < events), when still in the ring.
+  const OutputEvent& event(std::uint64_t i) const noexcept { return ring[i % kSharedEvents]; }
+};
+
+// Shared anonymous memory, made at the first call (or reset()): call it before fork().
+SharedRecord& shared();
+std::int64_t monotonic_ns() noexcept;
 
 // The fake's state; reset() brings back the defaults above and empties the record.
 State& state();
