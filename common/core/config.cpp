@@ -225,6 +225,8 @@ Config Config::load_file(const std::filesystem::path& path) {
 
 const std::string& Config::source() const noexcept { return impl_->source; }
 
+const std::string& Config::source_of(std::string_view path) const { return impl_->source_for(path); }
+
 void Config::fail(std::string_view path, const std::string& reason) const {
   throw ConfigError(impl_->source_for(path), std::string(path), reason);
 }

@@ -65,6 +65,8 @@ class Config {
 
   // The file name as given (or the source name of from_string()).
   const std::string& source() const noexcept;
+  // Where `path`'s value came from: the layer or --set that last gave it, else source().
+  const std::string& source_of(std::string_view path) const;
   // True when the key is present (even with no value).
   bool has(std::string_view path) const;
 

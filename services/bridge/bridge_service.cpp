@@ -20,6 +20,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/connection.hpp"
 #include "lcm/message_checks.hpp"
+#include "lcm/actuator_status.hpp"
 #include "lcm/servo_gains_status.hpp"
 #include "runtime/rig_auth_config.hpp"
 #include "runtime/summary_file.hpp"
@@ -480,6 +481,12 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     const ServoGainsFigures gains{g.kp, g.ki, g.kd, g.notch_hz, g.has_notch() ? g.notch_q : 0.0};
     for (const ServoGainCounter& c : kServoGainCounters) {
       status_.counter(servo_gain_counter_name(c, a), servo_gain_counter(c, gains));
+    }
+    // The rig's actuator limits, which the compensator and the re-identifier hold theirs against.
+    const ActuatorLimits& l = settings_.limits_of(a);
+    const ActuatorFigures limits{l.u_min_V, l.u_max_V, l.slew_V_per_s};
+    for (const ActuatorCounter& c : kActuatorCounters) {
+      status_.counter(actuator_counter_name(c, a), actuator_counter(c, limits));
     }
   }
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));

@@ -66,6 +66,7 @@ CompensatorService::CompensatorService(const CompensatorSettings& settings, lcm:
       models_(
           lcm, channels.model, [this](const model_params_t& m, std::int64_t) { on_model(m); }, model_envelope()),
       control_(lcm, channels.control, [this](const control_t& m, std::int64_t) { on_control(m); }),
+      rig_check_(lcm, channels.status, settings.rig_limits, "compensator"),
       status_(lcm, channels.status, "compensator"),
       // A block within the horizon of the next expected tick continues the stream (lost blocks
       // or a reorder: the plan still covers them); one further away must be confirmed.
@@ -214,6 +215,7 @@ int CompensatorService::run() {
                  static_cast<double>(latency_total_.max_ns()) / 1e3);
   }
   write_summary_json();
+  rig_check_.throw_if_refused();  // exit 2: started with limits the rig's bridge does not have
   return errors > 0 ? 1 : 0;
 }
 

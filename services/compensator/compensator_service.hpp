@@ -62,6 +62,7 @@
 #include "loop/sequence_guard.hpp"
 #include "runtime/control_acks.hpp"
 #include "runtime/counter_set.hpp"
+#include "runtime/rig_check.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -212,6 +213,7 @@ class CompensatorService {
   Subscription<mem_params_t> params_;
   Subscription<model_params_t> models_;
   Subscription<control_t> control_;
+  RigCheck rig_check_;  // refuses this process when the bridge's actuator limits are not its own
   ControlFilter filter_{"compensator"};
   ControlAcks acks_;  // what was done with the last requests, for their senders
   StatusReporter status_;

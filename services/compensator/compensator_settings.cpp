@@ -308,7 +308,8 @@ CompensatorSettings load_compensator_settings(const Config& config) {
     }
   });
 
-  // The actuator as the bridge limits it: the plan stays inside it (keep equal to the bridge's actuator.*).
+  // The actuator as the bridge limits it: the plan stays inside it (held against the bridge's at run time,
+  // runtime/rig_check.hpp).
   c.u_min_V = config.get<double>("actuator.u_min_V", c.u_min_V);
   c.u_max_V = config.get<double>("actuator.u_max_V", c.u_max_V);
   c.slew_V_per_s = config.get_positive("actuator.slew_V_per_s", c.slew_V_per_s);
@@ -360,6 +361,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   }
   validate_config_section(config, "", [&] { t.validate(); });
   read_axes_and_scan(config, s);
+  for (int axis = 0; axis < s.axes; ++axis) {
+    s.rig_limits.push_back(RigLimitsOwn::from(config, axis, {c.u_min_V, c.u_max_V, c.slew_V_per_s}, true));
+  }
   return s;
 }
 

@@ -18,6 +18,7 @@
 #include "loop/trajectory.hpp"
 #include "models/gain_plausibility.hpp"
 #include "models/model_set.hpp"
+#include "runtime/rig_check.hpp"
 
 namespace hystloop {
 
@@ -57,6 +58,9 @@ struct CompensatorSettings {
   // A parameter set (HX_PARAMS, HX_MODEL, or a model section of the file) whose gain leaves
   // [linear.gain / F, linear.gain * F] over the actuator's range is refused (models/gain_plausibility.hpp).
   double plausible_gain_factor = GainPlausibility{}.factor;  // compensator.plausible_gain_factor, F [-]
+  // The actuator limits the plan keeps inside, each axis's with where it came from: held against
+  // the bridge's at run time (runtime/rig_check.hpp).
+  std::vector<RigLimitsOwn> rig_limits;
 };
 
 // The band parameter sets are checked against: the configured linear model's gain (the stage's

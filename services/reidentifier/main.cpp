@@ -65,10 +65,13 @@ int main(int argc, char** argv) try {
   if (axis_option->count() > 0) service.overrides.push_back("reidentifier.axis=" + std::string(axis_name(axis)));
 
   ReidentOptions options;
+  RigLimitsOwn rig_limits;
   std::string url;
   const auto refused = configure_or_refuse("hystloop-reidentifier", [&] {
-    url = set_up_service(ReidentService::kProcessName, service,
-                         {.adjust = {}, .read = [&](const Config& config) { options = read_reident_options(config); }});
+    url = set_up_service(ReidentService::kProcessName, service, {.adjust = {}, .read = [&](const Config& config) {
+                                                                   options = read_reident_options(config);
+                                                                   rig_limits = reident_rig_limits(config, options);
+                                                                 }});
     if (options.axis != 0) {  // the log names the process as HX_STATUS does
       init_logging(ReidentService::process_name(options.axis), service.log_level,
                    service.log_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(service.log_file));
@@ -96,7 +99,7 @@ int main(int argc, char** argv) try {
                  mc.enabled ? "on" : "off", mc.selector.selection.candidates.size(), mc.selector.margin, mc.period_s,
                  mc.selector.decimation, mc.pinned ? std::string(to_string(*mc.pinned)) : std::string("no"));
     auto lcm = open_lcm(url, service.allow_network);
-    ReidentService reident(*lcm, names, options);
+    ReidentService reident(*lcm, names, options, {rig_limits});
     return reident.run();  // the service (and its refit worker) ends before run_service flushes the log
   });
 } catch (...) {  // CLI11's set-up, before the handlers above exist: nothing escapes main

@@ -174,4 +174,9 @@ ReidentOptions read_reident_options(const Config& config) {
   return o;
 }
 
+RigLimitsOwn reident_rig_limits(const Config& config, const ReidentOptions& options) {
+  const GainPlausibility& p = options.plausibility;
+  return RigLimitsOwn::from(config, options.axis, {p.u_min_V, p.u_max_V, 0.0}, false);
+}
+
 }  // namespace hystloop

@@ -61,7 +61,8 @@ std::string ReidentService::process_name(int axis) {
   return axis == 0 ? std::string(kProcessName) : std::string(kProcessName) + "-" + std::string(axis_name(axis));
 }
 
-ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options)
+ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options,
+                               std::vector<RigLimitsOwn> rig_limits)
     : lcm_(lcm),
       options_(options),
       process_(process_name(options.axis)),
@@ -99,6 +100,7 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
   control_ = std::make_unique<Subscription<control_t>>(lcm, names.control,
                                                        [this](const control_t& msg, std::int64_t) { on_control(msg); });
+  rig_check_ = std::make_unique<RigCheck>(lcm, names.status, std::move(rig_limits), process_);
 }
 
 void ReidentService::on_sensor_block(const sensor_block_t& msg) noexcept {
@@ -402,6 +404,7 @@ int ReidentService::run() {
       in_use.applied_version() == ParamsInUse::kUnknownVersion ? std::string("unknown")
                                                                : std::to_string(in_use.applied_version()),
       lcm_errors, counts);
+  rig_check_->throw_if_refused();  // exit 2: started with a range the rig's bridge does not have
   return 0;
 }
 

@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -51,6 +52,7 @@
 #include "reidentifier/reident_options.hpp"
 #include "runtime/control_acks.hpp"
 #include "runtime/counter_set.hpp"
+#include "runtime/rig_check.hpp"
 #include "runtime/status_reporter.hpp"
 
 namespace hystloop {
@@ -62,7 +64,10 @@ class ReidentService {
   // "reidentifier" for axis 0 (x), "reidentifier-y", "reidentifier-z" for 1 and 2.
   static std::string process_name(int axis);
 
-  ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options);
+  // `rig_limits`: this process's actuator range, refused when the rig's bridge reports another
+  // (runtime/rig_check.hpp); empty: not checked.
+  ReidentService(lcm::LCM& lcm, const ChannelNames& names, const ReidentOptions& options,
+                 std::vector<RigLimitsOwn> rig_limits = {});
 
   // Serves until SIGINT/SIGTERM or a SHUTDOWN request; returns the exit code (0).
   int run();
@@ -113,6 +118,7 @@ class ReidentService {
   std::unique_ptr<Subscription<command_block_t>> command_;
   std::unique_ptr<Subscription<mem_params_t>> params_in_;
   std::unique_ptr<Subscription<control_t>> control_;
+  std::unique_ptr<RigCheck> rig_check_;  // refuses this process when the bridge's actuator range is not its own
 };
 
 }  // namespace hystloop

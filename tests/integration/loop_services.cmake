@@ -25,3 +25,12 @@ if(TARGET hystloop-bridge AND TARGET hystloop-reidentifier AND TARGET hystloop-l
             $<TARGET_FILE:hystloop-reidentifier> $<TARGET_FILE:hystloop-logger> $<TARGET_FILE:logger_probe>)
   set_tests_properties(rig_restart PROPERTIES LABELS integration TIMEOUT 120 RESOURCE_LOCK hystloop_live_loop)
 endif()
+
+# One set of actuator limits per rig: a compensator or re-identifier with others is refused.
+if(TARGET hystloop-bridge AND TARGET hystloop-compensator AND TARGET hystloop-reidentifier)
+  add_test(NAME rig_limits
+    COMMAND ${_netns_run} -- ${CMAKE_CURRENT_LIST_DIR}/rig_limits.sh
+            $<TARGET_FILE:hystloop-bridge> $<TARGET_FILE:hystloop-compensator> $<TARGET_FILE:loop_probe>
+            $<TARGET_FILE:hystloop-reidentifier>)
+  set_tests_properties(rig_limits PROPERTIES LABELS integration TIMEOUT 90 RESOURCE_LOCK hystloop_live_loop)
+endif()

@@ -181,6 +181,7 @@ struct Reported {
   std::map<std::string, std::int64_t> counters;
 };
 Reported report_status(Harness& h) {
+  h.drain();  // reports published before (a verdict's immediate one) are not this one
   Subscription<service_status_t> listener(*h.lcm, h.channels.status);
   h.service.report(wall_utime(), false);
   h.drain();
