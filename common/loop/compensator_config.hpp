@@ -85,6 +85,10 @@ struct CompensatorConfig {
   // live; docs/TRACKING.md). 2 % = 0.1 V per tick at 5e4 V/s.
   double plan_slew_fraction = 0.99;
   double servo_slew_reserve = 0.02;
+  // An experiment that starts away from where the plan is (another experiment's offset, the
+  // tracking voltage) is approached at this rate until the command meets the excitation: a real
+  // stage's resonance is not rung by a move at the slew limit. The bridge's safe ramp's default.
+  double experiment_ramp_V_per_s = 1.0e3;
   // The share of the slew limit a tracked line's feedforward may use.
   double tracking_slew_fraction() const noexcept { return plan_slew_fraction - servo_slew_reserve; }
   double tracking_slew_V_per_s() const noexcept { return tracking_slew_fraction() * slew_V_per_s; }
@@ -123,7 +127,8 @@ struct CompensatorCounters {
   std::uint64_t plan_refusals = 0;        // trajectories and scans the plan refused (outside the limits, invalid)
   std::uint64_t trajectories_shaped = 0;  // taken after shaping to feasibility
   std::uint64_t stage_swaps = 0;          // stage models swapped in
-  std::uint64_t experiment_ramped = 0;    // experiment ticks ramped towards the excitation (a jump between two)
+  std::uint64_t experiment_ramped =
+      0;  // experiment ticks ramped towards an excitation that starts away (experiment_ramp_V_per_s)
 
   // Every counter with the name the compensator's status gives it. The sum over axes and the
   // status walk this list, and a field above that is not in it fails the static_assert below: no

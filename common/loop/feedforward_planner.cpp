@@ -262,18 +262,33 @@ CommandTick FeedforwardPlanner::plan_tick(std::int64_t k, PeriodicLearner* learn
     } else {
       experiment_u_.update(e.voltage_V);
     }
-    // From where the plan is (the previous experiment's offset, or the tracking voltage) at the
-    // slew limit's admitted share: the bridge never has to clamp an excitation.
+    // An excitation moves within the slew limit's admitted share (the bridge never has to clamp
+    // it); one that starts away from where the plan is (the previous experiment's offset, or the
+    // tracking voltage: a jump beyond that share) is approached at the conservative ramp rate
+    // until the command meets it (within a step, or the excitation crossed the command).
     const double max_step = config_.plan_slew_fraction * config_.slew_V_per_s * config_.dt_s;
+    const double ramp_step = std::min(max_step, config_.experiment_ramp_V_per_s * config_.dt_s);
+    const double gap = e.voltage_V - last_u_;
+    if (!approaching_ && std::abs(gap) > max_step) {
+      approaching_ = true;
+      approach_gap_V_ = gap;
+    }
     double u = e.voltage_V;
-    if (std::abs(u - last_u_) > max_step) {
-      u = last_u_ + std::copysign(max_step, u - last_u_);
-      ++counters_.experiment_ramped;
+    if (approaching_) {
+      const bool met = std::abs(gap) <= ramp_step || (gap > 0.0) != (approach_gap_V_ > 0.0);
+      if (met && std::abs(gap) <= max_step) {
+        approaching_ = false;
+      } else {
+        u = last_u_ + std::copysign(std::min(ramp_step, std::abs(gap)), gap);
+        approach_gap_V_ = gap;
+        ++counters_.experiment_ramped;
+      }
     }
     last_u_ = u;
     last_u_wanted_ = kNaN;
     return {k, u, kNaN, exchange_.version(), kExperimentMode};
   }
+  approaching_ = false;
   if (e.ended) {
     awaiting_anchor_ = true;
     anchor_tick_ = k;

@@ -198,6 +198,10 @@ class FeedforwardPlanner {
   // The experiment's voltage: where its last branch of the hysteresis began, for the anchor.
   ReversalDetector experiment_u_;
   bool in_experiment_ = false;
+  // Approaching an experiment that starts away from last_u_: at experiment_ramp_V_per_s until the
+  // command meets the excitation (then its own voltage, within the plan's slew share).
+  bool approaching_ = false;
+  double approach_gap_V_ = 0.0;       // the excitation minus the command at the last approach tick
   double experiment_branch_u_ = 0.0;  // the voltage of its last reversal [V]
 
   // The samples' numbering. A step back is never a restart here: the service builds a new law

@@ -210,6 +210,7 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "compensator.trajectory_check",
                                   "compensator.plan_slew_fraction",
                                   "compensator.servo_slew_reserve",
+                                  "compensator.experiment_ramp_V_per_s",
                                   "compensator.plausible_gain_factor",
                                   "actuator.u_min_V",
                                   "actuator.u_max_V",
@@ -316,6 +317,7 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   c.plan_slew_fraction = config.get_in_range("compensator.plan_slew_fraction", c.plan_slew_fraction, 0.05, 1.0);
   c.servo_slew_reserve =
       config.get_in_range("compensator.servo_slew_reserve", c.servo_slew_reserve, 0.0, c.plan_slew_fraction - 0.05);
+  c.experiment_ramp_V_per_s = config.get_positive("compensator.experiment_ramp_V_per_s", c.experiment_ramp_V_per_s);
 
   c.stage = read_stage_model(config, c.stage, c.dt_s);
 

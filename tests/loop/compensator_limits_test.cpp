@@ -484,7 +484,7 @@ TEST(CompensatorLimits, ConfigValidatesTheStageAndTheLearning) {
 namespace hystloop {
 namespace {
 
-TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
+TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsApproachedGently) {
   Compensator c(linear_config(false));
   ExperimentSpec big;
   big.amplitude_V = 300.0;
@@ -504,7 +504,9 @@ TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
     EXPECT_NE(std::string(e.what()).find("actuator.slew_V_per_s"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("at most 39.4 Hz"), std::string::npos) << e.what();
   }
-  // Two excitations at different offsets, back to back: the jump between them is a ramp.
+  // Two excitations at different offsets, back to back: the jumps to them (from 0 V, then between
+  // them) are approached at compensator.experiment_ramp_V_per_s (1000 V/s: 0.1 V a tick), not at
+  // the slew limit.
   ExperimentSpec low, high;
   low.offset_V = -100.0;
   low.amplitude_V = 20.0;
@@ -517,7 +519,25 @@ TEST(CompensatorLimits, AnExcitationMustFitTheActuatorAndIsRampedTo) {
   std::vector<CommandTick> ticks;
   const double worst = plan_for(c, 0.12, &ticks);
   EXPECT_LE(worst, kExperimentShare * 5e4 * 1e-4 + 1e-9);
-  EXPECT_GT(c.counters().experiment_ramped, 38u);  // 200 V at 4.95 V per tick, and 100 V from 0 V
+  ASSERT_GT(ticks.size(), 800u);
+  // The first excitation (400 ticks) ends before the approach from 0 V meets it (at -80 V at the
+  // earliest); the second is approached from there: 0.1 V a tick each way.
+  for (std::size_t k = 0; k < 400; ++k) ASSERT_NEAR(ticks[k].u_ff_V, -0.1 * static_cast<double>(k + 1), 1e-9) << k;
+  for (std::size_t k = 400; k < 800; ++k) {
+    ASSERT_NEAR(ticks[k].u_ff_V, -40.0 + 0.1 * static_cast<double>(k - 399), 1e-9) << k;
+  }
+  EXPECT_GE(c.counters().experiment_ramped, 800u);
+  // A faster approach where the rig allows it: the same jump in fewer ticks.
+  CompensatorConfig quick = linear_config(false);
+  quick.experiment_ramp_V_per_s = 1e4;
+  Compensator q(quick);
+  q.start_experiment(low);
+  ticks.clear();
+  plan_for(q, 0.03, &ticks);
+  EXPECT_NEAR(ticks[79].u_ff_V, -80.0, 1e-9);
+  EXPECT_LT(q.counters().experiment_ramped, 100u);
+  quick.experiment_ramp_V_per_s = 0.0;
+  EXPECT_THROW(Compensator{quick}, ParameterError);
 }
 
 }  // namespace
