@@ -47,11 +47,22 @@ inline double actuator_value(const ActuatorCounter& c, std::int64_t counter) noe
   return static_cast<double>(counter) * 1e-3 + c.origin;
 }
 
+// The stage's nominal gain the bridge's servo is scaled by (servo.nominal_gain_m_per_V), in fm/V
+// (6.3e-9 m/V is 6,300,000): the one gain every process of a rig judges a stage's models against.
+inline constexpr std::string_view kNominalGainCounter = "servo_nominal_gain_fm_per_V";
+inline constexpr double kNominalGainScale = 1e15;
+
+inline std::uint64_t nominal_gain_counter(double gain_m_per_V) noexcept {
+  const double v = gain_m_per_V * kNominalGainScale;
+  return v > 0.0 && std::isfinite(v) ? static_cast<std::uint64_t>(std::llround(v)) : 0U;
+}
+
 // Axis `axis`'s counter name: c.name for x (0), "y_" + c.name, "z_" + c.name.
-inline std::string actuator_counter_name(const ActuatorCounter& c, int axis) {
+inline std::string axis_counter_name(std::string_view name, int axis) {
   static constexpr std::string_view kPrefix[] = {"", "y_", "z_"};
   const std::string_view prefix = axis > 0 && axis < 3 ? kPrefix[axis] : std::string_view();
-  return std::string(prefix) + std::string(c.name);
+  return std::string(prefix) + std::string(name);
 }
+inline std::string actuator_counter_name(const ActuatorCounter& c, int axis) { return axis_counter_name(c.name, axis); }
 
 }  // namespace hystloop

@@ -488,6 +488,7 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
     for (const ActuatorCounter& c : kActuatorCounters) {
       status_.counter(actuator_counter_name(c, a), actuator_counter(c, limits));
     }
+    status_.counter(axis_counter_name(kNominalGainCounter, a), nominal_gain_counter(g.nominal_gain_m_per_V));
   }
   status_.counter("late_ppm_period", static_cast<std::uint64_t>(late_fraction * 1e6));
   status_.counter("clamped_per_s", rt.clamped_last_second.either);

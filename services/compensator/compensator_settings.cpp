@@ -364,7 +364,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   validate_config_section(config, "", [&] { t.validate(); });
   read_axes_and_scan(config, s);
   for (int axis = 0; axis < s.axes; ++axis) {
-    s.rig_limits.push_back(RigLimitsOwn::from(config, axis, {c.u_min_V, c.u_max_V, c.slew_V_per_s}, true));
+    s.rig_limits.push_back(
+        RigLimitsOwn::from(config, axis, {c.u_min_V, c.u_max_V, c.slew_V_per_s}, true)
+            .with_gain(config, c.models.linear.gain, s.plausible_gain_factor, "compensator.plausible_gain_factor"));
   }
   return s;
 }

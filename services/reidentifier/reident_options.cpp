@@ -176,7 +176,8 @@ ReidentOptions read_reident_options(const Config& config) {
 
 RigLimitsOwn reident_rig_limits(const Config& config, const ReidentOptions& options) {
   const GainPlausibility& p = options.plausibility;
-  return RigLimitsOwn::from(config, options.axis, {p.u_min_V, p.u_max_V, 0.0}, false);
+  return RigLimitsOwn::from(config, options.axis, {p.u_min_V, p.u_max_V, 0.0}, false)
+      .with_gain(config, p.nominal_gain_m_per_V, p.factor, "reidentifier.plausible_gain_factor");
 }
 
 }  // namespace hystloop

@@ -1,5 +1,6 @@
 #include "runtime/rig_check.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 
@@ -24,16 +25,43 @@ const char* axis_text(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"
 }  // namespace
 
 RigLimitsOwn RigLimitsOwn::from(const Config& config, int axis, const ActuatorFigures& limits, bool has_slew) {
-  RigLimitsOwn o{axis, limits, has_slew, {}};
+  RigLimitsOwn o;
+  o.axis = axis;
+  o.limits = limits;
+  o.has_slew = has_slew;
   for (std::size_t i = 0; i < kActuatorCounters.size(); ++i) {
     o.sources[i] = config.source_of("actuator." + std::string(kActuatorCounters[i].key));
   }
   return o;
 }
 
+RigLimitsOwn RigLimitsOwn::with_gain(const Config& config, double gain_m_per_V, double factor,
+                                     std::string factor_key) const {
+  RigLimitsOwn o = *this;
+  o.nominal_gain_m_per_V = gain_m_per_V;
+  o.gain_factor = factor;
+  o.gain_source = config.source_of("linear.gain");
+  o.gain_factor_key = std::move(factor_key);
+  return o;
+}
+
 std::optional<RigDifference> rig_limits_differ(const std::vector<RigLimitsOwn>& own, const std::string& process,
                                                const service_status_t& bridge) {
   for (const RigLimitsOwn& o : own) {
+    if (const auto theirs = counter(bridge, axis_counter_name(kNominalGainCounter, o.axis));
+        theirs && *theirs > 0 && std::isfinite(o.nominal_gain_m_per_V)) {
+      const double bridge_gain = static_cast<double>(*theirs) / kNominalGainScale;
+      const double ratio = o.nominal_gain_m_per_V / bridge_gain;
+      if (ratio > o.gain_factor || ratio < 1.0 / o.gain_factor) {
+        return RigDifference{
+            "linear.gain",
+            fmt::format("{:.4g} m/V in this {}'s configuration ({}), {:.4g} m/V at the bridge on {} (pid {}, axis {}: "
+                        "servo.nominal_gain_m_per_V): more than x{:g} ({}) apart, so one of them is not this stage's "
+                        "gain; set both from --probe-hardware --yes or an identification",
+                        o.nominal_gain_m_per_V, process, o.gain_source, bridge_gain, bridge.host, bridge.pid,
+                        axis_text(o.axis), o.gain_factor, o.gain_factor_key)};
+      }
+    }
     for (std::size_t i = 0; i < kActuatorCounters.size(); ++i) {
       const ActuatorCounter& c = kActuatorCounters[i];
       if (!o.has_slew && c.value == &ActuatorFigures::slew_V_per_s) continue;

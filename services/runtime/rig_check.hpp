@@ -10,6 +10,7 @@
 // limits other than its own.
 
 #include <array>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,9 +30,18 @@ struct RigLimitsOwn {
   bool has_slew = true;  // false: only the range is this process's (the re-identifier)
   // Where each limit came from (a file, "--set"), in kActuatorCounters' order.
   std::array<std::string, kActuatorCounters.size()> sources{};
+  // The stage's nominal gain this process judges models against (linear.gain) and the factor it
+  // allows them off it: refused when the bridge's servo.nominal_gain_m_per_V is further off than
+  // that (one of the two is not this stage's). NaN: not compared.
+  double nominal_gain_m_per_V = std::numeric_limits<double>::quiet_NaN();
+  double gain_factor = 10.0;
+  std::string gain_source;
+  std::string gain_factor_key;  // "compensator.plausible_gain_factor"
 
   // Axis `axis`'s limits as `config` gave them (actuator.u_min_V ...: one set for every axis).
   static RigLimitsOwn from(const Config& config, int axis, const ActuatorFigures& limits, bool has_slew);
+  // ... and the nominal gain (linear.gain) with its factor, named by `factor_key`.
+  RigLimitsOwn with_gain(const Config& config, double gain_m_per_V, double factor, std::string factor_key) const;
 };
 
 // One limit this process and the bridge disagree on: its key and why, naming both values.

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One set of actuator limits per rig, the bridge's: a compensator or a re-identifier started with
-# other limits is refused at the bridge's first report (exit 2, naming the key, both values and
-# where each came from); started with the bridge's, each runs on. Inside tools/netns-run.
+# other limits, or a nominal gain more than its plausible_gain_factor off the bridge's, is refused
+# at the bridge's first report (exit 2, naming the key, both values and where each came from);
+# started with the bridge's, each runs on. Inside tools/netns-run.
 #   rig_limits.sh <hystloop-bridge> <hystloop-compensator> <loop_probe> <hystloop-reidentifier>
 source "$(dirname "$0")/loop_common.sh" "$@"
 reidentifier="$4"
@@ -39,4 +40,15 @@ wait $rpid || fail "a re-identifier with the bridge's limits exited $?"
 grep -q "error refused:" "$dir/compensator_same.log" "$dir/reidentifier_same.log" && fail "refused with the bridge's limits"
 kill -TERM $bpid
 wait $bpid || fail "the bridge exited with $? on SIGTERM"
-echo "ok: other limits refused naming both, the bridge's accepted"
+
+# A bridge whose stage is a hundred times steeper than the compensator's linear.gain (a 100 um
+# stage left with the simulator's gain): more than plausible_gain_factor apart, refused.
+"$bridge" "${bridge_args[@]}" --set servo.nominal_gain_m_per_V=6.3e-7 >"$dir/bridge2.log" 2>&1 & bpid=$!; pids+=($bpid)
+wait_log "$dir/bridge2.log" "started in the safe state"
+expect_rig_refusal compensator_gain \
+  "linear.gain: 6.34e-09 m/V in this compensator's configuration" "6.3e-07 m/V at the bridge on" \
+  "more than x10 (compensator.plausible_gain_factor) apart" -- \
+  "$compensator" --config "$config/compensator.yaml"
+kill -TERM $bpid
+wait $bpid || fail "the second bridge exited with $? on SIGTERM"
+echo "ok: other limits and a gain of another stage refused naming both, the bridge's accepted"

@@ -37,7 +37,10 @@ service_status_t bridge_report(const std::vector<ActuatorFigures>& axes) {
 }
 
 RigLimitsOwn own(int axis, ActuatorFigures limits, bool has_slew = true) {
-  RigLimitsOwn o{axis, limits, has_slew, {}};
+  RigLimitsOwn o;
+  o.axis = axis;
+  o.limits = limits;
+  o.has_slew = has_slew;
   o.sources.fill("compensator.yaml");
   return o;
 }
@@ -86,6 +89,31 @@ TEST(RigCheck, ARangeOnlyProcessIgnoresTheSlewAndAReportWithoutLimitsIsNotAVerdi
   // A bridge that reports no limits (an older one), or not for this axis.
   EXPECT_FALSE(rig_limits_differ({own(0, {-1.0, 1.0, 1.0})}, "compensator", bridge_report({})));
   EXPECT_FALSE(rig_limits_differ({own(2, {-1.0, 1.0, 1.0})}, "compensator", bridge_report({rig, rig})));
+}
+
+TEST(RigCheck, ANominalGainFurtherOffTheBridgesThanThePlausibleFactorIsAnotherStages) {
+  const ActuatorFigures rig{-250.0, 250.0, 5e4};
+  service_status_t report = bridge_report({rig});
+  report.counter_names.emplace_back(kNominalGainCounter);
+  report.counter_values.push_back(6'300'000);  // 6.3e-9 m/V in fm/V
+  report.n_counters = static_cast<std::int32_t>(report.counter_names.size());
+  const Config config = Config::from_string("linear: {gain: 6.34e-9}\n", "compensator.yaml");
+  const auto with_gain = [&](double gain) {
+    return own(0, rig).with_gain(config, gain, 10.0, "compensator.plausible_gain_factor");
+  };
+  EXPECT_FALSE(rig_limits_differ({with_gain(6.34e-9)}, "compensator", report));  // an identified 6.34 by 6.3
+  EXPECT_FALSE(rig_limits_differ({with_gain(6.2e-8)}, "compensator", report));
+  const auto d = rig_limits_differ({with_gain(6.5e-7)}, "compensator", report);  // a 100 um stage's
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->key, "linear.gain");
+  EXPECT_TRUE(contains(d->reason,
+                       "6.5e-07 m/V in this compensator's configuration (compensator.yaml), 6.3e-09 m/V "
+                       "at the bridge on stage-pc (pid 4242, axis x: servo.nominal_gain_m_per_V)"))
+      << d->reason;
+  EXPECT_TRUE(rig_limits_differ({with_gain(6.2e-10)}, "compensator", report));
+  // Without a gain of its own (NaN), or from a bridge that reports none: not compared.
+  EXPECT_FALSE(rig_limits_differ({own(0, rig)}, "compensator", report));
+  EXPECT_FALSE(rig_limits_differ({with_gain(6.5e-7)}, "compensator", bridge_report({rig})));
 }
 
 TEST(RigCheck, EachLimitNamesTheFileOrOverrideThatGaveIt) {
