@@ -13,6 +13,8 @@
 #include <string>
 #include <string_view>
 
+#include "lcm/status_counters.hpp"
+
 namespace hystloop {
 
 struct ActuatorFigures {
@@ -58,11 +60,6 @@ inline std::uint64_t nominal_gain_counter(double gain_m_per_V) noexcept {
 }
 
 // Axis `axis`'s counter name: c.name for x (0), "y_" + c.name, "z_" + c.name.
-inline std::string axis_counter_name(std::string_view name, int axis) {
-  static constexpr std::string_view kPrefix[] = {"", "y_", "z_"};
-  const std::string_view prefix = axis > 0 && axis < 3 ? kPrefix[axis] : std::string_view();
-  return std::string(prefix) + std::string(name);
-}
 inline std::string actuator_counter_name(const ActuatorCounter& c, int axis) { return axis_counter_name(c.name, axis); }
 
 }  // namespace hystloop

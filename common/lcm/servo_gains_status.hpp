@@ -13,6 +13,8 @@
 #include <string>
 #include <string_view>
 
+#include "lcm/status_counters.hpp"
+
 namespace hystloop {
 
 struct ServoGainsFigures {
@@ -45,9 +47,7 @@ inline std::uint64_t servo_gain_counter(const ServoGainCounter& c, const ServoGa
 
 // Axis `axis`'s counter name: c.name for x (0), "y_" + c.name, "z_" + c.name.
 inline std::string servo_gain_counter_name(const ServoGainCounter& c, int axis) {
-  static constexpr std::string_view kPrefix[] = {"", "y_", "z_"};
-  const std::string_view prefix = axis > 0 && axis < 3 ? kPrefix[axis] : std::string_view();
-  return std::string(prefix) + std::string(c.name);
+  return axis_counter_name(c.name, axis);
 }
 
 // Axis `axis`'s gains from a report's counters; nullopt when any is missing (a bridge that

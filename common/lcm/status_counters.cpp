@@ -63,9 +63,11 @@ std::optional<std::int64_t> find_counter(const service_status_t& status, std::st
   return std::nullopt;
 }
 
-std::string params_version_counter(int axis) {
-  if (axis <= 0 || axis >= 3) return "params_version";
-  return std::string(1, "xyz"[axis]) + "_params_version";
+std::string axis_counter_name(std::string_view name, int axis) {
+  if (axis <= 0 || axis >= 3) return std::string(name);
+  return std::string(1, "xyz"[axis]) + "_" + std::string(name);
 }
+
+std::string params_version_counter(int axis) { return axis_counter_name("params_version", axis); }
 
 }  // namespace hystloop

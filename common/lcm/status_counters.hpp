@@ -30,6 +30,9 @@ bool add_publisher_counters(service_status_t& status, std::string_view endpoint,
 // as far as both reach); nullopt when it has none by that name.
 std::optional<std::int64_t> find_counter(const service_status_t& status, std::string_view name);
 
+// Axis `axis`'s name of a per-axis counter: `name` for x (0), "y_" + name, "z_" + name.
+std::string axis_counter_name(std::string_view name, int axis);
+
 // The compensator's counter of the parameter set in use on `axis` (0: x): "params_version" for x,
 // "y_params_version" / "z_params_version" for the others (what a tool that publishes a set waits on).
 std::string params_version_counter(int axis);

@@ -9,20 +9,10 @@
 
 #include "core/errors.hpp"
 #include "core/process.hpp"
+#include "lcm/status_counters.hpp"
+#include "models/axis_coupling.hpp"
 
 namespace hystloop {
-namespace {
-
-std::optional<std::int64_t> counter(const service_status_t& msg, const std::string& name) {
-  for (std::size_t i = 0; i < msg.counter_names.size() && i < msg.counter_values.size(); ++i) {
-    if (msg.counter_names[i] == name) return msg.counter_values[i];
-  }
-  return std::nullopt;
-}
-
-const char* axis_text(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
-
-}  // namespace
 
 RigLimitsOwn RigLimitsOwn::from(const Config& config, int axis, const ActuatorFigures& limits, bool has_slew) {
   RigLimitsOwn o;
@@ -48,7 +38,7 @@ RigLimitsOwn RigLimitsOwn::with_gain(const Config& config, double gain_m_per_V, 
 std::optional<RigDifference> rig_limits_differ(const std::vector<RigLimitsOwn>& own, const std::string& process,
                                                const service_status_t& bridge) {
   for (const RigLimitsOwn& o : own) {
-    if (const auto theirs = counter(bridge, axis_counter_name(kNominalGainCounter, o.axis));
+    if (const auto theirs = find_counter(bridge, axis_counter_name(kNominalGainCounter, o.axis));
         theirs && *theirs > 0 && std::isfinite(o.nominal_gain_m_per_V)) {
       const double bridge_gain = static_cast<double>(*theirs) / kNominalGainScale;
       const double ratio = o.nominal_gain_m_per_V / bridge_gain;
@@ -59,13 +49,13 @@ std::optional<RigDifference> rig_limits_differ(const std::vector<RigLimitsOwn>& 
                         "servo.nominal_gain_m_per_V): more than x{:g} ({}) apart, so one of them is not this stage's "
                         "gain; set both from --probe-hardware --yes or an identification",
                         o.nominal_gain_m_per_V, process, o.gain_source, bridge_gain, bridge.host, bridge.pid,
-                        axis_text(o.axis), o.gain_factor, o.gain_factor_key)};
+                        axis_name(o.axis), o.gain_factor, o.gain_factor_key)};
       }
     }
     for (std::size_t i = 0; i < kActuatorCounters.size(); ++i) {
       const ActuatorCounter& c = kActuatorCounters[i];
       if (!o.has_slew && c.value == &ActuatorFigures::slew_V_per_s) continue;
-      const std::optional<std::int64_t> theirs = counter(bridge, actuator_counter_name(c, o.axis));
+      const std::optional<std::int64_t> theirs = find_counter(bridge, actuator_counter_name(c, o.axis));
       if (!theirs) continue;  // a bridge that does not report them, or not this axis
       const auto mine = static_cast<std::int64_t>(actuator_counter(c, o.limits));
       if (mine == *theirs) continue;
@@ -74,7 +64,7 @@ std::optional<RigDifference> rig_limits_differ(const std::vector<RigLimitsOwn>& 
           fmt::format("{:g} in this {}'s configuration ({}), {:g} at the bridge on {} (pid {}, axis {}): a rig has one "
                       "set of actuator limits, the bridge's; give this process the bridge's",
                       o.limits.*c.value, process, o.sources[i], actuator_value(c, *theirs), bridge.host, bridge.pid,
-                      axis_text(o.axis))};
+                      axis_name(o.axis))};
     }
   }
   return std::nullopt;
