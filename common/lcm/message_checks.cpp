@@ -253,6 +253,8 @@ Verdict check_message(const control_t& msg) noexcept {
   f.nan_or_within(msg.kd, 0.0, kHuge);
   f.nan_or_within(msg.notch_hz, 0.0, kHuge);
   f.nan_or_within(msg.notch_q, 0.0, kHuge);
+  f.nan_or_within(msg.notch2_hz, 0.0, kHuge);
+  f.nan_or_within(msg.notch2_q, 0.0, kHuge);
   f.within(msg.experiment_amplitude_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
   f.within(msg.experiment_offset_V, -kMaxAbsVoltage_V, kMaxAbsVoltage_V);
   f.within(msg.experiment_frequency_Hz, 0.0, kMaxAbsFrequency_Hz);

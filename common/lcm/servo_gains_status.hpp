@@ -18,25 +18,31 @@
 namespace hystloop {
 
 struct ServoGainsFigures {
-  double kp = 0.0;        // [-]
-  double ki_per_s = 0.0;  // [1/s]
-  double kd_s = 0.0;      // [s]
-  double notch_hz = 0.0;  // [Hz], 0 = no notch
-  double notch_q = 0.0;   // [-]
+  double kp = 0.0;         // [-]
+  double ki_per_s = 0.0;   // [1/s]
+  double kd_s = 0.0;       // [s]
+  double notch_hz = 0.0;   // [Hz], 0 = no notch
+  double notch_q = 0.0;    // [-]
+  double notch2_hz = 0.0;  // [Hz], the second notch; 0 = none
+  double notch2_q = 0.0;   // [-]
 };
 
 struct ServoGainCounter {
   std::string_view name;
   double scale;  // counter = round(value x scale)
   double ServoGainsFigures::*value;
+  bool required = true;  // false: a bridge that does not report it has none (0)
 };
 
-inline constexpr std::array<ServoGainCounter, 5> kServoGainCounters{{
+inline constexpr std::array<ServoGainCounter, 7> kServoGainCounters{{
     {"servo_kp_ppm", 1e6, &ServoGainsFigures::kp},
     {"servo_ki_ppm_per_s", 1e6, &ServoGainsFigures::ki_per_s},
     {"servo_kd_ps", 1e12, &ServoGainsFigures::kd_s},
     {"servo_notch_mHz", 1e3, &ServoGainsFigures::notch_hz},
     {"servo_notch_q_ppm", 1e6, &ServoGainsFigures::notch_q},
+    // A bridge built before the second notch reports none: it has none.
+    {"servo_notch2_mHz", 1e3, &ServoGainsFigures::notch2_hz, false},
+    {"servo_notch2_q_ppm", 1e6, &ServoGainsFigures::notch2_q, false},
 }};
 
 // The counter value of one gain (gains are >= 0 and bounded, so this fits).
@@ -50,15 +56,15 @@ inline std::string servo_gain_counter_name(const ServoGainCounter& c, int axis) 
   return axis_counter_name(c.name, axis);
 }
 
-// Axis `axis`'s gains from a report's counters; nullopt when any is missing (a bridge that
-// reports none, or not that axis).
+// Axis `axis`'s gains from a report's counters; nullopt when a required one is missing (a bridge
+// that reports none, or not that axis).
 template <class FindCounter>
 std::optional<ServoGainsFigures> servo_gains_from_counters(FindCounter&& find, int axis = 0) {
   ServoGainsFigures g;
   for (const ServoGainCounter& c : kServoGainCounters) {
     const std::optional<std::int64_t> v = find(servo_gain_counter_name(c, axis));
-    if (!v) return std::nullopt;
-    g.*c.value = static_cast<double>(*v) / c.scale;
+    if (!v && c.required) return std::nullopt;
+    g.*c.value = v ? static_cast<double>(*v) / c.scale : 0.0;
   }
   return g;
 }

@@ -8,13 +8,30 @@
 namespace hystloop {
 namespace {
 
-NotchFilter make_notch(const FeedbackGains& g) {
-  return g.has_notch() ? NotchFilter(design_notch(g.notch_hz, g.notch_q, g.tick_rate_hz)) : NotchFilter();
+// Notch i of g, or the identity (b0 = 1) where it is off.
+NotchFilter make_notch(const FeedbackGains& g, std::size_t i) {
+  const ServoNotch n = g.notch(i);
+  return n.on() ? NotchFilter(design_notch(n.hz, n.q, g.tick_rate_hz)) : NotchFilter();
 }
 
-bool same_notch(const FeedbackGains& a, const FeedbackGains& b) {
-  if (!a.has_notch() && !b.has_notch()) return true;
-  return a.notch_hz == b.notch_hz && a.notch_q == b.notch_q && a.tick_rate_hz == b.tick_rate_hz;
+bool same_notches(const FeedbackGains& a, const FeedbackGains& b) {
+  for (std::size_t i = 0; i < kServoNotches; ++i) {
+    const ServoNotch na = a.notch(i), nb = b.notch(i);
+    if (!na.on() && !nb.on()) continue;
+    if (na.hz != nb.hz || na.q != nb.q || a.tick_rate_hz != b.tick_rate_hz) return false;
+  }
+  return true;
+}
+
+void validate_notch(const char* hz_field, const char* q_field, const ServoNotch& n, double tick_rate_hz) {
+  require_non_negative(hz_field, n.hz);
+  if (!n.on()) return;
+  const double max_hz = kNotchMaxFractionOfRate * tick_rate_hz;
+  if (!(n.hz < max_hz)) {
+    throw ParameterError(hz_field, "must be 0 (no notch) or below 0.45 x the tick rate (" + number_text(max_hz) +
+                                       " Hz) (got " + number_text(n.hz) + ")");
+  }
+  require_in_range(q_field, n.q, kNotchMinQ, kNotchMaxQ);
 }
 
 }  // namespace
@@ -29,15 +46,20 @@ void FeedbackGains::validate() const {
   if (!(u_max_V > u_min_V)) throw ParameterError("servo.u_max_V", "must be greater than servo.u_min_V");
   require_positive("servo.d_filter_hz", d_filter_hz);
   require_positive("servo.tick_rate_hz", tick_rate_hz);
-  require_non_negative("servo.notch_hz", notch_hz);
-  if (has_notch()) {
-    const double max_hz = kNotchMaxFractionOfRate * tick_rate_hz;
-    if (!(notch_hz < max_hz)) {
-      throw ParameterError("servo.notch_hz", "must be 0 (no notch) or below 0.45 x the tick rate (" +
-                                                 number_text(max_hz) + " Hz) (got " + number_text(notch_hz) + ")");
-    }
-    require_in_range("servo.notch_q", notch_q, kNotchMinQ, kNotchMaxQ);
+  validate_notch("servo.notch_hz", "servo.notch_q", notch(0), tick_rate_hz);
+  validate_notch("servo.notch2_hz", "servo.notch2_q", notch(1), tick_rate_hz);
+}
+
+std::string notches_text(const FeedbackGains& g) {
+  std::string on;
+  int count = 0;
+  for (std::size_t i = 0; i < kServoNotches; ++i) {
+    const ServoNotch n = g.notch(i);
+    if (!n.on()) continue;
+    on += (count++ == 0 ? "" : " and ") + number_text(n.hz) + " Hz (Q " + number_text(n.q) + ")";
   }
+  if (count == 0) return "no notch";
+  return (count == 1 ? "notch at " : "notches at ") + on;
 }
 
 double FeedbackGains::max_kd_s() const noexcept {
@@ -68,7 +90,7 @@ void FeedbackGains::check_bounds(std::string_view prefix) const {
 
 FeedbackController::FeedbackController(const FeedbackGains& gains) : gains_(gains) {
   gains_.validate();
-  notch_ = make_notch(gains_);
+  for (std::size_t i = 0; i < kServoNotches; ++i) notches_[i] = make_notch(gains_, i);
 }
 
 void FeedbackController::set_gains(const FeedbackGains& gains) {
@@ -79,12 +101,15 @@ void FeedbackController::set_gains(const FeedbackGains& gains) {
   } else if (gains.ki == 0.0) {
     integral_ = 0.0;
   }
-  if (!same_notch(gains, gains_)) {
+  if (!same_notches(gains, gains_)) {
     // A new filter with the old one's state would ring; one settled at the last output goes on
     // from it: its next output is output + b0 (x - output), x the PID part (near the output on a
-    // servo in operation, whose correction is slow against the resonance).
-    notch_ = make_notch(gains);
-    notch_.settle_at(output_V_);
+    // servo in operation, whose correction is slow against the resonance). Each filter's gain at
+    // DC is 1, so every one of the cascade settles at the same output.
+    for (std::size_t i = 0; i < kServoNotches; ++i) {
+      notches_[i] = make_notch(gains, i);
+      notches_[i].settle_at(output_V_);
+    }
   }
   gains_ = gains;
 }
@@ -94,7 +119,7 @@ void FeedbackController::reset() noexcept {
   prev_error_ = 0.0;
   d_state_ = 0.0;
   output_V_ = 0.0;
-  notch_.reset();
+  for (NotchFilter& n : notches_) n.reset();
   has_prev_ = false;
 }
 
@@ -111,33 +136,44 @@ double FeedbackController::update(double error_m, double u_ff_V, double dt_s, do
   prev_error_ = error_m;
   has_prev_ = true;
 
-  const bool notch = gains_.has_notch();
   const double u_pd = (gains_.kp * error_m + gains_.kd * d_state_) * inv_gain;
   if (gains_.ki > 0.0 && error_m != 0.0) {
-    // The total command for an integral I: u_ff + b0 (u_pd + ki I / gain) + s1 (the notch's next
-    // output; b0 = 1 and s1 = 0 without one), increasing in I.
-    const double b0 = notch ? notch_.coefficients().b0 : 1.0;
-    const double s1 = notch ? notch_.peek(0.0) : 0.0;
-    const auto command_V = [&](double integral) { return u_ff_V + b0 * (u_pd + gains_.ki * integral * inv_gain) + s1; };
+    // The total command for an integral I, on the next tick: u_ff + b0 (u_pd + ki I / gain) + s1,
+    // the cascade's next output being affine in its input x: b0 x + s1 (b0 = 1 and s1 = 0 without
+    // a notch: the identity filter of a notch off adds nothing, exactly); and once the notches have
+    // rung out (their gain at DC is 1): u_ff + u_pd + ki I / gain. Both increase in I.
+    double b0 = 1.0, s1 = 0.0;
+    for (const NotchFilter& n : notches_) {
+      s1 = n.peek(s1);  // n's next output for input b0 x + s1 is n.b0 b0 x + n.peek(s1)
+      b0 *= n.coefficients().b0;
+    }
+    const auto next_V = [&](double integral) { return u_ff_V + b0 * (u_pd + gains_.ki * integral * inv_gain) + s1; };
+    const auto settled_V = [&](double integral) { return u_ff_V + u_pd + gains_.ki * integral * inv_gain; };
     const double candidate = integral_ + error_m * dt_s;
     // The edge of what will be let through in the direction the integral moves, kBoundaryMargin_V
     // inside, so that rounding never has the clamp act on a command the integrator just moved.
     const double limit_V = error_m > 0.0 ? u_hi_V : u_lo_V;
     const double margin_V = kBoundaryMargin_V * (1.0 + std::abs(limit_V));
     const double edge_V = error_m > 0.0 ? limit_V - margin_V : limit_V + margin_V;
-    if (error_m > 0.0 ? command_V(candidate) <= edge_V : command_V(candidate) >= edge_V) {
+    const auto inside = [&](double command_V) { return error_m > 0.0 ? command_V <= edge_V : command_V >= edge_V; };
+    if (inside(next_V(candidate)) && inside(settled_V(candidate))) {
       integral_ = candidate;
     } else {
       // Conditional integration: the integral moves toward the edge, never past it; nor back, when
       // the command is beyond it already. Holding it instead would freeze it whenever one tick's
-      // growth is more than the slew limit's step.
-      const double at_edge = ((edge_V - u_ff_V - s1) / b0 - u_pd) * gains_.nominal_gain_m_per_V / gains_.ki;
-      integral_ = error_m > 0.0 ? std::max(integral_, std::min(candidate, at_edge))
-                                : std::min(integral_, std::max(candidate, at_edge));
+      // growth is more than the slew limit's step. Past it means either way: the next output
+      // alone would let the integral climb in the troughs of a notch's ringing, tick by tick,
+      // until the settled command sat far beyond the edge (a wind-up the clamp then hides).
+      const double next_edge = ((edge_V - u_ff_V - s1) / b0 - u_pd) * gains_.nominal_gain_m_per_V / gains_.ki;
+      const double settled_edge = (edge_V - u_ff_V - u_pd) * gains_.nominal_gain_m_per_V / gains_.ki;
+      integral_ = error_m > 0.0 ? std::max(integral_, std::min({candidate, next_edge, settled_edge}))
+                                : std::min(integral_, std::max({candidate, next_edge, settled_edge}));
     }
   }
   const double pid = u_pd + gains_.ki * integral_ * inv_gain;
-  output_V_ = notch ? notch_.step(pid) : pid;
+  double out = pid;
+  for (NotchFilter& n : notches_) out = n.step(out);
+  output_V_ = out;
   return output_V_;
 }
 

@@ -3,16 +3,22 @@
 // the stage's nominal gain so that they read in plain units whatever the stage:
 //   u_fb [V] = N[(kp * e + ki * integral(e) + kd * de/dt) / nominal_gain_m_per_V],   e = y_ref - y [m]
 // kp [-], ki [1/s], kd [s]. With the feedforward linearising the stage to ~unit gain,
-// ki is roughly the loop's crossover in rad/s. N is an optional notch at the stage's
-// resonance (notch_filter.hpp), which otherwise caps the loop's bandwidth.
+// ki is roughly the loop's crossover in rad/s. N is up to two notches in cascade
+// (notch_filter.hpp), one per lightly damped mode of the stage, which otherwise caps the loop's
+// bandwidth: a stage under a load often has a second mode within the servo's reach (a flexure's
+// first and second bending modes), and vendors' controllers offer two notches per axis for that.
 //
 // Anti-windup: each tick the caller says which total command u_ff + u_fb it will let through
 // (the bridge: the actuator's range intersected with what the slew limit reaches from the last
 // applied voltage). The integrator grows toward an edge of that interval only as far as the
 // command stays inside it (conditional integration): it follows a clamped actuator instead of
 // running ahead of it, so neither clamp winds it up, and a command the clamp cuts never has a
-// grown integral behind it.
+// grown integral behind it. With notches the edge holds for the next output and for the output
+// the notches settle to (their gain at DC is 1), so their ringing cannot ratchet the integral up.
 
+#include <array>
+#include <cstddef>
+#include <string>
 #include <string_view>
 
 #include "core/errors.hpp"
@@ -40,6 +46,14 @@ inline constexpr double kMaxServoKp = 2.0;
 inline constexpr double kMaxServoKiPerTick = 1.0;   // ki dt
 inline constexpr double kMaxServoKdStepGain = 2.0;  // kd / (dt + 1 / (2 pi d_filter_hz))
 
+// One notch of the servo's cascade: centre [Hz] (0 = none) and quality factor (centre / width) [-].
+struct ServoNotch {
+  double hz = 0.0;
+  double q = 2.0;
+  bool on() const noexcept { return hz > 0.0; }
+};
+inline constexpr std::size_t kServoNotches = 2;
+
 struct FeedbackGains {
   double kp = 0.0;                       // [-]
   double ki = 0.0;                       // [1/s]
@@ -50,10 +64,12 @@ struct FeedbackGains {
   double d_filter_hz = 1000.0;  // first-order low-pass on the derivative
   double notch_hz = 0.0;        // centre of the notch on the servo's output [Hz]; 0 = none
   double notch_q = 2.0;         // its quality factor, centre / width [-] (checked only with a notch)
+  double notch2_hz = 0.0;       // a second notch in cascade with the first [Hz]; 0 = none
+  double notch2_q = 2.0;        // its quality factor [-]
   double tick_rate_hz = 1e4;    // the rate update() is called at: the notch is designed for it
                                 // (the bridge sets it from its clock, as it sets u_min_V/u_max_V)
 
-  // Throws ParameterError naming the field ("servo.notch_hz"): the notch needs
+  // Throws ParameterError naming the field ("servo.notch_hz", "servo.notch2_q"): each notch needs
   // 0 < notch_hz < 0.45 tick_rate_hz and notch_q in [0.1, 50].
   void validate() const;
   // validate(), then the plausibility bounds above: ParameterError naming the field (prefix +
@@ -66,7 +82,16 @@ struct FeedbackGains {
   double max_kd_s() const noexcept;
   bool enabled() const noexcept { return kp != 0.0 || ki != 0.0 || kd != 0.0; }
   bool has_notch() const noexcept { return notch_hz > 0.0; }
+  bool has_notch2() const noexcept { return notch2_hz > 0.0; }
+  // Notch i (0: the first, 1: the second) as {centre [Hz], q [-]}; centre 0 = none.
+  ServoNotch notch(std::size_t i) const noexcept {
+    return i == 0 ? ServoNotch{notch_hz, notch_q} : ServoNotch{notch2_hz, notch2_q};
+  }
 };
+
+// "no notch", "notch at 780 Hz (Q 0.5)", "notches at 780 Hz (Q 0.5) and 2400 Hz (Q 1)": how
+// start-up lines and tools name a servo's notches.
+std::string notches_text(const FeedbackGains& g);
 
 // The notch's limits (FeedbackGains::validate): below 0.45 of the tick rate the prewarped
 // design is still a notch and not a band-stop pressed against Nyquist.
@@ -101,8 +126,8 @@ class FeedbackController {
 
  private:
   FeedbackGains gains_;
-  NotchFilter notch_;
-  double integral_ = 0.0;  // [m s]
+  std::array<NotchFilter, kServoNotches> notches_;  // in cascade; a filter for a notch off is the identity
+  double integral_ = 0.0;                           // [m s]
   double prev_error_ = 0.0;
   double d_state_ = 0.0;   // filtered derivative [m/s]
   double output_V_ = 0.0;  // the last correction returned

@@ -115,8 +115,10 @@ ServoLoopResponse::ServoLoopResponse(const FeedbackGains& gains_in, const ServoL
   stage_zoh(model, p_num, p_den);
   num_ = scale(multiply(c_num, p_num), model.slope_ratio);
   den_ = multiply(c_den, p_den);
-  if (g.has_notch()) {
-    const BiquadCoefficients n = design_notch(g.notch_hz, g.notch_q, g.tick_rate_hz);
+  for (std::size_t i = 0; i < kServoNotches; ++i) {
+    const ServoNotch notch = g.notch(i);
+    if (!notch.on()) continue;
+    const BiquadCoefficients n = design_notch(notch.hz, notch.q, g.tick_rate_hz);
     num_ = multiply(num_, {n.b0, n.b1, n.b2});
     den_ = multiply(den_, {1.0, n.a1, n.a2});
   }

@@ -5,7 +5,7 @@
 // with its delay (ServoLoopModel::linear), (unit DC gain; it
 // includes the tick between a voltage and the position sampled at the tick's end, what the
 // simulator hands the next tick), C the PID of FeedbackController (backward-Euler integral, the
-// filtered backward-difference derivative), N its notch, r the stage's local slope over
+// filtered backward-difference derivative), N its notches in cascade, r the stage's local slope over
 // nominal_gain_m_per_V (the hysteresis makes it move: Banning's stage from ~0.6 to ~1.4), and d
 // extra ticks of delay (1 on a card that reads the sensor right after writing the voltage: the
 // position then reaches the servo a tick later than in the simulator).

@@ -166,20 +166,25 @@ detail, host, utime_us, late, rejected, counters}}. Empty when no rig is running
       .def(
           "set_gains",
           [](ctl::RigClient& rig, std::optional<double> kp, std::optional<double> ki, std::optional<double> kd,
-             std::optional<double> notch_hz, std::optional<double> notch_q, std::optional<int> axis) {
+             std::optional<double> notch_hz, std::optional<double> notch_q, std::optional<int> axis,
+             std::optional<double> notch2_hz, std::optional<double> notch2_q) {
             ctl::GainsRequest g;
             g.kp = kp;
             g.ki = ki;
             g.kd = kd;
             g.notch_hz = notch_hz;
             g.notch_q = notch_q;
+            g.notch2_hz = notch2_hz;
+            g.notch2_q = notch2_q;
             g.axis = axis.value_or(-1);
             unlocked([&] { rig.set_gains(g); });
           },
           py::arg("kp") = py::none(), py::arg("ki") = py::none(), py::arg("kd") = py::none(),
           py::arg("notch_hz") = py::none(), py::arg("notch_q") = py::none(), py::arg("axis") = py::none(),
+          py::arg("notch2_hz") = py::none(), py::arg("notch2_q") = py::none(),
           R"(Bridge: the servo's gains, bumplessly; a gain not given stays as in force. kp [-], ki [1/s],
-kd [s], notch_hz [Hz] (0 removes the notch), notch_q [-]. axis: 0 x, 1 y, 2 z; None: every axis.)")
+kd [s], notch_hz [Hz] (0 removes the notch), notch_q [-]; notch2_hz, notch2_q a second notch in
+cascade (a second mode of the stage). axis: 0 x, 1 y, 2 z; None: every axis.)")
       .def(
           "set_mode", [](ctl::RigClient& rig, const std::string& mode) { unlocked([&] { rig.set_mode(mode); }); },
           py::arg("mode"), "Compensator: the feedforward mode (off, linear, mem, ...), confirmed by its report.")

@@ -107,8 +107,7 @@ void BridgeService::on_control(const control_t& msg) {
         const FeedbackGains& g = gains_[static_cast<std::size_t>(a)];
         spdlog::info("servo{} gains kp {}, ki {} 1/s, kd {} s, {} (request {})",
                      settings_.axes > 1 ? fmt::format(" {}", axis_name(a)) : std::string(), g.kp, g.ki, g.kd,
-                     g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : "no notch",
-                     msg.request_id);
+                     notches_text(g), msg.request_id);
       }
       return;
     }
@@ -478,7 +477,8 @@ void BridgeService::report(const RtReport& rt, std::int64_t utime, bool stopping
   acks_.report(status_);
   for (int a = 0; a < settings_.axes; ++a) {
     const FeedbackGains& g = gains_[static_cast<std::size_t>(a)];
-    const ServoGainsFigures gains{g.kp, g.ki, g.kd, g.notch_hz, g.has_notch() ? g.notch_q : 0.0};
+    const ServoGainsFigures gains{
+        g.kp, g.ki, g.kd, g.notch_hz, g.has_notch() ? g.notch_q : 0.0, g.notch2_hz, g.has_notch2() ? g.notch2_q : 0.0};
     for (const ServoGainCounter& c : kServoGainCounters) {
       status_.counter(servo_gain_counter_name(c, a), servo_gain_counter(c, gains));
     }

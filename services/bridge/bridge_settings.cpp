@@ -21,8 +21,8 @@ namespace {
 // An axis's own keys: actuator.<field> and servo.<field> for x, actuator.y.<field> ... for y and z.
 constexpr const char* kAxisActuatorKeys[] = {"u_min_V",           "u_max_V",        "slew_V_per_s",  "safe_u_V",
                                              "safe_ramp_V_per_s", "position_min_m", "position_max_m"};
-constexpr const char* kAxisServoKeys[] = {"kp",          "ki",       "kd",     "nominal_gain_m_per_V",
-                                          "d_filter_hz", "notch_hz", "notch_q"};
+constexpr const char* kAxisServoKeys[] = {
+    "kp", "ki", "kd", "nominal_gain_m_per_V", "d_filter_hz", "notch_hz", "notch_q", "notch2_hz", "notch2_q"};
 
 std::string axis_prefix(const char* section, int axis) { return axis_field(section, axis); }
 std::string axis_key(const char* section, int axis, const char* field) { return axis_prefix(section, axis) + field; }
@@ -63,6 +63,8 @@ FeedbackGains load_servo(const Config& config, int axis, FeedbackGains g, const 
   g.notch_hz = config.get_non_negative(p + "notch_hz", g.notch_hz);
   // Checked here even without a notch: a Q the file gives is meant to be used.
   g.notch_q = config.get_in_range(p + "notch_q", g.notch_q, kNotchMinQ, kNotchMaxQ);
+  g.notch2_hz = config.get_non_negative(p + "notch2_hz", g.notch2_hz);
+  g.notch2_q = config.get_in_range(p + "notch2_q", g.notch2_q, kNotchMinQ, kNotchMaxQ);
   g.u_min_V = a.u_min_V;
   g.u_max_V = a.u_max_V;
   g.tick_rate_hz = rate_hz;
@@ -413,11 +415,9 @@ std::vector<std::string> describe(const BridgeSettings& s) {
   }
   for (int axis = 0; axis < s.axes; ++axis) {
     const FeedbackGains& g = s.servo_of(axis);
-    lines.push_back(fmt::format(
-        "{}: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}", axis_label("servo", axis), g.kp, g.ki,
-        g.kd, g.nominal_gain_m_per_V,
-        g.has_notch() ? fmt::format("notch at {} Hz (Q {})", g.notch_hz, g.notch_q) : std::string("no notch"),
-        g.enabled() ? "" : " (off: feedforward only)"));
+    lines.push_back(fmt::format("{}: kp {}, ki {} 1/s, kd {} s on y_ref - y, nominal gain {} m/V, {}{}",
+                                axis_label("servo", axis), g.kp, g.ki, g.kd, g.nominal_gain_m_per_V, notches_text(g),
+                                g.enabled() ? "" : " (off: feedforward only)"));
   }
   lines.push_back(
       fmt::format("blocks: {} ticks per HX_SENSOR message ({:.4g} messages/s); commands taken up to {} s "

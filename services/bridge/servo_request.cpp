@@ -19,6 +19,8 @@ FeedbackGains requested_gains(const FeedbackGains& in_force, const control_t& ms
   // A sender that knows no notch sends 0 and 0: no notch, which validates as such.
   take(g.notch_hz, msg.notch_hz);
   take(g.notch_q, msg.notch_q);
+  take(g.notch2_hz, msg.notch2_hz);
+  take(g.notch2_q, msg.notch2_q);
   g.check_bounds();  // finite, >= 0, and within the plausibility bounds at this tick rate
   return g;
 }

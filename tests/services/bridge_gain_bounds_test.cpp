@@ -101,6 +101,20 @@ TEST(BridgeGainBounds, ARequestChangesOnlyTheGainsItGivesNaNKeepsTheOneInForce) 
   EXPECT_FALSE(no_notch.has_notch());
   EXPECT_EQ(no_notch.ki, 600.0);
 
+  // The second notch: set beside the first (which stays), then kept by NaN.
+  m = set_gains(keep, keep, keep);
+  m.notch_hz = keep;
+  m.notch_q = keep;
+  m.notch2_hz = 2400.0;
+  m.notch2_q = 3.0;
+  const FeedbackGains two = requested_gains(in_force, m);
+  EXPECT_EQ(two.notch_hz, 1720.0);
+  EXPECT_EQ(two.notch2_hz, 2400.0);
+  EXPECT_EQ(two.notch2_q, 3.0);
+  m.notch2_hz = keep;
+  m.notch2_q = keep;
+  EXPECT_EQ(requested_gains(two, m).notch2_hz, 2400.0);
+
   // A partial request is bounded like a whole one.
   EXPECT_THROW(requested_gains(in_force, set_gains(keep, 1e5, keep)), ParameterError);
 }

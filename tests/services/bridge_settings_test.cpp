@@ -387,6 +387,10 @@ TEST(BridgeSettings, ServoBlockAndWakeUpRefusalsNameTheField) {
   EXPECT_TRUE(contains(refusal("servo: {notch_hz: 1720, notch_q: 0.05}"), "bridge.yaml: servo.notch_q"));
   EXPECT_TRUE(contains(refusal("servo: {notch_q: 60}"), "bridge.yaml: servo.notch_q"));
   EXPECT_EQ(refusal("servo: {notch_hz: 4499, notch_q: 50}"), "accepted");
+  // The second notch alike, under its own names, per axis too.
+  EXPECT_TRUE(contains(refusal("servo: {notch2_hz: 4500}"), "bridge.yaml: servo.notch2_hz"));
+  EXPECT_TRUE(contains(refusal("servo: {notch2_hz: 2400, notch2_q: 0.05}"), "bridge.yaml: servo.notch2_q"));
+  EXPECT_EQ(refusal("servo: {notch_hz: 780, notch_q: 0.34, notch2_hz: 2400, notch2_q: 3}"), "accepted");
   // The servo's keys were feedback.* in the compensator: not a bridge key.
   EXPECT_TRUE(contains(refusal("feedback: {kp: 0.1}"), "feedback.kp"));
 

@@ -61,11 +61,16 @@ void GainsRequest::validate() const {
   check("ki", ki, servo.ki);
   check("kd", kd, servo.kd);
   servo.check_bounds("");
-  if (notch_hz) require_in_range("notch-hz", *notch_hz, 0.0, kMaxNotch_hz);
-  if (notch_q) {
-    if (notch_hz && *notch_hz == 0.0) throw ParameterError("notch-q", "only with a notch (--notch-hz > 0)");
-    require_in_range("notch-q", *notch_q, kNotchMinQ, kNotchMaxQ);
-  }
+  const auto check_notch = [](const char* hz_name, const char* q_name, const std::optional<double>& hz,
+                              const std::optional<double>& q) {
+    if (hz) require_in_range(hz_name, *hz, 0.0, kMaxNotch_hz);
+    if (q) {
+      if (hz && *hz == 0.0) throw ParameterError(q_name, std::string("only with a notch (--") + hz_name + " > 0)");
+      require_in_range(q_name, *q, kNotchMinQ, kNotchMaxQ);
+    }
+  };
+  check_notch("notch-hz", "notch-q", notch_hz, notch_q);
+  check_notch("notch2-hz", "notch2-q", notch2_hz, notch2_q);
 }
 
 std::int8_t parse_learning(std::string_view name) {
@@ -129,6 +134,8 @@ ServoGainsFigures GainsRequest::applied_to(ServoGainsFigures in_force) const noe
   in_force.kd_s = kd.value_or(in_force.kd_s);
   in_force.notch_hz = notch_hz.value_or(in_force.notch_hz);
   in_force.notch_q = notch_q.value_or(in_force.notch_q);
+  in_force.notch2_hz = notch2_hz.value_or(in_force.notch2_hz);
+  in_force.notch2_q = notch2_q.value_or(in_force.notch2_q);
   return in_force;
 }
 
@@ -151,6 +158,8 @@ void apply(const GainsRequest& gains, control_t& msg) {
   msg.kd = gains.kd.value_or(keep);
   msg.notch_hz = gains.notch_hz.value_or(keep);
   msg.notch_q = gains.notch_q.value_or(keep);
+  msg.notch2_hz = gains.notch2_hz.value_or(keep);
+  msg.notch2_q = gains.notch2_q.value_or(keep);
   msg.axis = static_cast<std::int8_t>(gains.axis);
 }
 

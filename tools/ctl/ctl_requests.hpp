@@ -38,16 +38,19 @@ struct GainsRequest {
   // (0, kMaxNotch_hz]; and its quality factor, in [kNotchMinQ, kNotchMaxQ] (loop/feedback.hpp).
   std::optional<double> notch_hz;
   std::optional<double> notch_q;
+  // A second notch in cascade (a second mode of the stage), the same way.
+  std::optional<double> notch2_hz{};
+  std::optional<double> notch2_q{};
   // The axis whose servo it sets (0 x, 1 y, 2 z), or every axis's (control_t::EVERY_AXIS): each
   // axis then keeps its own value of what is not given.
   int axis = -1;
   static constexpr double kMaxNotch_hz = 4500.0;  // below half the 10 kHz tick rate
   // Nothing given: the request is a question (print the gains in force).
-  bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q; }
+  bool empty() const noexcept { return !kp && !ki && !kd && !notch_hz && !notch_q && !notch2_hz && !notch2_q; }
   // The gains in force with those this request changes.
   ServoGainsFigures applied_to(ServoGainsFigures in_force) const noexcept;
   // Given gains finite, >= 0 and within the servo's plausibility bounds at 10 kHz (kp <= 2, ki <= 1e4 1/s,
-  // kd <= 5.2e-4 s: loop/feedback.hpp); the notch as above ("notch-hz", "notch-q").
+  // kd <= 5.2e-4 s: loop/feedback.hpp); the notches as above ("notch-hz", "notch2-q").
   void validate() const;
 };
 

@@ -21,13 +21,20 @@ std::optional<ServoLoopModel> servo_loop_model(const StageModel& stage, double d
   return m;
 }
 
-ServoCheck check_servo(const ServoGainsFigures& gains, const ServoLoopModel& model) {
+FeedbackGains servo_gains(const ServoGainsFigures& gains) {
   FeedbackGains g;
   g.kp = gains.kp;
   g.ki = gains.ki_per_s;
   g.kd = gains.kd_s;
   g.notch_hz = gains.notch_hz;
   if (gains.notch_hz > 0.0) g.notch_q = gains.notch_q;
+  g.notch2_hz = gains.notch2_hz;
+  if (gains.notch2_hz > 0.0) g.notch2_q = gains.notch2_q;
+  return g;
+}
+
+ServoCheck check_servo(const ServoGainsFigures& gains, const ServoLoopModel& model) {
+  const FeedbackGains g = servo_gains(gains);
   ServoCheck c;
   c.margins = ServoLoopResponse(g, model).margins();
   const LoopMargins& m = c.margins;

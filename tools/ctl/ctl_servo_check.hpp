@@ -29,6 +29,9 @@ struct ServoCheck {
 // the tick the simulator takes.
 std::optional<ServoLoopModel> servo_loop_model(const StageModel& stage, double dt_s, int extra_delay_ticks);
 
+// The servo's gains as the bridge reports them, as the controller's (at the default rig's tick rate).
+FeedbackGains servo_gains(const ServoGainsFigures& gains);
+
 ServoCheck check_servo(const ServoGainsFigures& gains, const ServoLoopModel& model);
 
 // "gain margin 6.7 dB at 1.21 kHz, phase margin 37 deg at 212 Hz, |S| peak 2.1 at 260 Hz".

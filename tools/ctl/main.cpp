@@ -4,7 +4,8 @@
 //
 //   status [--wait-healthy P... [--accept-safe P]... [--accept-degraded] --timeout S] [--listen S] [--counters]
 //   arm | disarm | stop-experiment [--target P]      shutdown [P]      reset-counters [P]
-//   mode off|MODEL                                   gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--target bridge]
+//   mode off|MODEL                                   gains --kp --ki --kd [--notch-hz HZ --notch-q Q] [--notch2-hz
+//   --notch2-q]
 //                                                    [--stage-config FILE [--extra-delay-ticks N] [--force]]
 //   learn on|off|reset [--target compensator]        learning for periodic references (SET_LEARNING)
 //   pin-model MODEL|auto [--axis x|y|z]              the re-identifier's model choice (ctl_pin_model.hpp)
@@ -142,7 +143,7 @@ bool print_gains(const std::string& bridge, const service_status_t& report) {
         axis > 0 || servo_gains_from_counters([&](std::string_view name) { return find_counter(report, name); }, 1);
     fmt::print("hystloop-ctl: '{}' servo{} gains in force: kp {:g}, ki {:g} 1/s, kd {:g} s, {}\n", bridge,
                several ? fmt::format(" {}", axis_name(axis)) : std::string(), g->kp, g->ki_per_s, g->kd_s,
-               g->notch_hz > 0.0 ? fmt::format("notch at {:g} Hz (Q {:g})", g->notch_hz, g->notch_q) : "no notch");
+               notches_text(servo_gains(*g)));
   }
   return any;
 }
@@ -493,6 +494,9 @@ CommandRun add_gains_command(CLI::App& app, Options& o) {
   gains->add_option("--notch-hz", o.gains.notch_hz,
                     "Notch at the stage's resonance [Hz], in (0, 4500]; 0 removes the notch");
   gains->add_option("--notch-q", o.gains.notch_q, "The notch's quality factor (centre / width), in [0.1, 50]");
+  gains->add_option("--notch2-hz", o.gains.notch2_hz,
+                    "A second notch in cascade, at the stage's second mode [Hz], in (0, 4500]; 0 removes it");
+  gains->add_option("--notch2-q", o.gains.notch2_q, "The second notch's quality factor, in [0.1, 50]");
   add_axis_option(gains, "--axis", o.gains.axis,
                   "The axis whose servo it sets (default: every axis, each keeping its own value of a gain not "
                   "given); printing: every axis's");

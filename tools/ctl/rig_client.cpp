@@ -129,7 +129,8 @@ void RigClient::arm() { control(control_t::ARM, options_.bridge, "ARM", {}, null
 void RigClient::disarm() { control(control_t::DISARM, options_.bridge, "DISARM", {}, nullptr, counter_is("armed", 0)); }
 
 void RigClient::set_gains(const GainsRequest& gains) {
-  if (gains.empty()) throw ParameterError("gains", "give at least one of kp, ki, kd, notch_hz, notch_q");
+  if (gains.empty())
+    throw ParameterError("gains", "give at least one of kp, ki, kd, notch_hz, notch_q, notch2_hz, notch2_q");
   gains.validate();
   control(
       control_t::SET_GAINS, options_.bridge, "SET_GAINS", [&](control_t& msg) { apply(gains, msg); }, nullptr);

@@ -231,6 +231,8 @@ void fields(Row& r, const control_t& m) {
       .f("kd_s", "s", m.kd)
       .f("notch_Hz", "Hz", m.notch_hz, "0 = no notch")
       .f("notch_q", "1", m.notch_q)
+      .f("notch2_Hz", "Hz", m.notch2_hz, "second notch; 0 = none")
+      .f("notch2_q", "1", m.notch2_q)
       .s("experiment", m.experiment)
       .f("experiment_amplitude_V", "V", m.experiment_amplitude_V)
       .f("experiment_offset_V", "V", m.experiment_offset_V)

@@ -155,7 +155,24 @@ TEST(CtlRequests, AGainNotGivenIsSentAsNaNSoTheBridgeKeepsItsOwn) {
   EXPECT_TRUE(std::isnan(msg.kd));
   EXPECT_TRUE(std::isnan(msg.notch_hz));
   EXPECT_TRUE(std::isnan(msg.notch_q));
+  EXPECT_TRUE(std::isnan(msg.notch2_hz));
+  EXPECT_TRUE(std::isnan(msg.notch2_q));
   EXPECT_EQ(check_message(msg), Verdict::kOk);
+  // The second notch travels in its own fields, checked by its own names.
+  g.notch2_hz = 2400.0;
+  g.notch2_q = 3.0;
+  apply(g, msg);
+  EXPECT_EQ(msg.notch2_hz, 2400.0);
+  EXPECT_EQ(msg.notch2_q, 3.0);
+  EXPECT_TRUE(std::isnan(msg.notch_hz));
+  EXPECT_EQ(field_of([] {
+              GainsRequest r;
+              r.notch2_hz = 4600.0;
+              r.validate();
+            }),
+            "notch2-hz");
+  g.notch2_hz.reset();
+  g.notch2_q.reset();
   g.ki = 2e4;  // past ki dt <= 1 at 10 kHz, given alone
   EXPECT_EQ(field_of([&] { g.validate(); }), "ki");
 }
@@ -685,7 +702,7 @@ TEST(CtlAck, ATrackerWaitsForEveryExpectedProcessOrEveryOneHeard) {
 }
 
 TEST(CtlAck, ServoGainsTravelAsCountersAndComeBack) {
-  const ServoGainsFigures g{0.1, 600.0, 2.5e-5, 1720.0, 3.5};
+  const ServoGainsFigures g{0.1, 600.0, 2.5e-5, 1720.0, 3.5, 2400.0, 3.0};
   service_status_t s{};
   for (const ServoGainCounter& c : kServoGainCounters) {
     s.counter_names.emplace_back(c.name);
@@ -698,7 +715,16 @@ TEST(CtlAck, ServoGainsTravelAsCountersAndComeBack) {
   EXPECT_DOUBLE_EQ(back->kd_s, 2.5e-5);
   EXPECT_DOUBLE_EQ(back->notch_hz, 1720.0);
   EXPECT_DOUBLE_EQ(back->notch_q, 3.5);
+  EXPECT_DOUBLE_EQ(back->notch2_hz, 2400.0);
+  EXPECT_DOUBLE_EQ(back->notch2_q, 3.0);
+  // A bridge that reports no second notch has none; one without a gain it must report, no gains.
+  s.counter_names.resize(5);
+  s.counter_values.resize(5);
+  const auto one_notch = servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); });
+  ASSERT_TRUE(one_notch.has_value());
+  EXPECT_EQ(one_notch->notch2_hz, 0.0);
   s.counter_names.pop_back();
+  s.counter_values.pop_back();
   EXPECT_FALSE(servo_gains_from_counters([&](std::string_view name) { return find_counter(s, name); }).has_value());
 }
 
