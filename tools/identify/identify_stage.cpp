@@ -17,6 +17,7 @@
 #include "ident/stage_identification.hpp"
 #include "identify_output.hpp"
 #include "log_samples.hpp"
+#include "loop/servo_notches.hpp"
 #include "models/csv_columns.hpp"
 #include "models/multisine.hpp"
 #include "plot_series.hpp"  // tools/report: write_text_file
@@ -189,6 +190,12 @@ std::string roots_yaml(const std::vector<C>& roots_hz) {
   return s + "]";
 }
 
+// The servo's notches for the fitted stage (loop/servo_notches.hpp), at the record's rate.
+std::vector<ModeNotch> fitted_notches(const StageRecord& r, const StageFitResult& fit) {
+  return notches_for_stage(
+      fit.poles_rad_s, [&](double f_hz) { return fit.model_response(f_hz); }, r.sample_rate_Hz);
+}
+
 std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
                        const std::string& heading) {
   std::ostringstream y;
@@ -217,6 +224,17 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     << "  zeros_hz: " << roots_yaml(roots_hz_once(fit.zeros_rad_s)) << "\n"
     << "  poles_hz: " << roots_yaml(roots_hz_once(fit.poles_rad_s)) << "\n"
     << "  delay_s: " << num(fit.delay_s, 8) << "\n";
+  const std::vector<ModeNotch> notches = fitted_notches(r, fit);
+  y << "# servo notches for this stage (the bridge's servo: section; check the gains' margins with\n"
+    << "# hystloop-ctl gains --stage-config on this file):";
+  if (notches.empty()) y << " none (no lightly damped mode lifts the gain)";
+  y << "\n";
+  for (std::size_t i = 0; i < notches.size(); ++i) {
+    const ModeNotch& n = notches[i];
+    const std::string key = i == 0 ? "notch" : "notch2";
+    y << "#   " << key << "_hz: " << num(n.notch.hz, 6) << "   " << key << "_q: " << num(n.notch.q, 3)
+      << "   # mode damping " << num(n.damping, 3) << ", " << num(n.peak_gain, 3) << " x the DC gain there\n";
+  }
   return y.str();
 }
 
@@ -240,6 +258,26 @@ void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
     const double w = std::abs(p);
     std::printf("  pole %.6g Hz, damping %.4g\n", w / (2.0 * std::numbers::pi), -p.real() / w);
   }
+}
+
+void print_notches(const StageRecord& r, const StageFitResult& fit) {
+  const std::vector<ModeNotch> notches = fitted_notches(r, fit);
+  if (notches.empty()) {
+    std::printf("servo notches: none (no lightly damped mode lifts the gain)\n");
+    return;
+  }
+  std::string args;
+  for (std::size_t i = 0; i < notches.size(); ++i) {
+    const ModeNotch& n = notches[i];
+    std::printf("servo notch %zu: %.6g Hz, Q %.3g (mode damping %.3g, %.3g x the DC gain there)\n", i + 1, n.notch.hz,
+                n.notch.q, n.damping, n.peak_gain);
+    const std::string flag = i == 0 ? "--notch" : "--notch2";
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " %s-hz %.6g %s-q %.3g", flag.c_str(), n.notch.hz, flag.c_str(), n.notch.q);
+    args += buf;
+  }
+  std::printf("  set them: hystloop-ctl gains%s%s --stage-config THIS_YAML (prints the margins first)\n", args.c_str(),
+              notches.size() < kServoNotches ? " --notch2-hz 0" : "");
 }
 
 report::PlotResult write_stage_plots(const FrequencyResponse& frf, const StageFitResult& fit,
@@ -359,6 +397,7 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   const FrequencyResponse& frf = id.frf;
   const StageFitResult& fit = id.fit;
   print_fit(frf, fit);
+  print_notches(r, fit);
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
   if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading)); rc != 0) return rc;

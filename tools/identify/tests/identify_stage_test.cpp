@@ -9,11 +9,14 @@
 #include <complex>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "loop/servo_notches.hpp"
 #include "models/linear_stage.hpp"
 #include "models/multisine.hpp"
 #include "support/tool_run.hpp"
@@ -110,6 +113,23 @@ TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
     EXPECT_TRUE(std::filesystem::exists(out + png)) << png << "\n" << r.output;
   }
   EXPECT_TRUE(std::filesystem::exists(out + "stage_frf.dat"));
+  // The servo's notches, from the identified model: those the true stage gives, to the fit's accuracy.
+  const std::vector<ModeNotch> want = notches_for_stage(truth(), 1e4);
+  ASSERT_EQ(want.size(), 2u);
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    const std::string label = "servo notch " + std::to_string(i + 1) + ": ";
+    const std::size_t n = r.output.find(label);
+    ASSERT_NE(n, std::string::npos) << r.output;
+    double hz = 0.0, q = 0.0;
+    ASSERT_EQ(std::sscanf(r.output.c_str() + n + label.size(), "%lf Hz, Q %lf", &hz, &q), 2) << r.output;
+    EXPECT_NEAR(hz, want[i].notch.hz, 1e-3 * want[i].notch.hz) << i;
+    EXPECT_NEAR(q, want[i].notch.q, 0.02 * want[i].notch.q) << i;
+  }
+  EXPECT_NE(r.output.find("hystloop-ctl gains --notch-hz"), std::string::npos) << r.output;
+  std::ifstream yaml(out + "config.yaml");
+  std::stringstream text;
+  text << yaml.rdbuf();
+  EXPECT_NE(text.str().find("#   notch2_hz: "), std::string::npos) << text.str();
 }
 
 TEST_F(IdentifyStage, AUyCsvNeedsItsSampleRateAndAGivenOrderIsKept) {

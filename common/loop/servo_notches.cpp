@@ -1,0 +1,60 @@
+#include "loop/servo_notches.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace hystloop {
+
+std::vector<ModeNotch> notches_for_stage(std::span<const std::complex<double>> poles_rad_s,
+                                         const std::function<std::complex<double>(double)>& response_hz,
+                                         double tick_rate_hz) {
+  const double dc = std::abs(response_hz(0.0));
+  std::vector<ModeNotch> found;
+  if (!(dc > 0.0) || !std::isfinite(dc)) return found;
+  for (const std::complex<double>& p : poles_rad_s) {
+    if (!(p.imag() > 0.0)) continue;  // one of each pair; real poles do not resonate
+    const double w = std::abs(p);
+    const double zeta = -p.real() / w;
+    const double f_hz = w / (2.0 * std::numbers::pi);
+    if (!(zeta < kNotchMaxDamping) || !(f_hz < kNotchMaxFractionOfRate * tick_rate_hz)) continue;
+    const double peak = std::abs(response_hz(f_hz)) / dc;
+    if (!(peak > 1.0)) continue;
+    // |N(r w)| for a notch of quality q: |1 - r^2| / sqrt((1 - r^2)^2 + (r / q)^2); = 1 / peak at r = 1.1.
+    const double r = 1.0 + kNotchDetuning;
+    const double gap = std::abs(1.0 - r * r);
+    const double q = r / std::sqrt(gap * gap * (peak * peak - 1.0));
+    found.push_back({ServoNotch{f_hz, std::clamp(q, kNotchMinQ, kNotchMaxSuggestedQ)}, zeta, peak});
+  }
+  std::sort(found.begin(), found.end(),
+            [](const ModeNotch& a, const ModeNotch& b) { return a.peak_gain > b.peak_gain; });
+  if (found.size() > kServoNotches) found.resize(kServoNotches);
+  return found;
+}
+
+std::vector<ModeNotch> notches_for_stage(const LinearStageSpec& stage, double tick_rate_hz) {
+  const double dt_s = 1.0 / tick_rate_hz;
+  const DiscreteLinearStage d = discretise(stage, dt_s);
+  std::vector<std::complex<double>> poles;
+  for (Eigen::Index i = 0; i < d.poles.size(); ++i) {
+    const std::complex<double> z = d.poles(i);
+    if (std::abs(z) > 0.0) poles.push_back(std::log(z) / dt_s);  // 0: a fractional delay's state
+  }
+  // A discrete model's response is its sampled one; a continuous model's, its own.
+  const bool discrete = !stage.numerator_zinv.empty();
+  return notches_for_stage(
+      poles, [&](double f_hz) { return discrete ? d.frequency_response(f_hz) : stage.frequency_response(f_hz); },
+      tick_rate_hz);
+}
+
+void set_notches(FeedbackGains& gains, std::span<const ModeNotch> notches) noexcept {
+  const ServoNotch none{0.0, 2.0};
+  const ServoNotch first = notches.size() > 0 ? notches[0].notch : none;
+  const ServoNotch second = notches.size() > 1 ? notches[1].notch : none;
+  gains.notch_hz = first.hz;
+  gains.notch_q = first.q;
+  gains.notch2_hz = second.hz;
+  gains.notch2_q = second.q;
+}
+
+}  // namespace hystloop
