@@ -47,9 +47,13 @@ FeedbackGains pi(double kp, double ki, double notch_hz = 0.0, double notch_q = 2
 }
 
 std::string notch_text(const FeedbackGains& g) {
-  char buf[64];
-  if (!g.has_notch()) return "none";
-  std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g", g.notch_hz, g.notch_q);
+  char buf[96];
+  if (!g.has_notch() && !g.has_notch2()) return "none";
+  if (!g.has_notch2()) {
+    std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g", g.notch_hz, g.notch_q);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g; %.0f Hz, Q %.2g", g.notch_hz, g.notch_q, g.notch2_hz, g.notch2_q);
+  }
   return buf;
 }
 
@@ -187,7 +191,8 @@ void kp_at_the_slew_limit(const FeedbackGains& defaults) {
 }  // namespace
 
 // The margins of the same servo on the two-mode stage (780 Hz zeta 0.03, 92 %; 2.4 kHz zeta 0.02,
-// 8 %; 1.5 ticks of delay): the defaults, tuned for Banning's stage, and a notch on its first mode.
+// 8 %; 1.5 ticks of delay): the defaults, tuned for Banning's stage, a notch on its first mode, and
+// deploy/config/two-mode's servo (a notch on each mode, as loop/servo_notches.hpp sets them).
 int two_mode_margins() {
   ServoLoopModel stage;
   stage.linear = LinearStageSpec::sum_of_modes({{780.0, 0.03, 0.92}, {2400.0, 0.02, 0.08}}, 1.5e-4);
@@ -200,6 +205,13 @@ int two_mode_margins() {
   margins_row("defaults without the notch", pi(0.05, 2000.0), stage);
   margins_row("notch on the 780 Hz mode", pi(0.05, 2000.0, 780.0, 0.5), stage);
   margins_row("integral only, notch on the mode", pi(0.0, 600.0, 780.0, 0.5), stage);
+  const FeedbackGains two_mode =
+      load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/bridge.yaml"))
+          .servo_of(0);
+  margins_row("deploy/config/two-mode (notches from the model)", two_mode, stage);
+  FeedbackGains one_notch = two_mode;
+  one_notch.notch2_hz = 0.0;
+  margins_row("the same without the second notch", one_notch, stage);
   return 0;
 }
 

@@ -31,6 +31,8 @@
 #include <cstring>
 #include <string>
 
+#include "bridge/bridge_settings.hpp"
+#include "core/config.hpp"
 #include "sim/scan_experiment.hpp"
 #include "sim/tracking_experiment.hpp"
 
@@ -68,14 +70,15 @@ std::string cell(const hystloop::ScanRun& r) {
 }
 
 // The line-rate table of docs/TRACKING.md ("Scans at line rate").
-bool scan_table(int block_ticks, const hystloop::TrackingExperiment& experiment, bool servo) {
+bool scan_table(int block_ticks, const hystloop::TrackingExperiment& experiment, bool servo,
+                const hystloop::ScanOptions& servo_options = {}) {
   using namespace hystloop;
   std::printf(
       "| reference | corner | model | servo, no stage inverse | + stage inverse | + learning, periods "
       "[20, 30) | periods to <= 1 nm |\n| --- | --- | --- | --- | --- | --- | --- |\n");
   bool all_taken = true;
   for (const ScanReference& r : scan_references()) {
-    ScanOptions o;
+    ScanOptions o = servo_options;
     o.block_ticks = block_ticks;
     o.servo = servo;
     // Without the stage's inverse the hysteresis model is fitted u -> y, the stage's lag in it; with
@@ -106,9 +109,26 @@ bool scan_table(int block_ticks, const hystloop::TrackingExperiment& experiment,
   return all_taken;
 }
 
+// The servo of deploy/config/two-mode/bridge.yaml (the product's is tuned for Banning's stage, and
+// unstable on this one): its gains and notches into the scan's options.
+hystloop::ScanOptions two_mode_servo() {
+  using namespace hystloop;
+  const BridgeSettings settings =
+      load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/bridge.yaml"));
+  const FeedbackGains& g = settings.servo_of(0);
+  ScanOptions o;
+  o.kp = g.kp;
+  o.ki = g.ki;
+  o.notch_hz = g.notch_hz;
+  o.notch_q = g.notch_q;
+  o.notch2_hz = g.notch2_hz;
+  o.notch2_q = g.notch2_q;
+  return o;
+}
+
 // Learning beside a deliberately wrong model of the two-mode stage: every period's RMS with
 // learning against the same period's without, the worst ratio, and what learning clamped.
-bool wrong_model_table() {
+bool wrong_model_table(bool servo) {
   using namespace hystloop;
   const TrackingExperiment e = two_mode_experiment();
   const double delay_s = e.series_stage.delay_s;
@@ -133,8 +153,9 @@ bool wrong_model_table() {
     if (r.shape == TrajectoryShape::kSine && r.frequency_hz != 100.0) continue;  // the 10, 50 Hz triangles, 100 Hz sine
     if (r.shape == TrajectoryShape::kTriangle && r.frequency_hz > 50.0) continue;
     for (const Wrong& w : wrongs) {
-      ScanOptions o;
-      o.servo = false;
+      // The learner alone beside the wrong model, or (--servo) with deploy/config/two-mode's servo.
+      ScanOptions o = two_mode_servo();
+      o.servo = servo;
       o.stage_inverse = true;
       o.stage_model = w.stage;
       o.mode = FeedforwardMode::kPi;
@@ -161,13 +182,12 @@ int main(int argc, char** argv) {
   using namespace hystloop;
   if (argc > 1) {
     const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
-    if (std::strcmp(argv[1], "--scan") == 0 && argc == 4 && std::strcmp(argv[2], "--two-mode") == 0 &&
-        std::strcmp(argv[3], "--wrong-models") == 0) {
-      return wrong_model_table() ? 0 : 1;
+    if (std::strcmp(argv[1], "--scan") == 0 && (argc == 4 || argc == 5) && std::strcmp(argv[2], "--two-mode") == 0 &&
+        std::strcmp(argv[3], "--wrong-models") == 0 && (argc == 4 || std::strcmp(argv[4], "--servo") == 0)) {
+      return wrong_model_table(argc == 5) ? 0 : 1;
     }
     if (std::strcmp(argv[1], "--scan") == 0 && argc == 3 && std::strcmp(argv[2], "--two-mode") == 0) {
-      // The product's servo is tuned for Banning's stage (its notch at 1.72 kHz): off on this one.
-      return scan_table(ScanOptions{}.block_ticks, two_mode_experiment(), false) ? 0 : 1;
+      return scan_table(ScanOptions{}.block_ticks, two_mode_experiment(), true, two_mode_servo()) ? 0 : 1;
     }
     if (std::strcmp(argv[1], "--scan") == 0) {
       int block_ticks = ScanOptions{}.block_ticks;
@@ -184,12 +204,15 @@ int main(int argc, char** argv) {
       return scan_table(block_ticks, TrackingExperiment{}, true) ? 0 : 1;
     }
     std::printf(
-        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models]]] [--help]\nPrints the tracking "
+        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models [--servo]]]] [--help]\nPrints the "
+        "tracking "
         "tables of "
         "docs/BENCHMARKS.md and docs/TRACKING.md (--scan: the line-rate scan table only; --block-ticks: "
         "sensor blocks of N ticks, default 10; --two-mode: the scan table on a two-mode stage with 1.5 ticks "
-        "of delay, its linear stage inverted with preview, the servo off; --wrong-models: learning beside a "
-        "deliberately wrong model of that stage, every period against learning off; exit 1 when a period exceeds "
+        "of delay, its linear stage inverted with preview, the servo of deploy/config/two-mode; --wrong-models: "
+        "learning beside a "
+        "deliberately wrong model of that stage, every period against learning off, the servo off unless --servo; exit "
+        "1 when a period exceeds "
         "1.1 times it or learning clamps).\n");
     return help ? 0 : 2;
   }

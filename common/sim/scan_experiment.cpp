@@ -60,6 +60,8 @@ LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const Identif
     c.servo.ki = o.ki;
     c.servo.notch_hz = o.notch_hz;
     c.servo.notch_q = o.notch_q;
+    c.servo.notch2_hz = o.notch2_hz;
+    c.servo.notch2_q = o.notch2_q;
     c.servo.nominal_gain_m_per_V = models.linear.gain;
   }
   return c;

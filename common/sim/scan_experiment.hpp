@@ -40,6 +40,7 @@ struct ScanOptions {
   std::optional<LinearStageSpec> stage_model;  // a series plant: the stage model inverted (nullopt: the plant's own)
   bool servo = true;                           // the bridge's servo as deploy/config/bridge.yaml sets it:
   double kp = 0.05, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
+  double notch2_hz = 0.0, notch2_q = 2.0;                           // a second notch [Hz, -]; 0 = none
   bool learning = false;
   // A line outside the actuator's limits (the servo's reserve included) is scaled to fit, as
   // deploy/hystloop scan asks (scan.yaml if_infeasible: shape); false: refused.

@@ -133,7 +133,7 @@ TEST(ServoLoopResponse, MarginsOfAStableLoopAreConsistent) {
 
 // Any stage: Banning's written as a linear stage gives Banning's loop, and a lightly damped mode
 // the servo's notch is not at makes the product's defaults unstable (why deploy/config/two-mode
-// runs the servo off) where a notch on that mode makes them stable again.
+// has a servo of its own) where a notch on that mode makes them stable again.
 TEST(ServoLoopResponse, AnyLinearStageGivesItsLoop) {
   FeedbackGains g;
   g.kp = 0.05;

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "bridge/bridge_settings.hpp"
 #include "loop/servo_loop_response.hpp"
+#include "loop/servo_notches.hpp"
 
 namespace hystloop {
 namespace {
@@ -64,6 +66,33 @@ TEST(BridgeServoMargins, TheDefaultKiNeedsTheNotch) {
   EXPECT_FALSE(ServoLoopResponse(plain, model_of(s)).stable());
   EXPECT_LT(largest_stable_ki(plain, model_of(s)), s.servo.ki);
   EXPECT_GT(largest_stable_ki(s.servo, model_of(s, 1.0, 1.0, 1)), 2.5 * s.servo.ki);
+}
+
+// deploy/config/two-mode's servo on the stage that config simulates (its own plant.stage): the
+// margins a lab wants, in the simulator's loop and on a card that reads a tick later, and both
+// notches where the identified model puts them (loop/servo_notches.hpp).
+TEST(BridgeServoMargins, TheTwoModeStagesServoHoldsSixDecibelsAndFortyDegrees) {
+  const BridgeSettings s =
+      load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/bridge.yaml"));
+  ASSERT_EQ(s.backend, "series");
+  const FeedbackGains& g = s.servo_of(0);
+  ASSERT_TRUE(g.has_notch() && g.has_notch2());
+  const std::vector<ModeNotch> want = notches_for_stage(s.stage.linear, 1.0 / s.dt_s());
+  ASSERT_EQ(want.size(), 2U);
+  EXPECT_NEAR(g.notch_hz, want[0].notch.hz, 1e-6);
+  EXPECT_NEAR(g.notch_q, want[0].notch.q, 0.01);
+  EXPECT_NEAR(g.notch2_hz, want[1].notch.hz, 1e-6);
+  EXPECT_NEAR(g.notch2_q, want[1].notch.q, 0.05);
+  for (const int delay : {0, 1}) {
+    ServoLoopModel m;
+    m.linear = s.stage.linear;
+    m.dt_s = s.dt_s();
+    m.extra_delay_ticks = delay;
+    const LoopMargins margins = ServoLoopResponse(g, m).margins();
+    ASSERT_TRUE(margins.stable) << delay;
+    EXPECT_GE(margins.gain_margin_dB, 6.0) << delay;     // 14.5 / 11.8 dB
+    EXPECT_GE(margins.phase_margin_deg, 40.0) << delay;  // 58 / 54 deg
+  }
 }
 
 }  // namespace
