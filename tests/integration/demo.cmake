@@ -17,3 +17,8 @@ endif()
 if(TARGET hystloop-bridge AND TARGET hystloop-identify AND TARGET hystloop-ctl)
   hystloop_deploy_test(loop_banning_series banning_check.sh banning)
 endif()
+
+# A stage's dynamics measured on the live loop (the two-mode example), and the fit of its log.
+if(TARGET hystloop-bridge AND TARGET hystloop-identify AND TARGET hystloop-ctl)
+  hystloop_deploy_test(loop_stage_identification stage_check.sh stage)
+endif()

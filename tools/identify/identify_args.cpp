@@ -142,6 +142,13 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "sampled as u_k was applied (a conventional DAQ)")
       ->check(CLI::IsMember({"end", "start"}))
       ->capture_default_str();
+  stage->add_option("--true-stage", args.true_stage,
+                    "a simulated record: the YAML whose plant.stage (the bridge's series plant) or stage section is "
+                    "the stage it came from; prints the model's error against it in dB and degrees up to "
+                    "--compare-to, and at how many lines it lies inside the measured +-2 sigma band");
+  stage->add_option("--compare-to", args.compare_to_Hz, "with --true-stage: the highest frequency compared [Hz]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   auto* pub = app.add_option_group("publishing", "sending the fitted set to a running compensator");
   pub->add_flag("--publish", args.publish,
                 "after a successful fit, publish the set (3 times, 10 ms apart): any model as model_params_t on "

@@ -73,6 +73,8 @@ struct IdentifyArgs {
   double max_delay_s = 1e-3;
   bool continuous = false;        // the data were not held and sampled at the sample rate (no ZOH in the model)
   std::string sample_at = "end";  // y_k measured at the end of tick k (the rig's, linear_stage.hpp) or its start
+  std::string true_stage;         // a YAML whose plant.stage (or stage) is the stage the record came from
+  double compare_to_Hz = 3000.0;  // the model held against it up to this frequency
   // bounds
   std::size_t max_samples = kDefaultMaxSamples;
   std::size_t decimate = 1;
