@@ -117,6 +117,9 @@ hystloop::ScanOptions two_mode_servo() {
       load_bridge_settings(Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/bridge.yaml"));
   const FeedbackGains& g = settings.servo_of(0);
   ScanOptions o;
+  // How far up the stage model is known (its identification's), as the two-mode compensator has it.
+  o.stage_known_to_hz = Config::load_file(std::string(HYSTLOOP_SOURCE_DIR) + "/deploy/config/two-mode/compensator.yaml")
+                            .get<double>("stage.known_to_hz", 0.0);
   o.kp = g.kp;
   o.ki = g.ki;
   o.notch_hz = g.notch_hz;
@@ -128,7 +131,7 @@ hystloop::ScanOptions two_mode_servo() {
 
 // Learning beside a deliberately wrong model of the two-mode stage: every period's RMS with
 // learning against the same period's without, the worst ratio, and what learning clamped.
-bool wrong_model_table(bool servo) {
+bool wrong_model_table(bool servo, bool known_band) {
   using namespace hystloop;
   const TrackingExperiment e = two_mode_experiment();
   const double delay_s = e.series_stage.delay_s;
@@ -153,9 +156,12 @@ bool wrong_model_table(bool servo) {
     if (r.shape == TrajectoryShape::kSine && r.frequency_hz != 100.0) continue;  // the 10, 50 Hz triangles, 100 Hz sine
     if (r.shape == TrajectoryShape::kTriangle && r.frequency_hz > 50.0) continue;
     for (const Wrong& w : wrongs) {
-      // The learner alone beside the wrong model, or (--servo) with deploy/config/two-mode's servo.
+      // The learner alone beside the wrong model, or (--servo) with deploy/config/two-mode's servo; a
+      // wrong model claims no band it is known in (the learning stays below its lowest mode) unless
+      // --known-band: then it keeps the band measured for the true stage, a claim now false.
       ScanOptions o = two_mode_servo();
       o.servo = servo;
+      if (!known_band) o.stage_known_to_hz = 0.0;
       o.stage_inverse = true;
       o.stage_model = w.stage;
       o.mode = FeedforwardMode::kPi;
@@ -182,9 +188,20 @@ int main(int argc, char** argv) {
   using namespace hystloop;
   if (argc > 1) {
     const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
-    if (std::strcmp(argv[1], "--scan") == 0 && (argc == 4 || argc == 5) && std::strcmp(argv[2], "--two-mode") == 0 &&
-        std::strcmp(argv[3], "--wrong-models") == 0 && (argc == 4 || std::strcmp(argv[4], "--servo") == 0)) {
-      return wrong_model_table(argc == 5) ? 0 : 1;
+    if (std::strcmp(argv[1], "--scan") == 0 && argc >= 4 && std::strcmp(argv[2], "--two-mode") == 0 &&
+        std::strcmp(argv[3], "--wrong-models") == 0) {
+      bool servo = false, known_band = false;
+      for (int i = 4; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--servo") == 0) {
+          servo = true;
+        } else if (std::strcmp(argv[i], "--known-band") == 0) {
+          known_band = true;
+        } else {
+          std::fprintf(stderr, "tracking_table: --wrong-models takes --servo and --known-band (got %s)\n", argv[i]);
+          return 2;
+        }
+      }
+      return wrong_model_table(servo, known_band) ? 0 : 1;
     }
     if (std::strcmp(argv[1], "--scan") == 0 && argc == 3 && std::strcmp(argv[2], "--two-mode") == 0) {
       return scan_table(ScanOptions{}.block_ticks, two_mode_experiment(), true, two_mode_servo()) ? 0 : 1;
@@ -204,7 +221,8 @@ int main(int argc, char** argv) {
       return scan_table(block_ticks, TrackingExperiment{}, true) ? 0 : 1;
     }
     std::printf(
-        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models [--servo]]]] [--help]\nPrints the "
+        "usage: tracking_table [--scan [--block-ticks N | --two-mode [--wrong-models [--servo] [--known-band]]]] "
+        "[--help]\nPrints the "
         "tracking "
         "tables of "
         "docs/BENCHMARKS.md and docs/TRACKING.md (--scan: the line-rate scan table only; --block-ticks: "

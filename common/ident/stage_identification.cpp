@@ -58,4 +58,20 @@ StageIdentification identify_stage_dynamics(std::span<const double> u, std::span
   return r;
 }
 
+double model_known_to_hz(const StageIdentification& id, double from_hz, double within) {
+  if (!id.ok()) return 0.0;
+  const FrequencyResponse& frf = id.frf;
+  const std::vector<double>& sigma = id.sigma();
+  double known = 0.0;
+  for (std::size_t i = 0; i < frf.frequency_Hz.size(); ++i) {
+    const double f = frf.frequency_Hz[i];
+    if (f < from_hz) continue;
+    const std::complex<double> m = id.fit.sampled_response(f);
+    const double bound = (std::abs(frf.G[i] - m) + 2.0 * sigma[i]) / std::abs(m);
+    if (!(bound <= within)) break;
+    known = f;
+  }
+  return known;
+}
+
 }  // namespace hystloop

@@ -45,4 +45,17 @@ StageIdentification identify_stage_dynamics(std::span<const double> u, std::span
                                             std::span<const std::size_t> lines, const FrfOptions& frf_options,
                                             StageFitOptions fit_options, bool sampled_at_tick_end);
 
+// How far up the fitted model is known: from the first line at or above from_hz, the lines'
+// relative bound
+//   (|G - M| + 2 sigma) / |M|,   G the measured response, M the model as the data were fitted,
+// stays within `within` up to the returned frequency [Hz] (the last line before the first that
+// exceeds it; the highest line when none does; 0 when the first does). A model known within 0.3
+// makes the plant a learning update sees 1 +- 0.3 there, well inside its bound
+// (loop/periodic_learner.hpp). Near an anti-resonance the measured gain falls into the noise and
+// the bound grows: the band ends there. from_hz: where the question starts (hystloop-identify:
+// where learning is allowed anyway, 0.7 of the lowest lightly damped mode; the lowest lines of a
+// hysteretic stage are its loop's, not the linear model's).
+inline constexpr double kStageKnownWithin = 0.3;
+double model_known_to_hz(const StageIdentification& id, double from_hz, double within = kStageKnownWithin);
+
 }  // namespace hystloop

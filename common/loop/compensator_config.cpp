@@ -18,8 +18,11 @@ double lowest_linear_feature_hz(const StageModel& stage, double dt_s) {
 LearningConfig learning_for_stage(const LearningConfig& learning, const StageModel& stage, double dt_s) {
   LearningConfig l = learning;
   const double feature_hz = lowest_linear_feature_hz(stage, dt_s);
-  if (feature_hz > 0.0)
-    l.cutoff_hz = std::max(std::min(l.cutoff_hz, kLearningShareOfResonance * feature_hz), 1.0 / l.max_period_s);
+  if (feature_hz > 0.0) {
+    const double known_hz =
+        std::max(kLearningShareOfResonance * feature_hz, kLearningShareOfKnownBand * stage.known_to_hz);
+    l.cutoff_hz = std::max(std::min(l.cutoff_hz, known_hz), 1.0 / l.max_period_s);
+  }
   return l;
 }
 

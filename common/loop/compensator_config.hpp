@@ -40,6 +40,10 @@ inline LearningConfig default_learning() {
 // The configured cutoff stays when it is lower; Banning's second order keeps it (the 2 kHz filter
 // converges on it: bench/tracking_table --scan).
 inline constexpr double kLearningShareOfResonance = 0.7;
+// A stage whose identification measured the model within kStageKnownWithin up to known_to_hz
+// (StageModel::known_to_hz) is learned up to this share of that band where it reaches further:
+// there the model, not its lowest mode, is what bounds |1 - T|.
+inline constexpr double kLearningShareOfKnownBand = 0.7;
 LearningConfig learning_for_stage(const LearningConfig& learning, const StageModel& stage, double dt_s);
 // The lowest lightly damped (zeta < 0.5) pole or zero of a linear stage [Hz] (0: none, or not a
 // linear stage).

@@ -65,6 +65,10 @@ struct StageModel {
   // truncation bound), and its optional zero-phase low-pass (0: off; PreviewStageInverse).
   std::int64_t preview_ticks = 0;
   double reference_bandwidth_hz = 0.0;
+  // kLinear: the frequency [Hz] up to which the stage's identification measured this model within
+  // kStageKnownWithin of the record (0: not said; hystloop-identify --model stage writes it). What
+  // learning may go up to beside the stage (loop/compensator_config.hpp, learning_for_stage).
+  double known_to_hz = 0.0;
 
   bool has_dynamics() const noexcept { return kind != Kind::kNone; }
   bool is_second_order() const noexcept { return kind == Kind::kSecondOrder; }

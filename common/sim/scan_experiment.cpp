@@ -35,6 +35,7 @@ StageModel scan_stage(const TrackingExperiment& e, const ScanOptions& o) {
   } else if (o.stage_inverse && e.plant == PlantKind::kSeries) {
     stage.kind = StageModel::Kind::kLinear;  // the plant's own stage, delay included
     stage.linear = o.stage_model ? *o.stage_model : e.series_stage;
+    stage.known_to_hz = o.stage_known_to_hz;
   }
   return stage;
 }
@@ -51,6 +52,7 @@ LoopSimulationConfig scan_loop_config(const TrackingExperiment& e, const Identif
     c.compensator.stage.second_order = stage.second_order;
     c.compensator.stage.order = stage.order;
     c.compensator.stage.linear = stage.linear;
+    c.compensator.stage.known_to_hz = stage.known_to_hz;
   }
   c.compensator.learning.enabled = o.learning;
   c.compensator.servo_slew_reserve = o.servo_slew_reserve;

@@ -38,7 +38,8 @@ struct ScanOptions {
   std::optional<FeedforwardMode> mode;  // nullopt: the identification's best (hystloop-identify --model auto)
   bool stage_inverse = true;  // Banning's k, c (a series plant: its linear stage) inverted beside the hysteresis
   std::optional<LinearStageSpec> stage_model;  // a series plant: the stage model inverted (nullopt: the plant's own)
-  bool servo = true;                           // the bridge's servo as deploy/config/bridge.yaml sets it:
+  double stage_known_to_hz = 0.0;  // ... and how far up its identification measured it (StageModel::known_to_hz)
+  bool servo = true;               // the bridge's servo as deploy/config/bridge.yaml sets it:
   double kp = 0.05, ki = 2000.0, notch_hz = 1720.0, notch_q = 0.7;  // PI [-, 1/s], notch [Hz, -]
   double notch2_hz = 0.0, notch2_q = 2.0;                           // a second notch [Hz, -]; 0 = none
   bool learning = false;

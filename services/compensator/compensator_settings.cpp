@@ -414,13 +414,18 @@ std::vector<std::string> describe(const CompensatorSettings& s) {
     lines.push_back("stage: none (the hysteresis inverse alone)");
   }
   const LearningConfig learning = learning_for_stage(c.learning, c.stage, c.dt_s);
+  const double feature_hz = lowest_linear_feature_hz(c.stage, c.dt_s);
+  const bool by_band = c.stage.known_to_hz * kLearningShareOfKnownBand > kLearningShareOfResonance * feature_hz;
   const std::string filter =
-      learning.cutoff_hz < c.learning.cutoff_hz
-          ? fmt::format(
-                "{:.4g} Hz, {} of the stage's lowest mode or anti-resonance {:.4g} Hz (learning.cutoff_hz {} Hz)",
-                learning.cutoff_hz, kLearningShareOfResonance, lowest_linear_feature_hz(c.stage, c.dt_s),
-                c.learning.cutoff_hz)
-          : fmt::format("{} Hz", learning.cutoff_hz);
+      learning.cutoff_hz >= c.learning.cutoff_hz ? fmt::format("{} Hz", learning.cutoff_hz)
+      : by_band                                  ? fmt::format(
+                                                       "{:.4g} Hz, {} of the band the stage's model is known to, stage.known_to_hz {:.4g} Hz "
+                                                                                        "(learning.cutoff_hz {} Hz)",
+                                                       learning.cutoff_hz, kLearningShareOfKnownBand, c.stage.known_to_hz, c.learning.cutoff_hz)
+                : fmt::format(
+                      "{:.4g} Hz, {} of the stage's lowest mode or anti-resonance {:.4g} Hz (learning.cutoff_hz "
+                      "{} Hz)",
+                      learning.cutoff_hz, kLearningShareOfResonance, feature_hz, c.learning.cutoff_hz);
   lines.push_back(fmt::format("learning: {} (gain {}, filter {}, |correction| <= {:.3g} m, periods up to {} s{})",
                               c.learning.enabled ? "on for periodic references" : "off", c.learning.gain, filter,
                               c.learning.max_correction_m, c.learning.max_period_s,

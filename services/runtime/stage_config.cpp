@@ -117,7 +117,8 @@ std::string describe_stage(const StageModel& stage, double dt_s) {
 
 std::vector<std::string> stage_config_keys() {
   std::vector<std::string> keys = {
-      "stage.kind", "stage.k", "stage.c", "stage.order", "stage.preview_ticks", "stage.reference_bandwidth_hz"};
+      "stage.kind",       "stage.k", "stage.c", "stage.order", "stage.preview_ticks", "stage.reference_bandwidth_hz",
+      "stage.known_to_hz"};
   for (std::string& k : linear_stage_keys("stage")) keys.push_back(std::move(k));
   return keys;
 }
@@ -152,7 +153,10 @@ StageModel read_stage_model(const Config& config, const StageModel& defaults, do
     }
     stage.preview_ticks = config.get<std::int64_t>("stage.preview_ticks", 0);
     stage.reference_bandwidth_hz = config.get_non_negative("stage.reference_bandwidth_hz", 0.0);
+    stage.known_to_hz = config.get_in_range("stage.known_to_hz", 0.0, 0.0, 0.5 / dt_s);
   } else {
+    if (config.has("stage.known_to_hz"))
+      config.fail("stage.known_to_hz", "is a linear stage's: set stage.kind to linear");
     for (const std::string& key : linear_stage_keys("stage")) {
       if (config.has(key)) config.fail(key, "is a linear stage's: set stage.kind to linear to use it");
     }

@@ -79,8 +79,18 @@ TEST(StageIdentification, TheEndOfTickSampleIsTheRigsOwnDelay) {
   ASSERT_TRUE(as_start.ok()) << as_start.reason();
   EXPECT_NEAR(as_start.fit.delay_s, 50e-6, 1e-6);
 
+  // How far up the model is known: the record's noise (0.01 of the output) makes the relative bound
+  // grow where the gain falls, at the anti-resonance between the modes (~1.85 kHz): the band ends
+  // before it and above the lowest mode; asked from above the top line, nothing is known.
+  const double known = model_known_to_hz(at_end, 0.7 * 780.0);
+  EXPECT_GT(known, 780.0);
+  EXPECT_LT(known, 1850.0);
+  EXPECT_EQ(model_known_to_hz(at_end, 0.0, 1e9), at_end.frf.frequency_Hz.back());  // no bound: every line
+  EXPECT_EQ(model_known_to_hz(at_end, 5000.0), 0.0);
+
   const StageIdentification none = identify_stage_dynamics(m.u_V, std::vector<double>(10), m.lines, fo, o, true);
   EXPECT_FALSE(none.ok());
+  EXPECT_EQ(model_known_to_hz(none, 0.0), 0.0);
   EXPECT_EQ(none.reason().rfind("no frequency response: ", 0), 0u) << none.reason();
 }
 

@@ -1114,6 +1114,15 @@ TEST(CompensatorSettings, ALinearStageIsReadInEveryFormAndRefusedByItsKey) {
   EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear, preview_ticks: 1, delay_s: 1.5e-4, modes: "
                                         "[{frequency_hz: 780, damping_ratio: 0.03}]}"),
                        "stage.preview_ticks"));
+  // How far up its identification measured it: read for a linear stage, within Nyquist, and only there.
+  const auto known = load_compensator_settings(
+      Config::from_string("stage: {kind: linear, known_to_hz: 1220, modes: [{frequency_hz: 780, damping_ratio: 0.03}]}",
+                          "compensator.yaml"));
+  EXPECT_EQ(known.control.stage.known_to_hz, 1220.0);
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: linear, known_to_hz: 6000, modes: "
+                                        "[{frequency_hz: 780, damping_ratio: 0.03}]}"),
+                       "stage.known_to_hz"));
+  EXPECT_TRUE(contains(settings_refusal("stage: {kind: second_order, known_to_hz: 1000}"), "stage.known_to_hz"));
 }
 
 }  // namespace

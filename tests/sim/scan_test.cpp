@@ -166,6 +166,15 @@ TEST(Scan, TheLearningFilterStaysBelowALinearStagesLowestModeOrAntiResonance) {
   LearningConfig low = default_learning();
   low.cutoff_hz = 100.0;
   EXPECT_EQ(learning_for_stage(low, stage, dt_s).cutoff_hz, 100.0);
+  // A band the stage's identification measured the model in takes learning further (0.7 of it),
+  // never past the configured cutoff, and never below the lowest mode's share.
+  stage.linear = two_mode_experiment().series_stage;
+  stage.known_to_hz = 1220.0;
+  EXPECT_NEAR(learning_for_stage(default_learning(), stage, dt_s).cutoff_hz, 0.7 * 1220.0, 1e-9);
+  stage.known_to_hz = 5000.0;
+  EXPECT_EQ(learning_for_stage(default_learning(), stage, dt_s).cutoff_hz, 2000.0);
+  stage.known_to_hz = 300.0;
+  EXPECT_NEAR(learning_for_stage(default_learning(), stage, dt_s).cutoff_hz, 0.7 * 780.0, 0.5);
 }
 
 TEST(Scan, AnInfeasibleLineIsRefusedNamingTheSlewLimit) {

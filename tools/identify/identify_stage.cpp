@@ -18,6 +18,7 @@
 #include "ident/stage_identification.hpp"
 #include "identify_output.hpp"
 #include "log_samples.hpp"
+#include "loop/compensator_config.hpp"
 #include "loop/servo_notches.hpp"
 #include "runtime/stage_config.hpp"
 #include "models/csv_columns.hpp"
@@ -199,7 +200,7 @@ std::vector<ModeNotch> fitted_notches(const StageRecord& r, const StageFitResult
 }
 
 std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
-                       const std::string& heading) {
+                       const std::string& heading, double known_to_hz) {
   std::ostringstream y;
   y << "# hystloop-identify --model stage: " << heading << "\n"
     << "# " << r.source << "\n"
@@ -225,7 +226,10 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     << "  kind: linear\n"
     << "  zeros_hz: " << roots_yaml(roots_hz_once(fit.zeros_rad_s)) << "\n"
     << "  poles_hz: " << roots_yaml(roots_hz_once(fit.poles_rad_s)) << "\n"
-    << "  delay_s: " << num(fit.delay_s, 8) << "\n";
+    << "  delay_s: " << num(fit.delay_s, 8) << "\n"
+    << "  known_to_hz: " << num(known_to_hz, 6) << "   # the model within " << num(100.0 * kStageKnownWithin, 3)
+    << " % of the record (+2 sigma) up to here: learning may go to " << num(100.0 * kLearningShareOfKnownBand, 3)
+    << " % of it\n";
   const std::vector<ModeNotch> notches = fitted_notches(r, fit);
   y << "# servo notches for this stage (the bridge's servo: section; check the gains' margins with\n"
     << "# hystloop-ctl gains --stage-config on this file):";
@@ -446,13 +450,25 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   const FrequencyResponse& frf = id.frf;
   const StageFitResult& fit = id.fit;
   print_fit(frf, fit);
+  // From where learning goes anyway beside the fitted stage (its lowest lightly damped pole or zero).
+  double lowest_hz = 0.0;
+  for (const auto* roots : {&fit.poles_rad_s, &fit.zeros_rad_s}) {
+    for (const C p : *roots) {
+      const double w = std::abs(p);
+      if (p.imag() > 0.0 && -p.real() / w < 0.5 && (lowest_hz == 0.0 || w / (2.0 * std::numbers::pi) < lowest_hz))
+        lowest_hz = w / (2.0 * std::numbers::pi);
+    }
+  }
+  const double known_to_hz = model_known_to_hz(id, kLearningShareOfResonance * lowest_hz);
+  std::printf("model known (within %g %% of the record, +2 sigma) up to %.6g Hz\n", 100.0 * kStageKnownWithin,
+              known_to_hz);
   print_notches(r, fit);
   if (!args.true_stage.empty()) {
     if (const int rc = compare_with_true_stage(r, frf, fit, args); rc != 0) return rc;
   }
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
-  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading)); rc != 0) return rc;
+  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading, known_to_hz)); rc != 0) return rc;
   if (target.plots_dir) {
     const report::PlotResult plots = write_stage_plots(frf, fit, heading, *target.plots_dir, args.gnuplot);
     for (const auto& f : plots.images) std::printf("plot: %s\n", f.string().c_str());

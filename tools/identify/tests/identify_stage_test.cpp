@@ -102,6 +102,11 @@ TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
   EXPECT_EQ(doc["stage"]["kind"].as<std::string>(), "linear");  // the compensator's stage section as it is
   EXPECT_EQ(doc["stage"]["zeros_hz"].size(), 1u);               // the pair two modes in parallel have
   EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
+  // How far up the model is known: above the lowest mode, below the anti-resonance (learning_for_stage
+  // then learns to 0.7 of it).
+  const double known_to_hz = doc["stage"]["known_to_hz"].as<double>();
+  EXPECT_GT(known_to_hz, 780.0) << r.output;
+  EXPECT_LE(known_to_hz, 3000.0) << r.output;
   // The gain is reported beside the stage, not in it.
   const std::string gain_label = "measured DC gain u -> y: ";
   const std::size_t at = r.output.find(gain_label);
@@ -196,6 +201,11 @@ TEST_F(IdentifyStage, AUyCsvNeedsItsSampleRateAndAGivenOrderIsKept) {
   const YAML::Node doc = YAML::LoadFile(path("stage.yaml"));
   EXPECT_EQ(doc["stage"]["poles_hz"].size(), 2u);
   EXPECT_NEAR(doc["stage"]["delay_s"].as<double>(), kDelay_s, 0.5e-6);
+  // How far up the model is known: above the lowest mode, below the anti-resonance (learning_for_stage
+  // then learns to 0.7 of it).
+  const double known_to_hz = doc["stage"]["known_to_hz"].as<double>();
+  EXPECT_GT(known_to_hz, 780.0) << r.output;
+  EXPECT_LE(known_to_hz, 3000.0) << r.output;
   const testing::ToolRun bad =
       testing::run_tool(kTool + " " + path("uy.csv") + layout + " --sample-rate 1e4 --order 4/2");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
