@@ -51,6 +51,8 @@ std::string notch_text(const FeedbackGains& g) {
   if (!g.has_notch() && !g.has_notch2()) return "none";
   if (!g.has_notch2()) {
     std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g", g.notch_hz, g.notch_q);
+  } else if (!g.has_notch()) {
+    std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g", g.notch2_hz, g.notch2_q);
   } else {
     std::snprintf(buf, sizeof buf, "%.0f Hz, Q %.2g; %.0f Hz, Q %.2g", g.notch_hz, g.notch_q, g.notch2_hz, g.notch2_q);
   }

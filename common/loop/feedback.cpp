@@ -14,13 +14,10 @@ NotchFilter make_notch(const FeedbackGains& g, std::size_t i) {
   return n.on() ? NotchFilter(design_notch(n.hz, n.q, g.tick_rate_hz)) : NotchFilter();
 }
 
-bool same_notches(const FeedbackGains& a, const FeedbackGains& b) {
-  for (std::size_t i = 0; i < kServoNotches; ++i) {
-    const ServoNotch na = a.notch(i), nb = b.notch(i);
-    if (!na.on() && !nb.on()) continue;
-    if (na.hz != nb.hz || na.q != nb.q || a.tick_rate_hz != b.tick_rate_hz) return false;
-  }
-  return true;
+bool same_notch(const FeedbackGains& a, const FeedbackGains& b, std::size_t i) {
+  const ServoNotch na = a.notch(i), nb = b.notch(i);
+  if (!na.on() && !nb.on()) return true;
+  return na.hz == nb.hz && na.q == nb.q && a.tick_rate_hz == b.tick_rate_hz;
 }
 
 void validate_notch(const char* hz_field, const char* q_field, const ServoNotch& n, double tick_rate_hz) {
@@ -101,15 +98,13 @@ void FeedbackController::set_gains(const FeedbackGains& gains) {
   } else if (gains.ki == 0.0) {
     integral_ = 0.0;
   }
-  if (!same_notches(gains, gains_)) {
-    // A new filter with the old one's state would ring; one settled at the last output goes on
-    // from it: its next output is output + b0 (x - output), x the PID part (near the output on a
-    // servo in operation, whose correction is slow against the resonance). Each filter's gain at
-    // DC is 1, so every one of the cascade settles at the same output.
-    for (std::size_t i = 0; i < kServoNotches; ++i) {
-      notches_[i] = make_notch(gains, i);
-      notches_[i].settle_at(output_V_);
-    }
+  for (std::size_t i = 0; i < kServoNotches; ++i) {
+    if (same_notch(gains, gains_, i)) continue;  // an unchanged filter keeps its state
+    // A new filter with the old one's state would ring; one settled at its last output goes on
+    // from it: its next output is that output + b0 (x - it), x its input (near it on a servo in
+    // operation, whose correction is slow against the resonance; the gain at DC is 1).
+    notches_[i] = make_notch(gains, i);
+    notches_[i].settle_at(notch_out_V_[i]);
   }
   gains_ = gains;
 }
@@ -120,6 +115,7 @@ void FeedbackController::reset() noexcept {
   d_state_ = 0.0;
   output_V_ = 0.0;
   for (NotchFilter& n : notches_) n.reset();
+  notch_out_V_.fill(0.0);
   has_prev_ = false;
 }
 
@@ -172,7 +168,7 @@ double FeedbackController::update(double error_m, double u_ff_V, double dt_s, do
   }
   const double pid = u_pd + gains_.ki * integral_ * inv_gain;
   double out = pid;
-  for (NotchFilter& n : notches_) out = n.step(out);
+  for (std::size_t i = 0; i < kServoNotches; ++i) out = notch_out_V_[i] = notches_[i].step(out);
   output_V_ = out;
   return output_V_;
 }

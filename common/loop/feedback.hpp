@@ -118,7 +118,8 @@ class FeedbackController {
 
   // New gains (check_bounds: a run-time change is refused outside the plausibility bounds, the
   // gains in force stay); the integral is rescaled so that its part of the output does not jump,
-  // and a changed notch starts settled at the last output (bumpless).
+  // a changed notch starts settled at its own last output and an unchanged one keeps its state
+  // (bumpless).
   void set_gains(const FeedbackGains& gains);
   const FeedbackGains& gains() const noexcept { return gains_; }
   void reset() noexcept;
@@ -126,8 +127,9 @@ class FeedbackController {
 
  private:
   FeedbackGains gains_;
-  std::array<NotchFilter, kServoNotches> notches_;  // in cascade; a filter for a notch off is the identity
-  double integral_ = 0.0;                           // [m s]
+  std::array<NotchFilter, kServoNotches> notches_;   // in cascade; a filter for a notch off is the identity
+  std::array<double, kServoNotches> notch_out_V_{};  // each filter's last output (a changed one settles there)
+  double integral_ = 0.0;                            // [m s]
   double prev_error_ = 0.0;
   double d_state_ = 0.0;   // filtered derivative [m/s]
   double output_V_ = 0.0;  // the last correction returned

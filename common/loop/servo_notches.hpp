@@ -9,8 +9,8 @@
 //  - below kNotchMaxFractionOfRate (0.45) of the tick rate (a notch there is still a notch);
 //  - peak = |G(j w)| / |G(0)| > 1: the resonance lifts the loop's gain (a mode whose residue is
 //    small against the others' roll-off is not worth the notch's phase);
-//  - the notch at w / 2 pi with the widest Q that still takes the peak down to unity 10 % off the
-//    centre, where the mode of a stage under another load, or of a model 10 % off, sits:
+//  - the notch at w / 2 pi, the narrowest (the highest Q) that still takes the peak down to unity
+//    10 % off the centre, where the mode of a stage under another load, or of a model 10 % off, sits:
 //      |N(1.1 w)| peak = 1,  N the notch,  so  Q = 1.1 / sqrt(0.21^2 (peak^2 - 1)),
 //    clamped to [kNotchMinQ, kNotchMaxSuggestedQ]. A wide notch costs phase below its centre; the
 //    margins (servo_loop_response.hpp) say whether the servo's gains still hold with it.

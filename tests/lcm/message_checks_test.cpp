@@ -307,6 +307,15 @@ TEST(MessageChecks, Control) {
   m.notch_hz = -1.0;
   EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
   m = fixtures::control(1);
+  m.notch2_hz = kNaN;  // the second notch alike
+  m.notch2_q = kNaN;
+  EXPECT_EQ(check_message(m), Verdict::kOk);
+  m.notch2_q = -2.0;
+  EXPECT_EQ(check_message(m), Verdict::kOutOfRange);
+  m.notch2_q = 2.0;
+  m.notch2_hz = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(check_message(m), Verdict::kNonFinite);
+  m = fixtures::control(1);
   m.command = control_t::RELEASE_PARAMS;  // the last command there is
   EXPECT_EQ(check_message(m), Verdict::kOk);
   m.command = control_t::RELEASE_PARAMS + 1;

@@ -221,6 +221,30 @@ TEST(Notch, ANotchChangeIsBumpless) {
   }
 }
 
+// Switching the second notch in on a running servo leaves the first's state as it was (a ringing
+// filter reset would jump); the new one starts settled at the first's last output.
+TEST(Notch, ChangingOneNotchKeepsTheOthersState) {
+  FeedbackGains g = servo_gains(0.5, 0.0);
+  g.notch_hz = 780.0;
+  g.notch_q = 0.5;
+  FeedbackController c(g);
+  NotchFilter first(design_notch(780.0, 0.5, 1e4));
+  double first_out = 0.0;
+  const auto error = [](int i) { return 1e-9 * std::sin(0.37 * i) + 2e-10 * std::sin(1.9 * i); };
+  for (int i = 0; i < 300; ++i) {
+    first_out = first.step(0.5 * error(i) / 1e-8);
+    ASSERT_NEAR(c.update(error(i), 0.0, 1e-4), first_out, 1e-15) << i;
+  }
+  g.notch2_hz = 2400.0;
+  g.notch2_q = 3.0;
+  c.set_gains(g);
+  NotchFilter second(design_notch(2400.0, 3.0, 1e4));
+  second.settle_at(first_out);
+  for (int i = 300; i < 600; ++i) {
+    ASSERT_NEAR(c.update(error(i), 0.0, 1e-4), second.step(first.step(0.5 * error(i) / 1e-8)), 1e-15) << i;
+  }
+}
+
 TEST(Notch, RefusesANotchOutsideItsRangeNamingTheField) {
   FeedbackGains g;  // 10 kHz: the notch must be below 4.5 kHz
   g.notch_hz = 4500.0;

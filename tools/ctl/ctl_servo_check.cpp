@@ -26,10 +26,11 @@ FeedbackGains servo_gains(const ServoGainsFigures& gains) {
   g.kp = gains.kp;
   g.ki = gains.ki_per_s;
   g.kd = gains.kd_s;
+  // A Q of 0 is a bridge that reports none for a notch that is off (older builds): the default.
   g.notch_hz = gains.notch_hz;
-  if (gains.notch_hz > 0.0) g.notch_q = gains.notch_q;
+  if (gains.notch_q > 0.0) g.notch_q = gains.notch_q;
   g.notch2_hz = gains.notch2_hz;
-  if (gains.notch2_hz > 0.0) g.notch2_q = gains.notch2_q;
+  if (gains.notch2_q > 0.0) g.notch2_q = gains.notch2_q;
   return g;
 }
 

@@ -142,12 +142,18 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
                    "sampled as u_k was applied (a conventional DAQ)")
       ->check(CLI::IsMember({"end", "start"}))
       ->capture_default_str();
-  stage->add_option("--true-stage", args.true_stage,
-                    "a simulated record: the YAML whose plant.stage (the bridge's series plant) or stage section is "
-                    "the stage it came from; prints the model's error against it in dB and degrees up to "
-                    "--compare-to, and at how many lines it lies inside the measured +-2 sigma band");
+  auto* true_stage =
+      stage
+          ->add_option(
+              "--true-stage", args.true_stage,
+              "a simulated record: the YAML whose plant.stage (the bridge's series plant) or stage section is "
+              "the stage it came from; prints the model's error against it in dB and degrees up to "
+              "--compare-to, and at how many lines it lies inside the measured +-2 sigma band (after the model "
+              "and plots are written; exit 2 when the file holds no linear stage)")
+          ->check(CLI::ExistingFile);
   stage->add_option("--compare-to", args.compare_to_Hz, "with --true-stage: the highest frequency compared [Hz]")
       ->check(CLI::PositiveNumber)
+      ->needs(true_stage)
       ->capture_default_str();
   auto* pub = app.add_option_group("publishing", "sending the fitted set to a running compensator");
   pub->add_flag("--publish", args.publish,
