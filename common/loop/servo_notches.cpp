@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace hystloop {
@@ -55,6 +56,77 @@ void set_notches(FeedbackGains& gains, std::span<const ModeNotch> notches) noexc
   gains.notch_q = first.q;
   gains.notch2_hz = second.hz;
   gains.notch2_q = second.q;
+}
+
+namespace {
+
+// The smaller margins of the loops at every slope ratio (unstable at any: not stable).
+LoopMargins worst_margins(const FeedbackGains& gains, ServoLoopModel model) {
+  LoopMargins worst;
+  worst.stable = true;
+  worst.gain_margin_dB = std::numeric_limits<double>::infinity();
+  worst.phase_margin_deg = std::numeric_limits<double>::infinity();
+  for (const double r : kServoDesignSlopeRatios) {
+    model.slope_ratio = r;
+    const LoopMargins m = ServoLoopResponse(gains, model).margins();
+    worst.stable = worst.stable && m.stable;
+    worst.max_pole_radius = std::max(worst.max_pole_radius, m.max_pole_radius);
+    if (m.gain_margin_dB < worst.gain_margin_dB) {
+      worst.gain_margin_dB = m.gain_margin_dB;
+      worst.gain_margin_hz = m.gain_margin_hz;
+    }
+    if (m.phase_margin_deg < worst.phase_margin_deg) {
+      worst.phase_margin_deg = m.phase_margin_deg;
+      worst.crossover_hz = m.crossover_hz;
+    }
+    if (m.sensitivity_peak > worst.sensitivity_peak) {
+      worst.sensitivity_peak = m.sensitivity_peak;
+      worst.sensitivity_peak_hz = m.sensitivity_peak_hz;
+    }
+  }
+  return worst;
+}
+
+bool meets_design(const LoopMargins& m) {
+  return m.stable && m.gain_margin_dB >= kServoDesignGainMargin_dB && m.phase_margin_deg >= kServoDesignPhaseMargin_deg;
+}
+
+}  // namespace
+
+StageServo servo_for_stage(const LinearStageSpec& stage, FeedbackGains base, int extra_delay_ticks) {
+  StageServo out;
+  out.notches = notches_for_stage(stage, base.tick_rate_hz);
+  base.kp = 0.0;
+  base.kd = 0.0;
+  set_notches(base, out.notches);
+  ServoLoopModel model;
+  model.linear = stage;
+  model.dt_s = 1.0 / base.tick_rate_hz;
+  model.extra_delay_ticks = extra_delay_ticks;
+  model.validate();
+  // With kp = kd = 0 the loop gain is ki times a fixed response: the gain margin falls as 1 / ki
+  // and the crossover climbs into the stage's phase lag, so the gains that meet the design are the
+  // ki up to a boundary, found by bisection on log ki (to 0.5 %).
+  const auto meets = [&](double ki) {
+    base.ki = ki;
+    return meets_design(worst_margins(base, model));
+  };
+  double lo = 1.0;  // [1/s]: below it the integral takes minutes to act
+  double hi = base.max_ki_per_s();
+  if (!meets(lo)) {
+    base.ki = 0.0;
+    out.gains = base;
+    return out;
+  }
+  if (meets(hi)) lo = hi;
+  while (hi / lo > 1.005) {
+    const double mid = std::sqrt(lo * hi);
+    (meets(mid) ? lo : hi) = mid;
+  }
+  base.ki = lo;
+  out.gains = base;
+  out.worst = worst_margins(base, model);
+  return out;
 }
 
 }  // namespace hystloop

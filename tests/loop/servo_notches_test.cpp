@@ -104,6 +104,54 @@ TEST(ServoNotches, TheySteadyAnIntegralServoOnTheTwoModeStage) {
   EXPECT_EQ(g.notch2_hz, 0.0);
 }
 
+// The servo suggested for a stage: its notches, kp 0 and the largest integral gain that keeps
+// 10 dB and 50 deg at both ends of the hysteresis' slope, on stages of other classes too (a single
+// low mode with 2.5 ticks of delay, a non-minimum-phase zero): the design holds at both slopes, and
+// 1 % more integral gain would break it (the largest, not merely a safe one).
+TEST(ServoNotches, TheSuggestedServoKeepsItsMarginsAtBothSlopesAndIsTheLargest) {
+  const LinearStageSpec stages[] = {
+      two_mode(),
+      LinearStageSpec::sum_of_modes({{450.0, 0.02, 1.0}}, 2.5e-4),
+      LinearStageSpec::zero_pole({{3000.0, 0.0}}, {{-55.0, 1100.0}}, 1e-4),
+  };
+  for (const LinearStageSpec& stage : stages) {
+    for (const int card : {0, 1}) {
+      FeedbackGains base;
+      base.kp = 0.3;  // taken out: kp 0
+      const StageServo s = servo_for_stage(stage, base, card);
+      EXPECT_EQ(s.gains.kp, 0.0);
+      ASSERT_GT(s.gains.ki, 0.0) << card;
+      EXPECT_EQ(s.gains.notch_hz, s.notches.empty() ? 0.0 : s.notches[0].notch.hz);
+      ServoLoopModel model;
+      model.linear = stage;
+      model.extra_delay_ticks = card;
+      bool all_hold = true;
+      FeedbackGains more = s.gains;
+      more.ki *= 1.01;  // past the bisection's bracket (0.5 %)
+      bool more_holds = true;
+      for (const double slope : kServoDesignSlopeRatios) {
+        model.slope_ratio = slope;
+        const LoopMargins m = ServoLoopResponse(s.gains, model).margins();
+        all_hold = all_hold && m.stable && m.gain_margin_dB >= kServoDesignGainMargin_dB &&
+                   m.phase_margin_deg >= kServoDesignPhaseMargin_deg;
+        const LoopMargins n = ServoLoopResponse(more, model).margins();
+        more_holds = more_holds && n.stable && n.gain_margin_dB >= kServoDesignGainMargin_dB &&
+                     n.phase_margin_deg >= kServoDesignPhaseMargin_deg;
+      }
+      EXPECT_TRUE(all_hold) << s.gains.ki << " card " << card;
+      EXPECT_FALSE(more_holds) << s.gains.ki << " card " << card;
+      EXPECT_GE(s.worst.gain_margin_dB, kServoDesignGainMargin_dB);
+      EXPECT_GE(s.worst.phase_margin_deg, kServoDesignPhaseMargin_deg);
+    }
+  }
+  // The two-mode stage's: its modes notched, and an integral gain near the hand-tuned 800 1/s of
+  // deploy/config/two-mode (14.5 dB / 58 deg in the simulator).
+  const StageServo two = servo_for_stage(two_mode(), FeedbackGains{});
+  ASSERT_EQ(two.notches.size(), 2U);
+  EXPECT_GT(two.gains.ki, 400.0);
+  EXPECT_LT(two.gains.ki, 3000.0);
+}
+
 TEST(ServoNotches, ABadModelIsRefusedNamingTheField) {
   EXPECT_EQ(testing::refused_field([] {
               notches_for_stage(LinearStageSpec::sum_of_modes({{780.0, -0.03, 1.0}}), kRate_hz);

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -193,10 +194,33 @@ std::string roots_yaml(const std::vector<C>& roots_hz) {
   return s + "]";
 }
 
-// The servo's notches for the fitted stage (loop/servo_notches.hpp), at the record's rate.
+// The fitted stage in the compensator's form (unit DC gain, the fitted delay).
+LinearStageSpec fitted_spec(const StageFitResult& fit) {
+  const auto roots = [](const std::vector<C>& rad_s) {
+    std::vector<LinearStageSpec::Root> out;
+    for (const C hz : roots_hz_once(rad_s)) out.push_back({hz.real(), hz.imag()});
+    return out;
+  };
+  return LinearStageSpec::zero_pole(roots(fit.zeros_rad_s), roots(fit.poles_rad_s), fit.delay_s);
+}
+
+// The servo for the fitted stage (loop/servo_notches.hpp: its notches and integral gain), at the
+// record's rate, the fitted delay taken as the loop's (a record of the live loop holds the card's
+// read after write). nullopt with a reason when the model is one the stage model refuses.
+std::optional<StageServo> fitted_servo(const StageRecord& r, const StageFitResult& fit, std::string* why = nullptr) {
+  FeedbackGains base;
+  base.tick_rate_hz = r.sample_rate_Hz;
+  try {
+    return servo_for_stage(fitted_spec(fit), base);
+  } catch (const ParameterError& e) {
+    if (why) *why = e.what();
+    return std::nullopt;
+  }
+}
+
 std::vector<ModeNotch> fitted_notches(const StageRecord& r, const StageFitResult& fit) {
-  return notches_for_stage(
-      fit.poles_rad_s, [&](double f_hz) { return fit.model_response(f_hz); }, r.sample_rate_Hz);
+  const std::optional<StageServo> servo = fitted_servo(r, fit);
+  return servo ? servo->notches : std::vector<ModeNotch>{};
 }
 
 std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
@@ -241,6 +265,10 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     y << "#   " << key << "_hz: " << num(n.notch.hz, 6) << "   " << key << "_q: " << num(n.notch.q, 3)
       << "   # mode damping " << num(n.damping, 3) << ", " << num(n.peak_gain, 3) << " x the DC gain there\n";
   }
+  if (const std::optional<StageServo> servo = fitted_servo(r, fit); servo && servo->gains.ki > 0.0) {
+    y << "#   kp: 0   ki: " << num(servo->gains.ki, 3) << "   # margins " << num(servo->worst.gain_margin_dB, 3)
+      << " dB / " << num(servo->worst.phase_margin_deg, 3) << " deg at the hysteresis' slope 0.6-1.4 of nominal\n";
+  }
   return y.str();
 }
 
@@ -266,12 +294,15 @@ void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
   }
 }
 
-void print_notches(const StageRecord& r, const StageFitResult& fit) {
-  const std::vector<ModeNotch> notches = fitted_notches(r, fit);
-  if (notches.empty()) {
-    std::printf("servo notches: none (no lightly damped mode lifts the gain)\n");
+void print_servo(const StageRecord& r, const StageFitResult& fit) {
+  std::string why;
+  const std::optional<StageServo> servo = fitted_servo(r, fit, &why);
+  if (!servo) {
+    std::printf("servo: none suggested (%s)\n", why.c_str());
     return;
   }
+  const std::vector<ModeNotch>& notches = servo->notches;
+  if (notches.empty()) std::printf("servo notches: none (no lightly damped mode lifts the gain)\n");
   std::string args;
   for (std::size_t i = 0; i < notches.size(); ++i) {
     const ModeNotch& n = notches[i];
@@ -282,8 +313,22 @@ void print_notches(const StageRecord& r, const StageFitResult& fit) {
     std::snprintf(buf, sizeof buf, " %s-hz %.6g %s-q %.3g", flag.c_str(), n.notch.hz, flag.c_str(), n.notch.q);
     args += buf;
   }
-  std::printf("  set them: hystloop-ctl gains%s%s --stage-config THIS_YAML (prints the margins first)\n", args.c_str(),
-              notches.size() < kServoNotches ? " --notch2-hz 0" : "");
+  if (notches.size() < kServoNotches) args += notches.empty() ? " --notch-hz 0 --notch2-hz 0" : " --notch2-hz 0";
+  if (servo->gains.ki > 0.0) {
+    std::printf(
+        "servo gains: kp 0, ki %.3g 1/s: margins %.3g dB / %.3g deg at the hysteresis' slope 0.6-1.4 of nominal "
+        "(designed for %g dB / %g deg)\n",
+        servo->gains.ki, servo->worst.gain_margin_dB, servo->worst.phase_margin_deg, kServoDesignGainMargin_dB,
+        kServoDesignPhaseMargin_deg);
+    std::printf(
+        "  set them: hystloop-ctl gains --kp 0 --ki %.3g --kd 0%s --stage-config THIS_YAML (prints the margins "
+        "first)\n",
+        servo->gains.ki, args.c_str());
+  } else {
+    std::printf("servo gains: no integral gain keeps %g dB / %g deg on this model\n", kServoDesignGainMargin_dB,
+                kServoDesignPhaseMargin_deg);
+    if (!notches.empty()) std::printf("  the notches: hystloop-ctl gains%s --stage-config THIS_YAML\n", args.c_str());
+  }
 }
 
 // The fitted model against the stage a simulated record came from: the continuous models at unit
@@ -399,6 +444,18 @@ StageFitOptions fit_options(const IdentifyArgs& args, const StageRecord& r) {
   return o;
 }
 
+// Where learning goes anyway beside the fitted stage: its lowest lightly damped pole or zero, by the
+// compensator's own rule (lowest_linear_feature_hz) on the model this run writes. 0: none.
+double lowest_feature_hz(const StageRecord& r, const StageFitResult& fit) {
+  StageModel stage;
+  stage.kind = StageModel::Kind::kLinear;
+  stage.linear = fitted_spec(fit);
+  try {
+    return lowest_linear_feature_hz(stage, 1.0 / r.sample_rate_Hz);
+  } catch (const ParameterError&) {  // a fit the stage model refuses: the compensator refuses it too
+    return 0.0;
+  }
+}
 }  // namespace
 
 std::vector<C> roots_hz_once(const std::vector<C>& roots_rad_s) {
@@ -450,19 +507,10 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   const FrequencyResponse& frf = id.frf;
   const StageFitResult& fit = id.fit;
   print_fit(frf, fit);
-  // From where learning goes anyway beside the fitted stage (its lowest lightly damped pole or zero).
-  double lowest_hz = 0.0;
-  for (const auto* roots : {&fit.poles_rad_s, &fit.zeros_rad_s}) {
-    for (const C p : *roots) {
-      const double w = std::abs(p);
-      if (p.imag() > 0.0 && -p.real() / w < 0.5 && (lowest_hz == 0.0 || w / (2.0 * std::numbers::pi) < lowest_hz))
-        lowest_hz = w / (2.0 * std::numbers::pi);
-    }
-  }
-  const double known_to_hz = model_known_to_hz(id, kLearningShareOfResonance * lowest_hz);
+  const double known_to_hz = model_known_to_hz(id, kLearningShareOfResonance * lowest_feature_hz(r, fit));
   std::printf("model known (within %g %% of the record, +2 sigma) up to %.6g Hz\n", 100.0 * kStageKnownWithin,
               known_to_hz);
-  print_notches(r, fit);
+  print_servo(r, fit);
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
   if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading, known_to_hz)); rc != 0) return rc;

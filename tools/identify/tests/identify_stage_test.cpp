@@ -130,11 +130,19 @@ TEST_F(IdentifyStage, RecoversTheTwoModeStageAndItsDelayFromACsv) {
     EXPECT_NEAR(hz, want[i].notch.hz, 1e-3 * want[i].notch.hz) << i;
     EXPECT_NEAR(q, want[i].notch.q, 0.02 * want[i].notch.q) << i;
   }
-  EXPECT_NE(r.output.find("hystloop-ctl gains --notch-hz"), std::string::npos) << r.output;
+  // The servo's integral gain, designed on the identified model: the true stage's to the fit's accuracy.
+  const double want_ki = servo_for_stage(truth(), FeedbackGains{}).gains.ki;
+  const std::size_t g = r.output.find("servo gains: kp 0, ki ");
+  ASSERT_NE(g, std::string::npos) << r.output;
+  double ki = 0.0;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + g + 22, "%lf", &ki), 1) << r.output;
+  EXPECT_NEAR(ki, want_ki, 0.05 * want_ki);
+  EXPECT_NE(r.output.find("hystloop-ctl gains --kp 0 --ki "), std::string::npos) << r.output;
   std::ifstream yaml(out + "config.yaml");
   std::stringstream text;
   text << yaml.rdbuf();
   EXPECT_NE(text.str().find("#   notch2_hz: "), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("#   kp: 0   ki: "), std::string::npos) << text.str();
 }
 
 // A simulated record held against the stage it came from: the model's error in dB and degrees,
