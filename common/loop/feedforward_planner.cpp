@@ -219,6 +219,8 @@ std::optional<double> FeedforwardPlanner::observe(const CompensatorInput& sample
   if (exchange_.anchor().observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) {
     ++counters_.reanchors;
   }
+  // Fast: half the plan's share of the slew limit per tick, where a servo along it could reach the limit.
+  servo_activity_.observe(sample, config_.dt_s, 0.5 * config_.tracking_slew_V_per_s() * config_.dt_s);
   return sample.y_m - servo_share_.position_m(sample, inverses_.linear_params().gain, config_.dt_s);
 }
 
@@ -423,14 +425,27 @@ CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, 
       learning->hold(k);  // a correction came from it: not null
     }
   };
-  if (u < config_.u_min_V || u > config_.u_max_V) {
+  // A learned correction takes only what the servo's recent peaks leave of the range and of the
+  // plan's share of the slew limit (ServoActivity): the bridge clamps the sum, not the feedforward.
+  double u_lo = config_.u_min_V, u_hi = config_.u_max_V;
+  double max_step = config_.tracking_slew_V_per_s() * config_.dt_s;
+  if (learned) {
+    const double lo = u_lo + servo_activity_.below_peak_V(), hi = u_hi - servo_activity_.above_peak_V();
+    if (lo < hi) {
+      u_lo = lo;
+      u_hi = hi;
+    }
+    const double left =
+        config_.plan_slew_fraction * config_.slew_V_per_s * config_.dt_s - servo_activity_.step_along_peak_V();
+    max_step = std::clamp(left, 0.5 * max_step, max_step);  // never below half the line's own
+  }
+  if (u < u_lo || u > u_hi) {
     limited(counters_.u_clamped);
-    u = std::clamp(u, config_.u_min_V, config_.u_max_V);
+    u = std::clamp(u, u_lo, u_hi);
   }
   // The plan keeps within the share of the slew limit a trajectory was admitted at (the rest is
   // the servo's, beside the sensor); what learning or a swap would ask beyond it is held back here
   // and counted, not clamped by the bridge behind the servo's back.
-  const double max_step = config_.tracking_slew_V_per_s() * config_.dt_s;
   if (std::abs(u - last_u_) > max_step) {
     limited(counters_.u_slew_clamped);
     u = last_u_ + std::copysign(max_step, u - last_u_);

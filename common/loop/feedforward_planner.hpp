@@ -183,6 +183,7 @@ class FeedforwardPlanner {
   bool stage_fresh_ = true;  // the stage inverse starts at rest at the next reference
   // Where the servo's share of the voltage has moved the stage, taken out of what the learning sees.
   ServoShare servo_share_;
+  ServoActivity servo_activity_;  // what a learned correction leaves the servo
   // A linear stage: its inverse with preview, and the reference planned ahead of the commands.
   std::optional<PreviewStageInverse> preview_;
   std::int64_t preview_ticks_ = 0;

@@ -1,5 +1,6 @@
 #include "loop/servo_share.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hystloop {
@@ -33,6 +34,31 @@ double ServoShare::position_m(const CompensatorInput& sample, double gain_m_per_
   if (!second_order_) return w;
   if (!consecutive) second_order_->reset(w);
   return second_order_->step(w, dt_s);
+}
+
+void ServoActivity::observe(const CompensatorInput& sample, double dt_s, double fast_step_V) noexcept {
+  if (dt_s != dt_s_) {
+    dt_s_ = dt_s;
+    decay_ = std::exp(-dt_s / kMemory_s);
+  }
+  along_V_ *= decay_;
+  above_V_ *= decay_;
+  below_V_ *= decay_;
+  const double fb = sample.u_V - sample.u_ff_V;
+  if (!std::isfinite(fb) || !std::isfinite(sample.u_ff_V)) {
+    seq_ = -1;
+    return;
+  }
+  if (seq_ >= 0 && sample.seq == seq_ + 1) {
+    const double ff_step = sample.u_ff_V - last_ff_V_;
+    if (std::abs(ff_step) >= fast_step_V)
+      along_V_ = std::max(along_V_, std::copysign(1.0, ff_step) * (fb - last_fb_V_));
+  }
+  above_V_ = std::max(above_V_, fb);
+  below_V_ = std::max(below_V_, -fb);
+  last_fb_V_ = fb;
+  last_ff_V_ = sample.u_ff_V;
+  seq_ = sample.seq;
 }
 
 }  // namespace hystloop

@@ -36,4 +36,31 @@ class ServoShare {
   std::int64_t seq_ = -1;  // the last sample it was stepped with
 };
 
+// What the servo's voltage (u_V - u_ff_V) has been doing lately, each a peak decaying over
+// kMemory_s: how far it has reached above and below the feedforward, and its largest step per tick
+// along the feedforward's own where that step is fast (at least fast_step_V: where the sum nears
+// the slew limit). The plan leaves the servo a reserve of the slew limit
+// (compensator.servo_slew_reserve, sized for noise and a line's start) and none of the range. A
+// servo working hard against a model that is far off (its gain 1.5 times too high) pushes along
+// the feedforward where the line is fastest, by several times the reserve, and the bridge would
+// clamp the sum once a learned correction took the feedforward to the plan's limit; where the
+// servo steps against the feedforward, or only at slow ticks, it takes nothing from it. The learned
+// correction is held to what these peaks leave (FeedforwardPlanner). Allocation- and lock-free.
+class ServoActivity {
+ public:
+  static constexpr double kMemory_s = 0.5;  // two periods of a 4 Hz line; a 10 Hz line's five
+
+  void observe(const CompensatorInput& sample, double dt_s, double fast_step_V) noexcept;
+  void reset() noexcept { *this = ServoActivity{}; }
+  double step_along_peak_V() const noexcept { return along_V_; }
+  double above_peak_V() const noexcept { return above_V_; }  // max(u - u_ff, 0)
+  double below_peak_V() const noexcept { return below_V_; }  // max(u_ff - u, 0)
+
+ private:
+  double along_V_ = 0.0, above_V_ = 0.0, below_V_ = 0.0;
+  double last_fb_V_ = 0.0, last_ff_V_ = 0.0;
+  std::int64_t seq_ = -1;  // the last sample with u_ff known
+  double dt_s_ = 0.0, decay_ = 1.0;
+};
+
 }  // namespace hystloop

@@ -108,6 +108,35 @@ TEST(Scan, BehindALinearStageTheHysteresisIsFittedWithoutIt) {
   }
 }
 
+// A model whose gain is 1.5 times the stage's, beside the two-mode stage's own servo (the integral
+// servo with two notches of deploy/config/two-mode): the servo pushes along the feedforward where
+// the 50 Hz triangle is fastest, by several times its slew reserve. Learning takes the feedforward
+// up to the plan's limit; the corrections are held to what the servo's recent steps leave, so the
+// bridge clamps nothing (it clamped 28 ticks when they were held to the plan's share alone).
+TEST(Scan, LearningLeavesTheServoItsStepsBesideAModelFarOffInGain) {
+  const TrackingExperiment experiment = two_mode_experiment();
+  const ScanReference line = scan_references()[1];  // triangle 50 Hz 1 um
+  ASSERT_EQ(line.frequency_hz, 50.0);
+  ScanOptions o;
+  o.kp = 0.0;
+  o.ki = 800.0;
+  o.notch_hz = 780.0;
+  o.notch_q = 0.34;
+  o.notch2_hz = 2400.0;
+  o.notch2_q = 3.0;
+  o.mode = FeedforwardMode::kPi;
+  IdentifiedModels models = identify_for_scan(experiment, line.amplitude_m, scan_stage(experiment, o));
+  for (double& w : models.pi.weights) w *= 1.5;
+  const ScanRun off = run_scan(experiment, models, line, o);
+  o.learning = true;
+  const ScanRun on = run_scan(experiment, models, line, o);
+  ASSERT_FALSE(off.refused || on.refused);
+  EXPECT_EQ(off.clamped_ticks, 0u);
+  EXPECT_EQ(on.clamped_ticks, 0u);
+  EXPECT_GT(on.counters.learning_held, 0u);                    // the servo's room was kept
+  EXPECT_LT(on.stats.rms_true_m, 0.5 * off.stats.rms_true_m);  // measured 97.6 against 235.7 nm
+}
+
 // Learning beside the two-mode stage's inverse, with its true model and with deliberately wrong
 // ones: with a filter past the stage's anti-resonance (1.85 kHz, where the inverse's gain is ~100)
 // the 10 Hz triangle ran away to the correction bound (30 nm, 185 nm max); learned only below 0.7
