@@ -192,7 +192,7 @@ bool wrong_model_table(bool servo, bool known_band) {
 // (loop/servo_notches.hpp: notches, kp 0, the largest ki keeping 10 dB / 50 deg). Per plant and
 // line: learning off and on, the worst period with learning against the same period without, and
 // the ticks clamped. Exit 1 when a line is refused, a period with learning exceeds 1.1 times its
-// learning-off RMS, or learning clamps.
+// learning-off RMS, or learning adds a clamp (the MEM plant's rows do: see docs/TRACKING.md).
 bool class_table() {
   using namespace hystloop;
   struct Plant {
@@ -227,9 +227,14 @@ bool class_table() {
     e.series_hysteresis = p.hysteresis;
     const StageServo servo = servo_for_stage(p.stage, FeedbackGains{});
     char servo_cell[128];
-    std::snprintf(servo_cell, sizeof servo_cell, "ki %.0f/s, %zu notch%s (%.1f dB / %.0f deg)", servo.gains.ki,
-                  servo.notches.size(), servo.notches.size() == 1 ? "" : "es", servo.worst.gain_margin_dB,
-                  servo.worst.phase_margin_deg);
+    if (servo.gains.ki > 0.0) {
+      std::snprintf(servo_cell, sizeof servo_cell, "ki %.0f/s, %zu notch%s (%.1f dB / %.0f deg)", servo.gains.ki,
+                    servo.notches.size(), servo.notches.size() == 1 ? "" : "es", servo.worst.gain_margin_dB,
+                    servo.worst.phase_margin_deg);
+    } else {
+      std::snprintf(servo_cell, sizeof servo_cell, "off (no ki keeps %g dB / %g deg)", kServoDesignGainMargin_dB,
+                    kServoDesignPhaseMargin_deg);
+    }
     for (const ScanReference& r : scan_references()) {
       if (r.shape == TrajectoryShape::kSine && r.frequency_hz != 100.0)
         continue;  // the 10, 50 Hz triangles, 100 Hz sine

@@ -109,6 +109,9 @@ struct CompensatorInput {
   // the servo (and any clamp) added, whose share of the position the learning takes out. NaN: not
   // known (the learning then sees the servo's share as part of the error).
   double u_ff_V = std::numeric_limits<double>::quiet_NaN();
+  // The bridge was in its safe state (sample_flags::kSafeState): u_ff_V is 0 and u_V its ramp to
+  // the safe voltage, nothing a servo did.
+  bool safe_state = false;
 };
 
 struct CompensatorCounters {

@@ -425,19 +425,18 @@ CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, 
       learning->hold(k);  // a correction came from it: not null
     }
   };
-  // A learned correction takes only what the servo's recent peaks leave of the range and of the
-  // plan's share of the slew limit (ServoActivity): the bridge clamps the sum, not the feedforward.
+  // A learned correction takes only what the servo's recent peaks leave of the range (on the side
+  // it pushes towards) and of the plan's share of the slew limit (ServoActivity): the bridge clamps
+  // the sum, not the feedforward. The slew held to never below half that share: a servo stepping
+  // more than that along the feedforward is the bridge's to clamp.
   double u_lo = config_.u_min_V, u_hi = config_.u_max_V;
   double max_step = config_.tracking_slew_V_per_s() * config_.dt_s;
   if (learned) {
-    const double lo = u_lo + servo_activity_.below_peak_V(), hi = u_hi - servo_activity_.above_peak_V();
-    if (lo < hi) {
-      u_lo = lo;
-      u_hi = hi;
-    }
+    if (correction > 0.0) u_hi = std::max(u_lo, u_hi - servo_activity_.above_peak_V());
+    if (correction < 0.0) u_lo = std::min(u_hi, u_lo + servo_activity_.below_peak_V());
     const double left =
         config_.plan_slew_fraction * config_.slew_V_per_s * config_.dt_s - servo_activity_.step_along_peak_V();
-    max_step = std::clamp(left, 0.5 * max_step, max_step);  // never below half the line's own
+    max_step = std::clamp(left, 0.5 * max_step, max_step);
   }
   if (u < u_lo || u > u_hi) {
     limited(counters_.u_clamped);

@@ -106,7 +106,7 @@ StageServo servo_for_stage(const LinearStageSpec& stage, FeedbackGains base, int
   model.validate();
   // With kp = kd = 0 the loop gain is ki times a fixed response: the gain margin falls as 1 / ki
   // and the crossover climbs into the stage's phase lag, so the gains that meet the design are the
-  // ki up to a boundary, found by bisection on log ki (to 0.5 %).
+  // ki up to a boundary, found by bisection on log ki (to 0.5 %), rounded down to a whole 1/s.
   const auto meets = [&](double ki) {
     base.ki = ki;
     return meets_design(worst_margins(base, model));
@@ -123,7 +123,7 @@ StageServo servo_for_stage(const LinearStageSpec& stage, FeedbackGains base, int
     const double mid = std::sqrt(lo * hi);
     (meets(mid) ? lo : hi) = mid;
   }
-  base.ki = lo;
+  base.ki = std::floor(lo);  // a whole 1/s, as it is printed and typed (lo >= 1)
   out.gains = base;
   out.worst = worst_margins(base, model);
   return out;

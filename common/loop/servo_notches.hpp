@@ -65,7 +65,7 @@ inline constexpr double kServoDesignPhaseMargin_deg = 50.0;
 inline constexpr std::array<double, 2> kServoDesignSlopeRatios = {0.6, 1.4};
 
 struct StageServo {
-  FeedbackGains gains;             // base with kp = kd = 0, the notches and ki (0: no integral gain holds)
+  FeedbackGains gains;             // base with kp = kd = 0, the notches and ki [1/s, whole] (0: none holds)
   std::vector<ModeNotch> notches;  // as notches_for_stage found them
   LoopMargins worst;               // the smaller margins over the slope ratios, at that ki
 };

@@ -41,11 +41,14 @@ void ServoActivity::observe(const CompensatorInput& sample, double dt_s, double 
     dt_s_ = dt_s;
     decay_ = std::exp(-dt_s / kMemory_s);
   }
-  along_V_ *= decay_;
-  above_V_ *= decay_;
-  below_V_ *= decay_;
+  const std::int64_t ticks = seen_seq_ >= 0 && sample.seq > seen_seq_ ? sample.seq - seen_seq_ : 1;
+  seen_seq_ = sample.seq;
+  const double decay = ticks == 1 ? decay_ : std::pow(decay_, static_cast<double>(ticks));
+  along_V_ *= decay;
+  above_V_ *= decay;
+  below_V_ *= decay;
   const double fb = sample.u_V - sample.u_ff_V;
-  if (!std::isfinite(fb) || !std::isfinite(sample.u_ff_V)) {
+  if (sample.safe_state || !std::isfinite(fb)) {
     seq_ = -1;
     return;
   }

@@ -43,23 +43,28 @@ class ServoShare {
 // (compensator.servo_slew_reserve, sized for noise and a line's start) and none of the range. A
 // servo working hard against a model that is far off (its gain 1.5 times too high) pushes along
 // the feedforward where the line is fastest, by several times the reserve, and the bridge would
-// clamp the sum once a learned correction took the feedforward to the plan's limit; where the
-// servo steps against the feedforward, or only at slow ticks, it takes nothing from it. The learned
-// correction is held to what these peaks leave (FeedforwardPlanner). Allocation- and lock-free.
+// clamp the sum once a learned correction took the feedforward to the plan's limit. A servo that
+// steps against the feedforward, or only at slow ticks, takes nothing of the slew limit from it;
+// its reach above and below the feedforward takes its share of the range. The learned correction
+// is held to what these peaks leave (FeedforwardPlanner). Samples of the bridge's safe state, or
+// without the feedforward, tell nothing of the servo. Allocation- and lock-free.
 class ServoActivity {
  public:
   static constexpr double kMemory_s = 0.5;  // two periods of a 4 Hz line; a 10 Hz line's five
 
   void observe(const CompensatorInput& sample, double dt_s, double fast_step_V) noexcept;
   void reset() noexcept { *this = ServoActivity{}; }
+  // Decaying peaks [V]: of the servo's step along the feedforward's fast steps, and of how far its
+  // voltage reached above (u - u_ff > 0) and below (u_ff - u > 0) the feedforward.
   double step_along_peak_V() const noexcept { return along_V_; }
-  double above_peak_V() const noexcept { return above_V_; }  // max(u - u_ff, 0)
-  double below_peak_V() const noexcept { return below_V_; }  // max(u_ff - u, 0)
+  double above_peak_V() const noexcept { return above_V_; }
+  double below_peak_V() const noexcept { return below_V_; }
 
  private:
   double along_V_ = 0.0, above_V_ = 0.0, below_V_ = 0.0;
   double last_fb_V_ = 0.0, last_ff_V_ = 0.0;
-  std::int64_t seq_ = -1;  // the last sample with u_ff known
+  std::int64_t seq_ = -1;       // the last sample with the servo's voltage known
+  std::int64_t seen_seq_ = -1;  // the last sample of any kind (the peaks decay per tick, gaps included)
   double dt_s_ = 0.0, decay_ = 1.0;
 };
 

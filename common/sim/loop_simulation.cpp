@@ -45,7 +45,7 @@ void LoopSimulation::run(double seconds, const std::function<void(const LoopTick
     rec.flags = b.flags | sample_flags::kSimulated;
     rec.params_version = b.params_version;
 
-    compensator_.observe({k_, b.u_applied_V, y, b.u_ff_V});
+    compensator_.observe({k_, b.u_applied_V, y, b.u_ff_V, (b.flags & sample_flags::kSafeState) != 0});
     if ((k_ + 1) % config_.block_ticks == 0) {  // a sensor block is complete: the compensator answers it
       while (const std::size_t planned = compensator_.plan(plan_)) {
         for (std::size_t j = 0; j < planned; ++j) bridge_.submit(plan_[j]);

@@ -97,7 +97,7 @@ void MultiAxisLoopSimulation::run(double seconds, const std::function<void(const
       rec.y_true_m[i] = stage_.true_position_m(static_cast<int>(i));
       rec.y_ref_m[i] = ticks_[i].y_ref_m;
       rec.flags[i] = ticks_[i].flags | sample_flags::kSimulated;
-      compensators_[i].observe({k_, u[i], y[i], ticks_[i].u_ff_V});
+      compensators_[i].observe({k_, u[i], y[i], ticks_[i].u_ff_V, (ticks_[i].flags & sample_flags::kSafeState) != 0});
     }
     if ((k_ + 1) % config_.block_ticks == 0) {
       for (std::size_t i = 0; i < axes_n; ++i) {

@@ -17,6 +17,7 @@
 #include "lcm/blocks.hpp"
 #include "lcm/status_counters.hpp"
 #include "lcm/feedforward_mode.hpp"
+#include "loop/bridge_core.hpp"  // sample_flags
 #include "models/model_descriptors.hpp"
 #include "runtime/io_loop.hpp"
 
@@ -98,7 +99,7 @@ void CompensatorService::on_sensor(const sensor_block_t& msg, std::int64_t recv_
     for_each_tick(
         msg,
         [&](const SensorTick& t) {
-          law.observe({t.seq, t.u_V, t.y_m, t.u_ff_V});
+          law.observe({t.seq, t.u_V, t.y_m, t.u_ff_V, (t.flags & sample_flags::kSafeState) != 0});
         },
         static_cast<std::size_t>(a));
   }

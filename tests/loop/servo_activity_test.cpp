@@ -35,12 +35,29 @@ TEST(ServoActivity, CountsTheServosStepsAlongTheFeedforwardsFastOnesOnly) {
   a.observe(sample(12, 5.0, 2.0), kDt, kFast);
   EXPECT_EQ(a.step_along_peak_V(), 0.0);
   EXPECT_EQ(a.above_peak_V(), 2.0);
-  a.observe(sample(13, 1.0, -3.0), kDt, kFast);
+  a.observe(sample(13, 1.0, -3.0), kDt, kFast);  // fast down (4 V), the servo down 5 V: along
+  EXPECT_NEAR(a.step_along_peak_V(), 5.0, 1e-12);
   EXPECT_EQ(a.below_peak_V(), 3.0);
   // Half a memory later the peaks are e^-1/2 of themselves.
   const auto ticks = static_cast<std::int64_t>(std::lround(0.5 * ServoActivity::kMemory_s / kDt));
   for (std::int64_t k = 14; k < 14 + ticks; ++k) a.observe(sample(k, 1.0, 0.0), kDt, kFast);
   EXPECT_NEAR(a.below_peak_V(), 3.0 * std::exp(-0.5), 1e-3);
+  // Fast down, the servo up: against the feedforward, nothing taken.
+  a.reset();
+  a.observe(sample(0, 0.0, 0.0), kDt, kFast);
+  a.observe(sample(1, -3.0, 0.5), kDt, kFast);
+  EXPECT_EQ(a.step_along_peak_V(), 0.0);
+  // The peaks decay per tick, across a gap too: 100 ticks missing take 100 ticks' decay.
+  a.reset();
+  a.observe(sample(0, 0.0, 2.0), kDt, kFast);
+  a.observe(sample(101, 0.0, 0.0), kDt, kFast);
+  EXPECT_NEAR(a.above_peak_V(), 2.0 * std::exp(-101 * kDt / ServoActivity::kMemory_s), 1e-12);
+  // The bridge's safe state (u_ff 0, u its ramp to the safe voltage) is not the servo's.
+  a.reset();
+  CompensatorInput safe = sample(0, 0.0, 60.0);
+  safe.safe_state = true;
+  a.observe(safe, kDt, kFast);
+  EXPECT_EQ(a.above_peak_V(), 0.0);
   // Without a feedforward known, nothing is learned of the servo.
   a.reset();
   a.observe({1, 5.0, 0.0, std::numeric_limits<double>::quiet_NaN()}, kDt, kFast);

@@ -133,7 +133,6 @@ TEST(Scan, LearningLeavesTheServoItsStepsBesideAModelFarOffInGain) {
   ASSERT_FALSE(off.refused || on.refused);
   EXPECT_EQ(off.clamped_ticks, 0u);
   EXPECT_EQ(on.clamped_ticks, 0u);
-  EXPECT_GT(on.counters.learning_held, 0u);                    // the servo's room was kept
   EXPECT_LT(on.stats.rms_true_m, 0.5 * off.stats.rms_true_m);  // measured 97.6 against 235.7 nm
 }
 

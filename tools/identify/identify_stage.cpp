@@ -266,7 +266,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
       << "   # mode damping " << num(n.damping, 3) << ", " << num(n.peak_gain, 3) << " x the DC gain there\n";
   }
   if (const std::optional<StageServo> servo = fitted_servo(r, fit); servo && servo->gains.ki > 0.0) {
-    y << "#   kp: 0   ki: " << num(servo->gains.ki, 3) << "   # margins " << num(servo->worst.gain_margin_dB, 3)
+    y << "#   kp: 0   ki: " << num(servo->gains.ki, 6) << "   # margins " << num(servo->worst.gain_margin_dB, 3)
       << " dB / " << num(servo->worst.phase_margin_deg, 3) << " deg at the hysteresis' slope 0.6-1.4 of nominal\n";
   }
   return y.str();
@@ -316,12 +316,12 @@ void print_servo(const StageRecord& r, const StageFitResult& fit) {
   if (notches.size() < kServoNotches) args += notches.empty() ? " --notch-hz 0 --notch2-hz 0" : " --notch2-hz 0";
   if (servo->gains.ki > 0.0) {
     std::printf(
-        "servo gains: kp 0, ki %.3g 1/s: margins %.3g dB / %.3g deg at the hysteresis' slope 0.6-1.4 of nominal "
+        "servo gains: kp 0, ki %.0f 1/s: margins %.3g dB / %.3g deg at the hysteresis' slope 0.6-1.4 of nominal "
         "(designed for %g dB / %g deg)\n",
         servo->gains.ki, servo->worst.gain_margin_dB, servo->worst.phase_margin_deg, kServoDesignGainMargin_dB,
         kServoDesignPhaseMargin_deg);
     std::printf(
-        "  set them: hystloop-ctl gains --kp 0 --ki %.3g --kd 0%s --stage-config THIS_YAML (prints the margins "
+        "  set them: hystloop-ctl gains --kp 0 --ki %.0f --kd 0%s --stage-config THIS_YAML (prints the margins "
         "first)\n",
         servo->gains.ki, args.c_str());
   } else {
