@@ -131,6 +131,24 @@ hystloop::ScanOptions two_mode_servo() {
   return o;
 }
 
+// A line learned and not: the two runs, and the worst period with learning against the same
+// period without.
+struct LearningPair {
+  hystloop::ScanRun off, on;
+  double worst = 0.0;
+};
+LearningPair learning_off_and_on(const hystloop::TrackingExperiment& e, const hystloop::IdentifiedModels& id,
+                                 const hystloop::ScanReference& r, hystloop::ScanOptions o) {
+  LearningPair p;
+  o.learning = false;
+  p.off = run_scan(e, id, r, o);
+  o.learning = true;
+  p.on = run_scan(e, id, r, o);
+  for (std::size_t k = 0; k < p.on.rms_per_period_m.size() && k < p.off.rms_per_period_m.size(); ++k)
+    p.worst = std::max(p.worst, p.on.rms_per_period_m[k] / p.off.rms_per_period_m[k]);
+  return p;
+}
+
 // Learning beside a deliberately wrong model of the two-mode stage: every period's RMS with
 // learning against the same period's without, the worst ratio, and what learning clamped.
 bool wrong_model_table(bool servo, bool known_band) {
@@ -169,12 +187,7 @@ bool wrong_model_table(bool servo, bool known_band) {
       o.mode = FeedforwardMode::kPi;
       IdentifiedModels id = identify_for_scan(e, r.amplitude_m, scan_stage(e, o));
       for (double& weight : id.pi.weights) weight *= w.gain;
-      const ScanRun off = run_scan(e, id, r, o);
-      o.learning = true;
-      const ScanRun on = run_scan(e, id, r, o);
-      double worst = 0.0;
-      for (std::size_t p = 0; p < on.rms_per_period_m.size() && p < off.rms_per_period_m.size(); ++p)
-        worst = std::max(worst, on.rms_per_period_m[p] / off.rms_per_period_m[p]);
+      const auto [off, on, worst] = learning_off_and_on(e, id, r, o);
       held = held && !on.refused && worst <= 1.1 && on.clamped_ticks <= off.clamped_ticks;
       std::printf("| %s | %s | %s | %s | %.2f | %llu, %llu |\n", w.name, r.name.c_str(), cell(off).c_str(),
                   cell(on).c_str(), worst, static_cast<unsigned long long>(off.clamped_ticks),
@@ -254,12 +267,7 @@ bool class_table() {
         held = false;
         continue;
       }
-      const ScanRun off = run_scan(e, id, r, o);
-      o.learning = true;
-      const ScanRun on = run_scan(e, id, r, o);
-      double worst = 0.0;
-      for (std::size_t k = 0; k < on.rms_per_period_m.size() && k < off.rms_per_period_m.size(); ++k)
-        worst = std::max(worst, on.rms_per_period_m[k] / off.rms_per_period_m[k]);
+      const auto [off, on, worst] = learning_off_and_on(e, id, r, o);
       held = held && !off.refused && !on.refused && worst <= 1.1 && on.clamped_ticks <= off.clamped_ticks;
       std::printf("| %s | %s | %s | %s | %s | %.2f | %llu, %llu |\n", p.name, servo_cell, r.name.c_str(),
                   cell(off).c_str(), cell(on).c_str(), worst, static_cast<unsigned long long>(off.clamped_ticks),

@@ -206,25 +206,23 @@ LinearStageSpec fitted_spec(const StageFitResult& fit) {
 
 // The servo for the fitted stage (loop/servo_notches.hpp: its notches and integral gain), at the
 // record's rate, the fitted delay taken as the loop's (a record of the live loop holds the card's
-// read after write). nullopt with a reason when the model is one the stage model refuses.
-std::optional<StageServo> fitted_servo(const StageRecord& r, const StageFitResult& fit, std::string* why = nullptr) {
+// read after write). No servo, with the reason, when the model is one the stage model refuses.
+struct FittedServo {
+  std::optional<StageServo> servo;
+  std::string why;
+};
+FittedServo fitted_servo(const StageRecord& r, const StageFitResult& fit) {
   FeedbackGains base;
   base.tick_rate_hz = r.sample_rate_Hz;
   try {
-    return servo_for_stage(fitted_spec(fit), base);
+    return {servo_for_stage(fitted_spec(fit), base), {}};
   } catch (const ParameterError& e) {
-    if (why) *why = e.what();
-    return std::nullopt;
+    return {std::nullopt, e.what()};
   }
 }
 
-std::vector<ModeNotch> fitted_notches(const StageRecord& r, const StageFitResult& fit) {
-  const std::optional<StageServo> servo = fitted_servo(r, fit);
-  return servo ? servo->notches : std::vector<ModeNotch>{};
-}
-
 std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
-                       const std::string& heading, double known_to_hz) {
+                       const std::string& heading, double known_to_hz, const FittedServo& fitted) {
   std::ostringstream y;
   y << "# hystloop-identify --model stage: " << heading << "\n"
     << "# " << r.source << "\n"
@@ -254,7 +252,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     << "  known_to_hz: " << num(known_to_hz, 6) << "   # the model within " << num(100.0 * kStageKnownWithin, 3)
     << " % of the record (+2 sigma) up to here: learning may go to " << num(100.0 * kLearningShareOfKnownBand, 3)
     << " % of it\n";
-  const std::vector<ModeNotch> notches = fitted_notches(r, fit);
+  const std::vector<ModeNotch> notches = fitted.servo ? fitted.servo->notches : std::vector<ModeNotch>{};
   y << "# servo notches for this stage (the bridge's servo: section; check the gains' margins with\n"
     << "# hystloop-ctl gains --stage-config on this file):";
   if (notches.empty()) y << " none (no lightly damped mode lifts the gain)";
@@ -265,7 +263,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     y << "#   " << key << "_hz: " << num(n.notch.hz, 6) << "   " << key << "_q: " << num(n.notch.q, 3)
       << "   # mode damping " << num(n.damping, 3) << ", " << num(n.peak_gain, 3) << " x the DC gain there\n";
   }
-  if (const std::optional<StageServo> servo = fitted_servo(r, fit); servo && servo->gains.ki > 0.0) {
+  if (const std::optional<StageServo>& servo = fitted.servo; servo && servo->gains.ki > 0.0) {
     y << "#   kp: 0   ki: " << num(servo->gains.ki, 6) << "   # margins " << num(servo->worst.gain_margin_dB, 3)
       << " dB / " << num(servo->worst.phase_margin_deg, 3) << " deg at the hysteresis' slope 0.6-1.4 of nominal\n";
   }
@@ -294,11 +292,10 @@ void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
   }
 }
 
-void print_servo(const StageRecord& r, const StageFitResult& fit) {
-  std::string why;
-  const std::optional<StageServo> servo = fitted_servo(r, fit, &why);
+void print_servo(const FittedServo& fitted) {
+  const std::optional<StageServo>& servo = fitted.servo;
   if (!servo) {
-    std::printf("servo: none suggested (%s)\n", why.c_str());
+    std::printf("servo: none suggested (%s)\n", fitted.why.c_str());
     return;
   }
   const std::vector<ModeNotch>& notches = servo->notches;
@@ -510,10 +507,11 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   const double known_to_hz = model_known_to_hz(id, kLearningShareOfResonance * lowest_feature_hz(r, fit));
   std::printf("model known (within %g %% of the record, +2 sigma) up to %.6g Hz\n", 100.0 * kStageKnownWithin,
               known_to_hz);
-  print_servo(r, fit);
+  const FittedServo servo = fitted_servo(r, fit);
+  print_servo(servo);
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
-  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading, known_to_hz)); rc != 0) return rc;
+  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading, known_to_hz, servo)); rc != 0) return rc;
   if (target.plots_dir) {
     const report::PlotResult plots = write_stage_plots(frf, fit, heading, *target.plots_dir, args.gnuplot);
     for (const auto& f : plots.images) std::printf("plot: %s\n", f.string().c_str());
