@@ -57,6 +57,7 @@ void CompensatorConfig::validate() const {
   require_in_range("compensator.plan_slew_fraction", plan_slew_fraction, 0.05, 1.0);
   require_in_range("compensator.servo_slew_reserve", servo_slew_reserve, 0.0, plan_slew_fraction - 0.05);
   require_in_range("compensator.experiment_ramp_V_per_s", experiment_ramp_V_per_s, 1e-3, 1e12);
+  swap_review.validate();
   if (horizon_ticks < 1 || horizon_ticks > kMaxHorizonTicks) {
     throw ParameterError("compensator.horizon_s", "must be 1 to " + std::to_string(kMaxHorizonTicks) + " ticks (got " +
                                                       std::to_string(horizon_ticks) + ")");

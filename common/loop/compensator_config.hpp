@@ -9,6 +9,7 @@
 #include <string>
 
 #include "loop/periodic_learner.hpp"
+#include "loop/swap_review.hpp"
 #include "loop/trajectory.hpp"
 #include "models/feedforward_mode.hpp"
 #include "models/model_set.hpp"
@@ -93,6 +94,9 @@ struct CompensatorConfig {
   // tracking voltage) is approached at this rate until the command meets the excitation: a real
   // stage's resonance is not rung by a move at the slew limit. The bridge's safe ramp's default.
   double experiment_ramp_V_per_s = 1.0e3;
+  // A set swapped in on a periodic line that tracks it worse than the set before is taken back
+  // (loop/swap_review.hpp): a refit judged on its window can still be wrong for the line.
+  SwapReviewConfig swap_review{};
   // The share of the slew limit a tracked line's feedforward may use.
   double tracking_slew_fraction() const noexcept { return plan_slew_fraction - servo_slew_reserve; }
   double tracking_slew_V_per_s() const noexcept { return tracking_slew_fraction() * slew_V_per_s; }
@@ -136,6 +140,8 @@ struct CompensatorCounters {
   std::uint64_t stage_swaps = 0;          // stage models swapped in
   std::uint64_t experiment_ramped =
       0;  // experiment ticks ramped towards an excitation that starts away (experiment_ramp_V_per_s)
+  std::uint64_t swaps_reviewed = 0;    // swaps on a periodic line judged by its tracking (swap_review)
+  std::uint64_t swaps_taken_back = 0;  // ... that tracked it worse: the set before swapped in again
 
   // Every counter with the name the compensator's status gives it. The sum over axes and the
   // status walk this list, and a field above that is not in it fails the static_assert below: no
@@ -162,6 +168,8 @@ struct CompensatorCounters {
     f("trajectories_shaped", &CompensatorCounters::trajectories_shaped);
     f("stage_swaps", &CompensatorCounters::stage_swaps);
     f("experiment_ramped", &CompensatorCounters::experiment_ramped);
+    f("swaps_reviewed", &CompensatorCounters::swaps_reviewed);
+    f("swaps_taken_back", &CompensatorCounters::swaps_taken_back);
   }
   // The sum over several axes' laws.
   CompensatorCounters& operator+=(const CompensatorCounters& b) noexcept {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace hystloop {
 
@@ -11,7 +12,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 FeedforwardPlanner::FeedforwardPlanner(const CompensatorConfig& config)
-    : config_(config), mode_(config.mode), inverses_(config.models), exchange_(config) {
+    : config_(config),
+      mode_(config.mode),
+      inverses_(config.models),
+      exchange_(config),
+      review_(config.swap_review, std::llround(SwapReview::kMaxWindow_s / config.dt_s) + 1, config.horizon_ticks) {
   reversals_.reset(0.0);
   set_stage(config.stage);
   counters_.stage_swaps = 0;
@@ -44,6 +49,7 @@ void FeedforwardPlanner::set_stage(const StageModel& stage) noexcept {
 void FeedforwardPlanner::carry_params_over(const FeedforwardPlanner& from) {
   inverses_.take_params_from(from.inverses_);
   exchange_.carry_over(from.exchange_);
+  taking_back_ = from.taking_back_;
   set_stage(from.stage_model_);
   counters_.stage_swaps = 0;  // the same stage: no swap
 }
@@ -139,8 +145,15 @@ double FeedforwardPlanner::restart_at_reversal(FeedforwardMode mode, double u_re
 
 void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) noexcept {
   const bool switching = exchange_.switches_model(mode_);
+  const bool taking_back = std::exchange(taking_back_, false);
+  // What the set replaces, for a review to take back (the model in force and, when the set brings
+  // one, the stage).
+  Replaced before{{}, exchange_.version()};
+  inverses_.get_params(before.params);
+  before.params.kind = model_kind_of(mode_).value_or(ModelKind::mem);
   const ParameterExchange::Pending taken = exchange_.take();
   const ModelParamSet& p = taken.params;
+  if (p.stage) before.params.stage = stage_model_;
   const FeedforwardMode to = mode_of(p.kind);
   const bool in_use = switching || to == mode_;
   FeedforwardAnchor& anchor = exchange_.anchor();
@@ -150,6 +163,11 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
   if (p.stage) set_stage(*p.stage);  // at a reversal the stage is nearly at rest: restart it there
   ++counters_.params_swapped;
   if (!in_use) return;
+  // A take-back restores a set the line tracked better under: not judged again (no back and forth).
+  if (review_.swapped(k, review_span(), !taking_back)) {
+    ++counters_.swaps_reviewed;
+    replaced_ = before;
+  }
   if (switching) {
     mode_ = to;
     ++counters_.model_switches;
@@ -179,6 +197,7 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
 void FeedforwardPlanner::set_mode(FeedforwardMode mode) noexcept {
   if (mode != mode_) {
     mode_ = mode;
+    review_.not_comparable(std::max<std::int64_t>(next_tick_, 0));
     inverse_fresh_ = true;
     if (counters_.planned > 0) anchor_ = StagePoint{last_u_, last_w_, kNaN};
   }
@@ -219,9 +238,28 @@ std::optional<double> FeedforwardPlanner::observe(const CompensatorInput& sample
   if (exchange_.anchor().observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) {
     ++counters_.reanchors;
   }
+  if (review_.observe(sample.seq, sample.y_m) == SwapReview::Verdict::worse && replaced_) {
+    // The set before goes back in at the next reversal, as any set does (re-anchored there), in
+    // place of one still waiting: a set fitted since is no better founded than the one refused.
+    ++counters_.swaps_taken_back;
+    exchange_.offer(replaced_->params, /*switch_model=*/true, replaced_->version);
+    taking_back_ = true;
+    replaced_.reset();
+  }
   // Fast: half the plan's share of the slew limit per tick, where a servo along it could reach the limit.
   servo_activity_.observe(sample, config_.dt_s, 0.5 * config_.tracking_slew_V_per_s() * config_.dt_s);
   return sample.y_m - servo_share_.position_m(sample, inverses_.linear_params().gain, config_.dt_s);
+}
+
+bool FeedforwardPlanner::comparable_reference(std::int64_t k) const noexcept {
+  if (scan_ || trajectory_starts_now_ || from_moving_ || !periodic(trajectory_)) return false;
+  return loop_time(k) >= trajectory_.start_s + first_extreme_s(trajectory_) + 1.0 / trajectory_.frequency_hz;
+}
+
+SwapReviewSpan FeedforwardPlanner::review_span() const noexcept {
+  if (!periodic(trajectory_) || scan_) return {};
+  return swap_review_span(1.0 / trajectory_.frequency_hz, config_.dt_s, config_.horizon_ticks + preview_ticks_,
+                          config_.reanchor_ramp_ticks);
 }
 
 void FeedforwardPlanner::restart_reference(double t_s, double from_m) noexcept {
@@ -288,6 +326,7 @@ CommandTick FeedforwardPlanner::plan_tick(std::int64_t k, PeriodicLearner* learn
     }
     last_u_ = u;
     last_u_wanted_ = kNaN;
+    review_.not_comparable(k);
     return {k, u, kNaN, exchange_.version(), kExperimentMode};
   }
   approaching_ = false;
@@ -299,6 +338,7 @@ CommandTick FeedforwardPlanner::plan_tick(std::int64_t k, PeriodicLearner* learn
   }
   if (awaiting_anchor_) {
     last_u_wanted_ = kNaN;
+    review_.not_comparable(k);
     return {k, last_u_, kNaN, exchange_.version(), static_cast<std::int8_t>(mode_)};
   }
   return tracking_tick(k, learning);
@@ -452,6 +492,7 @@ CommandTick FeedforwardPlanner::command(std::int64_t k, double u, double y_ref, 
   // The anchor compares the measured position with the reference the model was asked for (not
   // the learned correction: what the learning adds is meant to make y follow y_ref).
   anchor.planned(k, y_ref - shift_m_, u - shift_V, reversal);
+  review_.planned(k, y_ref, !learned && comparable_reference(k));
   last_w_ = w_ref;
   last_u_ = u;
   return {k, u, y_ref, exchange_.version(), static_cast<std::int8_t>(mode_)};

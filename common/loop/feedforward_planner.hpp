@@ -32,6 +32,7 @@
 #include "loop/periodic_learner.hpp"
 #include "loop/scan_path.hpp"
 #include "loop/servo_share.hpp"
+#include "loop/swap_review.hpp"
 #include "loop/trajectory.hpp"
 #include "models/linear_stage.hpp"
 #include "models/preview_inverse.hpp"
@@ -156,6 +157,11 @@ class FeedforwardPlanner {
   // the model's output there.
   double restart_at_reversal(FeedforwardMode mode, double u_rev) noexcept;
   double nominal_slope() const noexcept;  // [m/V] for the re-anchoring ramp when no secant is known
+  // Tick k's tracking can be held against the ticks before it (SwapReview): a periodic trajectory
+  // past its approach and first period, no scan.
+  bool comparable_reference(std::int64_t k) const noexcept;
+  // What a review of a swap on the line in force spans (no window when the line is not judged).
+  SwapReviewSpan review_span() const noexcept;
 
   CompensatorConfig config_;
   FeedforwardMode mode_;
@@ -194,6 +200,15 @@ class FeedforwardPlanner {
   double last_w_ = 0.0;                  // the stage-inverted reference last planned (the hysteresis model's target)
   PlanExtent extent_{};                  // of the tracking ticks planned (dry runs read it)
   double last_u_wanted_ = std::numeric_limits<double>::quiet_NaN();  // the last tick's u before any clamp
+  // Swaps judged by the tracking they give; the set a reviewed swap replaced, taken back when the
+  // review finds it tracked better.
+  SwapReview review_;
+  struct Replaced {
+    ModelParamSet params;
+    std::int32_t version;
+  };
+  std::optional<Replaced> replaced_;
+  bool taking_back_ = false;  // the waiting set is a take-back: not judged again
   ExperimentQueue experiments_;
   ReversalDetector reversals_;
   // The experiment's voltage: where its last branch of the hysteresis began, for the anchor.

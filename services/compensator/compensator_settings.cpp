@@ -211,6 +211,8 @@ const std::vector<std::string>& compensator_config_keys() {
                                   "compensator.plan_slew_fraction",
                                   "compensator.servo_slew_reserve",
                                   "compensator.experiment_ramp_V_per_s",
+                                  "compensator.swap_worse_ratio",
+                                  "compensator.swap_min_excess_m",
                                   "compensator.plausible_gain_factor",
                                   "actuator.u_min_V",
                                   "actuator.u_max_V",
@@ -318,6 +320,9 @@ CompensatorSettings load_compensator_settings(const Config& config) {
   c.servo_slew_reserve =
       config.get_in_range("compensator.servo_slew_reserve", c.servo_slew_reserve, 0.0, c.plan_slew_fraction - 0.05);
   c.experiment_ramp_V_per_s = config.get_positive("compensator.experiment_ramp_V_per_s", c.experiment_ramp_V_per_s);
+  c.swap_review.worse_ratio = config.get<double>("compensator.swap_worse_ratio", c.swap_review.worse_ratio);
+  c.swap_review.min_excess_m = config.get<double>("compensator.swap_min_excess_m", c.swap_review.min_excess_m);
+  c.swap_review.validate();
 
   c.stage = read_stage_model(config, c.stage, c.dt_s);
 
