@@ -87,6 +87,11 @@ class OnlineMemEstimator {
   std::uint64_t version() const noexcept { return version_; }
   const OnlineMemOptions& options() const noexcept { return options_; }
   std::uint64_t samples_fed() const noexcept { return seq_; }
+  // The window starts again: what was fed before belongs to another reference, and a window
+  // holding two is fitted by a set that explains neither. A window is full again after
+  // window_samples more (samples_since_restart).
+  void restart_window() noexcept { window_start_ = seq_; }
+  std::uint64_t samples_since_restart() const noexcept { return seq_ - window_start_; }
   std::uint64_t non_finite_samples() const noexcept { return non_finite_; }
   std::uint64_t dropouts() const noexcept { return dropouts_; }
   std::uint64_t refits_accepted() const noexcept { return accepted_; }
@@ -96,8 +101,9 @@ class OnlineMemEstimator {
   OnlineMemOptions options_;
   MemParams params_;
   std::uint64_t version_ = 1;
-  std::vector<double> u_, y_;  // the ring
-  std::uint64_t seq_ = 0;      // samples fed; next write at seq_ % capacity
+  std::vector<double> u_, y_;       // the ring
+  std::uint64_t seq_ = 0;           // samples fed; next write at seq_ % capacity
+  std::uint64_t window_start_ = 0;  // seq_ at the last restart_window()
   double last_u_ = 0.0, last_y_ = 0.0;
   std::size_t stuck_run_ = 0;
   PoisonKind poison_ = PoisonKind::none;

@@ -157,7 +157,7 @@ ModelDecision ModelChooser::poll(ReidentCore& core, std::int64_t now_us) {
   }
   const std::uint64_t fed = core.estimator().samples_fed();
   const std::size_t window = core.options().estimator.window_samples;
-  if (slot_.idle() && now_us >= next_us_ && fed >= window && fed != fed_at_last_) {
+  if (slot_.idle() && now_us >= next_us_ && core.estimator().samples_since_restart() >= window && fed != fed_at_last_) {
     core.estimator().snapshot(window_);  // allocation-free: window_ came from make_window()
     job_poisoned_ = window_.poison != PoisonKind::none;
     if (in_use_.kind == ModelKind::mem) in_use_.mem = core.in_use().params();  // MEM refits move it

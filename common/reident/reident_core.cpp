@@ -149,6 +149,12 @@ bool ReidentCore::implausible(const MemParams& params) noexcept {
   return true;
 }
 
+void ReidentCore::on_new_reference() noexcept {
+  flush_stage_removal();
+  estimator_.restart_window();
+  counters_.add(ReidentCounter::window_restarts);
+}
+
 RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
   RefitDecision d;
   if (worker_.done()) {
@@ -156,8 +162,8 @@ RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {
     worker_.release();
   }
   const std::uint64_t fed = estimator_.samples_fed();
-  if (mem_refits_ && worker_.idle() && now_us >= next_refit_us_ && fed >= options_.estimator.window_samples &&
-      fed != fed_at_last_snapshot_) {
+  if (mem_refits_ && worker_.idle() && now_us >= next_refit_us_ &&
+      estimator_.samples_since_restart() >= options_.estimator.window_samples && fed != fed_at_last_snapshot_) {
     estimator_.snapshot(worker_.job_window());               // no allocation: the worker's window is preallocated
     worker_.submit(in_use_.params(), in_use_.generation());  // "version": which set in use it was judged against
     counters_.add(ReidentCounter::refits_attempted);

@@ -82,6 +82,10 @@ class ReidentCore {
   ParamsOffer on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                         std::string_view source) noexcept;
   RefitDecision poll(std::int64_t now_us) noexcept;
+  // A new reference was requested for our axis (a trajectory or a scan): the estimator's window
+  // starts again, so that no refit (MEM's or the model choice's) is fitted across two references;
+  // the next one waits for a full window of the new. Counted (window_restarts).
+  void on_new_reference() noexcept;
 
   // A version for a refused candidate published as valid = false (--publish-invalid).
   std::int32_t claim_diagnostic_version() noexcept { return in_use_.claim_version(); }

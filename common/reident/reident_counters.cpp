@@ -25,6 +25,7 @@ constexpr std::array<std::string_view, kReidentCounterCount> kNames{
     "command_versions_dropped",
     "sensor_blocks_wrong_axes",
     "params_other_axis",
+    "window_restarts",
     // One per refusal reason, in FitStatus's order from kFirstRefusal.
     "refits_rejected_size_mismatch",
     "refits_rejected_non_finite_data",

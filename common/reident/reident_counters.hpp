@@ -35,6 +35,7 @@ enum class ReidentCounter : std::uint8_t {
   command_versions_dropped,  // HX_COMMAND version changes beyond VersionTimeline's capacity (pending at once)
   sensor_blocks_wrong_axes,  // HX_SENSOR blocks without the re-identifier's axis: not fitted, as refused
   params_other_axis,         // HX_PARAMS sets for another axis: another re-identifier's, ignored
+  window_restarts,           // a new reference requested (HX_TRAJECTORY, HX_SCAN): the window starts again
   refits_rejected_first      // + (FitStatus - kFirstRefusal) for each refusal reason a refit can have
 };
 

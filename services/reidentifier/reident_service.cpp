@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -100,6 +101,17 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
   control_ = std::make_unique<Subscription<control_t>>(lcm, names.control,
                                                        [this](const control_t& msg, std::int64_t) { on_control(msg); });
+  // A new reference for our axis: the window starts again (ReidentCore::on_new_reference). A request
+  // the compensator then refuses costs a window's wait for the next refit, nothing more.
+  trajectory_ = std::make_unique<Subscription<trajectory_t>>(
+      lcm, names.trajectory, [this](const trajectory_t& msg, std::int64_t) {
+        if (msg.axis != options_.axis || msg.version == std::exchange(trajectory_version_, msg.version)) return;
+        core_->on_new_reference();
+      });
+  scan_ = std::make_unique<Subscription<scan_t>>(lcm, names.scan, [this](const scan_t& msg, std::int64_t) {
+    if (msg.version == std::exchange(scan_version_, msg.version)) return;
+    core_->on_new_reference();
+  });
   rig_check_ = std::make_unique<RigCheck>(lcm, names.status, std::move(rig_limits), process_);
 }
 
@@ -201,6 +213,8 @@ void ReidentService::on_control(const control_t& msg) {
     reported_.rebase("command", command_->counters());
     reported_.rebase("params_in", params_in_->counters());
     reported_.rebase("control", control_->counters());
+    reported_.rebase("trajectory", trajectory_->counters());
+    reported_.rebase("scan", scan_->counters());
     reported_.rebase("params_out", params_out_.counters());
     reported_.rebase("model_out", model_out_.counters());
   }
@@ -363,6 +377,8 @@ void ReidentService::publish_status(std::int64_t now_us, bool stopping) {
   reported_.report(status_, "command", command_->counters());
   reported_.report(status_, "params_in", params_in_->counters());
   reported_.report(status_, "control", control_->counters());
+  reported_.report(status_, "trajectory", trajectory_->counters());
+  reported_.report(status_, "scan", scan_->counters());
   reported_.report(status_, "params_out", params_out_.counters());
   reported_.report(status_, "model_out", model_out_.counters());
   status_.loop_timing(block_cost_);  // per-block handler cost

@@ -19,6 +19,9 @@
 //                   ignored; a set with our publisher id and a version we never published is not
 //                   used, logged once, counted (params_forged) and DEGRADED on <rig>STATUS (for
 //                   30 s after the last one, and while the compensator applies it)
+//   <rig>TRAJECTORY, <rig>SCAN -> a new reference for our axis (each request's version once): the
+//                   estimator's window starts again (window_restarts), so that no refit is fitted
+//                   across two references
 //   <rig>CONTROL -> SHUTDOWN and RESET_COUNTERS addressed to our process name (or to all)
 //   every 10 ms  -> poll the core: publish an accepted candidate on <rig>PARAMS (valid = true,
 //                   residual_m = its held-out RMS); a refused one is counted, logged by the
@@ -42,7 +45,9 @@
 #include "hystloop/control_t.hpp"
 #include "hystloop/mem_params_t.hpp"
 #include "hystloop/model_params_t.hpp"
+#include "hystloop/scan_t.hpp"
 #include "hystloop/sensor_block_t.hpp"
+#include "hystloop/trajectory_t.hpp"
 #include "lcm/channels.hpp"
 #include "lcm/control_filter.hpp"
 #include "lcm/publisher.hpp"
@@ -118,6 +123,11 @@ class ReidentService {
   std::unique_ptr<Subscription<command_block_t>> command_;
   std::unique_ptr<Subscription<mem_params_t>> params_in_;
   std::unique_ptr<Subscription<control_t>> control_;
+  // New references (requests; sent more than once, each version restarts the window once).
+  std::unique_ptr<Subscription<trajectory_t>> trajectory_;
+  std::unique_ptr<Subscription<scan_t>> scan_;
+  std::int64_t trajectory_version_ = -1;
+  std::int64_t scan_version_ = -1;
   std::unique_ptr<RigCheck> rig_check_;  // refuses this process when the bridge's actuator range is not its own
 };
 

@@ -155,6 +155,25 @@ TEST(ReidentCore, SchedulesOneRefitPerPeriodOnceAFullWindowOfNewDataIsThere) {
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 3u);
 }
 
+// A new reference requested: the window starts again, and the next refit waits for a full window of
+// the new reference (a window holding the end of one line and the start of the next is fitted by a
+// set that explains neither).
+TEST(ReidentCore, ANewReferenceStartsTheWindowAgain) {
+  Rig rig;
+  rig.advance(0.6);  // more than a window (0.5 s in the small options)
+  rig.core.on_new_reference();
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::window_restarts), 1u);
+  rig.core.poll(rig.now);
+  EXPECT_TRUE(rig.core.worker().idle());  // the window holds the reference before only
+  rig.advance(0.4);
+  rig.core.poll(rig.now);
+  EXPECT_TRUE(rig.core.worker().idle());  // 0.4 s of the new one
+  rig.advance(0.2);
+  rig.core.poll(rig.now);
+  EXPECT_FALSE(rig.core.worker().idle());  // a full window of it
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 1u);
+}
+
 TEST(ReidentCore, AnOutcomeJudgedAgainstAReplacedSetIsNotAdopted) {
   Rig rig;
   rig.advance();
