@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "ident/stage_hysteresis_fit.hpp"
 #include "ident/stage_identification.hpp"
 #include "models/multisine.hpp"
 #include "py_common.hpp"
@@ -32,7 +34,7 @@ std::vector<C> roots_hz(const std::vector<C>& roots_rad_s) {
 py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_rate_Hz, std::size_t period_samples,
                         std::size_t periods, std::size_t realisations, std::size_t transient_periods,
                         const std::optional<std::pair<double, double>>& band, const std::string& order, int max_order,
-                        double max_delay_s, bool continuous, bool sampled_at_tick_end) {
+                        double max_delay_s, bool continuous, bool sampled_at_tick_end, std::size_t hysteresis_plays) {
   const std::span<const double> u = view_1d(u_in, "u"), y = view_1d(y_in, "y");
   StageFitOptions o;
   o.unit_dc_gain = false;  // the data carry the actuator's gain: reported as dc_gain
@@ -46,6 +48,8 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
   fo.realisations = realisations;
   fo.transient_periods = transient_periods;
   StageIdentification id;
+  HysteresisStageIdentification through;
+  double dc_gain = 0.0;
   try {
     set_stage_order(order, o);
     fo.validate();
@@ -60,7 +64,17 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
       mo.f_max_Hz = 0.45 * sample_rate_Hz;
     }
     const std::vector<std::size_t> lines = multisine_lines(mo);
-    id = identify_stage_dynamics(u, y, lines, fo, o, sampled_at_tick_end);
+    if (hysteresis_plays > 0) {
+      HysteresisStageOptions ho;
+      ho.operators = hysteresis_plays;
+      through = identify_stage_with_hysteresis(u, y, lines, fo, o, sampled_at_tick_end, ho);
+      dc_gain = through.linear.fit.dc_gain;
+      // A series model that could not be fitted leaves the stage from u -> y, as with 0 plays.
+      id = through.ok() && through.rounds > 0 ? through.stage : through.linear;
+    } else {
+      id = identify_stage_dynamics(u, y, lines, fo, o, sampled_at_tick_end);
+      dc_gain = id.fit.dc_gain;
+    }
   } catch (const ParameterError& e) {
     throw PyParameterError(e.field(), e.what());
   }
@@ -78,7 +92,13 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
   d["sigma_noise"] = frf.sigma_noise;
   d["coherence"] = frf.coherence;
   d["model_G"] = model;
-  d["dc_gain"] = fit.dc_gain;
+  d["dc_gain"] = dc_gain;
+  const bool series = through.ok() && through.rounds > 0;
+  d["through_hysteresis"] = series;
+  d["hysteresis_thresholds_V"] = series ? through.thresholds_V : std::vector<double>{};
+  d["hysteresis_weights"] = series ? through.weights : std::vector<double>{};
+  d["residual_rms"] = series ? through.residual_rms : std::numeric_limits<double>::quiet_NaN();
+  d["residual_rms_linear"] = series ? through.residual_rms_linear : std::numeric_limits<double>::quiet_NaN();
   d["poles_hz"] = roots_hz(fit.poles_rad_s);
   d["zeros_hz"] = roots_hz(fit.zeros_rad_s);
   d["delay_s"] = fit.delay_s;
@@ -97,9 +117,10 @@ void register_stage(py::module_& m) {
         py::arg("period_samples"), py::arg("periods"), py::arg("realisations") = 1, py::arg("transient_periods") = 1,
         py::arg("band") = py::none(), py::arg("order") = "auto", py::arg("max_order") = 8,
         py::arg("max_delay_s") = 1e-3, py::arg("continuous") = false, py::arg("sampled_at_tick_end") = true,
+        py::arg("hysteresis_plays") = 15,
         R"doc(identify_stage(u, y, *, sample_rate_Hz=1e4, period_samples, periods, realisations=1,
                transient_periods=1, band=None, order="auto", max_order=8, max_delay_s=1e-3,
-               continuous=False, sampled_at_tick_end=True) -> dict
+               continuous=False, sampled_at_tick_end=True, hysteresis_plays=15) -> dict
 
 A stage's linear dynamics from a periodic multisine record (hystloop-ctl experiment multisine,
 or any periodic excitation), the steps of hystloop-identify --model stage:
@@ -111,10 +132,17 @@ or any periodic excitation), the steps of hystloop-identify --model stage:
   continuous            the data were not held and sampled (no zero-order hold in the model)
   sampled_at_tick_end   y_k measured at the end of tick k (a hystloop bridge): the data are moved
                         by that tick so that delay_s is the rig's own
-Returns frequency_Hz, G [m/V] and sigma (its standard deviation, from periods and realisations),
-sigma_noise, coherence, model_G (the fitted model's response, as sampled), dc_gain [m/V],
-poles_hz and zeros_hz (s / 2 pi, complex), delay_s [s], order, chi2_per_line against
-chi2_expected, order_consistent, distortion_ratio. Refusals raise hystloop.ParameterError.)doc");
+  hysteresis_plays      play operators of a Prandtl-Ishlinskii hysteresis fitted together with the
+                        stage (as hystloop-identify --hysteresis-plays): the stage is measured from
+                        the hysteresis' output H(u), with unit DC gain; 0: from u -> y alone
+Returns frequency_Hz, G and sigma (its standard deviation, from periods and realisations; from H(u)
+to y, unit DC gain, when through_hysteresis, else from u to y [m/V]), sigma_noise, coherence,
+model_G (the fitted model's response, as sampled, in G's units), dc_gain [m/V] (u -> y), poles_hz
+and zeros_hz (s / 2 pi, complex), delay_s [s], order, chi2_per_line against chi2_expected,
+order_consistent, distortion_ratio; through_hysteresis, hysteresis_thresholds_V and
+hysteresis_weights [m/V] (H's plays), residual_rms and residual_rms_linear (what G(H(u)) and the
+u -> y fit leave of the record [m]; NaN without the hysteresis). Refusals raise
+hystloop.ParameterError.)doc");
 }
 
 }  // namespace hystloop::python

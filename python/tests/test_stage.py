@@ -47,6 +47,24 @@ class IdentifyStage(unittest.TestCase):
         self.assertLess(np.max(np.abs(g - model) / np.abs(model)), 0.01)
         self.assertTrue(np.all(np.asarray(st["sigma"]) > 0))
 
+    def test_through_the_hysteresis_the_gain_is_the_plays_and_u_to_y_is_kept_apart(self):
+        lines = range(1, 300)
+        u = multisine(lines, periods=4)
+        y = first_order(u, fc_hz=500.0, gain=6e-9, noise_m=1e-11)
+        through = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1")
+        alone = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1",
+                                        hysteresis_plays=0)
+        self.assertTrue(through["through_hysteresis"])
+        self.assertFalse(alone["through_hysteresis"])
+        self.assertTrue(math.isnan(alone["residual_rms"]))
+        # No hysteresis here: the linear play carries the gain, the stage is the same, G has unit DC gain.
+        self.assertEqual(len(through["hysteresis_weights"]), 15)
+        self.assertAlmostEqual(through["hysteresis_weights"][0] / 6e-9, 1.0, delta=1e-2)
+        self.assertAlmostEqual(through["dc_gain"], alone["dc_gain"], delta=1e-12)
+        self.assertAlmostEqual(abs(np.asarray(through["G"])[0]), 1.0, delta=1e-2)
+        self.assertAlmostEqual(through["poles_hz"][0].real / alone["poles_hz"][0].real, 1.0, delta=1e-2)
+        self.assertLessEqual(through["residual_rms"], through["residual_rms_linear"] * 1.01)
+
     def test_refusals_name_the_parameter(self):
         u = multisine(range(1, 50), periods=4)
         with self.assertRaises(hystloop.ParameterError) as e:

@@ -132,6 +132,13 @@ void add_identify_options(CLI::App& app, IdentifyArgs& args) {
   stage->add_option("--max-delay", args.max_delay_s, "largest input delay searched [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  stage
+      ->add_option("--hysteresis-plays", args.hysteresis_plays,
+                   "play operators of a Prandtl-Ishlinskii hysteresis fitted together with the stage, so that the "
+                   "series model explains the record and the stage is measured from the hysteresis' output, not "
+                   "from u (whose best linear approximation rises with frequency); 0: from u -> y alone")
+      ->check(CLI::Range(0, 32))
+      ->capture_default_str();
   stage->add_flag("--continuous", args.continuous,
                   "the record was not held and sampled at the sample rate: fit the continuous response (default: "
                   "the exact zero-order-hold response, as a bridge drives and samples)");

@@ -71,6 +71,9 @@ struct IdentifyArgs {
   std::string order = "auto";            // NUM/DEN (e.g. 2/4), or auto
   int max_order = 8;                     // auto: largest denominator order tried
   double max_delay_s = 1e-3;
+  // Play operators of the hysteresis fitted with the stage (ident/stage_hysteresis_fit.hpp); 0: the
+  // stage from u -> y alone (the best linear approximation of hysteresis and stage together).
+  std::size_t hysteresis_plays = 15;
   bool continuous = false;        // the data were not held and sampled at the sample rate (no ZOH in the model)
   std::string sample_at = "end";  // y_k measured at the end of tick k (the rig's, linear_stage.hpp) or its start
   std::string true_stage;         // a YAML whose plant.stage (or stage) is the stage the record came from

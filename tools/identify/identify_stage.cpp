@@ -16,6 +16,7 @@
 #include "core/config.hpp"
 #include "core/errors.hpp"
 #include "ident/sample_csv.hpp"
+#include "ident/stage_hysteresis_fit.hpp"
 #include "ident/stage_identification.hpp"
 #include "identify_output.hpp"
 #include "log_samples.hpp"
@@ -221,7 +222,7 @@ FittedServo fitted_servo(const StageRecord& r, const StageFitResult& fit) {
   }
 }
 
-std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit,
+std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const StageFitResult& fit, double dc_gain,
                        const std::string& heading, double known_to_hz, const FittedServo& fitted) {
   std::ostringstream y;
   y << "# hystloop-identify --model stage: " << heading << "\n"
@@ -229,7 +230,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
     << "# " << frf.frequency_Hz.size() << " lines " << num(frf.frequency_Hz.front()) << " .. "
     << num(frf.frequency_Hz.back()) << " Hz, " << frf.periods_used << " periods used x " << frf.realisations
     << " realisations; distortion ratio (sigma_total^2 / sigma_noise^2) " << num(frf.distortion_ratio, 3) << "\n"
-    << "# measured DC gain u -> y: " << num(fit.dc_gain, 8)
+    << "# measured DC gain u -> y: " << num(dc_gain, 8)
     << " per V (the hysteresis model carries it: the stage below has unit DC gain)\n"
     << "# model: orders " << fit.numerator_order << "/" << fit.denominator_order
     << (fit.zoh_sample_rate_Hz > 0.0 ? ", exact zero-order hold at " + num(fit.zoh_sample_rate_Hz) + " Hz"
@@ -270,7 +271,7 @@ std::string stage_yaml(const StageRecord& r, const FrequencyResponse& frf, const
   return y.str();
 }
 
-void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
+void print_fit(const FrequencyResponse& frf, const StageFitResult& fit, double dc_gain) {
   std::printf("FRF: %zu lines %.6g .. %.6g Hz, %zu periods used x %zu realisations, distortion ratio %.3g\n",
               frf.frequency_Hz.size(), frf.frequency_Hz.front(), frf.frequency_Hz.back(), frf.periods_used,
               frf.realisations, frf.distortion_ratio);
@@ -284,7 +285,7 @@ void print_fit(const FrequencyResponse& frf, const StageFitResult& fit) {
   std::printf("stage model: orders %d/%d, delay %.6g s, chi2 per line %.4g (expected %.4g)%s\n", fit.numerator_order,
               fit.denominator_order, fit.delay_s, fit.chi2_per_line, fit.chi2_expected,
               fit.order_consistent ? "" : " -- not explained by the uncertainty");
-  std::printf("measured DC gain u -> y: %.8g per V (carried by the hysteresis model)\n", fit.dc_gain);
+  std::printf("measured DC gain u -> y: %.8g per V (carried by the hysteresis model)\n", dc_gain);
   for (const C p : fit.poles_rad_s) {
     if (p.imag() < 0.0) continue;
     const double w = std::abs(p);
@@ -495,15 +496,36 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   fo.periods = r.periods;
   fo.realisations = r.realisations;
   fo.transient_periods = args.transient_periods;
-  const StageIdentification id =
-      identify_stage_dynamics(r.u, r.y, r.lines, fo, fit_options(args, r), !args.continuous && args.sample_at == "end");
+  const bool end_of_tick = !args.continuous && args.sample_at == "end";
+  StageIdentification id;
+  double dc_gain = 0.0;  // u -> y [m/V]: what the hysteresis model carries
+  if (args.hysteresis_plays > 0) {
+    HysteresisStageOptions ho;
+    ho.operators = args.hysteresis_plays;
+    HysteresisStageIdentification h =
+        identify_stage_with_hysteresis(r.u, r.y, r.lines, fo, fit_options(args, r), end_of_tick, ho);
+    if (h.linear.ok()) dc_gain = h.linear.fit.dc_gain;
+    if (h.ok() && h.rounds > 0) {
+      std::printf(
+          "through the hysteresis: %zu plays fitted with the stage (%d rounds); the record's residual %.3g (u -> y "
+          "alone: %.3g); the response below is from the hysteresis' output to y\n",
+          args.hysteresis_plays, h.rounds, h.residual_rms, h.residual_rms_linear);
+    } else if (h.linear.ok()) {
+      std::printf("through the hysteresis: no fit (%s); the stage from u -> y alone\n",
+                  h.stage.ok() ? "the plays explained nothing" : h.stage.reason().c_str());
+    }
+    id = h.ok() && h.rounds > 0 ? std::move(h.stage) : std::move(h.linear);
+  } else {
+    id = identify_stage_dynamics(r.u, r.y, r.lines, fo, fit_options(args, r), end_of_tick);
+    dc_gain = id.fit.dc_gain;
+  }
   if (!id.ok()) {
     std::cerr << "hystloop-identify: " << id.reason() << "\n";
     return kExitFailure;
   }
   const FrequencyResponse& frf = id.frf;
   const StageFitResult& fit = id.fit;
-  print_fit(frf, fit);
+  print_fit(frf, fit, dc_gain);
   const double known_to_hz = model_known_to_hz(id, kLearningShareOfResonance * lowest_feature_hz(r, fit));
   std::printf("model known (within %g %% of the record, +2 sigma) up to %.6g Hz\n", 100.0 * kStageKnownWithin,
               known_to_hz);
@@ -511,7 +533,9 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
   print_servo(servo);
   std::string heading = fs::path(args.files.front()).filename().string();
   const OutputTarget target = output_target(args.out);
-  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, heading, known_to_hz, servo)); rc != 0) return rc;
+  if (const int rc = write_yaml(target, stage_yaml(r, frf, fit, dc_gain, heading, known_to_hz, servo)); rc != 0) {
+    return rc;
+  }
   if (target.plots_dir) {
     const report::PlotResult plots = write_stage_plots(frf, fit, heading, *target.plots_dir, args.gnuplot);
     for (const auto& f : plots.images) std::printf("plot: %s\n", f.string().c_str());

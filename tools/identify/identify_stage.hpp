@@ -9,7 +9,9 @@
 // Work: the robust method's FRF with its uncertainty (ident/frequency_response.hpp), then the
 // rational model with delay (ident/stage_fit.hpp) weighted by sigma_total (sigma_noise with one
 // realisation), of the order given (--order NUM/DEN) or chosen, with the exact zero-order hold of a
-// bridge unless --continuous.
+// bridge unless --continuous. By default through the hysteresis (ident/stage_hysteresis_fit.hpp):
+// a Prandtl-Ishlinskii model of --hysteresis-plays plays fitted together with the stage, and the
+// FRF and fit from its output to y (--hysteresis-plays 0: from u -> y alone).
 // Output: a YAML stage section in LinearStageSpec's zero/pole form (models/linear_stage.hpp):
 //   stage:
 //     zeros_hz: [[re, im], ...]   # s = 2 pi (re + i im); im != 0 stands for its conjugate pair
