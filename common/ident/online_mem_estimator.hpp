@@ -92,6 +92,8 @@ class OnlineMemEstimator {
   // window_samples more (samples_since_restart).
   void restart_window() noexcept { window_start_ = seq_; }
   std::uint64_t samples_since_restart() const noexcept { return seq_ - window_start_; }
+  // A window snapshot taken when `fed` samples had been fed holds another reference's samples.
+  bool restarted_since(std::uint64_t fed) const noexcept { return window_start_ > 0 && window_start_ >= fed; }
   std::uint64_t non_finite_samples() const noexcept { return non_finite_; }
   std::uint64_t dropouts() const noexcept { return dropouts_; }
   std::uint64_t refits_accepted() const noexcept { return accepted_; }

@@ -68,7 +68,11 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
   fit_options.unit_dc_gain = false;  // u -> y carries the actuator's gain
   r.linear = identify_stage_dynamics(u, y, lines, frf_options, fit_options, sampled_at_tick_end);
   r.stage = r.linear;
-  if (!r.linear.ok() || lines.empty()) return r;
+  const double dc = r.linear.fit.dc_gain;
+  if (!r.linear.ok() || lines.empty() || !std::isfinite(dc) || dc == 0.0) return r;
+  // The plays' weights are >= 0 (a monotone hysteresis); an actuator wired the other way round has a
+  // negative gain: H is then -sum w_i F_ri[u], fitted to -y.
+  const double sign = dc > 0.0 ? 1.0 : -1.0;
 
   const std::size_t n = frf_options.period_samples;
   const std::size_t periods = frf_options.periods;
@@ -141,8 +145,8 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
     for (std::size_t rr = 0; rr < realisations; ++rr) {
       for (std::size_t k = 0; k < K; ++k) {
         const auto row = static_cast<Eigen::Index>(2 * (rr * K + k));
-        b(row) = Y[rr * K + k].real();
-        b(row + 1) = Y[rr * K + k].imag();
+        b(row) = sign * Y[rr * K + k].real();
+        b(row + 1) = sign * Y[rr * K + k].imag();
         for (std::size_t i = 0; i < ops; ++i) {
           const C z = gk[k] * P[(rr * ops + i) * K + k];
           a(row, static_cast<Eigen::Index>(i)) = z.real();
@@ -156,7 +160,7 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
     for (std::size_t i = 0; i < ops; ++i) {
       const double wi = weights.x(static_cast<Eigen::Index>(i));
       if (wi == 0.0) continue;
-      for (std::size_t t = 0; t < u.size(); ++t) w[t] += wi * plays[i][t];
+      for (std::size_t t = 0; t < u.size(); ++t) w[t] += sign * wi * plays[i][t];
     }
     StageIdentification next = identify_stage_dynamics(w, y, lines, frf_options, fit_options, sampled_at_tick_end);
     if (!next.ok()) {
@@ -172,7 +176,7 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
         for (std::size_t i = 0; i < ops; ++i) {
           hk += weights.x(static_cast<Eigen::Index>(i)) * P[(rr * ops + i) * K + k];
         }
-        res[rr * K + k] = Y[rr * K + k] - gn * hk;
+        res[rr * K + k] = Y[rr * K + k] - sign * gn * hk;
       }
     }
     r.weights.assign(weights.x.data(), weights.x.data() + weights.x.size());

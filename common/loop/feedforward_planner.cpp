@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <utility>
 
 namespace hystloop {
 
@@ -49,7 +48,6 @@ void FeedforwardPlanner::set_stage(const StageModel& stage) noexcept {
 void FeedforwardPlanner::carry_params_over(const FeedforwardPlanner& from) {
   inverses_.take_params_from(from.inverses_);
   exchange_.carry_over(from.exchange_);
-  taking_back_ = from.taking_back_;
   set_stage(from.stage_model_);
   counters_.stage_swaps = 0;  // the same stage: no swap
 }
@@ -145,7 +143,6 @@ double FeedforwardPlanner::restart_at_reversal(FeedforwardMode mode, double u_re
 
 void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) noexcept {
   const bool switching = exchange_.switches_model(mode_);
-  const bool taking_back = std::exchange(taking_back_, false);
   // What the set replaces, for a review to take back (the model in force and, when the set brings
   // one, the stage).
   Replaced before{{}, exchange_.version()};
@@ -154,6 +151,8 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
   const ParameterExchange::Pending taken = exchange_.take();
   const ModelParamSet& p = taken.params;
   if (p.stage) before.params.stage = stage_model_;
+  // A set for a model not in use that brings a stage changes what the line runs on.
+  if (p.stage && !(switching || mode_of(p.kind) == mode_)) review_.not_comparable(k);
   const FeedforwardMode to = mode_of(p.kind);
   const bool in_use = switching || to == mode_;
   FeedforwardAnchor& anchor = exchange_.anchor();
@@ -164,7 +163,7 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
   ++counters_.params_swapped;
   if (!in_use) return;
   // A take-back restores a set the line tracked better under: not judged again (no back and forth).
-  if (review_.swapped(k, review_span(), !taking_back)) {
+  if (review_.swapped(k, review_span(), !taken.take_back)) {
     ++counters_.swaps_reviewed;
     replaced_ = before;
   }
@@ -197,7 +196,10 @@ void FeedforwardPlanner::swap_params(std::int64_t k, PeriodicLearner* learning) 
 void FeedforwardPlanner::set_mode(FeedforwardMode mode) noexcept {
   if (mode != mode_) {
     mode_ = mode;
-    review_.not_comparable(std::max<std::int64_t>(next_tick_, 0));
+    // The operator's choice stands: no review of the model before it, and no take-back to it.
+    review_.cancel();
+    replaced_.reset();
+    exchange_.drop_take_back();
     inverse_fresh_ = true;
     if (counters_.planned > 0) anchor_ = StagePoint{last_u_, last_w_, kNaN};
   }
@@ -238,12 +240,13 @@ std::optional<double> FeedforwardPlanner::observe(const CompensatorInput& sample
   if (exchange_.anchor().observe(sample.seq, sample.y_m, sample.u_V, next_tick_, nominal_slope())) {
     ++counters_.reanchors;
   }
+  // The bridge's safe state is no tracking: a review across it says nothing.
+  if (sample.safe_state) review_.not_comparable(sample.seq);
   if (review_.observe(sample.seq, sample.y_m) == SwapReview::Verdict::worse && replaced_) {
     // The set before goes back in at the next reversal, as any set does (re-anchored there), in
     // place of one still waiting: a set fitted since is no better founded than the one refused.
     ++counters_.swaps_taken_back;
-    exchange_.offer(replaced_->params, /*switch_model=*/true, replaced_->version);
-    taking_back_ = true;
+    exchange_.offer(replaced_->params, /*switch_model=*/true, replaced_->version, /*take_back=*/true);
     replaced_.reset();
   }
   // Fast: half the plan's share of the slew limit per tick, where a servo along it could reach the limit.

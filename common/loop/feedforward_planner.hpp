@@ -208,7 +208,6 @@ class FeedforwardPlanner {
     std::int32_t version;
   };
   std::optional<Replaced> replaced_;
-  bool taking_back_ = false;  // the waiting set is a take-back: not judged again
   ExperimentQueue experiments_;
   ReversalDetector reversals_;
   // The experiment's voltage: where its last branch of the hysteresis began, for the anchor.

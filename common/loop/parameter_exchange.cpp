@@ -20,8 +20,9 @@ ParameterExchange::ParameterExchange(const CompensatorConfig& config)
     : anchor_(config.reanchor_ticks, reanchor_max_ticks(config), config.reanchor_ramp_ticks,
               config.slew_fraction * config.slew_V_per_s * config.dt_s, config.reanchor_u_rate_V_per_s * config.dt_s) {}
 
-void ParameterExchange::offer(const ModelParamSet& params, bool switch_model, std::int32_t version) noexcept {
-  pending_ = Pending{params, switch_model};
+void ParameterExchange::offer(const ModelParamSet& params, bool switch_model, std::int32_t version,
+                              bool take_back) noexcept {
+  pending_ = Pending{params, switch_model, take_back};
   pending_version_ = version;
 }
 

@@ -22,13 +22,19 @@ class ParameterExchange {
  public:
   struct Pending {
     ModelParamSet params;
-    bool switch_model;  // offer_model: make it the feedforward; offer_mem_params: parameters only
+    bool switch_model;       // offer_model: make it the feedforward; offer_mem_params: parameters only
+    bool take_back = false;  // the set a reviewed swap replaced, going back in: not judged again
   };
 
   explicit ParameterExchange(const CompensatorConfig& config);
 
-  // A validated, checked set; replaces one still waiting.
-  void offer(const ModelParamSet& params, bool switch_model, std::int32_t version) noexcept;
+  // A validated, checked set; replaces one still waiting (a take-back too: a newer set is judged
+  // as any).
+  void offer(const ModelParamSet& params, bool switch_model, std::int32_t version, bool take_back = false) noexcept;
+  // The mode was changed by hand: a take-back waiting would switch the model back. Dropped.
+  void drop_take_back() noexcept {
+    if (pending_ && pending_->take_back) pending_.reset();
+  }
   bool has_pending() const noexcept { return pending_.has_value(); }
   const Pending& pending() const noexcept { return *pending_; }  // only while has_pending()
   // The waiting set changes the model a plan in `mode` follows.

@@ -36,6 +36,7 @@ SwapReview::SwapReview(const SwapReviewConfig& config, std::int64_t max_window_t
 
 void SwapReview::planned(std::int64_t k, double y_ref_m, bool comparable) noexcept {
   if (first_planned_ < 0) first_planned_ = k;
+  last_planned_ = std::max(last_planned_, k);
   planned_[static_cast<std::size_t>(k % static_cast<std::int64_t>(planned_.size()))] = {k, y_ref_m};
   if (!comparable) not_comparable(k);
 }

@@ -17,6 +17,7 @@
 // Allocation-free after construction: the planned references and the measured errors are rings.
 // Time is the tick (any clock is the caller's).
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -60,6 +61,12 @@ class SwapReview {
   Verdict observe(std::int64_t seq, double y_m) noexcept;
 
   bool reviewing() const noexcept { return swap_tick_ >= 0; }
+  // Ends a review under way without a verdict, and no later window reaches back before the next
+  // tick planned (a mode changed by hand).
+  void cancel() noexcept {
+    end_review();
+    if (last_planned_ >= 0) last_incomparable_ = std::max(last_incomparable_, last_planned_ + 1);
+  }
   // Of the last verdict: the measured RMS error before and after the swap [m].
   double before_rms_m() const noexcept { return before_rms_m_; }
   double after_rms_m() const noexcept { return after_rms_m_; }
@@ -82,6 +89,7 @@ class SwapReview {
   std::vector<Planned> planned_;         // by tick, over the plan's lead
   std::vector<Error> errors_;            // by tick, over the longest window
   std::int64_t first_planned_ = -1;      // the first tick planned (-1: none yet)
+  std::int64_t last_planned_ = -1;       // the last
   std::int64_t last_incomparable_ = -1;  // the last tick not comparable, or settling after a swap
   std::int64_t swap_tick_ = -1;          // the swap under review (-1: none)
   SwapReviewSpan span_{};

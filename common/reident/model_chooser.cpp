@@ -93,6 +93,12 @@ ModelDecision ModelChooser::collect(ReidentCore& core) {
   ++counters_[selections];
   const std::optional<double> recent_m = recent_median_then_add(p.winner_holdout_rms_m);
   const bool pinned_elsewhere = options_.pinned && *options_.pinned != in_use_.kind;
+  if (p.proposes() && core.estimator().restarted_since(fed_at_last_)) {
+    // Fitted on the reference before the one now requested: a regime the line no longer has.
+    ++counters_[unsettled];
+    last_reason_ = "not published: fitted on the window before a new reference";
+    return d;
+  }
   if (!p.proposes() && !pinned_elsewhere) {
     ++counters_[kept];
     return d;

@@ -74,7 +74,8 @@ class ModelChooser {
     left_to_mem,
     implausible,
     held,       // a change or refit proposed while the operator holds the set in use: not published
-    unsettled,  // a proposal fitted across a change of regime (regime_factor): not published
+    unsettled,  // a proposal fitted across a change of regime (regime_factor), or before a new
+                // reference: not published
     kCounters
   };
   static const char* counter_name(std::size_t i) noexcept;  // "model_selections", ...

@@ -196,8 +196,10 @@ RefitDecision ReidentCore::decide(const RefitResult& r) noexcept {
     d.kind = RefitDecision::Kind::refused;
     return d;
   }
-  // A refit that finished after the model choice switched away from MEM is not published.
-  if (o.judged_against_version != in_use_.generation() || !mem_refits_) {
+  // A refit that finished after the model choice switched away from MEM, or whose window the new
+  // reference since has made another's, is not published.
+  if (o.judged_against_version != in_use_.generation() || !mem_refits_ ||
+      estimator_.restarted_since(fed_at_last_snapshot_)) {
     counters_.add(ReidentCounter::refits_superseded);
     d.kind = RefitDecision::Kind::superseded;
     return d;

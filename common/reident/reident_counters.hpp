@@ -23,7 +23,8 @@ enum class ReidentCounter : std::uint8_t {
   dropouts,              // y stuck while u moves: poisons the window
   refits_attempted,
   refits_accepted,
-  refits_superseded,         // judged against a set replaced meanwhile (by HX_PARAMS): not adopted
+  refits_superseded,         // judged against a set replaced meanwhile (HX_PARAMS), or of a window a new
+                             // reference has made another's: not adopted
   refits_implausible,        // accepted by the fit, but its gain leaves the rig's band: not published
                              // (also counted in refits_rejected_out_of_range)
   refits_held,               // accepted while the operator holds the set in use: reported, not published

@@ -117,10 +117,10 @@ void register_stage(py::module_& m) {
         py::arg("period_samples"), py::arg("periods"), py::arg("realisations") = 1, py::arg("transient_periods") = 1,
         py::arg("band") = py::none(), py::arg("order") = "auto", py::arg("max_order") = 8,
         py::arg("max_delay_s") = 1e-3, py::arg("continuous") = false, py::arg("sampled_at_tick_end") = true,
-        py::arg("hysteresis_plays") = 15,
+        py::arg("hysteresis_plays") = 0,
         R"doc(identify_stage(u, y, *, sample_rate_Hz=1e4, period_samples, periods, realisations=1,
                transient_periods=1, band=None, order="auto", max_order=8, max_delay_s=1e-3,
-               continuous=False, sampled_at_tick_end=True, hysteresis_plays=15) -> dict
+               continuous=False, sampled_at_tick_end=True, hysteresis_plays=0) -> dict
 
 A stage's linear dynamics from a periodic multisine record (hystloop-ctl experiment multisine,
 or any periodic excitation), the steps of hystloop-identify --model stage:
@@ -133,8 +133,9 @@ or any periodic excitation), the steps of hystloop-identify --model stage:
   sampled_at_tick_end   y_k measured at the end of tick k (a hystloop bridge): the data are moved
                         by that tick so that delay_s is the rig's own
   hysteresis_plays      play operators of a Prandtl-Ishlinskii hysteresis fitted together with the
-                        stage (as hystloop-identify --hysteresis-plays): the stage is measured from
-                        the hysteresis' output H(u), with unit DC gain; 0: from u -> y alone
+                        stage (as hystloop-identify --hysteresis-plays, whose default is 15): the
+                        stage is measured from the hysteresis' output H(u), with unit DC gain; 0
+                        (the default here, G in m/V as before): from u -> y alone
 Returns frequency_Hz, G and sigma (its standard deviation, from periods and realisations; from H(u)
 to y, unit DC gain, when through_hysteresis, else from u to y [m/V]), sigma_noise, coherence,
 model_G (the fitted model's response, as sampled, in G's units), dc_gain [m/V] (u -> y), poles_hz

@@ -51,9 +51,9 @@ class IdentifyStage(unittest.TestCase):
         lines = range(1, 300)
         u = multisine(lines, periods=4)
         y = first_order(u, fc_hz=500.0, gain=6e-9, noise_m=1e-11)
-        through = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1")
-        alone = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1",
-                                        hysteresis_plays=0)
+        through = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1",
+                                          hysteresis_plays=15)
+        alone = hystloop.identify_stage(u, y, period_samples=N, periods=4, band=(10.0, 2990.0), order="0/1")
         self.assertTrue(through["through_hysteresis"])
         self.assertFalse(alone["through_hysteresis"])
         self.assertTrue(math.isnan(alone["residual_rms"]))

@@ -103,6 +103,8 @@ TEST(StageHysteresisFit, BehindColemanHodgdonTheSeriesModelExplainsTheRecordAndT
     const HysteresisStageIdentification id =
         identify_stage_with_hysteresis(r.m.u_V, r.y, r.m.lines, r.frf, two_four(), true);
     ASSERT_TRUE(id.ok()) << id.stage.reason();
+    EXPECT_GT(id.rounds, 0) << "seed " << seed;  // the series model, not the fallback to u -> y
+    EXPECT_DOUBLE_EQ(id.stage.fit.dc_gain, 1.0);
     EXPECT_LE(worst_dB(id.stage.fit), worst_dB(id.linear.fit) + 0.05) << "seed " << seed;
     EXPECT_LE(id.residual_rms, id.residual_rms_linear) << "seed " << seed;
     EXPECT_NEAR(id.stage.fit.delay_s, 150e-6, 2e-6);

@@ -132,17 +132,29 @@ TEST(SwapReview, JudgesNothingWithoutAComparableWindowOnEitherSide) {
     EXPECT_FALSE(rig.review().reviewing());
     EXPECT_EQ(rig.run(3000, 9e-9), SwapReview::Verdict::none);
   }
-  {  // Samples missing from the window after: no verdict.
-    SwapReview review({}, 10001, kHorizon);
-    for (std::int64_t k = 0; k < 5000 + kHorizon; ++k) review.planned(k, 0.0, true);
-    for (std::int64_t k = 0; k < 3000; ++k) review.observe(k, 1e-9);
-    ASSERT_TRUE(review.swapped(3000, {1000, 1000}));
-    SwapReview::Verdict v = SwapReview::Verdict::none;
-    for (std::int64_t k = 3000; k < 5100; k += 3) {  // two in three missing
-      if (const auto now = review.observe(k, 9e-9); now != SwapReview::Verdict::none) v = now;
+  {  // Samples missing from the window after: no verdict (with them all, the same errors are one).
+    for (const std::int64_t stride : {1, 3}) {
+      SwapReview review({}, 10001, kHorizon);
+      std::int64_t planned = 0;
+      const auto plan_to = [&](std::int64_t k) {
+        for (; planned <= k + kHorizon; ++planned) review.planned(planned, 0.0, true);
+      };
+      for (std::int64_t k = 0; k < 2500; ++k) {
+        plan_to(k);
+        review.observe(k, 1e-9);
+      }
+      ASSERT_TRUE(review.swapped(planned, {1000, 1000}));
+      const std::int64_t swap = planned;
+      SwapReview::Verdict v = SwapReview::Verdict::none;
+      for (std::int64_t k = 2500; k < swap + 2100; ++k) {
+        plan_to(k);
+        const bool after = k >= swap;
+        if (after && (k - swap) % stride != 0) continue;  // stride 3: two in three missing after the swap
+        if (const auto now = review.observe(k, after ? 9e-9 : 1e-9); now != SwapReview::Verdict::none) v = now;
+      }
+      EXPECT_EQ(v, stride == 1 ? SwapReview::Verdict::worse : SwapReview::Verdict::none) << stride;
+      EXPECT_FALSE(review.reviewing());
     }
-    EXPECT_EQ(v, SwapReview::Verdict::none);
-    EXPECT_FALSE(review.reviewing());
   }
 }
 

@@ -172,6 +172,11 @@ TEST(ReidentCore, ANewReferenceStartsTheWindowAgain) {
   rig.core.poll(rig.now);
   EXPECT_FALSE(rig.core.worker().idle());  // a full window of it
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 1u);
+  // A refit of that window, finished after yet another reference was requested, is not adopted.
+  rig.core.on_new_reference();
+  ASSERT_TRUE(rig.core.worker().run_pending());
+  EXPECT_EQ(rig.core.poll(rig.now).kind, Kind::superseded);
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_superseded), 1u);
 }
 
 TEST(ReidentCore, AnOutcomeJudgedAgainstAReplacedSetIsNotAdopted) {
