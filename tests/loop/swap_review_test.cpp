@@ -2,6 +2,8 @@
 // way a review ends without a verdict.
 #include "loop/swap_review.hpp"
 
+#include "loop/parameter_exchange.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -156,6 +158,38 @@ TEST(SwapReview, JudgesNothingWithoutAComparableWindowOnEitherSide) {
       EXPECT_FALSE(review.reviewing());
     }
   }
+}
+
+// A take-back travels with its set: a newer set offered in its place is an ordinary one (judged),
+// and a mode set by hand drops a take-back waiting, never an ordinary set.
+TEST(ParameterExchangeTakeBack, ANewerSetReplacesATakeBackAndOnlyATakeBackIsDropped) {
+  ParameterExchange x{CompensatorConfig{}};
+  ModelParamSet set;
+  set.kind = ModelKind::pi;
+  x.offer(set, true, 3, /*take_back=*/true);
+  ASSERT_TRUE(x.has_pending());
+  EXPECT_TRUE(x.pending().take_back);
+  x.offer(set, true, 9);
+  EXPECT_FALSE(x.pending().take_back);
+  x.drop_take_back();
+  EXPECT_TRUE(x.has_pending());  // an ordinary set stays
+  x.offer(set, true, 3, /*take_back=*/true);
+  x.drop_take_back();
+  EXPECT_FALSE(x.has_pending());
+}
+
+TEST(SwapReview, CancelEndsAReviewAndNoLaterWindowReachesBackAcrossIt) {
+  Rig rig;
+  rig.run(3000, 1e-9);
+  ASSERT_TRUE(rig.swap());
+  rig.review().cancel();
+  EXPECT_FALSE(rig.review().reviewing());
+  EXPECT_EQ(rig.run(3000, 9e-9), SwapReview::Verdict::none);
+  EXPECT_TRUE(rig.swap());  // 3000 ticks later: the window before lies after the cancel
+  rig.run(200, 1e-9);
+  rig.review().cancel();
+  rig.run(500, 1e-9);
+  EXPECT_FALSE(rig.swap());  // its window before would reach back across the cancel
 }
 
 }  // namespace

@@ -113,5 +113,36 @@ TEST(SwapReview, ASwapBeforeTheLineHasSettledIsNotJudged) {
   EXPECT_EQ(sim.compensator().counters().swaps_reviewed, 0u);
 }
 
+// A mode the operator sets while a swap is under review stands: the review ends without a verdict
+// and nothing switches the model back.
+TEST(SwapReview, AModeSetByHandDuringAReviewIsNotTakenBack) {
+  const Plant plant = plants()[0];
+  const IdentifiedModels models =
+      identify_for_scan(plant.experiment, 0.5e-6, scan_stage(plant.experiment, plant.options));
+  LoopSimulation sim(scan_loop_config(plant.experiment, models, plant.options));
+  TrajectorySpec spec;
+  spec.shape = TrajectoryShape::kSine;
+  spec.amplitude_m = 0.5e-6;
+  spec.frequency_hz = 100.0;
+  spec.blend_s = 0.2;
+  sim.run(0.05);
+  sim.compensator().take_trajectory(spec, 0.3);
+  sim.run(0.95);
+  ModelParamSet bad;
+  bad.kind = ModelKind::pi;
+  bad.pi = models.pi;
+  for (double& w : bad.pi.weights) w *= 1.1;
+  sim.compensator().offer_model(bad, 7);
+  // Swapped in at the reversal at ~1.0025 s; its window after ends ~0.2 s later and is planned 50 ms
+  // ahead: at 1.18 s all of it is planned and the verdict not yet due.
+  sim.run(0.18);
+  ASSERT_EQ(sim.compensator().counters().swaps_reviewed, 1u);
+  ASSERT_EQ(sim.compensator().counters().swaps_taken_back, 0u);
+  sim.compensator().set_mode(FeedforwardMode::kKatalenic);
+  sim.run(1.0);
+  EXPECT_EQ(sim.compensator().counters().swaps_taken_back, 0u);
+  EXPECT_EQ(sim.compensator().mode(), FeedforwardMode::kKatalenic);
+}
+
 }  // namespace
 }  // namespace hystloop
