@@ -135,6 +135,11 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
   }
 
   fit_options.unit_dc_gain = true;  // from here H carries the gain
+  // The order the first fit chose (or was given) stays: the rounds refine the model, they do not
+  // search the orders again (each search is several fits; under a sanitizer, minutes).
+  fit_options.auto_order = false;
+  fit_options.numerator_order = r.linear.fit.numerator_order;
+  fit_options.denominator_order = r.linear.fit.denominator_order;
   const StageFitResult* g = &r.linear.fit;
   Eigen::MatrixXd a(static_cast<Eigen::Index>(2 * realisations * K), static_cast<Eigen::Index>(ops));
   Eigen::VectorXd b(a.rows());
@@ -182,6 +187,7 @@ HysteresisStageIdentification identify_stage_with_hysteresis(std::span<const dou
     r.weights.assign(weights.x.data(), weights.x.data() + weights.x.size());
     r.w = std::move(w);
     r.stage = std::move(next);
+    r.stage.fit.orders = r.linear.fit.orders;  // the search that chose the order (on u -> y)
     r.residual_rms = rms_of(res);
     r.rounds = round + 1;
     g = &r.stage.fit;

@@ -22,9 +22,10 @@
 // plays are periodic once the input has swept its range). NNLS on those lines (real and imaginary
 // parts, every realisation) gives the weights; then w = H(u) over the whole record is the stage's
 // input, and the robust method's FRF from w to y (its noise and distortion levels from periods and
-// realisations, as for u -> y) is fitted by fit_stage_model as before. Start: G from u -> y; then
-// `iterations` rounds. The lines between the excited ones carry the hysteresis' distortion, and
-// fit the weights too. The fitted G has unit DC gain when H carries the stage's gain (H in metres).
+// realisations, as for u -> y) is fitted by fit_stage_model as before. Start: G from u -> y (its
+// order given or chosen there, then kept); then `iterations` rounds. The lines between the excited ones carry the
+// hysteresis' distortion, and fit the weights too. The fitted G has unit DC gain when H carries the stage's gain (H in
+// metres).
 
 #include <cstddef>
 #include <span>
@@ -43,7 +44,8 @@ struct HysteresisStageOptions {
 };
 
 struct HysteresisStageIdentification {
-  StageIdentification stage;         // the last round's: FRF from w = H(u) to y, and its fit
+  StageIdentification stage;         // the last round's: FRF from w = H(u) to y, and its fit (its
+                                     // `orders`: the u -> y search that chose the order)
   StageIdentification linear;        // the first: u -> y, the BLA's (what identify_stage_dynamics gives)
   std::vector<double> thresholds_V;  // H's plays
   std::vector<double> weights;       // [m/V] >= 0; H = sign(u -> y DC gain) sum_i w_i F_ri[u]
