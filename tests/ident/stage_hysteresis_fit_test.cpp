@@ -97,7 +97,7 @@ TEST(StageHysteresisFit, WithoutHysteresisTheFirstPlayCarriesTheGainAndTheStageI
 TEST(StageHysteresisFit, BehindColemanHodgdonTheSeriesModelExplainsTheRecordAndTheStageIsNoWorse) {
   // Three noise draws: the series model explains the record at least as well as the linear
   // approximation, and its stage is no further from the truth (bench/stage_identification_table:
-  // 0.70 against 0.90 dB at the anti-resonance, median over five draws of the full experiment).
+  // 0.71 against 0.90 dB at the anti-resonance, median over five draws of the full experiment).
   for (const std::uint64_t seed : {1u, 2u, 3u}) {
     const Record r = record(HysteresisPlantSpec{}, seed);
     const HysteresisStageIdentification id =
