@@ -1,5 +1,6 @@
 #include "reident/reident_core.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -62,6 +63,10 @@ void ReidentCore::on_sample(const SensorTick& tick, std::int64_t now_us) noexcep
   }
   refused_since_last_ = 0;
   in_use_.on_sample(seq);
+  if (std::isfinite(tick.y_ref_m) && std::isfinite(last_ref_m_) && tick.y_ref_m != last_ref_m_) {
+    moving_ref_fed_ = estimator_.samples_fed() + 1;  // this tick, once fed
+  }
+  last_ref_m_ = tick.y_ref_m;
   if ((tick.flags & sensor_block_t::SAFE_STATE) != 0) {
     counters_.add(ReidentCounter::skipped_safe_state);
     flush_stage_removal();
@@ -149,10 +154,17 @@ bool ReidentCore::implausible(const MemParams& params) noexcept {
   return true;
 }
 
-void ReidentCore::on_new_reference() noexcept {
+bool ReidentCore::on_new_reference() noexcept {
+  // The window: the last window_samples fed, and none before the last restart.
+  const std::uint64_t fed = estimator_.samples_fed();
+  const std::uint64_t first =
+      fed - std::min<std::uint64_t>(options_.estimator.window_samples, estimator_.samples_since_restart());
+  if (moving_ref_fed_ <= first) return false;  // no tick of a moving reference in it
   flush_stage_removal();
   estimator_.restart_window();
+  moving_ref_fed_ = 0;
   counters_.add(ReidentCounter::window_restarts);
+  return true;
 }
 
 RefitDecision ReidentCore::poll(std::int64_t now_us) noexcept {

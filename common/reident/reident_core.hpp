@@ -19,6 +19,7 @@
 // change from outside (HX_PARAMS), which the estimator's own version does not know about.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "ident/stage_removal.hpp"
@@ -82,10 +83,12 @@ class ReidentCore {
   ParamsOffer on_params(const MemParams& params, std::int32_t version, std::int64_t publisher_id, bool valid,
                         std::string_view source) noexcept;
   RefitDecision poll(std::int64_t now_us) noexcept;
-  // A new reference was requested for our axis (a trajectory or a scan): the estimator's window
-  // starts again, so that no refit (MEM's or the model choice's) is fitted across two references;
-  // the next one waits for a full window of the new. Counted (window_restarts).
-  void on_new_reference() noexcept;
+  // A new reference was requested for our axis (a trajectory or a scan). When the window holds
+  // ticks of a reference that moved (another line), it starts again, so that no refit (MEM's or the
+  // model choice's) is fitted across two references: the next one waits for a full window of the
+  // new; counted (window_restarts), returns true. A window of an experiment (no reference) or a
+  // hold is kept: it is the same stage's loops, which the line after it is fitted on.
+  bool on_new_reference() noexcept;
 
   // A version for a refused candidate published as valid = false (--publish-invalid).
   std::int32_t claim_diagnostic_version() noexcept { return in_use_.claim_version(); }
@@ -143,6 +146,10 @@ class ReidentCore {
   SequenceGapDetector ticks_{0};
   std::int64_t refused_since_last_ = 0;  // ticks refused on the wire since the last sample (estimated)
   std::int64_t last_sample_us_ = -1;
+  // The last tick whose reference moved (a line being tracked): its reference, and the samples the
+  // estimator had been fed then (0: none since the start or the last restart).
+  double last_ref_m_ = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t moving_ref_fed_ = 0;
   std::int64_t poisoned_streak_ = 0;
   double last_refit_s_ = 0.0;
   bool mem_refits_ = true;

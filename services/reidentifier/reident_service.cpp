@@ -101,13 +101,18 @@ ReidentService::ReidentService(lcm::LCM& lcm, const ChannelNames& names, const R
       lcm, names.params, [this](const mem_params_t& msg, std::int64_t) { on_params(msg); });
   control_ = std::make_unique<Subscription<control_t>>(lcm, names.control,
                                                        [this](const control_t& msg, std::int64_t) { on_control(msg); });
-  // A new reference for our axis: the window starts again (ReidentCore::on_new_reference). A request
-  // the compensator then refuses costs a window's wait for the next refit, nothing more.
-  trajectory_ = std::make_unique<Subscription<trajectory_t>>(
-      lcm, names.trajectory, [this](const trajectory_t& msg, std::int64_t) {
-        if (msg.axis != options_.axis || msg.version == std::exchange(trajectory_version_, msg.version)) return;
-        core_->on_new_reference();
-      });
+  // A new reference for our axis: the window starts again where it holds another line
+  // (ReidentCore::on_new_reference). Only a trajectory that differs from the last one requested
+  // counts: the same line again (a rig's configured reference requested by a script) changes no
+  // loop. A request the compensator then refuses costs a window's wait for the next refit.
+  trajectory_ = std::make_unique<
+      Subscription<trajectory_t>>(lcm, names.trajectory, [this](const trajectory_t& msg, std::int64_t) {
+    if (msg.axis != options_.axis || msg.version == std::exchange(trajectory_version_, msg.version)) return;
+    const std::array<double, 4> line{static_cast<double>(msg.shape), msg.amplitude_m, msg.frequency_Hz, msg.offset_m};
+    const bool other = last_line_ && *last_line_ != line;
+    last_line_ = line;
+    if (other) core_->on_new_reference();
+  });
   scan_ = std::make_unique<Subscription<scan_t>>(lcm, names.scan, [this](const scan_t& msg, std::int64_t) {
     if (msg.version == std::exchange(scan_version_, msg.version)) return;
     core_->on_new_reference();

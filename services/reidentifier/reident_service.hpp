@@ -32,8 +32,10 @@
 //                   mode's model (linear, mem, pi, katalenic), or MODE_OFF = automatic choice again
 //   1 Hz         -> <rig>STATUS, under our process name
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,9 @@ class ReidentService {
   std::unique_ptr<Subscription<trajectory_t>> trajectory_;
   std::unique_ptr<Subscription<scan_t>> scan_;
   std::int64_t trajectory_version_ = -1;
+  // The last trajectory requested for our axis: a request for the same line (shape, amplitude,
+  // frequency, offset) is no new reference, and the first one heard has nothing to differ from.
+  std::optional<std::array<double, 4>> last_line_;
   std::int64_t scan_version_ = -1;
   std::unique_ptr<RigCheck> rig_check_;  // refuses this process when the bridge's actuator range is not its own
 };

@@ -155,25 +155,49 @@ TEST(ReidentCore, SchedulesOneRefitPerPeriodOnceAFullWindowOfNewDataIsThere) {
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 3u);
 }
 
-// A new reference requested: the window starts again, and the next refit waits for a full window of
-// the new reference (a window holding the end of one line and the start of the next is fitted by a
-// set that explains neither).
-TEST(ReidentCore, ANewReferenceStartsTheWindowAgain) {
+// A new reference requested: a window that holds another line (a reference that moved) starts
+// again, and the next refit waits for a full window of the new reference (a window holding the end
+// of one line and the start of the next is fitted by a set that explains neither). A window of an
+// experiment (no reference) is kept: the line after it is fitted on its loops.
+TEST(ReidentCore, ANewReferenceStartsAWindowThatHoldsAnotherLineAgain) {
   Rig rig;
-  rig.advance(0.6);  // more than a window (0.5 s in the small options)
-  rig.core.on_new_reference();
+  rig.advance(0.6);  // an experiment: u and y, no reference (more than a window, 0.5 s here)
+  EXPECT_FALSE(rig.core.on_new_reference());
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::window_restarts), 0u);
+  rig.core.poll(rig.now);
+  EXPECT_FALSE(rig.core.worker().idle());  // refitted on the experiment's window
+  ASSERT_TRUE(rig.core.worker().run_pending());
+  rig.core.poll(rig.now);
+  // A line: the reference moves (here the record's own y).
+  const auto line = [&](double seconds) {
+    const auto n = static_cast<std::size_t>(std::llround(seconds * 1e4));
+    for (std::size_t k = 0; k < n; ++k, ++rig.position) {
+      rig.core.on_sample(SensorTick{.seq = rig.seq++,
+                                    .u_V = rig.truth_record.u[rig.position],
+                                    .u_ff_V = rig.truth_record.u[rig.position],
+                                    .y_ref_m = rig.truth_record.y[rig.position],
+                                    .y_m = rig.truth_record.y[rig.position]},
+                         rig.now);
+      rig.now += testdata::kTickPeriod_us;
+    }
+  };
+  line(0.6);
+  rig.now += 2 * kSecond;  // the refit period has passed
+  EXPECT_TRUE(rig.core.on_new_reference());
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::window_restarts), 1u);
   rig.core.poll(rig.now);
-  EXPECT_TRUE(rig.core.worker().idle());  // the window holds the reference before only
-  rig.advance(0.4);
+  EXPECT_TRUE(rig.core.worker().idle());  // the window holds the line before only
+  line(0.4);
   rig.core.poll(rig.now);
   EXPECT_TRUE(rig.core.worker().idle());  // 0.4 s of the new one
-  rig.advance(0.2);
+  // Someone else's worse set in use meanwhile: the next refit would be adopted.
+  ASSERT_EQ(rig.core.on_params(rig.initial, 50, 42, true, "test"), ParamsOffer::adopted);
+  line(0.2);
   rig.core.poll(rig.now);
   EXPECT_FALSE(rig.core.worker().idle());  // a full window of it
-  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 1u);
-  // A refit of that window, finished after yet another reference was requested, is not adopted.
-  rig.core.on_new_reference();
+  EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_attempted), 2u);
+  // A refit of that window, finished after yet another line was requested, is not adopted.
+  EXPECT_TRUE(rig.core.on_new_reference());
   ASSERT_TRUE(rig.core.worker().run_pending());
   EXPECT_EQ(rig.core.poll(rig.now).kind, Kind::superseded);
   EXPECT_EQ(rig.core.counters().get(ReidentCounter::refits_superseded), 1u);
