@@ -30,6 +30,26 @@ std::vector<Plant> plants() {
   return {{"Banning's stage", TrackingExperiment{}, banning}, {"two modes", two_mode_experiment(), two_mode}};
 }
 
+// The 100 Hz 0.5 um sine from 0.3 s (approached over 0.2 s), after 0.05 s of the loop.
+void start_line(LoopSimulation& sim) {
+  TrajectorySpec spec;
+  spec.shape = TrajectoryShape::kSine;
+  spec.amplitude_m = 0.5e-6;
+  spec.frequency_hz = 100.0;
+  spec.blend_s = 0.2;
+  sim.run(0.05);
+  sim.compensator().take_trajectory(spec, 0.3);
+}
+
+// The identified PI set 10 % off in gain: a refit across two lines' loops errs by as much and more.
+ModelParamSet pi_off_in_gain(const IdentifiedModels& models) {
+  ModelParamSet bad;
+  bad.kind = ModelKind::pi;
+  bad.pi = models.pi;
+  for (double& w : bad.pi.weights) w *= 1.1;
+  return bad;
+}
+
 struct LineRun {
   double rms_m = 0.0;  // true, over the last 0.5 s
   CompensatorCounters counters;
@@ -42,13 +62,7 @@ LineRun run_line(const Plant& plant, const IdentifiedModels& models, const std::
   LoopSimulationConfig config = scan_loop_config(plant.experiment, models, plant.options);
   config.compensator.swap_review.worse_ratio = worse_ratio;
   LoopSimulation sim(config);
-  TrajectorySpec spec;
-  spec.shape = TrajectoryShape::kSine;
-  spec.amplitude_m = 0.5e-6;
-  spec.frequency_hz = 100.0;
-  spec.blend_s = 0.2;
-  sim.run(0.05);
-  sim.compensator().take_trajectory(spec, 0.3);
+  start_line(sim);
   sim.run(0.95);
   if (offered) sim.compensator().offer_model(*offered, 7);
   sim.run(1.5);
@@ -62,11 +76,7 @@ TEST(SwapReview, ASetThatTracksTheLineWorseIsTakenBackAndOneThatTracksItAsWellIs
     const LineRun none = run_line(plant, models, std::nullopt, 1.5);
     EXPECT_EQ(none.counters.swaps_reviewed, 0u) << plant.name;
 
-    // A PI set 10 % off in gain: a refit across two lines' loops errs by as much and more.
-    ModelParamSet bad;
-    bad.kind = ModelKind::pi;
-    bad.pi = models.pi;
-    for (double& w : bad.pi.weights) w *= 1.1;
+    const ModelParamSet bad = pi_off_in_gain(models);
     const LineRun kept_bad = run_line(plant, models, bad, 0.0);  // no review: what the swap does
     // Measured: 0.66 -> 8.2 nm on Banning's stage, 1.6 -> 36 nm behind the two modes.
     EXPECT_GT(kept_bad.rms_m, 2.0 * none.rms_m) << plant.name << ": " << none.rms_m * 1e9 << " nm without a swap";
@@ -96,17 +106,8 @@ TEST(SwapReview, ASwapBeforeTheLineHasSettledIsNotJudged) {
   const IdentifiedModels models =
       identify_for_scan(plant.experiment, 0.5e-6, scan_stage(plant.experiment, plant.options));
   LoopSimulation sim(scan_loop_config(plant.experiment, models, plant.options));
-  TrajectorySpec spec;
-  spec.shape = TrajectoryShape::kSine;
-  spec.amplitude_m = 0.5e-6;
-  spec.frequency_hz = 100.0;
-  spec.blend_s = 0.2;
-  sim.run(0.05);
-  sim.compensator().take_trajectory(spec, 0.3);
-  ModelParamSet bad;
-  bad.kind = ModelKind::pi;
-  bad.pi = models.pi;
-  for (double& w : bad.pi.weights) w *= 1.1;
+  start_line(sim);
+  const ModelParamSet bad = pi_off_in_gain(models);
   sim.compensator().offer_model(bad, 7);
   sim.run(1.0);
   EXPECT_EQ(sim.compensator().counters().params_swapped, 1u);
@@ -120,18 +121,9 @@ TEST(SwapReview, AModeSetByHandDuringAReviewIsNotTakenBack) {
   const IdentifiedModels models =
       identify_for_scan(plant.experiment, 0.5e-6, scan_stage(plant.experiment, plant.options));
   LoopSimulation sim(scan_loop_config(plant.experiment, models, plant.options));
-  TrajectorySpec spec;
-  spec.shape = TrajectoryShape::kSine;
-  spec.amplitude_m = 0.5e-6;
-  spec.frequency_hz = 100.0;
-  spec.blend_s = 0.2;
-  sim.run(0.05);
-  sim.compensator().take_trajectory(spec, 0.3);
+  start_line(sim);
   sim.run(0.95);
-  ModelParamSet bad;
-  bad.kind = ModelKind::pi;
-  bad.pi = models.pi;
-  for (double& w : bad.pi.weights) w *= 1.1;
+  const ModelParamSet bad = pi_off_in_gain(models);
   sim.compensator().offer_model(bad, 7);
   // Swapped in at the reversal at ~1.0025 s; its window after ends ~0.2 s later and is planned 50 ms
   // ahead: at 1.18 s all of it is planned and the verdict not yet due.
