@@ -62,6 +62,19 @@ std::vector<C> roots_of(const std::vector<double>& ascending) {
   return r;
 }
 
+// prod_i (1 - s / r_i), ascending (the constant term 1); the roots closed under conjugation.
+std::vector<double> unit_polynomial(const std::vector<C>& roots) {
+  std::vector<C> c{1.0};
+  for (C r : roots) {
+    std::vector<C> nc(c.size() + 1, 0.0);
+    for (std::size_t i = 0; i < c.size(); ++i) nc[i] += c[i], nc[i + 1] -= c[i] / r;
+    c = nc;
+  }
+  std::vector<double> out(c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) out[i] = c[i].real();
+  return out;
+}
+
 C polyval(const std::vector<double>& ascending, C x) {
   C v = 0.0;
   for (std::size_t i = ascending.size(); i-- > 0;) v = v * x + ascending[i];
@@ -240,15 +253,7 @@ SkFit sk_fit(const Prepared& pr, int m, int n, bool unit_dc, double tau_s, int m
     bool flipped = false;
     for (C& r : p)
       if (r.real() > 0.0) r = C(-r.real(), r.imag()), flipped = true;
-    if (flipped) {  // D = prod(1 - s / p): d[0] = 1
-      std::vector<C> c{1.0};
-      for (C r : p) {
-        std::vector<C> nc(c.size() + 1, 0.0);
-        for (std::size_t i = 0; i < c.size(); ++i) nc[i] += c[i], nc[i + 1] -= c[i] / r;
-        c = nc;
-      }
-      for (std::size_t i = 0; i < c.size(); ++i) fit.poly.d[i] = c[i].real();
-    }
+    if (flipped) fit.poly.d = unit_polynomial(p);  // d[0] = 1
   }
   double cost = 0.0;
   for (std::size_t k = 0; k < F; ++k) {
@@ -335,6 +340,54 @@ bool refine(const Prepared& pr, int m, int n, const StageFitOptions& o, Poly& po
   return true;
 }
 
+// A zero and its mirror image across the imaginary axis give the same |N(jw)|, and well below the
+// zero their phases differ by nearly a delay's: 2 Re(z) w / |z|^2. SK's profile settles the delay
+// first and the refinement cannot carry a real zero through infinity to the other half plane, so a
+// fit can end in the minimum that trades a right-half-plane zero for its mirror and more delay
+// (seen: a stage with a zero at +3 kHz and a tick of delay fitted with -3.1 kHz and two ticks, 19 deg
+// off at 3 kHz). Each zero within reach of the band (real, or a complex pair together), and all of
+// them at once, is mirrored with the delay moved to keep the low-frequency phase, refined, and the
+// lowest weighted cost kept.
+void try_mirrored_zeros(const Prepared& pr, int m, int n, const StageFitOptions& o, Poly& poly) {
+  if (m < 1 || poly.b[0] == 0.0 || !(o.max_delay_s > 0.0)) return;
+  const std::vector<C> zeros = roots_of(poly.b);  // in s~ = s / ws; ws is the band's top
+  std::vector<std::vector<std::size_t>> groups;   // a real zero, or the upper member of a pair with its conjugate
+  for (std::size_t i = 0; i < zeros.size(); ++i) {
+    if (std::abs(zeros[i]) > 4.0 || zeros[i].imag() < 0.0) continue;
+    if (zeros[i].imag() == 0.0) {
+      groups.push_back({i});
+      continue;
+    }
+    std::size_t mate = zeros.size();
+    for (std::size_t j = 0; j < zeros.size(); ++j)
+      if (j != i && std::abs(zeros[j] - std::conj(zeros[i])) <= 1e-9 * std::abs(zeros[i])) mate = j;
+    if (mate < zeros.size()) groups.push_back({i, mate});
+  }
+  if (groups.empty()) return;
+  std::vector<std::vector<std::size_t>> candidates = groups;
+  if (groups.size() > 1) {
+    candidates.emplace_back();
+    for (const auto& g : groups) candidates.back().insert(candidates.back().end(), g.begin(), g.end());
+  }
+  double best_cost = weighted_cost(poly, pr);
+  for (const auto& flip : candidates) {
+    std::vector<C> z = zeros;
+    double tau = poly.tau_s;
+    for (std::size_t i : flip) {
+      tau += 2.0 * z[i].real() / (std::norm(z[i]) * pr.ws);
+      z[i] = C(-z[i].real(), z[i].imag());
+    }
+    if (!(tau >= 0.0 && tau <= o.max_delay_s)) continue;
+    Poly trial = poly;  // b0 prod(1 - s~ / z_i): the same DC gain
+    trial.b = unit_polynomial(z);
+    for (double& b : trial.b) b *= poly.b[0];
+    trial.tau_s = tau;
+    refine(pr, m, n, o, trial);
+    const double cost = weighted_cost(trial, pr);
+    if (cost < best_cost) best_cost = cost, poly = trial;
+  }
+}
+
 int parameter_count(int m, int n, bool unit_dc) { return (m + 1 - (unit_dc ? 1 : 0)) + n + 1; }
 
 StageFitResult fit_order(const Prepared& pr, int m, int n, const StageFitOptions& o) {
@@ -359,7 +412,10 @@ StageFitResult fit_order(const Prepared& pr, int m, int n, const StageFitOptions
     res.reason = "the SK iterations gave no finite model";
     return res;
   }
-  if (o.refine) res.refined = refine(pr, m, n, o, poly);
+  if (o.refine) {
+    res.refined = refine(pr, m, n, o, poly);
+    try_mirrored_zeros(pr, m, n, o, poly);
+  }
   // The result in s [rad/s].
   const Zpk z = to_zpk(poly, pr.ws);
   res.poles_rad_s = z.poles, res.zeros_rad_s = z.zeros, res.gain = z.gain, res.delay_s = poly.tau_s;

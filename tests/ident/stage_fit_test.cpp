@@ -178,6 +178,36 @@ TEST(StageFit, NoiseFreeSampledDataAreFittedExactly) {
   EXPECT_NEAR(r.delay_s, s.delay_s, 1e-14);
 }
 
+TEST(StageFit, ARightHalfPlaneZeroIsNotTradedForItsMirrorAndMoreDelay) {
+  // A zero at +3 kHz and a tick of delay: below the zero its phase is nearly a delay's, and its
+  // mirror at -3 kHz with a second tick gives the same |G| and a phase within 19 deg up to 3 kHz.
+  // The fit must find the stage's own zero (without trying the mirror it ended at -3.1 kHz, 200 us).
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  StageFitResult truth;
+  truth.zeros_rad_s = {C(kTwoPi * 3000.0, 0.0)};
+  truth.poles_rad_s = {kTwoPi * C(-55.0, 1100.0), kTwoPi * C(-55.0, -1100.0)};
+  truth.gain = std::norm(truth.poles_rad_s[0]) / -truth.zeros_rad_s[0].real();  // unit DC gain
+  truth.delay_s = 1e-4;
+  truth.zoh_sample_rate_Hz = 1e4;
+  std::vector<double> f, sigma;
+  std::vector<C> g;
+  for (double fr = 5.0; fr <= 3000.0; fr += 5.0) {
+    f.push_back(fr);
+    g.push_back(truth.sampled_response(fr));
+    sigma.push_back(1e-3 * std::abs(g.back()));
+  }
+  StageFitOptions o = zoh_options();
+  o.numerator_order = 1;
+  o.denominator_order = 2;
+  const StageFitResult r = fit_stage_model({f, g, sigma}, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.zeros_rad_s.size(), 1u);
+  std::printf("zero %.1f Hz, delay %.2f us\n", r.zeros_rad_s[0].real() / kTwoPi, r.delay_s * 1e6);
+  EXPECT_NEAR(r.zeros_rad_s[0].real() / kTwoPi, 3000.0, 0.1);
+  EXPECT_NEAR(r.delay_s, 1e-4, 1e-9);
+  EXPECT_LT(worst_root_error(r.poles_rad_s, truth.poles_rad_s), 1e-6);
+}
+
 TEST(StageFit, WithoutTheHoldModelTheFitIsBiased) {
   // The same data fitted as if continuous (no ZOH): the sinc and half a tick go into the model.
   StageFitOptions o = zoh_options();
