@@ -6,13 +6,14 @@
 // hysteresis' best linear approximation (BLA), and a fit of it must find the actuator's gain beside
 // the stage's modes, a free parameter the noise moves where the response is weakest: at an
 // anti-resonance, where the modes nearly cancel. Measured (bench/stage_identification_table, the
-// default stage experiment, five draws of 1 nm noise): behind the two-mode stage the worst error,
-// at its 1.85 kHz anti-resonance, is 0.90 dB median from u -> y and 0.71 dB through the hysteresis,
-// lower or equal in the median on the table's other plants but one (0.03 against 0.04 dB, both
-// within the draws' spread); without noise both are within 0.06 dB of the truth (the BLA's
+// default stage experiment of 24 realisations of 5 periods, five draws of 1 nm noise): behind the
+// two-mode stage the worst error, at its 1.85 kHz anti-resonance, is 0.67 dB median from u -> y and
+// 0.43 dB through the hysteresis, lower or level in the median on the table's other plants (within
+// the draws' spread where higher); without noise both are within 0.06 dB of the truth (the BLA's
 // own bias on Coleman-Hodgdon's loops is that small). So what the series model buys is the gain
 // set by the hysteresis over every line of the record, and a stage with unit DC gain fitted to the
-// hysteresis' output; what limits the anti-resonance after that is the noise (longer records).
+// hysteresis' output; what limits the anti-resonance after that is the noise and the hysteresis'
+// distortion, both averaged over realisations (docs/TRACKING.md, "Measuring a stage").
 //
 // Method (an alternating, separable fit): H is a Prandtl-Ishlinskii model, y_H = sum_i w_i F_ri[u],
 // linear in its weights w_i >= 0 (the play operators F_ri of pi_fit.hpp, thresholds evenly spaced to
@@ -40,7 +41,8 @@ namespace hystloop {
 struct HysteresisStageOptions {
   std::size_t operators = 15;  // play operators of H (1 .. kPiMaxOperators)
   // Rounds of (weights, stage) after the first stage fit. Two: on the two-mode stage the worst error
-  // goes 0.74, 0.71, 0.70 dB over one, two, three (bench/stage_identification_table, median of five).
+  // goes 0.74, 0.71, 0.70 dB over one, two, three (bench/stage_identification_table with 8 realisations
+  // of 9 periods, median of five).
   int iterations = 2;
   void validate() const;  // throws ParameterError naming the field
 };
