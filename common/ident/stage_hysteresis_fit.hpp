@@ -30,6 +30,7 @@
 
 #include <cstddef>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "ident/frequency_response.hpp"
@@ -58,9 +59,14 @@ struct HysteresisStageIdentification {
   // lines up to the highest excited one [y's unit]: what the series model leaves against the BLA.
   double residual_rms = 0.0;
   double residual_rms_linear = 0.0;
-  // Rounds that gave a stage (fewer than asked when one failed: stage is then the last good round's;
-  // 0: none did, and stage is the u -> y fit, or, when the first round's fit failed, that failure)
+  // Rounds that gave a stage (fewer than asked when one failed or was not kept: stage is then the
+  // last good round's; 0: none did, and stage is the u -> y fit, or, when the first round's fit
+  // failed, that failure)
   int rounds = 0;
+  // A round whose series model leaves more than kKeptResidualRatio times the residual of what it
+  // would replace (u -> y's, or the round before) is not kept, and the rounds end there: why.
+  static constexpr double kKeptResidualRatio = 1.1;
+  std::string not_kept;
   bool ok() const noexcept { return stage.ok(); }
 };
 

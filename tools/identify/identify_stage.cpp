@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "core/cli.hpp"
 #include "core/config.hpp"
@@ -511,8 +512,10 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
           "alone: %.3g); the response below is from the hysteresis' output to y\n",
           args.hysteresis_plays, h.rounds, h.residual_rms, h.residual_rms_linear);
     } else if (h.linear.ok()) {
-      std::printf("through the hysteresis: no fit (%s); the stage from u -> y alone\n",
-                  h.stage.ok() ? "the plays explained nothing" : h.stage.reason().c_str());
+      const std::string why = !h.stage.ok()         ? h.stage.reason()
+                              : !h.not_kept.empty() ? h.not_kept
+                                                    : std::string("the plays explained nothing");
+      std::printf("through the hysteresis: no fit (%s); the stage from u -> y alone\n", why.c_str());
     }
     id = h.ok() && h.rounds > 0 ? std::move(h.stage) : std::move(h.linear);
   } else {
