@@ -99,6 +99,7 @@ py::dict identify_stage(const InArray& u_in, const InArray& y_in, double sample_
   d["hysteresis_weights"] = series ? through.weights : std::vector<double>{};
   d["residual_rms"] = series ? through.residual_rms : std::numeric_limits<double>::quiet_NaN();
   d["residual_rms_linear"] = series ? through.residual_rms_linear : std::numeric_limits<double>::quiet_NaN();
+  d["hysteresis_not_kept"] = through.not_kept;
   d["poles_hz"] = roots_hz(fit.poles_rad_s);
   d["zeros_hz"] = roots_hz(fit.zeros_rad_s);
   d["delay_s"] = fit.delay_s;
@@ -142,7 +143,9 @@ model_G (the fitted model's response, as sampled, in G's units), dc_gain [m/V] (
 and zeros_hz (s / 2 pi, complex), delay_s [s], order, chi2_per_line against chi2_expected,
 order_consistent, distortion_ratio; through_hysteresis, hysteresis_thresholds_V and
 hysteresis_weights [m/V] (H's plays), residual_rms and residual_rms_linear (what G(H(u)) and the
-u -> y fit leave of the record [m]; NaN without the hysteresis). Refusals raise
+u -> y fit leave of the record [m]; NaN without the hysteresis), hysteresis_not_kept (why a round
+through the hysteresis was not kept: its residual above 1.1 times what it replaced; empty
+otherwise). Refusals raise
 hystloop.ParameterError.)doc");
 }
 

@@ -64,6 +64,7 @@ class IdentifyStage(unittest.TestCase):
         self.assertAlmostEqual(abs(np.asarray(through["G"])[0]), 1.0, delta=1e-2)
         self.assertAlmostEqual(through["poles_hz"][0].real / alone["poles_hz"][0].real, 1.0, delta=1e-2)
         self.assertLessEqual(through["residual_rms"], through["residual_rms_linear"] * 1.01)
+        self.assertEqual(through["hysteresis_not_kept"], "")
 
     def test_refusals_name_the_parameter(self):
         u = multisine(range(1, 50), periods=4)
