@@ -14,6 +14,7 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <exception>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -64,7 +65,9 @@ Error against(const LinearStageSpec& truth, const StageFitResult& fit, double to
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app(
       "The stage experiment of deploy/hystloop stage on six simulated plants; the stage fitted from u -> y and with\n"
       "the hysteresis, each against the true stage up to 3 kHz (five noise draws). Exit 1 when a fit fails or the one\n"
@@ -170,4 +173,15 @@ int main(int argc, char** argv) {
     held = held && median(dB[1]) <= median(dB[0]) + 0.05 && median(deg[1]) <= median(deg[0]) + 0.3;
   }
   return held ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& err) {  // CLI11 building its options, or a fit's ParameterError
+    std::fprintf(stderr, "stage_identification_table: %s\n", err.what());
+    return 1;
+  }
 }
