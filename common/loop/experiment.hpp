@@ -21,9 +21,11 @@
 // e.g. "multisine f_min=5 periods=4 realisations=3 seed=7". format_multisine_kind writes it.
 //
 // The voltage is designed once, at start (prepare_experiment, on the compensator's I/O thread as the
-// request arrives), never per tick: an inverse FFT per realisation and one pass over the record
-// (7 ms for 24 realisations of 5 periods of 2000 ticks, 25 ms for the longest allowed, on the
-// 2-core VM of docs/BENCHMARKS.md; within the 50 ms the bridge holds):
+// request arrives), never per tick: an inverse FFT per realisation (models/multisine.hpp) and a
+// pass over the record; measured on the project's 2-core VM, 7 ms for 24 realisations of 5
+// periods of 2000 ticks and 25-37 ms for the longest allowed, inside the 50 ms the bridge holds (a
+// period of prime length sums its lines instead, as slow as before: 75 ms for 24 x 5 x 2003, which
+// outlasts it):
 //   [ramp-in: L ticks] [R realisations x P periods x N ticks: design_multisine's record] [ramp-out: L]
 // The ramps fade the periodic signal in from the offset and out to it with a raised cosine (no
 // step: a real stage's resonance would ring). Where one realisation gives way to the next (new

@@ -14,6 +14,15 @@ namespace hystloop {
 
 namespace {
 
+// The sum of n's prime factors, with multiplicity (2000 = 2^4 5^3: 23): an FFT's cost per sample.
+std::size_t prime_factor_sum(std::size_t n) {
+  std::size_t sum = 0;
+  for (std::size_t p = 2; p * p <= n; ++p) {
+    while (n % p == 0) sum += p, n /= p;
+  }
+  return n > 1 ? sum + n : sum;
+}
+
 std::vector<std::size_t> lines_unchecked(const MultisineOptions& o) {
   const double df = o.sample_rate_Hz / static_cast<double>(o.period_samples);
   const std::size_t nyquist = (o.period_samples - 1) / 2;  // lines strictly below fs / 2
@@ -81,25 +90,48 @@ Multisine design_multisine(const MultisineOptions& o) {
   for (std::size_t k : m.lines)
     m.frequency_Hz.push_back(static_cast<double>(k) * o.sample_rate_Hz / static_cast<double>(n_per));
   // A period is sum_k cos(2 pi k n / N + phi_k) = Re sum_k e^{j phi_k} e^{j 2 pi k n / N}: one inverse
-  // FFT of the lines' phasors, N log N per realisation. The sum written out costs F N (600 lines of
-  // 2000 ticks: 74 ms for 24 realisations), and a compensator designs the signal at a tick, inside
-  // the horizon the bridge holds; the FFT takes ~2 ms for the same record.
+  // FFT of the lines' phasors per realisation, about N (sum of N's prime factors) operations, where
+  // the sum written out costs F N (600 lines of 2000 ticks: the design of 24 realisations went from
+  // 74 to 5 ms). A compensator designs it as the request arrives, on the thread that answers the
+  // bridge. Eigen's FFT has no fast algorithm for a large prime factor, so where N's prime factors
+  // add up to more than the lines, the sum is written out (a table of N angles keeps it exact).
+  const bool use_fft = prime_factor_sum(n_per) <= f;
   Eigen::FFT<double> fft;
   fft.SetFlag(Eigen::FFT<double>::Unscaled);
+  std::vector<double> c, s;
+  if (!use_fft) {
+    c.resize(n_per), s.resize(n_per);
+    for (std::size_t i = 0; i < n_per; ++i) {
+      const double a = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n_per);
+      c[i] = std::cos(a), s[i] = std::sin(a);
+    }
+  }
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> phase(0.0, 2.0 * std::numbers::pi);
   m.u_V.assign(o.realisations * o.periods * n_per, o.offset_V);
-  std::vector<std::complex<double>> spectrum(n_per), time(n_per);
+  std::vector<std::complex<double>> spectrum(use_fft ? n_per : 0), time(use_fft ? n_per : 0);
   std::vector<double> period(n_per);
   for (std::size_t r = 0; r < o.realisations; ++r) {
     std::fill(spectrum.begin(), spectrum.end(), std::complex<double>(0.0, 0.0));
+    std::fill(period.begin(), period.end(), 0.0);
     for (std::size_t i = 0; i < f; ++i) {
       const double ph = phase(rng);
       m.phase_rad.push_back(ph);
-      spectrum[m.lines[i]] = std::polar(1.0, ph);
+      const std::size_t k = m.lines[i];
+      if (use_fft) {
+        spectrum[k] = std::polar(1.0, ph);
+        continue;
+      }
+      const double cp = std::cos(ph), sp = std::sin(ph);
+      for (std::size_t n = 0; n < n_per; ++n) {
+        const std::size_t idx = (k * n) % n_per;
+        period[n] += c[idx] * cp - s[idx] * sp;
+      }
     }
-    fft.inv(time, spectrum);
-    for (std::size_t n = 0; n < n_per; ++n) period[n] = time[n].real();
+    if (use_fft) {
+      fft.inv(time, spectrum);
+      for (std::size_t n = 0; n < n_per; ++n) period[n] = time[n].real();
+    }
     double amplitude = o.amplitude_V / std::sqrt(0.5 * static_cast<double>(f));
     if (o.amplitude_mode == MultisineAmplitude::peak) {
       double peak = 0.0;

@@ -58,10 +58,30 @@ TEST(Multisine, OnlyTheExcitedLinesCarryPowerAllAtOneAmplitude) {
           EXPECT_LT(std::abs(X[k]), 1e-10 * a) << k;
         }
       }
+      // Each line's phase as drawn: cos(2 pi k n / N + phi) reads a e^{j phi} at line k.
+      for (std::size_t i = 0; i < m.lines.size(); ++i) {
+        const std::complex<double> want = std::polar(a, m.phase_rad[r * m.lines.size() + i]);
+        EXPECT_LT(std::abs(X[m.lines[i]] - want), 1e-10 * a) << "line " << m.lines[i];
+      }
       // RMS about the offset as asked: A sqrt(F / 2).
       double ss = 0.0;
       for (std::size_t n = 0; n < 400; ++n) ss += std::pow(m.u_V[r * 1200 + n] - 1.5, 2);
       EXPECT_NEAR(std::sqrt(ss / 400.0), 2.0, 1e-10);
+    }
+  }
+}
+
+TEST(Multisine, APeriodOfPrimeLengthIsDesignedAsWell) {
+  // 401 ticks: no FFT of its own length is fast, so the lines are summed; the spectrum is the same.
+  MultisineOptions o = small();
+  o.period_samples = 401;
+  const Multisine m = design_multisine(o);
+  ASSERT_EQ(m.u_V.size(), 401u * 3u * 2u);
+  for (std::size_t r = 0; r < 2; ++r) {
+    const auto X = dft(m.u_V.data() + r * 3 * 401, 401);
+    for (std::size_t i = 0; i < m.lines.size(); ++i) {
+      const std::complex<double> want = std::polar(m.line_amplitude_V[r], m.phase_rad[r * m.lines.size() + i]);
+      EXPECT_LT(std::abs(X[m.lines[i]] - want), 1e-10 * m.line_amplitude_V[r]) << "line " << m.lines[i];
     }
   }
 }
