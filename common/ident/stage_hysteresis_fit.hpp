@@ -63,8 +63,8 @@ struct HysteresisStageIdentification {
   // last good round's; 0: none did, and stage is the u -> y fit, or, when the first round's fit
   // failed, that failure)
   int rounds = 0;
-  // A round whose series model leaves more than kKeptResidualRatio times the residual of what it
-  // would replace (u -> y's, or the round before) is not kept, and the rounds end there: why.
+  // A round whose series model leaves more than kKeptResidualRatio times u -> y's residual is not
+  // kept, and the rounds end there: why (empty when every round was kept).
   static constexpr double kKeptResidualRatio = 1.1;
   std::string not_kept;
   bool ok() const noexcept { return stage.ok(); }

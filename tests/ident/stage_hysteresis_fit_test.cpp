@@ -98,7 +98,7 @@ TEST(StageHysteresisFit, WithoutHysteresisTheFirstPlayCarriesTheGainAndTheStageI
 TEST(StageHysteresisFit, BehindColemanHodgdonTheSeriesModelExplainsTheRecordAndTheStageIsNoWorse) {
   // Three noise draws: the series model explains the record at least as well as the linear
   // approximation, and its stage is no further from the truth (bench/stage_identification_table:
-  // 0.71 against 0.90 dB at the anti-resonance, median over five draws of the full experiment).
+  // 0.43 against 0.67 dB at the anti-resonance, median over five draws of the default experiment).
   for (const std::uint64_t seed : {1u, 2u, 3u}) {
     const Record r = record(HysteresisPlantSpec{}, seed);
     const HysteresisStageIdentification id =
@@ -115,8 +115,8 @@ TEST(StageHysteresisFit, BehindColemanHodgdonTheSeriesModelExplainsTheRecordAndT
 
 TEST(StageHysteresisFit, ARoundThatExplainsTheRecordWorseIsNotKept) {
   // A noise-free record of one mode at 450 Hz behind Coleman-Hodgdon: the plays' weights fit the
-  // lines' distortion and the stage after them is further off than u -> y's (0.63 against 0.11 dB,
-  // its residual 0.67 against 0.11 nm when kept). The rounds end there: the stage is u -> y's.
+  // lines' distortion and the stage after them is further off than u -> y's (its residual 0.54
+  // against 0.12 nm). The rounds end there: the stage is u -> y's.
   const LinearStageSpec one_mode = LinearStageSpec::sum_of_modes({{450.0, 0.02, 1.0}}, 2.5e-4);
   const Record r = record(HysteresisPlantSpec{}, 1, one_mode, 0.0);
   StageFitOptions o;

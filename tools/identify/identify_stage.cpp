@@ -507,10 +507,11 @@ int identify_stage(const IdentifyArgs& args, const ExperimentLogOptions& log_opt
         identify_stage_with_hysteresis(r.u, r.y, r.lines, fo, fit_options(args, r), end_of_tick, ho);
     if (h.linear.ok()) dc_gain = h.linear.fit.dc_gain;
     if (h.ok() && h.rounds > 0) {
+      const std::string later = h.not_kept.empty() ? std::string() : " (then " + h.not_kept + ": not kept)";
       std::printf(
-          "through the hysteresis: %zu plays fitted with the stage (%d rounds); the record's residual %.3g (u -> y "
+          "through the hysteresis: %zu plays fitted with the stage (%d rounds%s); the record's residual %.3g (u -> y "
           "alone: %.3g); the response below is from the hysteresis' output to y\n",
-          args.hysteresis_plays, h.rounds, h.residual_rms, h.residual_rms_linear);
+          args.hysteresis_plays, h.rounds, later.c_str(), h.residual_rms, h.residual_rms_linear);
     } else if (h.linear.ok()) {
       const std::string why = !h.stage.ok()         ? h.stage.reason()
                               : !h.not_kept.empty() ? h.not_kept
