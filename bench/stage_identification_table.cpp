@@ -9,7 +9,7 @@
 // the record. Prints a table; exit 1 when a fit fails or the fit with the hysteresis is worse than
 // the one from u -> y (median beyond 0.05 dB / 0.3 deg).
 //
-//   build/release/bench/stage_identification_table [--noise-nm 1] [--realisations 24] [--periods 5] ...
+//   build/release/bench/stage_identification_table [--noise-nm 1] [--realisations 24] [--periods 5] [--plays 15] ...
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -92,6 +92,10 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(3, 100))
       ->capture_default_str();
   app.add_option("--realisations", mo.realisations, "realisations")->check(CLI::Range(1, 100))->capture_default_str();
+  HysteresisStageOptions ho;
+  app.add_option("--plays", ho.operators, "play operators of the hysteresis fitted with the stage")
+      ->check(CLI::Range(std::size_t{1}, kPiMaxOperators))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   HysteresisPlantSpec bouc_wen = HysteresisPlantSpec::named("bouc_wen");
   bouc_wen.bouc_wen.d = 7.4e-9;
@@ -143,7 +147,7 @@ int run(int argc, char** argv) {
       StageFitOptions o;
       o.zoh_sample_rate_Hz = 1e4;
       set_stage_order(p.order, o);
-      const HysteresisStageIdentification id = identify_stage_with_hysteresis(m.u_V, y, m.lines, fo, o, true);
+      const HysteresisStageIdentification id = identify_stage_with_hysteresis(m.u_V, y, m.lines, fo, o, true, ho);
       if (!id.linear.ok() || !id.ok()) {
         failed = !id.linear.ok() ? id.linear.reason() : id.stage.reason();
         break;
