@@ -22,10 +22,10 @@
 //
 // The voltage is designed once, at start (prepare_experiment, on the compensator's I/O thread as the
 // request arrives), never per tick: an inverse FFT per realisation (models/multisine.hpp) and a
-// pass over the record; measured on the project's 2-core VM, 7 ms for 24 realisations of 5
-// periods of 2000 ticks and 25-37 ms for the longest allowed, inside the 50 ms the bridge holds (a
-// period of prime length sums its lines instead, as slow as before: 75 ms for 24 x 5 x 2003, which
-// outlasts it):
+// pass over the record. That work must end well inside the horizon the bridge holds (50 ms): the
+// sum over the lines that came before the FFT outlasted it at 24 realisations of 5 periods of 2000
+// ticks and tripped the bridge's watchdog. A period whose length has a large prime factor still
+// sums its lines, F N per realisation, and can outlast it the same way. The record:
 //   [ramp-in: L ticks] [R realisations x P periods x N ticks: design_multisine's record] [ramp-out: L]
 // The ramps fade the periodic signal in from the offset and out to it with a raised cosine (no
 // step: a real stage's resonance would ring). Where one realisation gives way to the next (new

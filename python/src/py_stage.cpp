@@ -144,7 +144,7 @@ and zeros_hz (s / 2 pi, complex), delay_s [s], order, chi2_per_line against chi2
 order_consistent, distortion_ratio; through_hysteresis, hysteresis_thresholds_V and
 hysteresis_weights [m/V] (H's plays), residual_rms and residual_rms_linear (what G(H(u)) and the
 u -> y fit leave of the record [m]; NaN without the hysteresis), hysteresis_not_kept (why a round
-through the hysteresis was not kept: its residual above 1.1 times what it replaced; empty
+through the hysteresis was not kept: its residual above 1.1 times u -> y's; empty
 otherwise). Refusals raise
 hystloop.ParameterError.)doc");
 }
